@@ -1,0 +1,112 @@
+"""Command line: `spur-cad run JOB.toml --out DIR` computes everything in memory, then writes.
+
+Errors in the user's input print one line (`spur-cad: error: ...`) and exit 2 with nothing
+written; an unexpected failure prints a one-line internal error (traceback only with --debug)
+and exits 3.
+"""
+
+from __future__ import annotations
+
+import argparse
+import io
+import json
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+from spur_cad import __version__
+from spur_cad.errors import SpurCadError
+from spur_cad.geometry.inspection import inspection_sheet
+from spur_cad.geometry.sampling import ProfileSamples, sample_profile
+from spur_cad.job import Job, load_job
+from spur_cad.outputs import write_files_atomically
+
+EXIT_INPUT_ERROR = 2
+EXIT_INTERNAL_ERROR = 3
+
+
+def profile_csv(samples: ProfileSamples) -> bytes:
+    """Right half of one tooth space, root (x = 0) to tip, header x_mm,y_mm."""
+    buffer = io.StringIO()
+    buffer.write("x_mm,y_mm\n")
+    np.savetxt(buffer, samples.points, fmt="%.9f", delimiter=",")
+    return buffer.getvalue().encode()
+
+
+def build_summary(job: Job, samples: ProfileSamples, seconds: dict[str, float]) -> dict:
+    """summary.json content: gear data, inspection sheet, profile sampling facts, timings."""
+    counts = {name: int(np.count_nonzero(np.array(samples.label_names()) == name))
+              for name in ("root", "fillet", "involute", "tip")}
+    return {
+        "spur_cad_version": __version__,
+        "job": {"name": job.job.name, "file": job.source},
+        "gear": job.gear.describe(),
+        "inspection": inspection_sheet(job.gear),
+        "profile": {"tolerance_mm": job.job.profile_tolerance_mm, "points": len(samples),
+                    "points_per_segment": counts},
+        "timings_s": seconds,
+    }
+
+
+def run_job(job: Job) -> dict[str, bytes]:
+    """Compute every output of the job in memory (no file I/O)."""
+    from spur_cad.report.plots import tooth_space_png
+
+    seconds: dict[str, float] = {}
+    start = time.perf_counter()
+    samples = sample_profile(job.gear.tooth_space_profile(), job.job.profile_tolerance_mm)
+    seconds["profile"] = time.perf_counter() - start
+    start = time.perf_counter()
+    png = tooth_space_png(job.gear, samples)
+    seconds["plot"] = time.perf_counter() - start
+    summary = build_summary(job, samples, seconds)
+    return {
+        "profile.csv": profile_csv(samples),
+        "profile.png": png,
+        "summary.json": (json.dumps(summary, indent=2, sort_keys=False) + "\n").encode(),
+    }
+
+
+def _parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(prog="spur-cad", description="Spur gears cut on a 4-axis machining centre.")
+    parser.add_argument("--version", action="version", version=f"spur-cad {__version__}")
+    sub = parser.add_subparsers(dest="command", required=True)
+    run = sub.add_parser("run", help="run a job file and write its outputs")
+    run.add_argument("job", help="TOML job file")
+    run.add_argument("--out", required=True, help="output folder (created if missing)")
+    run.add_argument("--quiet", action="store_true", help="print nothing but errors")
+    run.add_argument("--debug", action="store_true", help="show tracebacks of internal errors")
+    return parser
+
+
+def main(argv: list[str] | None = None) -> int:
+    args = _parser().parse_args(argv)
+    try:
+        job = load_job(args.job)
+        files = run_job(job)
+        out_dir = Path(args.out)
+        if out_dir.exists() and not out_dir.is_dir():
+            raise SpurCadError(f"--out {out_dir}: exists and is not a folder")
+        try:
+            paths = write_files_atomically(out_dir, files)
+        except OSError as exc:
+            raise SpurCadError(f"cannot write to {out_dir}: {exc.strerror or exc}") from None
+    except SpurCadError as exc:
+        print(f"spur-cad: error: {exc}", file=sys.stderr)
+        return EXIT_INPUT_ERROR
+    except Exception as exc:  # noqa: BLE001 - the CLI never shows a traceback unless asked
+        if getattr(args, "debug", False):
+            raise
+        print(f"spur-cad: internal error: {type(exc).__name__}: {exc} (run with --debug for details; "
+              "please report it)", file=sys.stderr)
+        return EXIT_INTERNAL_ERROR
+    if not args.quiet:
+        for path in paths:
+            print(f"wrote {path}")
+    return 0
+
+
+if __name__ == "__main__":  # pragma: no cover
+    sys.exit(main())

@@ -1,0 +1,161 @@
+"""Inspection dimensions of the designed (allowance-thinned) gear: span measurement, dimension
+over pins or balls, chordal tooth thickness, minimum teeth without undercut (ISO 21771 terms).
+
+All use the design tooth thickness `s` (allowance applied), so they are what the
+inspector should measure on the finished part.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+from spur_cad.geometry.spec import GearSpec, involute_function, inverse_involute_function
+
+PIN_DIAMETER_STEP_MM = 0.01  # gauge pins are stocked in 0.01 mm steps
+
+
+@dataclass(frozen=True)
+class SpanMeasurement:
+    """Base tangent length W_k over k teeth, and the radius where the anvils touch the flanks."""
+
+    teeth_spanned: int
+    length_mm: float
+    contact_radius_mm: float
+
+
+@dataclass(frozen=True)
+class OverPinsMeasurement:
+    """Dimension over two pins (balls) of diameter D placed in opposite (or nearly opposite) spaces."""
+
+    pin_diameter_mm: float
+    dimension_mm: float
+    pin_centre_radius_mm: float
+    contact_radius_mm: float
+
+
+@dataclass(frozen=True)
+class ChordalThickness:
+    """Chordal tooth thickness and chordal height (from the tip) at a measuring radius."""
+
+    measuring_radius_mm: float
+    chordal_thickness_mm: float
+    chordal_height_mm: float
+
+
+def base_thickness_mm(spec: GearSpec) -> float:
+    """Tooth thickness on the base circle (arc): s_b = r_b (s/r + 2 inv(alpha))."""
+    return spec.base_radius_mm * (spec.tooth_thickness_mm / spec.reference_radius_mm
+                                  + 2.0 * involute_function(spec.pressure_angle_rad))
+
+
+def span_measurement(spec: GearSpec, teeth_spanned: int) -> SpanMeasurement:
+    """W_k = (k - 1) p_b + s_b; the anvils touch the flanks at radius sqrt(r_b^2 + (W_k/2)^2)."""
+    if not 1 <= teeth_spanned < spec.teeth:
+        raise ValueError(f"teeth spanned must be between 1 and {spec.teeth - 1}, got {teeth_spanned}")
+    length = (teeth_spanned - 1) * spec.base_pitch_mm + base_thickness_mm(spec)
+    contact = math.hypot(spec.base_radius_mm, length / 2.0)
+    return SpanMeasurement(teeth_spanned, length, contact)
+
+
+def recommended_span_teeth(spec: GearSpec) -> int:
+    """k whose anvil contact lies nearest the middle of the involute flank, within form..tip radius.
+
+    Starts from the ISO 21771 rule (contact near radius r + x m) and moves k until the contact
+    radius is on the usable involute.
+    """
+    alpha = spec.pressure_angle_rad
+    x = spec.profile_shift_coefficient
+    alpha_x = math.acos(spec.base_radius_mm / (spec.reference_radius_mm + x * spec.module_mm))
+    k_exact = spec.teeth / math.pi * (math.tan(alpha_x) - 2.0 * x * math.tan(alpha) / spec.teeth
+                                      - involute_function(alpha)) + 0.5
+    low, high = spec.form_radius_mm, spec.tip_radius_mm
+    middle = 0.5 * (low + high)
+    candidates = [k for k in range(1, spec.teeth) if low < span_measurement(spec, k).contact_radius_mm < high]
+    if not candidates:
+        return max(1, min(spec.teeth - 1, round(k_exact)))
+    return min(candidates, key=lambda k: (abs(k - k_exact) > 0.5, abs(span_measurement(spec, k).contact_radius_mm
+                                                                         - middle)))
+
+
+def over_pins(spec: GearSpec, pin_diameter_mm: float) -> OverPinsMeasurement:
+    """Dimension over pins: inv(a_M) = D / d_b + s / (m z) + inv(alpha) - pi / z, r_M = r_b / cos(a_M).
+
+    Even teeth: M = 2 r_M + D; odd teeth: M = 2 r_M cos(pi / (2 z)) + D.
+    """
+    if pin_diameter_mm <= 0.0:
+        raise ValueError(f"pin diameter must be positive, got {pin_diameter_mm}")
+    rb = spec.base_radius_mm
+    inv_alpha_m = (pin_diameter_mm / (2.0 * rb) + spec.tooth_thickness_mm / (2.0 * spec.reference_radius_mm)
+                   + involute_function(spec.pressure_angle_rad) - math.pi / spec.teeth)
+    alpha_m = inverse_involute_function(inv_alpha_m)
+    centre_radius = rb / math.cos(alpha_m)
+    if spec.teeth % 2 == 0:
+        dimension = 2.0 * centre_radius + pin_diameter_mm
+    else:
+        dimension = 2.0 * centre_radius * math.cos(math.pi / (2.0 * spec.teeth)) + pin_diameter_mm
+    # The pin touches the flank where the roll angle is a_M - theta_b (see docs/geometry.md).
+    roll = alpha_m - spec.base_half_space_angle_rad
+    contact = rb * math.hypot(1.0, roll)
+    return OverPinsMeasurement(pin_diameter_mm, dimension, centre_radius, contact)
+
+
+def recommended_pin_diameter_mm(spec: GearSpec) -> float:
+    """Pin touching the flanks at radius r + x m (ISO practice), rounded to gauge-pin steps.
+
+    The contact at roll t_c = tan(a_c) puts the pin centre at pressure angle a_M = theta_b + t_c,
+    so D = 2 r_b (tan(a_M) - t_c). If that contact is off the usable involute, the middle of
+    the flank is used instead.
+    """
+    rb = spec.base_radius_mm
+    target = spec.reference_radius_mm + spec.profile_shift_coefficient * spec.module_mm
+    if not spec.form_radius_mm < target < spec.tip_radius_mm:
+        target = 0.5 * (spec.form_radius_mm + spec.tip_radius_mm)
+    roll = math.sqrt((target / rb) ** 2 - 1.0)
+    diameter = 2.0 * rb * (math.tan(spec.base_half_space_angle_rad + roll) - roll)
+    return max(PIN_DIAMETER_STEP_MM, round(diameter / PIN_DIAMETER_STEP_MM) * PIN_DIAMETER_STEP_MM)
+
+
+def chordal_thickness(spec: GearSpec, measuring_radius_mm: float | None = None) -> ChordalThickness:
+    """Chord across the tooth at a radius (default: reference circle) and its height below the tip."""
+    radius = spec.reference_radius_mm if measuring_radius_mm is None else measuring_radius_mm
+    half_angle = spec.tooth_thickness_at_radius_mm(radius) / (2.0 * radius)
+    return ChordalThickness(radius, 2.0 * radius * math.sin(half_angle),
+                            spec.tip_radius_mm - radius * math.cos(half_angle))
+
+
+def minimum_teeth_without_undercut(spec: GearSpec) -> float:
+    """Smallest (real) tooth count the rack generates without undercut, at this shift and tip radius.
+
+    No undercut while the rack flank's lowest straight point stays within the interference
+    point: (h_f* - x) m - rho (1 - sin(alpha)) <= r sin^2(alpha), with r = m z / 2.
+    """
+    alpha = spec.pressure_angle_rad
+    height = ((spec.dedendum_coefficient - spec.profile_shift_coefficient) * spec.module_mm
+              - spec.rack_tip_radius_mm * (1.0 - math.sin(alpha)))
+    return 2.0 * height / (spec.module_mm * math.sin(alpha) ** 2)
+
+
+def inspection_sheet(spec: GearSpec) -> dict[str, float | int]:
+    """The inspection values a report or summary shows."""
+    k = recommended_span_teeth(spec)
+    span = span_measurement(spec, k)
+    pin = recommended_pin_diameter_mm(spec)
+    pins = over_pins(spec, pin)
+    chord = chordal_thickness(spec)
+    z_min = minimum_teeth_without_undercut(spec)
+    return {
+        "span_teeth_k": k,
+        "span_measurement_mm": span.length_mm,
+        "span_contact_radius_mm": span.contact_radius_mm,
+        "pin_diameter_mm": pins.pin_diameter_mm,
+        "dimension_over_pins_mm": pins.dimension_mm,
+        "pin_contact_radius_mm": pins.contact_radius_mm,
+        "chordal_thickness_mm": chord.chordal_thickness_mm,
+        "chordal_height_mm": chord.chordal_height_mm,
+        "chordal_measuring_radius_mm": chord.measuring_radius_mm,
+        "tooth_thickness_mm": spec.tooth_thickness_mm,
+        "thickness_reduction_mm": spec.thickness_reduction_mm,
+        "min_teeth_without_undercut": math.ceil(z_min - 1e-9),
+        "min_teeth_without_undercut_exact": z_min,
+    }

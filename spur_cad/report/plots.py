@@ -1,0 +1,57 @@
+"""Static figures rendered to PNG bytes with matplotlib's object API (no global pyplot state)."""
+
+from __future__ import annotations
+
+import io
+
+import numpy as np
+from matplotlib.backends.backend_agg import FigureCanvasAgg
+from matplotlib.figure import Figure
+
+from spur_cad.geometry.profile import SEGMENT_LABELS
+from spur_cad.geometry.sampling import ProfileSamples
+from spur_cad.geometry.spec import GearSpec
+
+SEGMENT_COLOURS = {"root": "#1f77b4", "fillet": "#d62728", "involute": "#2ca02c", "tip": "#9467bd"}
+
+
+def _png(fig: Figure) -> bytes:
+    FigureCanvasAgg(fig)
+    buffer = io.BytesIO()
+    fig.savefig(buffer, format="png", dpi=120)
+    return buffer.getvalue()
+
+
+def tooth_space_png(spec: GearSpec, samples: ProfileSamples) -> bytes:
+    """The tooth space (right half as sampled, left half mirrored), segments coloured, key circles dashed."""
+    fig = Figure(figsize=(8.0, 5.5), layout="constrained")
+    ax = fig.add_subplot(1, 1, 1)
+    for index, label in enumerate(SEGMENT_LABELS):
+        mask = samples.labels == index
+        if not mask.any():
+            continue
+        # Include the previous point so segments join up on the plot.
+        idx = np.nonzero(mask)[0]
+        idx = np.concatenate([[max(idx[0] - 1, 0)], idx])
+        pts = samples.points[idx]
+        colour = SEGMENT_COLOURS[label]
+        ax.plot(pts[:, 0], pts[:, 1], "-", color=colour, lw=2.0, label=label)
+        ax.plot(-pts[:, 0], pts[:, 1], "-", color=colour, lw=2.0)
+    half_angle = np.pi / spec.teeth
+    span = np.linspace(-1.3 * half_angle, 1.3 * half_angle, 200)
+    profile = spec.tooth_space_profile()
+    for name, radius in (("tip", spec.tip_radius_mm), ("reference", spec.reference_radius_mm),
+                         ("base", spec.base_radius_mm), ("form", profile.form_radius_mm),
+                         ("root", spec.root_radius_mm)):
+        ax.plot(radius * np.sin(span), radius * np.cos(span), ":", color="0.6", lw=0.8)
+        ax.annotate(f"{name} r={radius:.3f}", (radius * np.sin(span[-1]), radius * np.cos(span[-1])),
+                    fontsize=7, color="0.4")
+    ax.set_aspect("equal")
+    ax.set_xlabel("x [mm]")
+    ax.set_ylabel("y [mm] (space axis)")
+    title = (f"z={spec.teeth}  m={spec.module_mm:g}  alpha={spec.pressure_angle_deg:g} deg  x={spec.profile_shift_coefficient:g}"
+             f"  rho={spec.rack_tip_radius_mm:g} mm" + ("  UNDERCUT" if profile.undercut else ""))
+    ax.set_title(title, fontsize=9)
+    ax.legend(loc="upper center", fontsize=8, ncols=4)
+    ax.grid(True, lw=0.3)
+    return _png(fig)
