@@ -1,0 +1,94 @@
+"""pytest plumbing for the external tools: FreeCAD (`freecad` marker), LinuxCNC `rs274`
+(`linuxcnc` marker).
+
+A marked test whose tool is missing is skipped locally, but fails when the environment
+variable CI is "true": CI installs the tools (.ci/run), so a missing tool there is a bug.
+"""
+
+from __future__ import annotations
+
+import os
+import shutil
+import sysconfig
+
+import pytest
+
+from tests.rs274_helper import rs274_path
+
+FREECADCMD_NAMES = ("freecadcmd", "FreeCADCmd", "freecadcmd-python3")
+FREECADCMD_CANDIDATES = ("/usr/lib/freecad/bin/freecadcmd-python3", "/usr/lib/freecad/bin/FreeCADCmd",
+                         "/usr/lib/freecad-python3/bin/FreeCADCmd")
+FREECAD_GUI_NAMES = ("freecad", "FreeCAD", "freecad-python3")
+
+__all__ = ["freecad_gui_paths", "freecadcmd_path", "rs274_path"]
+
+
+def _find(names: tuple[str, ...], candidates: tuple[str, ...] = (), env_var: str | None = None) -> str | None:
+    """First executable from $env_var, then `names` on PATH, then the fixed `candidates`."""
+    override = os.environ.get(env_var) if env_var else None
+    if override:
+        return override if os.access(override, os.X_OK) else None
+    for name in names:
+        found = shutil.which(name)
+        if found:
+            return found
+    return next((path for path in candidates if os.access(path, os.X_OK)), None)
+
+
+def freecadcmd_path() -> str | None:
+    """Path of FreeCAD's console executable ($FREECADCMD, freecadcmd, FreeCADCmd), or None."""
+    return _find(FREECADCMD_NAMES, FREECADCMD_CANDIDATES, "FREECADCMD")
+
+
+def freecad_gui_paths() -> tuple[str, str] | None:
+    """(xvfb-run, freecad) for running the GUI headless, or None if either is missing."""
+    xvfb_run = shutil.which("xvfb-run")
+    freecad = _find(FREECAD_GUI_NAMES, ("/usr/lib/freecad/bin/freecad-python3",), "FREECAD_GUI")
+    return (xvfb_run, freecad) if xvfb_run and freecad else None
+
+
+def running_in_ci() -> bool:
+    """True when the environment variable CI says so (GitHub/GitLab set CI=true)."""
+    return os.environ.get("CI", "").strip().lower() in ("true", "1", "yes")
+
+
+def require_tool(path, tool: str, what: str):
+    """Return `path`; if it is missing, fail under CI and skip otherwise."""
+    if path:
+        return path
+    message = f"CI requires {tool}: {what} not found"
+    if running_in_ci():
+        pytest.fail(message, pytrace=False)
+    pytest.skip(f"{tool} not available: {what} not found")
+
+
+def pytest_runtest_setup(item: pytest.Item) -> None:
+    """Skip (locally) or fail (CI=true) marked tests whose external tool is missing."""
+    if item.get_closest_marker("freecad"):
+        require_tool(freecadcmd_path(), "FreeCAD", "freecadcmd")
+    if item.get_closest_marker("linuxcnc"):
+        require_tool(rs274_path(), "LinuxCNC", "rs274")
+
+
+@pytest.fixture(scope="session")
+def freecadcmd() -> str:
+    """Path of `freecadcmd` (skip locally / fail in CI when missing)."""
+    return require_tool(freecadcmd_path(), "FreeCAD", "freecadcmd")
+
+
+@pytest.fixture(scope="session")
+def freecad_gui() -> tuple[str, str]:
+    """(xvfb-run, freecad) for GUI tests (skip locally / fail in CI when missing)."""
+    return require_tool(freecad_gui_paths(), "FreeCAD GUI", "xvfb-run or freecad")
+
+
+@pytest.fixture(scope="session")
+def rs274() -> str:
+    """Path of LinuxCNC's `rs274` (skip locally / fail in CI when missing)."""
+    return require_tool(rs274_path(), "LinuxCNC", "rs274")
+
+
+@pytest.fixture(scope="session")
+def venv_site_packages() -> str:
+    """site-packages (purelib) of the running interpreter, to put on FreeCAD's sys.path."""
+    return sysconfig.get_paths()["purelib"]

@@ -1,0 +1,111 @@
+"""The command line end to end: outputs, their content, and bad input leaving nothing behind."""
+
+from __future__ import annotations
+
+import csv
+import json
+import math
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from spur_cad.cli import main
+
+ROOT = Path(__file__).resolve().parents[1]
+REFERENCE_JOB = ROOT / "resources" / "examples" / "reference_gear.toml"
+
+
+def run_cli(*args: str) -> subprocess.CompletedProcess:
+    """Run the installed console script as a user would."""
+    exe = Path(sys.executable).with_name("spur-cad")
+    command = [str(exe)] if exe.exists() else [sys.executable, "-m", "spur_cad.cli"]
+    return subprocess.run(command + list(args), capture_output=True, text=True, cwd=ROOT, timeout=300)
+
+
+def test_reference_job_writes_profile_summary_and_plot(tmp_path):
+    out = tmp_path / "out"
+    result = run_cli("run", str(REFERENCE_JOB), "--out", str(out))
+    assert result.returncode == 0, result.stderr
+    assert {p.name for p in out.iterdir()} == {"profile.csv", "profile.png", "summary.json"}
+    summary = json.loads((out / "summary.json").read_text())
+    gear, inspection = summary["gear"], summary["inspection"]
+    assert gear["reference_radius_mm"] == pytest.approx(46.0)
+    assert gear["base_radius_mm"] == pytest.approx(46.0 * math.cos(math.radians(20)))
+    assert gear["tip_radius_mm"] == pytest.approx(50.0)
+    assert gear["root_radius_mm"] == pytest.approx(41.0)
+    assert gear["base_radius_mm"] < gear["form_radius_mm"] < gear["reference_radius_mm"]
+    assert gear["undercut"] is False
+    # Root arc half angle from METHOD.md: v = d_1 / r, d_1 = e/2 - B tan(a) - rho / cos(a).
+    a = math.radians(20)
+    e = 4 * math.pi - 0.95 * 2 * math.pi
+    d1 = e / 2 - (46 - 41 - 0.8) * math.tan(a) - 0.8 / math.cos(a)
+    assert gear["root_arc_half_angle_deg"] == pytest.approx(math.degrees(d1 / 46), abs=1e-9)
+    assert inspection["span_teeth_k"] == 3
+    for key in ("span_measurement_mm", "pin_diameter_mm", "dimension_over_pins_mm"):
+        assert inspection[key] > 0
+    with open(out / "profile.csv", newline="") as handle:
+        rows = list(csv.reader(handle))
+    assert rows[0] == ["x_mm", "y_mm"]
+    pts = np.array(rows[1:], dtype=float)
+    assert pts[0] == pytest.approx([0.0, 41.0])
+    assert np.hypot(*pts[-1]) == pytest.approx(50.0)
+    assert np.all(np.diff(np.hypot(pts[:, 0], pts[:, 1])) >= -1e-8)  # root to tip: radius never falls (csv has 1e-9 mm digits)
+    assert (out / "profile.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    assert "wrote" in result.stdout
+
+
+def test_quiet_prints_nothing(tmp_path):
+    result = run_cli("run", str(REFERENCE_JOB), "--out", str(tmp_path / "o"), "--quiet")
+    assert result.returncode == 0 and result.stdout == "" and result.stderr == ""
+
+
+BAD_JOBS = {
+    "unknown key": ("[gear]\nteeth = 23\nmodule_mm = 4.0\nface_width_mm = 20\ncolour = 'red'\n",
+                    "bad.toml:5: unknown key 'colour' in [gear]"),
+    "wrong type": ("[gear]\nteeth = 23\nmodule_mm = 'four'\nface_width_mm = 20\n",
+                   "bad.toml:3: [gear] module_mm must be a number"),
+    "invalid gear": ("[gear]\nteeth = 23\nmodule_mm = 4.0\nface_width_mm = 20\nrack_tip_radius_mm = 2.3\n",
+                     "bad.toml:5: invalid gear: rack tip radius 2.3 mm is too large"),
+    "bad toml": ("[gear\nteeth = 23\n", "not valid TOML"),
+    "unknown section": ("[gears]\nteeth = 23\n", "unknown section [gears]"),
+    "too few teeth": ("[gear]\nteeth = 3\nmodule_mm = 4.0\nface_width_mm = 20\n", "too few teeth"),
+}
+
+
+@pytest.mark.parametrize("case", list(BAD_JOBS))
+def test_bad_job_gives_one_clear_line_and_writes_nothing(tmp_path, case):
+    text, expected = BAD_JOBS[case]
+    job = tmp_path / "bad.toml"
+    job.write_text(text)
+    out = tmp_path / "out"
+    result = run_cli("run", str(job), "--out", str(out))
+    assert result.returncode == 2
+    assert result.stderr.startswith("spur-cad: error: ")
+    assert expected in result.stderr
+    assert "Traceback" not in result.stderr and len(result.stderr.strip().splitlines()) == 1
+    assert not out.exists()
+
+
+def test_missing_job_file(tmp_path):
+    result = run_cli("run", str(tmp_path / "nope.toml"), "--out", str(tmp_path / "o"))
+    assert result.returncode == 2 and "job file not found" in result.stderr
+
+
+def test_out_path_that_is_a_file_is_an_error(tmp_path):
+    blocker = tmp_path / "file"
+    blocker.write_text("x")
+    assert main(["run", str(REFERENCE_JOB), "--out", str(blocker), "--quiet"]) == 2
+    assert blocker.read_text() == "x"
+
+
+def test_existing_outputs_are_replaced_whole(tmp_path):
+    out = tmp_path / "o"
+    assert main(["run", str(REFERENCE_JOB), "--out", str(out), "--quiet"]) == 0
+    first = (out / "summary.json").read_text()
+    assert main(["run", str(REFERENCE_JOB), "--out", str(out), "--quiet"]) == 0
+    assert json.loads((out / "summary.json").read_text())["gear"] == json.loads(first)["gear"]
+    assert not [p for p in os.listdir(out) if p.startswith(".")]  # no temporaries left behind
