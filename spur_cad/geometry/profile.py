@@ -339,7 +339,7 @@ def _undercut_junction(fillet: TrochoidalFillet, rb: float, theta_b: float,
         lo = brentq(lambda b: float(np.hypot(*fillet.points(np.array([b]))[0])) - rb * (1 + 1e-12), lo, hi,
                     xtol=1e-15)
     beta_j = brentq(lambda b: _fillet_minus_involute_angle(fillet, rb, theta_b, b), lo, hi, xtol=1e-15,
-                    rtol=4.5e-16, maxiter=200)
+                    rtol=1e-15, maxiter=200)
     x, y = fillet.points(np.array([beta_j]))[0]
     t_j = math.sqrt(max((x * x + y * y) / (rb * rb) - 1.0, 0.0))
 
