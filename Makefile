@@ -1,0 +1,32 @@
+# spur_cad developer tasks. `make test` is the command CI runs (see .ci/run).
+
+VENV        := .venv
+PYTHON      := $(VENV)/bin/python
+STAMP       := $(VENV)/.installed
+PYTEST_ARGS ?=
+
+.PHONY: venv demo test bench clean
+
+venv: $(STAMP)
+
+# Create the virtual environment only when it is missing.
+$(PYTHON):
+	python3 -m venv $(VENV)
+
+# (Re)install the project and its test extras when pyproject.toml is newer than the stamp.
+$(STAMP): pyproject.toml | $(PYTHON)
+	$(VENV)/bin/pip install -e '.[test]'
+	touch $(STAMP)
+
+demo: venv
+	$(VENV)/bin/spur-cad run resources/examples/reference_gear.toml --out out/
+
+test: venv
+	$(PYTHON) -m pytest -q $(PYTEST_ARGS)
+
+bench: venv
+	$(PYTHON) benchmarks/run_benchmarks.py
+
+clean:
+	rm -rf out/ build/ dist/ test-artifacts/ .pytest_cache/ *.egg-info
+	find . -path ./$(VENV) -prune -o -type d -name __pycache__ -prune -exec rm -rf {} +

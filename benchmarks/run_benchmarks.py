@@ -1,0 +1,71 @@
+"""Benchmarks run on demand (`make bench`); results go into docs/benchmarks.md by hand.
+
+Each benchmark reports the median of several runs and describes the machine.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import platform
+import statistics
+import time
+from typing import Callable
+
+from spur_cad.geometry import GearSpec, gear_outline, sample_profile
+
+
+def reference_spec() -> GearSpec:
+    return GearSpec(teeth=23, module_mm=4.0, rack_tip_radius_mm=0.8, thickness_allowance_fraction=0.05,
+                    face_width_mm=20.0)
+
+
+def median_seconds(work: Callable[[], object], runs: int) -> float:
+    times = []
+    for _ in range(runs):
+        start = time.perf_counter()
+        work()
+        times.append(time.perf_counter() - start)
+    return statistics.median(times)
+
+
+def machine() -> str:
+    cpu = platform.processor() or platform.machine()
+    try:
+        with open("/proc/cpuinfo") as handle:
+            for line in handle:
+                if line.startswith("model name"):
+                    cpu = line.split(":", 1)[1].strip()
+                    break
+    except OSError:
+        pass
+    return f"{cpu}, {os.cpu_count()} cores, Python {platform.python_version()}, {platform.system()}"
+
+
+def bench_profile(runs: int) -> dict:
+    """Exact profile construction (validation included) + sampling at 1 um, reference gear."""
+    def build_and_sample():
+        spec = reference_spec()
+        return sample_profile(spec.tooth_space_profile(), 0.001)
+
+    samples = build_and_sample()
+    spec = reference_spec()
+    outline_points = len(gear_outline(spec, 0.001))
+    return {
+        "profile_build_and_sample_1um_s": median_seconds(build_and_sample, runs),
+        "profile_points_half_space": len(samples),
+        "outline_1um_s": median_seconds(lambda: gear_outline(spec, 0.001), runs),
+        "outline_points": outline_points,
+    }
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__)
+    parser.add_argument("--runs", type=int, default=21)
+    args = parser.parse_args()
+    print(json.dumps({"machine": machine(), "runs": args.runs, "profile": bench_profile(args.runs)}, indent=2))
+
+
+if __name__ == "__main__":
+    main()
