@@ -1,11 +1,33 @@
 """spur_cad: CAD/CAM for spur gears cut with end mills on a 4-axis machining centre.
 
-The engine is layered (geometry -> cad -> cam -> post -> sim -> report/cli); importing this
-package loads nothing heavy and has no side effects.
+The engine is layered (geometry -> cad -> cam -> post -> sim -> report/cli). Importing this
+package loads nothing heavy: the CAD entry points below import CadQuery on first use.
+
+    import spur_cad
+    spec = spur_cad.GearSpec(teeth=23, module_mm=4.0, rack_tip_radius_mm=0.8, face_width_mm=20.0)
+    gear = spur_cad.make_gear(spec)            # cadquery.Workplane, machine frame (axis X)
+    stock = spur_cad.make_stock(spec)
+    solid = spur_cad.to_build123d(gear)        # build123d.Solid wrapping the same OCP shape
 """
 
 from spur_cad.errors import GearSpecError, JobFileError, SpurCadError
+from spur_cad.geometry.spec import GearSpec
 
 __version__ = "0.1.0"
 
-__all__ = ["GearSpecError", "JobFileError", "SpurCadError", "__version__"]
+_CAD_ENTRY_POINTS = {"make_gear", "make_stock", "to_build123d", "BlankFeatures", "StockSpec"}
+
+__all__ = ["GearSpec", "GearSpecError", "JobFileError", "SpurCadError", "__version__", *sorted(_CAD_ENTRY_POINTS)]
+
+
+def __getattr__(name: str):
+    """Lazy access to the CAD entry points, so `import spur_cad` does not load the CAD kernel."""
+    if name in {"BlankFeatures", "StockSpec"}:
+        from spur_cad.cad import specs
+
+        return getattr(specs, name)
+    if name in _CAD_ENTRY_POINTS:
+        from spur_cad.cad import solid
+
+        return getattr(solid, name)
+    raise AttributeError(f"module 'spur_cad' has no attribute {name!r}")

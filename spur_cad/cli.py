@@ -35,8 +35,8 @@ def profile_csv(samples: ProfileSamples) -> bytes:
     return buffer.getvalue().encode()
 
 
-def build_summary(job: Job, samples: ProfileSamples, seconds: dict[str, float]) -> dict:
-    """summary.json content: gear data, inspection sheet, profile sampling facts, timings."""
+def build_summary(job: Job, samples: ProfileSamples, cad: dict, seconds: dict[str, float]) -> dict:
+    """summary.json content: gear data, inspection sheet, profile sampling facts, CAD facts, timings."""
     counts = {name: int(np.count_nonzero(np.array(samples.label_names()) == name))
               for name in ("root", "fillet", "involute", "tip")}
     return {
@@ -46,6 +46,7 @@ def build_summary(job: Job, samples: ProfileSamples, seconds: dict[str, float]) 
         "inspection": inspection_sheet(job.gear),
         "profile": {"tolerance_mm": job.job.profile_tolerance_mm, "points": len(samples),
                     "points_per_segment": counts},
+        "cad": cad,
         "timings_s": seconds,
     }
 
@@ -61,12 +62,40 @@ def run_job(job: Job) -> dict[str, bytes]:
     start = time.perf_counter()
     png = tooth_space_png(job.gear, samples)
     seconds["plot"] = time.perf_counter() - start
-    summary = build_summary(job, samples, seconds)
+    start = time.perf_counter()
+    cad, step = build_cad(job)
+    seconds["cad_and_step"] = time.perf_counter() - start
+    summary = build_summary(job, samples, cad, seconds)
     return {
         "profile.csv": profile_csv(samples),
         "profile.png": png,
+        **step,
         "summary.json": (json.dumps(summary, indent=2, sort_keys=False) + "\n").encode(),
     }
+
+
+def build_cad(job: Job) -> tuple[dict, dict[str, bytes]]:
+    """Gear solid, stock and STEP files; returns (summary facts, files)."""
+    import cadquery as cq
+
+    from spur_cad.cad.solid import DEFAULT_FIT_TOLERANCE_MM, build_gear_shape, make_stock, solid_volume_mm3
+    from spur_cad.cad.step import step_files
+
+    shape, report = build_gear_shape(job.gear, job.gear_section.blank_features())
+    gear = cq.Workplane("YZ").add(cq.Solid(shape))
+    stock = make_stock(job.gear, job.stock)
+    files = step_files(gear, stock)
+    facts = {
+        "fit_tolerance_mm": DEFAULT_FIT_TOLERANCE_MM,
+        "fillet_max_deviation_mm": report.fillet_max_deviation_mm,
+        "involute_max_deviation_mm": report.involute_max_deviation_mm,
+        "fillet_spline_poles": report.fillet_poles,
+        "involute_spline_poles": report.involute_poles,
+        "gear_volume_mm3": solid_volume_mm3(shape),
+        "stock_volume_mm3": solid_volume_mm3(stock.val().wrapped),
+        "step_bytes": {name: len(content) for name, content in files.items()},
+    }
+    return facts, files
 
 
 def _parser() -> argparse.ArgumentParser:

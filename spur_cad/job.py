@@ -15,6 +15,7 @@ import typing
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from spur_cad.cad.specs import BlankFeatures, StockSpec
 from spur_cad.errors import GearSpecError, JobFileError
 from spur_cad.geometry.spec import GearSpec
 
@@ -57,16 +58,8 @@ class GearSection:
             thickness_allowance_mm=self.thickness_allowance_mm, face_width_mm=self.face_width_mm,
         )
 
-
-@dataclass(frozen=True)
-class StockSection:
-    """[stock]: blank cylinder (tip diameter + 2 x radial allowance) and an optional holding stub."""
-
-    radial_allowance_mm: float = 0.5
-    front_margin_mm: float = 1.0
-    back_margin_mm: float = 1.0
-    stub_diameter_mm: float = 0.0
-    stub_length_mm: float = 0.0
+    def blank_features(self) -> BlankFeatures:
+        return BlankFeatures(self.bore_diameter_mm, self.keyway_width_mm, self.keyway_depth_mm)
 
 
 @dataclass(frozen=True)
@@ -148,7 +141,7 @@ class Job:
     job: JobSection
     gear_section: GearSection
     gear: GearSpec
-    stock: StockSection = field(default_factory=StockSection)
+    stock: StockSpec = field(default_factory=StockSpec)
     tools: ToolsSection = field(default_factory=ToolsSection)
     roughing: RoughingSection = field(default_factory=RoughingSection)
     finishing: FinishingSection = field(default_factory=FinishingSection)
@@ -159,7 +152,7 @@ class Job:
 _SECTIONS: dict[str, type] = {
     "job": JobSection,
     "gear": GearSection,
-    "stock": StockSection,
+    "stock": StockSpec,
     "roughing": RoughingSection,
     "finishing": FinishingSection,
     "machine": MachineSection,
@@ -263,6 +256,12 @@ def parse_job(text: str, source: str = "<job>") -> Job:
             else source
         message = str(exc).replace("thickness_allowance_fraction", "thickness_allowance_percent / 100")
         raise JobFileError(f"{where}: invalid gear: {message}") from None
+    for check, table in ((gear_section.blank_features().validate, "gear"),
+                         (sections.get("stock", StockSpec()).validate, "stock")):
+        try:
+            check(spec)
+        except GearSpecError as exc:
+            raise JobFileError(f"{_where(source, text, table, exc.field)}: invalid [{table}]: {exc}") from None
     job_section: JobSection = sections.get("job", JobSection())
     if not job_section.profile_tolerance_mm > 0.0 or job_section.profile_tolerance_mm > 0.1:
         raise JobFileError(f"{_where(source, text, 'job', 'profile_tolerance_mm')}: [job] profile_tolerance_mm "

@@ -1,0 +1,78 @@
+"""Specifications of the blank features and the stock (plain dataclasses, no CAD kernel import).
+
+The job file's [stock] section is a StockSpec; the bore/keyway keys of [gear] form BlankFeatures.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+from spur_cad.errors import GearSpecError
+from spur_cad.geometry.spec import GearSpec
+
+
+@dataclass(frozen=True)
+class BlankFeatures:
+    """Optional bore (through, on the gear axis) and keyway (on the bore's +Z side, under tooth space 0).
+
+    `keyway_depth_mm` is measured from the bore surface outward (hub keyway depth t2).
+    """
+
+    bore_diameter_mm: float = 0.0
+    keyway_width_mm: float = 0.0
+    keyway_depth_mm: float = 0.0
+
+    def validate(self, spec: GearSpec) -> None:
+        """Raise GearSpecError unless the features leave a wall of at least one module under the root."""
+        for name in ("bore_diameter_mm", "keyway_width_mm", "keyway_depth_mm"):
+            value = getattr(self, name)
+            if not math.isfinite(value) or value < 0.0:
+                raise GearSpecError(f"{name} = {value:g} mm must be zero (none) or positive", field=name)
+        wall = spec.module_mm
+        if self.bore_diameter_mm > 0.0 and self.bore_diameter_mm / 2.0 > spec.root_radius_mm - wall:
+            raise GearSpecError(
+                f"bore diameter {self.bore_diameter_mm:g} mm leaves less than one module ({wall:g} mm) of wall under "
+                f"the root circle (root diameter {2 * spec.root_radius_mm:.3f} mm)", field="bore_diameter_mm")
+        has_width, has_depth = self.keyway_width_mm > 0.0, self.keyway_depth_mm > 0.0
+        if has_width != has_depth:
+            raise GearSpecError("a keyway needs both keyway_width_mm and keyway_depth_mm", field="keyway_width_mm")
+        if has_width:
+            if self.bore_diameter_mm <= 0.0:
+                raise GearSpecError("a keyway needs a bore (bore_diameter_mm)", field="keyway_width_mm")
+            if self.keyway_width_mm >= self.bore_diameter_mm:
+                raise GearSpecError(f"keyway width {self.keyway_width_mm:g} mm must be smaller than the bore "
+                                    f"diameter {self.bore_diameter_mm:g} mm", field="keyway_width_mm")
+            top = self.bore_diameter_mm / 2.0 + self.keyway_depth_mm
+            if top > spec.root_radius_mm - wall:
+                raise GearSpecError(
+                    f"keyway reaches radius {top:.3f} mm, leaving less than one module ({wall:g} mm) of wall under "
+                    f"the root circle ({spec.root_radius_mm:.3f} mm)", field="keyway_depth_mm")
+
+
+@dataclass(frozen=True)
+class StockSpec:
+    """[stock]: blank cylinder of tip diameter + 2 x radial allowance, from X = -front margin to
+    face width + back margin, optionally continued by a holding stub toward the chuck (+X)."""
+
+    radial_allowance_mm: float = 0.5
+    front_margin_mm: float = 1.0
+    back_margin_mm: float = 1.0
+    stub_diameter_mm: float = 0.0
+    stub_length_mm: float = 0.0
+
+    def validate(self, spec: GearSpec) -> None:
+        for name in ("radial_allowance_mm", "front_margin_mm", "back_margin_mm", "stub_diameter_mm",
+                     "stub_length_mm"):
+            value = getattr(self, name)
+            if not math.isfinite(value) or value < 0.0:
+                raise GearSpecError(f"{name} = {value:g} mm must not be negative", field=name)
+        if (self.stub_diameter_mm > 0.0) != (self.stub_length_mm > 0.0):
+            raise GearSpecError("a holding stub needs both stub_diameter_mm and stub_length_mm",
+                                field="stub_diameter_mm")
+        if self.stub_diameter_mm > 2.0 * self.blank_radius_mm(spec):
+            raise GearSpecError(f"stub diameter {self.stub_diameter_mm:g} mm is larger than the blank "
+                                f"({2 * self.blank_radius_mm(spec):.3f} mm)", field="stub_diameter_mm")
+
+    def blank_radius_mm(self, spec: GearSpec) -> float:
+        return spec.tip_radius_mm + self.radial_allowance_mm
