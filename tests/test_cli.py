@@ -30,7 +30,8 @@ def test_reference_job_writes_profile_summary_and_plot(tmp_path):
     out = tmp_path / "out"
     result = run_cli("run", str(REFERENCE_JOB), "--out", str(out))
     assert result.returncode == 0, result.stderr
-    assert {p.name for p in out.iterdir()} == {"profile.csv", "profile.png", "summary.json"}
+    assert {p.name for p in out.iterdir()} == {"profile.csv", "profile.png", "summary.json", "gear.step",
+                                               "stock.step", "job.step"}
     summary = json.loads((out / "summary.json").read_text())
     gear, inspection = summary["gear"], summary["inspection"]
     assert gear["reference_radius_mm"] == pytest.approx(46.0)
