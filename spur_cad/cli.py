@@ -78,7 +78,7 @@ def build_cad(job: Job) -> tuple[dict, dict[str, bytes]]:
     """Gear solid, stock and STEP files; returns (summary facts, files)."""
     import cadquery as cq
 
-    from spur_cad.cad.solid import DEFAULT_FIT_TOLERANCE_MM, build_gear_shape, make_stock, solid_volume_mm3
+    from spur_cad.cad.solid import build_gear_shape, make_stock, solid_volume_mm3
     from spur_cad.cad.step import step_files
 
     shape, report = build_gear_shape(job.gear, job.gear_section.blank_features())
@@ -86,7 +86,7 @@ def build_cad(job: Job) -> tuple[dict, dict[str, bytes]]:
     stock = make_stock(job.gear, job.stock)
     files = step_files(gear, stock)
     facts = {
-        "fit_tolerance_mm": DEFAULT_FIT_TOLERANCE_MM,
+        "fit_tolerance_mm": report.fit_tolerance_mm,
         "fillet_max_deviation_mm": report.fillet_max_deviation_mm,
         "involute_max_deviation_mm": report.involute_max_deviation_mm,
         "fillet_spline_poles": report.fillet_poles,

@@ -66,7 +66,8 @@ def test_solid_is_valid_closed_and_has_the_exact_volume(name):
     box = cq.Solid(shape).BoundingBox()
     assert box.xmin == pytest.approx(0.0, abs=1e-6) and box.xmax == pytest.approx(spec.face_width_mm, abs=1e-6)
     assert max(box.ymax, box.zmax, -box.ymin, -box.zmin) <= spec.tip_radius_mm + 1e-6
-    assert report.involute_max_deviation_mm <= 1e-5 and report.fillet_max_deviation_mm <= 1e-5
+    assert report.fit_tolerance_mm == pytest.approx(2.5e-6 * spec.module_mm)
+    assert max(report.involute_max_deviation_mm, report.fillet_max_deviation_mm) <= report.fit_tolerance_mm
 
 
 def test_bore_and_keyway_remove_exactly_their_area():

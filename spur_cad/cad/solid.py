@@ -42,7 +42,7 @@ from spur_cad.geometry.profile import Segment
 from spur_cad.geometry.sampling import segment_parameters
 from spur_cad.geometry.spec import GearSpec
 
-DEFAULT_FIT_TOLERANCE_MM = 1e-5  # B-spline vs exact curve: 0.01 um, far inside the 1 um section check
+FIT_TOLERANCE_PER_MODULE = 2.5e-6  # B-spline vs exact curve, x module: 0.01 um at m = 4
 _CHECK_POINTS_PER_SPAN = 8
 
 
@@ -93,7 +93,12 @@ def _max_deviation(curve: Geom_Curve, exact_points: np.ndarray) -> float:
     return worst
 
 
-def fit_segment(segment: Segment, fit_tolerance_mm: float = DEFAULT_FIT_TOLERANCE_MM) -> FittedCurve:
+def default_fit_tolerance_mm(spec: GearSpec) -> float:
+    """Spline fit tolerance scaled with the module, so small gears keep the same relative accuracy."""
+    return FIT_TOLERANCE_PER_MODULE * spec.module_mm
+
+
+def fit_segment(segment: Segment, fit_tolerance_mm: float) -> FittedCurve:
     """B-spline through exact points and tangents of a fillet/involute, refined until within tolerance."""
     chordal = 0.01
     for _ in range(12):
@@ -139,6 +144,7 @@ def _transformed_edge(edge: TopoDS_Edge, trsf: gp_Trsf) -> TopoDS_Edge:
 class GearSolidReport:
     """Facts about a built solid that the summary and tests use."""
 
+    fit_tolerance_mm: float
     fillet_max_deviation_mm: float
     involute_max_deviation_mm: float
     fillet_poles: int
@@ -146,8 +152,7 @@ class GearSolidReport:
     edges_per_space: int
 
 
-def gear_face_edges(spec: GearSpec, fit_tolerance_mm: float = DEFAULT_FIT_TOLERANCE_MM
-                    ) -> tuple[list[TopoDS_Edge], GearSolidReport]:
+def gear_face_edges(spec: GearSpec, fit_tolerance_mm: float) -> tuple[list[TopoDS_Edge], GearSolidReport]:
     """Edges of the whole transverse outline on the front face, in order around the gear."""
     profile = spec.tooth_space_profile()
     fillet_seg, involute_seg = profile.segment("fillet"), profile.segment("involute")
@@ -175,6 +180,7 @@ def gear_face_edges(spec: GearSpec, fit_tolerance_mm: float = DEFAULT_FIT_TOLERA
         rotation = _rotation_about_x(-k * pitch)
         edges.extend(_transformed_edge(edge, rotation) for edge in space_edges)
     report = GearSolidReport(
+        fit_tolerance_mm=fit_tolerance_mm,
         fillet_max_deviation_mm=fillet.max_deviation_mm if fillet else 0.0,
         involute_max_deviation_mm=involute.max_deviation_mm,
         fillet_poles=fillet.poles if fillet else 0, involute_poles=involute.poles,
@@ -207,10 +213,13 @@ def _x_cylinder(radius: float, x0: float, x1: float) -> TopoDS_Shape:
 
 
 def build_gear_shape(spec: GearSpec, features: BlankFeatures = BlankFeatures(),
-                     fit_tolerance_mm: float = DEFAULT_FIT_TOLERANCE_MM) -> tuple[TopoDS_Shape, GearSolidReport]:
-    """The gear as an OCP solid in the machine frame, with a report of the spline fits."""
+                     fit_tolerance_mm: float | None = None) -> tuple[TopoDS_Shape, GearSolidReport]:
+    """The gear as an OCP solid in the machine frame, with a report of the spline fits.
+
+    `fit_tolerance_mm` defaults to 2.5e-6 x module (see default_fit_tolerance_mm)."""
     features.validate(spec)
-    edges, report = gear_face_edges(spec, fit_tolerance_mm)
+    tolerance = default_fit_tolerance_mm(spec) if fit_tolerance_mm is None else fit_tolerance_mm
+    edges, report = gear_face_edges(spec, tolerance)
     b = spec.face_width_mm
     shape = _extrude(edges, b)
     if features.bore_diameter_mm > 0.0:
@@ -240,7 +249,7 @@ def build_stock_shape(spec: GearSpec, stock: StockSpec = StockSpec()) -> TopoDS_
 
 
 def make_gear(spec: GearSpec, features: BlankFeatures = BlankFeatures(),
-              fit_tolerance_mm: float = DEFAULT_FIT_TOLERANCE_MM) -> cq.Workplane:
+              fit_tolerance_mm: float | None = None) -> cq.Workplane:
     """The gear solid as a CadQuery Workplane (machine frame: axis X, front face at X = 0)."""
     shape, _ = build_gear_shape(spec, features, fit_tolerance_mm)
     return cq.Workplane("YZ").add(cq.Solid(shape))
