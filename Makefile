@@ -25,7 +25,8 @@ test: venv
 	$(PYTHON) -m pytest -q $(PYTEST_ARGS)
 
 bench: venv
-	$(PYTHON) benchmarks/run_benchmarks.py
+	$(VENV)/bin/pip install -q -e '.[test,bench]'
+	$(PYTHON) -m benchmarks.run_benchmarks
 
 clean:
 	rm -rf out/ build/ dist/ test-artifacts/ .pytest_cache/ *.egg-info

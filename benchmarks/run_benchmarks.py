@@ -60,11 +60,41 @@ def bench_profile(runs: int) -> dict:
     }
 
 
+def bench_cad(runs: int) -> dict:
+    """Gear solid + STEP: ours (reference gear) beside bd_warehouse's SpurGear (same m, z, alpha, b)."""
+    from benchmarks import bench_cad as cad
+
+    spec = reference_spec()
+    nominal = GearSpec(teeth=23, module_mm=4.0, rack_tip_radius_mm=0.8, face_width_mm=20.0)
+    ours_s = median_seconds(lambda: cad.ours(spec), runs)
+    theirs_s = median_seconds(lambda: cad.bd_warehouse_gear(nominal), runs)
+    our_shape, our_step = cad.ours(spec)
+    their_shape, their_step = cad.bd_warehouse_gear(nominal)
+    our_dev, our_form, our_phase = cad.deviation_of_ours(spec, our_shape)
+    their_dev, their_form, their_phase = cad.deviation_of_bd_warehouse(nominal, their_shape)
+    return {
+        "spur_cad_solid_plus_step_s": ours_s,
+        "bd_warehouse_solid_plus_step_s": theirs_s,
+        "time_ratio_bd_warehouse_over_spur_cad": theirs_s / ours_s,
+        "spur_cad_max_involute_deviation_mm": our_dev,
+        "spur_cad_involute_form_error_mm": our_form,
+        "spur_cad_fitted_phase_rad": our_phase,
+        "bd_warehouse_max_involute_deviation_mm": their_dev,
+        "bd_warehouse_involute_form_error_mm": their_form,
+        "bd_warehouse_fitted_phase_rad": their_phase,
+        "spur_cad_step_bytes": len(our_step),
+        "bd_warehouse_step_bytes": len(their_step),
+    }
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__)
     parser.add_argument("--runs", type=int, default=21)
+    parser.add_argument("--cad-runs", type=int, default=5)
     args = parser.parse_args()
-    print(json.dumps({"machine": machine(), "runs": args.runs, "profile": bench_profile(args.runs)}, indent=2))
+    results = {"machine": machine(), "runs": args.runs, "profile": bench_profile(args.runs),
+               "cad_runs": args.cad_runs, "cad": bench_cad(args.cad_runs)}
+    print(json.dumps(results, indent=2))
 
 
 if __name__ == "__main__":
