@@ -74,6 +74,10 @@ BAD_JOBS = {
     "bad toml": ("[gear\nteeth = 23\n", "not valid TOML"),
     "unknown section": ("[gears]\nteeth = 23\n", "unknown section [gears]"),
     "too few teeth": ("[gear]\nteeth = 3\nmodule_mm = 4.0\nface_width_mm = 20\n", "too few teeth"),
+    "bore through the root": ("[gear]\nteeth = 23\nmodule_mm = 4.0\nface_width_mm = 20\nbore_diameter_mm = 80\n",
+                              "bad.toml:5: invalid [gear]: bore diameter 80 mm leaves less than one module"),
+    "stub without length": ("[gear]\nteeth = 23\nmodule_mm = 4.0\nface_width_mm = 20\n[stock]\nstub_diameter_mm = 60\n",
+                            "bad.toml:6: invalid [stock]: a holding stub needs both"),
 }
 
 
