@@ -16,7 +16,9 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from spur_cad.cad.specs import BlankFeatures, StockSpec
-from spur_cad.errors import GearSpecError, JobFileError
+from spur_cad.cam.machine import FinishingParams, Machine, RoughingParams
+from spur_cad.cam.tools import Tool
+from spur_cad.errors import GearSpecError, JobFileError, SpurCadError
 from spur_cad.geometry.spec import GearSpec
 
 REQUIRED = object()  # marker default for keys the file must give
@@ -63,57 +65,6 @@ class GearSection:
 
 
 @dataclass(frozen=True)
-class ToolSection:
-    """[tools.roughing] / [tools.finishing]: a catalogue end mill and its cutting data."""
-
-    kind: str = "flat"  # flat | bull_nose | ball
-    diameter_mm: float = REQUIRED  # type: ignore[assignment]
-    corner_radius_mm: float = 0.0
-    flutes: int = 2
-    flute_length_mm: float = 0.0
-    stick_out_mm: float = 0.0
-    tool_number: int = 1
-    cutting_speed_m_min: float = 100.0
-    feed_per_tooth_mm: float = 0.02
-
-
-@dataclass(frozen=True)
-class RoughingSection:
-    """[roughing]: METHOD.md 4 parameters."""
-
-    flank_allowance_mm: float = 0.1
-    step_over_fraction: float = 0.5
-    max_level_depth_fraction: float = 0.5
-    clamp_rotary: bool = False
-
-
-@dataclass(frozen=True)
-class FinishingSection:
-    """[finishing]: METHOD.md 5 parameters."""
-
-    strategy: str = "perimeter"  # perimeter | along_x
-    target_scallop_mm: float = 0.002
-    step_over_mm: float = 0.0  # 0: derive from the target scallop
-    chordal_tolerance_mm: float = 0.001
-
-
-@dataclass(frozen=True)
-class MachineSection:
-    """[machine]: limits and habits of the machining centre and its rotary table."""
-
-    name: str = "generic 4-axis VMC"
-    max_spindle_rpm: float = 7000.0
-    max_feed_mm_min: float = 5000.0
-    max_rotary_speed_deg_min: float = 3600.0
-    rapid_feed_mm_min: float = 15000.0
-    clearance_mm: float = 1.0
-    block_time_s: float = 0.004
-    rotary_continuous: bool = True
-    rotary_clamp_code: str = ""
-    rotary_unclamp_code: str = ""
-
-
-@dataclass(frozen=True)
 class PostSection:
     """[post]: G-code dialect and formatting."""
 
@@ -127,10 +78,10 @@ class PostSection:
 
 @dataclass(frozen=True)
 class ToolsSection:
-    """[tools]: the roughing and finishing tools (each optional until the CAM stage needs it)."""
+    """[tools]: the roughing and finishing tools (without them the job stops after the CAD stage)."""
 
-    roughing: ToolSection | None = None
-    finishing: ToolSection | None = None
+    roughing: Tool | None = None
+    finishing: Tool | None = None
 
 
 @dataclass(frozen=True)
@@ -143,9 +94,9 @@ class Job:
     gear: GearSpec
     stock: StockSpec = field(default_factory=StockSpec)
     tools: ToolsSection = field(default_factory=ToolsSection)
-    roughing: RoughingSection = field(default_factory=RoughingSection)
-    finishing: FinishingSection = field(default_factory=FinishingSection)
-    machine: MachineSection = field(default_factory=MachineSection)
+    roughing: RoughingParams = field(default_factory=RoughingParams)
+    finishing: FinishingParams = field(default_factory=FinishingParams)
+    machine: Machine = field(default_factory=Machine)
     post: PostSection = field(default_factory=PostSection)
 
 
@@ -153,9 +104,9 @@ _SECTIONS: dict[str, type] = {
     "job": JobSection,
     "gear": GearSection,
     "stock": StockSpec,
-    "roughing": RoughingSection,
-    "finishing": FinishingSection,
-    "machine": MachineSection,
+    "roughing": RoughingParams,
+    "finishing": FinishingParams,
+    "machine": Machine,
     "post": PostSection,
 }
 _TOOL_SECTIONS = ("roughing", "finishing")
@@ -212,7 +163,7 @@ def _load_section(table: object, cls: type, name: str, source: str, text: str):
     values = {}
     for key, f in known.items():
         if key not in table:
-            if f.default is REQUIRED:
+            if f.default is REQUIRED or (f.default is dataclasses.MISSING and f.default_factory is dataclasses.MISSING):
                 raise JobFileError(f"{_where(source, text, name)}: [{name}] is missing the required key '{key}'")
             continue
         expected = hints[key]
@@ -245,7 +196,7 @@ def parse_job(text: str, source: str = "<job>") -> Job:
         if name not in _TOOL_SECTIONS:
             raise JobFileError(f"{_where(source, text, 'tools.' + name)}: unknown section [tools.{name}] "
                                "(known: [tools.roughing], [tools.finishing])")
-    tools = ToolsSection(**{name: _load_section(tools_table[name], ToolSection, f"tools.{name}", source, text)
+    tools = ToolsSection(**{name: _load_section(tools_table[name], Tool, f"tools.{name}", source, text)
                             for name in _TOOL_SECTIONS if name in tools_table})
     gear_section: GearSection = sections["gear"]
     try:
@@ -262,6 +213,20 @@ def parse_job(text: str, source: str = "<job>") -> Job:
             check(spec)
         except GearSpecError as exc:
             raise JobFileError(f"{_where(source, text, table, exc.field)}: invalid [{table}]: {exc}") from None
+    for name, check in (("machine", lambda m: m.validate()), ("roughing", lambda r: r.validate()),
+                        ("finishing", lambda f: f.validate())):
+        if name in sections:
+            try:
+                check(sections[name])
+            except SpurCadError as exc:
+                raise JobFileError(f"{_where(source, text, name)}: {exc}") from None
+    for role in _TOOL_SECTIONS:
+        tool = getattr(tools, role)
+        if tool is not None:
+            try:
+                tool.validate(role)
+            except SpurCadError as exc:
+                raise JobFileError(f"{_where(source, text, 'tools.' + role)}: [tools.{role}] {exc}") from None
     job_section: JobSection = sections.get("job", JobSection())
     if not job_section.profile_tolerance_mm > 0.0 or job_section.profile_tolerance_mm > 0.1:
         raise JobFileError(f"{_where(source, text, 'job', 'profile_tolerance_mm')}: [job] profile_tolerance_mm "

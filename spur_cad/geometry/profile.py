@@ -64,6 +64,9 @@ class CircularArc:
         """Exact sagitta R (1 - cos(dtheta / 2))."""
         return self.radius_mm * (1.0 - np.cos(np.abs(b - a) / 2.0))
 
+    def arc_length_bound(self, a: np.ndarray, b: np.ndarray) -> np.ndarray:
+        return self.radius_mm * np.abs(b - a)
+
 
 @dataclass(frozen=True)
 class Involute:
@@ -104,6 +107,9 @@ class Involute:
             curvature_bound = np.where(a > 0.0, length * length / (8.0 * rb * np.maximum(a, 1e-300)), np.inf)
         triangle_bound = 0.5 * length * np.tan(np.minimum(b - a, 3.0) / 2.0)
         return np.minimum(curvature_bound, triangle_bound)
+
+    def arc_length_bound(self, a: np.ndarray, b: np.ndarray) -> np.ndarray:
+        return self.base_radius_mm * (b * b - a * a) / 2.0
 
 
 @dataclass(frozen=True)
@@ -176,6 +182,12 @@ class TrochoidalFillet:
             curvature = np.where(speed_low > 0.0, turning_high / speed_low, np.inf)
             bound = curvature * length * length / 8.0
         return np.where(length == 0.0, 0.0, bound)
+
+    def arc_length_bound(self, a: np.ndarray, b: np.ndarray) -> np.ndarray:
+        ta1, ta2 = self._speed_terms(a)
+        tb1, tb2 = self._speed_terms(b)
+        speed_high = self.corner_radius_mm + (tb1 + np.maximum(ta2, tb2)) / self.reference_radius_mm
+        return speed_high * (b - a)
 
 
 Segment = CircularArc | Involute | TrochoidalFillet

@@ -38,8 +38,13 @@ class ProfileSamples:
         return len(self.points)
 
 
-def segment_parameters(segment: Segment, tolerance_mm: float) -> np.ndarray:
-    """Increasing parameters from segment.start to segment.end whose chords are within tolerance."""
+def segment_parameters(segment: Segment, tolerance_mm: float, extra_curvature: float = 0.0) -> np.ndarray:
+    """Increasing parameters from segment.start to segment.end whose chords are within tolerance.
+
+    With `extra_curvature` k > 0 the bound per interval grows by k l^2 / 8 (l: arc length): the
+    CAM layer passes 1 / r_t so that the cusp between two tool-corner circles of radius r_t
+    touching consecutive points is within the tolerance ((curvature + 1/r_t) l^2 / 8 bounds it).
+    """
     if not tolerance_mm > 0.0:
         raise ValueError(f"chordal tolerance must be positive, got {tolerance_mm}")
     if segment.end <= segment.start:
@@ -49,6 +54,8 @@ def segment_parameters(segment: Segment, tolerance_mm: float) -> np.ndarray:
     accepted: list[np.ndarray] = []
     for _ in range(_MAX_REFINEMENTS):
         bound = segment.chord_error_bound(pending_a, pending_b)
+        if extra_curvature > 0.0:
+            bound = bound + extra_curvature * segment.arc_length_bound(pending_a, pending_b) ** 2 / 8.0
         ok = bound <= tolerance_mm
         accepted.append(pending_a[ok])
         if ok.all():

@@ -1,0 +1,155 @@
+"""Toolpath IR: a neutral, typed sequence of moves in numpy arrays (CONVENTIONS.md).
+
+Each row is one move to the pose (x, y, z, a) from the previous row's pose (the first row
+starts from wherever the machine is). Machine frame: gear axis = X = rotary axis A, Y = 0 and
+Z = 0 on the rotary axis, X = 0 on the front face; the tool axis is Z and the pose is the
+centre of the tool tip. `a` is in degrees, right-hand about +X.
+
+`feed` is mm/min for linear moves where A does not move, inverse time (1/min: the move takes
+1/feed minutes) where A moves together with X/Y/Z (`inverse_time` True), and NaN for rapids
+and markers. Markers (clamp/unclamp of the rotary axis) carry the current pose unchanged.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from enum import IntEnum
+
+import numpy as np
+
+
+class MoveKind(IntEnum):
+    RAPID = 0
+    LINEAR = 1
+    CLAMP_ROTARY = 2
+    UNCLAMP_ROTARY = 3
+
+
+class Operation(IntEnum):
+    ROUGHING = 0
+    FINISHING = 1
+
+
+class Feature(IntEnum):
+    """What a move is doing, for reports, checks and subprogram folding."""
+
+    NONE = 0  # positioning: rapids, retracts, plunges, index moves
+    RIGHT_FLANK = 1
+    LEFT_FLANK = 2
+    ROOT = 3
+    TIP = 4
+    LEVEL = 5  # a roughing level pass (or the step between passes)
+
+
+@dataclass(frozen=True)
+class Toolpath:
+    """Moves of one operation with one tool (arrays of equal length)."""
+
+    kind: np.ndarray  # int8, MoveKind
+    x: np.ndarray
+    y: np.ndarray
+    z: np.ndarray
+    a: np.ndarray  # degrees
+    feed: np.ndarray
+    inverse_time: np.ndarray  # bool
+    space: np.ndarray  # int32 tooth space index k (space k is turned by k * 360/z from space 0), -1 none
+    station: np.ndarray  # int32 finishing station (X step) index, or roughing level index; -1 none
+    feature: np.ndarray  # int8, Feature
+    operation: Operation
+    tool_number: int
+    spindle_rpm: float
+    warnings: tuple[str, ...] = ()
+
+    def __len__(self) -> int:
+        return len(self.kind)
+
+    def poses(self) -> np.ndarray:
+        """(N, 4) array of x, y, z, a."""
+        return np.stack([self.x, self.y, self.z, self.a], axis=-1)
+
+    @property
+    def motion_mask(self) -> np.ndarray:
+        return (self.kind == MoveKind.RAPID) | (self.kind == MoveKind.LINEAR)
+
+
+@dataclass
+class ToolpathBuilder:
+    """Accumulates moves; generators keep one locally and call build() once (no shared state)."""
+
+    operation: Operation
+    tool_number: int
+    spindle_rpm: float
+    _rows: list[tuple] = field(default_factory=list)
+    _chunks: list[dict] = field(default_factory=list)
+    warnings: list[str] = field(default_factory=list)
+
+    def _flush_rows(self) -> None:
+        if not self._rows:
+            return
+        cols = list(zip(*self._rows))
+        self._chunks.append({
+            "kind": np.array(cols[0], dtype=np.int8), "x": np.array(cols[1], float), "y": np.array(cols[2], float),
+            "z": np.array(cols[3], float), "a": np.array(cols[4], float), "feed": np.array(cols[5], float),
+            "inverse_time": np.array(cols[6], bool), "space": np.array(cols[7], np.int32),
+            "station": np.array(cols[8], np.int32), "feature": np.array(cols[9], np.int8)})
+        self._rows = []
+
+    def move(self, kind: MoveKind, x: float, y: float, z: float, a: float, feed: float = float("nan"), *,
+             inverse_time: bool = False, space: int = -1, station: int = -1,
+             feature: Feature = Feature.NONE) -> None:
+        self._rows.append((int(kind), x, y, z, a, feed, inverse_time, space, station, int(feature)))
+
+    def extend(self, kind: np.ndarray, x: np.ndarray, y: np.ndarray, z: np.ndarray, a: np.ndarray,
+               feed: np.ndarray, inverse_time: np.ndarray, space: np.ndarray, station: np.ndarray,
+               feature: np.ndarray) -> None:
+        """Append many moves at once (arrays broadcast to a common length)."""
+        self._flush_rows()
+        n = max(np.size(v) for v in (kind, x, y, z, a, feed, inverse_time, space, station, feature))
+
+        def full(v, dtype):
+            return np.broadcast_to(np.asarray(v, dtype=dtype), (n,)).copy()
+
+        self._chunks.append({"kind": full(kind, np.int8), "x": full(x, float), "y": full(y, float),
+                             "z": full(z, float), "a": full(a, float), "feed": full(feed, float),
+                             "inverse_time": full(inverse_time, bool), "space": full(space, np.int32),
+                             "station": full(station, np.int32), "feature": full(feature, np.int8)})
+
+    def last_pose(self) -> tuple[float, float, float, float] | None:
+        if self._rows:
+            row = self._rows[-1]
+            return row[1], row[2], row[3], row[4]
+        if self._chunks:
+            c = self._chunks[-1]
+            return float(c["x"][-1]), float(c["y"][-1]), float(c["z"][-1]), float(c["a"][-1])
+        return None
+
+    def build(self) -> Toolpath:
+        self._flush_rows()
+        keys = ("kind", "x", "y", "z", "a", "feed", "inverse_time", "space", "station", "feature")
+        if self._chunks:
+            arrays = {k: np.concatenate([c[k] for c in self._chunks]) for k in keys}
+        else:
+            arrays = {k: np.zeros(0) for k in keys}
+        return Toolpath(operation=self.operation, tool_number=self.tool_number, spindle_rpm=self.spindle_rpm,
+                        warnings=tuple(self.warnings), **arrays)
+
+
+def part_frame_points(y: np.ndarray, z: np.ndarray, a_deg: np.ndarray) -> np.ndarray:
+    """Machine (Y, Z) at rotary angle A -> coordinates fixed to the part (as at A = 0).
+
+    A point fixed to the part at p is at R(A) p when A is commanded, so p = R(-A) (Y, Z).
+    """
+    a = np.radians(a_deg)
+    c, s = np.cos(a), np.sin(a)
+    return np.stack([y * c + z * s, -y * s + z * c], axis=-1)
+
+
+def relative_path_lengths(x0, y0, z0, a0, x1, y1, z1, a1, substeps: int = 16) -> np.ndarray:
+    """Length of the tool tip's path relative to the part for moves interpolated linearly in X, Y, Z, A."""
+    t = np.linspace(0.0, 1.0, substeps + 1)[:, None]
+    ys, zs, as_ = y0 + (y1 - y0) * t, z0 + (z1 - z0) * t, a0 + (a1 - a0) * t
+    xs = x0 + (x1 - x0) * t
+    p = part_frame_points(ys, zs, as_)
+    d = np.diff(p, axis=0)
+    dx = np.diff(xs, axis=0)
+    return np.sqrt(d[..., 0] ** 2 + d[..., 1] ** 2 + dx**2).sum(axis=0)

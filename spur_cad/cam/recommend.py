@@ -1,0 +1,108 @@
+"""Tool recommendations and limits (METHOD.md 3), and the tooth space's width at a height.
+
+Heights are measured along the space's symmetry axis in the gap frame (y), as the tool sees
+them when the space axis points up the tool axis.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from spur_cad.cam.tools import Tool, ToolError
+from spur_cad.geometry.sampling import sample_profile
+from spur_cad.geometry.spec import GearSpec
+
+PLUNGE_CAPACITY_FRACTION = 0.5  # A_p = 0.5 d: what a finishing tool's bottom takes when it plunges
+
+
+def flank_polyline(spec: GearSpec, tolerance_mm: float | None = None) -> np.ndarray:
+    """Right flank of a space (root arc, fillet, involute; no tip land), gap frame, root to tip edge."""
+    samples = sample_profile(spec.tooth_space_profile(), tolerance_mm or 1e-4 * spec.module_mm)
+    return samples.points[np.array(samples.label_names()) != "tip"]
+
+
+def space_half_width_mm(flank: np.ndarray, height_mm: float) -> float:
+    """Half-width a straight-sided tool can use at `height_mm` in a space whose right flank is the
+    polyline `flank` (gap frame; the left flank is its mirror).
+
+    A tool coming down the axis passes every height above too, so this is the smallest x of the
+    flank at or above that height (an undercut flank can bulge inward higher up); above the tip
+    edge it is the tip edge's x.
+    """
+    x, y = flank[:, 0], flank[:, 1]
+    candidates = list(x[y >= height_mm])
+    crossing = (y[:-1] - height_mm) * (y[1:] - height_mm) < 0.0
+    for i in np.nonzero(crossing)[0]:
+        t = (height_mm - y[i]) / (y[i + 1] - y[i])
+        candidates.append(x[i] + t * (x[i + 1] - x[i]))
+    return float(min(candidates)) if candidates else float(x[-1])
+
+
+@dataclass(frozen=True)
+class ToolRecommendations:
+    """Limits for the tools of one gear (mm)."""
+
+    finishing_max_flat_width_mm: float  # root arc length 2 v r_f
+    finishing_max_corner_radius_mm: float  # smallest fillet curvature radius
+    plunge_allowance_mm: float  # A_p = 0.5 x finishing flat width
+    roughing_max_diameter_mm: float  # space width at height r_f + A_p
+    required_flute_length_mm: float  # deepest cut below the stock surface (finishing reaches the root)
+    required_stick_out_mm: float  # flute length + clearance above the blank
+
+    def as_dict(self) -> dict[str, float]:
+        return dict(self.__dict__)
+
+
+def recommend_tools(spec: GearSpec, blank_radius_mm: float, clearance_mm: float,
+                    finishing_tool: Tool | None = None) -> ToolRecommendations:
+    """METHOD.md 3; A_p uses the chosen finishing tool's flat width, else the largest allowed."""
+    profile = spec.tooth_space_profile()
+    max_flat = 2.0 * profile.root_arc_half_angle_rad * spec.root_radius_mm
+    max_corner = profile.min_fillet_curvature_radius_mm
+    if not np.isfinite(max_corner):  # no fillet (sharp rack on the rolling line): the root corner is sharp
+        max_corner = 0.0
+    flat = finishing_tool.flat_width_mm if finishing_tool is not None else max_flat
+    plunge = PLUNGE_CAPACITY_FRACTION * flat
+    roughing_max = 2.0 * space_half_width_mm(flank_polyline(spec), spec.root_radius_mm + plunge)
+    flute = blank_radius_mm - spec.root_radius_mm
+    return ToolRecommendations(max_flat, max_corner, plunge, roughing_max, flute, flute + clearance_mm)
+
+
+def check_tools(spec: GearSpec, recommendations: ToolRecommendations, roughing: Tool | None,
+                finishing: Tool | None) -> None:
+    """Raise ToolError naming the violated limit and its value."""
+    rec = recommendations
+    if finishing is not None:
+        finishing.validate("finishing")
+        if finishing.kind == "flat":
+            raise ToolError("finishing tool must have a corner radius (bull_nose or ball): a sharp corner "
+                            "cannot follow the root fillet")
+        if finishing.flat_width_mm > rec.finishing_max_flat_width_mm + 1e-9:
+            raise ToolError(f"finishing tool flat width {finishing.flat_width_mm:.4f} mm (D - 2 r_t) exceeds "
+                            f"finishing_max_flat_width_mm = {rec.finishing_max_flat_width_mm:.4f} mm "
+                            "(root arc length 2 v r_f)")
+        if finishing.corner_radius > rec.finishing_max_corner_radius_mm + 1e-9:
+            raise ToolError(f"finishing tool corner radius {finishing.corner_radius:.4f} mm exceeds "
+                            f"finishing_max_corner_radius_mm = {rec.finishing_max_corner_radius_mm:.4f} mm "
+                            "(smallest curvature radius of the root fillet)")
+        _check_lengths(finishing, "finishing", rec)
+    if roughing is not None:
+        roughing.validate("roughing")
+        if roughing.kind != "flat":
+            raise ToolError(f"roughing tool kind '{roughing.kind}': roughing uses a flat end mill (METHOD.md 4)")
+        if roughing.diameter_mm > rec.roughing_max_diameter_mm + 1e-9:
+            raise ToolError(f"roughing tool diameter {roughing.diameter_mm:.4f} mm exceeds roughing_max_diameter_mm = "
+                            f"{rec.roughing_max_diameter_mm:.4f} mm (space width at root radius + "
+                            f"A_p = {rec.plunge_allowance_mm:.4f} mm)")
+        _check_lengths(roughing, "roughing", rec)
+
+
+def _check_lengths(tool: Tool, role: str, rec: ToolRecommendations) -> None:
+    if tool.flute_length_mm and tool.flute_length_mm < rec.required_flute_length_mm:
+        raise ToolError(f"{role} tool flute_length_mm = {tool.flute_length_mm:g} is shorter than the "
+                        f"required_flute_length_mm = {rec.required_flute_length_mm:.3f} mm")
+    if tool.stick_out_mm and tool.stick_out_mm < rec.required_stick_out_mm:
+        raise ToolError(f"{role} tool stick_out_mm = {tool.stick_out_mm:g} is shorter than the "
+                        f"required_stick_out_mm = {rec.required_stick_out_mm:.3f} mm")

@@ -1,0 +1,166 @@
+"""Roughing (METHOD.md 4): per tooth space, horizontal levels, zig-zag passes along X.
+
+The tool works on the design profile offset by the finish stock (so it never comes closer
+than that to the design). Levels are chosen bottom-up on that offset flank so that the
+staircase left between two levels is at most (flank allowance - finish stock): horizontally
+on the involute, as a straight distance on the concave fillet; the fillet/involute junction
+is always a level, and no level is deeper than the slotting limit below the one above.
+The lowest level is where the offset space is exactly as wide as the tool.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from spur_cad.cam.finishing import safe_height_mm
+from spur_cad.cam.ir import Feature, MoveKind, Operation, Toolpath, ToolpathBuilder
+from spur_cad.cam.machine import Machine, MachineError, RoughingParams
+from spur_cad.cam.recommend import space_half_width_mm
+from spur_cad.cam.tools import Tool, ToolError
+from spur_cad.geometry.sampling import sample_profile
+from spur_cad.geometry.spec import GearSpec
+
+PLUNGE_FEED_FRACTION = 0.5
+
+
+@dataclass(frozen=True)
+class RoughingLevels:
+    """Level heights (tool tip Z with the space axis up), top to bottom, and their half-width reach."""
+
+    heights_mm: np.ndarray
+    half_widths_mm: np.ndarray  # largest |Y| the tool edge may reach at each level (offset flank)
+    junction_height_mm: float | None
+
+    @property
+    def lowest_height_mm(self) -> float:
+        return float(self.heights_mm[-1])
+
+
+def offset_flank(spec: GearSpec, finish_stock_mm: float) -> tuple[np.ndarray, np.ndarray, float | None]:
+    """Right flank (root arc, fillet, involute) offset into the space by the finish stock, root to tip
+    edge, with each point's label and the height of the fillet/involute junction."""
+    samples = sample_profile(spec.tooth_space_profile(), 2e-4 * spec.module_mm)
+    names = np.array(samples.label_names())
+    keep = names != "tip"
+    points = samples.points[keep] + finish_stock_mm * samples.normals[keep]
+    labels = names[keep]
+    junction = None
+    involute = np.nonzero(labels == "involute")[0]
+    if len(involute) and involute[0] > 0:
+        junction = float(points[involute[0], 1])
+    return points, labels, junction
+
+
+def roughing_levels(spec: GearSpec, tool: Tool, params: RoughingParams, blank_radius_mm: float) -> RoughingLevels:
+    """Levels as described in the module docstring (pure function)."""
+    flank, labels, junction = offset_flank(spec, params.finish_stock_mm)
+    radius = tool.diameter_mm / 2.0
+    budget = params.flank_allowance_mm - params.finish_stock_mm
+    max_depth = params.max_level_depth_fraction * tool.diameter_mm
+    tip_edge_height = float(flank[-1, 1])
+
+    def width(h: float) -> float:
+        return space_half_width_mm(flank, h)
+
+    # Lowest level: the offset space is exactly as wide as the tool (bisection on a monotone test).
+    low, high = float(flank[:, 1].min()), tip_edge_height
+    if width(high) < radius:
+        raise ToolError(f"roughing tool diameter {tool.diameter_mm:g} mm does not fit the tooth space even at the tip "
+                        f"(space width {2 * width(high):.3f} mm there, finish stock included)")
+    for _ in range(100):
+        mid = 0.5 * (low + high)
+        low, high = (mid, high) if width(mid) < radius else (low, mid)
+    lowest = high
+
+    def flank_point(h: float) -> np.ndarray:
+        """Point of the offset flank at height h (first crossing from the root, tip edge above it)."""
+        y = flank[:, 1]
+        if h >= tip_edge_height:
+            return flank[-1]
+        i = int(np.nonzero((y[:-1] <= h) & (y[1:] >= h))[0][0]) if np.any((y[:-1] <= h) & (y[1:] >= h)) else 0
+        t = (h - y[i]) / (y[i + 1] - y[i]) if y[i + 1] != y[i] else 0.0
+        return flank[i] + t * (flank[i + 1] - flank[i])
+
+    def staircase(h_low: float, h_high: float) -> float:
+        """Material left between two levels: horizontal on the involute, straight on the fillet."""
+        p_low, p_high = flank_point(h_low), flank_point(min(h_high, tip_edge_height))
+        on_fillet = junction is not None and h_high <= junction + 1e-12
+        if on_fillet:
+            return float(np.hypot(*(p_high - p_low)))
+        return float(p_high[0] - p_low[0])
+
+    heights = [lowest]
+    top = blank_radius_mm - max_depth  # the first level cuts at most max_depth below the blank
+    while heights[-1] < top - 1e-9:
+        h = heights[-1]
+        ceiling = h + max_depth
+        if junction is not None and h < junction - 1e-9:
+            ceiling = min(ceiling, junction)
+        if staircase(h, ceiling) <= budget:
+            nxt = ceiling
+        else:  # largest height with the staircase within budget (staircase grows with height)
+            lo, hi = h, ceiling
+            for _ in range(60):
+                mid = 0.5 * (lo + hi)
+                lo, hi = (mid, hi) if staircase(h, mid) <= budget else (lo, mid)
+            nxt = lo
+            if nxt - h < 1e-6:
+                raise MachineError(f"[roughing] flank_allowance_mm = {params.flank_allowance_mm:g} is too small for "
+                                   "this flank: the levels would be less than 1 nm apart")
+        heights.append(min(nxt, top))
+    levels = np.array(heights[::-1])
+    half_widths = np.array([width(h) for h in levels])
+    return RoughingLevels(levels, half_widths, junction)
+
+
+def roughing_toolpath(spec: GearSpec, tool: Tool, machine: Machine, params: RoughingParams,
+                      blank_radius_mm: float, back_margin_mm: float = 0.0, stub_radius_mm: float = 0.0,
+                      front_margin_mm: float = 0.0) -> Toolpath:
+    """The roughing operation as IR (pure function)."""
+    params.validate()
+    machine.validate()
+    tool.validate("roughing")
+    if params.clamp_rotary and not (machine.rotary_clamp_code and machine.rotary_unclamp_code):
+        raise MachineError("[roughing] clamp_rotary needs [machine] rotary_clamp_code and rotary_unclamp_code")
+    levels = roughing_levels(spec, tool, params, blank_radius_mm)
+    radius = tool.diameter_mm / 2.0
+    x_front = -(front_margin_mm + radius + machine.clearance_mm)
+    x_back = spec.face_width_mm + radius + machine.clearance_mm
+    if stub_radius_mm > levels.lowest_height_mm and back_margin_mm < radius + machine.clearance_mm:
+        raise MachineError(f"the roughing tool would cut into the holding stub: its passes run to X = {x_back:.3f} mm; "
+                           f"make [stock] back_margin_mm at least {radius + machine.clearance_mm:.3f} mm")
+    safe_z = safe_height_mm(blank_radius_mm, machine)
+    feed = tool.feed_mm_min(machine)
+    step = params.step_over_fraction * tool.diameter_mm
+    pitch_deg = 360.0 / spec.teeth
+    builder = ToolpathBuilder(Operation.ROUGHING, tool.tool_number, tool.spindle_rpm(machine))
+    for k in range(spec.teeth):
+        a = -k * pitch_deg
+        if params.clamp_rotary and k > 0:
+            builder.move(MoveKind.UNCLAMP_ROTARY, *builder.last_pose(), space=k)
+        builder.move(MoveKind.RAPID, x_front, 0.0, safe_z, a, space=k)
+        if params.clamp_rotary:
+            builder.move(MoveKind.CLAMP_ROTARY, x_front, 0.0, safe_z, a, space=k)
+        x_here = x_front
+        for index, (height, half_width) in enumerate(zip(levels.heights_mm, levels.half_widths_mm)):
+            reach = max(half_width - radius, 0.0)
+            n = max(1, math.ceil(2.0 * reach / step - 1e-9)) if reach > 0.0 else 0
+            offsets = np.linspace(-reach, reach, n + 1) if n else np.array([0.0])
+            if x_here != x_front:  # come back to the front, above the cleared level, before going down
+                builder.move(MoveKind.LINEAR, x_here, builder.last_pose()[1], safe_z, a, feed, space=k, station=index)
+                builder.move(MoveKind.RAPID, x_front, offsets[0], safe_z, a, space=k, station=index)
+                x_here = x_front
+            builder.move(MoveKind.LINEAR, x_front, offsets[0], height, a, PLUNGE_FEED_FRACTION * feed, space=k,
+                         station=index)
+            for j, y in enumerate(offsets):
+                if j > 0:
+                    builder.move(MoveKind.LINEAR, x_here, y, height, a, feed, space=k, station=index,
+                                 feature=Feature.LEVEL)
+                x_here = x_back if x_here == x_front else x_front
+                builder.move(MoveKind.LINEAR, x_here, y, height, a, feed, space=k, station=index,
+                             feature=Feature.LEVEL)
+        builder.move(MoveKind.LINEAR, x_here, builder.last_pose()[1], safe_z, a, feed, space=k)
+    return builder.build()
