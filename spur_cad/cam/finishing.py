@@ -44,18 +44,30 @@ class TransversePoses:
 
 
 def _corner_poses(points: np.ndarray, normals: np.ndarray, tool: Tool) -> TransversePoses:
-    """Cutter locations touching right-flank contact points with the tool's right corner."""
+    """Cutter locations touching right-flank contact points with the tool's right corner.
+
+    The part is turned by the contact's polar angle (METHOD.md 5) unless that leaves the
+    normal outside the corner's quarter (-n' must point down and outward, between straight down
+    and horizontal): then the turn is clamped to the nearest angle where it is on the corner's
+    edge (this happens on overhanging undercut fillets). The silhouette tests check the result.
+    """
     r_t, d = tool.corner_radius, tool.flat_width_mm
-    theta = np.arctan2(points[:, 0], points[:, 1])  # clockwise polar angle from the space axis
     radius = np.hypot(points[:, 0], points[:, 1])
-    c, s = np.cos(theta), np.sin(theta)
-    n_y = normals[:, 0] * c - normals[:, 1] * s  # n turned counter-clockwise by theta
-    n_z = normals[:, 0] * s + normals[:, 1] * c
-    if np.any(n_y > 1e-9) or np.any(n_z < -1e-9):
-        raise ToolError("finishing: a flank contact would not lie on the tool's corner (the flank normal "
-                        "turns past horizontal or past vertical); this gear cannot be finished with this method")
-    centre_y, centre_z = r_t * n_y, radius + r_t * n_z
-    return TransversePoses(centre_y - d / 2.0, centre_z - r_t, np.degrees(theta), radius)
+    polar = np.arctan2(points[:, 0], points[:, 1])  # clockwise polar angle from the space axis
+    normal_angle = np.arctan2(normals[:, 1], normals[:, 0])  # counter-clockwise from +x
+    # Turning the part counter-clockwise by psi turns the normal to angle normal_angle + psi,
+    # which must lie in [90, 180] deg (n' pointing up-left: the right corner touches).
+    lowest, highest = np.pi / 2 - normal_angle, np.pi - normal_angle
+    lowest, highest = (np.mod(lowest + np.pi, 2 * np.pi) - np.pi, np.mod(highest + np.pi, 2 * np.pi) - np.pi)
+    turn = np.clip(polar, lowest, highest)
+    c, s = np.cos(turn), np.sin(turn)
+    # Contact point and normal with the part turned counter-clockwise by `turn`.
+    p_y, p_z = points[:, 0] * c - points[:, 1] * s, points[:, 0] * s + points[:, 1] * c
+    n_y, n_z = normals[:, 0] * c - normals[:, 1] * s, normals[:, 0] * s + normals[:, 1] * c
+    if np.any(n_y > 1e-9) or np.any(n_z < -1e-9):  # pragma: no cover - guarded by the clamp
+        raise ToolError("finishing: a flank contact cannot be reached by the tool's corner")
+    centre_y, centre_z = p_y + r_t * n_y, p_z + r_t * n_z
+    return TransversePoses(centre_y - d / 2.0, centre_z - r_t, np.degrees(turn), radius)
 
 
 def _flat_sweep(radius: float, theta_start: float, theta_end: float, y_start: float, y_end: float,

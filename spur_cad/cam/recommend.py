@@ -19,7 +19,7 @@ PLUNGE_CAPACITY_FRACTION = 0.5  # A_p = 0.5 d: what a finishing tool's bottom ta
 
 def flank_polyline(spec: GearSpec, tolerance_mm: float | None = None) -> np.ndarray:
     """Right flank of a space (root arc, fillet, involute; no tip land), gap frame, root to tip edge."""
-    samples = sample_profile(spec.tooth_space_profile(), tolerance_mm or 1e-4 * spec.module_mm)
+    samples = sample_profile(spec.tooth_space_profile(), tolerance_mm or 1e-6 * spec.module_mm)
     return samples.points[np.array(samples.label_names()) != "tip"]
 
 

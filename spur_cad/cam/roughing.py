@@ -42,7 +42,7 @@ class RoughingLevels:
 def offset_flank(spec: GearSpec, finish_stock_mm: float) -> tuple[np.ndarray, np.ndarray, float | None]:
     """Right flank (root arc, fillet, involute) offset into the space by the finish stock, root to tip
     edge, with each point's label and the height of the fillet/involute junction."""
-    samples = sample_profile(spec.tooth_space_profile(), 2e-4 * spec.module_mm)
+    samples = sample_profile(spec.tooth_space_profile(), 1e-6 * spec.module_mm)
     names = np.array(samples.label_names())
     keep = names != "tip"
     points = samples.points[keep] + finish_stock_mm * samples.normals[keep]

@@ -1,0 +1,171 @@
+"""CAM: tool recommendations against METHOD.md 3 computed independently, tool limits, the
+A-motion rule, inverse-time feeds from the true relative path, and the time estimator."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+import shapely
+from shapely.geometry import LineString, Polygon
+
+from spur_cad.cam.estimate import estimate
+from spur_cad.cam.finishing import finishing_toolpath, station_positions, station_step_mm
+from spur_cad.cam.ir import Feature, MoveKind, Operation, ToolpathBuilder
+from spur_cad.cam.machine import FinishingParams, Machine, RoughingParams
+from spur_cad.cam.recommend import check_tools, recommend_tools
+from spur_cad.cam.roughing import roughing_levels, roughing_toolpath
+from spur_cad.cam.tools import Tool, ToolError
+from spur_cad.geometry import gear_outline, sample_profile
+from tests.gears import spec_of, textbook_of
+
+CAM_GEARS = ["reference_z23_m4", "undercut_z8", "many_teeth_z120", "shifted_z12", "small_module_z30"]
+
+
+def tools_for(name: str) -> tuple[Tool, Tool]:
+    """Roughing and finishing tools sized from each gear's limits (as a user would pick them)."""
+    spec = spec_of(name)
+    rec = recommend_tools(spec, spec.tip_radius_mm + 0.5, 1.0)
+    r_t = round(0.6 * min(rec.finishing_max_corner_radius_mm, spec.rack_tip_radius_mm), 3)
+    d = round(0.6 * rec.finishing_max_flat_width_mm, 3)
+    finishing = Tool(diameter_mm=d + 2 * r_t, kind="bull_nose", corner_radius_mm=r_t)
+    rec_f = recommend_tools(spec, spec.tip_radius_mm + 0.5, 1.0, finishing)
+    roughing = Tool(diameter_mm=round(0.8 * rec_f.roughing_max_diameter_mm, 3), kind="flat", flutes=3)
+    return roughing, finishing
+
+
+@pytest.mark.parametrize("name", CAM_GEARS)
+def test_recommendations_match_method_formulas(name):
+    spec, g = spec_of(name), textbook_of(name)
+    _, finishing = tools_for(name)
+    rec = recommend_tools(spec, spec.tip_radius_mm + 0.5, 1.0, finishing)
+    # Root arc length 2 v r_f with v = d_1 / r (METHOD.md 2-3, textbook rack).
+    assert rec.finishing_max_flat_width_mm == pytest.approx(2 * g.corner_offset / g.r * g.rf, abs=1e-9)
+    # Smallest fillet curvature radius: circumradius of close triples of dense fillet samples.
+    samples = sample_profile(spec.tooth_space_profile(), 1e-7)
+    fillet = samples.points[np.array(samples.label_names()) == "fillet"]
+    a, b, c = fillet[:-2:5], fillet[1:-1:5], fillet[2::5]
+    cross = np.abs((b - a)[:, 0] * (c - a)[:, 1] - (b - a)[:, 1] * (c - a)[:, 0])
+    circum = (np.linalg.norm(b - a, axis=1) * np.linalg.norm(c - b, axis=1) * np.linalg.norm(a - c, axis=1)
+              / (2 * np.maximum(cross, 1e-300)))
+    assert rec.finishing_max_corner_radius_mm == pytest.approx(circum.min(), rel=1e-3)
+    assert rec.finishing_max_corner_radius_mm >= spec.rack_tip_radius_mm - 1e-12
+    # Roughing: width of the space (shapely on the gear outline) at height r_f + 0.5 d on the axis.
+    a_p = 0.5 * finishing.flat_width_mm
+    assert rec.plunge_allowance_mm == pytest.approx(a_p)
+    gear = Polygon(gear_outline(spec, 1e-6))
+    height = g.rf + a_p
+    line = LineString([(-g.m * 3, height), (g.m * 3, height)]).difference(gear)
+    pieces = [piece for piece in getattr(line, "geoms", [line]) if piece.distance(shapely.Point(0, height)) < 1e-9]
+    assert rec.roughing_max_diameter_mm == pytest.approx(pieces[0].length, abs=1e-5)
+    # Tool and flute length: from the blank surface to the root.
+    assert rec.required_flute_length_mm == pytest.approx(g.ra + 0.5 - g.rf)
+
+
+@pytest.mark.parametrize("change, words", [
+    (dict(finishing=Tool(diameter_mm=3.0, kind="bull_nose", corner_radius_mm=0.5)), "finishing_max_flat_width_mm"),
+    (dict(finishing=Tool(diameter_mm=3.0, kind="bull_nose", corner_radius_mm=1.3)), "finishing_max_corner_radius_mm"),
+    (dict(finishing=Tool(diameter_mm=2.0, kind="flat")), "must have a corner radius"),
+    (dict(roughing=Tool(diameter_mm=5.0, kind="flat")), "roughing_max_diameter_mm"),
+    (dict(roughing=Tool(diameter_mm=3.0, kind="bull_nose", corner_radius_mm=0.5)), "flat end mill"),
+    (dict(roughing=Tool(diameter_mm=3.0, flute_length_mm=5.0)), "required_flute_length_mm"),
+    (dict(roughing=Tool(diameter_mm=3.0, stick_out_mm=8.0)), "required_stick_out_mm"),
+    (dict(roughing=Tool(diameter_mm=3.0, kind="conical")), "kind 'conical' is unknown"),
+])
+def test_tool_limits_are_clear_errors(change, words):
+    spec = spec_of("reference_z23_m4")
+    finishing = change.get("finishing", Tool(diameter_mm=2.0, kind="bull_nose", corner_radius_mm=0.5))
+    roughing = change.get("roughing", Tool(diameter_mm=3.0))
+    rec = recommend_tools(spec, 50.5, 1.0, finishing)
+    with pytest.raises(ToolError, match=words):
+        check_tools(spec, rec, roughing, finishing)
+
+
+def _previous(values: np.ndarray) -> np.ndarray:
+    return np.concatenate([[values[0]], values[:-1]])
+
+
+@pytest.mark.parametrize("name", CAM_GEARS)
+def test_a_moves_only_above_the_gear_or_in_designed_finishing_moves(name):
+    spec = spec_of(name)
+    roughing, finishing = tools_for(name)
+    machine = Machine()
+    blank = spec.tip_radius_mm + 0.5
+    paths = [roughing_toolpath(spec, roughing, machine, RoughingParams(flank_allowance_mm=0.1 * spec.module_mm,
+                                                                       finish_stock_mm=0.005 * spec.module_mm),
+                               blank),
+             finishing_toolpath(spec, finishing, machine, FinishingParams(step_over_mm=spec.face_width_mm), blank)]
+    for path in paths:
+        moving = np.abs(path.a - _previous(path.a)) > 1e-12
+        designed = np.isin(path.feature, [Feature.RIGHT_FLANK, Feature.LEFT_FLANK, Feature.ROOT, Feature.TIP])
+        high = np.minimum(path.z, _previous(path.z)) >= spec.tip_radius_mm + machine.clearance_mm - 1e-9
+        assert np.all(high[moving & ~designed]), path.operation
+        if path.operation == Operation.ROUGHING:
+            assert not np.any(moving & designed)
+
+
+def test_inverse_time_feed_matches_relative_path_length():
+    """For simultaneous moves, 1/F (min) x feed = the tool tip's path length relative to the part,
+    integrated here independently with the rotation convention of CONVENTIONS.md."""
+    spec = spec_of("reference_z23_m4")
+    tool = Tool(diameter_mm=2.0, kind="bull_nose", corner_radius_mm=0.5, cutting_speed_m_min=120,
+                feed_per_tooth_mm=0.02)
+    machine = Machine()
+    path = finishing_toolpath(spec, tool, machine, FinishingParams(step_over_mm=100.0), 50.5)
+    feed = tool.feed_mm_min(machine)
+    idx = np.nonzero(path.inverse_time)[0]
+    assert len(idx) > 100
+    for i in idx[::37]:
+        t = np.linspace(0, 1, 2001)
+        y = path.y[i - 1] + (path.y[i] - path.y[i - 1]) * t
+        z = path.z[i - 1] + (path.z[i] - path.z[i - 1]) * t
+        a = np.radians(path.a[i - 1] + (path.a[i] - path.a[i - 1]) * t)
+        # A point at (Y, Z) of the machine at angle A sits at R(-A)(Y, Z) on the part.
+        py, pz = y * np.cos(a) + z * np.sin(a), -y * np.sin(a) + z * np.cos(a)
+        length = np.hypot(np.diff(py), np.diff(pz)).sum()
+        minutes = max(length / feed, abs(path.a[i] - path.a[i - 1]) / machine.max_rotary_speed_deg_min)
+        assert 1.0 / path.feed[i] == pytest.approx(minutes, rel=2e-3)
+
+
+def test_estimate_of_a_small_program_by_hand():
+    machine = Machine(rapid_feed_mm_min=6000.0, max_rotary_speed_deg_min=600.0, block_time_s=0.5)
+    b = ToolpathBuilder(Operation.ROUGHING, 1, 1000.0)
+    b.move(MoveKind.RAPID, 0.0, 0.0, 60.0, 0.0)
+    b.move(MoveKind.RAPID, 0.0, 0.0, 60.0, 90.0)  # rotary only: 90 deg at 600 deg/min = 9 s
+    b.move(MoveKind.LINEAR, 100.0, 0.0, 60.0, 90.0, 200.0)  # 100 mm at 200 mm/min = 30 s
+    b.move(MoveKind.LINEAR, 100.0, 1.0, 60.0, 90.0, 6000.0)  # 1 mm at 6000 mm/min = 0.01 s -> block time 0.5 s
+    result = estimate(b.build(), machine)
+    assert result.moves == 4
+    assert result.cutting_length_mm == pytest.approx(101.0)
+    assert result.time_s == pytest.approx(0.5 + 9.0 + 30.0 + 0.5)
+
+
+def test_stations_cover_the_face_width_with_the_scallop_step():
+    tool = Tool(diameter_mm=2.0, kind="bull_nose", corner_radius_mm=0.5)
+    params = FinishingParams(target_scallop_mm=0.005)
+    step = station_step_mm(tool, params)
+    # Worst case of METHOD.md 5: flat width d at the root, corner radius elsewhere.
+    h, d, r_t = 0.005, 1.0, 0.5
+    assert d / 2 - math.sqrt((d / 2) ** 2 - (step / 2) ** 2) <= h + 1e-12
+    assert r_t - math.sqrt(r_t**2 - (step / 2) ** 2) <= h + 1e-12
+    stations = station_positions(20.0, step)
+    assert stations[0] == 0.0 and stations[-1] == 20.0 and np.diff(stations).max() <= step + 1e-12
+
+
+def test_roughing_levels_junction_and_depth_limit():
+    spec = spec_of("reference_z23_m4")
+    tool = Tool(diameter_mm=3.5, flutes=3)
+    params = RoughingParams(flank_allowance_mm=0.3, finish_stock_mm=0.02, max_level_depth_fraction=0.5)
+    levels = roughing_levels(spec, tool, params, 50.5)
+    heights = levels.heights_mm
+    assert np.all(np.diff(heights) < 0)  # top to bottom
+    assert np.max(-np.diff(heights)) <= 0.5 * 3.5 + 1e-9
+    assert 50.5 - heights[0] <= 0.5 * 3.5 + 1e-9
+    assert np.min(np.abs(heights - levels.junction_height_mm)) < 1e-9
+    # Lowest level: the space (design offset by the finish stock) is exactly as wide as the tool there.
+    gear = Polygon(gear_outline(spec, 1e-6)).buffer(0.02, quad_segs=64)
+    low = heights[-1]
+    line = LineString([(-8, low), (8, low)]).difference(gear)
+    pieces = [p for p in getattr(line, "geoms", [line]) if p.distance(shapely.Point(0, low)) < 1e-9]
+    assert pieces[0].length == pytest.approx(3.5, abs=1e-4)
