@@ -43,31 +43,74 @@ class TransversePoses:
         return TransversePoses(-self.y, self.z, -self.a, self.contact_radius)
 
 
-def _corner_poses(points: np.ndarray, normals: np.ndarray, tool: Tool) -> TransversePoses:
-    """Cutter locations touching right-flank contact points with the tool's right corner.
+GOUGE_TOLERANCE_MM = 1e-5
+ROTATION_CANDIDATES = 181
 
-    The part is turned by the contact's polar angle (METHOD.md 5) unless that leaves the
-    normal outside the corner's quarter (-n' must point down and outward, between straight down
-    and horizontal): then the turn is clamped to the nearest angle where it is on the corner's
-    edge (this happens on overhanging undercut fillets). The silhouette tests check the result.
+
+def tool_signed_distance(points: np.ndarray, tip_y: float, tip_z: float, tool: Tool) -> np.ndarray:
+    """Signed distance of points (machine Y, Z) from the tool's section (negative inside).
+
+    The section (bottom corners rounded by r_t, sides going up for ever) is the Minkowski sum
+    of the strip |Y - tip_y| <= d/2, Z >= tip_z + r_t with a disc of radius r_t, so outside
+    that strip the distance is exact: hypot(dy, dz) - r_t.
     """
     r_t, d = tool.corner_radius, tool.flat_width_mm
+    dy = np.abs(points[:, 0] - tip_y) - d / 2.0
+    dz = tip_z + r_t - points[:, 1]
+    outside = np.hypot(np.maximum(dy, 0.0), np.maximum(dz, 0.0))
+    inside = np.minimum(np.maximum(dy, dz), 0.0)
+    return outside + inside - r_t
+
+
+def _pose_for_turn(point: np.ndarray, normal: np.ndarray, turn: float, tool: Tool) -> tuple[float, float]:
+    """Tip centre (Y, Z) touching `point` with the right corner when the part is turned by `turn`."""
+    c, s = math.cos(turn), math.sin(turn)
+    p_y, p_z = point[0] * c - point[1] * s, point[0] * s + point[1] * c
+    n_y, n_z = normal[0] * c - normal[1] * s, normal[0] * s + normal[1] * c
+    r_t = tool.corner_radius
+    return p_y + r_t * n_y - tool.flat_width_mm / 2.0, p_z + r_t * n_z - r_t
+
+
+def _gouge(design: np.ndarray, turn: float, tip: tuple[float, float], tool: Tool) -> float:
+    """How deep the tool at `tip` reaches into the design points turned by `turn` (0 if not at all)."""
+    c, s = math.cos(turn), math.sin(turn)
+    turned = np.stack([design[:, 0] * c - design[:, 1] * s, design[:, 0] * s + design[:, 1] * c], axis=-1)
+    return max(0.0, -float(tool_signed_distance(turned, tip[0], tip[1], tool).min()))
+
+
+def _corner_poses(points: np.ndarray, normals: np.ndarray, tool: Tool, design: np.ndarray) -> TransversePoses:
+    """Cutter locations touching right-flank contact points with the tool's right corner.
+
+    The part is turned by the contact's polar angle (METHOD.md 5) when that puts the contact on
+    the corner (-n' pointing down and outward) and the tool clear of the rest of the space
+    (`design`: dense exact points of the space and its tooth tips). Otherwise (overhanging
+    undercut flanks) the turn is searched within the range where the corner touches, nearest
+    first; a contact no turn can reach without gouging is an error.
+    """
     radius = np.hypot(points[:, 0], points[:, 1])
     polar = np.arctan2(points[:, 0], points[:, 1])  # clockwise polar angle from the space axis
     normal_angle = np.arctan2(normals[:, 1], normals[:, 0])  # counter-clockwise from +x
-    # Turning the part counter-clockwise by psi turns the normal to angle normal_angle + psi,
-    # which must lie in [90, 180] deg (n' pointing up-left: the right corner touches).
-    lowest, highest = np.pi / 2 - normal_angle, np.pi - normal_angle
-    lowest, highest = (np.mod(lowest + np.pi, 2 * np.pi) - np.pi, np.mod(highest + np.pi, 2 * np.pi) - np.pi)
-    turn = np.clip(polar, lowest, highest)
-    c, s = np.cos(turn), np.sin(turn)
-    # Contact point and normal with the part turned counter-clockwise by `turn`.
-    p_y, p_z = points[:, 0] * c - points[:, 1] * s, points[:, 0] * s + points[:, 1] * c
-    n_y, n_z = normals[:, 0] * c - normals[:, 1] * s, normals[:, 0] * s + normals[:, 1] * c
-    if np.any(n_y > 1e-9) or np.any(n_z < -1e-9):  # pragma: no cover - guarded by the clamp
-        raise ToolError("finishing: a flank contact cannot be reached by the tool's corner")
-    centre_y, centre_z = p_y + r_t * n_y, p_z + r_t * n_z
-    return TransversePoses(centre_y - d / 2.0, centre_z - r_t, np.degrees(turn), radius)
+    # Turning the part counter-clockwise by psi turns the normal to normal_angle + psi, which must
+    # lie in [90, 180] deg (n' pointing up-left: the right corner touches).
+    lowest = np.mod(np.pi / 2 - normal_angle + np.pi, 2 * np.pi) - np.pi
+    highest = lowest + np.pi / 2
+    turns, ys, zs = np.empty(len(points)), np.empty(len(points)), np.empty(len(points))
+    for i, (p, n) in enumerate(zip(points, normals)):
+        preferred = float(np.clip(polar[i], lowest[i], highest[i]))
+        tip = _pose_for_turn(p, n, preferred, tool)
+        if _gouge(design, preferred, tip, tool) > GOUGE_TOLERANCE_MM:
+            candidates = np.linspace(lowest[i], highest[i], ROTATION_CANDIDATES)
+            for turn in candidates[np.argsort(np.abs(candidates - preferred))]:
+                tip = _pose_for_turn(p, n, float(turn), tool)
+                if _gouge(design, float(turn), tip, tool) <= GOUGE_TOLERANCE_MM:
+                    preferred = float(turn)
+                    break
+            else:
+                raise ToolError(f"finishing: the flank point at radius {radius[i]:.4f} mm cannot be reached by the "
+                                f"tool's corner without gouging (undercut); use a tool with a smaller diameter or "
+                                "corner radius")
+        turns[i], (ys[i], zs[i]) = preferred, tip
+    return TransversePoses(ys, zs, np.degrees(turns), radius)
 
 
 def _flat_sweep(radius: float, theta_start: float, theta_end: float, y_start: float, y_end: float,
@@ -115,13 +158,20 @@ def space_poses(spec: GearSpec, tool: Tool, scallop_mm: float,
             params = params[1:]
         points.append(segment.points(params))
         normals.append(segment.normals(params))
-    right = _corner_poses(np.concatenate(points), np.concatenate(normals), tool)
+    right = _corner_poses(np.concatenate(points), np.concatenate(normals), tool, _space_design_points(spec))
     v = profile.root_arc_half_angle_rad
     root = _flat_sweep(spec.root_radius_mm, v, -v, -d / 2.0, d / 2.0, scallop_mm)
     tip_edge = profile.segment("tip").start  # clockwise polar angle of the right flank's tip edge
     pitch = 2.0 * math.pi / spec.teeth
     tip = _flat_sweep(spec.tip_radius_mm, -tip_edge, tip_edge - pitch, -d / 2.0, d / 2.0, scallop_mm)
     return SpacePoses(right, root, right.mirrored(), tip)
+
+
+def _space_design_points(spec: GearSpec) -> np.ndarray:
+    """Dense exact points of tooth space 0 (both halves, tip lands to the tooth centres)."""
+    from spur_cad.geometry.sampling import full_space_points, sample_profile
+
+    return full_space_points(sample_profile(spec.tooth_space_profile(), 2e-5 * spec.module_mm))
 
 
 def _fixed_spacing(segment, spacing_mm: float) -> np.ndarray:

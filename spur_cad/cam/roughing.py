@@ -94,23 +94,28 @@ def roughing_levels(spec: GearSpec, tool: Tool, params: RoughingParams, blank_ra
 
     heights = [lowest]
     top = blank_radius_mm - max_depth  # the first level cuts at most max_depth below the blank
-    while heights[-1] < top - 1e-9:
+    while True:
         h = heights[-1]
-        ceiling = h + max_depth
+        flank_done = h >= tip_edge_height - 1e-9 or staircase(h, tip_edge_height) <= budget
+        if flank_done:
+            if h >= top - 1e-9:
+                break
+            heights.append(min(h + max_depth, top))  # only the depth limit is left to satisfy
+            continue
+        ceiling = min(h + max_depth, tip_edge_height)
         if junction is not None and h < junction - 1e-9:
             ceiling = min(ceiling, junction)
         if staircase(h, ceiling) <= budget:
-            nxt = ceiling
-        else:  # largest height with the staircase within budget (staircase grows with height)
-            lo, hi = h, ceiling
-            for _ in range(60):
-                mid = 0.5 * (lo + hi)
-                lo, hi = (mid, hi) if staircase(h, mid) <= budget else (lo, mid)
-            nxt = lo
-            if nxt - h < 1e-6:
-                raise MachineError(f"[roughing] flank_allowance_mm = {params.flank_allowance_mm:g} is too small for "
-                                   "this flank: the levels would be less than 1 nm apart")
-        heights.append(min(nxt, top))
+            heights.append(ceiling)
+            continue
+        lo, hi = h, ceiling  # largest height whose staircase is within budget (it grows with height)
+        for _ in range(60):
+            mid = 0.5 * (lo + hi)
+            lo, hi = (mid, hi) if staircase(h, mid) <= budget else (lo, mid)
+        if lo - h < 1e-6:
+            raise MachineError(f"[roughing] flank_allowance_mm = {params.flank_allowance_mm:g} is too small for "
+                               "this flank: the levels would be less than 1 nm apart")
+        heights.append(lo)
     levels = np.array(heights[::-1])
     half_widths = np.array([width(h) for h in levels])
     return RoughingLevels(levels, half_widths, junction)

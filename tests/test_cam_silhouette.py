@@ -1,0 +1,99 @@
+"""Acceptance of the toolpaths by an independent 2-D check (tests/silhouette.py): every
+programmed pose's tool silhouette, turned into the part frame by the commanded A, against the
+designed gear. Nothing here uses the generators' geometry."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from shapely.geometry import Polygon
+
+from spur_cad.cam.finishing import finishing_toolpath
+from spur_cad.cam.ir import Feature, MoveKind
+from spur_cad.cam.machine import FinishingParams, Machine, RoughingParams
+from spur_cad.cam.recommend import recommend_tools
+from spur_cad.cam.roughing import roughing_levels, roughing_toolpath
+from spur_cad.geometry import gear_outline
+from tests import silhouette
+from tests.gears import spec_of
+from tests.test_cam import CAM_GEARS, tools_for
+
+HALF_MICRON = 0.5e-3
+SCALLOP = 0.005
+TOOL_LENGTH = 30.0
+
+
+def _spaces(teeth: int) -> list[int]:
+    return [0, 1, teeth - 1]
+
+
+@pytest.fixture(scope="module")
+def design_polygons():
+    return {name: Polygon(gear_outline(spec_of(name), 1e-5)) for name in CAM_GEARS}
+
+
+@pytest.mark.parametrize("name", CAM_GEARS)
+def test_finishing_never_gouges_and_leaves_at_most_the_scallop(name, design_polygons):
+    spec = spec_of(name)
+    _, tool = tools_for(name)
+    path = finishing_toolpath(spec, tool, Machine(), FinishingParams(target_scallop_mm=SCALLOP,
+                                                                      step_over_mm=spec.face_width_mm),
+                              spec.tip_radius_mm + 0.5)
+    spaces = _spaces(spec.teeth)
+    rows = path.motion_mask & (path.station == 0) & np.isin(path.space, spaces)
+    sils = silhouette.silhouettes_in_part_frame(path, tool.diameter_mm, tool.corner_radius, TOOL_LENGTH,
+                                                mask=rows)
+    assert silhouette.max_penetration_mm(design_polygons[name], sils) <= HALF_MICRON
+    points, labels = silhouette.design_boundary(spec, spaces)
+    leftover = silhouette.leftover_mm(points, sils)
+    assert leftover.max() <= SCALLOP + HALF_MICRON, (leftover.max(), labels[int(np.argmax(leftover))])
+
+
+@pytest.mark.parametrize("name", CAM_GEARS)
+def test_finishing_cuts_every_flank_downward(name):
+    spec = spec_of(name)
+    _, tool = tools_for(name)
+    path = finishing_toolpath(spec, tool, Machine(), FinishingParams(target_scallop_mm=SCALLOP, step_over_mm=2.0),
+                              spec.tip_radius_mm + 0.5)
+    for feature in (Feature.RIGHT_FLANK, Feature.LEFT_FLANK):
+        runs = silhouette.cutting_direction_ok(path, feature)
+        assert len(runs) == spec.teeth * len(np.unique(path.station)) and all(runs)
+
+
+@pytest.mark.parametrize("name", CAM_GEARS)
+def test_roughing_respects_finish_stock_and_flank_allowance(name, design_polygons):
+    spec = spec_of(name)
+    tool, finishing = tools_for(name)
+    params = RoughingParams(flank_allowance_mm=0.1 * spec.module_mm, finish_stock_mm=0.005 * spec.module_mm)
+    blank = spec.tip_radius_mm + 0.5
+    path = roughing_toolpath(spec, tool, Machine(), params, blank)
+    rows = path.motion_mask & (path.space == 0)
+    sils = silhouette.silhouettes_in_part_frame(path, tool.diameter_mm, 0.0, TOOL_LENGTH, mask=rows)
+    # Never closer than the finish stock to the design: no reach into the design grown by it.
+    grown = design_polygons[name].buffer(params.finish_stock_mm - 1e-6, quad_segs=256)
+    assert silhouette.max_penetration_mm(grown, sils) <= HALF_MICRON
+    # At most the flank allowance left on the flanks above the lowest level.
+    levels = roughing_levels(spec, tool, params, blank)
+    points, labels = silhouette.design_boundary(spec, [0], labels=("fillet", "involute"))
+    above = points[:, 1] >= levels.lowest_height_mm
+    leftover = silhouette.leftover_mm(points[above], sils)
+    assert leftover.max() <= params.flank_allowance_mm + HALF_MICRON
+    # What stays below the lowest level is within what the finishing tool's bottom can take.
+    rec = recommend_tools(spec, blank, 1.0, finishing)
+    assert levels.lowest_height_mm - spec.root_radius_mm <= rec.plunge_allowance_mm + 1e-9
+
+
+@pytest.mark.parametrize("name", CAM_GEARS)
+def test_rapids_never_touch_the_stock(name):
+    spec = spec_of(name)
+    roughing, finishing = tools_for(name)
+    blank = spec.tip_radius_mm + 0.5
+    machine = Machine()
+    params = RoughingParams(flank_allowance_mm=0.1 * spec.module_mm, finish_stock_mm=0.005 * spec.module_mm)
+    for path, tool in ((roughing_toolpath(spec, roughing, machine, params, blank), roughing),
+                       (finishing_toolpath(spec, finishing, machine, FinishingParams(step_over_mm=2.0), blank),
+                        finishing)):
+        assert np.any(path.kind == MoveKind.RAPID)
+        clearance = silhouette.rapids_clear_of_circle(path, tool.diameter_mm, tool.corner_radius, TOOL_LENGTH,
+                                                      blank)
+        assert clearance >= machine.clearance_mm - 1e-6
