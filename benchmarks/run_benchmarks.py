@@ -11,6 +11,7 @@ import os
 import platform
 import statistics
 import time
+from pathlib import Path
 from typing import Callable
 
 from spur_cad.geometry import GearSpec, gear_outline, sample_profile
@@ -87,13 +88,36 @@ def bench_cad(runs: int) -> dict:
     }
 
 
+def bench_cam(runs: int) -> dict:
+    """Roughing + finishing generation for the reference job, with moves and estimated times
+    beside the reference process's finishing strategy (0.08 mm contact spacing, 0.14 mm X step)."""
+    from spur_cad.cam.estimate import estimate
+    from spur_cad.cam.finishing import finishing_toolpath
+    from spur_cad.cam.machine import FinishingParams
+    from spur_cad.cam.roughing import roughing_toolpath
+    from spur_cad.job import load_job
+
+    job = load_job(Path(__file__).resolve().parents[1] / "resources" / "examples" / "reference_gear.toml")
+    spec, machine, blank = job.gear, job.machine, job.stock.blank_radius_mm(job.gear)
+    rough = lambda: roughing_toolpath(spec, job.tools.roughing, machine, job.roughing, blank,  # noqa: E731
+                                      job.stock.back_margin_mm, job.stock.stub_diameter_mm / 2, job.stock.front_margin_mm)
+    finish = lambda: finishing_toolpath(spec, job.tools.finishing, machine, job.finishing, blank)  # noqa: E731
+    reference = finishing_toolpath(spec, job.tools.finishing, machine, FinishingParams(step_over_mm=0.14), blank,
+                                   contact_spacing_mm=0.08)
+    r, f, ref = estimate(rough(), machine), estimate(finish(), machine), estimate(reference, machine)
+    return {"roughing_generation_s": median_seconds(rough, runs), "finishing_generation_s": median_seconds(finish, runs),
+            "roughing_moves": r.moves, "roughing_time_s": r.time_s, "finishing_moves": f.moves,
+            "finishing_time_s": f.time_s, "reference_strategy_moves": ref.moves,
+            "reference_strategy_time_s": ref.time_s}
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__)
     parser.add_argument("--runs", type=int, default=21)
     parser.add_argument("--cad-runs", type=int, default=5)
     args = parser.parse_args()
     results = {"machine": machine(), "runs": args.runs, "profile": bench_profile(args.runs),
-               "cad_runs": args.cad_runs, "cad": bench_cad(args.cad_runs)}
+               "cad_runs": args.cad_runs, "cad": bench_cad(args.cad_runs), "cam": bench_cam(args.cad_runs)}
     print(json.dumps(results, indent=2))
 
 
