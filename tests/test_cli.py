@@ -56,6 +56,17 @@ def test_reference_job_writes_profile_summary_and_plot(tmp_path):
     assert np.hypot(*pts[-1]) == pytest.approx(50.0)
     assert np.all(np.diff(np.hypot(pts[:, 0], pts[:, 1])) >= -1e-8)  # root to tip: radius never falls (csv has 1e-9 mm digits)
     assert (out / "profile.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    tools, roughing, finishing = summary["tools"], summary["roughing"], summary["finishing"]
+    for key in ("finishing_max_flat_width_mm", "finishing_max_corner_radius_mm", "roughing_max_diameter_mm",
+                "required_flute_length_mm"):
+        assert tools[key] > 0
+    assert tools["finishing_max_flat_width_mm"] == pytest.approx(2 * d1 / 46 * 41, abs=1e-9)
+    assert roughing["levels_per_space"] >= 2 and 0 < roughing["lowest_level_height_mm"] <= 0.5 * 1.0
+    for key in ("moves", "cutting_length_mm", "estimated_time_s"):
+        assert roughing[key] > 0 and finishing[key] > 0
+    assert finishing["stations"] >= 2 and finishing["points_per_flank"] > 10
+    assert finishing["reference_strategy_moves"] > finishing["moves"] > 0
+    assert finishing["reference_strategy_time_s"] > 0
     assert "wrote" in result.stdout
 
 
@@ -76,6 +87,11 @@ BAD_JOBS = {
     "too few teeth": ("[gear]\nteeth = 3\nmodule_mm = 4.0\nface_width_mm = 20\n", "too few teeth"),
     "bore through the root": ("[gear]\nteeth = 23\nmodule_mm = 4.0\nface_width_mm = 20\nbore_diameter_mm = 80\n",
                               "bad.toml:5: invalid [gear]: bore diameter 80 mm leaves less than one module"),
+    "finishing tool too wide": ("[gear]\nteeth = 23\nmodule_mm = 4.0\nface_width_mm = 20\nrack_tip_radius_mm = 0.8\n"
+                                "[tools.finishing]\nkind = 'bull_nose'\ndiameter_mm = 3.0\ncorner_radius_mm = 0.5\n",
+                                "finishing tool flat width 2.0000 mm (D - 2 r_t) exceeds finishing_max_flat_width_mm"),
+    "unknown strategy": ("[gear]\nteeth = 23\nmodule_mm = 4.0\nface_width_mm = 20\n[finishing]\nstrategy = 'spiral'\n",
+                         "bad.toml:5: [finishing] strategy 'spiral' is unknown"),
     "stub without length": ("[gear]\nteeth = 23\nmodule_mm = 4.0\nface_width_mm = 20\n[stock]\nstub_diameter_mm = 60\n",
                             "bad.toml:6: invalid [stock]: a holding stub needs both"),
 }
