@@ -107,7 +107,7 @@ def build_cam(job: Job) -> dict:
     """Tool recommendations always; toolpaths and estimates for the tools the job gives."""
     from spur_cad.cam.estimate import estimate
     from spur_cad.cam.finishing import finishing_toolpath, station_positions, station_step_mm
-    from spur_cad.cam.machine import FinishingParams
+    from spur_cad.cam.machine import FinishingParams, check_travel
     from spur_cad.cam.recommend import check_tools, recommend_tools
     from spur_cad.cam.roughing import roughing_levels, roughing_toolpath
 
@@ -129,6 +129,7 @@ def build_cam(job: Job) -> dict:
                             f"{rec.plunge_allowance_mm:.3f} mm); use a smaller roughing tool")
         path = roughing_toolpath(spec, roughing_tool, machine, job.roughing, blank, stock.back_margin_mm,
                                  stock.stub_diameter_mm / 2.0, stock.front_margin_mm)
+        check_travel(machine, path.x, path.y, path.z, path.a, "roughing")
         est = estimate(path, machine)
         result["roughing"] = {"levels_per_space": int(len(levels.heights_mm)),
                               "lowest_level_height_mm": lowest_above_root,
@@ -138,6 +139,7 @@ def build_cam(job: Job) -> dict:
         warnings.extend(path.warnings)
     if finishing_tool is not None:
         path = finishing_toolpath(spec, finishing_tool, machine, job.finishing, blank)
+        check_travel(machine, path.x, path.y, path.z, path.a, "finishing")
         est = estimate(path, machine)
         reference = finishing_toolpath(spec, finishing_tool, machine, FinishingParams(
             strategy="perimeter", target_scallop_mm=job.finishing.target_scallop_mm, step_over_mm=0.14), blank,

@@ -169,3 +169,18 @@ def test_roughing_levels_junction_and_depth_limit():
     line = LineString([(-8, low), (8, low)]).difference(gear)
     pieces = [p for p in getattr(line, "geoms", [line]) if p.distance(shapely.Point(0, low)) < 1e-9]
     assert pieces[0].length == pytest.approx(3.5, abs=1e-4)
+
+
+def test_travel_limits_name_the_axis():
+    from spur_cad.cam.machine import MachineError, check_travel
+
+    spec = spec_of("reference_z23_m4")
+    tool = Tool(diameter_mm=2.0, kind="bull_nose", corner_radius_mm=0.5)
+    machine = Machine(z_max_mm=50.0, rotary_continuous=False, a_min_deg=-90.0, a_max_deg=90.0)
+    path = finishing_toolpath(spec, tool, machine, FinishingParams(step_over_mm=20.0), 50.5)
+    with pytest.raises(MachineError, match=r"finishing needs Z = 51.500 mm, outside the machine's travel"):
+        check_travel(machine, path.x, path.y, path.z, path.a, "finishing")
+    limited = Machine(rotary_continuous=False, a_min_deg=-90.0, a_max_deg=90.0)
+    with pytest.raises(MachineError, match=r"finishing needs A = -3"):
+        check_travel(limited, path.x, path.y, path.z, path.a, "finishing")
+    check_travel(Machine(), path.x, path.y, path.z, path.a, "finishing")  # generous defaults pass

@@ -46,6 +46,23 @@ class Machine:
                 raise MachineError(f"[machine] {low} must be below {high}")
 
 
+def check_travel(machine: Machine, x, y, z, a, operation: str) -> None:
+    """Raise MachineError naming the axis and the value when a pose leaves the machine's travel
+    (A only when the table is not continuous)."""
+    import numpy as np
+
+    axes = [("X", x, machine.x_min_mm, machine.x_max_mm, "mm"), ("Y", y, machine.y_min_mm, machine.y_max_mm, "mm"),
+            ("Z", z, machine.z_min_mm, machine.z_max_mm, "mm")]
+    if not machine.rotary_continuous:
+        axes.append(("A", a, machine.a_min_deg, machine.a_max_deg, "deg"))
+    for name, values, low, high, unit in axes:
+        values = np.asarray(values)
+        if len(values) and (values.min() < low or values.max() > high):
+            worst = values.min() if values.min() < low else values.max()
+            raise MachineError(f"{operation} needs {name} = {worst:.3f} {unit}, outside the machine's travel "
+                               f"[{low:g}, {high:g}] {unit}")
+
+
 @dataclass(frozen=True)
 class RoughingParams:
     """[roughing]: METHOD.md 4. Allowances are measured from the designed flank."""
