@@ -97,3 +97,20 @@ def test_rapids_never_touch_the_stock(name):
         clearance = silhouette.rapids_clear_of_circle(path, tool.diameter_mm, tool.corner_radius, TOOL_LENGTH,
                                                       blank)
         assert clearance >= machine.clearance_mm - 1e-6
+
+
+@pytest.mark.parametrize("name", ["reference_z23_m4", "undercut_z8"])
+def test_along_x_strategy_is_as_safe_and_warns_about_marks(name, design_polygons):
+    spec = spec_of(name)
+    _, tool = tools_for(name)
+    path = finishing_toolpath(spec, tool, Machine(), FinishingParams(strategy="along_x", target_scallop_mm=SCALLOP),
+                              spec.tip_radius_mm + 0.5)
+    assert any("parallel to the contact lines" in w for w in path.warnings)
+    rows = path.motion_mask & (path.space == 0)
+    sils = silhouette.silhouettes_in_part_frame(path, tool.diameter_mm, tool.corner_radius, TOOL_LENGTH, mask=rows)
+    assert silhouette.max_penetration_mm(design_polygons[name], sils) <= HALF_MICRON
+    points, _ = silhouette.design_boundary(spec, [0])
+    assert silhouette.leftover_mm(points, sils).max() <= SCALLOP + HALF_MICRON
+    # Every pass along X covers the whole face width plus the tool radius at both ends.
+    passes = (path.kind == MoveKind.LINEAR) & (path.x != np.concatenate([[path.x[0]], path.x[:-1]]))
+    assert path.x[passes].min() < -tool.diameter_mm / 2 and path.x[passes].max() > spec.face_width_mm + tool.diameter_mm / 2
