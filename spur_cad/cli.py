@@ -106,7 +106,7 @@ def build_cad(job: Job) -> tuple[dict, dict[str, bytes]]:
 def build_cam(job: Job) -> dict:
     """Tool recommendations always; toolpaths and estimates for the tools the job gives."""
     from spur_cad.cam.estimate import estimate
-    from spur_cad.cam.finishing import finishing_toolpath, station_positions, station_step_mm
+    from spur_cad.cam.finishing import finishing_toolpath, space_poses, station_positions, station_step_mm
     from spur_cad.cam.machine import FinishingParams, check_travel
     from spur_cad.cam.recommend import check_tools, recommend_tools
     from spur_cad.cam.roughing import roughing_levels, roughing_toolpath
@@ -145,7 +145,6 @@ def build_cam(job: Job) -> dict:
             strategy="perimeter", target_scallop_mm=job.finishing.target_scallop_mm, step_over_mm=0.14), blank,
             contact_spacing_mm=0.08)
         ref = estimate(reference, machine)
-        from spur_cad.cam.finishing import space_poses
         poses = space_poses(spec, finishing_tool, job.finishing.target_scallop_mm)
         stations = station_positions(spec.face_width_mm, station_step_mm(finishing_tool, job.finishing))
         result["finishing"] = {"strategy": job.finishing.strategy,

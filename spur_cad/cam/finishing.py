@@ -23,7 +23,7 @@ import numpy as np
 from spur_cad.cam.ir import Feature, MoveKind, Operation, Toolpath, ToolpathBuilder, relative_path_lengths
 from spur_cad.cam.machine import FinishingParams, Machine
 from spur_cad.cam.tools import Tool, ToolError
-from spur_cad.geometry.sampling import segment_parameters
+from spur_cad.geometry.sampling import full_space_points, sample_profile, segment_parameters
 from spur_cad.geometry.spec import GearSpec
 
 PLUNGE_FEED_FRACTION = 0.5
@@ -169,8 +169,6 @@ def space_poses(spec: GearSpec, tool: Tool, scallop_mm: float,
 
 def _space_design_points(spec: GearSpec) -> np.ndarray:
     """Dense exact points of tooth space 0 (both halves, tip lands to the tooth centres)."""
-    from spur_cad.geometry.sampling import full_space_points, sample_profile
-
     return full_space_points(sample_profile(spec.tooth_space_profile(), 2e-5 * spec.module_mm))
 
 
