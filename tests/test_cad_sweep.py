@@ -6,19 +6,15 @@ from __future__ import annotations
 from hypothesis import HealthCheck, given, settings
 
 from spur_cad.cad.solid import build_gear_shape, solid_volume_mm3
-from spur_cad.errors import GearSpecError
-from spur_cad.geometry import GearSpec, gear_outline
+from spur_cad.geometry import gear_outline
 from spur_cad.geometry.sampling import polygon_area
-from tests.test_hypothesis_sweep import gear_parameters
+from tests.test_hypothesis_sweep import gear_parameters, spec_or_category
 
 
 def classify_solid(params: dict) -> tuple[str, str]:
-    params = dict(params)
-    params["rack_tip_radius_mm"] = params.pop("rack_tip_fraction") * params["module_mm"]
-    try:
-        spec = GearSpec(face_width_mm=5.0, **params)
-    except GearSpecError as exc:
-        return "rejected", str(exc)
+    spec = spec_or_category(params, 5.0)
+    if isinstance(spec, tuple):
+        return spec
     try:
         shape, _ = build_gear_shape(spec)
     except Exception as exc:  # noqa: BLE001 - the category is the point

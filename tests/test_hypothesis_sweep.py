@@ -25,16 +25,24 @@ gear_parameters = st.fixed_dictionaries({
 })
 
 
-def classify(params: dict) -> tuple[str, str]:
-    """('rejected', message) | ('valid', '') | ('crash', repr) | ('invalid outline', why)."""
+def spec_or_category(params: dict, face_width_mm: float) -> GearSpec | tuple[str, str]:
+    """The GearSpec for swept parameters (rack tip radius given as a fraction of the module), or
+    the failure category: ('rejected', message) or ('crash', repr)."""
     params = dict(params)
     params["rack_tip_radius_mm"] = params.pop("rack_tip_fraction") * params["module_mm"]
     try:
-        spec = GearSpec(face_width_mm=10.0, **params)
+        return GearSpec(face_width_mm=face_width_mm, **params)
     except GearSpecError as exc:
         return ("rejected", str(exc)) if str(exc) else ("crash", "empty GearSpecError message")
     except Exception as exc:  # noqa: BLE001 - the category is the point
         return "crash", f"{type(exc).__name__}: {exc}"
+
+
+def classify(params: dict) -> tuple[str, str]:
+    """('rejected', message) | ('valid', '') | ('crash', repr) | ('invalid outline', why)."""
+    spec = spec_or_category(params, 10.0)
+    if isinstance(spec, tuple):
+        return spec
     try:
         outline = gear_outline(spec, 2e-4 * spec.module_mm)
     except Exception as exc:  # noqa: BLE001
