@@ -14,10 +14,11 @@ from OCP.BRepAdaptor import BRepAdaptor_Curve
 from OCP.BRepAlgoAPI import BRepAlgoAPI_Section
 from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeFace, BRepBuilderAPI_MakeVertex
 from OCP.BRepCheck import BRepCheck_Analyzer
+from OCP.BRepClass3d import BRepClass3d_SolidClassifier
 from OCP.BRepExtrema import BRepExtrema_DistShapeShape
 from OCP.GeomAPI import GeomAPI_ProjectPointOnCurve
 from OCP.gp import gp_Dir, gp_Pln, gp_Pnt
-from OCP.TopAbs import TopAbs_EDGE, TopAbs_FACE, TopAbs_SHELL, TopAbs_SOLID
+from OCP.TopAbs import TopAbs_EDGE, TopAbs_FACE, TopAbs_OUT, TopAbs_SHELL, TopAbs_SOLID
 from OCP.TopExp import TopExp_Explorer
 from OCP.TopoDS import TopoDS
 
@@ -28,7 +29,7 @@ from spur_cad.cad.step import step_files
 from spur_cad.geometry import gear_outline, sample_profile
 from spur_cad.geometry.inspection import recommended_span_teeth, span_measurement
 from spur_cad.geometry.sampling import polygon_area
-from tests.gears import GEAR_CASES, spec_of
+from tests.gears import spec_of
 
 CAD_CASES = ["reference_z23_m4", "undercut_z8", "shifted_z12", "small_module_z30", "pa25_sharp_rack_z17",
              "big_shift_corner_above_rolling_line_z30"]
@@ -40,11 +41,6 @@ def _count(shape, kind) -> int:
         n += 1
         explorer.Next()
     return n
-
-
-def _to_gap(points_yz: np.ndarray) -> np.ndarray:
-    """Machine (Y, Z) -> gap frame (x, y): identical axes by construction of the frame."""
-    return points_yz
 
 
 def keyway_area_outside_bore(width: float, top: float, bore_radius: float) -> float:
@@ -79,12 +75,8 @@ def test_bore_and_keyway_remove_exactly_their_area():
             - keyway_area_outside_bore(8.0, 15.0 + 3.3, 15.0))
     assert solid_volume_mm3(shape) == pytest.approx(area * spec.face_width_mm, rel=1e-6)
     # The keyway is on the +Z side (under tooth space 0): a point there is outside the material.
-    probe = BRepExtrema_DistShapeShape(BRepBuilderAPI_MakeVertex(gp_Pnt(10.0, 0.0, 17.0)).Vertex(), shape)
-    from OCP.BRepClass3d import BRepClass3d_SolidClassifier
-    from OCP.TopAbs import TopAbs_OUT
     assert BRepClass3d_SolidClassifier(shape, gp_Pnt(10.0, 0.0, 17.0), 1e-7).State() == TopAbs_OUT
     assert BRepClass3d_SolidClassifier(shape, gp_Pnt(10.0, 0.0, -17.0), 1e-7).State() != TopAbs_OUT
-    assert probe.IsDone()
 
 
 @pytest.mark.parametrize("features, words", [
@@ -119,10 +111,11 @@ def test_mid_face_section_matches_exact_profile_within_1um(name):
     spec = spec_of(name)
     shape, _ = build_gear_shape(spec)
     section, section_points = _section_points(shape, spec.face_width_mm / 2)
-    # Section -> exact: distance of every section point to the dense exact outline (1e-7 mm polyline).
+    # Section -> exact: distance of every section point to the dense exact outline (1e-7 mm polyline);
+    # machine (Y, Z) and the gap frame's (x, y) are the same axes.
     ring = gear_outline(spec, 1e-7 * spec.module_mm)
     segments = shapely.linestrings(np.stack([ring, np.roll(ring, -1, axis=0)], axis=1))
-    _, forward = shapely.STRtree(segments).query_nearest(shapely.points(_to_gap(section_points)),
+    _, forward = shapely.STRtree(segments).query_nearest(shapely.points(section_points),
                                                          return_distance=True, all_matches=False)
     assert forward.max() < 1e-3 + 1e-7 * spec.module_mm
     # Exact -> section: dense exact samples of three spaces, distance to the section edges by OCP's
