@@ -17,7 +17,6 @@ from pathlib import Path
 import numpy as np
 
 from spur_cad import __version__
-from spur_cad.cam.tools import ToolError
 from spur_cad.errors import SpurCadError
 from spur_cad.geometry.inspection import inspection_sheet
 from spur_cad.geometry.sampling import ProfileSamples, sample_profile
@@ -108,7 +107,7 @@ def build_cam(job: Job) -> dict:
     from spur_cad.cam.estimate import estimate
     from spur_cad.cam.finishing import finishing_toolpath, space_poses, station_positions, station_step_mm
     from spur_cad.cam.machine import FinishingParams, check_travel
-    from spur_cad.cam.recommend import check_tools, recommend_tools
+    from spur_cad.cam.recommend import check_roughing_reach, check_tools, recommend_tools
     from spur_cad.cam.roughing import roughing_levels, roughing_toolpath
 
     spec, machine, stock = job.gear, job.machine, job.stock
@@ -123,10 +122,8 @@ def build_cam(job: Job) -> dict:
     if roughing_tool is not None:
         levels = roughing_levels(spec, roughing_tool, job.roughing, blank)
         lowest_above_root = levels.lowest_height_mm - spec.root_radius_mm
-        if finishing_tool is not None and lowest_above_root > rec.plunge_allowance_mm + 1e-9:
-            raise ToolError(f"roughing tool diameter {roughing_tool.diameter_mm:g} mm leaves {lowest_above_root:.3f} mm "
-                            f"above the root, more than the finishing tool can plunge (A_p = "
-                            f"{rec.plunge_allowance_mm:.3f} mm); use a smaller roughing tool")
+        if finishing_tool is not None:
+            check_roughing_reach(roughing_tool, lowest_above_root, rec)
         path = roughing_toolpath(spec, roughing_tool, machine, job.roughing, blank, stock.back_margin_mm,
                                  stock.stub_diameter_mm / 2.0, stock.front_margin_mm)
         check_travel(machine, path.x, path.y, path.z, path.a, "roughing")

@@ -184,3 +184,22 @@ def test_travel_limits_name_the_axis():
     with pytest.raises(MachineError, match=r"finishing needs A = -3"):
         check_travel(limited, path.x, path.y, path.z, path.a, "finishing")
     check_travel(Machine(), path.x, path.y, path.z, path.a, "finishing")  # generous defaults pass
+
+
+def test_roughing_that_leaves_too_much_above_the_root_is_an_error():
+    """A roughing tool at the diameter limit still leaves a little more than A_p once the finish
+    stock is added; the reach check names A_p."""
+    from spur_cad.cam.recommend import check_roughing_reach
+
+    spec = spec_of("reference_z23_m4")
+    finishing = Tool(diameter_mm=2.0, kind="bull_nose", corner_radius_mm=0.5)
+    rec = recommend_tools(spec, 50.5, 1.0, finishing)
+    at_limit = Tool(diameter_mm=rec.roughing_max_diameter_mm, flutes=3)
+    levels = roughing_levels(spec, at_limit, RoughingParams(finish_stock_mm=0.05), 50.5)
+    leftover = levels.lowest_height_mm - spec.root_radius_mm
+    assert leftover > rec.plunge_allowance_mm
+    with pytest.raises(ToolError, match=r"more than the finishing tool can plunge \(A_p = 0.500 mm\)"):
+        check_roughing_reach(at_limit, leftover, rec)
+    small = Tool(diameter_mm=3.0, flutes=3)
+    check_roughing_reach(small, roughing_levels(spec, small, RoughingParams(), 50.5).lowest_height_mm
+                         - spec.root_radius_mm, rec)

@@ -99,6 +99,15 @@ def check_tools(spec: GearSpec, recommendations: ToolRecommendations, roughing: 
         _check_lengths(roughing, "roughing", rec)
 
 
+def check_roughing_reach(roughing: Tool, lowest_level_above_root_mm: float, rec: ToolRecommendations) -> None:
+    """The material roughing leaves above the root must be within the finishing tool's plunge
+    capacity A_p (METHOD.md 3); raise ToolError otherwise."""
+    if lowest_level_above_root_mm > rec.plunge_allowance_mm + 1e-9:
+        raise ToolError(f"roughing tool diameter {roughing.diameter_mm:g} mm leaves {lowest_level_above_root_mm:.3f} mm "
+                        f"above the root, more than the finishing tool can plunge (A_p = "
+                        f"{rec.plunge_allowance_mm:.3f} mm); use a smaller roughing tool")
+
+
 def _check_lengths(tool: Tool, role: str, rec: ToolRecommendations) -> None:
     if tool.flute_length_mm and tool.flute_length_mm < rec.required_flute_length_mm:
         raise ToolError(f"{role} tool flute_length_mm = {tool.flute_length_mm:g} is shorter than the "
