@@ -8,160 +8,17 @@ and exits 3.
 from __future__ import annotations
 
 import argparse
-import io
-import json
 import sys
-import time
 from pathlib import Path
-
-import numpy as np
 
 from spur_cad import __version__
 from spur_cad.errors import SpurCadError
-from spur_cad.geometry.inspection import inspection_sheet
-from spur_cad.geometry.sampling import ProfileSamples, sample_profile
-from spur_cad.job import Job, load_job
+from spur_cad.job import load_job
 from spur_cad.outputs import write_files_atomically
+from spur_cad.pipeline import run_job
 
 EXIT_INPUT_ERROR = 2
 EXIT_INTERNAL_ERROR = 3
-
-
-def profile_csv(samples: ProfileSamples) -> bytes:
-    """Right half of one tooth space, root (x = 0) to tip, header x_mm,y_mm."""
-    buffer = io.StringIO()
-    buffer.write("x_mm,y_mm\n")
-    np.savetxt(buffer, samples.points, fmt="%.9f", delimiter=",")
-    return buffer.getvalue().encode()
-
-
-def build_summary(job: Job, samples: ProfileSamples, cad: dict, cam: dict, seconds: dict[str, float]) -> dict:
-    """summary.json content: gear data, inspection sheet, profile sampling facts, CAD and CAM facts, timings."""
-    counts = {name: int(np.count_nonzero(np.array(samples.label_names()) == name))
-              for name in ("root", "fillet", "involute", "tip")}
-    return {
-        "spur_cad_version": __version__,
-        "job": {"name": job.job.name, "file": job.source},
-        "gear": job.gear.describe(),
-        "inspection": inspection_sheet(job.gear),
-        "profile": {"tolerance_mm": job.job.profile_tolerance_mm, "points": len(samples),
-                    "points_per_segment": counts},
-        "cad": cad,
-        **cam,
-        "timings_s": seconds,
-    }
-
-
-def run_job(job: Job) -> dict[str, bytes]:
-    """Compute every output of the job in memory (no file I/O)."""
-    from spur_cad.report.plots import tooth_space_png
-
-    seconds: dict[str, float] = {}
-    start = time.perf_counter()
-    samples = sample_profile(job.gear.tooth_space_profile(), job.job.profile_tolerance_mm)
-    seconds["profile"] = time.perf_counter() - start
-    start = time.perf_counter()
-    png = tooth_space_png(job.gear, samples)
-    seconds["plot"] = time.perf_counter() - start
-    start = time.perf_counter()
-    cad, step = build_cad(job)
-    seconds["cad_and_step"] = time.perf_counter() - start
-    start = time.perf_counter()
-    cam = build_cam(job)
-    seconds["cam"] = time.perf_counter() - start
-    summary = build_summary(job, samples, cad, cam, seconds)
-    return {
-        "profile.csv": profile_csv(samples),
-        "profile.png": png,
-        **step,
-        "summary.json": (json.dumps(summary, indent=2, sort_keys=False) + "\n").encode(),
-    }
-
-
-def build_cad(job: Job) -> tuple[dict, dict[str, bytes]]:
-    """Gear solid, stock and STEP files; returns (summary facts, files)."""
-    import cadquery as cq
-
-    from spur_cad.cad.solid import build_gear_shape, make_stock, solid_volume_mm3
-    from spur_cad.cad.step import step_files
-
-    shape, report = build_gear_shape(job.gear, job.gear_section.blank_features())
-    gear = cq.Workplane("YZ").add(cq.Solid(shape))
-    stock = make_stock(job.gear, job.stock)
-    files = step_files(gear, stock)
-    facts = {
-        "fit_tolerance_mm": report.fit_tolerance_mm,
-        "fillet_max_deviation_mm": report.fillet_max_deviation_mm,
-        "involute_max_deviation_mm": report.involute_max_deviation_mm,
-        "fillet_spline_poles": report.fillet_poles,
-        "involute_spline_poles": report.involute_poles,
-        "gear_volume_mm3": solid_volume_mm3(shape),
-        "stock_volume_mm3": solid_volume_mm3(stock.val().wrapped),
-        "step_bytes": {name: len(content) for name, content in files.items()},
-    }
-    return facts, files
-
-
-def build_cam(job: Job) -> dict:
-    """Tool recommendations always; toolpaths and estimates for the tools the job gives."""
-    from spur_cad.cam.estimate import estimate
-    from spur_cad.cam.finishing import finishing_toolpath, space_poses, station_positions, station_step_mm
-    from spur_cad.cam.machine import FinishingParams, check_travel
-    from spur_cad.cam.recommend import check_roughing_reach, check_tools, recommend_tools
-    from spur_cad.cam.roughing import roughing_levels, roughing_toolpath
-
-    spec, machine, stock = job.gear, job.machine, job.stock
-    blank = stock.blank_radius_mm(spec)
-    finishing_tool, roughing_tool = job.tools.finishing, job.tools.roughing
-    rec = recommend_tools(spec, blank, machine.clearance_mm, finishing_tool)
-    check_tools(spec, rec, roughing_tool, finishing_tool)
-    result: dict = {"tools": {**rec.as_dict(),
-                              "roughing": _tool_facts(roughing_tool, machine),
-                              "finishing": _tool_facts(finishing_tool, machine)}}
-    warnings: list[str] = []
-    if roughing_tool is not None:
-        levels = roughing_levels(spec, roughing_tool, job.roughing, blank)
-        lowest_above_root = levels.lowest_height_mm - spec.root_radius_mm
-        if finishing_tool is not None:
-            check_roughing_reach(roughing_tool, lowest_above_root, rec)
-        path = roughing_toolpath(spec, roughing_tool, machine, job.roughing, blank, stock.back_margin_mm,
-                                 stock.stub_diameter_mm / 2.0, stock.front_margin_mm)
-        check_travel(machine, path.x, path.y, path.z, path.a, "roughing")
-        est = estimate(path, machine)
-        result["roughing"] = {"levels_per_space": int(len(levels.heights_mm)),
-                              "lowest_level_height_mm": lowest_above_root,
-                              "level_heights_mm": [float(h) for h in levels.heights_mm],
-                              "moves": est.moves, "cutting_length_mm": est.cutting_length_mm,
-                              "rapid_length_mm": est.rapid_length_mm, "estimated_time_s": est.time_s}
-        warnings.extend(path.warnings)
-    if finishing_tool is not None:
-        path = finishing_toolpath(spec, finishing_tool, machine, job.finishing, blank)
-        check_travel(machine, path.x, path.y, path.z, path.a, "finishing")
-        est = estimate(path, machine)
-        reference = finishing_toolpath(spec, finishing_tool, machine, FinishingParams(
-            strategy="perimeter", target_scallop_mm=job.finishing.target_scallop_mm, step_over_mm=0.14), blank,
-            contact_spacing_mm=0.08)
-        ref = estimate(reference, machine)
-        poses = space_poses(spec, finishing_tool, job.finishing.target_scallop_mm)
-        stations = station_positions(spec.face_width_mm, station_step_mm(finishing_tool, job.finishing))
-        result["finishing"] = {"strategy": job.finishing.strategy,
-                               "stations": int(len(stations)) if job.finishing.strategy == "perimeter" else 1,
-                               "station_step_mm": float(stations[1] - stations[0]) if len(stations) > 1 else 0.0,
-                               "points_per_flank": poses.points_per_flank,
-                               "moves": est.moves, "cutting_length_mm": est.cutting_length_mm,
-                               "rapid_length_mm": est.rapid_length_mm, "estimated_time_s": est.time_s,
-                               "reference_strategy_moves": ref.moves, "reference_strategy_time_s": ref.time_s}
-        warnings.extend(path.warnings)
-    result["warnings"] = warnings
-    return result
-
-
-def _tool_facts(tool, machine) -> dict | None:
-    if tool is None:
-        return None
-    return {"kind": tool.kind, "diameter_mm": tool.diameter_mm, "corner_radius_mm": tool.corner_radius,
-            "flat_width_mm": tool.flat_width_mm, "spindle_rpm": tool.spindle_rpm(machine),
-            "feed_mm_min": tool.feed_mm_min(machine)}
 
 
 def _parser() -> argparse.ArgumentParser:
