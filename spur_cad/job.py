@@ -180,6 +180,21 @@ def parse_job(text: str, source: str = "<job>") -> Job:
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
         raise JobFileError(f"{source}: not valid TOML: {exc}") from None
+    return _job_from_data(data, source, text)
+
+
+def job_from_dict(data: dict, source: str) -> Job:
+    """Validate a job given as nested dicts (the TOML structure), e.g. built by the FreeCAD workbench.
+
+    Same checks and messages as parse_job, without line numbers (`source` names the origin).
+    """
+    return _job_from_data(data, source, "")
+
+
+def _job_from_data(data: dict, source: str, text: str) -> Job:
+    """Validate parsed job data; `text` (the file's text, or "") only locates keys for messages."""
+    if not isinstance(data, dict):
+        raise JobFileError(f"{source}: a job must be a table of sections")
     allowed = sorted(list(_SECTIONS) + ["tools"])
     for name in data:
         if name not in _SECTIONS and name != "tools":
