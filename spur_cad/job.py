@@ -20,6 +20,7 @@ from spur_cad.cam.machine import FinishingParams, Machine, RoughingParams
 from spur_cad.cam.tools import Tool
 from spur_cad.errors import GearSpecError, JobFileError, SpurCadError
 from spur_cad.geometry.spec import GearSpec
+from spur_cad.post.settings import PostSettings
 
 REQUIRED = object()  # marker default for keys the file must give
 
@@ -65,18 +66,6 @@ class GearSection:
 
 
 @dataclass(frozen=True)
-class PostSection:
-    """[post]: G-code dialect and formatting."""
-
-    dialect: str = "linuxcnc"
-    line_numbers: bool = False
-    max_line_number: int = 99999
-    folded: bool = True
-    rotary_sign: int = 1
-    program_number: int = 1000
-
-
-@dataclass(frozen=True)
 class ToolsSection:
     """[tools]: the roughing and finishing tools (without them the job stops after the CAD stage)."""
 
@@ -97,7 +86,7 @@ class Job:
     roughing: RoughingParams = field(default_factory=RoughingParams)
     finishing: FinishingParams = field(default_factory=FinishingParams)
     machine: Machine = field(default_factory=Machine)
-    post: PostSection = field(default_factory=PostSection)
+    post: PostSettings = field(default_factory=PostSettings)
 
 
 _SECTIONS: dict[str, type] = {
@@ -107,7 +96,7 @@ _SECTIONS: dict[str, type] = {
     "roughing": RoughingParams,
     "finishing": FinishingParams,
     "machine": Machine,
-    "post": PostSection,
+    "post": PostSettings,
 }
 _TOOL_SECTIONS = ("roughing", "finishing")
 
@@ -229,7 +218,7 @@ def _job_from_data(data: dict, source: str, text: str) -> Job:
         except GearSpecError as exc:
             raise JobFileError(f"{_where(source, text, table, exc.field)}: invalid [{table}]: {exc}") from None
     for name, check in (("machine", lambda m: m.validate()), ("roughing", lambda r: r.validate()),
-                        ("finishing", lambda f: f.validate())):
+                        ("finishing", lambda f: f.validate()), ("post", lambda p: p.validate())):
         if name in sections:
             try:
                 check(sections[name])

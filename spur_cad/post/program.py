@@ -1,0 +1,327 @@
+"""The post: a toolpath (IR) in, the text of one G-code program out (no file I/O).
+
+One data-driven post serves every dialect (dialects.py). Coordinates are rounded to integer
+units of each axis's last digit. A is written as the run's base angle plus the angle relative
+to it, each rounded, so a flat program and its folded twin command exactly the same numbers
+(error to the exact pose <= one unit of the last digit).
+
+Folding: the IR is cut into runs of consecutive moves on one tooth space (`Toolpath.space`).
+Runs whose text, written relative to their X and A base, is identical become one subprogram
+(or repeat section) called once per run with that base; other runs are written inline.
+"""
+
+from __future__ import annotations
+
+import functools
+from dataclasses import dataclass
+
+import numpy as np
+
+from spur_cad.cam.ir import MoveKind, Toolpath
+from spur_cad.post.dialects import Dialect, dialect
+from spur_cad.post.settings import PostError, PostSettings
+
+
+@dataclass(frozen=True)
+class ProgramInfo:
+    """What the header says and the machine codes the body needs."""
+
+    title: str  # e.g. "spur_cad finishing"
+    comments: tuple[str, ...]  # gear data, tool, strategy, estimated time
+    rotary_clamp_code: str = ""
+    rotary_unclamp_code: str = ""
+
+
+@dataclass(frozen=True)
+class PostedProgram:
+    text: str
+    extension: str
+    lines: int
+    bytes: int
+    subprograms: int
+    calls: int
+
+
+@dataclass(frozen=True)
+class _Run:
+    start: int
+    stop: int
+    x_base: int | None  # X in units when every move of the run has the same X, else None
+    a_base: int  # A of the run's first move, in units (rotary sign applied)
+
+
+def post_program(path: Toolpath, settings: PostSettings, info: ProgramInfo) -> PostedProgram:
+    """Write `path` as one program in the settings' dialect."""
+    settings.validate()
+    d = dialect(settings.dialect)
+    if len(path) == 0:
+        raise PostError(f"{info.title}: the toolpath is empty")
+    if settings.rotary_mode == "wrapped" and d.direction_codes is None:
+        _check_shortest_path(path)
+    lin, rot = 10 ** d.linear_decimals, 10 ** d.rotary_decimals
+    x = np.rint(path.x * lin).astype(np.int64)
+    y = np.rint(path.y * lin).astype(np.int64)
+    z = np.rint(path.z * lin).astype(np.int64)
+    a_signed = settings.rotary_sign * path.a
+    feed = _program_feeds(path, d, settings.rotary_sign)
+    runs = _runs(path, x, a_signed, rot)
+    columns = _Columns(path.kind, x, y, z, a_signed, path.inverse_time, feed, rot)
+    writer = _Writer(d, settings, info, columns, path.tool_number, int(round(path.spindle_rpm)))
+
+    body: list[tuple[str, object]] = []  # ("lines", [...]) or ("call", (sub index, run))
+    sub_bodies: list[list[str]] = []
+    if settings.folded:
+        keys = [writer.run_key(run) if path.space[run.start] >= 0 else None for run in runs]
+        counts: dict[bytes, int] = {}
+        for key in keys:
+            if key is not None:
+                counts[key] = counts.get(key, 0) + 1
+        subs: dict[bytes, int] = {}
+        for run, key in zip(runs, keys):
+            if key is not None and counts[key] > 1:
+                if key not in subs:
+                    subs[key] = len(sub_bodies)
+                    sub_bodies.append(writer.run_lines(run, folded=True))
+                body.append(("call", (subs[key], run)))
+            else:
+                body.append(("lines", writer.run_lines(run, folded=False)))
+    else:
+        body = [("lines", writer.run_lines(run, folded=False)) for run in runs]
+    text = writer.program(body, sub_bodies)
+    return PostedProgram(text=text, extension=d.extension, lines=text.count("\n"), bytes=len(text.encode()),
+                         subprograms=len(sub_bodies), calls=sum(1 for kind, _ in body if kind == "call"))
+
+
+def _check_shortest_path(path: Toolpath) -> None:
+    moves = path.kind <= MoveKind.LINEAR
+    steps = np.abs(np.diff(path.a[moves]))
+    if len(steps) and steps.max() >= 180.0:
+        raise PostError(f"rotary_mode = 'wrapped': an A move of {steps.max():.3f} deg is not the shortest way "
+                        "round, and this dialect has no direction codes; use rotary_mode = 'unwound'")
+
+
+def _program_feeds(path: Toolpath, d: Dialect, rotary_sign: int) -> np.ndarray:
+    """F per move: mm/min, or 1/min under G93. Without G93, the controller is taken to read F on a
+    simultaneous move as the rate along sqrt(dX^2+dY^2+dZ^2+dA^2) (A in degrees), so F is that
+    length times the intended 1/time."""
+    feed = path.feed.copy()
+    if d.inverse_time or not path.inverse_time.any():
+        return feed
+    prev = lambda v: np.concatenate([v[:1], v[:-1]])  # noqa: E731 - start pose of each move
+    length = np.sqrt((path.x - prev(path.x)) ** 2 + (path.y - prev(path.y)) ** 2 + (path.z - prev(path.z)) ** 2
+                     + (path.a - prev(path.a)) ** 2)
+    return np.where(path.inverse_time, length * path.feed, feed)
+
+
+def _runs(path: Toolpath, x: np.ndarray, a_signed: np.ndarray, rot: int) -> list[_Run]:
+    """Maximal runs of consecutive moves on one tooth space (moves on no space form their own runs)."""
+    space = path.space
+    cuts = np.flatnonzero(np.diff(space) != 0) + 1
+    bounds = np.concatenate([[0], cuts, [len(space)]])
+    runs = []
+    for start, stop in zip(bounds[:-1], bounds[1:]):
+        xs = x[start:stop]
+        x_base = int(xs[0]) if np.all(xs == xs[0]) else None
+        runs.append(_Run(int(start), int(stop), x_base, int(round(a_signed[start] * rot))))
+    return runs
+
+
+@dataclass(frozen=True)
+class _Columns:
+    kind: np.ndarray
+    x: np.ndarray
+    y: np.ndarray
+    z: np.ndarray
+    a: np.ndarray  # degrees, rotary sign applied
+    inverse: np.ndarray
+    feed: np.ndarray
+    rot: int
+
+
+@functools.lru_cache(maxsize=1 << 16)
+def _number(units: int, decimals: int) -> str:
+    """Integer units of 10^-decimals as a decimal with at least one digit after the point."""
+    sign = "-" if units < 0 else ""
+    whole, frac = divmod(abs(units), 10 ** decimals)
+    digits = f"{frac:0{decimals}d}".rstrip("0") or "0"
+    return f"{sign}{whole}.{digits}"
+
+
+class _Writer:
+    """Writes runs and the program frame for one dialect (holds no state between calls)."""
+
+    def __init__(self, d: Dialect, settings: PostSettings, info: ProgramInfo, c: _Columns, tool: int, rpm: int):
+        self.d, self.settings, self.info, self.c = d, settings, info, c
+        self.tool, self.rpm = tool, rpm
+
+    def comment(self, text: str) -> str:
+        text = text.replace("(", "[").replace(")", "]").replace(";", ",")
+        if self.d.uppercase_comments:
+            text = text.upper()
+        return f"({text})" if self.d.comment_style == "paren" else f"; {text}"
+
+    def run_key(self, run: _Run) -> bytes:
+        """Everything a run's folded text depends on, as bytes: equal keys give equal subprogram text."""
+        c, sl = self.c, slice(run.start, run.stop)
+        a_rel = np.rint((c.a[sl] - c.a[run.start]) * c.rot).astype(np.int64)
+        x = c.x[sl] - run.x_base if run.x_base is not None else c.x[sl]
+        decimals = np.where(c.inverse[sl] & self.d.inverse_time, self.d.inverse_feed_decimals, self.d.feed_decimals)
+        feed = np.rint(np.nan_to_num(c.feed[sl]) * 10.0 ** decimals).astype(np.int64)
+        flag = b"x" if run.x_base is not None else b"-"
+        return b"".join([flag, c.kind[sl].tobytes(), x.tobytes(), c.y[sl].tobytes(), c.z[sl].tobytes(),
+                         a_rel.tobytes(), c.inverse[sl].tobytes(), feed.tobytes()])
+
+    def run_lines(self, run: _Run, *, folded: bool) -> list[str]:
+        """One run's blocks; folded: X and A written relative to the dialect's base parameters."""
+        d, c = self.d, self.c
+        lin_dec, rot_dec, rot = d.linear_decimals, d.rotary_decimals, c.rot
+        wrapped = self.settings.rotary_mode == "wrapped"
+        lines: list[str] = []
+        motion = feed_mode = None
+        last_f = last_x = last_y = last_z = last_a = None
+        last_a_exact = None
+        sl = slice(run.start, run.stop)
+        a_rels = np.rint((c.a[sl] - c.a[run.start]) * rot).astype(np.int64).tolist()
+        rows = zip(range(run.start, run.stop), c.kind[sl].tolist(), c.x[sl].tolist(), c.y[sl].tolist(),
+                   c.z[sl].tolist(), a_rels, c.a[sl].tolist(), c.inverse[sl].tolist(), c.feed[sl].tolist())
+        for i, kind, x, y, z, a_rel, a_exact, inverse_move, feed in rows:
+            if kind == MoveKind.CLAMP_ROTARY or kind == MoveKind.UNCLAMP_ROTARY:
+                code = self.info.rotary_clamp_code if kind == MoveKind.CLAMP_ROTARY else self.info.rotary_unclamp_code
+                if code:
+                    lines.append(code)
+                continue
+            words: list[str] = []
+            if x != last_x:
+                words.append(d.param_word.format(address="X", param=d.x_param)
+                             if folded and run.x_base is not None else "X" + _number(x, lin_dec))
+            if y != last_y:
+                words.append("Y" + _number(y, lin_dec))
+            if z != last_z:
+                words.append("Z" + _number(z, lin_dec))
+            direction = None
+            if a_rel != last_a:
+                if folded:
+                    words.append(d.param_word.format(address="A", param=d.a_param) if a_rel == 0 else
+                                 d.param_offset_word.format(address="A", param=d.a_param,
+                                                            offset=("+" if a_rel > 0 else "") + _number(a_rel, rot_dec)))
+                else:
+                    total = run.a_base + a_rel
+                    words.append("A" + _number(total % (360 * rot) if wrapped else total, rot_dec))
+                    if wrapped and d.direction_codes and last_a_exact is not None:
+                        direction = d.direction_codes[0] if a_exact > last_a_exact else d.direction_codes[1]
+            if not words:
+                continue  # nothing moves at the output's precision
+            last_x, last_y, last_z, last_a, last_a_exact = x, y, z, a_rel, a_exact
+            head: list[str] = []
+            if kind == MoveKind.RAPID:
+                if motion != "G0":
+                    head.append("G0")
+                    motion = "G0"
+            else:
+                inverse = inverse_move and d.inverse_time
+                mode = "G93" if inverse else "G94"
+                if mode != feed_mode:
+                    head.append(mode)
+                    feed_mode = mode
+                    last_f = None
+                if motion != "G1":
+                    head.append("G1")
+                    motion = "G1"
+                decimals = d.inverse_feed_decimals if inverse else d.feed_decimals
+                if not feed > 0.0:
+                    raise PostError(f"{self.info.title}: move {i} has no usable feed ({feed!r})")
+                f = int(round(feed * 10 ** decimals))
+                if inverse or f != last_f:  # G93 needs F in every feed block
+                    words.append("F" + _number(f, decimals))
+                    last_f = f
+            if direction:
+                words.append(direction)
+            lines.append(" ".join(head + words))
+        if feed_mode == "G93":
+            lines.append("G94")
+        return lines
+
+    def program(self, body: list[tuple[str, object]], sub_bodies: list[list[str]]) -> str:
+        d, s, info = self.d, self.settings, self.info
+        sub_ids = self._sub_ids(len(sub_bodies))
+        lin_dec, rot_dec = d.linear_decimals, d.rotary_decimals
+
+        def call_lines(index: int, run: _Run) -> list[str]:
+            x = _number(run.x_base if run.x_base is not None else 0, lin_dec)
+            a = _number(run.a_base, rot_dec)
+            return [line.format(sub=sub_ids[index], x=x, a=a) for line in d.call]
+
+        head: list[str] = ["%"] if d.percent_delimited else []
+        if d.program_start:
+            head.append(d.program_start.format(number=s.program_number, title=self._title()))
+        head += [self.comment(line) for line in (info.title, *info.comments)]
+        definitions: list[str] = []
+        if not d.subprograms_after_end and d.fold_style != "repeat":
+            for index, lines in enumerate(sub_bodies):
+                definitions += [d.sub_start.format(sub=sub_ids[index]), *lines,
+                                d.sub_end.format(sub=sub_ids[index])]
+        main = [d.setup, *[t.format(tool=self.tool) for t in d.tool_change],
+                d.spindle_on.format(rpm=self.rpm)]
+        if s.coolant:
+            main.append(d.coolant_on)
+        written: set[int] = set()
+        for kind, item in body:
+            if kind == "lines":
+                main += item
+                continue
+            index, run = item
+            if d.fold_style == "repeat" and index not in written:  # first use: the section itself, labelled
+                written.add(index)
+                main += [d.call[0].format(x=_number(run.x_base or 0, lin_dec), a=_number(run.a_base, rot_dec)),
+                         d.sub_start.format(sub=sub_ids[index]), *sub_bodies[index],
+                         d.sub_end.format(sub=sub_ids[index])]
+            else:
+                main += call_lines(index, run)
+        if s.coolant:
+            main.append(d.coolant_off)
+        main += [d.spindle_off, d.program_end]
+        tail: list[str] = []
+        if d.subprograms_after_end:
+            for index, lines in enumerate(sub_bodies):
+                tail += [d.sub_start.format(sub=sub_ids[index]), *lines, d.sub_end.format(sub=sub_ids[index])]
+        if d.percent_delimited:
+            tail.append("%")
+        lines = head + definitions + main + tail
+        if s.line_numbers:
+            lines = self._numbered(lines, min(sub_ids) - 1 if d.fold_style == "local_sub" and sub_ids
+                                   else s.max_line_number)
+        return "\n".join(lines) + "\n"
+
+    def _title(self) -> str:
+        return self.comment(self.info.title)[1:-1] if self.d.comment_style == "paren" else self.info.title
+
+    def _sub_ids(self, count: int) -> list[int]:
+        """Subprogram numbers: after the program number; Haas labels (N numbers) at the top of the range."""
+        if self.d.fold_style == "local_sub":
+            top = self.settings.max_line_number
+            return [top - count + 1 + i for i in range(count)]
+        first = self.settings.program_number + 1
+        if count and first + count - 1 > 9999:
+            raise PostError(f"[post] program_number = {self.settings.program_number}: {count} subprograms "
+                            "would be numbered past 9999; choose a lower program_number")
+        return [first + i for i in range(count)]
+
+    def _numbered(self, lines: list[str], limit: int) -> list[str]:
+        """N words on every block that may carry one, never past `limit`."""
+        step, overflow = self.settings.line_number_step, self.settings.line_number_overflow
+        if limit < step:
+            raise PostError(f"[post] max_line_number = {self.settings.max_line_number} leaves no block numbers "
+                            "below the subprogram labels")
+        out, n, numbering = [], step, True
+        for line in lines:
+            first = line[:1]
+            if not numbering or first in ("%", "(", ";", "O", "o", "N", "#") or line.endswith(":"):
+                out.append(line)
+                continue
+            out.append(f"N{n} {line}")
+            n += step
+            if n > limit:
+                if overflow == "stop":
+                    numbering = False
+                n = step
+        return out
