@@ -74,13 +74,63 @@ def run_job(job: Job) -> dict[str, bytes]:
     start = time.perf_counter()
     plan = plan_cam(job)
     seconds["cam"] = time.perf_counter() - start
-    summary = build_summary(job, samples, cad, plan.facts, seconds)
+    start = time.perf_counter()
+    post, programs = build_programs(job, plan)
+    seconds["post"] = time.perf_counter() - start
+    summary = build_summary(job, samples, cad, {**plan.facts, "post": post}, seconds)
     return {
         "profile.csv": profile_csv(samples),
         "profile.png": png,
         **step,
+        **programs,
         "summary.json": (json.dumps(summary, indent=2, sort_keys=False) + "\n").encode(),
     }
+
+
+def build_programs(job: Job, plan: CamPlan) -> tuple[dict, dict[str, bytes]]:
+    """G-code for each toolpath the plan has (roughing.<ext>, finishing.<ext>); returns (summary facts, files)."""
+    from spur_cad.post import ProgramInfo, dialect, post_program
+
+    settings = job.post
+    facts: dict = {"dialect": settings.dialect, "folded": settings.folded}
+    files: dict[str, bytes] = {}
+    for name, path in (("roughing", plan.roughing), ("finishing", plan.finishing)):
+        if path is None:
+            continue
+        info = ProgramInfo(title=f"spur_cad {__version__} {name}: {job.job.name}",
+                           comments=program_comments(job, plan, name),
+                           rotary_clamp_code=job.machine.rotary_clamp_code,
+                           rotary_unclamp_code=job.machine.rotary_unclamp_code)
+        program = post_program(path, settings, info)
+        files[f"{name}.{dialect(settings.dialect).extension}"] = program.text.encode()
+        facts[f"{name}_lines"] = program.lines
+        facts[f"{name}_bytes"] = program.bytes
+        facts[f"{name}_subprograms"] = program.subprograms
+    return facts, files
+
+
+def program_comments(job: Job, plan: CamPlan, operation: str) -> tuple[str, ...]:
+    """Header comments of a program: gear data, tool, strategy, estimated time (no date: outputs are reproducible)."""
+    spec = job.gear
+    tool = job.tools.roughing if operation == "roughing" else job.tools.finishing
+    facts = plan.facts[operation]
+    if operation == "roughing":
+        strategy = (f"strategy: {facts['levels_per_space']} levels per space, flank allowance "
+                    f"{job.roughing.flank_allowance_mm:g} mm")
+    else:
+        strategy = (f"strategy: {facts['strategy']}, {facts['stations']} stations, {facts['points_per_flank']} "
+                    f"contacts per flank, target scallop {job.finishing.target_scallop_mm * 1000:g} um")
+    minutes = facts["estimated_time_s"] / 60.0
+    return (
+        f"gear: z = {spec.teeth}, m = {spec.module_mm:g} mm, alpha = {spec.pressure_angle_deg:g} deg, "
+        f"x = {spec.profile_shift_coefficient:g}, b = {spec.face_width_mm:g} mm, rho = {spec.rack_tip_radius_mm:g} mm",
+        f"radii: tip {spec.tip_radius_mm:.4f} mm, root {spec.root_radius_mm:.4f} mm",
+        f"tool T{tool.tool_number}: {tool.kind} D {tool.diameter_mm:g} mm, corner radius {tool.corner_radius:g} mm, "
+        f"S {tool.spindle_rpm(job.machine):.0f} rpm, F {tool.feed_mm_min(job.machine):.0f} mm/min",
+        strategy,
+        f"estimated time: {minutes:.1f} min ({facts['moves']} moves)",
+        "frame: X = gear axis (front face X0), Y0 Z0 on the A axis, tool tip centre programmed",
+    )
 
 
 def build_cad(job: Job) -> tuple[dict, dict[str, bytes]]:

@@ -30,8 +30,8 @@ def test_reference_job_writes_profile_summary_and_plot(tmp_path):
     out = tmp_path / "out"
     result = run_cli("run", str(REFERENCE_JOB), "--out", str(out))
     assert result.returncode == 0, result.stderr
-    assert {p.name for p in out.iterdir()} == {"profile.csv", "profile.png", "summary.json", "gear.step",
-                                               "stock.step", "job.step"}
+    assert {p.name for p in out.iterdir()} >= {"profile.csv", "profile.png", "summary.json", "gear.step",
+                                               "stock.step", "job.step", "roughing.ngc", "finishing.ngc"}
     summary = json.loads((out / "summary.json").read_text())
     gear, inspection = summary["gear"], summary["inspection"]
     assert gear["reference_radius_mm"] == pytest.approx(46.0)
@@ -67,6 +67,12 @@ def test_reference_job_writes_profile_summary_and_plot(tmp_path):
     assert finishing["stations"] >= 2 and finishing["points_per_flank"] > 10
     assert finishing["reference_strategy_moves"] > finishing["moves"] > 0
     assert finishing["reference_strategy_time_s"] > 0
+    post = summary["post"]
+    assert post["dialect"] == "linuxcnc"
+    for name in ("roughing", "finishing"):
+        text = (out / f"{name}.ngc").read_text()
+        assert post[f"{name}_lines"] == text.count("\n") and text.rstrip().endswith("M30")
+    assert post["finishing_bytes"] == (out / "finishing.ngc").stat().st_size
     assert "wrote" in result.stdout
 
 
@@ -92,6 +98,11 @@ BAD_JOBS = {
                                 "finishing tool flat width 2.0000 mm (D - 2 r_t) exceeds finishing_max_flat_width_mm"),
     "unknown strategy": ("[gear]\nteeth = 23\nmodule_mm = 4.0\nface_width_mm = 20\n[finishing]\nstrategy = 'spiral'\n",
                          "bad.toml:5: [finishing] strategy 'spiral' is unknown"),
+    "unknown post dialect": ("[gear]\nteeth = 23\nmodule_mm = 4.0\nface_width_mm = 20\n[post]\ndialect = 'heidenhain'\n",
+                             "bad.toml:5: [post] dialect = 'heidenhain' is not known (known: linuxcnc, fanuc, haas, "
+                             "siemens, okuma)"),
+    "folded wrapped program": ("[gear]\nteeth = 23\nmodule_mm = 4.0\nface_width_mm = 20\n[post]\n"
+                               "rotary_mode = 'wrapped'\n", "bad.toml:5: [post] folded = true needs rotary_mode"),
     "stub without length": ("[gear]\nteeth = 23\nmodule_mm = 4.0\nface_width_mm = 20\n[stock]\nstub_diameter_mm = 60\n",
                             "bad.toml:6: invalid [stock]: a holding stub needs both"),
 }
