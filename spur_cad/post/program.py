@@ -254,7 +254,8 @@ class _Writer:
         head: list[str] = ["%"] if d.percent_delimited else []
         if d.program_start:
             head.append(d.program_start.format(number=s.program_number, title=self._title()))
-        head += [self.comment(line) for line in (info.title, *info.comments)]
+        titled = (info.comments if d.program_start and "{title}" in d.program_start else (info.title, *info.comments))
+        head += [self.comment(line) for line in titled]
         definitions: list[str] = []
         if not d.subprograms_after_end and d.fold_style != "repeat":
             for index, lines in enumerate(sub_bodies):
