@@ -1,0 +1,130 @@
+"""The design points the simulation measures at: blades along the design normals ("point-vector" method).
+
+One tooth space's boundary (tooth centre to tooth centre: right tip land, right involute, right
+fillet, root arc, left fillet, left involute, left tip land) is sampled at even arc-length
+spacing from the exact profile of `spur_cad.geometry`; every tooth space k uses the same
+points turned by k * 360/z degrees (counter-clockwise in machine (Y, Z), as the part sits at
+A = 0). Each point carries its exact unit normal pointing out of the material (into the space).
+The same transverse points are repeated on rows along X.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from spur_cad.geometry.profile import SEGMENT_LABELS, ToothSpaceProfile
+from spur_cad.geometry.spec import GearSpec
+
+FEATURES = ("root", "fillet", "involute", "tip")  # = SEGMENT_LABELS
+RIGHT, CENTRE, LEFT = 1, 0, -1
+
+
+@dataclass(frozen=True)
+class DesignGrid:
+    """Sampled design of one tooth space (sector-local frame = gap frame of space 0) and the X rows.
+
+    `points`/`normals` are (M, 2) in machine (Y, Z) at A = 0 for space 0; `feature` indexes
+    FEATURES; `side` is RIGHT/LEFT (CENTRE for the root centre and tooth centres); `arc_mm` is
+    the arc length along the outline from the right tooth centre. `rows_x` (R,) are the X
+    positions of the rows, `row_width` (R,) the slab of stock each row stands for (volume).
+    """
+
+    teeth: int
+    points: np.ndarray
+    normals: np.ndarray
+    feature: np.ndarray
+    side: np.ndarray
+    arc_mm: np.ndarray
+    rows_x: np.ndarray
+    row_width: np.ndarray
+    spacing_mm: float
+
+    @property
+    def pitch_rad(self) -> float:
+        return 2.0 * math.pi / self.teeth
+
+    def space_points(self, k: int) -> np.ndarray:
+        """Design points of tooth space k (part frame)."""
+        return rotate(self.points, k * self.pitch_rad)
+
+    def space_normals(self, k: int) -> np.ndarray:
+        return rotate(self.normals, k * self.pitch_rad)
+
+    def feature_names(self) -> list[str]:
+        """'right involute', 'root', ... per point."""
+        side_name = {RIGHT: "right ", LEFT: "left ", CENTRE: ""}
+        return [f"{side_name[int(s)]}{FEATURES[int(f)]}" for f, s in zip(self.feature, self.side)]
+
+
+def rotate(points: np.ndarray, angle_rad: float) -> np.ndarray:
+    """Turn (N, 2) machine (Y, Z) points counter-clockwise by angle (as A turns the part)."""
+    c, s = math.cos(angle_rad), math.sin(angle_rad)
+    return np.stack([points[:, 0] * c - points[:, 1] * s, points[:, 0] * s + points[:, 1] * c], axis=-1)
+
+
+def _even_parameters(segment, spacing_mm: float) -> np.ndarray:
+    """Parameters of a segment at even arc length (at most `spacing_mm` apart), both ends included."""
+    dense = np.linspace(segment.start, segment.end, 4001)
+    pts = segment.points(dense)
+    arc = np.concatenate([[0.0], np.cumsum(np.hypot(*np.diff(pts, axis=0).T))])
+    n = max(1, math.ceil(arc[-1] / spacing_mm))
+    return np.interp(np.linspace(0.0, arc[-1], n + 1), arc, dense)
+
+
+def sample_space(profile: ToothSpaceProfile, spacing_mm: float) -> tuple[np.ndarray, ...]:
+    """Points, normals, feature, side of one whole space, right tooth centre -> left tooth centre.
+
+    The last point (left tooth centre) is left out: it is the next space's first point.
+    """
+    pts, nrm, feat = [], [], []
+    for index, segment in enumerate(profile.segments):  # right half, root -> tip
+        if segment.end <= segment.start:
+            continue
+        params = _even_parameters(segment, spacing_mm)
+        if pts:
+            params = params[1:]
+        pts.append(segment.points(params))
+        nrm.append(segment.normals(params))
+        feat.append(np.full(len(params), SEGMENT_LABELS.index(segment.label)))
+    right_p, right_n, right_f = np.concatenate(pts), np.concatenate(nrm), np.concatenate(feat)
+    mirror = np.array([-1.0, 1.0])
+    points = np.concatenate([right_p[::-1], right_p[1:] * mirror])
+    normals = np.concatenate([right_n[::-1], right_n[1:] * mirror])
+    feature = np.concatenate([right_f[::-1], right_f[1:]])
+    side = np.concatenate([np.full(len(right_p), RIGHT), np.full(len(right_p) - 1, LEFT)])
+    side[len(right_p) - 1] = CENTRE  # root centre
+    side[0] = CENTRE  # tooth centre
+    # Gap frame (x, y) is machine (Y, Z) at A = 0 for space 0 (CONVENTIONS.md).
+    return points[:-1], normals[:-1], feature[:-1], side[:-1]
+
+
+def row_positions(x_min: float, x_max: float, spacing_mm: float, extra: np.ndarray = np.zeros(0),
+                  face_width_mm: float | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """Row X positions: an even grid over [x_min, x_max] (through X = 0 and X = b when given), plus `extra`
+    positions (finishing stations and the midpoints between them, where scallop ridges stand); returns
+    (positions, slab widths) with the slabs tiling [x_min, x_max]."""
+    anchors = [0.0] if face_width_mm is None else [0.0, face_width_mm]
+    step = spacing_mm
+    if face_width_mm is not None and face_width_mm > 0.0:
+        step = face_width_mm / math.ceil(face_width_mm / spacing_mm)
+    grid = np.arange(math.floor((x_min - anchors[0]) / step), math.ceil((x_max - anchors[0]) / step) + 1) * step
+    grid = grid[(grid >= x_min - 1e-9) & (grid <= x_max + 1e-9)]
+    extra = np.asarray(extra, float)
+    extra = extra[(extra >= x_min) & (extra <= x_max)]
+    rows = np.unique(np.round(np.concatenate([grid, extra, [x_min, x_max], anchors]), 9))
+    rows = rows[(rows >= x_min - 1e-9) & (rows <= x_max + 1e-9)]
+    edges = np.concatenate([[x_min], 0.5 * (rows[1:] + rows[:-1]), [x_max]])
+    return rows, np.diff(edges)
+
+
+def design_grid(spec: GearSpec, spacing_mm: float, x_min: float, x_max: float,
+                extra_rows: np.ndarray = np.zeros(0)) -> DesignGrid:
+    """The design grid of `spec`: points every `spacing_mm` along the space, rows over [x_min, x_max]."""
+    points, normals, feature, side = sample_space(spec.tooth_space_profile(), spacing_mm)
+    arc = np.concatenate([[0.0], np.cumsum(np.hypot(*np.diff(points, axis=0).T))])
+    rows, width = row_positions(x_min, x_max, spacing_mm, extra_rows, spec.face_width_mm)
+    return DesignGrid(spec.teeth, points, normals, feature.astype(np.int8), side.astype(np.int8), arc, rows, width,
+                      spacing_mm)

@@ -1,0 +1,190 @@
+"""Numba kernels: clip the blades (design point + t * normal, t in [t_min, h]) by tool positions.
+
+The tool (flat, bull-nose or ball end mill, axis +Z, tip centre at the programmed point, shank
+going up for ever) is the set of points within r_t of its core, the cylinder of radius rho
+(flat half-width) above height r_t (corner radius); R = rho + r_t. Along a blade the distance
+to that convex core minus r_t is a convex function with slope at most 1, so the first point of
+the blade inside the tool is found exactly by Newton's method started at the blade's inner
+end: from the left, a convex function's Newton iterates never pass its first root.
+
+Each blade keeps h, the outer end of the material left along it (h < 0: gouge, h > 0:
+leftover). A tool position removes everything from its first entry t_e outward, so
+h <- min(h, t_e): the result does not depend on the order of the cuts.
+Compiled lazily on first use (cache=True keeps the machine code between runs).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+INF = np.inf
+_NEWTON_STEPS = 60
+_F_TOLERANCE = 1e-10
+
+
+@njit(cache=True, inline="always")
+def _gap_and_slope(t, dx, ay, az, ny, nz, rho, rt):
+    """G(t) = distance from the blade point to the tool's core minus r_t (<= 0 inside the tool), and dG/dt."""
+    u = ay + t * ny
+    dz = az + t * nz
+    s = math.sqrt(dx * dx + u * u)
+    e = s - rho
+    if e < 0.0:
+        e = 0.0
+    v = rt - dz
+    if v < 0.0:
+        v = 0.0
+    dist = math.sqrt(e * e + v * v)
+    if dist <= 1e-300:
+        return -rt, 0.0
+    ds = u * ny / s if s > 1e-300 else 0.0
+    return dist - rt, (e * ds - v * nz) / dist
+
+
+@njit(cache=True)
+def first_entry(dx, ay, az, ny, nz, lo, hi, radius, rho, rt):
+    """Smallest t in [lo, hi] where the blade point (dx, ay + t ny, az + t nz) relative to the tool tip
+    is inside the tool; +inf when the blade misses the tool there.
+
+    The tool is the set of points within r_t of its core (the cylinder of radius rho above height
+    r_t), so G(t) = dist(core) - r_t is convex along the blade with |dG/dt| <= 1: Newton's method
+    from the inner end climbs monotonically to the first root, and G(lo) > hi - lo rules a blade out.
+    """
+    if dx >= radius or dx <= -radius:
+        return INF
+    if rt <= 0.0:  # flat end mill: inside iff dz >= 0 within the side walls
+        w = math.sqrt(radius * radius - dx * dx)
+        if abs(ny) > 1e-15:
+            t1 = (-w - ay) / ny
+            t2 = (w - ay) / ny
+            if t1 > t2:
+                t1, t2 = t2, t1
+            if t1 > lo:
+                lo = t1
+            if t2 < hi:
+                hi = t2
+        elif ay * ay > w * w:
+            return INF
+        if lo > hi:
+            return INF
+        if nz > 0.0:
+            t = -az / nz
+            if t < lo:
+                t = lo
+            return t if t <= hi else INF
+        if az + lo * nz >= 0.0:
+            return lo
+        return INF
+    if lo > hi:
+        return INF
+    f, slope = _gap_and_slope(lo, dx, ay, az, ny, nz, rho, rt)
+    if f <= 0.0:
+        return lo
+    if f > hi - lo or slope >= 0.0:
+        return INF
+    fh, slope_h = _gap_and_slope(hi, dx, ay, az, ny, nz, rho, rt)
+    if fh > 0.0 and slope_h <= 0.0:
+        return INF
+    t = lo
+    for _ in range(_NEWTON_STEPS):
+        step = -f / slope
+        t_next = t + step
+        if t_next > hi:
+            return INF
+        f, slope = _gap_and_slope(t_next, dx, ay, az, ny, nz, rho, rt)
+        if f <= _F_TOLERANCE:
+            return t_next
+        if slope >= 0.0 or f > hi - t_next:
+            return INF
+        if step < 1e-12:
+            return t_next if f < 1e-7 else INF
+        t = t_next
+    return t
+
+
+@njit(cache=True)
+def _sector_range(y, z, a, reach, radius, blade_len, pitch, teeth):
+    """Sectors (tooth spaces, unreduced index range) whose blades may meet the tool at (y, z) at angle a."""
+    if z - blade_len <= 0.0:
+        return 0, teeth - 1
+    half = math.atan2(abs(y) + radius + blade_len, z - blade_len)
+    first = math.ceil((-half - a) / pitch - 0.5)
+    last = math.floor((half - a) / pitch + 0.5)
+    if last - first + 1 >= teeth:
+        return 0, teeth - 1
+    return first, last
+
+
+@njit(cache=True)
+def _clip_at_pose(x, y, z, a, x_end, h, points, normals, chunk_start, chunk_centre, chunk_radius,
+                  rows, t_min, t_max, radius, rho, rt, reach, blade_len, pitch, teeth):
+    """Clip the blades by the tool at (x, y, z, a); with x_end > x, by the tool swept along X from x to x_end
+    (the union of the slices is the slice nearest the axis: t_e(dx) grows with |dx|)."""
+    if z > reach:
+        return 0
+    first, last = _sector_range(y, z, a, reach, radius, blade_len, pitch, teeth)
+    r_lo = np.searchsorted(rows, x - radius, side="right")
+    r_hi = np.searchsorted(rows, x_end + radius, side="left")
+    if r_lo >= r_hi:
+        return 0
+    cuts = 0
+    n_chunks = len(chunk_radius)
+    for k in range(first, last + 1):
+        sector = k % teeth
+        theta = a + k * pitch
+        c = math.cos(theta)
+        s = math.sin(theta)
+        for ci in range(n_chunks):
+            py = chunk_centre[ci, 0]
+            pz = chunk_centre[ci, 1]
+            cy = c * py - s * pz
+            cz = s * py + c * pz
+            ddy = abs(cy - y) - rho
+            ddz = z + rt - cz
+            out = math.sqrt(max(ddy, 0.0) ** 2 + max(ddz, 0.0) ** 2)
+            inside = min(max(ddy, ddz), 0.0)
+            if out + inside - rt > chunk_radius[ci]:
+                continue
+            for j in range(chunk_start[ci], chunk_start[ci + 1]):
+                px = points[j, 0]
+                pz_ = points[j, 1]
+                nx = normals[j, 0]
+                nz_ = normals[j, 1]
+                ay = c * px - s * pz_ - y
+                az = s * px + c * pz_ - z
+                ny = c * nx - s * nz_
+                nz = s * nx + c * nz_
+                deepest = first_entry(0.0, ay, az, ny, nz, t_min, t_max, radius, rho, rt)
+                if deepest == INF:
+                    continue
+                hrow = h[sector, j]
+                for r in range(r_lo, r_hi):
+                    current = hrow[r]
+                    if deepest >= current:
+                        continue
+                    xr = rows[r]
+                    if xr < x:
+                        entry = first_entry(x - xr, ay, az, ny, nz, t_min, current, radius, rho, rt)
+                    elif xr > x_end:
+                        entry = first_entry(xr - x_end, ay, az, ny, nz, t_min, current, radius, rho, rt)
+                    else:
+                        entry = deepest
+                    if entry < current:
+                        hrow[r] = entry
+                        cuts += 1
+    return cuts
+
+
+@njit(cache=True)
+def clip_poses(poses, x_end, h, points, normals, chunk_start, chunk_centre, chunk_radius, rows, t_min, t_max,
+               radius, rho, rt, reach, blade_len, pitch, teeth):
+    """Clip by a batch of tool positions (N, 4): x, y, z, a (rad); x_end[i] > x[i] sweeps along X."""
+    cuts = 0
+    for i in range(poses.shape[0]):
+        cuts += _clip_at_pose(poses[i, 0], poses[i, 1], poses[i, 2], poses[i, 3], x_end[i], h, points, normals,
+                              chunk_start, chunk_centre, chunk_radius, rows, t_min, t_max, radius, rho, rt, reach,
+                              blade_len, pitch, teeth)
+    return cuts

@@ -1,0 +1,332 @@
+"""Material removal by every IR move, measured along the design normals (point-vector method).
+
+See docs/simulation.md for the choice of representation. Each move is linear in X, Y, Z, A
+(as the IR defines it); the tool is applied in the part frame (the part turned back by A):
+
+- a move along X only (roughing passes, along-X finishing) is clipped exactly as one swept
+  tool (the union of the tool's slices along X is its slice nearest the axis);
+- a move in Z only is the tool at its lower end (the tool is everything above its bottom);
+- any other move (simultaneous Y/Z/A finishing moves, plunges with Y, index moves) is
+  clipped at poses spaced `pose_step_mm` apart along the move's relative motion, so the
+  cusps between them stay within a quarter of the resolution;
+- moves that stay above every blade cut nothing and are skipped.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass, field
+from typing import Callable, Sequence
+
+import numpy as np
+
+from spur_cad.cam.ir import MoveKind, Toolpath
+from spur_cad.cam.tools import Tool
+from spur_cad.errors import SpurCadError
+from spur_cad.geometry.spec import GearSpec
+from spur_cad.sim.design import DesignGrid, design_grid, rotate
+
+CHUNK_POINTS = 8
+POSE_BATCH = 20000
+
+
+class SimulationError(SpurCadError, ValueError):
+    """Simulation settings that cannot work (the message names the setting and its value)."""
+
+
+@dataclass(frozen=True)
+class SimSettings:
+    """Resolution and blade lengths. `resolution_mm` bounds the simulation's own error: cusps
+    between clipped poses (<= resolution / 4) and the spacing of design points and rows."""
+
+    resolution_mm: float = 0.005
+    gouge_range_mm: float = 0.5  # blades reach this far into the material (deeper gouges read as this)
+    leftover_range_mm: float = 1.0  # and this far out of it (more leftover reads as this)
+
+    def validate(self) -> None:
+        if not 0.0005 <= self.resolution_mm <= 0.1:
+            raise SimulationError(f"[simulation] resolution_mm = {self.resolution_mm:g} must be in [0.0005, 0.1] mm")
+        for name in ("gouge_range_mm", "leftover_range_mm"):
+            value = getattr(self, name)
+            if not 10.0 * self.resolution_mm <= value <= 20.0:
+                raise SimulationError(f"[simulation] {name} = {value:g} must be in [10 x resolution, 20] mm")
+
+
+@dataclass(frozen=True)
+class StockCylinder:
+    """The stock the simulation starts from: a cylinder about X over [x_min, x_max]."""
+
+    radius_mm: float
+    x_min: float
+    x_max: float
+
+
+@dataclass(frozen=True)
+class Operation:
+    """One toolpath with the tool that cuts it."""
+
+    path: Toolpath
+    tool: Tool
+
+
+@dataclass(frozen=True)
+class SimResult:
+    """Deviation of every design point (h: (teeth, M, rows), mm; < 0 gouge, > 0 leftover) and facts."""
+
+    grid: DesignGrid
+    deviation: np.ndarray
+    initial: np.ndarray
+    stock: StockCylinder
+    face_width_mm: float
+    settings: SimSettings
+    removed_volume_mm3: float
+    seconds: float
+    poses_clipped: int
+    x_sweeps: int
+    moves: int
+    station_x: np.ndarray = field(default_factory=lambda: np.zeros(0))
+
+    @property
+    def gear_rows(self) -> np.ndarray:
+        """Rows inside the face width (0 <= X <= b): where the part's surface is measured."""
+        x = self.grid.rows_x
+        return (x >= -1e-9) & (x <= self.face_width_mm + 1e-9)
+
+    def station_of_row(self) -> np.ndarray:
+        """Nearest finishing station index per row (-1 without finishing stations)."""
+        if len(self.station_x) == 0:
+            return np.full(len(self.grid.rows_x), -1)
+        return np.abs(self.grid.rows_x[:, None] - self.station_x[None, :]).argmin(axis=1)
+
+    @property
+    def uncut_points(self) -> int:
+        """Design points of the face width never cut below the blade's outer end (their leftover is
+        at least leftover_range_mm, and the removed volume overestimates there)."""
+        top = self.settings.leftover_range_mm - 1e-9
+        return int(np.count_nonzero(self.deviation[:, :, self.gear_rows] >= top))
+
+    def worst(self, gouge: bool) -> dict:
+        """Where the largest gouge (or leftover) is: space, feature, X, station, value (mm)."""
+        dev = self.deviation[:, :, self.gear_rows]
+        flat = int(np.argmin(dev) if gouge else np.argmax(dev))
+        k, j, r = np.unravel_index(flat, dev.shape)
+        row = np.nonzero(self.gear_rows)[0][r]
+        return {"value_mm": float(dev[k, j, r]), "space": int(k), "feature": self.grid.feature_names()[j],
+                "point": int(j), "x_mm": float(self.grid.rows_x[row]), "station": int(self.station_of_row()[row])}
+
+    def facts(self) -> dict:
+        """summary.json's `simulation` section."""
+        dev = self.deviation[:, :, self.gear_rows]
+        finished = dev[dev < self.settings.leftover_range_mm - 1e-9]
+        positive = np.maximum(finished, 0.0)
+        names = np.array(self.grid.feature_names())
+        per_feature = {}
+        for name in ("right involute", "right fillet", "root", "left fillet", "left involute", "tip"):
+            mask = np.array([n.endswith(name) if name in ("root", "tip") else n == name for n in names])
+            if mask.any():
+                values = dev[:, mask, :]
+                per_feature[name] = {"max_gouge_mm": float(max(0.0, -values.min())),
+                                     "max_leftover_mm": float(max(0.0, values.max())),
+                                     "mean_mm": float(values.mean())}
+        return {
+            "resolution_mm": self.settings.resolution_mm,
+            "max_gouge_mm": float(max(0.0, -dev.min())),
+            "max_leftover_mm": float(max(0.0, dev.max())),
+            "removed_volume_mm3": self.removed_volume_mm3,
+            "seconds": self.seconds,
+            "design_points": int(dev.size),
+            "points_per_space": int(self.grid.points.shape[0]),
+            "rows": int(self.gear_rows.sum()),
+            "point_spacing_mm": self.grid.spacing_mm,
+            "uncut_points": self.uncut_points,
+            "scallop_mean_mm": float(positive.mean()) if positive.size else 0.0,
+            "scallop_p95_mm": float(np.percentile(positive, 95)) if positive.size else 0.0,
+            "scallop_p99_mm": float(np.percentile(positive, 99)) if positive.size else 0.0,
+            "worst_gouge": self.worst(True),
+            "worst_leftover": self.worst(False),
+            "per_feature": per_feature,
+            "moves": self.moves,
+            "poses_clipped": self.poses_clipped,
+            "x_sweeps": self.x_sweeps,
+            "gouge_range_mm": self.settings.gouge_range_mm,
+            "leftover_range_mm": self.settings.leftover_range_mm,
+        }
+
+
+def pose_step_mm(tool: Tool, resolution_mm: float) -> float:
+    """Spacing of clipped poses along a move: the cusp between two copies of a corner of radius r a
+    distance l apart is l^2 / (8 r); keep it within resolution / 4 (sharp flat tools: resolution / 4)."""
+    radius = tool.corner_radius if tool.corner_radius > 0.0 else 0.0
+    if radius == 0.0:
+        return resolution_mm / 4.0
+    return math.sqrt(8.0 * radius * resolution_mm / 4.0)
+
+
+def _tool_shape(tool: Tool) -> tuple[float, float, float]:
+    """(R, rho, r_t): outer radius, flat half-width, corner radius."""
+    radius = tool.diameter_mm / 2.0
+    rt = tool.corner_radius
+    return radius, radius - rt, rt
+
+
+def decompose(path: Toolpath, tool: Tool, resolution_mm: float, reach_mm: float,
+              flat_step_mm: float | None = None,
+              x_range: tuple[float, float] = (-np.inf, np.inf)) -> tuple[np.ndarray, np.ndarray, int]:
+    """Poses (N, 4: x, y, z, a rad) and their X-sweep ends (N,) that together remove what the moves remove.
+
+    Returns (poses, x_end, number of moves along X only). Markers carry no motion and are skipped;
+    the first row's start is unknown (the IR says so): it is clipped at its end pose only.
+    """
+    motion = (path.kind == MoveKind.RAPID) | (path.kind == MoveKind.LINEAR)
+    x, y, z, a = (np.asarray(v, float)[motion] for v in (path.x, path.y, path.z, path.a))
+    if len(x) == 0:
+        return np.zeros((0, 4)), np.zeros(0), 0
+    a = np.radians(a)
+    x0, y0, z0, a0 = (np.concatenate([[v[0]], v[:-1]]) for v in (x, y, z, a))
+    dx, dy, dz, da = x - x0, y - y0, z - z0, a - a0
+    radius = tool.diameter_mm / 2.0
+    above = (np.minimum(z0, z) > reach_mm) | (np.maximum(x0, x) < x_range[0] - radius) \
+        | (np.minimum(x0, x) > x_range[1] + radius)
+    still_yza = (dy == 0.0) & (dz == 0.0) & (da == 0.0)
+    along_x = ~above & still_yza & (dx != 0.0)
+    only_z = ~above & (dx == 0.0) & (dy == 0.0) & (da == 0.0)
+    general = ~above & ~along_x & ~only_z
+    general[0] = False
+    only_z[0] = not above[0]  # first row: its end pose only
+    sweeps = np.stack([np.minimum(x0, x)[along_x], y[along_x], z[along_x], a[along_x]], axis=-1)
+    sweep_end = np.maximum(x0, x)[along_x]
+    lows = np.stack([x[only_z], y[only_z], np.minimum(z0, z)[only_z], a[only_z]], axis=-1)
+    idx = np.nonzero(general)[0]
+    step = np.full(len(idx), pose_step_mm(tool, resolution_mm))
+    if flat_step_mm is not None and tool.corner_radius == 0.0:
+        # A flat tool moving horizontally without turning (roughing's steps across a level) leaves no cusp on
+        # its flat bottom; its round edge (radius D/2) does, as a corner of that radius.
+        step[(dz[idx] == 0.0) & (da[idx] == 0.0)] = flat_step_mm
+    radius_from_axis = np.maximum(np.hypot(y0[idx], z0[idx]), np.hypot(y[idx], z[idx])) + tool.diameter_mm / 2.0
+    travel = (np.abs(dx[idx]) + np.hypot(dy[idx], dz[idx]) + np.minimum(radius_from_axis, reach_mm)
+              * np.abs(da[idx]))
+    pieces = np.maximum(1, np.ceil(travel / step)).astype(np.int64)
+    move_of = np.repeat(idx, pieces)
+    offsets = np.arange(len(move_of)) - np.repeat(np.cumsum(pieces) - pieces, pieces)
+    frac = (offsets + 1) / np.repeat(pieces, pieces)
+    interp = np.stack([x0[move_of] + dx[move_of] * frac, y0[move_of] + dy[move_of] * frac,
+                       z0[move_of] + dz[move_of] * frac, a0[move_of] + da[move_of] * frac], axis=-1)
+    poses = np.concatenate([sweeps, lows, interp])
+    x_end = np.concatenate([sweep_end, lows[:, 0], interp[:, 0]])
+    return poses, x_end, int(along_x.sum())
+
+
+def _chunks(grid: DesignGrid, t_min: float, t_max: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Groups of consecutive design points with a circle holding all their blades."""
+    m = len(grid.points)
+    start = np.arange(0, m + CHUNK_POINTS - 1, CHUNK_POINTS)
+    start[-1] = m
+    start = np.unique(np.minimum(start, m))
+    inner = grid.points + t_min * grid.normals
+    outer = grid.points + t_max * grid.normals
+    centres, radii = [], []
+    for lo, hi in zip(start[:-1], start[1:]):
+        ends = np.concatenate([inner[lo:hi], outer[lo:hi]])
+        centre = 0.5 * (ends.min(axis=0) + ends.max(axis=0))
+        centres.append(centre)
+        radii.append(float(np.hypot(*(ends - centre).T).max()) + 1e-9)
+    return start.astype(np.int64), np.array(centres), np.array(radii)
+
+
+def initial_blades(grid: DesignGrid, stock: StockCylinder, t_max: float) -> np.ndarray:
+    """Blade outer ends before cutting: where the normal leaves the stock cylinder (at most t_max)."""
+    p, n = grid.points, grid.normals
+    pn = np.einsum("ij,ij->i", p, n)
+    inside = stock.radius_mm**2 - np.einsum("ij,ij->i", p, p)
+    exit_t = -pn + np.sqrt(np.maximum(pn * pn + inside, 0.0))
+    h0 = np.minimum(exit_t, t_max)
+    return np.broadcast_to(h0[None, :, None], (grid.teeth, len(p), len(grid.rows_x))).copy()
+
+
+def section_areas(grid: DesignGrid, h: np.ndarray) -> np.ndarray:
+    """Area of the whole simulated transverse section per row (shoelace over all spaces' points p + h n)."""
+    areas = np.zeros(h.shape[2])
+    for k in range(grid.teeth):
+        p = grid.space_points(k)
+        n = grid.space_normals(k)
+        q = p[:, :, None] + n[:, :, None] * h[k][:, None, :]  # (M, 2, rows)
+        nxt_p = grid.space_points(k + 1)[0]
+        nxt_n = grid.space_normals(k + 1)[0]
+        nxt = nxt_p[:, None] + nxt_n[:, None] * h[(k + 1) % grid.teeth][0][None, :]
+        ys = np.concatenate([q[:, 0, :], nxt[0][None, :]])
+        zs = np.concatenate([q[:, 1, :], nxt[1][None, :]])
+        areas += 0.5 * (ys[:-1] * zs[1:] - ys[1:] * zs[:-1]).sum(axis=0)
+    return areas
+
+
+def simulate(spec: GearSpec, stock: StockCylinder, operations: Sequence[Operation],
+             settings: SimSettings = SimSettings(), *, station_x: np.ndarray | None = None,
+             rows_x_range: tuple[float, float] | None = None,
+             progress: Callable[[float], None] | None = None) -> SimResult:
+    """Cut the stock with every operation in order and measure the result against the design.
+
+    `station_x`: finishing station positions (rows are added there and halfway between them, where
+    the scallop ridges stand). `rows_x_range` limits the rows (default: the stock's X extent).
+    """
+    from spur_cad.sim.kernel import clip_poses
+
+    settings.validate()
+    started = time.perf_counter()
+    res = settings.resolution_mm
+    corner_radii = [op.tool.corner_radius for op in operations if op.tool.corner_radius > 0.0] or [0.5]
+    spacing = math.sqrt(8.0 * min(min(corner_radii), 1.0) * res / 2.0)
+    stations = np.unique(np.asarray(station_x if station_x is not None else np.zeros(0), float))
+    extra = np.concatenate([stations, 0.5 * (stations[1:] + stations[:-1])]) if len(stations) else np.zeros(0)
+    x_lo, x_hi = rows_x_range if rows_x_range is not None else (stock.x_min, stock.x_max)
+    grid = design_grid(spec, spacing, x_lo, x_hi, extra)
+    t_min, t_max = -settings.gouge_range_mm, settings.leftover_range_mm
+    h = initial_blades(grid, stock, t_max)
+    initial = h.copy()
+    chunk_start, chunk_centre, chunk_radius = _chunks(grid, t_min, t_max)
+    blade_ends = np.concatenate([grid.points + t_min * grid.normals, grid.points + t_max * grid.normals])
+    reach = float(np.hypot(*blade_ends.T).max()) + 1e-9
+    blade_len = max(settings.gouge_range_mm, settings.leftover_range_mm)
+    batches = []
+    sweeps = moves = 0
+    for op in operations:
+        radius, rho, rt = _tool_shape(op.tool)
+        flat_step = math.sqrt(8.0 * radius * res / 4.0)
+        poses, x_end, n_sweeps = decompose(op.path, op.tool, res, reach, flat_step, (x_lo, x_hi))
+        sweeps += n_sweeps
+        moves += len(op.path)
+        for lo in range(0, len(poses), POSE_BATCH):
+            batches.append((poses[lo:lo + POSE_BATCH], x_end[lo:lo + POSE_BATCH], radius, rho, rt))
+    total = sum(len(b[0]) for b in batches)
+    done = 0
+    for poses, x_end, radius, rho, rt in batches:
+        clip_poses(np.ascontiguousarray(poses), np.ascontiguousarray(x_end), h, grid.points, grid.normals,
+                   chunk_start, chunk_centre, chunk_radius, grid.rows_x, t_min, t_max, radius, rho, rt, reach,
+                   blade_len, grid.pitch_rad, grid.teeth)
+        done += len(poses)
+        if progress is not None:
+            progress(done / max(total, 1))
+    stock_area = math.pi * stock.radius_mm**2
+    removed = float(((stock_area - section_areas(grid, h)) * grid.row_width).sum())
+    return SimResult(grid, h, initial, stock, spec.face_width_mm, settings, removed, time.perf_counter() - started,
+                     total, sweeps, moves, stations)
+
+
+def shifted(path: Toolpath, mask: np.ndarray, dy: np.ndarray | float = 0.0, dz: np.ndarray | float = 0.0) -> Toolpath:
+    """A copy of `path` with the moves in `mask` moved by (dy, dz) in machine Y/Z (for planted-fault checks)."""
+    y, z = path.y.copy(), path.z.copy()
+    y[mask] += np.broadcast_to(dy, y.shape)[mask] if np.ndim(dy) else dy
+    z[mask] += np.broadcast_to(dz, z.shape)[mask] if np.ndim(dz) else dz
+    return subset(path, np.ones(len(path), bool), y=y, z=z)
+
+
+def subset(path: Toolpath, mask: np.ndarray, **replace) -> Toolpath:
+    """The moves of `path` selected by `mask` (optionally with replaced x/y/z/a arrays of full length)."""
+    arrays = {name: replace.get(name, getattr(path, name))[mask] for name in
+              ("kind", "x", "y", "z", "a", "feed", "inverse_time", "space", "station", "feature")}
+    return Toolpath(operation=path.operation, tool_number=path.tool_number, spindle_rpm=path.spindle_rpm,
+                    warnings=path.warnings, **arrays)
+
+
+__all__ = ["Operation", "SimResult", "SimSettings", "SimulationError", "StockCylinder", "decompose", "rotate",
+           "simulate", "shifted", "subset"]
