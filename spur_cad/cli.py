@@ -30,11 +30,33 @@ def _parser() -> argparse.ArgumentParser:
     run.add_argument("--out", required=True, help="output folder (created if missing)")
     run.add_argument("--quiet", action="store_true", help="print nothing but errors")
     run.add_argument("--debug", action="store_true", help="show tracebacks of internal errors")
+    freecad = sub.add_parser("install-freecad", help="make the FreeCAD workbench and this spur_cad available "
+                                                     "to your FreeCAD (undo with --uninstall)")
+    freecad.add_argument("--uninstall", action="store_true", help="remove what install-freecad added")
     return parser
+
+
+def _install_freecad(uninstall: bool) -> int:
+    """`spur-cad install-freecad [--uninstall]` (see spur_cad.freecad_install)."""
+    import os
+
+    from spur_cad.freecad_install import install
+    from spur_cad.freecad_install import uninstall as remove
+
+    try:
+        lines = remove(os.environ) if uninstall else install(os.environ)
+    except SpurCadError as exc:
+        print(f"spur-cad: error: {exc}", file=sys.stderr)
+        return EXIT_INPUT_ERROR
+    for line in lines:
+        print(line)
+    return 0
 
 
 def main(argv: list[str] | None = None) -> int:
     args = _parser().parse_args(argv)
+    if args.command == "install-freecad":
+        return _install_freecad(args.uninstall)
     try:
         job = load_job(args.job)
         files = run_job(job)

@@ -1,0 +1,355 @@
+"""The workbench's commands: Python entry points (used headless and by macros) and their GUI commands.
+
+Entry points take and return document objects:
+
+    gear = make_gear(doc, Teeth=12, Module=3.0)      # property names of schema.GEAR_FIELDS
+    stock = make_stock(gear)
+    job = make_job(gear, stock)                       # tools suggested within the recommendations
+    doc.recompute()
+    export_job(job, "/tmp/out")                       # the same files as `spur-cad run`
+    gear, stock, job = import_job_file(doc, "job.toml")
+    result = simulate(job)                            # needs spur_cad.sim
+
+The GUI commands run the entry points through FreeCADGui.doCommandGui, so they are recorded
+in macros; a SpurCadError is shown as its message (report view and a message box), never as a
+traceback.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import FreeCAD
+
+from spur_cad_workbench import schema
+from spur_cad_workbench.features import (
+    GearFeature,
+    JobFeature,
+    StockFeature,
+    ToolpathFeature,
+    ViewProvider,
+    job_of,
+)
+
+GEAR_COLOUR = (0.55, 0.62, 0.72)
+STOCK_COLOUR = (0.85, 0.75, 0.45)
+ROUGHING_COLOUR = (0.85, 0.45, 0.1)
+FINISHING_COLOUR = (0.1, 0.55, 0.2)
+
+
+def _checked(values: dict, fields, what: str) -> dict:
+    """`values` (property name -> value) restricted to `fields`; unknown names are an error."""
+    from spur_cad.errors import SpurCadError
+
+    known = {field.prop for field in fields}
+    unknown = sorted(set(values) - known)
+    if unknown:
+        raise SpurCadError(f"unknown {what} properties: {', '.join(unknown)} (known: {', '.join(sorted(known))})")
+    return values
+
+
+def _view(obj, colour=None, transparency: int | None = None) -> None:
+    if not FreeCAD.GuiUp or obj.ViewObject is None:
+        return
+    ViewProvider(obj.ViewObject)
+    if colour is not None:
+        if hasattr(obj.ViewObject, "ShapeColor"):
+            obj.ViewObject.ShapeColor = colour
+        if hasattr(obj.ViewObject, "NormalColor"):
+            obj.ViewObject.NormalColor = colour
+        if hasattr(obj.ViewObject, "LineColor") and obj.TypeId.startswith("Part"):
+            obj.ViewObject.LineColor = colour
+    if transparency is not None and hasattr(obj.ViewObject, "Transparency"):
+        obj.ViewObject.Transparency = transparency
+
+
+def _document(doc):
+    return doc if doc is not None else (FreeCAD.ActiveDocument or FreeCAD.newDocument("Gear"))
+
+
+def make_gear(doc=None, **values):
+    """A new parametric gear (schema.GEAR_FIELDS values, defaults: schema.NEW_GEAR) in `doc`."""
+    doc = _document(doc)
+    gear_values = {**schema.default_values()["gear"], **_checked(values, schema.GEAR_FIELDS, "gear")}
+    obj = doc.addObject("Part::FeaturePython", "Gear")
+    GearFeature(obj, gear_values)
+    _view(obj, GEAR_COLOUR)
+    return obj
+
+
+def make_stock(gear, **values):
+    """The stock (blank) for `gear`, linked to it."""
+    stock_values = {**schema.default_values()["stock"], **_checked(values, schema.STOCK_FIELDS, "stock")}
+    obj = gear.Document.addObject("Part::FeaturePython", "Stock")
+    StockFeature(obj, gear, stock_values)
+    _view(obj, STOCK_COLOUR, transparency=75)
+    return obj
+
+
+def _toolpath_object(doc, operation: str):
+    """A toolpath object: a FreeCAD Path object when the Path module loads, else a Part wire compound."""
+    try:
+        import Path  # noqa: F401  (FreeCAD's Path workbench module)
+
+        type_id = "Path::FeaturePython"
+    except ImportError:
+        type_id = "Part::FeaturePython"
+    obj = doc.addObject(type_id, f"{operation.capitalize()}Toolpath")
+    ToolpathFeature(obj, operation)
+    _view(obj, ROUGHING_COLOUR if operation == "roughing" else FINISHING_COLOUR)
+    return obj
+
+
+def make_job(gear, stock, suggest: bool = True, **values):
+    """A 4-axis job for `gear` and `stock` with its roughing and finishing toolpath objects.
+
+    Without tool values the tools are suggested within the gear's recommendations
+    (validation.suggest_tools); `suggest=False` keeps the job file's defaults (no tools).
+    """
+    from spur_cad_workbench.features import document_values
+    from spur_cad_workbench.validation import suggest_tools
+
+    job_values = {**schema.default_values()["job"], **_checked(values, schema.JOB_FIELDS, "job")}
+    if suggest and not any(name.startswith(("Roughing", "Finishing", "Use")) for name in values):
+        current = {**document_values(stock), "job": job_values}
+        job_values.update(suggest_tools(current))
+    doc = gear.Document
+    obj = doc.addObject("App::FeaturePython", "Job")
+    JobFeature(obj, gear, stock, job_values)
+    _view(obj)
+    obj.RoughingToolpath = _toolpath_object(doc, "roughing")
+    obj.FinishingToolpath = _toolpath_object(doc, "finishing")
+    return obj
+
+
+def import_job_file(doc, path: str):
+    """Gear, stock and job objects holding the job file at `path` (validated as `spur-cad run` does)."""
+    from spur_cad.job import load_job
+
+    job = load_job(path)
+    values = schema.values_from_job(job)
+    doc = _document(doc)
+    gear = make_gear(doc, **values["gear"])
+    stock = make_stock(gear, **values["stock"])
+    job_obj = make_job(gear, stock, suggest=False, **values["job"])
+    job_obj.Label = job.job.name
+    doc.recompute()
+    return gear, stock, job_obj
+
+
+def find_job(doc):
+    """The document's job object if there is exactly one; None otherwise."""
+    jobs = [obj for obj in doc.Objects if getattr(getattr(obj, "Proxy", None), "KIND", "") == "job"]
+    return jobs[0] if len(jobs) == 1 else None
+
+
+def export_job(job_obj, out_dir: str) -> list[str]:
+    """Write the job's files (STEP gear/stock/assembly, G-code, profile, summary) as `spur-cad run` does."""
+    from spur_cad.errors import SpurCadError
+    from spur_cad.outputs import write_files_atomically
+    from spur_cad.pipeline import run_job
+
+    job = job_of(job_obj)
+    files = run_job(job)
+    out = Path(out_dir)
+    if out.exists() and not out.is_dir():
+        raise SpurCadError(f"{out}: exists and is not a folder")
+    try:
+        paths = write_files_atomically(out, files)
+    except OSError as exc:
+        raise SpurCadError(f"cannot write to {out}: {exc.strerror or exc}") from None
+    FreeCAD.Console.PrintMessage(f"{job_obj.Label}: wrote {len(paths)} files to {out}\n")
+    return [str(path) for path in paths]
+
+
+def simulate(job_obj, resolution_mm: float = 0.01):
+    """Simulate the job's toolpaths (spur_cad.sim) and show the deviation from the design as coloured points."""
+    from spur_cad.pipeline import plan_cam
+
+    from spur_cad_workbench.simulation import show_result, simulate_job, simulator
+
+    simulator()  # raises SimulationUnavailable before any work
+    job = job_of(job_obj)
+    result = simulate_job(job, plan_cam(job), resolution_mm)
+    return show_result(job_obj, result)
+
+
+# --- GUI commands ------------------------------------------------------------------------------
+
+
+def _icon(name: str) -> str:
+    from spur_cad_workbench.resources import icon_path
+
+    return icon_path(name)
+
+
+def _selected(kind: str):
+    import FreeCADGui
+
+    for obj in FreeCADGui.Selection.getSelection():
+        if getattr(getattr(obj, "Proxy", None), "KIND", "") == kind:
+            return obj
+    doc = FreeCAD.ActiveDocument
+    if doc is None:
+        return None
+    found = [obj for obj in doc.Objects if getattr(getattr(obj, "Proxy", None), "KIND", "") == kind]
+    return found[-1] if found else None
+
+
+def show_message(title: str, message: str, error: bool = True) -> None:
+    """A message for the user: one line in the report view and a (non-blocking) message box."""
+    (FreeCAD.Console.PrintError if error else FreeCAD.Console.PrintWarning)(f"{title}: {message}\n")
+    if FreeCAD.GuiUp:
+        import FreeCADGui
+        from PySide import QtGui
+
+        box = QtGui.QMessageBox(QtGui.QMessageBox.Warning if error else QtGui.QMessageBox.Information,
+                                title, message, QtGui.QMessageBox.Ok, FreeCADGui.getMainWindow())
+        box.setObjectName("SpurCadMessage")
+        box.setModal(False)
+        box.show()
+
+
+def run_recorded(lines: list[str], title: str) -> bool:
+    """Run Python lines through FreeCADGui.doCommandGui (recorded in macros); show SpurCadErrors."""
+    import FreeCADGui
+    from spur_cad.errors import SpurCadError
+
+    try:
+        FreeCADGui.doCommandGui("import spur_cad_workbench.commands")
+        for line in lines:
+            FreeCADGui.doCommandGui(line)
+    except SpurCadError as exc:
+        show_message(title, str(exc))
+        return False
+    return True
+
+
+class _Command:
+    """Base of the GUI commands: resources from class attributes."""
+
+    NAME = ""
+    ICON = "spur_cad"
+    MENU = ""
+    TIP = ""
+
+    def GetResources(self):
+        return {"Pixmap": _icon(self.ICON), "MenuText": self.MENU, "ToolTip": self.TIP}
+
+
+class GearCommand(_Command):
+    NAME, ICON, MENU = "SpurCad_Gear", "gear", "Spur gear"
+    TIP = "Create a parametric spur gear (exact rack-generated teeth) on the rotary axis X"
+
+    def IsActive(self):
+        return True
+
+    def Activated(self):
+        lines = ["if App.ActiveDocument is None: App.newDocument('Gear')",
+                 "spur_cad_gear = spur_cad_workbench.commands.make_gear(App.ActiveDocument)",
+                 "App.ActiveDocument.recompute()"]
+        if run_recorded(lines, "Spur gear"):
+            import FreeCADGui
+
+            FreeCADGui.SendMsgToActiveView("ViewFit")
+
+
+class StockCommand(_Command):
+    NAME, ICON, MENU = "SpurCad_Stock", "stock", "Stock"
+    TIP = "Create the blank (stock) for the selected gear, linked to it"
+
+    def IsActive(self):
+        return _selected("gear") is not None
+
+    def Activated(self):
+        gear = _selected("gear")
+        run_recorded([f"spur_cad_stock = spur_cad_workbench.commands.make_stock("
+                      f"App.ActiveDocument.getObject({gear.Name!r}))", "App.ActiveDocument.recompute()"], "Stock")
+
+
+class JobCommand(_Command):
+    NAME, ICON, MENU = "SpurCad_Job", "job", "4-axis job"
+    TIP = "Create a 4-axis job (tools, cutting data, strategies, machine, post) and edit it in a task panel"
+
+    def IsActive(self):
+        return _selected("stock") is not None
+
+    def Activated(self):
+        stock = _selected("stock")
+        gear = stock.Gear
+        ok = run_recorded([f"spur_cad_job = spur_cad_workbench.commands.make_job("
+                           f"App.ActiveDocument.getObject({gear.Name!r}), App.ActiveDocument.getObject({stock.Name!r}))",
+                           "App.ActiveDocument.recompute()"], "4-axis job")
+        if ok:
+            from spur_cad_workbench.taskpanel import show_job_panel
+
+            show_job_panel(stock.Document.Objects[-3])
+
+
+class ImportJobCommand(_Command):
+    NAME, ICON, MENU = "SpurCad_ImportJob", "import_job", "Import job file..."
+    TIP = "Create gear, stock and job objects from a spur_cad job file (TOML)"
+
+    def IsActive(self):
+        return True
+
+    def Activated(self):
+        import FreeCADGui
+        from PySide import QtGui
+
+        path, _ = QtGui.QFileDialog.getOpenFileName(FreeCADGui.getMainWindow(), "Import spur_cad job file", "",
+                                                    "spur_cad job (*.toml)")
+        if path:
+            run_recorded(["if App.ActiveDocument is None: App.newDocument('Gear')",
+                          f"spur_cad_objects = spur_cad_workbench.commands.import_job_file(App.ActiveDocument, "
+                          f"{path!r})"], "Import job file")
+
+
+class SimulateCommand(_Command):
+    NAME, ICON, MENU = "SpurCad_Simulate", "simulate", "Simulate"
+    TIP = "Simulate the job's cutting and show the part coloured by deviation from the design"
+
+    def IsActive(self):
+        return _selected("job") is not None
+
+    def Activated(self):
+        from spur_cad_workbench.simulation import SimulationUnavailable, simulator
+
+        try:
+            simulator()
+        except SimulationUnavailable as exc:
+            show_message("Simulate", str(exc), error=False)
+            return
+        job = _selected("job")
+        run_recorded([f"spur_cad_simulation = spur_cad_workbench.commands.simulate("
+                      f"App.ActiveDocument.getObject({job.Name!r}))"], "Simulate")
+
+
+class ExportCommand(_Command):
+    NAME, ICON, MENU = "SpurCad_Export", "export", "Export STEP and G-code..."
+    TIP = "Write the job's STEP files (gear, stock, assembly) and G-code programs, as `spur-cad run` does"
+
+    def IsActive(self):
+        return _selected("job") is not None
+
+    def Activated(self):
+        import FreeCADGui
+        from PySide import QtGui
+
+        job = _selected("job")
+        folder = QtGui.QFileDialog.getExistingDirectory(FreeCADGui.getMainWindow(), "Export job files to")
+        if folder:
+            run_recorded([f"spur_cad_files = spur_cad_workbench.commands.export_job("
+                          f"App.ActiveDocument.getObject({job.Name!r}), {folder!r})"], "Export")
+
+
+COMMANDS = (GearCommand, StockCommand, JobCommand, ImportJobCommand, SimulateCommand, ExportCommand)
+
+
+def register_commands() -> list[str]:
+    """Register the GUI commands with FreeCAD; returns their names (toolbar and menu order)."""
+    import FreeCADGui
+
+    for command in COMMANDS:
+        FreeCADGui.addCommand(command.NAME, command())
+    return [command.NAME for command in COMMANDS]

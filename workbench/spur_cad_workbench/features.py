@@ -1,0 +1,399 @@
+"""FeaturePython document objects: gear, stock, 4-axis job and its toolpaths.
+
+Every value lives in a primitive property (schema.py); the Python proxies hold no state, and
+`dumps` / `__getstate__` return None, so a saved document names the proxy classes but pickles
+nothing. `SchemaVersion` on each object lets `onDocumentRestored` migrate older documents
+(today: add properties that a newer schema introduced, with their defaults).
+
+Shapes come from spur_cad's CadQuery/OCP solids, transferred as BREP text. Input errors
+(SpurCadError) do not raise out of `execute` (FreeCAD would print a traceback): the object's
+`Status` property says what is wrong and the report view gets the one-line message.
+"""
+
+from __future__ import annotations
+
+import io
+
+import FreeCAD
+
+from spur_cad_workbench import schema
+from spur_cad_workbench.resources import icon_path
+
+PROP_READ_ONLY = 1
+PROP_OUTPUT = 8
+
+
+def add_fields(obj, fields, values: dict | None = None, outputs: bool = False) -> None:
+    """Add the properties of `fields` that `obj` lacks; set them from `values` (inputs) when given."""
+    attr = PROP_READ_ONLY | PROP_OUTPUT if outputs else 0
+    for field in fields:
+        if field.prop in obj.PropertiesList:
+            continue
+        obj.addProperty(field.property_type, field.prop, field.group, field.doc, attr)
+        if field.kind == "choice":
+            setattr(obj, field.prop, list(field.choices))
+        if values is not None and field.prop in values:
+            setattr(obj, field.prop, values[field.prop])
+
+
+def _plain(value):
+    """A property value as plain Python (Quantity -> float in mm or deg)."""
+    return float(value.Value) if hasattr(value, "Value") else value
+
+
+def read_values(obj, fields) -> dict:
+    """{property name: plain value} of `fields` on `obj`."""
+    return {field.prop: _plain(getattr(obj, field.prop)) for field in fields}
+
+
+def write_values(obj, values: dict) -> None:
+    """Set properties whose value differs (setting an equal value would still touch the object)."""
+    for prop, value in values.items():
+        if _plain(getattr(obj, prop)) != value:
+            setattr(obj, prop, value)
+
+
+def write_outputs(obj, values: dict) -> None:
+    """Set read-only computed properties."""
+    for prop, value in values.items():
+        if _plain(getattr(obj, prop)) != value:
+            setattr(obj, prop, value)
+
+
+def add_bookkeeping(obj) -> None:
+    """SchemaVersion (for migration) and Status (last recompute's outcome), both read-only."""
+    if "SchemaVersion" not in obj.PropertiesList:
+        obj.addProperty("App::PropertyInteger", "SchemaVersion", "Base", "schema of this object's properties",
+                        PROP_READ_ONLY)
+        obj.SchemaVersion = schema.SCHEMA_VERSION
+    if "Status" not in obj.PropertiesList:
+        obj.addProperty("App::PropertyString", "Status", "Base", "outcome of the last recompute",
+                        PROP_READ_ONLY | PROP_OUTPUT)
+
+
+def report(obj, message: str | None) -> None:
+    """Record the recompute's outcome; an error also goes to the report view as one line."""
+    prefix = f"{source_of(obj)}: "
+    if message is not None and message.startswith(prefix):
+        message = message[len(prefix):]
+    status = "ok" if message is None else f"error: {message}"
+    if obj.Status != status:
+        obj.Status = status
+    if message is not None:
+        FreeCAD.Console.PrintError(f"{obj.Label}: {message}\n")
+
+
+def part_shape(ocp_shape):
+    """An OCP shape (CadQuery's kernel) as a FreeCAD Part.Shape, via BREP text."""
+    import cadquery as cq
+    import Part
+
+    buffer = io.BytesIO()
+    cq.Shape.cast(ocp_shape).exportBrep(buffer)
+    shape = Part.Shape()
+    shape.importBrepFromString(buffer.getvalue().decode("ascii"))
+    return shape
+
+
+def set_shape(obj, shape) -> None:
+    """Replace obj.Shape keeping the object's placement (the solids are already in the machine frame)."""
+    placement = obj.Placement
+    obj.Shape = shape
+    obj.Placement = placement
+
+
+def linked(obj, prop: str, kind: str):
+    """The object linked by `prop`, checked to be a spur_cad `kind` ('gear', 'stock', ...)."""
+    from spur_cad.errors import SpurCadError
+
+    target = getattr(obj, prop, None)
+    if target is None:
+        raise SpurCadError(f"no {kind} linked (property {prop})")
+    if getattr(getattr(target, "Proxy", None), "KIND", None) != kind:
+        raise SpurCadError(f"{prop} links {target.Label}, which is not a spur_cad {kind}")
+    return target
+
+
+def document_values(obj) -> dict[str, dict]:
+    """Property values of the gear / stock / job behind `obj` (and the objects it links)."""
+    kind = obj.Proxy.KIND
+    if kind == "gear":
+        return {"gear": read_values(obj, schema.GEAR_FIELDS)}
+    if kind == "stock":
+        gear = linked(obj, "Gear", "gear")
+        return {"gear": read_values(gear, schema.GEAR_FIELDS), "stock": read_values(obj, schema.STOCK_FIELDS)}
+    if kind == "job":
+        stock = linked(obj, "Stock", "stock")
+        gear = linked(obj, "Gear", "gear")
+        return {"gear": read_values(gear, schema.GEAR_FIELDS), "stock": read_values(stock, schema.STOCK_FIELDS),
+                "job": read_values(obj, schema.JOB_FIELDS)}
+    raise ValueError(f"not a spur_cad object with job values: {obj.Label}")
+
+
+def source_of(obj) -> str:
+    """What a job built from the document says it came from: the document's file, else its name."""
+    return obj.Document.FileName or obj.Document.Name
+
+
+def job_of(obj):
+    """The validated spur_cad Job (or its gear/stock part) described by `obj`; raises SpurCadError."""
+    from spur_cad.job import job_from_dict
+
+    return job_from_dict(schema.job_data(document_values(obj)), source_of(obj))
+
+
+class _Proxy:
+    """Common proxy behaviour: no state of its own, migration on restore."""
+
+    KIND = ""
+    FIELDS: tuple = ()
+    OUTPUTS: tuple = ()
+
+    def __init__(self, obj):
+        obj.Proxy = self
+
+    def dumps(self):
+        return None
+
+    def loads(self, state):
+        return None
+
+    def __getstate__(self):
+        return None
+
+    def __setstate__(self, state):
+        return None
+
+    def onDocumentRestored(self, obj):
+        """Migrate an older document: add the properties this schema has and the document lacks."""
+        version = obj.SchemaVersion if "SchemaVersion" in obj.PropertiesList else 0
+        if version > schema.SCHEMA_VERSION:
+            FreeCAD.Console.PrintWarning(f"{obj.Label}: saved by a newer spur_cad (schema {version}); "
+                                         "properties it added are kept but not used\n")
+            return
+        if version < schema.SCHEMA_VERSION:
+            defaults = schema.default_values().get(self.KIND, {})
+            add_fields(obj, self.FIELDS, defaults)
+            add_fields(obj, self.OUTPUTS, outputs=True)
+            add_bookkeeping(obj)
+            obj.SchemaVersion = schema.SCHEMA_VERSION
+            FreeCAD.Console.PrintMessage(f"{obj.Label}: migrated from schema {version} to {schema.SCHEMA_VERSION}\n")
+
+
+class GearFeature(_Proxy):
+    """The gear: ISO 21771 inputs, computed radii and inspection values, the exact solid."""
+
+    KIND = "gear"
+    FIELDS = schema.GEAR_FIELDS
+    OUTPUTS = schema.GEAR_OUTPUTS
+
+    def __init__(self, obj, values: dict):
+        super().__init__(obj)
+        add_fields(obj, self.FIELDS, values)
+        add_fields(obj, self.OUTPUTS, outputs=True)
+        add_bookkeeping(obj)
+
+    def execute(self, obj):
+        from spur_cad.cad.solid import build_gear_shape
+        from spur_cad.errors import SpurCadError
+        from spur_cad.geometry.inspection import inspection_sheet
+
+        try:
+            job = job_of(obj)
+            shape, _ = build_gear_shape(job.gear, job.gear_section.blank_features())
+        except SpurCadError as exc:
+            report(obj, str(exc))
+            return
+        spec, sheet = job.gear, inspection_sheet(job.gear)
+        write_outputs(obj, {
+            "ReferenceRadius": spec.reference_radius_mm, "BaseRadius": spec.base_radius_mm,
+            "TipRadius": spec.tip_radius_mm, "RootRadius": spec.root_radius_mm, "FormRadius": spec.form_radius_mm,
+            "ToothThickness": spec.tooth_thickness_mm, "SpanTeeth": int(sheet["span_teeth_k"]),
+            "SpanMeasurement": sheet["span_measurement_mm"], "PinDiameter": sheet["pin_diameter_mm"],
+            "DimensionOverPins": sheet["dimension_over_pins_mm"], "Undercut": bool(spec.undercut),
+            "UndercutDepth": spec.undercut_depth_mm,
+            "MinTeethWithoutUndercut": int(sheet["min_teeth_without_undercut"])})
+        set_shape(obj, part_shape(shape))
+        report(obj, None)
+
+
+class StockFeature(_Proxy):
+    """The blank, sized from the linked gear (tip radius + allowance, margins, holding stub)."""
+
+    KIND = "stock"
+    FIELDS = schema.STOCK_FIELDS
+    OUTPUTS = schema.STOCK_OUTPUTS
+
+    def __init__(self, obj, gear, values: dict):
+        super().__init__(obj)
+        obj.addProperty("App::PropertyLink", "Gear", "Stock", "the gear this stock is for")
+        obj.Gear = gear
+        add_fields(obj, self.FIELDS, values)
+        add_fields(obj, self.OUTPUTS, outputs=True)
+        add_bookkeeping(obj)
+
+    def execute(self, obj):
+        from spur_cad.cad.solid import build_stock_shape
+        from spur_cad.errors import SpurCadError
+
+        try:
+            job = job_of(obj)
+            shape = build_stock_shape(job.gear, job.stock)
+        except SpurCadError as exc:
+            report(obj, str(exc))
+            return
+        write_outputs(obj, {"BlankRadius": job.stock.blank_radius_mm(job.gear)})
+        set_shape(obj, part_shape(shape))
+        report(obj, None)
+
+
+class JobFeature(_Proxy):
+    """The 4-axis job: tools, cutting data, strategies, machine, post; plans both toolpaths on recompute."""
+
+    KIND = "job"
+    FIELDS = schema.JOB_FIELDS
+    OUTPUTS = schema.JOB_OUTPUTS
+
+    def __init__(self, obj, gear, stock, values: dict):
+        super().__init__(obj)
+        obj.addProperty("App::PropertyLink", "Gear", "Job", "the gear to cut")
+        obj.addProperty("App::PropertyLink", "Stock", "Job", "the blank it is cut from")
+        obj.addProperty("App::PropertyLink", "RoughingToolpath", "Toolpaths", "roughing toolpath object")
+        obj.addProperty("App::PropertyLink", "FinishingToolpath", "Toolpaths", "finishing toolpath object")
+        obj.Gear, obj.Stock = gear, stock
+        add_fields(obj, self.FIELDS, values)
+        add_fields(obj, self.OUTPUTS, outputs=True)
+        add_bookkeeping(obj)
+
+    def execute(self, obj):
+        from spur_cad.errors import SpurCadError
+        from spur_cad.pipeline import plan_cam
+
+        try:
+            job = job_of(obj)
+            plan = plan_cam(job)
+        except SpurCadError as exc:
+            report(obj, str(exc))
+            return
+        facts, rec = plan.facts, plan.facts["tools"]
+        outputs = {"FinishingMaxFlatWidth": rec["finishing_max_flat_width_mm"],
+                   "FinishingMaxCornerRadius": rec["finishing_max_corner_radius_mm"],
+                   "PlungeAllowance": rec["plunge_allowance_mm"], "RoughingMaxDiameter": rec["roughing_max_diameter_mm"],
+                   "RequiredFluteLength": rec["required_flute_length_mm"],
+                   "RequiredStickOut": rec["required_stick_out_mm"], "Warnings": list(facts["warnings"])}
+        for name in schema.TOOL_ROLES:
+            title = name.capitalize()
+            outputs[f"{title}Moves"] = int(facts[name]["moves"]) if name in facts else 0
+            outputs[f"{title}Time"] = facts[name]["estimated_time_s"] / 60.0 if name in facts else 0.0
+            target = getattr(obj, f"{title}Toolpath")
+            if target is not None:
+                update_toolpath(target, getattr(plan, name), job, facts.get(name))
+        write_outputs(obj, outputs)
+        report(obj, None)
+
+
+class ToolpathFeature(_Proxy):
+    """One operation's toolpath drawn in the part frame; its content is set by the job's recompute."""
+
+    KIND = "toolpath"
+    OUTPUTS = schema.TOOLPATH_OUTPUTS
+
+    def __init__(self, obj, operation: str):
+        super().__init__(obj)
+        add_fields(obj, self.OUTPUTS, outputs=True)
+        add_bookkeeping(obj)
+        obj.Operation = operation
+
+    def execute(self, obj):
+        return None
+
+
+def uses_path_module(obj) -> bool:
+    """Whether a toolpath object is a FreeCAD Path object (else a Part wire compound)."""
+    return obj.isDerivedFrom("Path::Feature")
+
+
+def update_toolpath(obj, path, job, facts: dict | None) -> None:
+    """Draw `path` (IR or None) into the toolpath object and set its computed properties."""
+    from spur_cad_workbench.display import display_path, gcode_text, polylines
+
+    if path is None:
+        drawn, moves, outputs = None, 0, {"Moves": 0, "DisplayedMoves": 0, "CuttingLength": 0.0,
+                                          "EstimatedTime": 0.0, "ToolNumber": 0, "SpindleSpeed": 0.0}
+    else:
+        drawn = display_path(path)
+        moves = drawn.moves_shown
+        outputs = {"Moves": int(facts["moves"]), "DisplayedMoves": int(moves),
+                   "CuttingLength": float(facts["cutting_length_mm"]),
+                   "EstimatedTime": float(facts["estimated_time_s"]) / 60.0, "ToolNumber": int(path.tool_number),
+                   "SpindleSpeed": float(path.spindle_rpm)}
+    if uses_path_module(obj):
+        import Path
+
+        program = Path.Path()
+        if drawn is not None and len(drawn.points):
+            program.setFromGCode(gcode_text(drawn))
+        obj.Path = program
+    else:
+        import Part
+
+        wires = [] if drawn is None else [Part.makePolygon([FreeCAD.Vector(*p) for p in run])
+                                          for _, run in polylines(drawn)]
+        obj.Shape = Part.makeCompound(wires)
+    write_outputs(obj, outputs)
+    report(obj, None)
+    obj.purgeTouched()  # set by the job's recompute: nothing left for the toolpath itself to do
+
+
+class ViewProvider:
+    """Icon, tree children and editing of the workbench's objects; no state."""
+
+    def __init__(self, vobj):
+        vobj.Proxy = self
+
+    def attach(self, vobj):
+        self.Object = vobj.Object
+
+    def getIcon(self):
+        kind = getattr(getattr(getattr(self, "Object", None), "Proxy", None), "KIND", "")
+        return icon_path({"gear": "gear", "stock": "stock", "job": "job", "toolpath": "toolpath"}.get(kind, "spur_cad"))
+
+    def claimChildren(self):
+        obj = getattr(self, "Object", None)
+        if obj is None or getattr(obj.Proxy, "KIND", "") != "job":
+            return []
+        return [child for child in (obj.RoughingToolpath, obj.FinishingToolpath) if child is not None]
+
+    def setEdit(self, vobj, mode=0):
+        if getattr(vobj.Object.Proxy, "KIND", "") != "job":
+            return False
+        from spur_cad_workbench.taskpanel import show_job_panel
+
+        show_job_panel(vobj.Object)
+        return True
+
+    def unsetEdit(self, vobj, mode=0):
+        import FreeCADGui
+
+        FreeCADGui.Control.closeDialog()
+        return True
+
+    def doubleClicked(self, vobj):
+        if getattr(vobj.Object.Proxy, "KIND", "") != "job":
+            return False
+        from spur_cad_workbench.taskpanel import show_job_panel
+
+        show_job_panel(vobj.Object)
+        return True
+
+    def dumps(self):
+        return None
+
+    def loads(self, state):
+        return None
+
+    def __getstate__(self):
+        return None
+
+    def __setstate__(self, state):
+        return None

@@ -1,0 +1,120 @@
+"""The Simulate command's link to spur_cad.sim, guarded for a spur_cad without the simulator.
+
+`simulate_job` cuts the stock with the job's toolpaths through spur_cad.sim's public API
+(`simulate`, `StockCylinder`, `Operation`, `SimSettings`); `show_result` draws every design
+point of the face width, in the part frame, coloured by its deviation (blue gouge, green on
+the design, red leftover). Without spur_cad.sim, `simulator()` raises SimulationUnavailable
+with the message the command shows.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from spur_cad.errors import SpurCadError
+
+MAX_SHOWN_POINTS = 300_000
+
+NOT_AVAILABLE = "simulation not available: this spur_cad has no simulator (spur_cad.sim)"
+
+
+class SimulationUnavailable(SpurCadError):
+    """The installed spur_cad cannot simulate (no spur_cad.sim)."""
+
+
+def simulator():
+    """The spur_cad.sim module; raises SimulationUnavailable when it is not installed."""
+    try:
+        import spur_cad.sim as sim
+    except ModuleNotFoundError as exc:
+        if exc.name in ("spur_cad.sim", "spur_cad"):
+            raise SimulationUnavailable(NOT_AVAILABLE) from None
+        raise
+    return sim
+
+
+def simulate_job(job, plan, resolution_mm: float):
+    """spur_cad.sim's result for the job's roughing then finishing toolpaths (the planned IR)."""
+    from spur_cad.cam.finishing import station_positions, station_step_mm
+
+    sim = simulator()
+    spec, stock = job.gear, job.stock
+    cylinder = sim.StockCylinder(stock.blank_radius_mm(spec), -stock.front_margin_mm,
+                                 spec.face_width_mm + stock.back_margin_mm)
+    operations = [sim.Operation(path, tool) for path, tool in ((plan.roughing, job.tools.roughing),
+                                                               (plan.finishing, job.tools.finishing))
+                  if path is not None]
+    if not operations:
+        raise SpurCadError("the job has no toolpaths to simulate (choose a roughing or finishing tool)")
+    stations = None
+    if job.tools.finishing is not None and job.finishing.strategy == "perimeter":
+        stations = station_positions(spec.face_width_mm, station_step_mm(job.tools.finishing, job.finishing))
+    return sim.simulate(spec, cylinder, operations, sim.SimSettings(resolution_mm=resolution_mm), station_x=stations)
+
+
+def colour_scale_mm(resolution_mm: float) -> float:
+    """Deviation shown fully blue (gouge) or red (leftover): five times the simulation's resolution."""
+    return 5.0 * resolution_mm
+
+
+def deviation_colours(deviation: np.ndarray, scale_mm: float) -> np.ndarray:
+    """(N, 3) RGB in [0, 1]: blue at -scale (gouge), green at 0, red at +scale (leftover) and beyond."""
+    t = np.clip(np.asarray(deviation, float) / scale_mm, -1.0, 1.0)
+    red = np.clip(t, 0.0, 1.0)
+    blue = np.clip(-t, 0.0, 1.0)
+    return np.column_stack([red, 1.0 - np.abs(t), blue])
+
+
+def result_points(result) -> tuple[np.ndarray, np.ndarray]:
+    """Design points of the face width in the part frame (N, 3) and their deviations (N,), rows thinned
+    evenly when there are more than MAX_SHOWN_POINTS."""
+    grid = result.grid
+    rows = np.nonzero(result.gear_rows)[0]
+    per_row = grid.teeth * len(grid.points)
+    stride = max(1, int(np.ceil(len(rows) * per_row / MAX_SHOWN_POINTS)))
+    rows = rows[::stride]
+    transverse = np.concatenate([grid.space_points(k) for k in range(grid.teeth)])  # (teeth * M, 2)
+    points = np.concatenate([np.column_stack([np.full(len(transverse), grid.rows_x[r]), transverse]) for r in rows])
+    deviation = np.concatenate([result.deviation[:, :, r].reshape(-1) for r in rows])
+    return points, deviation
+
+
+def show_result(job_obj, result):
+    """A Points object '<job> simulation' with the coloured design points and the result's facts."""
+    import FreeCAD
+    import Points
+
+    doc = job_obj.Document
+    name = f"{job_obj.Label} simulation"
+    found = [obj for obj in doc.Objects if obj.TypeId == "Points::Feature" and obj.Label == name]
+    obj = found[0] if found else doc.addObject("Points::Feature", "Simulation")
+    obj.Label = name
+    points, deviation = result_points(result)
+    facts = result.facts()
+    scale = colour_scale_mm(result.settings.resolution_mm)
+    properties = (("Color", "App::PropertyColorList", "deviation colour per point"),
+                  ("Resolution", "App::PropertyLength", "simulation resolution"),
+                  ("MaxGouge", "App::PropertyLength", "largest gouge (material removed below the design)"),
+                  ("MaxLeftover", "App::PropertyLength", "largest leftover (material above the design)"),
+                  ("RemovedVolume", "App::PropertyFloat", "removed volume (mm^3)"),
+                  ("Seconds", "App::PropertyFloat", "simulation time (s)"),
+                  ("Legend", "App::PropertyString", "colour legend"))
+    for prop, type_id, doc_text in properties:
+        if prop not in obj.PropertiesList:
+            obj.addProperty(type_id, prop, "Simulation", doc_text, 1 if prop != "Color" else 0)
+    obj.Points = Points.Points([FreeCAD.Vector(*p) for p in points])
+    obj.Color = [tuple(c) for c in deviation_colours(deviation, scale)]
+    obj.Resolution = result.settings.resolution_mm
+    obj.MaxGouge = facts["max_gouge_mm"]
+    obj.MaxLeftover = facts["max_leftover_mm"]
+    obj.RemovedVolume = facts["removed_volume_mm3"]
+    obj.Seconds = facts["seconds"]
+    obj.Legend = (f"blue: gouge of {scale:g} mm or more, green: on the design, red: leftover of {scale:g} mm or "
+                  f"more ({len(points)} of {result.deviation[:, :, result.gear_rows].size} design points shown)")
+    doc.recompute()
+    if FreeCAD.GuiUp and obj.ViewObject is not None:
+        obj.ViewObject.DisplayMode = "Color"
+        obj.ViewObject.PointSize = 3
+    FreeCAD.Console.PrintMessage(f"{name}: max gouge {facts['max_gouge_mm']:.4f} mm, max leftover "
+                                 f"{facts['max_leftover_mm']:.4f} mm\n")
+    return obj

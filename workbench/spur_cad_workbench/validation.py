@@ -1,0 +1,142 @@
+"""Checks of a job's property values for the task panel, and tool suggestions (plain Python, no FreeCAD).
+
+`validate` runs the same checks as the command line (spur_cad.job.job_from_dict, then the
+tool limits and the roughing reach of spur_cad.cam.recommend) and files each SpurCadError
+message under the panel group it is about, so the panel shows it beside the fields.
+"""
+
+from __future__ import annotations
+
+import math
+import re
+from dataclasses import dataclass
+
+from spur_cad.errors import SpurCadError
+
+from spur_cad_workbench.schema import TOOL_SWITCHES, job_data
+
+# Panel groups (the property groups of schema.JOB_FIELDS, plus the gear and stock objects).
+SECTION_GROUPS = {"tools.roughing": "Roughing tool", "tools.finishing": "Finishing tool",
+                  "roughing": "Roughing strategy", "finishing": "Finishing strategy", "machine": "Machine",
+                  "post": "Post", "job": "Job", "gear": "Gear", "stock": "Stock"}
+_SECTION_RE = re.compile(r"\[(tools\.roughing|tools\.finishing|roughing|finishing|machine|post|job|gear|stock)\]")
+
+
+@dataclass(frozen=True)
+class Validation:
+    """Outcome of checking a job: the Job when valid, messages by panel group, recommendations when known."""
+
+    job: object | None
+    messages: dict[str, str]
+    recommendations: object | None
+
+    @property
+    def ok(self) -> bool:
+        return self.job is not None and not self.messages
+
+
+def group_of(message: str) -> str:
+    """Panel group a job_from_dict or tool-check message is about."""
+    found = _SECTION_RE.search(message)
+    if found:
+        return SECTION_GROUPS[found.group(1)]
+    if "invalid gear" in message:
+        return "Gear"
+    for role in ("roughing", "finishing"):
+        if message.startswith(f"{role} "):
+            return SECTION_GROUPS[f"tools.{role}"]
+    return "Job"
+
+
+def _strip_source(message: str, source: str) -> str:
+    prefix = f"{source}: "
+    return message[len(prefix):] if message.startswith(prefix) else message
+
+
+def validate(values: dict[str, dict[str, object]], source: str = "job") -> Validation:
+    """Check gear, stock and job values as the command line would; never raises for a SpurCadError."""
+    from spur_cad.cam.recommend import check_roughing_reach, check_tools, recommend_tools
+    from spur_cad.cam.roughing import roughing_levels
+    from spur_cad.job import job_from_dict
+
+    data = job_data(values)
+    base = {name: section for name, section in data.items() if name != "tools"}
+    try:
+        without_tools = job_from_dict(base, source)
+    except SpurCadError as exc:
+        message = _strip_source(str(exc), source)
+        return Validation(None, {group_of(message): message}, None)
+    spec, blank = without_tools.gear, without_tools.stock.blank_radius_mm(without_tools.gear)
+    clearance = without_tools.machine.clearance_mm
+    try:
+        job = job_from_dict(data, source)
+    except SpurCadError as exc:
+        message = _strip_source(str(exc), source)
+        return Validation(None, {group_of(message): message}, recommend_tools(spec, blank, clearance))
+    rec = recommend_tools(spec, blank, clearance, job.tools.finishing)
+    roughing, finishing = job.tools.roughing, job.tools.finishing
+    try:
+        check_tools(spec, rec, roughing, finishing)
+        if roughing is not None and finishing is not None:
+            levels = roughing_levels(spec, roughing, job.roughing, blank)
+            check_roughing_reach(roughing, levels.lowest_height_mm - spec.root_radius_mm, rec)
+    except SpurCadError as exc:
+        message = str(exc)
+        return Validation(None, {group_of(message): message}, rec)
+    return Validation(job, {}, rec)
+
+
+def recommendation_notes(rec) -> dict[str, str]:
+    """Text shown beside the tool fields (property name -> note) for ToolRecommendations `rec`."""
+    if rec is None:
+        return {}
+    notes = {
+        "RoughingToolDiameter": f"at most {rec.roughing_max_diameter_mm:.3f} mm (space width at root + A_p)",
+        "FinishingToolDiameter": f"flat width D - 2 r_t at most {rec.finishing_max_flat_width_mm:.3f} mm "
+                                 "(root arc length)",
+        "FinishingCornerRadius": f"at most {rec.finishing_max_corner_radius_mm:.3f} mm (smallest fillet radius)",
+    }
+    for role in ("Roughing", "Finishing"):
+        notes[f"{role}FluteLength"] = f"at least {rec.required_flute_length_mm:.3f} mm (or 0: not checked)"
+        notes[f"{role}StickOut"] = f"at least {rec.required_stick_out_mm:.3f} mm (or 0: not checked)"
+    return notes
+
+
+def _floor_to(value: float, step: float) -> float:
+    return math.floor(value / step + 1e-9) * step
+
+
+def suggest_tools(values: dict[str, dict[str, object]]) -> dict[str, object]:
+    """Job property values choosing tools within the recommendations (for a new job); {} if none fits.
+
+    Finishing: bull-nose with r_t at 90 % of the smallest fillet radius (0.05 mm steps, at most
+    1 mm) and flat width at 90 % of the root arc; roughing: the largest 0.1 mm diameter that
+    passes the tool limits and the roughing-reach rule.
+    """
+    from spur_cad.cam.recommend import recommend_tools
+
+    check = validate({**values, "job": {**values["job"], TOOL_SWITCHES["roughing"].prop: False,
+                                        TOOL_SWITCHES["finishing"].prop: False}})
+    if check.job is None:
+        return {}
+    spec = check.job.gear
+    rec = check.recommendations
+    corner = min(_floor_to(0.9 * rec.finishing_max_corner_radius_mm, 0.05), 1.0)
+    flat = _floor_to(0.9 * rec.finishing_max_flat_width_mm, 0.05)
+    if corner <= 0.0 or flat <= 0.0:
+        return {}
+    chosen = {"UseFinishingTool": True, "FinishingToolKind": "bull_nose", "FinishingToolDiameter": round(flat + 2 * corner, 6),
+              "FinishingCornerRadius": round(corner, 6)}
+    from spur_cad.cam.tools import Tool
+
+    finishing = Tool(diameter_mm=chosen["FinishingToolDiameter"], kind="bull_nose", corner_radius_mm=corner)
+    blank = check.job.stock.blank_radius_mm(spec)
+    limit = recommend_tools(spec, blank, check.job.machine.clearance_mm, finishing).roughing_max_diameter_mm
+    diameter = _floor_to(limit, 0.1)
+    while diameter >= 0.2:
+        candidate = {**chosen, "UseRoughingTool": True, "RoughingToolKind": "flat", "RoughingToolDiameter": round(diameter, 6),
+                     "RoughingCornerRadius": 0.0}
+        if validate({**values, "job": {**values["job"], **candidate}}).ok:
+            return candidate
+        diameter -= 0.1
+    return chosen
