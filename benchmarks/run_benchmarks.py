@@ -111,13 +111,39 @@ def bench_cam(runs: int) -> dict:
             "reference_strategy_time_s": ref.time_s}
 
 
+def bench_post(runs: int) -> dict:
+    """G-code for the reference job: lines and bytes flat vs folded per dialect, and posting time."""
+    from spur_cad.job import load_job
+    from spur_cad.pipeline import plan_cam
+    from spur_cad.post import DIALECT_NAMES, PostSettings, ProgramInfo, post_program
+
+    job = load_job(Path(__file__).resolve().parents[1] / "resources" / "examples" / "reference_gear.toml")
+    plan = plan_cam(job)
+    info = ProgramInfo("benchmark", ("reference job",))
+    result: dict = {}
+    for dialect in DIALECT_NAMES:
+        for folded in (False, True):
+            label = f"{dialect}_{'folded' if folded else 'flat'}"
+            settings = PostSettings(dialect=dialect, folded=folded)
+            finishing = post_program(plan.finishing, settings, info)
+            roughing = post_program(plan.roughing, settings, info)
+            result[label] = {"finishing_lines": finishing.lines, "finishing_bytes": finishing.bytes,
+                             "roughing_lines": roughing.lines, "roughing_bytes": roughing.bytes}
+        for folded in (False, True):
+            seconds = median_seconds(lambda: post_program(plan.finishing, PostSettings(dialect=dialect,  # noqa: B023
+                                                                                          folded=folded), info), runs)
+            result[f"{dialect}_{'folded' if folded else 'flat'}"]["finishing_post_s"] = seconds
+    return result
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__)
     parser.add_argument("--runs", type=int, default=21)
     parser.add_argument("--cad-runs", type=int, default=5)
     args = parser.parse_args()
     results = {"machine": machine(), "runs": args.runs, "profile": bench_profile(args.runs),
-               "cad_runs": args.cad_runs, "cad": bench_cad(args.cad_runs), "cam": bench_cam(args.cad_runs)}
+               "cad_runs": args.cad_runs, "cad": bench_cad(args.cad_runs), "cam": bench_cam(args.cad_runs),
+               "post": bench_post(args.cad_runs)}
     print(json.dumps(results, indent=2))
 
 
