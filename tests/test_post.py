@@ -356,3 +356,35 @@ def test_comments_cannot_break_the_program():
             else:
                 assert line.count("(") == line.count(")") <= 1, line
         assert read_program(text, dialect).ended
+
+
+@pytest.mark.parametrize("folded", [False, True])
+def test_rotary_clamp_codes_hold_the_table_while_roughing_cuts(folded, cam_paths):
+    spec, tool, *_ = cam_paths["shifted_z12"]
+    machine = Machine(rotary_clamp_code="M10", rotary_unclamp_code="M11")
+    path = roughing_toolpath(spec, tool, machine, RoughingParams(flank_allowance_mm=0.1 * spec.module_mm,
+                                                                 clamp_rotary=True), spec.tip_radius_mm + 0.5)
+    info = ProgramInfo("clamped", (), rotary_clamp_code="M10", rotary_unclamp_code="M11")
+    text = post_program(path, PostSettings(folded=folded), info).text
+    # Expand the program by its call order (independent reader for the moves; the M codes by text).
+    program = read_program(text, "linuxcnc")
+    assert_same_moves([(m.rapid, np.array(m.end)) for m in program.moves], path, 4, 4)
+    assert "M10" in text and "M11" in text
+    clamped, cuts, lines = False, 0, []
+    if folded:  # inline the subprogram text at each call, in order
+        sub = re.search(r"^o(\d+) sub\n(.*?)^o\1 endsub\n", text, flags=re.M | re.S)
+        for line in text[sub.end():].splitlines():
+            lines += sub.group(2).splitlines() if line.startswith(f"o{sub.group(1)} call") else [line]
+    else:
+        lines = text.splitlines()
+    for line in lines:
+        if line == "M10":
+            clamped = True
+        elif line == "M11":
+            clamped = False
+        elif re.search(r"\bA", line):
+            assert not clamped, f"A moves while the table is clamped: {line}"
+        elif line.startswith("X"):  # a level pass along the face width
+            assert clamped, f"cutting with the table unclamped: {line}"
+            cuts += 1
+    assert cuts > spec.teeth
