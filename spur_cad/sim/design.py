@@ -114,6 +114,9 @@ def row_positions(x_min: float, x_max: float, spacing_mm: float, extra: np.ndarr
     grid = grid[(grid >= x_min - 1e-9) & (grid <= x_max + 1e-9)]
     extra = np.asarray(extra, float)
     extra = extra[(extra >= x_min) & (extra <= x_max)]
+    if len(extra) > 1:  # the grid only fills where the extra rows leave gaps wider than the spacing
+        nearest = np.abs(grid[:, None] - extra[None, :]).min(axis=1)
+        grid = grid[nearest > 0.5 * spacing_mm]
     rows = np.unique(np.round(np.concatenate([grid, extra, [x_min, x_max], anchors]), 9))
     rows = rows[(rows >= x_min - 1e-9) & (rows <= x_max + 1e-9)]
     edges = np.concatenate([[x_min], 0.5 * (rows[1:] + rows[:-1]), [x_max]])

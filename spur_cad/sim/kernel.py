@@ -86,7 +86,7 @@ def first_entry(dx, ay, az, ny, nz, lo, hi, radius, rho, rt):
     if f > hi - lo or slope >= 0.0:
         return INF
     fh, slope_h = _gap_and_slope(hi, dx, ay, az, ny, nz, rho, rt)
-    if fh > 0.0 and slope_h <= 0.0:
+    if fh > 0.0 and (slope_h <= 0.0 or f + fh > hi - lo):  # |slope| <= 1: min G >= (G(lo) + G(hi) - (hi - lo)) / 2
         return INF
     t = lo
     for _ in range(_NEWTON_STEPS):
@@ -119,7 +119,7 @@ def _sector_range(y, z, a, reach, radius, blade_len, pitch, teeth):
 
 
 @njit(cache=True)
-def _clip_at_pose(x, y, z, a, x_end, h, points, normals, chunk_start, chunk_centre, chunk_radius,
+def _clip_at_pose(x, y, z, a, x_end, h, h_top, points, normals, chunk_start, chunk_centre, chunk_radius,
                   rows, t_min, t_max, radius, rho, rt, reach, blade_len, pitch, teeth):
     """Clip the blades by the tool at (x, y, z, a); with x_end > x, by the tool swept along X from x to x_end
     (the union of the slices is the slice nearest the axis: t_e(dx) grows with |dx|)."""
@@ -130,6 +130,8 @@ def _clip_at_pose(x, y, z, a, x_end, h, points, normals, chunk_start, chunk_cent
     r_hi = np.searchsorted(rows, x_end + radius, side="left")
     if r_lo >= r_hi:
         return 0
+    r_in = np.searchsorted(rows, x, side="left")  # rows[r_in:r_out] lie within [x, x_end]
+    r_out = np.searchsorted(rows, x_end, side="right")
     cuts = 0
     n_chunks = len(chunk_radius)
     for k in range(first, last + 1):
@@ -157,34 +159,66 @@ def _clip_at_pose(x, y, z, a, x_end, h, points, normals, chunk_start, chunk_cent
                 az = s * px + c * pz_ - z
                 ny = c * nx - s * nz_
                 nz = s * nx + c * nz_
-                deepest = first_entry(0.0, ay, az, ny, nz, t_min, t_max, radius, rho, rt)
+                top = h_top[sector, j]
+                deepest = first_entry(0.0, ay, az, ny, nz, t_min, top, radius, rho, rt)
                 if deepest == INF:
                     continue
                 hrow = h[sector, j]
-                for r in range(r_lo, r_hi):
+                for r in range(r_in, r_out):  # rows within the sweep see the slice through the tool axis
+                    if deepest < hrow[r]:
+                        hrow[r] = deepest
+                        cuts += 1
+                # Outside the sweep the slice at distance |dx| shrinks as |dx| grows: the entry only grows
+                # (a lower bound for the next row outward), and no slice wider than reach_x meets the blade.
+                u_in = ay + t_min * ny
+                u_out = ay + top * ny
+                dy_min = 0.0 if u_in * u_out <= 0.0 else min(abs(u_in), abs(u_out))
+                dz_top = max(az + t_min * nz, az + top * nz)
+                slice_radius = radius
+                if dz_top < rt:
+                    slice_radius = rho + math.sqrt(max(rt * rt - (rt - dz_top) ** 2, 0.0))
+                reach_x2 = slice_radius * slice_radius - dy_min * dy_min
+                if reach_x2 <= 0.0:
+                    continue
+                reach_x = math.sqrt(reach_x2)
+                lower = deepest
+                for r in range(r_out, r_hi):
+                    dx = rows[r] - x_end
+                    if dx > reach_x:
+                        break
                     current = hrow[r]
-                    if deepest >= current:
+                    if lower >= current:
                         continue
-                    xr = rows[r]
-                    if xr < x:
-                        entry = first_entry(x - xr, ay, az, ny, nz, t_min, current, radius, rho, rt)
-                    elif xr > x_end:
-                        entry = first_entry(xr - x_end, ay, az, ny, nz, t_min, current, radius, rho, rt)
-                    else:
-                        entry = deepest
+                    entry = first_entry(dx, ay, az, ny, nz, lower, current, radius, rho, rt)
                     if entry < current:
                         hrow[r] = entry
+                        lower = entry
+                        cuts += 1
+                lower = deepest
+                for r in range(r_in - 1, r_lo - 1, -1):
+                    dx = x - rows[r]
+                    if dx > reach_x:
+                        break
+                    current = hrow[r]
+                    if lower >= current:
+                        continue
+                    entry = first_entry(dx, ay, az, ny, nz, lower, current, radius, rho, rt)
+                    if entry < current:
+                        hrow[r] = entry
+                        lower = entry
                         cuts += 1
     return cuts
 
 
 @njit(cache=True)
-def clip_poses(poses, x_end, h, points, normals, chunk_start, chunk_centre, chunk_radius, rows, t_min, t_max,
+def clip_poses(poses, x_end, h, h_top, points, normals, chunk_start, chunk_centre, chunk_radius, rows, t_min, t_max,
                radius, rho, rt, reach, blade_len, pitch, teeth):
-    """Clip by a batch of tool positions (N, 4): x, y, z, a (rad); x_end[i] > x[i] sweeps along X."""
+    """Clip by a batch of tool positions (N, 4): x, y, z, a (rad); x_end[i] > x[i] sweeps along X.
+
+    `h_top[sector, point]` is an upper bound of the blade's h over all rows (h only falls)."""
     cuts = 0
     for i in range(poses.shape[0]):
-        cuts += _clip_at_pose(poses[i, 0], poses[i, 1], poses[i, 2], poses[i, 3], x_end[i], h, points, normals,
+        cuts += _clip_at_pose(poses[i, 0], poses[i, 1], poses[i, 2], poses[i, 3], x_end[i], h, h_top, points, normals,
                               chunk_start, chunk_centre, chunk_radius, rows, t_min, t_max, radius, rho, rt, reach,
                               blade_len, pitch, teeth)
     return cuts

@@ -8,7 +8,7 @@ See docs/simulation.md for the choice of representation. Each move is linear in 
 - a move in Z only is the tool at its lower end (the tool is everything above its bottom);
 - any other move (simultaneous Y/Z/A finishing moves, plunges with Y, index moves) is
   clipped at poses spaced `pose_step_mm` apart along the move's relative motion, so the
-  cusps between them stay within a quarter of the resolution;
+  cusps between them stay within half the resolution;
 - moves that stay above every blade cut nothing and are skipped.
 """
 
@@ -38,7 +38,7 @@ class SimulationError(SpurCadError, ValueError):
 @dataclass(frozen=True)
 class SimSettings:
     """Resolution and blade lengths. `resolution_mm` bounds the simulation's own error: cusps
-    between clipped poses (<= resolution / 4) and the spacing of design points and rows."""
+    between clipped poses (<= resolution / 2) and the spacing of design points and rows."""
 
     resolution_mm: float = 0.005
     gouge_range_mm: float = 0.5  # blades reach this far into the material (deeper gouges read as this)
@@ -156,11 +156,11 @@ class SimResult:
 
 def pose_step_mm(tool: Tool, resolution_mm: float) -> float:
     """Spacing of clipped poses along a move: the cusp between two copies of a corner of radius r a
-    distance l apart is l^2 / (8 r); keep it within resolution / 4 (sharp flat tools: resolution / 4)."""
+    distance l apart is l^2 / (8 r); keep it within resolution / 2 (sharp flat tools: resolution / 2)."""
     radius = tool.corner_radius if tool.corner_radius > 0.0 else 0.0
     if radius == 0.0:
-        return resolution_mm / 4.0
-    return math.sqrt(8.0 * radius * resolution_mm / 4.0)
+        return resolution_mm / 2.0
+    return math.sqrt(8.0 * radius * resolution_mm / 2.0)
 
 
 def _tool_shape(tool: Tool) -> tuple[float, float, float]:
@@ -291,7 +291,7 @@ def simulate(spec: GearSpec, stock: StockCylinder, operations: Sequence[Operatio
     sweeps = moves = 0
     for op in operations:
         radius, rho, rt = _tool_shape(op.tool)
-        flat_step = math.sqrt(8.0 * radius * res / 4.0)
+        flat_step = math.sqrt(8.0 * radius * res / 2.0)
         poses, x_end, n_sweeps = decompose(op.path, op.tool, res, reach, flat_step, (x_lo, x_hi))
         sweeps += n_sweeps
         moves += len(op.path)
@@ -300,7 +300,8 @@ def simulate(spec: GearSpec, stock: StockCylinder, operations: Sequence[Operatio
     total = sum(len(b[0]) for b in batches)
     done = 0
     for poses, x_end, radius, rho, rt in batches:
-        clip_poses(np.ascontiguousarray(poses), np.ascontiguousarray(x_end), h, grid.points, grid.normals,
+        h_top = np.ascontiguousarray(h.max(axis=2))
+        clip_poses(np.ascontiguousarray(poses), np.ascontiguousarray(x_end), h, h_top, grid.points, grid.normals,
                    chunk_start, chunk_centre, chunk_radius, grid.rows_x, t_min, t_max, radius, rho, rt, reach,
                    blade_len, grid.pitch_rad, grid.teeth)
         done += len(poses)
