@@ -36,6 +36,30 @@ def _parser() -> argparse.ArgumentParser:
     return parser
 
 
+class ProgressBars:
+    """A `run_job` progress callback: one tqdm bar per long stage on `stream` (never with --quiet)."""
+
+    def __init__(self, stream) -> None:
+        self._stream = stream
+        self._bars: dict = {}
+
+    def __call__(self, stage: str, fraction: float) -> None:
+        from tqdm import tqdm
+
+        bar = self._bars.get(stage)
+        if bar is None:
+            bar = self._bars[stage] = tqdm(total=100, desc=f"{stage:>13}", file=self._stream, leave=True,
+                                           bar_format="{desc}: {percentage:3.0f}%|{bar:30}| {elapsed}")
+        bar.n = min(100, round(100.0 * fraction))
+        bar.refresh()
+        if fraction >= 1.0:
+            bar.close()
+
+    def close(self) -> None:
+        for bar in self._bars.values():
+            bar.close()
+
+
 def _install_freecad(uninstall: bool) -> int:
     """`spur-cad install-freecad [--uninstall]` (see spur_cad.freecad_install)."""
     import os
@@ -59,7 +83,12 @@ def main(argv: list[str] | None = None) -> int:
         return _install_freecad(args.uninstall)
     try:
         job = load_job(args.job)
-        files = run_job(job)
+        bars = None if args.quiet else ProgressBars(sys.stderr)
+        try:
+            files = run_job(job, bars)
+        finally:
+            if bars is not None:
+                bars.close()
         out_dir = Path(args.out)
         if out_dir.exists() and not out_dir.is_dir():
             raise SpurCadError(f"--out {out_dir}: exists and is not a folder")

@@ -66,6 +66,20 @@ class GearSection:
 
 
 @dataclass(frozen=True)
+class SimulationSection:
+    """[simulation]: verification by simulated cutting (spur_cad.sim) and its resolution."""
+
+    enabled: bool = True
+    resolution_mm: float = 0.005
+
+    def validate(self) -> None:
+        """Raise SimulationError for a resolution the simulator does not accept."""
+        from spur_cad.sim.simulate import SimSettings
+
+        SimSettings(resolution_mm=self.resolution_mm).validate()
+
+
+@dataclass(frozen=True)
 class ToolsSection:
     """[tools]: the roughing and finishing tools (without them the job stops after the CAD stage)."""
 
@@ -87,6 +101,7 @@ class Job:
     finishing: FinishingParams = field(default_factory=FinishingParams)
     machine: Machine = field(default_factory=Machine)
     post: PostSettings = field(default_factory=PostSettings)
+    simulation: SimulationSection = field(default_factory=SimulationSection)
 
 
 _SECTIONS: dict[str, type] = {
@@ -97,6 +112,7 @@ _SECTIONS: dict[str, type] = {
     "finishing": FinishingParams,
     "machine": Machine,
     "post": PostSettings,
+    "simulation": SimulationSection,
 }
 _TOOL_SECTIONS = ("roughing", "finishing")
 
@@ -218,7 +234,8 @@ def _job_from_data(data: dict, source: str, text: str) -> Job:
         except GearSpecError as exc:
             raise JobFileError(f"{_where(source, text, table, exc.field)}: invalid [{table}]: {exc}") from None
     for name, check in (("machine", lambda m: m.validate()), ("roughing", lambda r: r.validate()),
-                        ("finishing", lambda f: f.validate()), ("post", lambda p: p.validate())):
+                        ("finishing", lambda f: f.validate()), ("post", lambda p: p.validate()),
+                        ("simulation", lambda s: s.validate())):
         if name in sections:
             try:
                 check(sections[name])
@@ -235,7 +252,7 @@ def _job_from_data(data: dict, source: str, text: str) -> Job:
     if not job_section.profile_tolerance_mm > 0.0 or job_section.profile_tolerance_mm > 0.1:
         raise JobFileError(f"{_where(source, text, 'job', 'profile_tolerance_mm')}: [job] profile_tolerance_mm "
                            f"must be in (0, 0.1] mm, got {job_section.profile_tolerance_mm:g}")
-    optional = {name: sections[name] for name in ("stock", "roughing", "finishing", "machine", "post")
+    optional = {name: sections[name] for name in ("stock", "roughing", "finishing", "machine", "post", "simulation")
                 if name in sections}
     return Job(source=source, job=job_section, gear_section=gear_section, gear=spec, tools=tools, **optional)
 

@@ -10,7 +10,7 @@ import io
 import json
 import time
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Callable
 
 import numpy as np
 
@@ -57,9 +57,16 @@ def build_summary(job: Job, samples: ProfileSamples, cad: dict, cam: dict, secon
     }
 
 
-def run_job(job: Job) -> dict[str, bytes]:
-    """Compute every output of the job in memory (no file I/O)."""
+def run_job(job: Job, progress: Callable[[str, float], None] | None = None) -> dict[str, bytes]:
+    """Compute every output of the job in memory (no file I/O). `progress(stage, fraction)` is told how
+    far each long stage is (the CLI draws progress bars with it)."""
     from spur_cad.report.plots import tooth_space_png
+    from spur_cad.report.stage import report_stage
+    from spur_cad.sim.stage import simulate_stage
+
+    def tell(stage: str, fraction: float) -> None:
+        if progress is not None:
+            progress(stage, fraction)
 
     seconds: dict[str, float] = {}
     start = time.perf_counter()
@@ -69,20 +76,35 @@ def run_job(job: Job) -> dict[str, bytes]:
     png = tooth_space_png(job.gear, samples)
     seconds["plot"] = time.perf_counter() - start
     start = time.perf_counter()
+    tell("CAD and STEP", 0.0)
     cad, step = build_cad(job)
+    tell("CAD and STEP", 1.0)
     seconds["cad_and_step"] = time.perf_counter() - start
     start = time.perf_counter()
+    tell("toolpaths", 0.0)
     plan = plan_cam(job)
+    tell("toolpaths", 1.0)
     seconds["cam"] = time.perf_counter() - start
     start = time.perf_counter()
     post, programs = build_programs(job, plan)
     seconds["post"] = time.perf_counter() - start
-    summary = build_summary(job, samples, cad, {**plan.facts, "post": post}, seconds)
+    start = time.perf_counter()
+    tell("simulation", 0.0)
+    simulation, sim_result = simulate_stage(job, plan, lambda fraction: tell("simulation", fraction))
+    tell("simulation", 1.0)
+    seconds["simulation"] = time.perf_counter() - start
+    summary = build_summary(job, samples, cad, {**plan.facts, "post": post, "simulation": simulation}, seconds)
+    start = time.perf_counter()
+    tell("report", 0.0)
+    report = report_stage(job, summary, png, plan, sim_result)
+    tell("report", 1.0)
+    seconds["report"] = time.perf_counter() - start
     return {
         "profile.csv": profile_csv(samples),
         "profile.png": png,
         **step,
         **programs,
+        "report.html": report,
         "summary.json": (json.dumps(summary, indent=2, sort_keys=False) + "\n").encode(),
     }
 

@@ -14,8 +14,9 @@ from spur_cad.sim.simulate import (
     decompose,
     shifted,
     simulate,
+    simulate_grid,
     subset,
 )
 
 __all__ = ["Operation", "SimResult", "SimSettings", "SimulationError", "StockCylinder", "decompose", "shifted",
-           "simulate", "subset"]
+           "simulate", "simulate_grid", "subset"]

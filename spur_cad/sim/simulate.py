@@ -269,17 +269,35 @@ def simulate(spec: GearSpec, stock: StockCylinder, operations: Sequence[Operatio
     `station_x`: finishing station positions (rows are added there and halfway between them, where
     the scallop ridges stand). `rows_x_range` limits the rows (default: the stock's X extent).
     """
-    from spur_cad.sim.kernel import clip_poses
-
     settings.validate()
     started = time.perf_counter()
-    res = settings.resolution_mm
     corner_radii = [op.tool.corner_radius for op in operations if op.tool.corner_radius > 0.0] or [0.5]
-    spacing = math.sqrt(8.0 * min(min(corner_radii), 1.0) * res / 2.0)
+    spacing = point_spacing_mm(min(corner_radii), settings.resolution_mm)
     stations = np.unique(np.asarray(station_x if station_x is not None else np.zeros(0), float))
     extra = np.concatenate([stations, 0.5 * (stations[1:] + stations[:-1])]) if len(stations) else np.zeros(0)
     x_lo, x_hi = rows_x_range if rows_x_range is not None else (stock.x_min, stock.x_max)
     grid = design_grid(spec, spacing, x_lo, x_hi, extra)
+    return simulate_grid(grid, stock, operations, settings, face_width_mm=spec.face_width_mm, station_x=stations,
+                         progress=progress, started=started)
+
+
+def point_spacing_mm(corner_radius_mm: float, resolution_mm: float) -> float:
+    """Spacing of design points and rows: a surface bulging with radius r between two samples l apart
+    rises at most l^2 / (8 r) above them; r is the smallest corner radius (at most 1 mm), the rise
+    resolution / 2."""
+    return math.sqrt(8.0 * min(corner_radius_mm, 1.0) * resolution_mm / 2.0)
+
+
+def simulate_grid(grid: DesignGrid, stock: StockCylinder, operations: Sequence[Operation],
+                  settings: SimSettings = SimSettings(), *, face_width_mm: float, station_x: np.ndarray = np.zeros(0),
+                  progress: Callable[[float], None] | None = None, started: float | None = None) -> SimResult:
+    """`simulate` on a given design grid (any outline with normals, e.g. a plain cylinder in tests)."""
+    from spur_cad.sim.kernel import clip_poses
+
+    settings.validate()
+    started = time.perf_counter() if started is None else started
+    res = settings.resolution_mm
+    x_lo, x_hi = float(grid.rows_x[0]), float(grid.rows_x[-1])
     t_min, t_max = -settings.gouge_range_mm, settings.leftover_range_mm
     h = initial_blades(grid, stock, t_max)
     initial = h.copy()
@@ -307,10 +325,11 @@ def simulate(spec: GearSpec, stock: StockCylinder, operations: Sequence[Operatio
         done += len(poses)
         if progress is not None:
             progress(done / max(total, 1))
+    # Rows stand for slabs of the stock; the stock's length outside the rows' span is not counted.
     stock_area = math.pi * stock.radius_mm**2
     removed = float(((stock_area - section_areas(grid, h)) * grid.row_width).sum())
-    return SimResult(grid, h, initial, stock, spec.face_width_mm, settings, removed, time.perf_counter() - started,
-                     total, sweeps, moves, stations)
+    return SimResult(grid, h, initial, stock, face_width_mm, settings, removed, time.perf_counter() - started,
+                     total, sweeps, moves, np.asarray(station_x, float))
 
 
 def shifted(path: Toolpath, mask: np.ndarray, dy: np.ndarray | float = 0.0, dz: np.ndarray | float = 0.0) -> Toolpath:
@@ -330,4 +349,4 @@ def subset(path: Toolpath, mask: np.ndarray, **replace) -> Toolpath:
 
 
 __all__ = ["Operation", "SimResult", "SimSettings", "SimulationError", "StockCylinder", "decompose", "rotate",
-           "simulate", "shifted", "subset"]
+           "simulate", "simulate_grid", "shifted", "subset"]

@@ -1,0 +1,130 @@
+"""The job report's figures (PNG bytes, matplotlib object API): roughing levels, finishing contacts and
+cutter locations, the simulated deviation map."""
+
+from __future__ import annotations
+
+import math
+from typing import TYPE_CHECKING
+
+import numpy as np
+from matplotlib.figure import Figure
+
+from spur_cad.geometry.sampling import full_space_points, sample_profile
+from spur_cad.geometry.spec import GearSpec
+from spur_cad.report.plots import _png
+
+if TYPE_CHECKING:
+    from spur_cad.cam.tools import Tool
+    from spur_cad.sim.simulate import SimResult
+
+
+def _space_outline(spec: GearSpec) -> np.ndarray:
+    """Tooth space 0 from tooth centre to tooth centre (machine Y, Z at A = 0)."""
+    return full_space_points(sample_profile(spec.tooth_space_profile(), 1e-3 * spec.module_mm))
+
+
+def roughing_levels_png(spec: GearSpec, heights_mm: np.ndarray, half_widths_mm: np.ndarray, tool: Tool,
+                        blank_radius_mm: float) -> bytes:
+    """The tooth space with each roughing level: the tool bottom's reach at that height, the tool drawn at
+    both ends of the lowest level."""
+    fig = Figure(figsize=(7.5, 6.0), layout="constrained")
+    ax = fig.add_subplot(1, 1, 1)
+    outline = _space_outline(spec)
+    ax.plot(outline[:, 0], outline[:, 1], "-", color="k", lw=1.5, label="design")
+    span = np.linspace(-math.pi / spec.teeth, math.pi / spec.teeth, 200)
+    ax.plot(blank_radius_mm * np.sin(span), blank_radius_mm * np.cos(span), ":", color="0.5", lw=1, label="blank")
+    radius = tool.diameter_mm / 2.0
+    for i, (h, w) in enumerate(zip(heights_mm, half_widths_mm)):
+        ax.plot([-w, w], [h, h], "-", color="tab:orange", lw=1.2, label="levels (tool edge reach)" if i == 0 else None)
+    h, w = heights_mm[-1], half_widths_mm[-1]
+    for centre in (-(w - radius), w - radius):
+        ax.add_patch(_rectangle(centre - radius, h, tool.diameter_mm, 2.5 * tool.diameter_mm))
+    ax.set_aspect("equal")
+    ax.set_xlabel("Y [mm] (space axis up)")
+    ax.set_ylabel("Z [mm]")
+    ax.set_ylim(spec.root_radius_mm - 0.5, blank_radius_mm + 1.0)
+    ax.set_title(f"roughing: {len(heights_mm)} levels, flat end mill D {tool.diameter_mm:g} mm", fontsize=9)
+    ax.legend(fontsize=8, loc="lower right")
+    ax.grid(True, lw=0.3)
+    return _png(fig)
+
+
+def _rectangle(y0: float, z0: float, width: float, height: float):
+    from matplotlib.patches import Rectangle
+
+    return Rectangle((y0, z0), width, height, fill=False, edgecolor="tab:blue", lw=0.8)
+
+
+def finishing_png(spec: GearSpec, tool: Tool, y: np.ndarray, z: np.ndarray, a_deg: np.ndarray,
+                  every: int = 10) -> bytes:
+    """Space 0 with the finishing contact points and the cutter locations (tool tip centres) in the part
+    frame; every `every`-th tool is drawn turned with the part. Contacts are the design points nearest
+    to each corner-circle centre."""
+    from spur_cad.cam.ir import part_frame_points
+
+    fig = Figure(figsize=(7.5, 6.0), layout="constrained")
+    ax = fig.add_subplot(1, 1, 1)
+    outline = _space_outline(spec)
+    ax.plot(outline[:, 0], outline[:, 1], "-", color="k", lw=1.2, label="design")
+    r_t, half_flat = tool.corner_radius, tool.flat_width_mm / 2.0
+    tips = part_frame_points(y, z, a_deg)
+    contacts = []
+    for side in (1.0, -1.0):  # right and left corner-circle centres
+        centres = part_frame_points(y + side * half_flat, z + r_t, a_deg)
+        d = np.hypot(outline[None, :, 0] - centres[:, None, 0], outline[None, :, 1] - centres[:, None, 1])
+        nearest = d.argmin(axis=1)
+        touching = np.abs(d[np.arange(len(centres)), nearest] - r_t) < max(0.02, 0.05 * r_t)
+        contacts.append(outline[nearest[touching]])
+    contacts = np.concatenate(contacts)
+    ax.plot(tips[:, 0], tips[:, 1], ".", ms=2, color="tab:blue", label="cutter locations (tip centre)")
+    ax.plot(contacts[:, 0], contacts[:, 1], ".", ms=3, color="tab:red", label="contact points")
+    phi = np.linspace(0.0, math.pi / 2, 12)
+    top = 3.0 * tool.diameter_mm
+    profile_y = np.concatenate([[-half_flat - r_t], -half_flat - r_t * np.sin(phi[::-1]),
+                                half_flat + r_t * np.sin(phi), [half_flat + r_t]])
+    profile_z = np.concatenate([[top], r_t - r_t * np.cos(phi[::-1]), r_t - r_t * np.cos(phi), [top]])
+    for i in range(0, len(y), every):
+        shape = part_frame_points(y[i] + profile_y, z[i] + profile_z, np.full(len(profile_y), a_deg[i]))
+        ax.plot(shape[:, 0], shape[:, 1], "-", color="0.6", lw=0.5)
+    ax.set_aspect("equal")
+    ax.set_xlabel("part Y [mm] (space 0, A = 0)")
+    ax.set_ylabel("part Z [mm]")
+    ax.set_ylim(spec.root_radius_mm - 1.0, spec.tip_radius_mm + 1.5)
+    ax.set_title(f"finishing: {len(y)} poses per space, {tool.kind} D {tool.diameter_mm:g} mm r {r_t:g} mm "
+                 f"(every {every}th tool drawn)", fontsize=9)
+    ax.legend(fontsize=8, loc="lower right")
+    ax.grid(True, lw=0.3)
+    return _png(fig)
+
+
+def deviation_map_png(result: SimResult) -> bytes:
+    """Deviation over the space outline (arc length) x face width for the tooth space with the largest
+    deviation, and per tooth space the largest gouge and leftover."""
+    rows = result.gear_rows
+    dev = result.deviation[:, :, rows] * 1000.0  # um
+    x = result.grid.rows_x[rows]
+    arc = result.grid.arc_mm
+    worst = int(np.abs(dev).reshape(dev.shape[0], -1).max(axis=1).argmax())
+    limit = max(float(np.abs(dev[worst]).max()), 1000.0 * result.settings.resolution_mm)
+    fig = Figure(figsize=(9.0, 7.0), layout="constrained")
+    ax, bars = fig.subplots(2, 1, height_ratios=[3, 1.4])
+    image = ax.pcolormesh(arc, x, dev[worst].T, cmap="RdBu_r", vmin=-limit, vmax=limit, shading="nearest")
+    fig.colorbar(image, ax=ax, label="deviation [um] (red: leftover, blue: gouge)")
+    names = result.grid.feature_names()
+    starts = [0] + [j for j in range(1, len(names)) if names[j] != names[j - 1]]
+    for j in starts:
+        ax.axvline(arc[j], color="k", lw=0.4)
+        ax.annotate(names[j], (arc[j], x[-1]), fontsize=6, rotation=90, va="top", ha="right")
+    ax.set_xlabel("position along the tooth space, right tooth centre -> root -> left tooth centre [mm]")
+    ax.set_ylabel("X (face width) [mm]")
+    ax.set_title(f"simulated deviation of tooth space {worst} (largest |deviation|); resolution "
+                 f"{1000 * result.settings.resolution_mm:g} um", fontsize=9)
+    per_space = dev.reshape(dev.shape[0], -1)
+    spaces = np.arange(dev.shape[0])
+    bars.bar(spaces - 0.2, np.maximum(per_space.max(axis=1), 0.0), width=0.4, color="tab:red", label="max leftover")
+    bars.bar(spaces + 0.2, np.maximum(-per_space.min(axis=1), 0.0), width=0.4, color="tab:blue", label="max gouge")
+    bars.set_xlabel("tooth space")
+    bars.set_ylabel("[um]")
+    bars.legend(fontsize=8)
+    bars.grid(True, lw=0.3, axis="y")
+    return _png(fig)

@@ -1,0 +1,208 @@
+"""report.html: one self-contained page (images as base64 data URIs, inline CSS, no scripts, no links out).
+
+Every value shown is read from the job's summary dict (the same content as summary.json); the
+figures come in as PNG bytes. Sections a job does not have (no tools, no simulation, no post)
+are left out or say so.
+"""
+
+from __future__ import annotations
+
+import base64
+import html
+from typing import Iterable
+
+_CSS = """
+body { font-family: sans-serif; margin: 2em auto; max-width: 62em; color: #222; }
+h1 { font-size: 1.5em; } h2 { font-size: 1.2em; border-bottom: 1px solid #ccc; margin-top: 1.8em; }
+table { border-collapse: collapse; margin: 0.6em 0; } td, th { border: 1px solid #ccc; padding: 0.2em 0.6em; }
+th { background: #f3f3f3; text-align: left; } td.num { text-align: right; font-variant-numeric: tabular-nums; }
+img { max-width: 100%; border: 1px solid #ddd; } .warn { color: #a40; } .ok { color: #070; }
+"""
+
+
+def _e(value: object) -> str:
+    return html.escape(str(value))
+
+
+def _fmt(value: object, digits: int = 4) -> str:
+    if isinstance(value, bool) or value is None:
+        return "-" if value is None else ("yes" if value else "no")
+    if isinstance(value, float):
+        return f"{value:.{digits}f}"
+    return str(value)
+
+
+def _table(rows: Iterable[tuple[str, object]], head: tuple[str, ...] = ()) -> str:
+    out = ["<table>"]
+    if head:
+        out.append("<tr>" + "".join(f"<th>{_e(h)}</th>" for h in head) + "</tr>")
+    for row in rows:
+        label, *values = row
+        cells = "".join(f'<td class="num">{_e(v if isinstance(v, str) else _fmt(v))}</td>' for v in values)
+        out.append(f"<tr><th>{_e(label)}</th>{cells}</tr>")
+    out.append("</table>")
+    return "\n".join(out)
+
+
+def _image(png: bytes | None, alt: str) -> str:
+    if not png:
+        return ""
+    data = base64.b64encode(png).decode("ascii")
+    return f'<p><img alt="{_e(alt)}" src="data:image/png;base64,{data}"></p>'
+
+
+def _minutes(seconds: float) -> str:
+    return f"{seconds / 3600.0:.2f} h ({seconds / 60.0:.0f} min)"
+
+
+def _gear(summary: dict) -> str:
+    gear = summary.get("gear", {})
+    keys = ("teeth", "module_mm", "pressure_angle_deg", "profile_shift_coefficient", "addendum_coefficient",
+            "dedendum_coefficient", "rack_tip_radius_mm", "face_width_mm", "reference_radius_mm", "base_radius_mm",
+            "tip_radius_mm", "root_radius_mm", "form_radius_mm", "tooth_thickness_mm", "space_width_mm",
+            "tip_thickness_mm", "root_arc_length_mm", "undercut")
+    return "<h2>Gear</h2>" + _table((k, gear[k]) for k in keys if k in gear)
+
+
+def _inspection(summary: dict) -> str:
+    ins = summary.get("inspection", {})
+    if not ins:
+        return ""
+    sim = summary.get("simulation", {})
+    nominal = ins["tooth_thickness_mm"] + ins["thickness_reduction_mm"]
+    rows = [
+        (f"span measurement W_k over k = {ins['span_teeth_k']} teeth [mm]", ins["span_measurement_mm"]),
+        ("  anvils touch the flanks at radius [mm]", ins["span_contact_radius_mm"]),
+        ("pin (ball) diameter [mm]", ins["pin_diameter_mm"]),
+        ("dimension over pins [mm]", ins["dimension_over_pins_mm"]),
+        ("  pins touch the flanks at radius [mm]", ins["pin_contact_radius_mm"]),
+        ("chordal tooth thickness [mm]", ins["chordal_thickness_mm"]),
+        (f"  at chordal height [mm] (measuring radius {ins['chordal_measuring_radius_mm']:g} mm)",
+         ins["chordal_height_mm"]),
+        ("tooth thickness on the reference circle s [mm]", ins["tooth_thickness_mm"]),
+        ("  nominal p/2 + 2 x m tan(alpha) [mm]", nominal),
+        ("  thickness allowance (upper deviation) [mm]", -ins["thickness_reduction_mm"]),
+        ("minimum teeth without undercut", ins["min_teeth_without_undercut"]),
+    ]
+    text = "<h2>Inspection sheet</h2>" + _table(rows)
+    flanks = [sim.get("per_feature", {}).get(f"{side} involute") for side in ("right", "left")]
+    if sim.get("enabled") and all(flanks):
+        low = -max(f["max_gouge_mm"] for f in flanks)
+        high = max(f["max_leftover_mm"] for f in flanks)
+        text += ("<p>Tolerance expected from the simulated cut (involute flanks, normal deviation "
+                 f"{1000 * low:+.1f} to {1000 * high:+.1f} um on each flank): span measurement "
+                 f"{ins['span_measurement_mm'] + 2 * low:.4f} to {ins['span_measurement_mm'] + 2 * high:.4f} mm; "
+                 f"tooth thickness {ins['tooth_thickness_mm']:.4f} mm "
+                 f"(nominal {nominal:.4f} mm, {-ins['thickness_reduction_mm']:+.4f} mm allowance).</p>")
+    return text
+
+
+def _tools(summary: dict) -> str:
+    tools = summary.get("tools")
+    if not tools:
+        return ""
+    rec = [(k, v) for k, v in tools.items() if k not in ("roughing", "finishing") and not isinstance(v, (dict, list))]
+    text = "<h2>Tools</h2><h3>Recommendations</h3>" + _table(rec)
+    chosen = []
+    for role in ("roughing", "finishing"):
+        tool = tools.get(role)
+        if tool:
+            chosen.append((role, tool["kind"], tool["diameter_mm"], tool["corner_radius_mm"], tool["flat_width_mm"],
+                           tool["spindle_rpm"], tool["feed_mm_min"]))
+    if chosen:
+        text += "<h3>Chosen tools</h3>" + _table(
+            chosen, ("", "kind", "D [mm]", "corner r [mm]", "flat width [mm]", "spindle [rpm]", "feed [mm/min]"))
+    return text
+
+
+def _program(summary: dict) -> str:
+    rough, finish, post = summary.get("roughing"), summary.get("finishing"), summary.get("post")
+    if not rough and not finish:
+        return ""
+    rows = []
+    for name, facts in (("roughing", rough), ("finishing", finish)):
+        if facts:
+            lines = post.get(f"{name}_lines") if post else None
+            size = post.get(f"{name}_bytes") if post else None
+            rows.append((name, facts["moves"], "-" if lines is None else str(lines),
+                         "-" if size is None else f"{size / 1000:.1f} kB", f"{facts['cutting_length_mm'] / 1000:.2f} m",
+                         _minutes(facts["estimated_time_s"])))
+    text = "<h2>Programs and cycle time</h2>"
+    if post:
+        text += f"<p>Post: {_e(post.get('dialect', '-'))}" + (", folded into subprograms" if post.get("folded") else "")
+        text += "</p>"
+    text += _table(rows, ("", "moves (IR)", "G-code lines", "G-code size", "cutting path", "estimated time"))
+    if finish and "reference_strategy_time_s" in finish:
+        text += _table([("this job's finishing", finish["moves"], _minutes(finish["estimated_time_s"])),
+                        ("reference process's strategy (0.08 mm contacts, 0.14 mm X step)",
+                         finish["reference_strategy_moves"], _minutes(finish["reference_strategy_time_s"]))],
+                       ("finishing", "moves", "estimated time"))
+    if rough:
+        text += (f"<p>Roughing: {rough['levels_per_space']} levels per space, lowest level "
+                 f"{rough['lowest_level_height_mm']:.3f} mm above the root circle.</p>")
+    if finish:
+        text += (f"<p>Finishing: {_e(finish['strategy'])}, {finish['stations']} stations "
+                 f"({finish['station_step_mm']:.4f} mm apart), {finish['points_per_flank']} contact points per "
+                 "flank.</p>")
+    return text
+
+
+def _simulation(summary: dict) -> str:
+    sim = summary.get("simulation")
+    if not sim:
+        return ""
+    if not sim.get("enabled"):
+        return "<h2>Simulated cut</h2><p>Simulation disabled ([simulation] enabled = false) or no toolpaths.</p>"
+    res = sim["resolution_mm"]
+    gouge_ok = sim["max_gouge_mm"] <= res
+    rows = [("resolution [mm]", res), ("max gouge [mm]", sim["max_gouge_mm"]),
+            ("max leftover [mm]", sim["max_leftover_mm"]), ("scallop mean / p95 / p99 [um]",
+                                                           f"{1000 * sim['scallop_mean_mm']:.2f} / "
+                                                           f"{1000 * sim['scallop_p95_mm']:.2f} / "
+                                                           f"{1000 * sim['scallop_p99_mm']:.2f}"),
+            ("removed volume [mm^3]", f"{sim['removed_volume_mm3']:.1f}"),
+            ("design points x rows (all spaces)", sim["design_points"]), ("simulation time [s]", f"{sim['seconds']:.1f}")]
+    text = "<h2>Simulated cut</h2>" + _table(rows)
+    verdict = "ok" if gouge_ok else "warn"
+    text += (f'<p class="{verdict}">Largest gouge {1000 * sim["max_gouge_mm"]:.2f} um '
+             f'({"within" if gouge_ok else "beyond"} the resolution). Largest leftover '
+             f'{1000 * sim["max_leftover_mm"]:.2f} um at tooth space {sim["worst_leftover"]["space"]}, '
+             f'{_e(sim["worst_leftover"]["feature"])}, X = {sim["worst_leftover"]["x_mm"]:.3f} mm.</p>')
+    per = sim.get("per_feature", {})
+    text += _table(((name, 1000 * f["max_gouge_mm"], 1000 * f["max_leftover_mm"], 1000 * f["mean_mm"])
+                    for name, f in per.items()), ("feature", "max gouge [um]", "max leftover [um]", "mean [um]"))
+    return text
+
+
+def _warnings(summary: dict) -> str:
+    items = list(summary.get("warnings", []))
+    sim = summary.get("simulation", {})
+    if sim.get("enabled"):
+        if sim["max_gouge_mm"] > sim["resolution_mm"]:
+            w = sim["worst_gouge"]
+            items.append(f"simulation: gouge of {1000 * sim['max_gouge_mm']:.1f} um at tooth space {w['space']}, "
+                         f"{w['feature']}, X = {w['x_mm']:.3f} mm (station {w['station']})")
+        if sim.get("uncut_points"):
+            items.append(f"simulation: {sim['uncut_points']} design points keep more than "
+                         f"{sim['leftover_range_mm']:g} mm of material (never cut)")
+    body = "".join(f"<li>{_e(w)}</li>" for w in items) if items else "<li>none</li>"
+    return f"<h2>Warnings</h2><ul class=\"warn\">{body}</ul>"
+
+
+def render_report(summary: dict, images: dict[str, bytes]) -> bytes:
+    """The whole report as UTF-8 HTML bytes. `images`: 'profile', 'roughing', 'finishing', 'deviation' PNGs."""
+    job = summary.get("job", {})
+    title = f"spur_cad report: {job.get('name', 'job')}"
+    parts = [
+        "<!DOCTYPE html>", '<html lang="en"><head><meta charset="utf-8">', f"<title>{_e(title)}</title>",
+        f"<style>{_CSS}</style></head><body>", f"<h1>{_e(title)}</h1>",
+        f"<p>Job file {_e(job.get('file', '-'))}, spur_cad {_e(summary.get('spur_cad_version', ''))}.</p>",
+        _warnings(summary), _gear(summary), _image(images.get("profile"), "tooth space profile"),
+        _inspection(summary), _tools(summary), _program(summary),
+        "<h2>Roughing levels</h2>" + _image(images.get("roughing"), "roughing levels") if images.get("roughing") else "",
+        "<h2>Finishing contacts and cutter locations</h2>" + _image(images.get("finishing"), "finishing poses")
+        if images.get("finishing") else "",
+        _simulation(summary), _image(images.get("deviation"), "deviation map"),
+        "</body></html>",
+    ]
+    return ("\n".join(p for p in parts if p) + "\n").encode("utf-8")
