@@ -162,16 +162,16 @@ def export_job(job_obj, out_dir: str) -> list[str]:
     return [str(path) for path in paths]
 
 
-def simulate(job_obj, resolution_mm: float = 0.01):
-    """Simulate the job's toolpaths (spur_cad.sim) and show the deviation from the design as coloured points."""
+def simulate(job_obj, resolution_mm: float | None = None):
+    """Simulate the job's toolpaths (spur_cad.sim, at the job's SimulationResolution unless given) and show
+    the design points coloured by their deviation."""
     from spur_cad.pipeline import plan_cam
 
     from spur_cad_workbench.simulation import show_result, simulate_job, simulator
 
     simulator()  # raises SimulationUnavailable before any work
     job = job_of(job_obj)
-    result = simulate_job(job, plan_cam(job), resolution_mm)
-    return show_result(job_obj, result)
+    return show_result(job_obj, simulate_job(job, plan_cam(job), resolution_mm))
 
 
 # --- GUI commands ------------------------------------------------------------------------------
@@ -277,13 +277,9 @@ class JobCommand(_Command):
     def Activated(self):
         stock = _selected("stock")
         gear = stock.Gear
-        ok = run_recorded([f"spur_cad_job = spur_cad_workbench.commands.make_job("
-                           f"App.ActiveDocument.getObject({gear.Name!r}), App.ActiveDocument.getObject({stock.Name!r}))",
-                           "App.ActiveDocument.recompute()"], "4-axis job")
-        if ok:
-            from spur_cad_workbench.taskpanel import show_job_panel
-
-            show_job_panel(stock.Document.Objects[-3])
+        run_recorded([f"spur_cad_job = spur_cad_workbench.commands.make_job("
+                      f"App.ActiveDocument.getObject({gear.Name!r}), App.ActiveDocument.getObject({stock.Name!r}))",
+                      "App.ActiveDocument.recompute()", "Gui.ActiveDocument.setEdit(spur_cad_job.Name)"], "4-axis job")
 
 
 class ImportJobCommand(_Command):

@@ -71,7 +71,8 @@ def activate(user_app_data_dir: str | Path) -> list[str]:
     _prefer_environment_portions(folders)
     numpy = sys.modules.get("numpy")
     numpy_file = str(getattr(numpy, "__file__", "") or "")
-    if numpy is not None and folders and not any(numpy_file.startswith(folder) for folder in folders):
+    provided = [folder for folder in folders if (Path(folder) / "numpy").is_dir()]
+    if numpy is not None and provided and not any(numpy_file.startswith(folder) for folder in provided):
         problems.append(f"numpy was already loaded from {numpy_file} before spur_cad's environment was added; "
                         "spur_cad may not work (another add-on imported numpy first)")
     return problems

@@ -381,9 +381,9 @@ class ViewProvider:
     def doubleClicked(self, vobj):
         if getattr(vobj.Object.Proxy, "KIND", "") != "job":
             return False
-        from spur_cad_workbench.taskpanel import show_job_panel
+        import FreeCADGui
 
-        show_job_panel(vobj.Object)
+        FreeCADGui.ActiveDocument.setEdit(vobj.Object.Name)
         return True
 
     def dumps(self):

@@ -1,7 +1,7 @@
 """The document schema: which FreeCAD property holds which job-file key (plain Python, no FreeCAD).
 
 Three document objects carry one job: the gear ([gear]), the stock ([stock]) and the job
-([job], [tools.*], [roughing], [finishing], [machine], [post]). Every key of the job file has
+([job], [tools.*], [roughing], [finishing], [machine], [simulation], [post]). Every key of the job file has
 exactly one property, so a job file maps onto a document and back without loss, and every
 property is a primitive FreeCAD type (saved as XML text, never pickled). `SCHEMA_VERSION` is
 stored on each object so later versions can migrate old documents.
@@ -168,6 +168,10 @@ JOB_FIELDS = (
     _f("ZMax", "distance", "Machine", "machine", "z_max_mm", "Z travel limit, high (mm)"),
     _f("RotaryClampCode", "string", "Machine", "machine", "rotary_clamp_code", "M code clamping A"),
     _f("RotaryUnclampCode", "string", "Machine", "machine", "rotary_unclamp_code", "M code unclamping A"),
+    _f("SimulationEnabled", "bool", "Simulation", "simulation", "enabled",
+       "simulate the cutting when exporting (summary and report)"),
+    _f("SimulationResolution", "length", "Simulation", "simulation", "resolution_mm",
+       "resolution of the simulation (mm); finer is slower"),
     _f("PostDialect", "choice", "Post", "post", "dialect", "G-code dialect", DIALECT_NAMES),
     _f("LineNumbers", "bool", "Post", "post", "line_numbers", "write N block numbers"),
     _f("LineNumberStep", "int", "Post", "post", "line_number_step", "step between block numbers"),
@@ -214,7 +218,7 @@ def _section_objects(job) -> dict[str, object | None]:
     """The dataclass behind each job-file section of a spur_cad.job.Job."""
     return {"job": job.job, "gear": job.gear_section, "stock": job.stock, "tools.roughing": job.tools.roughing,
             "tools.finishing": job.tools.finishing, "roughing": job.roughing, "finishing": job.finishing,
-            "machine": job.machine, "post": job.post}
+            "machine": job.machine, "post": job.post, "simulation": job.simulation}
 
 
 def _section_defaults() -> dict[str, dict[str, object]]:
@@ -222,14 +226,15 @@ def _section_defaults() -> dict[str, dict[str, object]]:
     from spur_cad.cad.specs import StockSpec
     from spur_cad.cam.machine import FinishingParams, Machine, RoughingParams
     from spur_cad.cam.tools import Tool
-    from spur_cad.job import GearSection, JobSection
+    from spur_cad.job import GearSection, JobSection, SimulationSection
     from spur_cad.post.settings import PostSettings
 
     tool = dataclasses.asdict(Tool(diameter_mm=0.0))
     return {"job": dataclasses.asdict(JobSection()), "gear": {f.name: f.default for f in dataclasses.fields(GearSection)},
             "stock": dataclasses.asdict(StockSpec()), "tools.roughing": tool, "tools.finishing": dict(tool),
             "roughing": dataclasses.asdict(RoughingParams()), "finishing": dataclasses.asdict(FinishingParams()),
-            "machine": dataclasses.asdict(Machine()), "post": dataclasses.asdict(PostSettings())}
+            "machine": dataclasses.asdict(Machine()), "post": dataclasses.asdict(PostSettings()),
+            "simulation": dataclasses.asdict(SimulationSection())}
 
 
 # A new gear (no job file): ISO 53 basic rack profile A (tip radius 0.38 m) on the reference gear's size.

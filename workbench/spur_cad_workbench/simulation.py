@@ -1,7 +1,7 @@
 """The Simulate command's link to spur_cad.sim, guarded for a spur_cad without the simulator.
 
-`simulate_job` cuts the stock with the job's toolpaths through spur_cad.sim's public API
-(`simulate`, `StockCylinder`, `Operation`, `SimSettings`); `show_result` draws every design
+`simulate_job` cuts the stock with the job's toolpaths through spur_cad.sim's pipeline stage
+(`spur_cad.sim.stage.simulate_stage`, as `spur-cad run` does); `show_result` draws every design
 point of the face width, in the part frame, coloured by its deviation (blue gouge, green on
 the design, red leftover). Without spur_cad.sim, `simulator()` raises SimulationUnavailable
 with the message the command shows.
@@ -33,23 +33,22 @@ def simulator():
     return sim
 
 
-def simulate_job(job, plan, resolution_mm: float):
-    """spur_cad.sim's result for the job's roughing then finishing toolpaths (the planned IR)."""
-    from spur_cad.cam.finishing import station_positions, station_step_mm
+def simulate_job(job, plan, resolution_mm: float | None = None):
+    """spur_cad.sim's result for the job's roughing then finishing IR, at the job's [simulation] resolution
+    unless `resolution_mm` is given (simulated even when [simulation] enabled is false: the user asked)."""
+    import dataclasses
 
-    sim = simulator()
-    spec, stock = job.gear, job.stock
-    cylinder = sim.StockCylinder(stock.blank_radius_mm(spec), -stock.front_margin_mm,
-                                 spec.face_width_mm + stock.back_margin_mm)
-    operations = [sim.Operation(path, tool) for path, tool in ((plan.roughing, job.tools.roughing),
-                                                               (plan.finishing, job.tools.finishing))
-                  if path is not None]
-    if not operations:
+    simulator()
+    from spur_cad.sim.stage import simulate_stage
+
+    settings = dataclasses.replace(job.simulation, enabled=True,
+                                   resolution_mm=resolution_mm or job.simulation.resolution_mm)
+    settings.validate()
+    wanted = dataclasses.replace(job, simulation=settings)
+    _, result = simulate_stage(wanted, plan)
+    if result is None:
         raise SpurCadError("the job has no toolpaths to simulate (choose a roughing or finishing tool)")
-    stations = None
-    if job.tools.finishing is not None and job.finishing.strategy == "perimeter":
-        stations = station_positions(spec.face_width_mm, station_step_mm(job.tools.finishing, job.finishing))
-    return sim.simulate(spec, cylinder, operations, sim.SimSettings(resolution_mm=resolution_mm), station_x=stations)
+    return result
 
 
 def colour_scale_mm(resolution_mm: float) -> float:

@@ -1,0 +1,330 @@
+"""The workbench in FreeCAD's console (freecadcmd), installed as users install it: objects made through the
+commands' Python entry points recompute, follow property changes, export exactly what the CLI writes,
+save and reopen without pickles, and report bad input as messages."""
+
+from __future__ import annotations
+
+import json
+import tomllib
+import zipfile
+from pathlib import Path
+
+import pytest
+
+from spur_cad.cli import main
+from spur_cad.job import load_job, parse_job
+from spur_cad.pipeline import plan_cam
+from tests.freecad_helper import describe
+from tests.textbook import Textbook, span_iso
+from tests.workbench_helper import (
+    REFERENCE_JOB,
+    SMALL_GEAR_PROPERTIES,
+    SMALL_JOB_PROPERTIES,
+    SMALL_STOCK_PROPERTIES,
+    output_differences,
+    run_workbench_code,
+    small_job_text,
+)
+
+pytestmark = pytest.mark.freecad
+
+STATES = """
+def states(doc):
+    return {o.Name: [list(o.State), getattr(o, "Status", "")] for o in doc.Objects}
+"""
+
+
+def _all_up_to_date(states: dict) -> bool:
+    return all(state == ["Up-to-date"] and status == "ok" for state, status in states.values())
+
+
+SMALL_BODY = STATES + """
+import math, FreeCAD, Part
+from spur_cad_workbench import commands
+doc = FreeCAD.newDocument("Wb")
+gear = commands.make_gear(doc, **PROPS["gear"])
+stock = commands.make_stock(gear, **PROPS["stock"])
+job = commands.make_job(gear, stock, **PROPS["job"])
+doc.recompute()
+RESULT["first"] = states(doc)
+RESULT["first_tip_radius"] = gear.TipRadius.Value
+gear.Teeth = 13                                   # a property change recomputes gear, stock and job
+doc.recompute()
+RESULT["second"] = states(doc)
+b, z = gear.FaceWidth.Value, gear.Teeth
+bb = gear.Shape.BoundBox
+RESULT["bbox"] = [bb.XMin, bb.XMax, bb.YMin, bb.YMax, bb.ZMin, bb.ZMax]
+RESULT["radii"] = dict(tip=gear.TipRadius.Value, root=gear.RootRadius.Value, base=gear.BaseRadius.Value,
+                       span=gear.SpanMeasurement.Value, k=gear.SpanTeeth, undercut=gear.Undercut,
+                       blank=stock.BlankRadius.Value)
+r = gear.TipRadius.Value - 0.3 * gear.Module.Value
+inside = lambda y, zz: gear.Shape.isInside(FreeCAD.Vector(b / 2, y, zz), 1e-6, True)
+RESULT["space0_at_plus_z"] = inside(0.0, r)
+RESULT["tooth_at_half_pitch"] = inside(r * math.sin(math.pi / z), r * math.cos(math.pi / z))
+RESULT["volume"] = gear.Shape.Volume
+RESULT["stock_bbox"] = [stock.Shape.BoundBox.XMin, stock.Shape.BoundBox.XMax, stock.Shape.BoundBox.ZMax]
+RESULT["job"] = dict(roughing=job.RoughingMoves, finishing=job.FinishingMoves,
+                     max_flat=job.FinishingMaxFlatWidth.Value, types=[job.RoughingToolpath.TypeId,
+                     job.FinishingToolpath.TypeId], shown=job.FinishingToolpath.DisplayedMoves,
+                     total=job.FinishingToolpath.Moves)
+# Toolpath points in the part frame must lie outside the gear, and finishing ones hug its surface.
+for name, obj in (("roughing", job.RoughingToolpath), ("finishing", job.FinishingToolpath)):
+    cuts = [c for c in obj.Path.Commands if c.Name == "G1"]
+    pts = [FreeCAD.Vector(c.Parameters["X"], c.Parameters["Y"], c.Parameters["Z"]) for c in cuts[::max(1, len(cuts) // 300)]]
+    if name == "roughing":  # passes run along X across the face at constant (Y, Z): check them mid-face
+        pts = [FreeCAD.Vector(b / 2, p.y, p.z) for p in pts]
+    pts = [p for p in pts if 0.0 < p.x < b]
+    distances = [gear.Shape.distToShape(Part.Vertex(p))[0] for p in pts]
+    RESULT[name + "_inside"] = [d for p, d in zip(pts, distances) if gear.Shape.isInside(p, 1e-4, False) and d > 1e-4]
+    RESULT[name + "_distances"] = distances
+RESULT["files"] = commands.export_job(job, OUT)
+# the same job file imported into a second document exports the same files too
+imported = commands.import_job_file(FreeCAD.newDocument("Imported"), JOB_FILE)
+RESULT["imported_labels"] = [o.Label for o in imported]
+commands.export_job(imported[2], OUT_IMPORTED)
+"""
+
+
+def test_commands_recompute_follow_changes_and_export_like_the_cli(freecadcmd, tmp_path):
+    props = {"gear": SMALL_GEAR_PROPERTIES, "stock": SMALL_STOCK_PROPERTIES, "job": SMALL_JOB_PROPERTIES}
+    out, out_imported = tmp_path / "workbench_out", tmp_path / "imported_out"
+    job_file = tmp_path / "small13.toml"
+    job_file.write_text(small_job_text(teeth=13))
+    body = (f"PROPS = {props!r}\nOUT = {str(out)!r}\nOUT_IMPORTED = {str(out_imported)!r}\n"
+            f"JOB_FILE = {str(job_file)!r}\n" + SMALL_BODY)
+    result, proc = run_workbench_code(body, tmp_path / "fc", freecadcmd=freecadcmd)
+    assert result is not None and result.get("ok"), describe(proc, result)
+    assert "Traceback" not in proc.stdout + proc.stderr, describe(proc, result)
+    assert _all_up_to_date(result["first"]) and _all_up_to_date(result["second"]), result
+    assert set(result["first"]) == {"Gear", "Stock", "Job", "RoughingToolpath", "FinishingToolpath"}
+
+    # computed properties against the textbook (z changed from 12 to 13)
+    book = Textbook(z=13, m=3.0, alpha_deg=20.0, rho=0.9, allowance_fraction=0.02)
+    assert result["first_tip_radius"] == pytest.approx(3.0 * (6 + 1))
+    radii = result["radii"]
+    assert radii["tip"] == pytest.approx(book.ra) and radii["root"] == pytest.approx(book.rf)
+    assert radii["base"] == pytest.approx(book.rb)
+    assert radii["span"] == pytest.approx(span_iso(book, radii["k"]), abs=1e-9)
+    assert radii["blank"] == pytest.approx(book.ra + 0.5)
+
+    # placed per CONVENTIONS.md: axis X, front face X = 0, tooth space 0 symmetric about +Z
+    x0, x1, y0, y1, z0, z1 = result["bbox"]
+    assert (x0, x1) == pytest.approx((0.0, 6.0), abs=1e-6)
+    assert max(abs(y0), y1, abs(z0), z1) == pytest.approx(book.ra, abs=1e-3)
+    assert result["space0_at_plus_z"] is False and result["tooth_at_half_pitch"] is True
+    assert result["stock_bbox"] == pytest.approx([-1.0, 7.0, book.ra + 0.5], abs=1e-6)
+
+    # toolpaths drawn in the part frame: outside the gear; the finishing tip centre touches it
+    assert result["roughing_inside"] == [] and result["finishing_inside"] == []
+    finishing = sorted(result["finishing_distances"])  # mostly cutting: within the tool's reach of the flank
+    assert finishing[0] < 1e-3 and finishing[int(0.9 * len(finishing))] <= 1.5, finishing
+    assert min(result["roughing_distances"]) > 0.0
+    assert result["job"]["types"] == ["Path::FeaturePython", "Path::FeaturePython"]
+
+    # exported files: the same content as `spur-cad run` on the same job file
+    cli = tmp_path / "cli_out"
+    assert main(["run", str(job_file), "--out", str(cli), "--quiet"]) == 0
+    assert output_differences(cli, out, (str(job_file), "Wb")) == []
+    assert output_differences(cli, out_imported, (str(job_file), "Imported")) == []
+    assert result["imported_labels"] == ["Gear", "Stock", "small quick gear"]
+    summary = json.loads((cli / "summary.json").read_text())
+    assert result["job"]["roughing"] == summary["roughing"]["moves"]
+    assert result["job"]["finishing"] == summary["finishing"]["moves"] == result["job"]["total"]
+    assert result["job"]["max_flat"] == pytest.approx(summary["tools"]["finishing_max_flat_width_mm"])
+    assert {Path(f).name for f in result["files"]} == {p.name for p in cli.iterdir()}
+
+
+REFERENCE_BODY = STATES + """
+import FreeCAD
+from spur_cad_workbench import commands
+doc = FreeCAD.newDocument("Ref")
+gear, stock, job = commands.import_job_file(doc, JOB)
+RESULT["states"] = states(doc)
+RESULT["gear"] = dict(teeth=gear.Teeth, module=gear.Module.Value, rho=gear.RackTipRadius.Value,
+                      allowance=gear.ThicknessAllowancePercent, b=gear.FaceWidth.Value)
+RESULT["stock"] = dict(stub=stock.StubDiameter.Value, back=stock.BackMargin.Value)
+RESULT["job"] = dict(label=job.Label, rough_d=job.RoughingToolDiameter.Value, kind=job.FinishingToolKind,
+                     corner=job.FinishingCornerRadius.Value, scallop=job.TargetScallop.Value,
+                     clearance=job.Clearance.Value, block=job.BlockTime)
+RESULT["toolpaths"] = {tp.Operation: dict(moves=tp.Moves, shown=tp.DisplayedMoves, size=tp.Path.Size)
+                       for tp in (job.RoughingToolpath, job.FinishingToolpath)}
+"""
+
+
+def test_reference_job_file_maps_onto_the_document(freecadcmd, tmp_path):
+    """The reference job file: every value lands on its property; its 759,759 finishing moves are drawn
+    as a subset of whole stations (the export path is checked with the small job above)."""
+    body = f"JOB = {str(REFERENCE_JOB)!r}\n" + REFERENCE_BODY
+    result, proc = run_workbench_code(body, tmp_path / "fc", freecadcmd=freecadcmd, timeout_s=300)
+    assert result is not None and result.get("ok"), describe(proc, result)
+    assert _all_up_to_date(result["states"]), result["states"]
+    data = tomllib.loads(REFERENCE_JOB.read_text())
+    gear, tools = data["gear"], data["tools"]
+    assert result["gear"] == dict(teeth=gear["teeth"], module=gear["module_mm"], rho=gear["rack_tip_radius_mm"],
+                                  allowance=gear["thickness_allowance_percent"], b=gear["face_width_mm"])
+    assert result["stock"] == dict(stub=data["stock"]["stub_diameter_mm"], back=data["stock"]["back_margin_mm"])
+    assert result["job"] == dict(label=data["job"]["name"], rough_d=tools["roughing"]["diameter_mm"],
+                                 kind=tools["finishing"]["kind"], corner=tools["finishing"]["corner_radius_mm"],
+                                 scallop=data["finishing"]["target_scallop_mm"],
+                                 clearance=data["machine"]["clearance_mm"], block=data["machine"]["block_time_s"])
+    plan = plan_cam(load_job(REFERENCE_JOB))  # the same file through the library
+    roughing, finishing = result["toolpaths"]["roughing"], result["toolpaths"]["finishing"]
+    assert roughing["moves"] == len(plan.roughing) and roughing["shown"] == roughing["moves"]
+    assert finishing["moves"] == len(plan.finishing) > 700_000
+    assert 0 < finishing["shown"] <= 60_000 and finishing["size"] >= finishing["shown"]
+
+
+SAVE_BODY = STATES + """
+import FreeCAD
+from spur_cad_workbench import commands
+doc = FreeCAD.newDocument("Saved")
+gear = commands.make_gear(doc, **PROPS["gear"])
+stock = commands.make_stock(gear, **PROPS["stock"])
+job = commands.make_job(gear, stock, **PROPS["job"])
+doc.recompute()
+gear.removeProperty("KeywayDepth")      # as if saved by an older schema without this property
+gear.SchemaVersion = 0
+doc.saveAs(FILE)
+FreeCAD.closeDocument("Saved")
+doc = FreeCAD.openDocument(FILE)
+RESULT["restored"] = states(doc)
+gear = doc.getObject("Gear")
+RESULT["migrated"] = dict(version=gear.SchemaVersion, has=("KeywayDepth" in gear.PropertiesList),
+                          value=gear.KeywayDepth.Value)
+for obj in doc.Objects:
+    obj.touch()
+doc.recompute()
+RESULT["recomputed"] = states(doc)
+job = doc.getObject("Job")
+RESULT["moves"] = [job.RoughingMoves, job.FinishingMoves, job.FinishingToolpath.Moves]
+RESULT["links"] = [job.Gear.Name, job.Stock.Name, doc.getObject("Stock").Gear.Name]
+doc.save()
+"""
+
+PRIMITIVE_PROPERTIES = {"App::PropertyAngle", "App::PropertyBool", "App::PropertyDistance", "App::PropertyEnumeration",
+                        "App::PropertyExpressionEngine", "App::PropertyFloat", "App::PropertyInteger",
+                        "App::PropertyLength", "App::PropertyLink", "App::PropertyMap", "App::PropertyPlacement",
+                        "App::PropertyString", "App::PropertyStringList", "App::PropertyUUID",
+                        "Part::PropertyPartShape", "Path::PropertyPath", "App::PropertyPythonObject"}
+
+
+def test_documents_save_and_reopen_without_pickles(freecadcmd, tmp_path):
+    props = {"gear": SMALL_GEAR_PROPERTIES, "stock": SMALL_STOCK_PROPERTIES, "job": SMALL_JOB_PROPERTIES}
+    saved = tmp_path / "gear.FCStd"
+    body = f"PROPS = {props!r}\nFILE = {str(saved)!r}\n" + SAVE_BODY
+    result, proc = run_workbench_code(body, tmp_path / "fc", freecadcmd=freecadcmd)
+    assert result is not None and result.get("ok"), describe(proc, result)
+    assert "Traceback" not in proc.stdout + proc.stderr, describe(proc, result)
+    restored = result["restored"]  # the migrated gear is touched (a property was added), nothing is invalid
+    assert all("Invalid" not in state and status == "ok" for state, status in restored.values()), restored
+    assert _all_up_to_date(result["recomputed"]), result
+    assert result["migrated"] == dict(version=1, has=True, value=0.0)
+    assert result["moves"][0] > 0 and result["moves"][1] == result["moves"][2] > 0
+    assert result["links"] == ["Gear", "Stock", "Gear"]
+    with zipfile.ZipFile(saved) as archive:
+        document = archive.read("Document.xml").decode()
+    import xml.etree.ElementTree as ET
+
+    root = ET.fromstring(document)
+    types = {p.get("type") for p in root.iter("Property")}
+    assert types <= PRIMITIVE_PROPERTIES, types - PRIMITIVE_PROPERTIES
+    proxies = [(p.get("module"), p.get("class"), p.get("value")) for p in root.iter("Python")]
+    assert len(proxies) == 5
+    import base64
+
+    for module, cls, value in proxies:
+        assert module == "spur_cad_workbench.features"
+        assert base64.b64decode(value) == b"null"  # JSON null: no pickled state
+
+
+ERROR_BODY = STATES + """
+import FreeCAD
+from spur_cad_workbench import commands
+doc = FreeCAD.newDocument("Bad")
+gear = commands.make_gear(doc, **PROPS["gear"])
+stock = commands.make_stock(gear, **PROPS["stock"])
+job = commands.make_job(gear, stock, **PROPS["job"])
+doc.recompute()
+job.FinishingToolDiameter = 9.0
+doc.recompute()
+RESULT["job_status"] = job.Status
+gear.Teeth = 3
+doc.recompute()
+RESULT["after"] = states(doc)
+from spur_cad.errors import SpurCadError
+try:
+    commands.export_job(job, OUT)
+except SpurCadError as exc:
+    RESULT["export_error"] = str(exc)
+try:
+    commands.make_gear(doc, Teth=20)
+except SpurCadError as exc:
+    RESULT["unknown_property"] = str(exc)
+"""
+
+
+def _cli_error(text: str, tmp_path: Path, capsys) -> str:
+    job_file = tmp_path / "bad.toml"
+    job_file.write_text(text)
+    assert main(["run", str(job_file), "--out", str(tmp_path / "bad_out"), "--quiet"]) == 2
+    line = capsys.readouterr().err.strip()
+    assert line.startswith("spur-cad: error: ")
+    return line[len("spur-cad: error: "):]
+
+
+def test_bad_input_is_a_message_on_the_object_not_a_traceback(freecadcmd, tmp_path, capsys):
+    props = {"gear": SMALL_GEAR_PROPERTIES, "stock": SMALL_STOCK_PROPERTIES, "job": SMALL_JOB_PROPERTIES}
+    body = f"PROPS = {props!r}\nOUT = {str(tmp_path / 'never')!r}\n" + ERROR_BODY
+    result, proc = run_workbench_code(body, tmp_path / "fc", freecadcmd=freecadcmd)
+    assert result is not None and result.get("ok"), describe(proc, result)
+    output = proc.stdout + proc.stderr
+    assert "Traceback" not in output, describe(proc, result)
+    tool_message = _cli_error(small_job_text(finishing_diameter=9.0), tmp_path, capsys)
+    assert result["job_status"] == f"error: {tool_message}"
+    gear_message = _cli_error(small_job_text(teeth=3), tmp_path, capsys).split(": ", 1)[1]  # drop "bad.toml:8"
+    after = result["after"]
+    assert after["Gear"][1] == f"error: {gear_message}" and after["Stock"][1] == after["Gear"][1]
+    assert f"Gear: {gear_message}" in output  # one line in the report (here: the console)
+    assert result["export_error"].endswith(gear_message)
+    assert not (tmp_path / "never").exists()
+    assert result["unknown_property"].startswith("unknown gear properties: Teth")
+
+
+SIM_BODY = """
+import FreeCAD
+from spur_cad_workbench import commands, simulation
+doc = FreeCAD.newDocument("Sim")
+gear = commands.make_gear(doc, **PROPS["gear"])
+stock = commands.make_stock(gear, **PROPS["stock"])
+job = commands.make_job(gear, stock, **PROPS["job"])
+doc.recompute()
+try:
+    simulation.simulator()
+except simulation.SimulationUnavailable as exc:
+    RESULT["unavailable"] = str(exc)
+else:
+    sim = commands.simulate(job, resolution_mm=0.02)
+    pts = sim.Points.Points
+    RESULT.update(count=len(pts), colours=len(sim.Color), gouge=sim.MaxGouge.Value, leftover=sim.MaxLeftover.Value,
+                  legend=sim.Legend, xs=[min(p.x for p in pts), max(p.x for p in pts)],
+                  radii=[min((p.y**2 + p.z**2) ** 0.5 for p in pts), max((p.y**2 + p.z**2) ** 0.5 for p in pts)],
+                  green=sum(1 for c in sim.Color if c[1] > 0.99), red=sum(1 for c in sim.Color if c[0] > 0.99))
+"""
+
+
+def test_simulate_shows_the_design_points_coloured_by_deviation(freecadcmd, tmp_path):
+    props = {"gear": SMALL_GEAR_PROPERTIES, "stock": SMALL_STOCK_PROPERTIES, "job": SMALL_JOB_PROPERTIES}
+    body = f"PROPS = {props!r}\n" + SIM_BODY
+    result, proc = run_workbench_code(body, tmp_path / "fc", freecadcmd=freecadcmd)
+    assert result is not None and result.get("ok"), describe(proc, result)
+    if "unavailable" in result:
+        assert result["unavailable"].startswith("simulation not available")
+        return
+    spec = parse_job(small_job_text(), "s").gear
+    assert result["count"] == result["colours"] > 0
+    assert result["xs"][0] >= -1e-9 and result["xs"][1] <= spec.face_width_mm + 1e-9
+    assert result["radii"][0] >= spec.root_radius_mm - 0.01 and result["radii"][1] <= spec.tip_radius_mm + 0.01
+    assert 0.0 <= result["gouge"] <= 0.02  # within the resolution: the toolpaths do not gouge
+    assert result["green"] > 0 and "blue: gouge" in result["legend"]
+    if result["leftover"] >= 0.1:  # 1.5 mm stations leave ridges: some points show full red
+        assert result["red"] > 0

@@ -1,0 +1,315 @@
+"""Workbench parts that run without FreeCAD: the document schema, the panel's checks, tool suggestions,
+the part-frame toolpath display, the environment activation, and job_from_dict."""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+import math
+import re
+import sys
+import tomllib
+import typing
+from types import SimpleNamespace
+
+import numpy as np
+import pytest
+
+from spur_cad.cam.ir import MoveKind, Operation, ToolpathBuilder
+from spur_cad.cam.recommend import check_roughing_reach, check_tools, recommend_tools
+from spur_cad.cam.roughing import roughing_levels
+from spur_cad.cam.tools import Tool
+from spur_cad.errors import JobFileError, SpurCadError
+from spur_cad.job import Job, job_from_dict, load_job, parse_job
+from tests.gears import GEAR_CASES
+from tests.workbench_helper import REFERENCE_JOB, ROOT, small_job_text
+
+
+@pytest.fixture
+def wb(monkeypatch):
+    """The workbench package (plain-Python modules only), importable from workbench/."""
+    monkeypatch.syspath_prepend(str(ROOT / "workbench"))
+    from spur_cad_workbench import display, environment, schema, simulation, validation
+
+    return SimpleNamespace(schema=schema, validation=validation, display=display, environment=environment,
+                           simulation=simulation)
+
+
+# --- job_from_dict -------------------------------------------------------------------------------
+
+
+def test_job_from_dict_is_parse_job_without_text():
+    text = REFERENCE_JOB.read_text()
+    assert job_from_dict(tomllib.loads(text), "doc") == dataclasses.replace(parse_job(text, "x"), source="doc")
+
+
+@pytest.mark.parametrize("old, new, message", [
+    ("flutes = 3", "flutes = 3.5", "doc: [tools.roughing] flutes must be a whole number, got 3.5"),
+    ("teeth = 23", "teeth = 3", "doc: invalid gear: teeth = 3: too few teeth"),
+    ("max_spindle_rpm = 7000.0", "max_spindle_rmp = 7000.0", "doc: unknown key 'max_spindle_rmp' in [machine]"),
+    ('strategy = "perimeter"', 'strategy = "spiral"', "doc: [finishing] strategy 'spiral' is unknown"),
+])
+def test_job_from_dict_messages_are_parse_jobs_without_line(old, new, message):
+    text = REFERENCE_JOB.read_text()
+    assert old in text
+    bad = text.replace(old, new)
+    with pytest.raises(JobFileError) as from_file:
+        parse_job(bad, "doc")
+    with pytest.raises(JobFileError) as from_dict:
+        job_from_dict(tomllib.loads(bad), "doc")
+    assert str(from_dict.value).startswith(message)
+    assert re.match(r"doc:\d+: ", str(from_file.value))
+    assert re.sub(r"^doc:\d+: ", "doc: ", str(from_file.value)) == str(from_dict.value)
+
+
+# --- schema --------------------------------------------------------------------------------------
+
+
+def _section_classes() -> dict[str, type]:
+    """Job-file sections and their dataclasses, read from spur_cad.job.Job's fields (so new sections count)."""
+    hints = typing.get_type_hints(Job)
+    sections = {("gear" if f.name == "gear_section" else f.name): hints[f.name] for f in dataclasses.fields(Job)
+                if f.name not in ("source", "gear", "tools")}
+    sections["tools.roughing"] = sections["tools.finishing"] = Tool
+    return sections
+
+
+def test_every_job_file_key_has_exactly_one_property(wb):
+    fields = [f for fs in wb.schema.FIELDS.values() for f in fs if f.key]
+    pairs = [(f.section, f.key) for f in fields]
+    expected = {(name, field.name) for name, cls in _section_classes().items() for field in dataclasses.fields(cls)}
+    assert sorted(pairs) == sorted(expected)
+    props = [f.prop for fs in (*wb.schema.FIELDS.values(), *wb.schema.OUTPUTS.values()) for f in fs]
+    assert len(props) == len(set(props))
+    assert all(f.kind in wb.schema.PROPERTY_TYPES for fs in wb.schema.FIELDS.values() for f in fs)
+
+
+def test_property_kinds_match_the_job_files_types(wb):
+    """int keys are integer properties, bool keys booleans, str keys strings or choices, numbers numeric."""
+    numeric = {"length", "distance", "angle", "float"}
+    for role, fields in wb.schema.FIELDS.items():
+        for f in fields:
+            if not f.key:
+                assert f.kind == "bool"
+                continue
+            annotation = typing.get_type_hints(_section_classes()[f.section])[f.key]
+            allowed = {int: {"int"}, bool: {"bool"}, str: {"string", "choice"}, float: numeric}[annotation]
+            assert f.kind in allowed, f
+            if f.key.endswith("_deg"):
+                assert f.kind == "angle", f
+
+
+def test_defaults_are_in_the_choices(wb):
+    values = wb.schema.default_values()
+    for role, fields in wb.schema.FIELDS.items():
+        for f in fields:
+            if f.kind == "choice":
+                assert values[role][f.prop] in f.choices, f
+
+
+@pytest.mark.parametrize("text", [REFERENCE_JOB.read_text(), small_job_text(),
+                                  "[gear]\nteeth = 30\nmodule_mm = 2\nface_width_mm = 10\n"])
+def test_job_round_trips_through_properties(wb, text):
+    job = parse_job(text, "a.toml")
+    values = wb.schema.values_from_job(job)
+    assert set(values) == {"gear", "stock", "job"}
+    again = job_from_dict(json.loads(json.dumps(wb.schema.job_data(values))), "a.toml")
+    assert again == job
+
+
+def test_tool_switch_off_drops_the_tool_section(wb):
+    values = wb.schema.values_from_job(load_job(REFERENCE_JOB))
+    values["job"]["UseRoughingTool"] = False
+    job = job_from_dict(wb.schema.job_data(values), "x")
+    assert job.tools.roughing is None and job.tools.finishing is not None
+
+
+# --- validation (the task panel's checks) -------------------------------------------------------------
+
+
+def _small_values(wb, **job_changes):
+    values = wb.schema.values_from_job(parse_job(small_job_text(), "small.toml"))
+    values["job"].update(job_changes)
+    return values
+
+
+def test_valid_job_has_no_messages_and_the_recommendations(wb):
+    result = wb.validation.validate(_small_values(wb))
+    assert result.ok and result.messages == {}
+    job = result.job
+    rec = recommend_tools(job.gear, job.stock.blank_radius_mm(job.gear), job.machine.clearance_mm, job.tools.finishing)
+    assert result.recommendations == rec
+    notes = wb.validation.recommendation_notes(rec)
+    assert f"{rec.roughing_max_diameter_mm:.3f} mm" in notes["RoughingToolDiameter"]
+    assert f"{rec.finishing_max_flat_width_mm:.3f} mm" in notes["FinishingToolDiameter"]
+
+
+def _cli_message(text: str) -> str:
+    """The message `spur-cad run` shows for a job (checked the CLI's way: parse, then plan)."""
+    from spur_cad.pipeline import plan_cam
+
+    try:
+        plan_cam(parse_job(text, "small.toml"))
+    except SpurCadError as exc:
+        return str(exc)
+    raise AssertionError("the job is valid")
+
+
+@pytest.mark.parametrize("changes, group, old, new", [
+    ({"FinishingToolDiameter": 9.0}, "Finishing tool", "diameter_mm = 1.5", "diameter_mm = 9.0"),
+    ({"RoughingToolDiameter": -1.0}, "Roughing tool", "diameter_mm = 2.0", "diameter_mm = -1.0"),
+    ({"RoughingToolDiameter": 3.0}, "Roughing tool", "diameter_mm = 2.0", "diameter_mm = 3.0"),
+    ({"TargetScallop": 0.5}, "Finishing strategy", "target_scallop_mm = 0.05", "target_scallop_mm = 0.5"),
+])
+def test_invalid_values_give_the_command_lines_message_in_their_group(wb, changes, group, old, new):
+    result = wb.validation.validate(_small_values(wb, **changes), "small.toml")
+    assert not result.ok
+    cli = _cli_message(small_job_text().replace(old, new))
+    cli = cli.split(": ", 1)[1] if cli.startswith("small.toml:") else cli
+    assert result.messages == {group: cli}
+
+
+def test_gear_errors_are_filed_under_gear(wb):
+    values = _small_values(wb)
+    values["gear"]["Teeth"] = 3
+    result = wb.validation.validate(values, "doc")
+    assert list(result.messages) == ["Gear"]
+    assert result.messages["Gear"].startswith("invalid gear: teeth = 3: too few teeth")
+
+
+@pytest.mark.parametrize("name", sorted(GEAR_CASES))
+def test_suggested_tools_pass_the_tool_limits(wb, name):
+    z, m, pa, x, rho, frac, mm = GEAR_CASES[name]
+    values = wb.schema.default_values()
+    values["gear"].update(Teeth=z, Module=m, PressureAngle=pa, ProfileShift=x, RackTipRadius=rho,
+                          ThicknessAllowancePercent=frac * 100, ThicknessAllowance=mm, FaceWidth=10.0)
+    values["job"].update(wb.validation.suggest_tools(values))
+    job = job_from_dict(wb.schema.job_data(values), name)
+    assert job.tools.finishing is not None and job.tools.finishing.kind == "bull_nose"
+    blank = job.stock.blank_radius_mm(job.gear)
+    rec = recommend_tools(job.gear, blank, job.machine.clearance_mm, job.tools.finishing)
+    check_tools(job.gear, rec, job.tools.roughing, job.tools.finishing)
+    if job.tools.roughing is not None:
+        levels = roughing_levels(job.gear, job.tools.roughing, job.roughing, blank)
+        check_roughing_reach(job.tools.roughing, levels.lowest_height_mm - job.gear.root_radius_mm, rec)
+
+
+# --- toolpath display in the part frame ---------------------------------------------------------------
+
+
+def _machine_pose(p_y: float, p_z: float, a_deg: float) -> tuple[float, float]:
+    """Where a point fixed to the part at (p_y, p_z) is when A is commanded (CONVENTIONS.md)."""
+    a = math.radians(a_deg)
+    return p_y * math.cos(a) - p_z * math.sin(a), p_y * math.sin(a) + p_z * math.cos(a)
+
+
+def test_display_turns_each_pose_back_by_a(wb):
+    rng = np.random.default_rng(7)
+    part = rng.uniform(-30, 30, size=(50, 2))
+    angles = rng.uniform(-720, 720, size=50)
+    for (py, pz), a in zip(part, angles):
+        builder = ToolpathBuilder(Operation.FINISHING, 1, 1000.0)
+        y, z = _machine_pose(py, pz, a)
+        builder.move(MoveKind.LINEAR, 1.0, y, z, a, 100.0)
+        shown = wb.display.display_path(builder.build())
+        assert np.allclose(shown.points[-1], [1.0, py, pz], atol=1e-9)
+
+
+def test_index_move_is_drawn_as_an_arc_around_the_axis(wb):
+    """Turning A by 90 deg with the tool held at radius 40 draws a quarter circle of radius 40 in the part."""
+    builder = ToolpathBuilder(Operation.ROUGHING, 1, 1000.0)
+    builder.move(MoveKind.RAPID, 0.0, 0.0, 40.0, 0.0)
+    builder.move(MoveKind.RAPID, 0.0, 0.0, 40.0, 90.0)
+    shown = wb.display.display_path(builder.build())
+    radii = np.hypot(shown.points[:, 1], shown.points[:, 2])
+    assert np.allclose(radii, 40.0)
+    assert len(shown.points) >= 1 + 90 / wb.display.MAX_A_STEP_DEG
+    end_angle = math.degrees(math.atan2(shown.points[-1, 1], shown.points[-1, 2]))
+    assert end_angle == pytest.approx(90.0)  # the part point now under the tool was 90 deg toward +Y
+
+
+def test_large_programs_show_whole_stations_first_and_last(wb):
+    builder = ToolpathBuilder(Operation.FINISHING, 2, 1000.0)
+    for station in range(40):
+        for i in range(1000):
+            builder.move(MoveKind.LINEAR, station * 0.1, float(i), 30.0, 0.0, 100.0, station=station)
+    path = builder.build()
+    moves = wb.display.shown_moves(path, limit=5000)
+    stations = np.unique(path.station[moves])
+    assert len(moves) <= 5000 and len(stations) == 5
+    assert stations[0] == 0 and stations[-1] == 39
+    assert all(np.count_nonzero(path.station[moves] == s) == 1000 for s in stations)
+
+
+def test_polylines_split_rapids_from_feeds(wb):
+    builder = ToolpathBuilder(Operation.ROUGHING, 1, 1000.0)
+    builder.move(MoveKind.RAPID, 0.0, 0.0, 50.0, 0.0)
+    builder.move(MoveKind.LINEAR, 0.0, 0.0, 45.0, 0.0, 100.0)
+    builder.move(MoveKind.LINEAR, 10.0, 0.0, 45.0, 0.0, 100.0)
+    builder.move(MoveKind.RAPID, 10.0, 0.0, 50.0, 0.0)
+    runs = wb.display.polylines(wb.display.display_path(builder.build()))
+    assert [rapid for rapid, _ in runs] == [False, True]
+    assert np.allclose(runs[0][1], [[0, 0, 50], [0, 0, 45], [10, 0, 45]])
+    text = wb.display.gcode_text(wb.display.display_path(builder.build()))
+    assert text.splitlines()[2] == "G1 X0.0000 Y0.0000 Z45.0000"
+
+
+# --- simulation colours -----------------------------------------------------------------------------
+
+
+def test_deviation_colours(wb):
+    colours = wb.simulation.deviation_colours(np.array([-1.0, -0.05, 0.0, 0.05, 1.0]), 0.1)
+    assert np.allclose(colours[0], [0, 0, 1]) and np.allclose(colours[-1], [1, 0, 0])
+    assert np.allclose(colours[2], [0, 1, 0])
+    assert np.allclose(colours[1], [0, 0.5, 0.5]) and np.allclose(colours[3], [0.5, 0.5, 0])
+
+
+def test_simulation_guard_names_the_missing_simulator(wb, monkeypatch):
+    monkeypatch.setitem(sys.modules, "spur_cad.sim", None)  # as if spur_cad had no simulator
+    with pytest.raises(wb.simulation.SimulationUnavailable, match="^simulation not available"):
+        wb.simulation.simulator()
+
+
+# --- environment activation (the workbench's Init.py) ----------------------------------------------------
+
+
+def test_activate_puts_recorded_folders_first_and_reads_pth(wb, tmp_path, monkeypatch):
+    monkeypatch.setattr(sys, "path", list(sys.path))
+    site_dir, extra = tmp_path / "site", tmp_path / "extra"
+    site_dir.mkdir()
+    extra.mkdir()
+    (site_dir / "extra.pth").write_text(str(extra) + "\n")
+    record = {"site_packages": [str(site_dir)], "python_version": f"{sys.version_info[0]}.{sys.version_info[1]}"}
+    (tmp_path / wb.environment.RECORD_NAME).write_text(json.dumps(record))
+    assert wb.environment.activate(tmp_path) == []
+    assert sys.path[:2] == [str(site_dir), str(extra)]
+
+
+def test_activate_reports_problems(wb, tmp_path, monkeypatch):
+    monkeypatch.setattr(sys, "path", list(sys.path))
+    record = {"site_packages": [str(tmp_path / "gone")], "python_version": "2.7"}
+    (tmp_path / wb.environment.RECORD_NAME).write_text(json.dumps(record))
+    problems = wb.environment.activate(tmp_path)
+    assert any("Python 2.7" in p for p in problems)
+    assert any("gone does not exist" in p for p in problems)
+    assert wb.environment.activate(tmp_path / "nothing_installed") == []
+
+
+def test_activate_lets_preloaded_packages_find_the_environments_modules(wb, tmp_path, monkeypatch):
+    """Like Debian's mpl_toolkits (a regular package imported by a .pth file before FreeCAD starts)."""
+    monkeypatch.setattr(sys, "path", list(sys.path))
+    system, env = tmp_path / "system", tmp_path / "env"
+    (system / "wb_test_toolkit").mkdir(parents=True)
+    (system / "wb_test_toolkit" / "__init__.py").write_text("")
+    (env / "wb_test_toolkit").mkdir(parents=True)
+    (env / "wb_test_toolkit" / "plot3d.py").write_text("NAME = 'from env'\n")
+    monkeypatch.syspath_prepend(str(system))
+    import wb_test_toolkit  # noqa: F401
+
+    monkeypatch.setitem(sys.modules, "wb_test_toolkit", sys.modules["wb_test_toolkit"])
+    (tmp_path / wb.environment.RECORD_NAME).write_text(json.dumps({"site_packages": [str(env)]}))
+    wb.environment.activate(tmp_path)
+    from wb_test_toolkit import plot3d
+
+    assert plot3d.NAME == "from env"
+    monkeypatch.delitem(sys.modules, "wb_test_toolkit.plot3d")

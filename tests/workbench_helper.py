@@ -1,0 +1,145 @@
+"""Shared pieces of the workbench tests: a small quick job, running code in FreeCAD with the workbench
+installed the way users install it, and comparing the workbench's exported files with the CLI's."""
+
+from __future__ import annotations
+
+import json
+import re
+from pathlib import Path
+
+from tests.freecad_helper import run_freecad_code
+
+ROOT = Path(__file__).resolve().parents[1]
+ARTIFACTS = ROOT / "test-artifacts"
+REFERENCE_JOB = ROOT / "resources" / "examples" / "reference_gear.toml"
+
+# A job that plans in about a second: 12 teeth, 6 mm face width, finishing stations 1.5 mm apart.
+SMALL_JOB = """
+[job]
+name = "small quick gear"
+profile_tolerance_mm = 0.002
+
+[gear]
+teeth = {teeth}
+module_mm = 3.0
+rack_tip_radius_mm = 0.9
+thickness_allowance_percent = 2.0
+face_width_mm = 6.0
+bore_diameter_mm = 10.0
+
+[stock]
+radial_allowance_mm = 0.5
+
+[tools.roughing]
+kind = "flat"
+diameter_mm = 2.0
+flutes = 3
+
+[tools.finishing]
+kind = "bull_nose"
+diameter_mm = {finishing_diameter}
+corner_radius_mm = 0.5
+
+[finishing]
+target_scallop_mm = 0.05
+step_over_mm = 1.5
+"""
+
+# The same job as property values of the workbench's objects (written out by hand, not via the schema).
+SMALL_GEAR_PROPERTIES = dict(Teeth=12, Module=3.0, RackTipRadius=0.9, ThicknessAllowancePercent=2.0, FaceWidth=6.0,
+                             BoreDiameter=10.0)
+SMALL_STOCK_PROPERTIES = dict(RadialAllowance=0.5)
+SMALL_JOB_PROPERTIES = dict(JobName="small quick gear", ProfileTolerance=0.002, UseRoughingTool=True,
+                            RoughingToolKind="flat", RoughingToolDiameter=2.0, RoughingFlutes=3,
+                            UseFinishingTool=True, FinishingToolKind="bull_nose", FinishingToolDiameter=1.5,
+                            FinishingCornerRadius=0.5, TargetScallop=0.05, FinishingStepOver=1.5)
+
+
+def small_job_text(teeth: int = 12, finishing_diameter: float = 1.5) -> str:
+    return SMALL_JOB.format(teeth=teeth, finishing_diameter=finishing_diameter)
+
+
+def install_workbench(home: Path) -> None:
+    """Install the workbench for a user whose HOME is `home`, as `spur-cad install-freecad` does."""
+    from spur_cad.freecad_install import install
+
+    install({"HOME": str(home)})
+
+
+def run_workbench_code(body: str, work: Path, **kwargs):
+    """run_freecad_code with the workbench installed in the run's HOME (work/home) and no other path set up."""
+    install_workbench(work / "home")
+    return run_freecad_code(body, work, **kwargs)
+
+
+def step_volumes(path: Path) -> list[float]:
+    """Volumes (mm^3) of the solids in a STEP file, by OCP's NURBS-accurate integration."""
+    from OCP.IFSelect import IFSelect_RetDone
+    from OCP.STEPControl import STEPControl_Reader
+    from OCP.TopAbs import TopAbs_SOLID
+    from OCP.TopExp import TopExp_Explorer
+
+    from spur_cad.cad.solid import solid_volume_mm3
+
+    reader = STEPControl_Reader()
+    assert reader.ReadFile(str(path)) == IFSelect_RetDone, path
+    reader.TransferRoots()
+    explorer = TopExp_Explorer(reader.OneShape(), TopAbs_SOLID)
+    volumes = []
+    while explorer.More():
+        volumes.append(solid_volume_mm3(explorer.Current()))
+        explorer.Next()
+    return sorted(volumes)
+
+
+_DATE = re.compile(r"\d{4}-\d{2}-\d{2}")
+GCODE_SUFFIXES = {".ngc", ".nc", ".mpf", ".min", ".tap", ".gcode", ".spf", ".ssb"}
+
+
+def _without_date_comments(text: str) -> list[str]:
+    return [line for line in text.splitlines() if not (_DATE.search(line) and ("(" in line or ";" in line))]
+
+
+def output_differences(cli_dir: Path, workbench_dir: Path, sources: tuple[str, ...] = ()) -> list[str]:
+    """How the workbench's files differ from the CLI's for the same job (empty: the same content).
+
+    STEP: solid volumes within 1e-9 relative; summary.json: equal apart from timings and the job's
+    source; G-code: equal apart from comment lines with a date; the HTML report: equal apart from
+    the job's source (`sources`: the CLI's and the workbench's) and times in seconds; other files: bytes.
+    """
+    problems = []
+    cli_names = sorted(p.name for p in cli_dir.iterdir())
+    wb_names = sorted(p.name for p in workbench_dir.iterdir())
+    if cli_names != wb_names:
+        problems.append(f"file names differ: CLI {cli_names}, workbench {wb_names}")
+    for name in sorted(set(cli_names) & set(wb_names)):
+        cli, wb = cli_dir / name, workbench_dir / name
+        if name.endswith(".step"):
+            a, b = step_volumes(cli), step_volumes(wb)
+            if len(a) != len(b) or any(abs(x - y) > 1e-9 * abs(x) for x, y in zip(a, b)):
+                problems.append(f"{name}: volumes {a} vs {b}")
+        elif name == "summary.json":
+            a, b = json.loads(cli.read_text()), json.loads(wb.read_text())
+            for data in (a, b):
+                data.pop("timings_s", None)
+                data.get("job", {}).pop("file", None)
+                data.get("simulation", {}).pop("seconds", None)
+            if a != b:
+                keys = sorted(k for k in set(a) | set(b) if a.get(k) != b.get(k))
+                problems.append(f"summary.json differs in {keys}")
+        elif Path(name).suffix in GCODE_SUFFIXES:
+            if _without_date_comments(cli.read_text()) != _without_date_comments(wb.read_text()):
+                problems.append(f"{name}: G-code differs")
+        elif name.endswith(".html"):
+            if _comparable_html(cli.read_text(), sources) != _comparable_html(wb.read_text(), sources):
+                problems.append(f"{name}: differs")
+        elif cli.read_bytes() != wb.read_bytes():
+            problems.append(f"{name}: bytes differ")
+    return problems
+
+
+def _comparable_html(text: str, sources: tuple[str, ...]) -> str:
+    """An HTML report without what legitimately differs between two runs: the job's source and times."""
+    for source in sources:
+        text = text.replace(source, "<source>")
+    return re.sub(r"(\[s\]</th>\s*<td[^>]*>)[^<]*", r"\1<time>", text)
