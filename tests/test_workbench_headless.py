@@ -70,7 +70,7 @@ RESULT["job"] = dict(roughing=job.RoughingMoves, finishing=job.FinishingMoves,
 # Toolpath points in the part frame must lie outside the gear, and finishing ones hug its surface.
 for name, obj in (("roughing", job.RoughingToolpath), ("finishing", job.FinishingToolpath)):
     cuts = [c for c in obj.Path.Commands if c.Name == "G1"]
-    pts = [FreeCAD.Vector(c.Parameters["X"], c.Parameters["Y"], c.Parameters["Z"]) for c in cuts[::max(1, len(cuts) // 300)]]
+    pts = [FreeCAD.Vector(c.Parameters["X"], c.Parameters["Y"], c.Parameters["Z"]) for c in cuts[::max(1, len(cuts) // 80)]]
     if name == "roughing":  # passes run along X across the face at constant (Y, Z): check them mid-face
         pts = [FreeCAD.Vector(b / 2, p.y, p.z) for p in pts]
     pts = [p for p in pts if 0.0 < p.x < b]

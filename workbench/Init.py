@@ -6,7 +6,6 @@
 def _spur_cad_activate_environment():
     """Put the recorded site-packages in front of sys.path; report problems in the report view."""
     import FreeCAD
-
     from spur_cad_workbench import environment
 
     try:

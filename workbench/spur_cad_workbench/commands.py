@@ -110,7 +110,8 @@ def make_job(gear, stock, suggest: bool = True, **values):
     from spur_cad_workbench.validation import suggest_tools
 
     job_values = {**schema.default_values()["job"], **_checked(values, schema.JOB_FIELDS, "job")}
-    if suggest and not any(name.startswith(("Roughing", "Finishing", "Use")) for name in values):
+    tool_props = {field.prop for field in schema.JOB_FIELDS if field.section.startswith("tools.")}
+    if suggest and not tool_props & set(values):
         current = {**document_values(stock), "job": job_values}
         job_values.update(suggest_tools(current))
     doc = gear.Document
@@ -166,7 +167,6 @@ def simulate(job_obj, resolution_mm: float | None = None):
     """Simulate the job's toolpaths (spur_cad.sim, at the job's SimulationResolution unless given) and show
     the design points coloured by their deviation."""
     from spur_cad.pipeline import plan_cam
-
     from spur_cad_workbench.simulation import show_result, simulate_job, simulator
 
     simulator()  # raises SimulationUnavailable before any work
@@ -213,6 +213,7 @@ def show_message(title: str, message: str, error: bool = True) -> None:
 def run_recorded(lines: list[str], title: str) -> bool:
     """Run Python lines through FreeCADGui.doCommandGui (recorded in macros); show SpurCadErrors."""
     import FreeCADGui
+
     from spur_cad.errors import SpurCadError
 
     try:
@@ -223,6 +224,20 @@ def run_recorded(lines: list[str], title: str) -> bool:
         show_message(title, str(exc))
         return False
     return True
+
+
+NEW_DOCUMENT = "if App.ActiveDocument is None: App.newDocument('Gear')"
+RECOMPUTE = "App.ActiveDocument.recompute()"
+
+
+def _call(result: str, function: str, *arguments: str) -> str:
+    """A macro line calling an entry point of this module."""
+    return f"{result} = spur_cad_workbench.commands.{function}({', '.join(arguments)})"
+
+
+def _object(obj) -> str:
+    """A macro expression for a document object."""
+    return f"App.ActiveDocument.getObject({obj.Name!r})"
 
 
 class _Command:
@@ -245,10 +260,8 @@ class GearCommand(_Command):
         return True
 
     def Activated(self):
-        lines = ["if App.ActiveDocument is None: App.newDocument('Gear')",
-                 "spur_cad_gear = spur_cad_workbench.commands.make_gear(App.ActiveDocument)",
-                 "App.ActiveDocument.recompute()"]
-        if run_recorded(lines, "Spur gear"):
+        if run_recorded([NEW_DOCUMENT, _call("spur_cad_gear", "make_gear", "App.ActiveDocument"), RECOMPUTE],
+                        "Spur gear"):
             import FreeCADGui
 
             FreeCADGui.SendMsgToActiveView("ViewFit")
@@ -263,8 +276,7 @@ class StockCommand(_Command):
 
     def Activated(self):
         gear = _selected("gear")
-        run_recorded([f"spur_cad_stock = spur_cad_workbench.commands.make_stock("
-                      f"App.ActiveDocument.getObject({gear.Name!r}))", "App.ActiveDocument.recompute()"], "Stock")
+        run_recorded([_call("spur_cad_stock", "make_stock", _object(gear)), RECOMPUTE], "Stock")
 
 
 class JobCommand(_Command):
@@ -276,10 +288,8 @@ class JobCommand(_Command):
 
     def Activated(self):
         stock = _selected("stock")
-        gear = stock.Gear
-        run_recorded([f"spur_cad_job = spur_cad_workbench.commands.make_job("
-                      f"App.ActiveDocument.getObject({gear.Name!r}), App.ActiveDocument.getObject({stock.Name!r}))",
-                      "App.ActiveDocument.recompute()", "Gui.ActiveDocument.setEdit(spur_cad_job.Name)"], "4-axis job")
+        run_recorded([_call("spur_cad_job", "make_job", _object(stock.Gear), _object(stock)), RECOMPUTE,
+                      "Gui.ActiveDocument.setEdit(spur_cad_job.Name)"], "4-axis job")
 
 
 class ImportJobCommand(_Command):
@@ -296,9 +306,8 @@ class ImportJobCommand(_Command):
         path, _ = QtGui.QFileDialog.getOpenFileName(FreeCADGui.getMainWindow(), "Import spur_cad job file", "",
                                                     "spur_cad job (*.toml)")
         if path:
-            run_recorded(["if App.ActiveDocument is None: App.newDocument('Gear')",
-                          f"spur_cad_objects = spur_cad_workbench.commands.import_job_file(App.ActiveDocument, "
-                          f"{path!r})"], "Import job file")
+            run_recorded([NEW_DOCUMENT, _call("spur_cad_objects", "import_job_file", "App.ActiveDocument", repr(path))],
+                         "Import job file")
 
 
 class SimulateCommand(_Command):
@@ -317,8 +326,7 @@ class SimulateCommand(_Command):
             show_message("Simulate", str(exc), error=False)
             return
         job = _selected("job")
-        run_recorded([f"spur_cad_simulation = spur_cad_workbench.commands.simulate("
-                      f"App.ActiveDocument.getObject({job.Name!r}))"], "Simulate")
+        run_recorded([_call("spur_cad_simulation", "simulate", _object(job))], "Simulate")
 
 
 class ExportCommand(_Command):
@@ -335,8 +343,7 @@ class ExportCommand(_Command):
         job = _selected("job")
         folder = QtGui.QFileDialog.getExistingDirectory(FreeCADGui.getMainWindow(), "Export job files to")
         if folder:
-            run_recorded([f"spur_cad_files = spur_cad_workbench.commands.export_job("
-                          f"App.ActiveDocument.getObject({job.Name!r}), {folder!r})"], "Export")
+            run_recorded([_call("spur_cad_files", "export_job", _object(job), repr(folder))], "Export")
 
 
 COMMANDS = (GearCommand, StockCommand, JobCommand, ImportJobCommand, SimulateCommand, ExportCommand)

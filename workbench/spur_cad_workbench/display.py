@@ -10,6 +10,7 @@ their finishing stations (first and last included); the object says how many mov
 
 from __future__ import annotations
 
+import itertools
 import math
 from dataclasses import dataclass
 
@@ -100,7 +101,7 @@ def polylines(display: DisplayPath) -> list[tuple[bool, np.ndarray]]:
         return runs
     change = np.nonzero(np.diff(rapid[1:].astype(np.int8)))[0] + 2
     bounds = np.concatenate([[1], change, [len(points)]])
-    for begin, end in zip(bounds[:-1], bounds[1:]):
+    for begin, end in itertools.pairwise(bounds):
         run = points[begin - 1:end]
         keep = np.concatenate([[True], np.any(np.abs(np.diff(run, axis=0)) > 1e-9, axis=1)])
         if keep.sum() >= 2:

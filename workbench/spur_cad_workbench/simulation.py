@@ -24,13 +24,14 @@ class SimulationUnavailable(SpurCadError):
 
 def simulator():
     """The spur_cad.sim module; raises SimulationUnavailable when it is not installed."""
+    import importlib
+
     try:
-        import spur_cad.sim as sim
+        return importlib.import_module("spur_cad.sim")
     except ModuleNotFoundError as exc:
         if exc.name in ("spur_cad.sim", "spur_cad"):
             raise SimulationUnavailable(NOT_AVAILABLE) from None
         raise
-    return sim
 
 
 def simulate_job(job, plan, resolution_mm: float | None = None):

@@ -8,7 +8,6 @@ fields. OK writes the values to the job and recomputes; with an error OK keeps t
 
 from __future__ import annotations
 
-import FreeCAD
 import FreeCADGui
 from PySide import QtCore, QtGui
 

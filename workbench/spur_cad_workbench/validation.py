@@ -12,7 +12,6 @@ import re
 from dataclasses import dataclass
 
 from spur_cad.errors import SpurCadError
-
 from spur_cad_workbench.schema import TOOL_SWITCHES, job_data
 
 # Panel groups (the property groups of schema.JOB_FIELDS, plus the gear and stock objects).
@@ -50,7 +49,7 @@ def group_of(message: str) -> str:
 
 def _strip_source(message: str, source: str) -> str:
     prefix = f"{source}: "
-    return message[len(prefix):] if message.startswith(prefix) else message
+    return message.removeprefix(prefix)
 
 
 def validate(values: dict[str, dict[str, object]], source: str = "job") -> Validation:
