@@ -135,6 +135,17 @@ FreeCADGui.runCommand("SpurCad_ImportJob")
 settle()
 RESULT["imported"] = [o.Label for o in doc.Objects if getattr(getattr(o, "Proxy", None), "KIND", "") == "job"]
 
+imported_job = doc.getObject("Job001")         # a bad value: Export shows the message, writes nothing
+imported_job.FinishingToolDiameter = 9.0
+os.makedirs(OUT + "_bad")
+answer_file_dialog(OUT + "_bad")
+select(imported_job)
+FreeCADGui.runCommand("SpurCad_Export")
+settle()
+boxes = [w for w in QtGui.QApplication.topLevelWidgets() if w.objectName() == "SpurCadMessage" and w.isVisible()]
+RESULT["export_error"] = [[b.windowTitle(), b.text()] for b in boxes]
+RESULT["exported_bad"] = os.listdir(OUT + "_bad")
+
 settle()
 RESULT["report"] = report.toPlainText()
 RESULT["console"] = console.toPlainText() if console is not None else ""
@@ -191,6 +202,9 @@ def test_workbench_commands_panel_and_screenshot_in_the_gui(freecad_gui, tmp_pat
     assert {"gear.step", "stock.step", "job.step", "summary.json"} <= set(result["exported"])
     assert any(name.startswith("roughing.") for name in result["exported"])
     assert result["imported"] == ["Job", "small quick gear"]
+    expected = _expected(small_job_text(finishing_diameter=9.0))
+    assert ["Export", expected] in result["export_error"] and result["exported_bad"] == []
+    assert f"Export: {expected}" in result["report"]
 
     # every command went through FreeCADGui.doCommandGui: echoed as macro lines
     for call in ("make_gear(", "make_stock(", "make_job(", "simulate(", "export_job(", "import_job_file("):
