@@ -6,6 +6,7 @@ import csv
 import json
 import math
 import os
+import re
 import subprocess
 import sys
 from pathlib import Path
@@ -141,3 +142,16 @@ def test_existing_outputs_are_replaced_whole(tmp_path):
     assert main(["run", str(REFERENCE_JOB), "--out", str(out), "--quiet"]) == 0
     assert json.loads((out / "summary.json").read_text())["gear"] == json.loads(first)["gear"]
     assert not [p for p in os.listdir(out) if p.startswith(".")]  # no temporaries left behind
+
+
+def test_progress_bars_go_to_stderr_and_the_report_is_written(tmp_path):
+    job = tmp_path / "coarse.toml"
+    job.write_text(REFERENCE_JOB.read_text() + "\n[simulation]\nresolution_mm = 0.02\n")
+    out = tmp_path / "o"
+    result = run_cli("run", str(job), "--out", str(out))
+    assert result.returncode == 0, result.stderr
+    for stage in ("CAD and STEP", "toolpaths", "simulation", "report"):
+        assert re.search(rf"{stage}: +100%", result.stderr), stage
+    assert "wrote" in result.stdout and "%" not in result.stdout
+    assert (out / "report.html").read_bytes().startswith(b"<!DOCTYPE html>")
+    assert json.loads((out / "summary.json").read_text())["simulation"]["resolution_mm"] == 0.02

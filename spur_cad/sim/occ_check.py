@@ -1,0 +1,179 @@
+"""Cross-check of the fast simulation with OCP booleans on a subset of moves (slow, for tests and benchmarks).
+
+The way CAD-based machining simulations are usually built: the stock is a B-rep solid, each move's
+tool swept solid is subtracted from it (BRepAlgoAPI_Cut with all tools at once). Swept solids:
+a move along X only is exact (the tool's silhouette extruded along X, plus the tool at both ends);
+a move in Z only is the tool at its lower end (exact); any other move is the union of the tool at
+poses `refine` times denser than the fast simulation's (so the boolean result is the better
+approximation of the continuous sweep). The result is then probed along the same blades (lines
+along the design normals) with BRepIntCurveSurface_Inter and compared with the fast simulation.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass
+
+import numpy as np
+
+from spur_cad.cam.ir import MoveKind, Toolpath
+from spur_cad.cam.tools import Tool
+from spur_cad.geometry.spec import GearSpec
+from spur_cad.sim.simulate import Operation, SimResult, SimSettings, StockCylinder, pose_step_mm, simulate
+
+
+@dataclass(frozen=True)
+class CrossCheck:
+    """Fast simulation vs OCP booleans on one subset of moves."""
+
+    max_difference_mm: float
+    compared_blades: int
+    cut_blades: int
+    fast_seconds: float
+    occ_seconds: float
+    tool_solids: int
+
+    @property
+    def speed_ratio(self) -> float:
+        """How many times faster the fast simulation was on this subset."""
+        return self.occ_seconds / self.fast_seconds
+
+
+def tool_solid(tool: Tool, height: float):
+    """The tool as a CadQuery solid of revolution about +Z, tip centre at the origin (exact corner arcs)."""
+    import cadquery as cq
+
+    radius, rt = tool.diameter_mm / 2.0, tool.corner_radius
+    rho = radius - rt
+    wp = cq.Workplane("XZ").moveTo(0.0, 0.0)
+    if rho > 0.0:
+        wp = wp.lineTo(rho, 0.0)
+    if rt > 0.0:
+        mid = (rho + rt * math.sin(math.pi / 4), rt - rt * math.cos(math.pi / 4))
+        wp = wp.threePointArc(mid, (radius, rt))
+    wp = wp.lineTo(radius, height).lineTo(0.0, height).close()
+    return wp.revolve(360.0, (0, 0, 0), (0, 1, 0)).val()
+
+
+def _silhouette_prism(tool: Tool, height: float, length: float):
+    """The tool's section through its axis in the YZ plane (X = 0), extruded by `length` along +X."""
+    import cadquery as cq
+
+    radius, rt = tool.diameter_mm / 2.0, tool.corner_radius
+    rho = radius - rt
+    wp = cq.Workplane("YZ").moveTo(-radius, height).lineTo(-radius, rt)
+    if rt > 0.0:
+        wp = wp.threePointArc((-rho - rt * math.sin(math.pi / 4), rt - rt * math.cos(math.pi / 4)), (-rho, 0.0))
+    if rho > 0.0:
+        wp = wp.lineTo(rho, 0.0)
+    if rt > 0.0:
+        wp = wp.threePointArc((rho + rt * math.sin(math.pi / 4), rt - rt * math.cos(math.pi / 4)), (radius, rt))
+    wp = wp.lineTo(radius, height).close()
+    return wp.extrude(length).val()
+
+
+def _place(shape, x: float, y: float, z: float, a_deg: float):
+    """Machine pose -> part frame: move the tool tip to (x, y, z), then turn the part back by -A about X."""
+    return shape.translate((x, y, z)).rotate((0, 0, 0), (1, 0, 0), -a_deg)
+
+
+def swept_solids(path: Toolpath, tool: Tool, stock: StockCylinder, resolution_mm: float, height: float,
+                 refine: int = 2) -> list:
+    """Tool solids whose union is what the moves of `path` remove from `stock` (see the module docstring);
+    moves that cannot reach the stock (above it, or beyond its ends by more than the tool radius) are left out."""
+    motion = (path.kind == MoveKind.RAPID) | (path.kind == MoveKind.LINEAR)
+    x, y, z, a = (np.asarray(v, float)[motion] for v in (path.x, path.y, path.z, path.a))
+    base = tool_solid(tool, height)
+    radius = tool.diameter_mm / 2.0
+    solids = [_place(base, x[0], y[0], z[0], a[0])]
+    step = pose_step_mm(tool, resolution_mm) / refine
+    for i in range(1, len(x)):
+        x0, y0, z0, a0 = x[i - 1], y[i - 1], z[i - 1], a[i - 1]
+        if (min(z0, z[i]) > stock.radius_mm or max(x0, x[i]) < stock.x_min - radius
+                or min(x0, x[i]) > stock.x_max + radius):
+            continue
+        if y0 == y[i] and z0 == z[i] and a0 == a[i] and x0 != x[i]:
+            lo, hi = min(x0, x[i]), max(x0, x[i])
+            solids.append(_place(_silhouette_prism(tool, height, hi - lo), lo, y0, z0, a0))
+            solids.append(_place(base, x[i], y[i], z[i], a[i]))
+            continue
+        if x0 == x[i] and y0 == y[i] and a0 == a[i]:
+            solids.append(_place(base, x[i], y[i], min(z0, z[i]), a[i]))
+            continue
+        reach = max(math.hypot(y0, z0), math.hypot(y[i], z[i])) + tool.diameter_mm
+        travel = abs(x[i] - x0) + math.hypot(y[i] - y0, z[i] - z0) + reach * abs(math.radians(a[i] - a0))
+        here = step
+        if tool.corner_radius == 0.0 and z0 == z[i] and a0 == a[i]:  # flat bottom translating: its round edge
+            here = math.sqrt(8.0 * radius * resolution_mm / 2.0) / refine
+        pieces = max(1, math.ceil(travel / here))
+        for f in np.arange(1, pieces + 1) / pieces:
+            solids.append(_place(base, x0 + (x[i] - x0) * f, y0 + (y[i] - y0) * f, z0 + (z[i] - z0) * f,
+                                 a0 + (a[i] - a0) * f))
+    return solids
+
+
+def probe_blades(shape, origins: np.ndarray, directions: np.ndarray, t_min: float, t_max: float) -> np.ndarray:
+    """Outer end of the material on each blade (origin + t direction, t from t_min) in an OCP solid:
+    the first boundary crossing after t_min (t_min when t_min is already outside, t_max when none)."""
+    from OCP.BRepClass3d import BRepClass3d_SolidClassifier
+    from OCP.BRepIntCurveSurface import BRepIntCurveSurface_Inter
+    from OCP.gp import gp_Dir, gp_Lin, gp_Pnt
+    from OCP.TopAbs import TopAbs_IN
+
+    out = np.empty(len(origins))
+    for i, (o, d) in enumerate(zip(origins, directions)):
+        start = o + t_min * d
+        classifier = BRepClass3d_SolidClassifier(shape, gp_Pnt(*start), 1e-7)
+        if classifier.State() != TopAbs_IN:
+            out[i] = t_min
+            continue
+        inter = BRepIntCurveSurface_Inter()
+        inter.Init(shape, gp_Lin(gp_Pnt(*o), gp_Dir(*d)), 1e-7)
+        crossings = []
+        while inter.More():
+            crossings.append(inter.W())
+            inter.Next()
+        after = [w for w in crossings if t_min < w <= t_max + 1e-9]
+        out[i] = min(after) if after else t_max
+    return out
+
+
+def cross_check(spec: GearSpec, stock: StockCylinder, path: Toolpath, tool: Tool, settings: SimSettings,
+                rows_x_range: tuple[float, float], station_x: np.ndarray = np.zeros(0), refine: int = 2,
+                max_blades: int = 400, seed: int = 0) -> CrossCheck:
+    """Remove `path` from the stock both ways and compare the blades it cut (a random sample of at most
+    `max_blades`, plus as many uncut blades near them, which must stay uncut in both)."""
+    import cadquery as cq
+
+    start = time.perf_counter()
+    fast: SimResult = simulate(spec, stock, [Operation(path, tool)], settings, station_x=station_x,
+                               rows_x_range=rows_x_range)
+    fast_seconds = time.perf_counter() - start
+    start = time.perf_counter()
+    height = stock.radius_mm + 2.0 * tool.diameter_mm
+    solids = swept_solids(path, tool, stock, settings.resolution_mm, height, refine)
+    blank = cq.Solid.makeCylinder(stock.radius_mm, stock.x_max - stock.x_min, cq.Vector(stock.x_min, 0, 0),
+                                  cq.Vector(1, 0, 0))
+    result = blank.cut(*solids)
+    occ_seconds = time.perf_counter() - start
+    cut = np.argwhere(fast.deviation < fast.initial - 1e-9)
+    uncut = np.argwhere((fast.deviation >= fast.initial - 1e-9) & (fast.initial < settings.leftover_range_mm - 1e-9))
+    rng = np.random.default_rng(seed)
+    picks = [cut[rng.permutation(len(cut))[:max_blades]]]
+    if len(uncut):
+        picks.append(uncut[rng.permutation(len(uncut))[:max_blades // 4]])
+    chosen = np.concatenate(picks)
+    grid = fast.grid
+    origins, directions = [], []
+    for k, j, r in chosen:
+        p = grid.space_points(int(k))[j]
+        n = grid.space_normals(int(k))[j]
+        origins.append((grid.rows_x[r], p[0], p[1]))
+        directions.append((0.0, n[0], n[1]))
+    occ_h = probe_blades(result.wrapped, np.array(origins), np.array(directions), -settings.gouge_range_mm,
+                         settings.leftover_range_mm)
+    occ_h = np.minimum(occ_h, fast.initial[tuple(chosen.T)])
+    fast_h = fast.deviation[tuple(chosen.T)]
+    return CrossCheck(float(np.abs(occ_h - fast_h).max()), len(chosen), len(cut), fast_seconds, occ_seconds,
+                      len(solids))

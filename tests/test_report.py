@@ -1,0 +1,62 @@
+"""report.html: self-contained (images embedded, nothing fetched) and showing summary.json's values."""
+
+from __future__ import annotations
+
+import base64
+import json
+import re
+from pathlib import Path
+
+import pytest
+
+from spur_cad.job import load_job
+from spur_cad.pipeline import run_job
+from spur_cad.report.html import render_report
+
+ROOT = Path(__file__).resolve().parents[1]
+REFERENCE_JOB = ROOT / "resources" / "examples" / "reference_gear.toml"
+PNG = b"\x89PNG\r\n\x1a\n"
+
+
+@pytest.fixture(scope="module")
+def outputs():
+    files = run_job(load_job(REFERENCE_JOB))
+    return files["report.html"].decode("utf-8"), json.loads(files["summary.json"])
+
+
+def test_report_embeds_every_image_and_refers_to_nothing_outside(outputs):
+    html, _ = outputs
+    assert html.startswith("<!DOCTYPE html>")
+    sources = re.findall(r'<img[^>]*\ssrc="([^"]*)"', html)
+    assert len(sources) == 4  # profile, roughing levels, finishing poses, deviation map
+    for src in sources:
+        assert src.startswith("data:image/png;base64,")
+        assert base64.b64decode(src.split(",", 1)[1], validate=True)[:8] == PNG
+    assert not re.search(r"https?://|<script|<link|<iframe|url\(", html, re.IGNORECASE)
+
+
+def test_report_shows_the_inspection_sheet_and_simulation_values_of_the_summary(outputs):
+    html, summary = outputs
+    ins = summary["inspection"]
+    for key in ("span_measurement_mm", "dimension_over_pins_mm", "pin_diameter_mm", "chordal_thickness_mm",
+                "tooth_thickness_mm"):
+        assert f"{ins[key]:.4f}" in html, key
+    assert f"{-ins['thickness_reduction_mm']:.4f}" in html  # the thickness tolerance (allowance)
+    assert f"over k = {ins['span_teeth_k']} teeth" in html
+    sim = summary["simulation"]
+    assert f"{sim['max_gouge_mm']:.4f}" in html and f"{sim['max_leftover_mm']:.4f}" in html
+    assert f"{sim['removed_volume_mm3']:.1f}" in html
+    finishing = summary["finishing"]
+    for seconds in (finishing["estimated_time_s"], finishing["reference_strategy_time_s"]):
+        assert f"{seconds / 3600:.2f} h" in html
+    for role in ("roughing", "finishing"):
+        assert f"{summary['tools'][role]['diameter_mm']:.4f}" in html
+    assert str(summary["post"]["finishing_lines"]) in html
+
+
+def test_report_without_tools_simulation_or_post_still_renders(outputs):
+    _, summary = outputs
+    bare = {key: summary[key] for key in ("spur_cad_version", "job", "gear", "inspection")}
+    html = render_report(bare, {}).decode("utf-8")
+    assert "Inspection sheet" in html and "Simulated cut" not in html and "<img" not in html
+    assert f"{summary['inspection']['span_measurement_mm']:.4f}" in html
