@@ -140,10 +140,13 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__)
     parser.add_argument("--runs", type=int, default=21)
     parser.add_argument("--cad-runs", type=int, default=5)
+    parser.add_argument("--sim-runs", type=int, default=5)
     args = parser.parse_args()
+    from benchmarks.bench_sim import bench_sim
+
     results = {"machine": machine(), "runs": args.runs, "profile": bench_profile(args.runs),
                "cad_runs": args.cad_runs, "cad": bench_cad(args.cad_runs), "cam": bench_cam(args.cad_runs),
-               "post": bench_post(args.cad_runs)}
+               "post": bench_post(args.cad_runs), "sim_runs": args.sim_runs, "sim": bench_sim(args.sim_runs)}
     print(json.dumps(results, indent=2))
 
 

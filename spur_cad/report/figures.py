@@ -67,14 +67,17 @@ def finishing_png(spec: GearSpec, tool: Tool, y: np.ndarray, z: np.ndarray, a_de
     outline = _space_outline(spec)
     ax.plot(outline[:, 0], outline[:, 1], "-", color="k", lw=1.2, label="design")
     r_t, half_flat = tool.corner_radius, tool.flat_width_mm / 2.0
+    from spur_cad.sim.design import sample_space
+
     tips = part_frame_points(y, z, a_deg)
+    dense = sample_space(spec.tooth_space_profile(), 0.005)[0]
     contacts = []
     for side in (1.0, -1.0):  # right and left corner-circle centres
         centres = part_frame_points(y + side * half_flat, z + r_t, a_deg)
-        d = np.hypot(outline[None, :, 0] - centres[:, None, 0], outline[None, :, 1] - centres[:, None, 1])
+        d = np.hypot(dense[None, :, 0] - centres[:, None, 0], dense[None, :, 1] - centres[:, None, 1])
         nearest = d.argmin(axis=1)
-        touching = np.abs(d[np.arange(len(centres)), nearest] - r_t) < max(0.02, 0.05 * r_t)
-        contacts.append(outline[nearest[touching]])
+        touching = np.abs(d[np.arange(len(centres)), nearest] - r_t) < 0.01
+        contacts.append(dense[nearest[touching]])
     contacts = np.concatenate(contacts)
     ax.plot(tips[:, 0], tips[:, 1], ".", ms=2, color="tab:blue", label="cutter locations (tip centre)")
     ax.plot(contacts[:, 0], contacts[:, 1], ".", ms=3, color="tab:red", label="contact points")
