@@ -8,6 +8,7 @@ and exits 3.
 from __future__ import annotations
 
 import argparse
+import shutil
 import sys
 from pathlib import Path
 
@@ -37,7 +38,8 @@ def _parser() -> argparse.ArgumentParser:
 
 
 class ProgressBars:
-    """A `run_job` progress callback: one tqdm bar per long stage on `stream` (never with --quiet)."""
+    """A `run_job` progress callback: one tqdm bar per long stage on `stream` (used when stderr is a
+    terminal and --quiet is not given, so that logs and pipes get only the one-line messages)."""
 
     def __init__(self, stream) -> None:
         self._stream = stream
@@ -48,7 +50,9 @@ class ProgressBars:
 
         bar = self._bars.get(stage)
         if bar is None:
+            size = shutil.get_terminal_size()  # 80 x 24 when the terminal does not say (tqdm would draw nothing)
             bar = self._bars[stage] = tqdm(total=100, desc=f"{stage:>13}", file=self._stream, leave=True,
+                                           ncols=min(100, size.columns), nrows=max(size.lines, 10),
                                            bar_format="{desc}: {percentage:3.0f}%|{bar:30}| {elapsed}")
         bar.n = min(100, round(100.0 * fraction))
         bar.refresh()
@@ -83,7 +87,7 @@ def main(argv: list[str] | None = None) -> int:
         return _install_freecad(args.uninstall)
     try:
         job = load_job(args.job)
-        bars = None if args.quiet else ProgressBars(sys.stderr)
+        bars = ProgressBars(sys.stderr) if not args.quiet and sys.stderr.isatty() else None
         try:
             files = run_job(job, bars)
         finally:

@@ -144,14 +144,40 @@ def test_existing_outputs_are_replaced_whole(tmp_path):
     assert not [p for p in os.listdir(out) if p.startswith(".")]  # no temporaries left behind
 
 
-def test_progress_bars_go_to_stderr_and_the_report_is_written(tmp_path):
+def run_cli_on_a_terminal(*args: str) -> tuple[int, str, str]:
+    """Run the console script with stderr on a pseudo-terminal (as in an interactive shell)."""
+    import pty
+
+    exe = Path(sys.executable).with_name("spur-cad")
+    command = [str(exe)] if exe.exists() else [sys.executable, "-m", "spur_cad.cli"]
+    master, slave = pty.openpty()
+    proc = subprocess.Popen(command + list(args), stdout=subprocess.PIPE, stderr=slave, cwd=ROOT)
+    os.close(slave)
+    chunks = []
+    while True:
+        try:
+            data = os.read(master, 65536)
+        except OSError:  # EIO: the child closed the terminal
+            break
+        if not data:
+            break
+        chunks.append(data)
+    os.close(master)
+    stdout = proc.stdout.read().decode()
+    proc.stdout.close()
+    return proc.wait(timeout=300), stdout, b"".join(chunks).decode(errors="replace")
+
+
+def test_progress_bars_on_the_terminal_and_nothing_with_quiet(tmp_path):
     job = tmp_path / "coarse.toml"
     job.write_text(REFERENCE_JOB.read_text() + "\n[simulation]\nresolution_mm = 0.02\n")
     out = tmp_path / "o"
-    result = run_cli("run", str(job), "--out", str(out))
-    assert result.returncode == 0, result.stderr
+    code, stdout, terminal = run_cli_on_a_terminal("run", str(job), "--out", str(out))
+    assert code == 0, terminal
     for stage in ("CAD and STEP", "toolpaths", "simulation", "report"):
-        assert re.search(rf"{stage}: +100%", result.stderr), stage
-    assert "wrote" in result.stdout and "%" not in result.stdout
+        assert re.search(rf"{stage}: +100%", terminal), stage
+    assert "wrote" in stdout and "%" not in stdout
     assert (out / "report.html").read_bytes().startswith(b"<!DOCTYPE html>")
     assert json.loads((out / "summary.json").read_text())["simulation"]["resolution_mm"] == 0.02
+    code, stdout, terminal = run_cli_on_a_terminal("run", str(job), "--out", str(out), "--quiet")
+    assert code == 0 and stdout == "" and terminal == ""
