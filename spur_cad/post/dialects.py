@@ -7,7 +7,7 @@ golden tests.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 from spur_cad.post.settings import PostError
 
@@ -47,50 +47,50 @@ class Dialect:
     direction_codes: tuple[str, str] | None = None  # (positive, negative) A direction for wrapped A
 
 
-DIALECTS: dict[str, Dialect] = {
-    "linuxcnc": Dialect(
-        name="linuxcnc", extension="ngc", percent_delimited=False, program_start="", comment_style="paren",
-        uppercase_comments=False, setup="G21 G90 G94 G17 G40 G49 G80 G64 P0.001", tool_change=("T{tool} M6",
-                                                                                               "G43 H{tool}"),
-        spindle_on="S{rpm} M3", coolant_on="M8", coolant_off="M9", spindle_off="M5", program_end="M30",
-        linear_decimals=4, rotary_decimals=4, feed_decimals=1, inverse_feed_decimals=4, inverse_time=True,
-        fold_style="linuxcnc_sub", x_param="#1", a_param="#2", param_word="{address}{param}",
-        param_offset_word="{address}[{param}{offset}]", sub_start="o{sub} sub", sub_end="o{sub} endsub",
-        call=("o{sub} call [{x}] [{a}]",), subprograms_after_end=False),
-    "fanuc": Dialect(
-        name="fanuc", extension="nc", percent_delimited=True, program_start="O{number:04d} ({title})",
-        comment_style="paren", uppercase_comments=True, setup="G21 G90 G94 G17 G40 G49 G80",
-        tool_change=("T{tool} M06", "G43 H{tool}"), spindle_on="S{rpm} M03", coolant_on="M08", coolant_off="M09",
-        spindle_off="M05", program_end="M30", linear_decimals=3, rotary_decimals=3, feed_decimals=1,
-        inverse_feed_decimals=3, inverse_time=True, fold_style="macro_call", x_param="#24", a_param="#1",
-        param_word="{address}{param}", param_offset_word="{address}[{param}{offset}]", sub_start="O{sub:04d}",
-        sub_end="M99", call=("G65 P{sub:04d} X{x} A{a}",), subprograms_after_end=True),
-    "haas": Dialect(
-        name="haas", extension="nc", percent_delimited=True, program_start="O{number:05d} ({title})",
-        comment_style="paren", uppercase_comments=True, setup="G21 G90 G94 G17 G40 G49 G80",
-        tool_change=("T{tool} M06", "G43 H{tool}"), spindle_on="S{rpm} M03", coolant_on="M08", coolant_off="M09",
-        spindle_off="M05", program_end="M30", linear_decimals=3, rotary_decimals=3, feed_decimals=1,
-        inverse_feed_decimals=3, inverse_time=True, fold_style="local_sub", x_param="#101", a_param="#102",
-        param_word="{address}{param}", param_offset_word="{address}[{param}{offset}]", sub_start="N{sub}",
-        sub_end="M99", call=("#101={x}", "#102={a}", "M97 P{sub}"), subprograms_after_end=True),
-    "siemens": Dialect(
-        name="siemens", extension="mpf", percent_delimited=False, program_start="", comment_style="semicolon",
-        uppercase_comments=False, setup="G71 G90 G94 G17 G40", tool_change=("T{tool} D1", "M6"),
-        spindle_on="S{rpm} M3", coolant_on="M8", coolant_off="M9", spindle_off="M5", program_end="M30",
-        linear_decimals=4, rotary_decimals=4, feed_decimals=1, inverse_feed_decimals=4, inverse_time=True,
-        fold_style="repeat", x_param="R1", a_param="R2", param_word="{address}={param}",
-        param_offset_word="{address}={param}{offset}", sub_start="SPACE{sub}:", sub_end="SPACE{sub}_END:",
-        call=("R1={x} R2={a}", "REPEAT SPACE{sub} SPACE{sub}_END P=1"), subprograms_after_end=False),
-    "okuma": Dialect(
-        name="okuma", extension="min", percent_delimited=False, program_start="O{number:04d} ({title})",
-        comment_style="paren", uppercase_comments=True, setup="G21 G90 G94 G17 G40 G80",
-        tool_change=("T{tool} M06", "G56 H{tool}"), spindle_on="S{rpm} M03", coolant_on="M08", coolant_off="M09",
-        spindle_off="M05", program_end="M30", linear_decimals=3, rotary_decimals=3, feed_decimals=1,
-        inverse_feed_decimals=3, inverse_time=False, fold_style="macro_call", x_param="XST", a_param="ASP",
-        param_word="{address}={param}", param_offset_word="{address}={param}{offset}", sub_start="O{sub:04d}",
-        sub_end="RTS", call=("CALL O{sub:04d} XST={x} ASP={a}",), subprograms_after_end=True,
-        direction_codes=("M15", "M16")),
-}
+LINUXCNC = Dialect(
+    name="linuxcnc", extension="ngc", percent_delimited=False, program_start="", comment_style="paren",
+    uppercase_comments=False, setup="G21 G90 G94 G17 G40 G49 G80 G64 P0.001", tool_change=("T{tool} M6",
+                                                                                           "G43 H{tool}"),
+    spindle_on="S{rpm} M3", coolant_on="M8", coolant_off="M9", spindle_off="M5", program_end="M30",
+    linear_decimals=4, rotary_decimals=4, feed_decimals=1, inverse_feed_decimals=4, inverse_time=True,
+    fold_style="linuxcnc_sub", x_param="#1", a_param="#2", param_word="{address}{param}",
+    param_offset_word="{address}[{param}{offset}]", sub_start="o{sub} sub", sub_end="o{sub} endsub",
+    call=("o{sub} call [{x}] [{a}]",), subprograms_after_end=False)
+
+FANUC = Dialect(
+    name="fanuc", extension="nc", percent_delimited=True, program_start="O{number:04d} ({title})",
+    comment_style="paren", uppercase_comments=True, setup="G21 G90 G94 G17 G40 G49 G80",
+    tool_change=("T{tool} M06", "G43 H{tool}"), spindle_on="S{rpm} M03", coolant_on="M08", coolant_off="M09",
+    spindle_off="M05", program_end="M30", linear_decimals=3, rotary_decimals=3, feed_decimals=1,
+    inverse_feed_decimals=3, inverse_time=True, fold_style="macro_call", x_param="#24", a_param="#1",
+    param_word="{address}{param}", param_offset_word="{address}[{param}{offset}]", sub_start="O{sub:04d}",
+    sub_end="M99", call=("G65 P{sub:04d} X{x} A{a}",), subprograms_after_end=True)
+
+# Haas differs from Fanuc in the program number's digits and in folding: local subprograms
+# (M97 P<N label> in the same file) with their parameters in common variables.
+HAAS = replace(FANUC, name="haas", program_start="O{number:05d} ({title})", fold_style="local_sub",
+               x_param="#101", a_param="#102", sub_start="N{sub}", call=("#101={x}", "#102={a}", "M97 P{sub}"))
+
+SIEMENS = Dialect(
+    name="siemens", extension="mpf", percent_delimited=False, program_start="", comment_style="semicolon",
+    uppercase_comments=False, setup="G71 G90 G94 G17 G40", tool_change=("T{tool} D1", "M6"),
+    spindle_on="S{rpm} M3", coolant_on="M8", coolant_off="M9", spindle_off="M5", program_end="M30",
+    linear_decimals=4, rotary_decimals=4, feed_decimals=1, inverse_feed_decimals=4, inverse_time=True,
+    fold_style="repeat", x_param="R1", a_param="R2", param_word="{address}={param}",
+    param_offset_word="{address}={param}{offset}", sub_start="SPACE{sub}:", sub_end="SPACE{sub}_END:",
+    call=("R1={x} R2={a}", "REPEAT SPACE{sub} SPACE{sub}_END P=1"), subprograms_after_end=False)
+
+OKUMA = Dialect(
+    name="okuma", extension="min", percent_delimited=False, program_start="O{number:04d} ({title})",
+    comment_style="paren", uppercase_comments=True, setup="G21 G90 G94 G17 G40 G80",
+    tool_change=("T{tool} M06", "G56 H{tool}"), spindle_on="S{rpm} M03", coolant_on="M08", coolant_off="M09",
+    spindle_off="M05", program_end="M30", linear_decimals=3, rotary_decimals=3, feed_decimals=1,
+    inverse_feed_decimals=3, inverse_time=False, fold_style="macro_call", x_param="XST", a_param="ASP",
+    param_word="{address}={param}", param_offset_word="{address}={param}{offset}", sub_start="O{sub:04d}",
+    sub_end="RTS", call=("CALL O{sub:04d} XST={x} ASP={a}",), subprograms_after_end=True,
+    direction_codes=("M15", "M16"))
+
+DIALECTS: dict[str, Dialect] = {d.name: d for d in (LINUXCNC, FANUC, HAAS, SIEMENS, OKUMA)}
 
 
 def dialect(name: str) -> Dialect:

@@ -201,9 +201,9 @@ class _Writer:
             direction = None
             if a_rel != last_a:
                 if folded:
+                    offset = ("+" if a_rel > 0 else "") + _number(a_rel, rot_dec)
                     words.append(d.param_word.format(address="A", param=d.a_param) if a_rel == 0 else
-                                 d.param_offset_word.format(address="A", param=d.a_param,
-                                                            offset=("+" if a_rel > 0 else "") + _number(a_rel, rot_dec)))
+                                 d.param_offset_word.format(address="A", param=d.a_param, offset=offset))
                 else:
                     total = run.a_base + a_rel
                     words.append("A" + _number(total % (360 * rot) if wrapped else total, rot_dec))

@@ -181,32 +181,30 @@ def _clip_at_pose(x, y, z, a, x_end, h, h_top, points, normals, chunk_start, chu
                 if reach_x2 <= 0.0:
                     continue
                 reach_x = math.sqrt(reach_x2)
-                lower = deepest
-                for r in range(r_out, r_hi):
-                    dx = rows[r] - x_end
-                    if dx > reach_x:
-                        break
-                    current = hrow[r]
-                    if lower >= current:
-                        continue
-                    entry = first_entry(dx, ay, az, ny, nz, lower, current, radius, rho, rt)
-                    if entry < current:
-                        hrow[r] = entry
-                        lower = entry
-                        cuts += 1
-                lower = deepest
-                for r in range(r_in - 1, r_lo - 1, -1):
-                    dx = x - rows[r]
-                    if dx > reach_x:
-                        break
-                    current = hrow[r]
-                    if lower >= current:
-                        continue
-                    entry = first_entry(dx, ay, az, ny, nz, lower, current, radius, rho, rt)
-                    if entry < current:
-                        hrow[r] = entry
-                        lower = entry
-                        cuts += 1
+                cuts += _walk_rows(hrow, rows, r_out, r_hi, 1, x_end, reach_x, deepest, ay, az, ny, nz, radius, rho, rt)
+                cuts += _walk_rows(hrow, rows, r_in - 1, r_lo - 1, -1, x, reach_x, deepest, ay, az, ny, nz, radius,
+                                   rho, rt)
+    return cuts
+
+
+@njit(cache=True)
+def _walk_rows(hrow, rows, start, stop, step, x_edge, reach_x, deepest, ay, az, ny, nz, radius, rho, rt):
+    """Clip one blade on the rows outside the sweep, walking away from the edge `x_edge` of the
+    sweep (step +1 beyond its end, -1 before its start) until the slice no longer reaches."""
+    cuts = 0
+    lower = deepest
+    for r in range(start, stop, step):
+        dx = (rows[r] - x_edge) * step
+        if dx > reach_x:
+            break
+        current = hrow[r]
+        if lower >= current:
+            continue
+        entry = first_entry(dx, ay, az, ny, nz, lower, current, radius, rho, rt)
+        if entry < current:
+            hrow[r] = entry
+            lower = entry
+            cuts += 1
     return cuts
 
 

@@ -142,15 +142,8 @@ def job_of(obj):
     return job_from_dict(schema.job_data(document_values(obj)), source_of(obj))
 
 
-class _Proxy:
-    """Common proxy behaviour: no state of its own, migration on restore."""
-
-    KIND = ""
-    FIELDS: tuple = ()
-    OUTPUTS: tuple = ()
-
-    def __init__(self, obj):
-        obj.Proxy = self
+class _Stateless:
+    """Saved documents hold no pickled Python: proxies save as null (all state lives in properties)."""
 
     def dumps(self):
         return None
@@ -163,6 +156,17 @@ class _Proxy:
 
     def __setstate__(self, state):
         return None
+
+
+class _Proxy(_Stateless):
+    """Common proxy behaviour: no state of its own, migration on restore."""
+
+    KIND = ""
+    FIELDS: tuple = ()
+    OUTPUTS: tuple = ()
+
+    def __init__(self, obj):
+        obj.Proxy = self
 
     def onDocumentRestored(self, obj):
         """Migrate an older document: add the properties this schema has and the document lacks."""
@@ -345,7 +349,7 @@ def update_toolpath(obj, path, job, facts: dict | None) -> None:
     obj.purgeTouched()  # set by the job's recompute: nothing left for the toolpath itself to do
 
 
-class ViewProvider:
+class ViewProvider(_Stateless):
     """Icon, tree children and editing of the workbench's objects; no state."""
 
     def __init__(self, vobj):
@@ -386,14 +390,3 @@ class ViewProvider:
         FreeCADGui.ActiveDocument.setEdit(vobj.Object.Name)
         return True
 
-    def dumps(self):
-        return None
-
-    def loads(self, state):
-        return None
-
-    def __getstate__(self):
-        return None
-
-    def __setstate__(self, state):
-        return None
