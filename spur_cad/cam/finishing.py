@@ -23,7 +23,12 @@ import numpy as np
 from spur_cad.cam.ir import Feature, MoveKind, Operation, Toolpath, ToolpathBuilder, relative_path_lengths
 from spur_cad.cam.machine import FinishingParams, Machine
 from spur_cad.cam.tools import Tool, ToolError
-from spur_cad.geometry.sampling import full_space_points, sample_profile, segment_parameters
+from spur_cad.geometry.sampling import (
+    even_arc_length_parameters,
+    full_space_points,
+    sample_profile,
+    segment_parameters,
+)
 from spur_cad.geometry.spec import GearSpec
 
 PLUNGE_FEED_FRACTION = 0.5
@@ -152,7 +157,7 @@ def space_poses(spec: GearSpec, tool: Tool, scallop_mm: float,
         if contact_spacing_mm is None:
             params = segment_parameters(segment, scallop_mm, extra_curvature=1.0 / r_t)
         else:
-            params = _fixed_spacing(segment, contact_spacing_mm)
+            params = even_arc_length_parameters(segment, contact_spacing_mm)
         params = params[::-1]
         if points:  # the junction is shared with the previous segment
             params = params[1:]
@@ -171,14 +176,6 @@ def _space_design_points(spec: GearSpec) -> np.ndarray:
     """Dense exact points of tooth space 0 (both halves, tip lands to the tooth centres)."""
     return full_space_points(sample_profile(spec.tooth_space_profile(), 2e-5 * spec.module_mm))
 
-
-def _fixed_spacing(segment, spacing_mm: float) -> np.ndarray:
-    """Parameters at (about) equal arc-length spacing along a segment (reference-process sampling)."""
-    dense = np.linspace(segment.start, segment.end, 4001)
-    pts = segment.points(dense)
-    arc = np.concatenate([[0.0], np.cumsum(np.hypot(*np.diff(pts, axis=0).T))])
-    n = max(1, math.ceil(arc[-1] / spacing_mm))
-    return np.interp(np.linspace(0.0, arc[-1], n + 1), arc, dense)
 
 
 def station_step_mm(tool: Tool, params: FinishingParams) -> float:

@@ -38,6 +38,16 @@ class ProfileSamples:
         return len(self.points)
 
 
+def even_arc_length_parameters(segment: Segment, spacing_mm: float) -> np.ndarray:
+    """Parameters of a segment at even arc length (at most about `spacing_mm` apart), both ends
+    included; arc length from a 4000-chord polyline, for fixed-spacing sampling (not tolerance-driven)."""
+    dense = np.linspace(segment.start, segment.end, 4001)
+    pts = segment.points(dense)
+    arc = np.concatenate([[0.0], np.cumsum(np.hypot(*np.diff(pts, axis=0).T))])
+    n = max(1, math.ceil(arc[-1] / spacing_mm))
+    return np.interp(np.linspace(0.0, arc[-1], n + 1), arc, dense)
+
+
 def segment_parameters(segment: Segment, tolerance_mm: float, extra_curvature: float = 0.0) -> np.ndarray:
     """Increasing parameters from segment.start to segment.end whose chords are within tolerance.
 

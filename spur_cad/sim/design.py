@@ -16,6 +16,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from spur_cad.geometry.profile import SEGMENT_LABELS, ToothSpaceProfile
+from spur_cad.geometry.sampling import even_arc_length_parameters
 from spur_cad.geometry.spec import GearSpec
 
 FEATURES = ("root", "fillet", "involute", "tip")  # = SEGMENT_LABELS
@@ -65,14 +66,6 @@ def rotate(points: np.ndarray, angle_rad: float) -> np.ndarray:
     return np.stack([points[:, 0] * c - points[:, 1] * s, points[:, 0] * s + points[:, 1] * c], axis=-1)
 
 
-def _even_parameters(segment, spacing_mm: float) -> np.ndarray:
-    """Parameters of a segment at even arc length (at most `spacing_mm` apart), both ends included."""
-    dense = np.linspace(segment.start, segment.end, 4001)
-    pts = segment.points(dense)
-    arc = np.concatenate([[0.0], np.cumsum(np.hypot(*np.diff(pts, axis=0).T))])
-    n = max(1, math.ceil(arc[-1] / spacing_mm))
-    return np.interp(np.linspace(0.0, arc[-1], n + 1), arc, dense)
-
 
 def sample_space(profile: ToothSpaceProfile, spacing_mm: float) -> tuple[np.ndarray, ...]:
     """Points, normals, feature, side of one whole space, right tooth centre -> left tooth centre.
@@ -83,7 +76,7 @@ def sample_space(profile: ToothSpaceProfile, spacing_mm: float) -> tuple[np.ndar
     for index, segment in enumerate(profile.segments):  # right half, root -> tip
         if segment.end <= segment.start:
             continue
-        params = _even_parameters(segment, spacing_mm)
+        params = even_arc_length_parameters(segment, spacing_mm)
         if pts:
             params = params[1:]
         pts.append(segment.points(params))
