@@ -1,0 +1,33 @@
+"""The reference job's G-code (every dialect, folded and flat) and profile.csv are byte-identical
+to the files generated before the architecture rework (tests/data/make_reference_outputs.py says
+how they were made). A refactoring that changes one byte of a program fails here."""
+
+from __future__ import annotations
+
+import lzma
+from pathlib import Path
+
+import pytest
+
+from tests.data.make_reference_outputs import reference_files
+
+REFERENCE_DIR = Path(__file__).resolve().parent / "data" / "reference_outputs"
+
+
+def _first_difference(expected: bytes, actual: bytes) -> str:
+    old, new = expected.decode().splitlines(), actual.decode().splitlines()
+    for number, (a, b) in enumerate(zip(old, new), start=1):
+        if a != b:
+            return f"line {number}: expected {a!r}, got {b!r}"
+    return f"line counts differ: expected {len(old)}, got {len(new)}"
+
+
+@pytest.mark.slow
+def test_reference_job_outputs_are_byte_identical() -> None:
+    files = reference_files(REFERENCE_DIR / "reference_gear.toml")
+    stored = sorted(p.name for p in REFERENCE_DIR.iterdir() if p.name.endswith((".xz", ".csv")))
+    assert sorted(name if name == "profile.csv" else name + ".xz" for name in files) == stored
+    for name, content in files.items():
+        path = REFERENCE_DIR / (name if name == "profile.csv" else name + ".xz")
+        expected = path.read_bytes() if name == "profile.csv" else lzma.decompress(path.read_bytes())
+        assert content == expected, f"{name}: {_first_difference(expected, content)}"
