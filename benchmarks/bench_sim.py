@@ -12,9 +12,11 @@ import numpy as np
 from spur_cad.cam.ir import Feature
 from spur_cad.job import load_job
 from spur_cad.pipeline import plan_cam
-from spur_cad.sim import Operation, SimSettings, simulate, subset
+from spur_cad.sim import Cut, SimSettings, simulate, subset
 from spur_cad.sim.occ_check import cross_check
-from spur_cad.sim.stage import finishing_stations, job_stock
+from spur_cad.pipeline import job_stock
+from spur_cad.summary import simulation_section
+from spur_cad.sim import finishing_stations
 
 REFERENCE_JOB = Path(__file__).resolve().parents[1] / "resources" / "examples" / "reference_gear.toml"
 
@@ -23,14 +25,14 @@ def full_job(resolution_mm: float, runs: int) -> dict:
     """Median seconds of the whole reference job's simulation (numba compiled beforehand) and its facts."""
     job = load_job(REFERENCE_JOB)
     plan = plan_cam(job)
-    ops = [Operation(plan.roughing, job.tools.roughing), Operation(plan.finishing, job.tools.finishing)]
-    stations = finishing_stations(plan.finishing)
+    ops = [Cut(plan.roughing.toolpath, job.tools.roughing), Cut(plan.finishing.toolpath, job.tools.finishing)]
+    stations = finishing_stations(plan.finishing.toolpath)
     times, result = [], None
     for _ in range(runs):
         start = time.perf_counter()
         result = simulate(job.gear, job_stock(job), ops, SimSettings(resolution_mm=resolution_mm), station_x=stations)
         times.append(time.perf_counter() - start)
-    facts = result.facts()
+    facts = simulation_section(result, result.settings.resolution_mm)
     return {"median_s": statistics.median(times), "runs": runs, "moves": facts["moves"],
             "poses_clipped": facts["poses_clipped"], "design_points": facts["design_points"],
             "max_gouge_mm": facts["max_gouge_mm"], "max_leftover_mm": facts["max_leftover_mm"],
@@ -41,7 +43,7 @@ def occ_ratio(runs: int) -> dict:
     """Fast simulation vs OCP booleans on the cross-check subsets (6 finishing flank moves, 5 roughing moves)."""
     job = load_job(REFERENCE_JOB)
     plan = plan_cam(job)
-    fin, rough = plan.finishing, plan.roughing
+    fin, rough = plan.finishing.toolpath, plan.roughing.toolpath
     x = finishing_stations(fin)
     finishing = np.zeros(len(fin), bool)
     finishing[np.nonzero((fin.station == 70) & (fin.space == 3) & (fin.feature == Feature.RIGHT_FLANK))[0][40:46]] = True

@@ -125,12 +125,12 @@ def bench_post(runs: int) -> dict:
         for folded in (False, True):
             label = f"{dialect}_{'folded' if folded else 'flat'}"
             settings = PostSettings(dialect=dialect, folded=folded)
-            finishing = post_program(plan.finishing, settings, info)
-            roughing = post_program(plan.roughing, settings, info)
+            finishing = post_program(plan.finishing.toolpath, settings, info)
+            roughing = post_program(plan.roughing.toolpath, settings, info)
             result[label] = {"finishing_lines": finishing.lines, "finishing_bytes": finishing.bytes,
                              "roughing_lines": roughing.lines, "roughing_bytes": roughing.bytes}
         for folded in (False, True):
-            seconds = median_seconds(lambda: post_program(plan.finishing, PostSettings(dialect=dialect,  # noqa: B023
+            seconds = median_seconds(lambda: post_program(plan.finishing.toolpath, PostSettings(dialect=dialect,  # noqa: B023
                                                                                           folded=folded), info), runs)
             result[f"{dialect}_{'folded' if folded else 'flat'}"]["finishing_post_s"] = seconds
     return result

@@ -11,7 +11,8 @@ import shapely
 from shapely.geometry import LineString, Polygon
 
 from spur_cad.cam.estimate import estimate
-from spur_cad.cam.finishing import finishing_toolpath, station_positions, station_step_mm
+from spur_cad.cam.contacts import station_positions, station_step_mm
+from spur_cad.cam.finishing import finishing_toolpath
 from spur_cad.cam.ir import Feature, MoveKind, Operation, ToolpathBuilder
 from spur_cad.cam.machine import FinishingParams, Machine, RoughingParams
 from spur_cad.cam.recommend import check_tools, recommend_tools
@@ -144,7 +145,7 @@ def test_estimate_of_a_small_program_by_hand():
 def test_stations_cover_the_face_width_with_the_scallop_step():
     tool = Tool(diameter_mm=2.0, kind="bull_nose", corner_radius_mm=0.5)
     params = FinishingParams(target_scallop_mm=0.005)
-    step = station_step_mm(tool, params)
+    step = station_step_mm(tool, params.target_scallop_mm, params.step_over_mm)
     # Worst case of METHOD.md 5: flat width d at the root, corner radius elsewhere.
     h, d, r_t = 0.005, 1.0, 0.5
     assert d / 2 - math.sqrt((d / 2) ** 2 - (step / 2) ** 2) <= h + 1e-12

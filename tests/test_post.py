@@ -152,7 +152,7 @@ def test_folded_reference_finishing_is_15x_smaller_and_runs_the_same(tmp_path):
 
     job = load_job(REFERENCE_JOB)
     assert job.gear.face_width_mm == 20.0  # full face width, as the shop cut it
-    path = plan_cam(job).finishing
+    path = plan_cam(job).finishing.toolpath
     flat = post_program(path, PostSettings(folded=False), INFO)
     folded = post_program(path, PostSettings(folded=True), INFO)
     assert flat.lines >= 15 * folded.lines, (flat.lines, folded.lines)

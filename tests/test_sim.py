@@ -9,14 +9,16 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from spur_cad.cam.ir import Feature, MoveKind, Operation as IrOperation, ToolpathBuilder
+from spur_cad.cam.ir import Feature, MoveKind, Operation, ToolpathBuilder
 from spur_cad.cam.tools import Tool
 from spur_cad.geometry.sampling import full_space_points, sample_profile
 from spur_cad.job import load_job
 from spur_cad.pipeline import plan_cam
-from spur_cad.sim import Operation, SimSettings, StockCylinder, simulate, simulate_grid, subset
+from spur_cad.sim import Cut, SimSettings, StockCylinder, simulate, simulate_grid, subset
 from spur_cad.sim.design import DesignGrid, row_positions
-from spur_cad.sim.stage import finishing_stations, job_stock
+from spur_cad.pipeline import job_stock
+from spur_cad.summary import simulation_section
+from spur_cad.sim import finishing_stations
 
 ROOT = Path(__file__).resolve().parents[1]
 REFERENCE_JOB = ROOT / "resources" / "examples" / "reference_gear.toml"
@@ -33,7 +35,7 @@ def cylinder_grid(radius: float, points: int, x_min: float, x_max: float, spacin
 
 
 def one_move_path(start, end, tool_number=1):
-    builder = ToolpathBuilder(IrOperation.ROUGHING, tool_number, 1000.0)
+    builder = ToolpathBuilder(Operation.ROUGHING, tool_number, 1000.0)
     builder.move(MoveKind.RAPID, *start)
     builder.move(MoveKind.LINEAR, *end, feed=100.0, feature=Feature.LEVEL)
     return builder.build()
@@ -69,7 +71,7 @@ def test_flat_tool_pass_along_x_over_a_cylinder_matches_interval_arithmetic_and_
     path = one_move_path((-15.0, y_t, 30.0, 0.0), (-15.0, y_t, z_t, 0.0))  # plunge outside the part
     path2 = one_move_path((-15.0, y_t, z_t, 0.0), (35.0, y_t, z_t, 0.0))  # the pass along X
     settings = SimSettings(resolution_mm=0.005, gouge_range_mm=1.5, leftover_range_mm=1.5)
-    result = simulate_grid(grid, StockCylinder(stock_r, 0.0, 20.0), [Operation(path, tool), Operation(path2, tool)],
+    result = simulate_grid(grid, StockCylinder(stock_r, 0.0, 20.0), [Cut(path, tool), Cut(path2, tool)],
                            settings, face_width_mm=20.0)
     beta = np.linspace(0.0, 2 * math.pi, 1800, endpoint=False)
     entry = radial_entry_in_half_strip(beta, design_r, y_t, z_t, diameter / 2) - design_r
@@ -104,7 +106,7 @@ def test_plunge_of_a_curved_tool_matches_brute_force_membership(kind, diameter, 
     y_t, z_t, x_t = 0.4, 9.3, 2.0
     path = one_move_path((x_t, y_t, 30.0, 0.0), (x_t, y_t, z_t, 0.0))
     settings = SimSettings(resolution_mm=0.005, gouge_range_mm=0.5, leftover_range_mm=0.5)
-    result = simulate_grid(grid, StockCylinder(stock_r, 0.0, 4.0), [Operation(path, tool)], settings,
+    result = simulate_grid(grid, StockCylinder(stock_r, 0.0, 4.0), [Cut(path, tool)], settings,
                            face_width_mm=4.0)
     beta = np.linspace(0.0, 2 * math.pi, 720, endpoint=False)
     t = np.arange(-0.5, 0.5 + 1e-12, 2e-5)
@@ -131,10 +133,10 @@ def reference():
 
 def test_reference_job_is_cut_to_the_design_within_scallop_and_resolution(reference):
     job, plan = reference
-    ops = [Operation(plan.roughing, job.tools.roughing), Operation(plan.finishing, job.tools.finishing)]
+    ops = [Cut(plan.roughing.toolpath, job.tools.roughing), Cut(plan.finishing.toolpath, job.tools.finishing)]
     result = simulate(job.gear, job_stock(job), ops, SimSettings(resolution_mm=RES),
-                      station_x=finishing_stations(plan.finishing))
-    facts = result.facts()
+                      station_x=finishing_stations(plan.finishing.toolpath))
+    facts = simulation_section(result, result.settings.resolution_mm)
     assert facts["max_gouge_mm"] <= RES
     assert facts["max_leftover_mm"] <= job.finishing.target_scallop_mm + RES
     assert facts["uncut_points"] == 0
@@ -154,7 +156,7 @@ def test_reference_job_is_cut_to_the_design_within_scallop_and_resolution(refere
 
 
 def _finishing_window(plan, stations: range, spaces: range):
-    fin = plan.finishing
+    fin = plan.finishing.toolpath
     mask = np.isin(fin.station, list(stations)) & np.isin(fin.space, list(spaces))
     return mask
 
@@ -162,9 +164,9 @@ def _finishing_window(plan, stations: range, spaces: range):
 def _window_result(job, plan, path, centre_station, spaces):
     """Simulate a window of the finishing program; deviation of the given spaces on rows within three
     stations of the centre (every station that reaches them is in the window)."""
-    x = finishing_stations(plan.finishing)
+    x = finishing_stations(plan.finishing.toolpath)
     rows = (x[centre_station - 3], x[centre_station + 3])
-    result = simulate(job.gear, job_stock(job), [Operation(path, job.tools.finishing)], SimSettings(resolution_mm=RES),
+    result = simulate(job.gear, job_stock(job), [Cut(path, job.tools.finishing)], SimSettings(resolution_mm=RES),
                       station_x=x, rows_x_range=rows)
     return result, result.deviation[list(MEASURED)]
 
@@ -178,14 +180,14 @@ MEASURED = (SPACE, SPACE + 1)  # space k's right tip land is cut with space k - 
 def test_finishing_window_without_faults_is_clean(reference):
     job, plan = reference
     mask = _finishing_window(plan, WINDOW, SPACES)
-    result, dev = _window_result(job, plan, subset(plan.finishing, mask), STATION, SPACES)
+    result, dev = _window_result(job, plan, subset(plan.finishing.toolpath, mask), STATION, SPACES)
     assert -dev.min() <= RES
     assert dev.max() <= job.finishing.target_scallop_mm + RES
 
 
 def test_root_lowered_by_20um_at_one_station_reports_a_20um_gouge_there(reference):
     job, plan = reference
-    fin = plan.finishing
+    fin = plan.finishing.toolpath
     mask = _finishing_window(plan, WINDOW, SPACES)
     fault = (fin.feature == Feature.ROOT) & (fin.station == STATION) & (fin.space == SPACE)
     z = fin.z - np.where(fault, 0.020, 0.0)
@@ -207,7 +209,7 @@ def test_root_lowered_by_20um_at_one_station_reports_a_20um_gouge_there(referenc
 
 def test_right_flank_moved_20um_into_the_part_reports_a_20um_gouge_on_that_flank(reference):
     job, plan = reference
-    fin, tool = plan.finishing, job.tools.finishing
+    fin, tool = plan.finishing.toolpath, job.tools.finishing
     mask = _finishing_window(plan, WINDOW, SPACES)
     fault = (fin.feature == Feature.RIGHT_FLANK) & (fin.station == STATION) & (fin.space == SPACE)
     # Independent normal at each contact: nearest exact design point to the right corner-circle centre.
@@ -236,7 +238,7 @@ def test_right_flank_moved_20um_into_the_part_reports_a_20um_gouge_on_that_flank
 
 def test_a_station_left_out_reports_leftover_there(reference):
     job, plan = reference
-    fin = plan.finishing
+    fin = plan.finishing.toolpath
     mask = _finishing_window(plan, WINDOW, SPACES) & (fin.station != STATION)
     result, dev = _window_result(job, plan, subset(fin, mask), STATION, SPACES)
     assert dev.max() > job.finishing.target_scallop_mm + RES

@@ -12,7 +12,8 @@ from spur_cad.job import load_job
 from spur_cad.pipeline import plan_cam
 from spur_cad.sim import SimSettings, subset
 from spur_cad.sim.occ_check import cross_check
-from spur_cad.sim.stage import finishing_stations, job_stock
+from spur_cad.pipeline import job_stock
+from spur_cad.sim import finishing_stations
 
 ROOT = Path(__file__).resolve().parents[1]
 RES = 0.005
@@ -26,7 +27,7 @@ def reference():
 
 def test_finishing_flank_moves_agree_with_ocp_booleans(reference):
     job, plan = reference
-    fin = plan.finishing
+    fin = plan.finishing.toolpath
     moves = np.nonzero((fin.station == 70) & (fin.space == 3) & (fin.feature == Feature.RIGHT_FLANK))[0][40:46]
     mask = np.zeros(len(fin), bool)
     mask[moves] = True
@@ -40,7 +41,7 @@ def test_finishing_flank_moves_agree_with_ocp_booleans(reference):
 
 def test_roughing_passes_agree_with_ocp_booleans(reference):
     job, plan = reference
-    rough = plan.roughing
+    rough = plan.roughing.toolpath
     first_space = np.nonzero(rough.space == 0)[0]
     mask = np.zeros(len(rough), bool)
     mask[first_space[:5]] = True  # approach, plunge, passes along X and a step across the first level

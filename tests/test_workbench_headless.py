@@ -169,8 +169,8 @@ def test_reference_job_file_maps_onto_the_document(freecadcmd, tmp_path):
                                  clearance=data["machine"]["clearance_mm"], block=data["machine"]["block_time_s"])
     plan = plan_cam(load_job(REFERENCE_JOB))  # the same file through the library
     roughing, finishing = result["toolpaths"]["roughing"], result["toolpaths"]["finishing"]
-    assert roughing["moves"] == len(plan.roughing) and roughing["shown"] == roughing["moves"]
-    assert finishing["moves"] == len(plan.finishing) > 700_000
+    assert roughing["moves"] == len(plan.roughing.toolpath) and roughing["shown"] == roughing["moves"]
+    assert finishing["moves"] == len(plan.finishing.toolpath) > 700_000
     assert 0 < finishing["shown"] <= 60_000 and finishing["size"] >= finishing["shown"]
 
 

@@ -17,6 +17,8 @@ from spur_cad.cam.machine import Machine
 
 @dataclass(frozen=True)
 class Estimate:
+    """Moves, cutting and rapid path lengths (relative to the part) and cycle time of one operation."""
+
     moves: int
     cutting_length_mm: float
     rapid_length_mm: float
@@ -32,12 +34,9 @@ def estimate(path: Toolpath, machine: Machine) -> Estimate:
     if not motion.any():
         return Estimate(int(len(path)), 0.0, 0.0, len(path) * machine.block_time_s)
 
-    def start(v: np.ndarray) -> np.ndarray:
-        return np.concatenate([[v[0]], v[:-1]])
-
-    length = relative_path_lengths(start(path.x), start(path.y), start(path.z), start(path.a),
-                                   path.x, path.y, path.z, path.a, substeps=8)
-    rotary = np.abs(path.a - start(path.a))
+    x0, y0, z0, a0 = path.start_poses().T
+    length = relative_path_lengths(x0, y0, z0, a0, path.x, path.y, path.z, path.a, substeps=8)
+    rotary = np.abs(path.a - a0)
     rapid = path.kind == MoveKind.RAPID
     linear = path.kind == MoveKind.LINEAR
     minutes = np.zeros(len(path))

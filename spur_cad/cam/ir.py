@@ -1,4 +1,4 @@
-"""Toolpath IR: a neutral, typed sequence of moves in numpy arrays (CONVENTIONS.md).
+"""Toolpath IR: a neutral, typed sequence of moves in numpy arrays (docs/architecture.md).
 
 Each row is one move to the pose (x, y, z, a) from the previous row's pose (the first row
 starts from wherever the machine is). Machine frame: gear axis = X = rotary axis A, Y = 0 and
@@ -12,10 +12,13 @@ and markers. Markers (clamp/unclamp of the rotary axis) carry the current pose u
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass, field
 from enum import IntEnum
 
 import numpy as np
+
+from spur_cad.geometry.frames import machine_to_part
 
 
 class MoveKind(IntEnum):
@@ -67,9 +70,19 @@ class Toolpath:
         """(N, 4) array of x, y, z, a."""
         return np.stack([self.x, self.y, self.z, self.a], axis=-1)
 
+    def start_poses(self) -> np.ndarray:
+        """(N, 4) pose each move starts from: the previous row's pose (the first row from its own pose,
+        since where the machine is before the program is unknown)."""
+        poses = self.poses()
+        return np.concatenate([poses[:1], poses[:-1]])
+
     @property
     def motion_mask(self) -> np.ndarray:
         return (self.kind == MoveKind.RAPID) | (self.kind == MoveKind.LINEAR)
+
+    def replace(self, **arrays: np.ndarray) -> "Toolpath":
+        """A copy with some arrays replaced (same length), e.g. feeds converted to inverse time."""
+        return dataclasses.replace(self, **arrays)
 
 
 @dataclass
@@ -134,22 +147,12 @@ class ToolpathBuilder:
                         warnings=tuple(self.warnings), **arrays)
 
 
-def part_frame_points(y: np.ndarray, z: np.ndarray, a_deg: np.ndarray) -> np.ndarray:
-    """Machine (Y, Z) at rotary angle A -> coordinates fixed to the part (as at A = 0).
-
-    A point fixed to the part at p is at R(A) p when A is commanded, so p = R(-A) (Y, Z).
-    """
-    a = np.radians(a_deg)
-    c, s = np.cos(a), np.sin(a)
-    return np.stack([y * c + z * s, -y * s + z * c], axis=-1)
-
-
 def relative_path_lengths(x0, y0, z0, a0, x1, y1, z1, a1, substeps: int = 16) -> np.ndarray:
     """Length of the tool tip's path relative to the part for moves interpolated linearly in X, Y, Z, A."""
     t = np.linspace(0.0, 1.0, substeps + 1)[:, None]
     ys, zs, as_ = y0 + (y1 - y0) * t, z0 + (z1 - z0) * t, a0 + (a1 - a0) * t
     xs = x0 + (x1 - x0) * t
-    p = part_frame_points(ys, zs, as_)
+    p = machine_to_part(ys, zs, as_)
     d = np.diff(p, axis=0)
     dx = np.diff(xs, axis=0)
     return np.sqrt(d[..., 0] ** 2 + d[..., 1] ** 2 + dx**2).sum(axis=0)

@@ -84,21 +84,18 @@ class RoughingParams:
                                "must be in (0, 2]")
 
 
-FINISHING_STRATEGIES = ("perimeter", "along_x")
-
-
 @dataclass(frozen=True)
 class FinishingParams:
     """[finishing]: METHOD.md 5."""
 
-    strategy: str = "perimeter"  # perimeter | along_x
+    strategy: str = "perimeter"  # a name in spur_cad.cam.strategies.REGISTRY
     target_scallop_mm: float = 0.005
     step_over_mm: float = 0.0  # X step between stations; 0: derived from the target scallop
 
     def validate(self) -> None:
-        if self.strategy not in FINISHING_STRATEGIES:
-            raise MachineError(f"[finishing] strategy '{self.strategy}' is unknown "
-                               f"(use one of {', '.join(FINISHING_STRATEGIES)})")
+        from spur_cad.cam.strategies import get_strategy  # the registry imports this module
+
+        get_strategy(self.strategy)
         if not 0.0 < self.target_scallop_mm <= 0.1:
             raise MachineError(f"[finishing] target_scallop_mm = {self.target_scallop_mm:g} must be in (0, 0.1]")
         if self.step_over_mm < 0.0:

@@ -15,16 +15,13 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from spur_cad.cam.finishing import safe_height_mm
+from spur_cad.cam.common import PLUNGE_FEED_FRACTION, safe_height_mm
 from spur_cad.cam.ir import Feature, MoveKind, Operation, Toolpath, ToolpathBuilder
 from spur_cad.cam.machine import Machine, MachineError, RoughingParams
 from spur_cad.cam.recommend import space_half_width_mm
 from spur_cad.cam.tools import Tool, ToolError
 from spur_cad.geometry.sampling import sample_profile
 from spur_cad.geometry.spec import GearSpec
-
-PLUNGE_FEED_FRACTION = 0.5
-
 
 @dataclass(frozen=True)
 class RoughingLevels:
@@ -123,14 +120,15 @@ def roughing_levels(spec: GearSpec, tool: Tool, params: RoughingParams, blank_ra
 
 def roughing_toolpath(spec: GearSpec, tool: Tool, machine: Machine, params: RoughingParams,
                       blank_radius_mm: float, back_margin_mm: float = 0.0, stub_radius_mm: float = 0.0,
-                      front_margin_mm: float = 0.0) -> Toolpath:
-    """The roughing operation as IR (pure function)."""
+                      front_margin_mm: float = 0.0, levels: RoughingLevels | None = None) -> Toolpath:
+    """The roughing operation as IR (pure function); `levels` when the caller has computed them already."""
     params.validate()
     machine.validate()
     tool.validate("roughing")
     if params.clamp_rotary and not (machine.rotary_clamp_code and machine.rotary_unclamp_code):
         raise MachineError("[roughing] clamp_rotary needs [machine] rotary_clamp_code and rotary_unclamp_code")
-    levels = roughing_levels(spec, tool, params, blank_radius_mm)
+    if levels is None:
+        levels = roughing_levels(spec, tool, params, blank_radius_mm)
     radius = tool.diameter_mm / 2.0
     x_front = -(front_margin_mm + radius + machine.clearance_mm)
     x_back = spec.face_width_mm + radius + machine.clearance_mm

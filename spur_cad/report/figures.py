@@ -60,7 +60,7 @@ def finishing_png(spec: GearSpec, tool: Tool, y: np.ndarray, z: np.ndarray, a_de
     """Space 0 with the finishing contact points and the cutter locations (tool tip centres) in the part
     frame; every `every`-th tool is drawn turned with the part. Contacts are the design points nearest
     to each corner-circle centre."""
-    from spur_cad.cam.ir import part_frame_points
+    from spur_cad.geometry.frames import machine_to_part
 
     fig = Figure(figsize=(7.5, 6.0), layout="constrained")
     ax = fig.add_subplot(1, 1, 1)
@@ -69,11 +69,11 @@ def finishing_png(spec: GearSpec, tool: Tool, y: np.ndarray, z: np.ndarray, a_de
     r_t, half_flat = tool.corner_radius, tool.flat_width_mm / 2.0
     from spur_cad.sim.design import sample_space
 
-    tips = part_frame_points(y, z, a_deg)
+    tips = machine_to_part(y, z, a_deg)
     dense = sample_space(spec.tooth_space_profile(), 0.005)[0]
     contacts = []
     for side in (1.0, -1.0):  # right and left corner-circle centres
-        centres = part_frame_points(y + side * half_flat, z + r_t, a_deg)
+        centres = machine_to_part(y + side * half_flat, z + r_t, a_deg)
         d = np.hypot(dense[None, :, 0] - centres[:, None, 0], dense[None, :, 1] - centres[:, None, 1])
         nearest = d.argmin(axis=1)
         touching = np.abs(d[np.arange(len(centres)), nearest] - r_t) < 0.01
@@ -87,7 +87,7 @@ def finishing_png(spec: GearSpec, tool: Tool, y: np.ndarray, z: np.ndarray, a_de
                                 half_flat + r_t * np.sin(phi), [half_flat + r_t]])
     profile_z = np.concatenate([[top], r_t - r_t * np.cos(phi[::-1]), r_t - r_t * np.cos(phi), [top]])
     for i in range(0, len(y), every):
-        shape = part_frame_points(y[i] + profile_y, z[i] + profile_z, np.full(len(profile_y), a_deg[i]))
+        shape = machine_to_part(y[i] + profile_y, z[i] + profile_z, np.full(len(profile_y), a_deg[i]))
         ax.plot(shape[:, 0], shape[:, 1], "-", color="0.6", lw=0.5)
     ax.set_aspect("equal")
     ax.set_xlabel("part Y [mm] (space 0, A = 0)")

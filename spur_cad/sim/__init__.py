@@ -6,17 +6,18 @@ it). See docs/simulation.md.
 """
 
 from spur_cad.sim.simulate import (
-    Operation,
+    Cut,
     SimResult,
     SimSettings,
     SimulationError,
     StockCylinder,
     decompose,
+    finishing_stations,
     shifted,
     simulate,
     simulate_grid,
     subset,
 )
 
-__all__ = ["Operation", "SimResult", "SimSettings", "SimulationError", "StockCylinder", "decompose", "shifted",
+__all__ = ["Cut", "SimResult", "SimSettings", "SimulationError", "StockCylinder", "decompose", "finishing_stations", "shifted",
            "simulate", "simulate_grid", "subset"]

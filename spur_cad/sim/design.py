@@ -15,6 +15,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from spur_cad.geometry.frames import turn_points
 from spur_cad.geometry.profile import SEGMENT_LABELS, ToothSpaceProfile
 from spur_cad.geometry.sampling import even_arc_length_parameters
 from spur_cad.geometry.spec import GearSpec
@@ -49,21 +50,15 @@ class DesignGrid:
 
     def space_points(self, k: int) -> np.ndarray:
         """Design points of tooth space k (part frame)."""
-        return rotate(self.points, k * self.pitch_rad)
+        return turn_points(self.points, k * self.pitch_rad)
 
     def space_normals(self, k: int) -> np.ndarray:
-        return rotate(self.normals, k * self.pitch_rad)
+        return turn_points(self.normals, k * self.pitch_rad)
 
     def feature_names(self) -> list[str]:
         """'right involute', 'root', ... per point."""
         side_name = {RIGHT: "right ", LEFT: "left ", CENTRE: ""}
         return [f"{side_name[int(s)]}{FEATURES[int(f)]}" for f, s in zip(self.feature, self.side)]
-
-
-def rotate(points: np.ndarray, angle_rad: float) -> np.ndarray:
-    """Turn (N, 2) machine (Y, Z) points counter-clockwise by angle (as A turns the part)."""
-    c, s = math.cos(angle_rad), math.sin(angle_rad)
-    return np.stack([points[:, 0] * c - points[:, 1] * s, points[:, 0] * s + points[:, 1] * c], axis=-1)
 
 
 

@@ -20,7 +20,7 @@ import numpy as np
 from spur_cad.cam.ir import MoveKind, Toolpath
 from spur_cad.cam.tools import Tool
 from spur_cad.geometry.spec import GearSpec
-from spur_cad.sim.simulate import Operation, SimResult, SimSettings, StockCylinder, pose_step_mm, simulate
+from spur_cad.sim.simulate import Cut, SimResult, SimSettings, StockCylinder, pose_step_mm, simulate
 
 
 @dataclass(frozen=True)
@@ -147,7 +147,7 @@ def cross_check(spec: GearSpec, stock: StockCylinder, path: Toolpath, tool: Tool
     import cadquery as cq
 
     start = time.perf_counter()
-    fast: SimResult = simulate(spec, stock, [Operation(path, tool)], settings, station_x=station_x,
+    fast: SimResult = simulate(spec, stock, [Cut(path, tool)], settings, station_x=station_x,
                                rows_x_range=rows_x_range)
     fast_seconds = time.perf_counter() - start
     start = time.perf_counter()

@@ -21,11 +21,11 @@ from typing import Callable, Sequence
 
 import numpy as np
 
-from spur_cad.cam.ir import MoveKind, Toolpath
+from spur_cad.cam.ir import Feature, MoveKind, Toolpath
 from spur_cad.cam.tools import Tool
 from spur_cad.errors import SpurCadError
 from spur_cad.geometry.spec import GearSpec
-from spur_cad.sim.design import DesignGrid, design_grid, rotate
+from spur_cad.sim.design import DesignGrid, design_grid
 
 CHUNK_POINTS = 8
 POSE_BATCH = 20000
@@ -63,7 +63,7 @@ class StockCylinder:
 
 
 @dataclass(frozen=True)
-class Operation:
+class Cut:
     """One toolpath with the tool that cuts it."""
 
     path: Toolpath
@@ -93,6 +93,16 @@ class SimResult:
         x = self.grid.rows_x
         return (x >= -1e-9) & (x <= self.face_width_mm + 1e-9)
 
+    @property
+    def max_gouge_mm(self) -> float:
+        """Largest gouge inside the face width (0 when none)."""
+        return float(max(0.0, -self.deviation[:, :, self.gear_rows].min()))
+
+    @property
+    def max_leftover_mm(self) -> float:
+        """Largest leftover inside the face width (0 when none)."""
+        return float(max(0.0, self.deviation[:, :, self.gear_rows].max()))
+
     def station_of_row(self) -> np.ndarray:
         """Nearest finishing station index per row (-1 without finishing stations)."""
         if len(self.station_x) == 0:
@@ -115,43 +125,14 @@ class SimResult:
         return {"value_mm": float(dev[k, j, r]), "space": int(k), "feature": self.grid.feature_names()[j],
                 "point": int(j), "x_mm": float(self.grid.rows_x[row]), "station": int(self.station_of_row()[row])}
 
-    def facts(self) -> dict:
-        """summary.json's `simulation` section."""
-        dev = self.deviation[:, :, self.gear_rows]
-        finished = dev[dev < self.settings.leftover_range_mm - 1e-9]
-        positive = np.maximum(finished, 0.0)
-        names = np.array(self.grid.feature_names())
-        per_feature = {}
-        for name in ("right involute", "right fillet", "root", "left fillet", "left involute", "tip"):
-            mask = np.array([n.endswith(name) if name in ("root", "tip") else n == name for n in names])
-            if mask.any():
-                values = dev[:, mask, :]
-                per_feature[name] = {"max_gouge_mm": float(max(0.0, -values.min())),
-                                     "max_leftover_mm": float(max(0.0, values.max())),
-                                     "mean_mm": float(values.mean())}
-        return {
-            "resolution_mm": self.settings.resolution_mm,
-            "max_gouge_mm": float(max(0.0, -dev.min())),
-            "max_leftover_mm": float(max(0.0, dev.max())),
-            "removed_volume_mm3": self.removed_volume_mm3,
-            "seconds": self.seconds,
-            "design_points": int(dev.size),
-            "points_per_space": int(self.grid.points.shape[0]),
-            "rows": int(self.gear_rows.sum()),
-            "point_spacing_mm": self.grid.spacing_mm,
-            "uncut_points": self.uncut_points,
-            "scallop_mean_mm": float(positive.mean()) if positive.size else 0.0,
-            "scallop_p95_mm": float(np.percentile(positive, 95)) if positive.size else 0.0,
-            "scallop_p99_mm": float(np.percentile(positive, 99)) if positive.size else 0.0,
-            "worst_gouge": self.worst(True),
-            "worst_leftover": self.worst(False),
-            "per_feature": per_feature,
-            "moves": self.moves,
-            "poses_clipped": self.poses_clipped,
-            "x_sweeps": self.x_sweeps,
-            "gouge_range_mm": self.settings.gouge_range_mm,
-            "leftover_range_mm": self.settings.leftover_range_mm,
-        }
+
+def finishing_stations(path: Toolpath | None) -> np.ndarray:
+    """X of the transverse finishing stations found in the IR (cutting moves that do not move X)."""
+    if path is None or len(path) == 0:
+        return np.zeros(0)
+    start_x = path.start_poses()[:, 0]
+    cutting = (path.kind == MoveKind.LINEAR) & (path.feature != Feature.NONE) & (path.x == start_x)
+    return np.unique(path.x[cutting])
 
 
 def pose_step_mm(tool: Tool, resolution_mm: float) -> float:
@@ -178,12 +159,14 @@ def decompose(path: Toolpath, tool: Tool, resolution_mm: float, reach_mm: float,
     Returns (poses, x_end, number of moves along X only). Markers carry no motion and are skipped;
     the first row's start is unknown (the IR says so): it is clipped at its end pose only.
     """
-    motion = (path.kind == MoveKind.RAPID) | (path.kind == MoveKind.LINEAR)
-    x, y, z, a = (np.asarray(v, float)[motion] for v in (path.x, path.y, path.z, path.a))
-    if len(x) == 0:
+    motion = path.motion_mask
+    if not motion.any():
         return np.zeros((0, 4)), np.zeros(0), 0
-    a = np.radians(a)
-    x0, y0, z0, a0 = (np.concatenate([[v[0]], v[:-1]]) for v in (x, y, z, a))
+    ends, starts = path.poses()[motion], path.start_poses()[motion]
+    starts[0] = ends[0]  # markers carry the pose unchanged; only the first move's start is unknown
+    x, y, z, a = ends.T
+    x0, y0, z0, a0 = starts.T
+    a, a0 = np.radians(a), np.radians(a0)
     dx, dy, dz, da = x - x0, y - y0, z - z0, a - a0
     radius = tool.diameter_mm / 2.0
     above = (np.minimum(z0, z) > reach_mm) | (np.maximum(x0, x) < x_range[0] - radius) \
@@ -260,7 +243,7 @@ def section_areas(grid: DesignGrid, h: np.ndarray) -> np.ndarray:
     return areas
 
 
-def simulate(spec: GearSpec, stock: StockCylinder, operations: Sequence[Operation],
+def simulate(spec: GearSpec, stock: StockCylinder, operations: Sequence[Cut],
              settings: SimSettings = SimSettings(), *, station_x: np.ndarray | None = None,
              rows_x_range: tuple[float, float] | None = None,
              progress: Callable[[float], None] | None = None) -> SimResult:
@@ -288,7 +271,7 @@ def point_spacing_mm(corner_radius_mm: float, resolution_mm: float) -> float:
     return math.sqrt(8.0 * min(corner_radius_mm, 1.0) * resolution_mm / 2.0)
 
 
-def simulate_grid(grid: DesignGrid, stock: StockCylinder, operations: Sequence[Operation],
+def simulate_grid(grid: DesignGrid, stock: StockCylinder, operations: Sequence[Cut],
                   settings: SimSettings = SimSettings(), *, face_width_mm: float, station_x: np.ndarray = np.zeros(0),
                   progress: Callable[[float], None] | None = None, started: float | None = None) -> SimResult:
     """`simulate` on a given design grid (any outline with normals, e.g. a plain cylinder in tests)."""
@@ -348,5 +331,5 @@ def subset(path: Toolpath, mask: np.ndarray, **replace) -> Toolpath:
                     warnings=path.warnings, **arrays)
 
 
-__all__ = ["Operation", "SimResult", "SimSettings", "SimulationError", "StockCylinder", "decompose", "rotate",
+__all__ = ["Cut", "SimResult", "SimSettings", "SimulationError", "StockCylinder", "decompose", "finishing_stations",
            "simulate", "simulate_grid", "shifted", "subset"]

@@ -1,7 +1,7 @@
 """Toolpaths drawn in the part's frame (plain numpy; the FreeCAD objects are made in features.py).
 
 The IR is in the machine frame where A turns the part, so a move is drawn where the tool tip
-goes relative to the part: each pose is turned by -A (spur_cad.cam.ir.part_frame_points), and
+goes relative to the part: each pose is turned by -A (spur_cad.geometry.frames.machine_to_part), and
 a move that turns A by more than MAX_A_STEP_DEG is drawn through intermediate poses (the
 machine interpolates X, Y, Z, A linearly), so an index move is an arc around the gear, not a
 chord through it. Programs with more than MAX_DISPLAY_MOVES moves are drawn with a subset of
@@ -16,7 +16,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from spur_cad.cam.ir import MoveKind, Toolpath, part_frame_points
+from spur_cad.cam.ir import MoveKind, Toolpath
+from spur_cad.geometry.frames import machine_to_part
 
 MAX_DISPLAY_MOVES = 60_000
 MAX_A_STEP_DEG = 2.0
@@ -78,10 +79,10 @@ def display_path(path: Toolpath, limit: int = MAX_DISPLAY_MOVES, max_a_step_deg:
     ys = y0[owner] + (y1 - y0)[owner] * t
     zs = z0[owner] + (z1 - z0)[owner] * t
     as_ = a0[owner] + (a1 - a0)[owner] * t
-    transverse = part_frame_points(ys, zs, as_)
+    transverse = machine_to_part(ys, zs, as_)
     points = np.column_stack([xs, transverse[:, 0], transverse[:, 1]])
     rapid = (path.kind[moves] == MoveKind.RAPID)[owner] | ~joined[owner]
-    start_point = part_frame_points(np.array([y0[0]]), np.array([z0[0]]), np.array([a0[0]]))[0]
+    start_point = machine_to_part(np.array([y0[0]]), np.array([z0[0]]), np.array([a0[0]]))[0]
     points = np.vstack([[x0[0], start_point[0], start_point[1]], points])
     rapid = np.concatenate([[True], rapid])
     return DisplayPath(points, rapid, len(moves), len(motion))

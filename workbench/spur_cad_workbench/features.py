@@ -279,19 +279,20 @@ class JobFeature(_Proxy):
         except SpurCadError as exc:
             report(obj, str(exc))
             return
-        facts, rec = plan.facts, plan.facts["tools"]
-        outputs = {"FinishingMaxFlatWidth": rec["finishing_max_flat_width_mm"],
-                   "FinishingMaxCornerRadius": rec["finishing_max_corner_radius_mm"],
-                   "PlungeAllowance": rec["plunge_allowance_mm"], "RoughingMaxDiameter": rec["roughing_max_diameter_mm"],
-                   "RequiredFluteLength": rec["required_flute_length_mm"],
-                   "RequiredStickOut": rec["required_stick_out_mm"], "Warnings": list(facts["warnings"])}
+        rec = plan.recommendations
+        outputs = {"FinishingMaxFlatWidth": rec.finishing_max_flat_width_mm,
+                   "FinishingMaxCornerRadius": rec.finishing_max_corner_radius_mm,
+                   "PlungeAllowance": rec.plunge_allowance_mm, "RoughingMaxDiameter": rec.roughing_max_diameter_mm,
+                   "RequiredFluteLength": rec.required_flute_length_mm,
+                   "RequiredStickOut": rec.required_stick_out_mm, "Warnings": list(plan.warnings)}
         for name in schema.TOOL_ROLES:
             title = name.capitalize()
-            outputs[f"{title}Moves"] = int(facts[name]["moves"]) if name in facts else 0
-            outputs[f"{title}Time"] = facts[name]["estimated_time_s"] / 60.0 if name in facts else 0.0
+            planned = getattr(plan, name)
+            outputs[f"{title}Moves"] = planned.estimate.moves if planned is not None else 0
+            outputs[f"{title}Time"] = planned.estimate.time_s / 60.0 if planned is not None else 0.0
             target = getattr(obj, f"{title}Toolpath")
             if target is not None:
-                update_toolpath(target, getattr(plan, name), job, facts.get(name))
+                update_toolpath(target, planned)
         write_outputs(obj, outputs)
         report(obj, None)
 
@@ -317,19 +318,21 @@ def uses_path_module(obj) -> bool:
     return obj.isDerivedFrom("Path::Feature")
 
 
-def update_toolpath(obj, path, job, facts: dict | None) -> None:
-    """Draw `path` (IR or None) into the toolpath object and set its computed properties."""
+def update_toolpath(obj, planned) -> None:
+    """Draw a planned operation (spur_cad.cam.plan RoughingPlan / FinishingPlan, or None) into the toolpath
+    object and set its computed properties."""
     from spur_cad_workbench.display import display_path, gcode_text, polylines
 
+    path = planned.toolpath if planned is not None else None
     if path is None:
         drawn, moves, outputs = None, 0, {"Moves": 0, "DisplayedMoves": 0, "CuttingLength": 0.0,
                                           "EstimatedTime": 0.0, "ToolNumber": 0, "SpindleSpeed": 0.0}
     else:
         drawn = display_path(path)
         moves = drawn.moves_shown
-        outputs = {"Moves": int(facts["moves"]), "DisplayedMoves": int(moves),
-                   "CuttingLength": float(facts["cutting_length_mm"]),
-                   "EstimatedTime": float(facts["estimated_time_s"]) / 60.0, "ToolNumber": int(path.tool_number),
+        outputs = {"Moves": int(planned.estimate.moves), "DisplayedMoves": int(moves),
+                   "CuttingLength": float(planned.estimate.cutting_length_mm),
+                   "EstimatedTime": float(planned.estimate.time_s) / 60.0, "ToolNumber": int(path.tool_number),
                    "SpindleSpeed": float(path.spindle_rpm)}
     if uses_path_module(obj):
         import Path

@@ -12,7 +12,7 @@ from __future__ import annotations
 import dataclasses
 from dataclasses import dataclass
 
-from spur_cad.cam.machine import FINISHING_STRATEGIES
+from spur_cad.cam.strategies import strategy_names
 from spur_cad.cam.tools import TOOL_KINDS
 from spur_cad.post.settings import DIALECT_NAMES
 
@@ -146,7 +146,7 @@ JOB_FIELDS = (
     _f("ClampRotary", "bool", "Roughing strategy", "roughing", "clamp_rotary",
        "clamp A around each tooth space (needs the machine's codes)"),
     _f("FinishingStrategy", "choice", "Finishing strategy", "finishing", "strategy",
-       "perimeter (stations along X) or along_x", FINISHING_STRATEGIES),
+       "perimeter (stations along X) or along_x", strategy_names()),
     _f("TargetScallop", "length", "Finishing strategy", "finishing", "target_scallop_mm", "target scallop height (mm)"),
     _f("FinishingStepOver", "length", "Finishing strategy", "finishing", "step_over_mm",
        "X step between stations (mm), 0: from the target scallop"),

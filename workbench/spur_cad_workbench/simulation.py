@@ -1,7 +1,7 @@
 """The Simulate command's link to spur_cad.sim, guarded for a spur_cad without the simulator.
 
 `simulate_job` cuts the stock with the job's toolpaths through spur_cad.sim's pipeline stage
-(`spur_cad.sim.stage.simulate_stage`, as `spur-cad run` does); `show_result` draws every design
+(`spur_cad.pipeline.simulate_stage`, as `spur-cad run` does); `show_result` draws every design
 point of the face width, in the part frame, coloured by its deviation (blue gouge, green on
 the design, red leftover). Without spur_cad.sim, `simulator()` raises SimulationUnavailable
 with the message the command shows.
@@ -40,13 +40,13 @@ def simulate_job(job, plan, resolution_mm: float | None = None):
     import dataclasses
 
     simulator()
-    from spur_cad.sim.stage import simulate_stage
+    from spur_cad.pipeline import simulate_stage
 
     settings = dataclasses.replace(job.simulation, enabled=True,
                                    resolution_mm=resolution_mm or job.simulation.resolution_mm)
     settings.validate()
     wanted = dataclasses.replace(job, simulation=settings)
-    _, result = simulate_stage(wanted, plan)
+    result = simulate_stage(wanted, plan)
     if result is None:
         raise SpurCadError("the job has no toolpaths to simulate (choose a roughing or finishing tool)")
     return result
@@ -90,7 +90,6 @@ def show_result(job_obj, result):
     obj = found[0] if found else doc.addObject("Points::Feature", "Simulation")
     obj.Label = name
     points, deviation = result_points(result)
-    facts = result.facts()
     scale = colour_scale_mm(result.settings.resolution_mm)
     properties = (("Color", "App::PropertyColorList", "deviation colour per point"),
                   ("Resolution", "App::PropertyLength", "simulation resolution"),
@@ -105,16 +104,16 @@ def show_result(job_obj, result):
     obj.Points = Points.Points([FreeCAD.Vector(*p) for p in points])
     obj.Color = [tuple(c) for c in deviation_colours(deviation, scale)]
     obj.Resolution = result.settings.resolution_mm
-    obj.MaxGouge = facts["max_gouge_mm"]
-    obj.MaxLeftover = facts["max_leftover_mm"]
-    obj.RemovedVolume = facts["removed_volume_mm3"]
-    obj.Seconds = facts["seconds"]
+    obj.MaxGouge = result.max_gouge_mm
+    obj.MaxLeftover = result.max_leftover_mm
+    obj.RemovedVolume = result.removed_volume_mm3
+    obj.Seconds = result.seconds
     obj.Legend = (f"blue: gouge of {scale:g} mm or more, green: on the design, red: leftover of {scale:g} mm or "
                   f"more ({len(points)} of {result.deviation[:, :, result.gear_rows].size} design points shown)")
     doc.recompute()
     if FreeCAD.GuiUp and obj.ViewObject is not None:
         obj.ViewObject.DisplayMode = "Color"
         obj.ViewObject.PointSize = 3
-    FreeCAD.Console.PrintMessage(f"{name}: max gouge {facts['max_gouge_mm']:.4f} mm, max leftover "
-                                 f"{facts['max_leftover_mm']:.4f} mm\n")
+    FreeCAD.Console.PrintMessage(f"{name}: max gouge {result.max_gouge_mm:.4f} mm, max leftover "
+                                 f"{result.max_leftover_mm:.4f} mm\n")
     return obj

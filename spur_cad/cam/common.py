@@ -1,0 +1,37 @@
+"""What every CAM generator shares: the safe height for indexing, the plunge feed, and the
+conversion of simultaneous rotary moves to inverse-time feeds (docs/method.md)."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from spur_cad.cam.ir import MoveKind, Toolpath, relative_path_lengths
+from spur_cad.cam.machine import Machine
+
+PLUNGE_FEED_FRACTION = 0.5
+"""Plunges (Z moves into the cut) run at this fraction of the tool's cutting feed."""
+
+
+def safe_height_mm(blank_radius_mm: float, machine: Machine) -> float:
+    """Z at which the tool may index A: above the blank by the clearance."""
+    return blank_radius_mm + machine.clearance_mm
+
+
+def apply_inverse_time(path: Toolpath, machine: Machine) -> Toolpath:
+    """Convert linear moves that turn A into inverse-time feeds (1/min) from the relative path length,
+    limited by the rotary axis's maximum speed."""
+    if len(path) == 0:
+        return path
+    start = path.start_poses()
+    moving_a = (path.kind == MoveKind.LINEAR) & (np.abs(path.a - start[:, 3]) > 1e-12)
+    if not moving_a.any():
+        return path
+    idx = np.nonzero(moving_a)[0]
+    x0, y0, z0, a0 = start[idx].T
+    length = relative_path_lengths(x0, y0, z0, a0, path.x[idx], path.y[idx], path.z[idx], path.a[idx])
+    minutes = np.maximum(length / path.feed[idx], np.abs(path.a[idx] - a0) / machine.max_rotary_speed_deg_min)
+    feed = path.feed.copy()
+    feed[idx] = 1.0 / minutes
+    inverse = path.inverse_time.copy()
+    inverse[idx] = True
+    return path.replace(feed=feed, inverse_time=inverse)

@@ -1,0 +1,58 @@
+"""The finishing-strategy protocol: what a strategy is and what it gives back (docs/architecture.md).
+
+A strategy has a name, a one-line description, a frozen parameters dataclass whose fields are
+keys of the job file's [finishing] section, and a pure `generate` function that turns the gear,
+tool and machine into a toolpath (IR) and a typed result. Register it in
+`spur_cad.cam.strategies.REGISTRY`; the job file, CLI, workbench, simulation and report find it
+there.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from dataclasses import dataclass
+from typing import Any, Protocol
+
+import numpy as np
+
+from spur_cad.cam.contacts import SpacePoses
+from spur_cad.cam.ir import Toolpath
+from spur_cad.cam.machine import Machine
+from spur_cad.cam.tools import Tool
+from spur_cad.geometry.spec import GearSpec
+
+
+@dataclass(frozen=True)
+class FinishingResult:
+    """What a finishing strategy planned, besides its toolpath (typed facts for summary and report)."""
+
+    strategy: str
+    params: Any  # the strategy's parameters dataclass, as used
+    poses: SpacePoses  # transverse contact poses of one tooth space (report figure)
+    stations: int  # transverse stations across the face width (1 when the strategy has none)
+    station_step_mm: float
+    station_x_mm: np.ndarray  # X of the stations, where the simulation puts extra rows (empty: none)
+
+    @property
+    def points_per_flank(self) -> int:
+        return self.poses.points_per_flank
+
+
+class FinishingStrategy(Protocol):
+    """A finishing strategy (see the module docstring)."""
+
+    name: str
+    description: str
+    params_type: type
+
+    def generate(self, spec: GearSpec, tool: Tool, machine: Machine, params: Any,
+                 blank_radius_mm: float) -> tuple[Toolpath, FinishingResult]:
+        """The finishing operation as IR plus its facts (pure function)."""
+        ...
+
+
+def params_from_section(strategy: FinishingStrategy, section: object, **overrides: Any) -> Any:
+    """The strategy's parameters taken by name from the [finishing] section (fields it lacks keep defaults)."""
+    values = {f.name: getattr(section, f.name) for f in dataclasses.fields(strategy.params_type)
+              if hasattr(section, f.name)}
+    return strategy.params_type(**{**values, **overrides})

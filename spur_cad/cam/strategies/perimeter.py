@@ -1,0 +1,105 @@
+"""Perimeter finishing (docs/method.md): at each transverse station along X the tool goes once
+around the gear, both flanks cut downward with the corner, root and tip land with the flat
+bottom while Y and A move together (inverse-time feeds)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from spur_cad.cam.common import PLUNGE_FEED_FRACTION, apply_inverse_time, safe_height_mm
+from spur_cad.cam.contacts import SpacePoses, TransversePoses, space_poses, station_positions, station_step_mm
+from spur_cad.cam.ir import Feature, MoveKind, Operation, Toolpath, ToolpathBuilder
+from spur_cad.cam.machine import MachineError, Machine
+from spur_cad.cam.strategies.base import FinishingResult
+from spur_cad.cam.tools import Tool
+from spur_cad.geometry.spec import GearSpec
+
+
+@dataclass(frozen=True)
+class PerimeterParams:
+    """[finishing] keys the perimeter strategy uses."""
+
+    target_scallop_mm: float = 0.005
+    step_over_mm: float = 0.0  # X step between stations; 0: derived from the target scallop
+    contact_spacing_mm: float | None = None  # fixed arc-length contact spacing (the reference process's)
+
+    def validate(self) -> None:
+        if not 0.0 < self.target_scallop_mm <= 0.1:
+            raise MachineError(f"[finishing] target_scallop_mm = {self.target_scallop_mm:g} must be in (0, 0.1]")
+        if self.step_over_mm < 0.0:
+            raise MachineError(f"[finishing] step_over_mm = {self.step_over_mm:g} must not be negative")
+
+
+class PerimeterStrategy:
+    """See the module docstring."""
+
+    name = "perimeter"
+    description = "transverse stations along X, once around the gear at each (simultaneous Y/Z/A)"
+    params_type = PerimeterParams
+
+    def generate(self, spec: GearSpec, tool: Tool, machine: Machine, params: PerimeterParams,
+                 blank_radius_mm: float) -> tuple[Toolpath, FinishingResult]:
+        params.validate()
+        machine.validate()
+        tool.validate("finishing")
+        poses = space_poses(spec, tool, params.target_scallop_mm, params.contact_spacing_mm)
+        stations = station_positions(spec.face_width_mm,
+                                     station_step_mm(tool, params.target_scallop_mm, params.step_over_mm))
+        builder = ToolpathBuilder(Operation.FINISHING, tool.tool_number, tool.spindle_rpm(machine))
+        _tile_stations(builder, spec, machine, poses, stations, tool.feed_mm_min(machine),
+                       safe_height_mm(blank_radius_mm, machine))
+        step = float(stations[1] - stations[0]) if len(stations) > 1 else 0.0
+        result = FinishingResult(self.name, params, poses, len(stations), step, stations)
+        return apply_inverse_time(builder.build(), machine), result
+
+
+def _space_sequence(poses: SpacePoses, safe_z: float) -> list[tuple]:
+    """(kind, y, z, a_rel, feature, plunge) rows of one space at one station, in cutting order."""
+    rows = []
+
+    def approach(p: TransversePoses, feature: Feature):
+        rows.append((MoveKind.RAPID, p.y[0], safe_z, p.a[0], Feature.NONE, False))
+        rows.append((MoveKind.LINEAR, p.y[0], p.z[0], p.a[0], Feature.NONE, True))
+        for y, z, a in zip(p.y[1:], p.z[1:], p.a[1:]):
+            rows.append((MoveKind.LINEAR, y, z, a, feature, False))
+
+    def retract():
+        _, y, _, a, _, _ = rows[-1]
+        rows.append((MoveKind.LINEAR, y, safe_z, a, Feature.NONE, False))
+
+    approach(poses.right_flank, Feature.RIGHT_FLANK)
+    for y, z, a in zip(poses.root.y[1:], poses.root.z[1:], poses.root.a[1:]):
+        rows.append((MoveKind.LINEAR, y, z, a, Feature.ROOT, False))
+    retract()
+    approach(poses.left_flank, Feature.LEFT_FLANK)
+    retract()
+    approach(poses.tip, Feature.TIP)
+    retract()
+    return rows
+
+
+def _tile_stations(builder: ToolpathBuilder, spec: GearSpec, machine: Machine, poses: SpacePoses,
+                   stations: np.ndarray, feed: float, safe_z: float) -> None:
+    """Every station: once around the gear, space by space; stations tiled with numpy."""
+    rows = _space_sequence(poses, safe_z)
+    kind = np.array([r[0] for r in rows], dtype=np.int8)
+    y = np.array([r[1] for r in rows])
+    z = np.array([r[2] for r in rows])
+    a_rel = np.array([r[3] for r in rows])
+    feature = np.array([r[4] for r in rows], dtype=np.int8)
+    plunge = np.array([r[5] for r in rows])
+    teeth, pitch_deg = spec.teeth, 360.0 / spec.teeth
+    per_space, per_station = len(rows), len(rows) * teeth
+    n_total = per_station * len(stations)
+    space_index = np.tile(np.repeat(np.arange(teeth), per_space), len(stations))
+    station_index = np.repeat(np.arange(len(stations)), per_station)
+    turns = station_index * teeth if machine.rotary_continuous else np.zeros(n_total, int)
+    # Space k is brought up by A = -k * pitch; continuous tables keep turning the same way.
+    a = np.tile(a_rel, teeth * len(stations)) - (space_index + turns) * pitch_deg
+    feeds = np.where(np.tile(plunge, teeth * len(stations)), PLUNGE_FEED_FRACTION * feed, feed)
+    feeds = np.where(np.tile(kind, teeth * len(stations)) == MoveKind.RAPID, np.nan, feeds)
+    builder.extend(np.tile(kind, teeth * len(stations)), stations[station_index],
+                   np.tile(y, teeth * len(stations)), np.tile(z, teeth * len(stations)), a, feeds, False,
+                   space_index, station_index, np.tile(feature, teeth * len(stations)))

@@ -1,0 +1,174 @@
+"""summary.json, built here and nowhere else: from the job, the sampled profile, the CAD result,
+the typed CAM plan, the posted programs and the simulation result. Its keys are a public
+interface (users' scripts read them): add keys, never rename or remove one."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from spur_cad import __version__
+from spur_cad.cam.estimate import Estimate
+from spur_cad.cam.machine import Machine
+from spur_cad.cam.plan import CamPlan, FinishingPlan, RoughingPlan
+from spur_cad.cam.recommend import ToolRecommendations
+from spur_cad.cam.tools import Tool
+from spur_cad.geometry.inspection import inspection_sheet
+from spur_cad.geometry.sampling import ProfileSamples
+from spur_cad.post.program import PostedProgram
+from spur_cad.post.settings import PostSettings
+
+if TYPE_CHECKING:  # the CAD kernel and the simulator load only when a job uses them
+    from spur_cad.cad.solid import GearSolidReport
+    from spur_cad.sim.simulate import SimResult
+
+SEGMENT_NAMES = ("root", "fillet", "involute", "tip")
+
+
+@dataclass(frozen=True)
+class CadResult:
+    """The CAD stage's facts: the solid's spline-fit report, volumes and STEP file sizes."""
+
+    report: GearSolidReport
+    gear_volume_mm3: float
+    stock_volume_mm3: float
+    step_bytes: dict[str, int]
+
+
+def build_summary(job, samples: ProfileSamples, cad: CadResult, plan: CamPlan, post: PostSettings,
+                  programs: dict[str, PostedProgram], simulation: SimResult | None,
+                  seconds: dict[str, float]) -> dict:
+    """The whole summary.json content (`job` is a spur_cad.job.Job)."""
+    counts = {name: int(np.count_nonzero(np.array(samples.label_names()) == name)) for name in SEGMENT_NAMES}
+    return {
+        "spur_cad_version": __version__,
+        "job": {"name": job.job.name, "file": job.source},
+        "gear": job.gear.describe(),
+        "inspection": inspection_sheet(job.gear),
+        "profile": {"tolerance_mm": job.job.profile_tolerance_mm, "points": len(samples),
+                    "points_per_segment": counts},
+        "cad": cad_section(cad),
+        **cam_sections(plan, job.machine, job.tools.roughing, job.tools.finishing),
+        "post": post_section(post, programs),
+        "simulation": simulation_section(simulation, job.simulation.resolution_mm),
+        "timings_s": seconds,
+    }
+
+
+def cad_section(cad: CadResult) -> dict:
+    """summary.json's `cad` section."""
+    report = cad.report
+    return {
+        "fit_tolerance_mm": report.fit_tolerance_mm,
+        "fillet_max_deviation_mm": report.fillet_max_deviation_mm,
+        "involute_max_deviation_mm": report.involute_max_deviation_mm,
+        "fillet_spline_poles": report.fillet_poles,
+        "involute_spline_poles": report.involute_poles,
+        "gear_volume_mm3": cad.gear_volume_mm3,
+        "stock_volume_mm3": cad.stock_volume_mm3,
+        "step_bytes": dict(cad.step_bytes),
+    }
+
+
+def cam_sections(plan: CamPlan, machine: Machine, roughing_tool: Tool | None, finishing_tool: Tool | None) -> dict:
+    """summary.json's `tools`, `roughing`, `finishing` (when planned) and `warnings` sections."""
+    sections: dict = {"tools": {**recommendations_section(plan.recommendations),
+                                "roughing": tool_section(roughing_tool, machine),
+                                "finishing": tool_section(finishing_tool, machine)}}
+    if plan.roughing is not None:
+        sections["roughing"] = roughing_section(plan.roughing)
+    if plan.finishing is not None:
+        sections["finishing"] = finishing_section(plan.finishing)
+    sections["warnings"] = list(plan.warnings)
+    return sections
+
+
+def recommendations_section(rec: ToolRecommendations) -> dict:
+    return {"finishing_max_flat_width_mm": rec.finishing_max_flat_width_mm,
+            "finishing_max_corner_radius_mm": rec.finishing_max_corner_radius_mm,
+            "plunge_allowance_mm": rec.plunge_allowance_mm,
+            "roughing_max_diameter_mm": rec.roughing_max_diameter_mm,
+            "required_flute_length_mm": rec.required_flute_length_mm,
+            "required_stick_out_mm": rec.required_stick_out_mm}
+
+
+def tool_section(tool: Tool | None, machine: Machine) -> dict | None:
+    if tool is None:
+        return None
+    return {"kind": tool.kind, "diameter_mm": tool.diameter_mm, "corner_radius_mm": tool.corner_radius,
+            "flat_width_mm": tool.flat_width_mm, "spindle_rpm": tool.spindle_rpm(machine),
+            "feed_mm_min": tool.feed_mm_min(machine)}
+
+
+def _estimate_facts(est: Estimate) -> dict:
+    return {"moves": est.moves, "cutting_length_mm": est.cutting_length_mm, "rapid_length_mm": est.rapid_length_mm,
+            "estimated_time_s": est.time_s}
+
+
+def roughing_section(roughing: RoughingPlan) -> dict:
+    return {"levels_per_space": len(roughing.levels.heights_mm),
+            "lowest_level_height_mm": roughing.lowest_level_above_root_mm,
+            "level_heights_mm": [float(h) for h in roughing.levels.heights_mm],
+            **_estimate_facts(roughing.estimate)}
+
+
+def finishing_section(finishing: FinishingPlan) -> dict:
+    result = finishing.result
+    return {"strategy": result.strategy, "stations": result.stations, "station_step_mm": result.station_step_mm,
+            "points_per_flank": result.points_per_flank, **_estimate_facts(finishing.estimate),
+            "reference_strategy_moves": finishing.reference_estimate.moves,
+            "reference_strategy_time_s": finishing.reference_estimate.time_s}
+
+
+def post_section(settings: PostSettings, programs: dict[str, PostedProgram]) -> dict:
+    """summary.json's `post` section: dialect, folding, and lines/bytes/subprograms of each program."""
+    facts: dict = {"dialect": settings.dialect, "folded": settings.folded}
+    for name, program in programs.items():
+        facts[f"{name}_lines"] = program.lines
+        facts[f"{name}_bytes"] = program.bytes
+        facts[f"{name}_subprograms"] = program.subprograms
+    return facts
+
+
+def simulation_section(result: SimResult | None, resolution_mm: float) -> dict:
+    """summary.json's `simulation` section (only `enabled` and the resolution when nothing was simulated)."""
+    if result is None:
+        return {"enabled": False, "resolution_mm": resolution_mm}
+    dev = result.deviation[:, :, result.gear_rows]
+    finished = dev[dev < result.settings.leftover_range_mm - 1e-9]
+    positive = np.maximum(finished, 0.0)
+    names = np.array(result.grid.feature_names())
+    per_feature = {}
+    for name in ("right involute", "right fillet", "root", "left fillet", "left involute", "tip"):
+        mask = np.array([n.endswith(name) if name in ("root", "tip") else n == name for n in names])
+        if mask.any():
+            values = dev[:, mask, :]
+            per_feature[name] = {"max_gouge_mm": float(max(0.0, -values.min())),
+                                 "max_leftover_mm": float(max(0.0, values.max())),
+                                 "mean_mm": float(values.mean())}
+    return {
+        "enabled": True,
+        "resolution_mm": result.settings.resolution_mm,
+        "max_gouge_mm": result.max_gouge_mm,
+        "max_leftover_mm": result.max_leftover_mm,
+        "removed_volume_mm3": result.removed_volume_mm3,
+        "seconds": result.seconds,
+        "design_points": int(dev.size),
+        "points_per_space": int(result.grid.points.shape[0]),
+        "rows": int(result.gear_rows.sum()),
+        "point_spacing_mm": result.grid.spacing_mm,
+        "uncut_points": result.uncut_points,
+        "scallop_mean_mm": float(positive.mean()) if positive.size else 0.0,
+        "scallop_p95_mm": float(np.percentile(positive, 95)) if positive.size else 0.0,
+        "scallop_p99_mm": float(np.percentile(positive, 99)) if positive.size else 0.0,
+        "worst_gouge": result.worst(True),
+        "worst_leftover": result.worst(False),
+        "per_feature": per_feature,
+        "moves": result.moves,
+        "poses_clipped": result.poses_clipped,
+        "x_sweeps": result.x_sweeps,
+        "gouge_range_mm": result.settings.gouge_range_mm,
+        "leftover_range_mm": result.settings.leftover_range_mm,
+    }
