@@ -10,14 +10,14 @@ package loads nothing heavy: the CAD entry points below import CadQuery on first
     solid = spur_cad.to_build123d(gear)        # build123d.Solid wrapping the same OCP shape
 """
 
-from spur_cad.errors import GearSpecError, JobFileError, SpurCadError
+from spur_cad.errors import GearSpecError, JobFileError, SpurCadError, StockError
 from spur_cad.geometry.spec import GearSpec
 
 __version__ = "0.1.0"
 
 _CAD_ENTRY_POINTS = {"make_gear", "make_stock", "to_build123d", "BlankFeatures", "StockSpec"}
 
-__all__ = ["GearSpec", "GearSpecError", "JobFileError", "SpurCadError", "__version__", *sorted(_CAD_ENTRY_POINTS)]
+__all__ = ["GearSpec", "GearSpecError", "JobFileError", "SpurCadError", "StockError", "__version__", *sorted(_CAD_ENTRY_POINTS)]
 
 
 def __getattr__(name: str):

@@ -18,5 +18,13 @@ class GearSpecError(SpurCadError, ValueError):
         self.field = field
 
 
+class StockError(SpurCadError, ValueError):
+    """A stock (blank, margins, holding stub) that cannot be made; `field` names the StockSpec field."""
+
+    def __init__(self, message: str, field: str | None = None):
+        super().__init__(message)
+        self.field = field
+
+
 class JobFileError(SpurCadError, ValueError):
     """A job file that cannot be read: bad TOML, unknown key, wrong type, missing value."""

@@ -18,7 +18,7 @@ from pathlib import Path
 from spur_cad.cad.specs import BlankFeatures, StockSpec
 from spur_cad.cam.machine import FinishingParams, Machine, RoughingParams
 from spur_cad.cam.tools import Tool
-from spur_cad.errors import GearSpecError, JobFileError, SpurCadError
+from spur_cad.errors import GearSpecError, JobFileError, SpurCadError, StockError
 from spur_cad.geometry.spec import GearSpec
 from spur_cad.post.settings import PostSettings
 
@@ -231,7 +231,7 @@ def _job_from_data(data: dict, source: str, text: str) -> Job:
                          (sections.get("stock", StockSpec()).validate, "stock")):
         try:
             check(spec)
-        except GearSpecError as exc:
+        except (GearSpecError, StockError) as exc:
             raise JobFileError(f"{_where(source, text, table, exc.field)}: invalid [{table}]: {exc}") from None
     for name, check in (("machine", lambda m: m.validate()), ("roughing", lambda r: r.validate()),
                         ("finishing", lambda f: f.validate()), ("post", lambda p: p.validate()),

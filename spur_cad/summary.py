@@ -97,7 +97,7 @@ def recommendations_section(rec: ToolRecommendations) -> dict:
 def tool_section(tool: Tool | None, machine: Machine) -> dict | None:
     if tool is None:
         return None
-    return {"kind": tool.kind, "diameter_mm": tool.diameter_mm, "corner_radius_mm": tool.corner_radius,
+    return {"kind": tool.kind, "diameter_mm": tool.diameter_mm, "corner_radius_mm": tool.effective_corner_radius_mm,
             "flat_width_mm": tool.flat_width_mm, "spindle_rpm": tool.spindle_rpm(machine),
             "feed_mm_min": tool.feed_mm_min(machine)}
 

@@ -25,6 +25,7 @@ from OCP.TopoDS import TopoDS
 import spur_cad
 from spur_cad.cad.solid import build_gear_shape, build_stock_shape, solid_volume_mm3
 from spur_cad.cad.specs import BlankFeatures, StockSpec
+from spur_cad.errors import StockError
 from spur_cad.cad.step import step_files
 from spur_cad.geometry import gear_outline, sample_profile
 from spur_cad.geometry.inspection import recommended_span_teeth, span_measurement
@@ -214,7 +215,7 @@ def test_stock_volume_and_stub():
     (StockSpec(stub_diameter_mm=200.0, stub_length_mm=5.0), "larger than the blank"),
 ])
 def test_stock_errors(stock, words):
-    with pytest.raises(spur_cad.GearSpecError, match=words):
+    with pytest.raises(StockError, match=words):
         build_stock_shape(spec_of("reference_z23_m4"), stock)
 
 

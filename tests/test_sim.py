@@ -217,7 +217,7 @@ def test_right_flank_moved_20um_into_the_part_reports_a_20um_gouge_on_that_flank
     idx = np.nonzero(fault)[0]
     a = np.radians(fin.a[idx]) + SPACE * 2 * math.pi / job.gear.teeth
     c, s = np.cos(a), np.sin(a)
-    centre = np.stack([fin.y[idx] + tool.flat_width_mm / 2, fin.z[idx] + tool.corner_radius], axis=-1)
+    centre = np.stack([fin.y[idx] + tool.flat_width_mm / 2, fin.z[idx] + tool.effective_corner_radius_mm], axis=-1)
     dy, dz = fin.y.copy(), fin.z.copy()
     for i, (ci, si, cc) in enumerate(zip(c, s, centre)):
         turned = np.stack([design[:, 0] * ci - design[:, 1] * si, design[:, 0] * si + design[:, 1] * ci], axis=-1)

@@ -8,7 +8,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from spur_cad.errors import GearSpecError
+from spur_cad.errors import GearSpecError, StockError
 from spur_cad.geometry.spec import GearSpec
 
 
@@ -66,12 +66,12 @@ class StockSpec:
                      "stub_length_mm"):
             value = getattr(self, name)
             if not math.isfinite(value) or value < 0.0:
-                raise GearSpecError(f"{name} = {value:g} mm must not be negative", field=name)
+                raise StockError(f"{name} = {value:g} mm must not be negative", field=name)
         if (self.stub_diameter_mm > 0.0) != (self.stub_length_mm > 0.0):
-            raise GearSpecError("a holding stub needs both stub_diameter_mm and stub_length_mm",
+            raise StockError("a holding stub needs both stub_diameter_mm and stub_length_mm",
                                 field="stub_diameter_mm")
         if self.stub_diameter_mm > 2.0 * self.blank_radius_mm(spec):
-            raise GearSpecError(f"stub diameter {self.stub_diameter_mm:g} mm is larger than the blank "
+            raise StockError(f"stub diameter {self.stub_diameter_mm:g} mm is larger than the blank "
                                 f"({2 * self.blank_radius_mm(spec):.3f} mm)", field="stub_diameter_mm")
 
     def blank_radius_mm(self, spec: GearSpec) -> float:

@@ -63,7 +63,7 @@ def tool_signed_distance(points: np.ndarray, tip_y: float, tip_z: float, tool: T
     of the strip |Y - tip_y| <= d/2, Z >= tip_z + r_t with a disc of radius r_t, so outside
     that strip the distance is exact: hypot(dy, dz) - r_t.
     """
-    r_t, d = tool.corner_radius, tool.flat_width_mm
+    r_t, d = tool.effective_corner_radius_mm, tool.flat_width_mm
     dy = np.abs(points[:, 0] - tip_y) - d / 2.0
     dz = tip_z + r_t - points[:, 1]
     outside = np.hypot(np.maximum(dy, 0.0), np.maximum(dz, 0.0))
@@ -75,7 +75,7 @@ def _pose_for_turn(point: np.ndarray, normal: np.ndarray, turn: float, tool: Too
     """Tip centre (Y, Z) touching `point` with the right corner when the part is turned by `turn`."""
     p_y, p_z = turn_point(point[0], point[1], turn)
     n_y, n_z = turn_point(normal[0], normal[1], turn)
-    r_t = tool.corner_radius
+    r_t = tool.effective_corner_radius_mm
     return p_y + r_t * n_y - tool.flat_width_mm / 2.0, p_z + r_t * n_z - r_t
 
 
@@ -150,7 +150,7 @@ def space_poses(spec: GearSpec, tool: Tool, scallop_mm: float,
     """All transverse poses of one space. `contact_spacing_mm` (fixed arc-length spacing) reproduces
     the reference process's sampling for comparison; by default the scallop bound decides."""
     profile = spec.tooth_space_profile()
-    r_t, d = tool.corner_radius, tool.flat_width_mm
+    r_t, d = tool.effective_corner_radius_mm, tool.flat_width_mm
     points, normals = [], []
     for label in ("involute", "fillet"):  # tip -> root
         segment = profile.segment(label)
@@ -186,7 +186,7 @@ def station_step_mm(tool: Tool, target_scallop_mm: float, step_over_mm: float = 
     if step_over_mm > 0.0:
         return step_over_mm
     h = target_scallop_mm
-    candidates = [2.0 * math.sqrt(h * (2.0 * tool.corner_radius - h))]
+    candidates = [2.0 * math.sqrt(h * (2.0 * tool.effective_corner_radius_mm - h))]
     if tool.flat_width_mm > 2.0 * h:
         candidates.append(2.0 * math.sqrt(h * (tool.flat_width_mm - h)))
     return min(candidates)

@@ -83,8 +83,8 @@ def check_tools(spec: GearSpec, recommendations: ToolRecommendations, roughing: 
             raise ToolError(f"finishing tool flat width {finishing.flat_width_mm:.4f} mm (D - 2 r_t) exceeds "
                             f"finishing_max_flat_width_mm = {rec.finishing_max_flat_width_mm:.4f} mm "
                             "(root arc length 2 v r_f)")
-        if finishing.corner_radius > rec.finishing_max_corner_radius_mm + 1e-9:
-            raise ToolError(f"finishing tool corner radius {finishing.corner_radius:.4f} mm exceeds "
+        if finishing.effective_corner_radius_mm > rec.finishing_max_corner_radius_mm + 1e-9:
+            raise ToolError(f"finishing tool corner radius {finishing.effective_corner_radius_mm:.4f} mm exceeds "
                             f"finishing_max_corner_radius_mm = {rec.finishing_max_corner_radius_mm:.4f} mm "
                             "(smallest curvature radius of the root fillet)")
         _check_lengths(finishing, "finishing", rec)

@@ -54,14 +54,14 @@ class Tool:
                 raise ToolError(f"{role} tool {name} = {getattr(self, name):g} must not be negative")
 
     @property
-    def corner_radius(self) -> float:
+    def effective_corner_radius_mm(self) -> float:
         """r_t (a ball's is D/2 even when the file omits it)."""
         return self.diameter_mm / 2.0 if self.kind == "ball" else self.corner_radius_mm
 
     @property
     def flat_width_mm(self) -> float:
         """d = D - 2 r_t: the flat part of the tool's bottom."""
-        return self.diameter_mm - 2.0 * self.corner_radius
+        return self.diameter_mm - 2.0 * self.effective_corner_radius_mm
 
     def spindle_rpm(self, machine: Machine) -> float:
         """n = 1000 V_c / (pi D), capped by the spindle's maximum."""

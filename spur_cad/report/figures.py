@@ -66,7 +66,7 @@ def finishing_png(spec: GearSpec, tool: Tool, y: np.ndarray, z: np.ndarray, a_de
     ax = fig.add_subplot(1, 1, 1)
     outline = _space_outline(spec)
     ax.plot(outline[:, 0], outline[:, 1], "-", color="k", lw=1.2, label="design")
-    r_t, half_flat = tool.corner_radius, tool.flat_width_mm / 2.0
+    r_t, half_flat = tool.effective_corner_radius_mm, tool.flat_width_mm / 2.0
     from spur_cad.sim.design import sample_space
 
     tips = machine_to_part(y, z, a_deg)

@@ -20,7 +20,7 @@ from spur_cad.geometry.profile import SEGMENT_LABELS, ToothSpaceProfile
 from spur_cad.geometry.sampling import even_arc_length_parameters
 from spur_cad.geometry.spec import GearSpec
 
-FEATURES = ("root", "fillet", "involute", "tip")  # = SEGMENT_LABELS
+FEATURES = SEGMENT_LABELS  # one vocabulary: the profile segments of spur_cad.geometry.profile
 RIGHT, CENTRE, LEFT = 1, 0, -1
 
 

@@ -1,8 +1,8 @@
 """Numba kernels: clip the blades (design point + t * normal, t in [t_min, h]) by tool positions.
 
 The tool (flat, bull-nose or ball end mill, axis +Z, tip centre at the programmed point, shank
-going up for ever) is the set of points within r_t of its core, the cylinder of radius rho
-(flat half-width) above height r_t (corner radius); R = rho + r_t. Along a blade the distance
+going up for ever) is the set of points within r_t of its core, the cylinder of radius half_flat
+(flat half-width) above height r_t (corner radius); R = half_flat + r_t. Along a blade the distance
 to that convex core minus r_t is a convex function with slope at most 1, so the first point of
 the blade inside the tool is found exactly by Newton's method started at the blade's inner
 end: from the left, a convex function's Newton iterates never pass its first root.
@@ -26,12 +26,12 @@ _F_TOLERANCE = 1e-10
 
 
 @njit(cache=True, inline="always")
-def _gap_and_slope(t, dx, ay, az, ny, nz, rho, rt):
+def _gap_and_slope(t, dx, ay, az, ny, nz, half_flat, rt):
     """G(t) = distance from the blade point to the tool's core minus r_t (<= 0 inside the tool), and dG/dt."""
     u = ay + t * ny
     dz = az + t * nz
     s = math.sqrt(dx * dx + u * u)
-    e = s - rho
+    e = s - half_flat
     if e < 0.0:
         e = 0.0
     v = rt - dz
@@ -45,11 +45,11 @@ def _gap_and_slope(t, dx, ay, az, ny, nz, rho, rt):
 
 
 @njit(cache=True)
-def first_entry(dx, ay, az, ny, nz, lo, hi, radius, rho, rt):
+def first_entry(dx, ay, az, ny, nz, lo, hi, radius, half_flat, rt):
     """Smallest t in [lo, hi] where the blade point (dx, ay + t ny, az + t nz) relative to the tool tip
     is inside the tool; +inf when the blade misses the tool there.
 
-    The tool is the set of points within r_t of its core (the cylinder of radius rho above height
+    The tool is the set of points within r_t of its core (the cylinder of radius half_flat above height
     r_t), so G(t) = dist(core) - r_t is convex along the blade with |dG/dt| <= 1: Newton's method
     from the inner end climbs monotonically to the first root, and G(lo) > hi - lo rules a blade out.
     """
@@ -80,12 +80,12 @@ def first_entry(dx, ay, az, ny, nz, lo, hi, radius, rho, rt):
         return INF
     if lo > hi:
         return INF
-    f, slope = _gap_and_slope(lo, dx, ay, az, ny, nz, rho, rt)
+    f, slope = _gap_and_slope(lo, dx, ay, az, ny, nz, half_flat, rt)
     if f <= 0.0:
         return lo
     if f > hi - lo or slope >= 0.0:
         return INF
-    fh, slope_h = _gap_and_slope(hi, dx, ay, az, ny, nz, rho, rt)
+    fh, slope_h = _gap_and_slope(hi, dx, ay, az, ny, nz, half_flat, rt)
     if fh > 0.0 and (slope_h <= 0.0 or f + fh > hi - lo):  # |slope| <= 1: min G >= (G(lo) + G(hi) - (hi - lo)) / 2
         return INF
     t = lo
@@ -94,7 +94,7 @@ def first_entry(dx, ay, az, ny, nz, lo, hi, radius, rho, rt):
         t_next = t + step
         if t_next > hi:
             return INF
-        f, slope = _gap_and_slope(t_next, dx, ay, az, ny, nz, rho, rt)
+        f, slope = _gap_and_slope(t_next, dx, ay, az, ny, nz, half_flat, rt)
         if f <= _F_TOLERANCE:
             return t_next
         if slope >= 0.0 or f > hi - t_next:
@@ -120,7 +120,7 @@ def _sector_range(y, z, a, reach, radius, blade_len, pitch, teeth):
 
 @njit(cache=True)
 def _clip_at_pose(x, y, z, a, x_end, h, h_top, points, normals, chunk_start, chunk_centre, chunk_radius,
-                  rows, t_min, t_max, radius, rho, rt, reach, blade_len, pitch, teeth):
+                  rows, t_min, t_max, radius, half_flat, rt, reach, blade_len, pitch, teeth):
     """Clip the blades by the tool at (x, y, z, a); with x_end > x, by the tool swept along X from x to x_end
     (the union of the slices is the slice nearest the axis: t_e(dx) grows with |dx|)."""
     if z > reach:
@@ -144,7 +144,7 @@ def _clip_at_pose(x, y, z, a, x_end, h, h_top, points, normals, chunk_start, chu
             pz = chunk_centre[ci, 1]
             cy = c * py - s * pz
             cz = s * py + c * pz
-            ddy = abs(cy - y) - rho
+            ddy = abs(cy - y) - half_flat
             ddz = z + rt - cz
             out = math.sqrt(max(ddy, 0.0) ** 2 + max(ddz, 0.0) ** 2)
             inside = min(max(ddy, ddz), 0.0)
@@ -160,7 +160,7 @@ def _clip_at_pose(x, y, z, a, x_end, h, h_top, points, normals, chunk_start, chu
                 ny = c * nx - s * nz_
                 nz = s * nx + c * nz_
                 top = h_top[sector, j]
-                deepest = first_entry(0.0, ay, az, ny, nz, t_min, top, radius, rho, rt)
+                deepest = first_entry(0.0, ay, az, ny, nz, t_min, top, radius, half_flat, rt)
                 if deepest == INF:
                     continue
                 hrow = h[sector, j]
@@ -176,19 +176,19 @@ def _clip_at_pose(x, y, z, a, x_end, h, h_top, points, normals, chunk_start, chu
                 dz_top = max(az + t_min * nz, az + top * nz)
                 slice_radius = radius
                 if dz_top < rt:
-                    slice_radius = rho + math.sqrt(max(rt * rt - (rt - dz_top) ** 2, 0.0))
+                    slice_radius = half_flat + math.sqrt(max(rt * rt - (rt - dz_top) ** 2, 0.0))
                 reach_x2 = slice_radius * slice_radius - dy_min * dy_min
                 if reach_x2 <= 0.0:
                     continue
                 reach_x = math.sqrt(reach_x2)
-                cuts += _walk_rows(hrow, rows, r_out, r_hi, 1, x_end, reach_x, deepest, ay, az, ny, nz, radius, rho, rt)
+                cuts += _walk_rows(hrow, rows, r_out, r_hi, 1, x_end, reach_x, deepest, ay, az, ny, nz, radius, half_flat, rt)
                 cuts += _walk_rows(hrow, rows, r_in - 1, r_lo - 1, -1, x, reach_x, deepest, ay, az, ny, nz, radius,
-                                   rho, rt)
+                                   half_flat, rt)
     return cuts
 
 
 @njit(cache=True)
-def _walk_rows(hrow, rows, start, stop, step, x_edge, reach_x, deepest, ay, az, ny, nz, radius, rho, rt):
+def _walk_rows(hrow, rows, start, stop, step, x_edge, reach_x, deepest, ay, az, ny, nz, radius, half_flat, rt):
     """Clip one blade on the rows outside the sweep, walking away from the edge `x_edge` of the
     sweep (step +1 beyond its end, -1 before its start) until the slice no longer reaches."""
     cuts = 0
@@ -200,7 +200,7 @@ def _walk_rows(hrow, rows, start, stop, step, x_edge, reach_x, deepest, ay, az, 
         current = hrow[r]
         if lower >= current:
             continue
-        entry = first_entry(dx, ay, az, ny, nz, lower, current, radius, rho, rt)
+        entry = first_entry(dx, ay, az, ny, nz, lower, current, radius, half_flat, rt)
         if entry < current:
             hrow[r] = entry
             lower = entry
@@ -210,13 +210,13 @@ def _walk_rows(hrow, rows, start, stop, step, x_edge, reach_x, deepest, ay, az, 
 
 @njit(cache=True)
 def clip_poses(poses, x_end, h, h_top, points, normals, chunk_start, chunk_centre, chunk_radius, rows, t_min, t_max,
-               radius, rho, rt, reach, blade_len, pitch, teeth):
+               radius, half_flat, rt, reach, blade_len, pitch, teeth):
     """Clip by a batch of tool positions (N, 4): x, y, z, a (rad); x_end[i] > x[i] sweeps along X.
 
     `h_top[sector, point]` is an upper bound of the blade's h over all rows (h only falls)."""
     cuts = 0
     for i in range(poses.shape[0]):
         cuts += _clip_at_pose(poses[i, 0], poses[i, 1], poses[i, 2], poses[i, 3], x_end[i], h, h_top, points, normals,
-                              chunk_start, chunk_centre, chunk_radius, rows, t_min, t_max, radius, rho, rt, reach,
+                              chunk_start, chunk_centre, chunk_radius, rows, t_min, t_max, radius, half_flat, rt, reach,
                               blade_len, pitch, teeth)
     return cuts

@@ -44,13 +44,13 @@ def tool_solid(tool: Tool, height: float):
     """The tool as a CadQuery solid of revolution about +Z, tip centre at the origin (exact corner arcs)."""
     import cadquery as cq
 
-    radius, rt = tool.diameter_mm / 2.0, tool.corner_radius
-    rho = radius - rt
+    radius, rt = tool.diameter_mm / 2.0, tool.effective_corner_radius_mm
+    half_flat = radius - rt
     wp = cq.Workplane("XZ").moveTo(0.0, 0.0)
-    if rho > 0.0:
-        wp = wp.lineTo(rho, 0.0)
+    if half_flat > 0.0:
+        wp = wp.lineTo(half_flat, 0.0)
     if rt > 0.0:
-        mid = (rho + rt * math.sin(math.pi / 4), rt - rt * math.cos(math.pi / 4))
+        mid = (half_flat + rt * math.sin(math.pi / 4), rt - rt * math.cos(math.pi / 4))
         wp = wp.threePointArc(mid, (radius, rt))
     wp = wp.lineTo(radius, height).lineTo(0.0, height).close()
     return wp.revolve(360.0, (0, 0, 0), (0, 1, 0)).val()
@@ -60,15 +60,15 @@ def _silhouette_prism(tool: Tool, height: float, length: float):
     """The tool's section through its axis in the YZ plane (X = 0), extruded by `length` along +X."""
     import cadquery as cq
 
-    radius, rt = tool.diameter_mm / 2.0, tool.corner_radius
-    rho = radius - rt
+    radius, rt = tool.diameter_mm / 2.0, tool.effective_corner_radius_mm
+    half_flat = radius - rt
     wp = cq.Workplane("YZ").moveTo(-radius, height).lineTo(-radius, rt)
     if rt > 0.0:
-        wp = wp.threePointArc((-rho - rt * math.sin(math.pi / 4), rt - rt * math.cos(math.pi / 4)), (-rho, 0.0))
-    if rho > 0.0:
-        wp = wp.lineTo(rho, 0.0)
+        wp = wp.threePointArc((-half_flat - rt * math.sin(math.pi / 4), rt - rt * math.cos(math.pi / 4)), (-half_flat, 0.0))
+    if half_flat > 0.0:
+        wp = wp.lineTo(half_flat, 0.0)
     if rt > 0.0:
-        wp = wp.threePointArc((rho + rt * math.sin(math.pi / 4), rt - rt * math.cos(math.pi / 4)), (radius, rt))
+        wp = wp.threePointArc((half_flat + rt * math.sin(math.pi / 4), rt - rt * math.cos(math.pi / 4)), (radius, rt))
     wp = wp.lineTo(radius, height).close()
     return wp.extrude(length).val()
 
@@ -104,7 +104,7 @@ def swept_solids(path: Toolpath, tool: Tool, stock: StockCylinder, resolution_mm
         reach = max(math.hypot(y0, z0), math.hypot(y[i], z[i])) + tool.diameter_mm
         travel = abs(x[i] - x0) + math.hypot(y[i] - y0, z[i] - z0) + reach * abs(math.radians(a[i] - a0))
         here = step
-        if tool.corner_radius == 0.0 and z0 == z[i] and a0 == a[i]:  # flat bottom translating: its round edge
+        if tool.effective_corner_radius_mm == 0.0 and z0 == z[i] and a0 == a[i]:  # flat bottom translating: its round edge
             here = math.sqrt(8.0 * radius * resolution_mm / 2.0) / refine
         pieces = max(1, math.ceil(travel / here))
         for f in np.arange(1, pieces + 1) / pieces:

@@ -138,16 +138,16 @@ def finishing_stations(path: Toolpath | None) -> np.ndarray:
 def pose_step_mm(tool: Tool, resolution_mm: float) -> float:
     """Spacing of clipped poses along a move: the cusp between two copies of a corner of radius r a
     distance l apart is l^2 / (8 r); keep it within resolution / 2 (sharp flat tools: resolution / 2)."""
-    radius = tool.corner_radius if tool.corner_radius > 0.0 else 0.0
+    radius = tool.effective_corner_radius_mm if tool.effective_corner_radius_mm > 0.0 else 0.0
     if radius == 0.0:
         return resolution_mm / 2.0
     return math.sqrt(8.0 * radius * resolution_mm / 2.0)
 
 
 def _tool_shape(tool: Tool) -> tuple[float, float, float]:
-    """(R, rho, r_t): outer radius, flat half-width, corner radius."""
+    """(R, half_flat, r_t): outer radius, flat half-width, corner radius."""
     radius = tool.diameter_mm / 2.0
-    rt = tool.corner_radius
+    rt = tool.effective_corner_radius_mm
     return radius, radius - rt, rt
 
 
@@ -182,7 +182,7 @@ def decompose(path: Toolpath, tool: Tool, resolution_mm: float, reach_mm: float,
     lows = np.stack([x[only_z], y[only_z], np.minimum(z0, z)[only_z], a[only_z]], axis=-1)
     idx = np.nonzero(general)[0]
     step = np.full(len(idx), pose_step_mm(tool, resolution_mm))
-    if flat_step_mm is not None and tool.corner_radius == 0.0:
+    if flat_step_mm is not None and tool.effective_corner_radius_mm == 0.0:
         # A flat tool moving horizontally without turning (roughing's steps across a level) leaves no cusp on
         # its flat bottom; its round edge (radius D/2) does, as a corner of that radius.
         step[(dz[idx] == 0.0) & (da[idx] == 0.0)] = flat_step_mm
@@ -254,7 +254,7 @@ def simulate(spec: GearSpec, stock: StockCylinder, operations: Sequence[Cut],
     """
     settings.validate()
     started = time.perf_counter()
-    corner_radii = [op.tool.corner_radius for op in operations if op.tool.corner_radius > 0.0] or [0.5]
+    corner_radii = [op.tool.effective_corner_radius_mm for op in operations if op.tool.effective_corner_radius_mm > 0.0] or [0.5]
     spacing = point_spacing_mm(min(corner_radii), settings.resolution_mm)
     stations = np.unique(np.asarray(station_x if station_x is not None else np.zeros(0), float))
     extra = np.concatenate([stations, 0.5 * (stations[1:] + stations[:-1])]) if len(stations) else np.zeros(0)
@@ -291,19 +291,19 @@ def simulate_grid(grid: DesignGrid, stock: StockCylinder, operations: Sequence[C
     batches = []
     sweeps = moves = 0
     for op in operations:
-        radius, rho, rt = _tool_shape(op.tool)
+        radius, half_flat, rt = _tool_shape(op.tool)
         flat_step = math.sqrt(8.0 * radius * res / 2.0)
         poses, x_end, n_sweeps = decompose(op.path, op.tool, res, reach, flat_step, (x_lo, x_hi))
         sweeps += n_sweeps
         moves += len(op.path)
         for lo in range(0, len(poses), POSE_BATCH):
-            batches.append((poses[lo:lo + POSE_BATCH], x_end[lo:lo + POSE_BATCH], radius, rho, rt))
+            batches.append((poses[lo:lo + POSE_BATCH], x_end[lo:lo + POSE_BATCH], radius, half_flat, rt))
     total = sum(len(b[0]) for b in batches)
     done = 0
-    for poses, x_end, radius, rho, rt in batches:
+    for poses, x_end, radius, half_flat, rt in batches:
         h_top = np.ascontiguousarray(h.max(axis=2))
         clip_poses(np.ascontiguousarray(poses), np.ascontiguousarray(x_end), h, h_top, grid.points, grid.normals,
-                   chunk_start, chunk_centre, chunk_radius, grid.rows_x, t_min, t_max, radius, rho, rt, reach,
+                   chunk_start, chunk_centre, chunk_radius, grid.rows_x, t_min, t_max, radius, half_flat, rt, reach,
                    blade_len, grid.pitch_rad, grid.teeth)
         done += len(poses)
         if progress is not None:
