@@ -4,7 +4,15 @@ from __future__ import annotations
 
 
 class SpurCadError(Exception):
-    """Base class for errors caused by user input; the CLI and GUI show the message only."""
+    """Base class for errors caused by user input; the CLI and GUI show the message only.
+
+    `key` names the job-file key to blame as "section.key" (e.g. "finishing.target_scallop_mm")
+    when the error is raised after the job file was read, so front ends can point at its line.
+    """
+
+    def __init__(self, message: str = "", *, key: str | None = None):
+        super().__init__(message)
+        self.key = key
 
 
 class GearSpecError(SpurCadError, ValueError):
@@ -24,6 +32,11 @@ class StockError(SpurCadError, ValueError):
     def __init__(self, message: str, field: str | None = None):
         super().__init__(message)
         self.field = field
+
+
+class WorkLimitError(SpurCadError, ValueError):
+    """Input that would need more work (moves, points, memory) than spur_cad's limits allow; raised
+    before the work is done, naming the quantity, the limit and what to change."""
 
 
 class JobFileError(SpurCadError, ValueError):

@@ -120,11 +120,16 @@ def _corner_poses(points: np.ndarray, normals: np.ndarray, tool: Tool, design: n
     return TransversePoses(ys, zs, np.degrees(turns), radius)
 
 
+def _flat_sweep_steps(radius: float, angle: float, scallop: float) -> int:
+    """Poses - 1 of a flat sweep over `angle`: leftover r (1/cos(step/2) - 1) = scallop between poses."""
+    step = 2.0 * math.acos(1.0 / (1.0 + scallop / radius))
+    return max(1, math.ceil(abs(angle) / step))
+
+
 def _flat_sweep(radius: float, theta_start: float, theta_end: float, y_start: float, y_end: float,
                 scallop: float) -> TransversePoses:
     """Flat bottom tangent to a circle about the axis at its top while the part turns (root or tip)."""
-    step = 2.0 * math.acos(1.0 / (1.0 + scallop / radius))  # leftover r (1/cos(step/2) - 1) = scallop
-    n = max(1, math.ceil(abs(theta_end - theta_start) / step))
+    n = _flat_sweep_steps(radius, theta_end - theta_start, scallop)
     theta = np.linspace(theta_start, theta_end, n + 1)
     fraction = np.linspace(0.0, 1.0, n + 1)
     return TransversePoses(y_start + (y_end - y_start) * fraction, np.full(n + 1, radius), np.degrees(theta),
@@ -143,6 +148,41 @@ class SpacePoses:
     @property
     def points_per_flank(self) -> int:
         return len(self.right_flank.y)
+
+
+@dataclass(frozen=True)
+class ContactCounts:
+    """How many poses `space_poses` makes per feature, counted without computing the poses."""
+
+    flank: int
+    root: int
+    tip: int
+
+    @property
+    def per_space(self) -> int:
+        """Poses of one whole space (both flanks, root, tip land)."""
+        return 2 * self.flank + self.root + self.tip
+
+
+def contact_counts(spec: GearSpec, tool: Tool, scallop_mm: float,
+                   contact_spacing_mm: float | None = None) -> ContactCounts:
+    """The numbers of poses space_poses would make (cheap: parameters only, no tool placement)."""
+    profile = spec.tooth_space_profile()
+    flank = 0
+    for label in ("involute", "fillet"):
+        segment = profile.segment(label)
+        if segment is None or segment.end <= segment.start:
+            continue
+        if contact_spacing_mm is None:
+            params = segment_parameters(segment, scallop_mm, extra_curvature=1.0 / tool.effective_corner_radius_mm)
+        else:
+            params = even_arc_length_parameters(segment, contact_spacing_mm)
+        flank += len(params) - (1 if flank else 0)
+    v = profile.root_arc_half_angle_rad
+    tip_edge = profile.segment("tip").start
+    tip_angle = 2.0 * tip_edge - 2.0 * math.pi / spec.teeth
+    return ContactCounts(flank, _flat_sweep_steps(spec.root_radius_mm, 2.0 * v, scallop_mm) + 1,
+                         _flat_sweep_steps(spec.tip_radius_mm, tip_angle, scallop_mm) + 1)
 
 
 def space_poses(spec: GearSpec, tool: Tool, scallop_mm: float,

@@ -13,10 +13,19 @@ from spur_cad.cam.finishing import plan_finishing
 from spur_cad.cam.ir import Toolpath
 from spur_cad.cam.machine import FinishingParams, Machine, RoughingParams, check_travel
 from spur_cad.cam.recommend import ToolRecommendations, check_roughing_reach, check_tools, recommend_tools
-from spur_cad.cam.roughing import RoughingLevels, roughing_levels, roughing_toolpath
-from spur_cad.cam.strategies import FinishingResult
+from spur_cad.cam.contacts import ContactCounts, contact_counts
+from spur_cad.cam.roughing import RoughingLevels, estimated_roughing_moves, roughing_levels, roughing_toolpath
+from spur_cad.cam.strategies import FinishingResult, get_strategy, params_from_section
+from spur_cad.errors import WorkLimitError
 from spur_cad.cam.tools import Tool
 from spur_cad.geometry.spec import GearSpec
+
+MAX_TOOLPATH_MOVES = 10_000_000
+"""Largest toolpath a plan builds (about 13 x the reference job's perimeter finishing: some 0.6 GB of
+IR and 0.4 GB of flat G-code); larger work is refused before it is generated."""
+
+MAX_CONTACTS_PER_FLANK = 20_000
+"""Largest number of finishing contact poses per flank (each is placed and gouge-checked)."""
 
 REFERENCE_CONTACT_SPACING_MM = 0.08
 """Contact spacing along the profile of the shop-tested reference process (fixed arc length)."""
@@ -88,8 +97,18 @@ def plan_cam(inputs: CamInputs) -> CamPlan:
     return CamPlan(rec, roughing, finishing, tuple(warnings))
 
 
+def check_moves(operation: str, moves: int, remedy: str, key: str) -> None:
+    """Refuse (WorkLimitError naming `key`) an operation whose estimated moves exceed MAX_TOOLPATH_MOVES."""
+    if moves > MAX_TOOLPATH_MOVES:
+        raise WorkLimitError(f"{operation} would need about {moves:.2g} moves (limit {MAX_TOOLPATH_MOVES:.0e}); "
+                             f"{remedy}", key=key)
+
+
 def _plan_roughing(inputs: CamInputs, rec: ToolRecommendations, blank: float) -> RoughingPlan:
     spec, tool, stock = inputs.spec, inputs.roughing_tool, inputs.stock
+    inputs.roughing.validate()
+    moves, driver = estimated_roughing_moves(spec, tool, inputs.roughing, blank)
+    check_moves("roughing", moves, f"raise [roughing] {driver}", f"roughing.{driver}")
     levels = roughing_levels(spec, tool, inputs.roughing, blank)
     lowest_above_root = levels.lowest_height_mm - spec.root_radius_mm
     if inputs.finishing_tool is not None:
@@ -100,12 +119,31 @@ def _plan_roughing(inputs: CamInputs, rec: ToolRecommendations, blank: float) ->
     return RoughingPlan(tool, levels, lowest_above_root, path, estimate(path, inputs.machine))
 
 
+def check_finishing_work(spec: GearSpec, tool: Tool, section: FinishingParams, **overrides) -> None:
+    """Refuse finishing whose contacts per flank or moves exceed the limits, before generating it."""
+    strategy = get_strategy(section.strategy)
+    params = params_from_section(strategy, section, **overrides)
+    try:
+        counts = contact_counts(spec, tool, params.target_scallop_mm, overrides.get("contact_spacing_mm"))
+    except WorkLimitError:
+        counts = ContactCounts(MAX_CONTACTS_PER_FLANK + 1, 0, 0)
+    if counts.flank > MAX_CONTACTS_PER_FLANK:
+        raise WorkLimitError(f"finishing would need more than {MAX_CONTACTS_PER_FLANK:,} contact points per flank "
+                             f"for target_scallop_mm = {params.target_scallop_mm:.3g}; raise [finishing] "
+                             "target_scallop_mm", key="finishing.target_scallop_mm")
+    driver = "step_over_mm" if getattr(params, "step_over_mm", 0.0) > 0.0 else "target_scallop_mm"
+    check_moves("finishing", strategy.estimate_moves(spec, tool, params), f"raise [finishing] {driver}",
+                f"finishing.{driver}")
+
+
 def _plan_finishing(inputs: CamInputs, blank: float) -> FinishingPlan:
     spec, tool, machine = inputs.spec, inputs.finishing_tool, inputs.machine
+    check_finishing_work(spec, tool, inputs.finishing)
     path, result = plan_finishing(spec, tool, machine, inputs.finishing, blank)
     check_travel(machine, path.x, path.y, path.z, path.a, "finishing")
     reference_section = FinishingParams(strategy="perimeter", target_scallop_mm=inputs.finishing.target_scallop_mm,
                                         step_over_mm=REFERENCE_STATION_STEP_MM)
+    check_finishing_work(spec, tool, reference_section, contact_spacing_mm=REFERENCE_CONTACT_SPACING_MM)
     reference, _ = plan_finishing(spec, tool, machine, reference_section, blank,
                                   contact_spacing_mm=REFERENCE_CONTACT_SPACING_MM)
     return FinishingPlan(tool, result, path, estimate(path, machine), estimate(reference, machine))

@@ -51,6 +51,25 @@ def offset_flank(spec: GearSpec, finish_stock_mm: float) -> tuple[np.ndarray, np
     return points, labels, junction
 
 
+def estimated_roughing_moves(spec: GearSpec, tool: Tool, params: RoughingParams,
+                             blank_radius_mm: float) -> tuple[int, str]:
+    """An upper bound of the moves roughing_toolpath makes, from the inputs alone (no levels computed),
+    and the [roughing] key that drives it most.
+
+    Levels: the depth limit alone needs (blank - root) / max depth of them; the flank staircase
+    budget adds at most (half a pitch, more than the flank's horizontal extent) / budget. Passes per
+    level: the widest level is narrower than a pitch."""
+    max_depth = params.max_level_depth_fraction * tool.diameter_mm
+    budget = params.flank_allowance_mm - params.finish_stock_mm
+    depth_levels = math.ceil((blank_radius_mm - spec.root_radius_mm) / max_depth)
+    flank_levels = math.ceil(spec.pitch_mm / 2.0 / budget)
+    passes = math.ceil(spec.pitch_mm / (params.step_over_fraction * tool.diameter_mm)) + 1
+    moves = spec.teeth * ((depth_levels + flank_levels + 2) * (2 * passes + 4) + 4)
+    driver = max((depth_levels, "max_level_depth_fraction"), (flank_levels, "flank_allowance_mm"),
+                 (passes, "step_over_fraction"))[1]
+    return moves, driver
+
+
 def roughing_levels(spec: GearSpec, tool: Tool, params: RoughingParams, blank_radius_mm: float) -> RoughingLevels:
     """Levels as described in the module docstring (pure function)."""
     flank, labels, junction = offset_flank(spec, params.finish_stock_mm)

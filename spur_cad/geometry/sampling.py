@@ -12,11 +12,14 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from spur_cad.errors import WorkLimitError
 from spur_cad.geometry.profile import SEGMENT_LABELS, Segment, ToothSpaceProfile
 from spur_cad.geometry.spec import GearSpec
 
 DEFAULT_TOLERANCE_MM = 0.001
 _MAX_REFINEMENTS = 80
+MAX_POINTS_PER_SEGMENT = 1_000_000
+"""Chordal sampling refuses (WorkLimitError) rather than build more points than this on one segment."""
 
 
 @dataclass(frozen=True)
@@ -55,8 +58,8 @@ def segment_parameters(segment: Segment, tolerance_mm: float, extra_curvature: f
     CAM layer passes 1 / r_t so that the cusp between two tool-corner circles of radius r_t
     touching consecutive points is within the tolerance ((curvature + 1/r_t) l^2 / 8 bounds it).
     """
-    if not tolerance_mm > 0.0:
-        raise ValueError(f"chordal tolerance must be positive, got {tolerance_mm}")
+    if not (math.isfinite(tolerance_mm) and tolerance_mm > 0.0):
+        raise ValueError(f"chordal tolerance must be a positive number, got {tolerance_mm}")
     if segment.end <= segment.start:
         return np.array([segment.start, segment.end])
     pending_a = np.array([segment.start])
@@ -74,6 +77,9 @@ def segment_parameters(segment: Segment, tolerance_mm: float, extra_curvature: f
         # The bound shrinks like the square of the interval: split into enough pieces at once.
         pieces = np.where(np.isfinite(bound), np.ceil(np.sqrt(bound / tolerance_mm) * 1.05), 2.0)
         pieces = np.clip(pieces, 2, 8).astype(int)
+        if sum(len(p) for p in accepted) + int(pieces.sum()) > MAX_POINTS_PER_SEGMENT:
+            raise WorkLimitError(f"a chordal tolerance of {tolerance_mm:.3g} mm would need more than "
+                                 f"{MAX_POINTS_PER_SEGMENT:,} points on the {segment.label}; use a larger tolerance")
         new_a, new_b = [], []
         for lo, hi, n in zip(a, b, pieces):
             edges = np.linspace(lo, hi, n + 1)

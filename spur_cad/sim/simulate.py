@@ -259,9 +259,29 @@ def simulate(spec: GearSpec, stock: StockCylinder, operations: Sequence[Cut],
     stations = np.unique(np.asarray(station_x if station_x is not None else np.zeros(0), float))
     extra = np.concatenate([stations, 0.5 * (stations[1:] + stations[:-1])]) if len(stations) else np.zeros(0)
     x_lo, x_hi = rows_x_range if rows_x_range is not None else (stock.x_min, stock.x_max)
+    check_design_size(spec, spacing, x_hi - x_lo, len(extra), settings.resolution_mm)
     grid = design_grid(spec, spacing, x_lo, x_hi, extra)
     return simulate_grid(grid, stock, operations, settings, face_width_mm=spec.face_width_mm, station_x=stations,
                          progress=progress, started=started)
+
+
+MAX_DESIGN_VALUES = 60_000_000
+"""Largest design grid (points per space x rows x spaces) simulated: about 0.5 GB per array of
+deviations (the reference job at 5 um has some 2 million); larger grids are refused beforehand."""
+
+
+def check_design_size(spec: GearSpec, spacing_mm: float, length_mm: float, extra_rows: int,
+                      resolution_mm: float) -> None:
+    """Refuse (SimulationError naming [simulation] resolution_mm) a design grid above MAX_DESIGN_VALUES.
+
+    The space boundary (tooth centre to tooth centre) is shorter than the tip circle's pitch arc plus
+    three times the whole depth on each side, which bounds the points per space."""
+    boundary = 2.0 * math.pi * spec.tip_radius_mm / spec.teeth + 6.0 * (spec.tip_radius_mm - spec.root_radius_mm)
+    values = spec.teeth * (boundary / spacing_mm + 2) * (length_mm / spacing_mm + extra_rows + 3)
+    if values > MAX_DESIGN_VALUES:
+        raise SimulationError(f"the simulation would measure about {values:.2g} design points (limit "
+                              f"{MAX_DESIGN_VALUES:.0e}); raise [simulation] resolution_mm (now {resolution_mm:g} mm) "
+                              "or set [simulation] enabled = false", key="simulation.resolution_mm")
 
 
 def point_spacing_mm(corner_radius_mm: float, resolution_mm: float) -> float:

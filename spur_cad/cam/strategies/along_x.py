@@ -6,7 +6,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from spur_cad.cam.common import PLUNGE_FEED_FRACTION, apply_inverse_time, safe_height_mm
-from spur_cad.cam.contacts import SpacePoses, space_poses, station_positions, station_step_mm
+from spur_cad.cam.contacts import SpacePoses, contact_counts, space_poses, station_positions, station_step_mm
 from spur_cad.cam.ir import Feature, MoveKind, Operation, Toolpath, ToolpathBuilder
 from spur_cad.cam.machine import Machine, MachineError
 from spur_cad.cam.strategies.base import FinishingResult
@@ -37,6 +37,12 @@ class AlongXStrategy:
     name = "along_x"
     description = "one pass along X per contact pose, A fixed during each pass"
     params_type = AlongXParams
+
+    def estimate_moves(self, spec: GearSpec, tool: Tool, params: AlongXParams) -> int:
+        params.validate()
+        counts = contact_counts(spec, tool, params.target_scallop_mm)
+        poses = (counts.flank + counts.root - 1) + counts.flank + counts.tip
+        return spec.teeth * (2 * poses + 6)
 
     def generate(self, spec: GearSpec, tool: Tool, machine: Machine, params: AlongXParams,
                  blank_radius_mm: float) -> tuple[Toolpath, FinishingResult]:

@@ -45,6 +45,11 @@ class FinishingStrategy(Protocol):
     description: str
     params_type: type
 
+    def estimate_moves(self, spec: GearSpec, tool: Tool, params: Any) -> int:
+        """How many IR moves `generate` would make, counted cheaply beforehand (the plan refuses
+        work beyond its limits before generating)."""
+        ...
+
     def generate(self, spec: GearSpec, tool: Tool, machine: Machine, params: Any,
                  blank_radius_mm: float) -> tuple[Toolpath, FinishingResult]:
         """The finishing operation as IR plus its facts (pure function)."""

@@ -4,14 +4,22 @@ bottom while Y and A move together (inverse-time feeds)."""
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
 
 from spur_cad.cam.common import PLUNGE_FEED_FRACTION, apply_inverse_time, safe_height_mm
-from spur_cad.cam.contacts import SpacePoses, TransversePoses, space_poses, station_positions, station_step_mm
+from spur_cad.cam.contacts import (
+    SpacePoses,
+    TransversePoses,
+    contact_counts,
+    space_poses,
+    station_positions,
+    station_step_mm,
+)
 from spur_cad.cam.ir import Feature, MoveKind, Operation, Toolpath, ToolpathBuilder
-from spur_cad.cam.machine import MachineError, Machine
+from spur_cad.cam.machine import Machine, MachineError
 from spur_cad.cam.strategies.base import FinishingResult
 from spur_cad.cam.tools import Tool
 from spur_cad.geometry.spec import GearSpec
@@ -38,6 +46,13 @@ class PerimeterStrategy:
     name = "perimeter"
     description = "transverse stations along X, once around the gear at each (simultaneous Y/Z/A)"
     params_type = PerimeterParams
+
+    def estimate_moves(self, spec: GearSpec, tool: Tool, params: PerimeterParams) -> int:
+        params.validate()
+        counts = contact_counts(spec, tool, params.target_scallop_mm, params.contact_spacing_mm)
+        stations = math.ceil(spec.face_width_mm / station_step_mm(tool, params.target_scallop_mm,
+                                                                   params.step_over_mm)) + 1
+        return stations * spec.teeth * (counts.per_space + 4)
 
     def generate(self, spec: GearSpec, tool: Tool, machine: Machine, params: PerimeterParams,
                  blank_radius_mm: float) -> tuple[Toolpath, FinishingResult]:

@@ -1,0 +1,78 @@
+"""Work is bounded before it is done: inputs that would need runaway moves, points or memory are
+refused quickly with a WorkLimitError / SimulationError naming the job key to change."""
+
+from __future__ import annotations
+
+import dataclasses
+import time
+
+import numpy as np
+import pytest
+
+from spur_cad.cam.plan import MAX_TOOLPATH_MOVES
+from spur_cad.errors import WorkLimitError
+from spur_cad.geometry.sampling import sample_profile
+from spur_cad.job import load_job
+from spur_cad.pipeline import plan_cam
+from spur_cad.sim.simulate import SimulationError, check_design_size, point_spacing_mm
+
+REFERENCE = "resources/examples/reference_gear.toml"
+
+
+@pytest.fixture(scope="module")
+def small_job():
+    job = load_job(REFERENCE)
+    return dataclasses.replace(job, gear=dataclasses.replace(job.gear, face_width_mm=3.0))
+
+
+@pytest.mark.parametrize("section, values, key", [
+    ("finishing", {"step_over_mm": 1e-9}, "finishing.step_over_mm"),
+    ("finishing", {"target_scallop_mm": 1e-9}, "finishing.target_scallop_mm"),
+    ("roughing", {"step_over_fraction": 1e-9}, "roughing.step_over_fraction"),
+    ("roughing", {"max_level_depth_fraction": 1e-9}, "roughing.max_level_depth_fraction"),
+    ("roughing", {"flank_allowance_mm": 0.02 + 1e-9}, "roughing.flank_allowance_mm"),
+])
+def test_runaway_toolpaths_are_refused_before_they_are_built(small_job, section, values, key):
+    job = dataclasses.replace(small_job, **{section: dataclasses.replace(getattr(small_job, section), **values)})
+    started = time.perf_counter()
+    with pytest.raises(WorkLimitError) as info:
+        plan_cam(job)
+    assert time.perf_counter() - started < 30.0  # generous: the refusal comes from an estimate, not the work
+    assert info.value.key == key
+    assert f"[{section}] {key.split('.')[1]}" in str(info.value)
+
+
+def test_move_estimates_bound_the_real_toolpaths(small_job):
+    """The estimates the limits use are not far below what the generators make (else the limit leaks)."""
+    from spur_cad.cam.roughing import estimated_roughing_moves
+    from spur_cad.cam.strategies import get_strategy, params_from_section
+
+    plan = plan_cam(small_job)
+    blank = small_job.stock.blank_radius_mm(small_job.gear)
+    rough, _ = estimated_roughing_moves(small_job.gear, small_job.tools.roughing, small_job.roughing, blank)
+    assert rough >= len(plan.roughing.toolpath)
+    for name in ("perimeter", "along_x"):
+        section = dataclasses.replace(small_job.finishing, strategy=name)
+        strategy = get_strategy(name)
+        estimate = strategy.estimate_moves(small_job.gear, small_job.tools.finishing,
+                                           params_from_section(strategy, section))
+        actual = len(plan_cam(dataclasses.replace(small_job, finishing=section)).finishing.toolpath)
+        assert 0.95 * actual <= estimate <= 1.05 * actual + 100
+    assert MAX_TOOLPATH_MOVES >= 10 * 759_759  # the reference job's perimeter finishing fits with room
+
+
+def test_tiny_sampling_tolerance_is_refused_quickly(small_job):
+    started = time.perf_counter()
+    with pytest.raises(WorkLimitError, match="chordal tolerance"):
+        sample_profile(small_job.gear.tooth_space_profile(), 1e-15)
+    assert time.perf_counter() - started < 30.0
+
+
+def test_simulation_grid_is_bounded(small_job):
+    spec = small_job.gear
+    spacing = point_spacing_mm(0.5, 0.005)
+    check_design_size(spec, spacing, spec.face_width_mm + 3.0, 0, 0.005)  # the job itself: fine
+    with pytest.raises(SimulationError) as info:
+        check_design_size(dataclasses.replace(spec, teeth=1000, face_width_mm=2000.0), spacing, 2003.0, 0, 0.005)
+    assert info.value.key == "simulation.resolution_mm"
+    assert np.isfinite(spacing)
