@@ -17,6 +17,7 @@ from spur_cad.geometry.inspection import (
     span_measurement,
 )
 from spur_cad.geometry.sampling import full_space_points
+from spur_cad.geometry.spec import GearSpec
 from tests.gears import GEAR_CASES, spec_of, textbook_of
 from tests.textbook import over_pins_iso, point_polyline_distance, span_iso
 
@@ -97,3 +98,21 @@ def test_chordal_thickness_at_reference_circle():
     half = spec.tooth_thickness_mm / (2 * spec.reference_radius_mm)
     assert chord.chordal_thickness_mm == pytest.approx(2 * spec.reference_radius_mm * math.sin(half), abs=1e-12)
     assert chord.chordal_height_mm == pytest.approx(spec.tip_radius_mm - spec.reference_radius_mm * math.cos(half))
+
+
+@pytest.mark.parametrize("teeth, shift", [(23, -1.0), (10, -0.4), (17, -0.6), (23, -0.7), (40, -1.3)])
+def test_inspection_of_strongly_negative_shift(teeth, shift):
+    """Gears whose r + x m circle lies below the usable involute (it crashed the inspection before): the
+    span anvils and the pins still touch the usable involute, and W_k is the textbook value for that k."""
+    spec = GearSpec(teeth=teeth, module_mm=4.0, rack_tip_radius_mm=0.8, profile_shift_coefficient=shift,
+                    thickness_allowance_fraction=0.05, face_width_mm=3.0)
+    assert spec.reference_radius_mm + shift * spec.module_mm < spec.form_radius_mm
+    sheet = inspection_sheet(spec)
+    assert spec.form_radius_mm <= sheet["span_contact_radius_mm"] <= spec.tip_radius_mm
+    assert spec.form_radius_mm <= sheet["pin_contact_radius_mm"] <= spec.tip_radius_mm
+    k = sheet["span_teeth_k"]
+    alpha = math.radians(20.0)
+    s = spec.tooth_thickness_mm
+    textbook = spec.module_mm * math.cos(alpha) * ((k - 1) * math.pi + teeth * (math.tan(alpha) - alpha)) \
+        + s * math.cos(alpha)
+    assert sheet["span_measurement_mm"] == pytest.approx(textbook, abs=1e-9)

@@ -66,7 +66,10 @@ def recommended_span_teeth(spec: GearSpec) -> int:
     """
     alpha = spec.pressure_angle_rad
     x = spec.profile_shift_coefficient
-    alpha_x = math.acos(spec.base_radius_mm / (spec.reference_radius_mm + x * spec.module_mm))
+    # ISO 21771 aims the anvils at radius r + x m; with a large negative shift that circle can lie below
+    # the usable involute (even below the base circle), so the aim is kept on the involute.
+    aim = min(max(spec.reference_radius_mm + x * spec.module_mm, spec.form_radius_mm), spec.tip_radius_mm)
+    alpha_x = math.acos(spec.base_radius_mm / aim)
     k_exact = spec.teeth / math.pi * (math.tan(alpha_x) - 2.0 * x * math.tan(alpha) / spec.teeth
                                       - involute_function(alpha)) + 0.5
     low, high = spec.form_radius_mm, spec.tip_radius_mm
