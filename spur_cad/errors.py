@@ -39,5 +39,16 @@ class WorkLimitError(SpurCadError, ValueError):
     before the work is done, naming the quantity, the limit and what to change."""
 
 
+class ArgumentError(SpurCadError, TypeError):
+    """A public function called with an argument of the wrong kind; the message names the argument."""
+
+
+def require_instance(value: object, expected: type | tuple[type, ...], argument: str) -> None:
+    """Raise ArgumentError naming `argument` unless `value` is an instance of `expected`."""
+    if not isinstance(value, expected):
+        names = " or ".join(t.__name__ for t in (expected if isinstance(expected, tuple) else (expected,)))
+        raise ArgumentError(f"{argument} must be a {names}, got {type(value).__name__}")
+
+
 class JobFileError(SpurCadError, ValueError):
     """A job file that cannot be read: bad TOML, unknown key, wrong type, missing value."""

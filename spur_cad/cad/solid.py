@@ -38,6 +38,7 @@ from OCP.TColStd import TColStd_HArray1OfBoolean
 from OCP.TopoDS import TopoDS, TopoDS_Edge, TopoDS_Shape
 
 from spur_cad.cad.specs import BlankFeatures, StockSpec
+from spur_cad.errors import ArgumentError, require_instance
 from spur_cad.geometry.profile import Segment
 from spur_cad.geometry.sampling import segment_parameters
 from spur_cad.geometry.spec import GearSpec
@@ -217,6 +218,8 @@ def build_gear_shape(spec: GearSpec, features: BlankFeatures = BlankFeatures(),
     """The gear as an OCP solid in the machine frame, with a report of the spline fits.
 
     `fit_tolerance_mm` defaults to 2.5e-6 x module (see default_fit_tolerance_mm)."""
+    require_instance(spec, GearSpec, "spec")
+    require_instance(features, BlankFeatures, "features")
     features.validate(spec)
     tolerance = default_fit_tolerance_mm(spec) if fit_tolerance_mm is None else fit_tolerance_mm
     edges, report = gear_face_edges(spec, tolerance)
@@ -236,6 +239,8 @@ def build_gear_shape(spec: GearSpec, features: BlankFeatures = BlankFeatures(),
 
 def build_stock_shape(spec: GearSpec, stock: StockSpec = StockSpec()) -> TopoDS_Shape:
     """The blank: cylinder over the face width plus margins, and the holding stub toward +X."""
+    require_instance(spec, GearSpec, "spec")
+    require_instance(stock, StockSpec, "stock")
     stock.validate(spec)
     b = spec.face_width_mm
     x_end = b + stock.back_margin_mm
@@ -264,11 +269,14 @@ def to_build123d(workplane_or_shape):
     """Wrap the same OCP shape as a build123d Solid (no copy, no re-modelling)."""
     import build123d
 
+    require_instance(workplane_or_shape, (cq.Workplane, cq.Shape, TopoDS_Shape), "workplane_or_shape")
     shape = workplane_or_shape
     if isinstance(shape, cq.Workplane):
         shape = shape.val()
     if isinstance(shape, cq.Shape):
         shape = shape.wrapped
+    if not isinstance(shape, TopoDS_Shape) or shape.IsNull():
+        raise ArgumentError("workplane_or_shape holds no solid")
     return build123d.Solid(shape)
 
 

@@ -10,6 +10,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
+from spur_cad.errors import require_instance
 from spur_cad.geometry.spec import GearSpec, involute_function, inverse_involute_function
 
 PIN_DIAMETER_STEP_MM = 0.01  # gauge pins are stocked in 0.01 mm steps
@@ -141,6 +142,7 @@ def minimum_teeth_without_undercut(spec: GearSpec) -> float:
 
 def inspection_sheet(spec: GearSpec) -> dict[str, float | int]:
     """The inspection values a report or summary shows."""
+    require_instance(spec, GearSpec, "spec")
     k = recommended_span_teeth(spec)
     span = span_measurement(spec, k)
     pin = recommended_pin_diameter_mm(spec)

@@ -12,7 +12,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from spur_cad.errors import WorkLimitError
+from spur_cad.errors import WorkLimitError, require_instance
 from spur_cad.geometry.profile import SEGMENT_LABELS, Segment, ToothSpaceProfile
 from spur_cad.geometry.spec import GearSpec
 
@@ -98,6 +98,8 @@ def sample_profile(profile: ToothSpaceProfile, tolerance_mm: float = DEFAULT_TOL
     At a junction the point keeps the label, normal and curvature of the segment that ends
     there (for a tangent junction the normals agree anyway).
     """
+    require_instance(profile, ToothSpaceProfile, "profile")
+    require_instance(tolerance_mm, (int, float), "tolerance_mm")
     pts, nrm, rad, lab, par = [], [], [], [], []
     for index, segment in enumerate(profile.segments):
         params = segment_parameters(segment, tolerance_mm)

@@ -41,6 +41,14 @@ def inverse_involute_function(value: float) -> float:
     return angle
 
 
+def _shown(value: object, limit: int = 40) -> str:
+    """A value as a message shows it: numbers readably (no 400-digit integers), other text shortened."""
+    if isinstance(value, int) and not isinstance(value, bool) and abs(value) > 1e15:
+        return f"{'-' if value < 0 else ''}{len(str(abs(value)))}-digit number"
+    text = repr(value)
+    return text if len(text) <= limit else text[:limit - 3] + "..."
+
+
 def _range_check(name: str, value: float, low: float, high: float, *, low_open: bool,
                  high_open: bool, unit: str, why: str = "") -> None:
     """Raise GearSpecError naming `name` unless low (<|<=) value (<|<=) high."""
@@ -85,9 +93,11 @@ class GearSpec:
             value = getattr(self, f.name)
             if f.name == "teeth":
                 if isinstance(value, bool) or not isinstance(value, int):
-                    raise GearSpecError(f"teeth must be a whole number, got {value!r}", field="teeth")
+                    raise GearSpecError(f"teeth must be a whole number, got {_shown(value)}", field="teeth")
             elif isinstance(value, bool) or not isinstance(value, (int, float)):
-                raise GearSpecError(f"{f.name} must be a number, got {value!r}", field=f.name)
+                raise GearSpecError(f"{f.name} must be a number, got {_shown(value)}", field=f.name)
+            elif isinstance(value, int) and abs(value) > 1e15:
+                raise GearSpecError(f"{f.name} = {_shown(value)} is not a meaningful size", field=f.name)
         if self.teeth < MIN_TEETH:
             raise GearSpecError(
                 f"teeth = {self.teeth}: too few teeth; spur_cad needs at least {MIN_TEETH}", field="teeth")
@@ -109,7 +119,7 @@ class GearSpec:
                      low_open=False, high_open=True, unit="")
         _range_check("thickness_allowance_mm", self.thickness_allowance_mm, 0.0, 0.5 * self.module_mm,
                      low_open=False, high_open=False, unit=" mm", why="at most 0.5 x module")
-        _range_check("face_width_mm", self.face_width_mm, 0.0, 5000.0, low_open=True, high_open=False,
+        _range_check("face_width_mm", self.face_width_mm, 0.5, 2000.0, low_open=False, high_open=False,
                      unit=" mm")
         if self.root_radius_mm <= 0.0:
             raise GearSpecError(
