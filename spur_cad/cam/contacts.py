@@ -32,6 +32,7 @@ from spur_cad.geometry.sampling import (
 )
 from spur_cad.geometry.spec import GearSpec
 
+
 @dataclass(frozen=True)
 class TransversePoses:
     """Tool-tip poses of one feature in the transverse plane for space 0: Y, Z (mm), A (deg)."""

@@ -8,16 +8,16 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from spur_cad.cad.specs import StockSpec
+from spur_cad.cam.contacts import ContactCounts, contact_counts
 from spur_cad.cam.estimate import Estimate, estimate
 from spur_cad.cam.finishing import plan_finishing
 from spur_cad.cam.ir import Toolpath
 from spur_cad.cam.machine import FinishingParams, Machine, RoughingParams, check_travel
 from spur_cad.cam.recommend import ToolRecommendations, check_roughing_reach, check_tools, recommend_tools
-from spur_cad.cam.contacts import ContactCounts, contact_counts
 from spur_cad.cam.roughing import RoughingLevels, estimated_roughing_moves, roughing_levels, roughing_toolpath
 from spur_cad.cam.strategies import FinishingResult, get_strategy, params_from_section
-from spur_cad.errors import WorkLimitError
 from spur_cad.cam.tools import Tool
+from spur_cad.errors import WorkLimitError
 from spur_cad.geometry.spec import GearSpec
 
 MAX_TOOLPATH_MOVES = 10_000_000

@@ -23,6 +23,7 @@ from spur_cad.cam.tools import Tool, ToolError
 from spur_cad.geometry.sampling import sample_profile
 from spur_cad.geometry.spec import GearSpec
 
+
 @dataclass(frozen=True)
 class RoughingLevels:
     """Level heights (tool tip Z with the space axis up), top to bottom, and their half-width reach."""

@@ -8,7 +8,7 @@ from spur_cad.geometry.sampling import (
     sample_profile,
     tooth_space_samples,
 )
-from spur_cad.geometry.spec import GearSpec, involute_function, inverse_involute_function
+from spur_cad.geometry.spec import GearSpec, inverse_involute_function, involute_function
 
 __all__ = [
     "DEFAULT_TOLERANCE_MM",

@@ -7,9 +7,9 @@ from dataclasses import dataclass
 
 from spur_cad.cam.common import PLUNGE_FEED_FRACTION, apply_inverse_time, safe_height_mm
 from spur_cad.cam.contacts import SpacePoses, contact_counts, space_poses, station_positions, station_step_mm
-from spur_cad.cam.ir import Feature, MoveKind, Operation, Toolpath, ToolpathBuilder
-from spur_cad.cam.machine import Machine, MachineError
-from spur_cad.cam.strategies.base import FinishingResult
+from spur_cad.cam.ir import Feature, MoveKind, Toolpath, ToolpathBuilder
+from spur_cad.cam.machine import Machine
+from spur_cad.cam.strategies.base import FinishingResult, ScallopParams, finishing_builder
 from spur_cad.cam.tools import Tool
 from spur_cad.geometry.spec import GearSpec
 
@@ -18,17 +18,8 @@ ALONG_X_WARNING = ("finishing strategy along_x: each contact line is cut by one 
 
 
 @dataclass(frozen=True)
-class AlongXParams:
+class AlongXParams(ScallopParams):
     """[finishing] keys the along-X strategy uses (step_over_mm only for the reported station step)."""
-
-    target_scallop_mm: float = 0.005
-    step_over_mm: float = 0.0
-
-    def validate(self) -> None:
-        if not 0.0 < self.target_scallop_mm <= 0.1:
-            raise MachineError(f"[finishing] target_scallop_mm = {self.target_scallop_mm:g} must be in (0, 0.1]")
-        if self.step_over_mm < 0.0:
-            raise MachineError(f"[finishing] step_over_mm = {self.step_over_mm:g} must not be negative")
 
 
 class AlongXStrategy:
@@ -46,11 +37,8 @@ class AlongXStrategy:
 
     def generate(self, spec: GearSpec, tool: Tool, machine: Machine, params: AlongXParams,
                  blank_radius_mm: float) -> tuple[Toolpath, FinishingResult]:
-        params.validate()
-        machine.validate()
-        tool.validate("finishing")
+        builder = finishing_builder(tool, machine, params)
         poses = space_poses(spec, tool, params.target_scallop_mm)
-        builder = ToolpathBuilder(Operation.FINISHING, tool.tool_number, tool.spindle_rpm(machine))
         _passes(builder, spec, tool, machine, poses, tool.feed_mm_min(machine),
                 safe_height_mm(blank_radius_mm, machine))
         builder.warnings.append(ALONG_X_WARNING)

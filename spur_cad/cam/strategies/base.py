@@ -16,8 +16,8 @@ from typing import Any, Protocol
 import numpy as np
 
 from spur_cad.cam.contacts import SpacePoses
-from spur_cad.cam.ir import Toolpath
-from spur_cad.cam.machine import Machine
+from spur_cad.cam.ir import Operation, Toolpath, ToolpathBuilder
+from spur_cad.cam.machine import Machine, MachineError
 from spur_cad.cam.tools import Tool
 from spur_cad.geometry.spec import GearSpec
 
@@ -38,6 +38,20 @@ class FinishingResult:
         return self.poses.points_per_flank
 
 
+@dataclass(frozen=True)
+class ScallopParams:
+    """The [finishing] keys most strategies share: the target scallop and the X step (0: derived)."""
+
+    target_scallop_mm: float = 0.005
+    step_over_mm: float = 0.0
+
+    def validate(self) -> None:
+        if not 0.0 < self.target_scallop_mm <= 0.1:
+            raise MachineError(f"[finishing] target_scallop_mm = {self.target_scallop_mm:g} must be in (0, 0.1]")
+        if self.step_over_mm < 0.0:
+            raise MachineError(f"[finishing] step_over_mm = {self.step_over_mm:g} must not be negative")
+
+
 class FinishingStrategy(Protocol):
     """A finishing strategy (see the module docstring)."""
 
@@ -54,6 +68,14 @@ class FinishingStrategy(Protocol):
                  blank_radius_mm: float) -> tuple[Toolpath, FinishingResult]:
         """The finishing operation as IR plus its facts (pure function)."""
         ...
+
+
+def finishing_builder(tool: Tool, machine: Machine, params: Any) -> ToolpathBuilder:
+    """Validate a strategy's inputs and start its toolpath (every strategy's first step)."""
+    params.validate()
+    machine.validate()
+    tool.validate("finishing")
+    return ToolpathBuilder(Operation.FINISHING, tool.tool_number, tool.spindle_rpm(machine))
 
 
 def params_from_section(strategy: FinishingStrategy, section: object, **overrides: Any) -> Any:

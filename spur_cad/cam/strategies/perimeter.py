@@ -18,26 +18,18 @@ from spur_cad.cam.contacts import (
     station_positions,
     station_step_mm,
 )
-from spur_cad.cam.ir import Feature, MoveKind, Operation, Toolpath, ToolpathBuilder
-from spur_cad.cam.machine import Machine, MachineError
-from spur_cad.cam.strategies.base import FinishingResult
+from spur_cad.cam.ir import Feature, MoveKind, Toolpath, ToolpathBuilder
+from spur_cad.cam.machine import Machine
+from spur_cad.cam.strategies.base import FinishingResult, ScallopParams, finishing_builder
 from spur_cad.cam.tools import Tool
 from spur_cad.geometry.spec import GearSpec
 
 
 @dataclass(frozen=True)
-class PerimeterParams:
-    """[finishing] keys the perimeter strategy uses."""
+class PerimeterParams(ScallopParams):
+    """[finishing] keys the perimeter strategy uses (step_over_mm: X step between stations)."""
 
-    target_scallop_mm: float = 0.005
-    step_over_mm: float = 0.0  # X step between stations; 0: derived from the target scallop
     contact_spacing_mm: float | None = None  # fixed arc-length contact spacing (the reference process's)
-
-    def validate(self) -> None:
-        if not 0.0 < self.target_scallop_mm <= 0.1:
-            raise MachineError(f"[finishing] target_scallop_mm = {self.target_scallop_mm:g} must be in (0, 0.1]")
-        if self.step_over_mm < 0.0:
-            raise MachineError(f"[finishing] step_over_mm = {self.step_over_mm:g} must not be negative")
 
 
 class PerimeterStrategy:
@@ -56,13 +48,10 @@ class PerimeterStrategy:
 
     def generate(self, spec: GearSpec, tool: Tool, machine: Machine, params: PerimeterParams,
                  blank_radius_mm: float) -> tuple[Toolpath, FinishingResult]:
-        params.validate()
-        machine.validate()
-        tool.validate("finishing")
+        builder = finishing_builder(tool, machine, params)
         poses = space_poses(spec, tool, params.target_scallop_mm, params.contact_spacing_mm)
         stations = station_positions(spec.face_width_mm,
                                      station_step_mm(tool, params.target_scallop_mm, params.step_over_mm))
-        builder = ToolpathBuilder(Operation.FINISHING, tool.tool_number, tool.spindle_rpm(machine))
         _tile_stations(builder, spec, machine, poses, stations, tool.feed_mm_min(machine),
                        safe_height_mm(blank_radius_mm, machine))
         step = float(stations[1] - stations[0]) if len(stations) > 1 else 0.0
