@@ -80,16 +80,34 @@ class CamInputs:
     machine: Machine
 
 
-def plan_cam(inputs: CamInputs) -> CamPlan:
-    """Tool recommendations always; toolpaths and estimates for the tools the job gives (pure)."""
+def check_cam_inputs(inputs: CamInputs) -> tuple[ToolRecommendations, RoughingLevels | None]:
+    """Every check that needs no toolpath (cheap enough for a GUI to run while the user types): tool
+    recommendations, tool limits, the roughing work bound and the roughing reach. Returns the
+    recommendations and the roughing levels (None without a roughing tool)."""
     spec, machine, stock = inputs.spec, inputs.machine, inputs.stock
     blank = stock.blank_radius_mm(spec)
     rec = recommend_tools(spec, blank, machine.clearance_mm, inputs.finishing_tool)
     check_tools(spec, rec, inputs.roughing_tool, inputs.finishing_tool)
+    if inputs.roughing_tool is None:
+        return rec, None
+    tool = inputs.roughing_tool
+    inputs.roughing.validate()
+    moves, driver = estimated_roughing_moves(spec, tool, inputs.roughing, blank)
+    check_moves("roughing", moves, f"raise [roughing] {driver}", f"roughing.{driver}")
+    levels = roughing_levels(spec, tool, inputs.roughing, blank)
+    if inputs.finishing_tool is not None:
+        check_roughing_reach(tool, levels.lowest_height_mm - spec.root_radius_mm, rec)
+    return rec, levels
+
+
+def plan_cam(inputs: CamInputs) -> CamPlan:
+    """Tool recommendations always; toolpaths and estimates for the tools the job gives (pure)."""
+    rec, levels = check_cam_inputs(inputs)
+    blank = inputs.stock.blank_radius_mm(inputs.spec)
     roughing = finishing = None
     warnings: list[str] = []
-    if inputs.roughing_tool is not None:
-        roughing = _plan_roughing(inputs, rec, blank)
+    if levels is not None:
+        roughing = _plan_roughing(inputs, levels, blank)
         warnings.extend(roughing.toolpath.warnings)
     if inputs.finishing_tool is not None:
         finishing = _plan_finishing(inputs, blank)
@@ -104,15 +122,9 @@ def check_moves(operation: str, moves: int, remedy: str, key: str) -> None:
                              f"{remedy}", key=key)
 
 
-def _plan_roughing(inputs: CamInputs, rec: ToolRecommendations, blank: float) -> RoughingPlan:
+def _plan_roughing(inputs: CamInputs, levels: RoughingLevels, blank: float) -> RoughingPlan:
     spec, tool, stock = inputs.spec, inputs.roughing_tool, inputs.stock
-    inputs.roughing.validate()
-    moves, driver = estimated_roughing_moves(spec, tool, inputs.roughing, blank)
-    check_moves("roughing", moves, f"raise [roughing] {driver}", f"roughing.{driver}")
-    levels = roughing_levels(spec, tool, inputs.roughing, blank)
     lowest_above_root = levels.lowest_height_mm - spec.root_radius_mm
-    if inputs.finishing_tool is not None:
-        check_roughing_reach(tool, lowest_above_root, rec)
     path = roughing_toolpath(spec, tool, inputs.machine, inputs.roughing, blank, stock.back_margin_mm,
                              stock.stub_diameter_mm / 2.0, stock.front_margin_mm, levels=levels)
     check_travel(inputs.machine, path.x, path.y, path.z, path.a, "roughing")

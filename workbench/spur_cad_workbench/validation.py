@@ -54,9 +54,10 @@ def _strip_source(message: str, source: str) -> str:
 
 def validate(values: dict[str, dict[str, object]], source: str = "job") -> Validation:
     """Check gear, stock and job values as the command line would; never raises for a SpurCadError."""
-    from spur_cad.cam.recommend import check_roughing_reach, check_tools, recommend_tools
-    from spur_cad.cam.roughing import roughing_levels
+    from spur_cad.cam.plan import check_cam_inputs
+    from spur_cad.cam.recommend import recommend_tools
     from spur_cad.job import job_from_dict
+    from spur_cad.pipeline import cam_inputs
 
     data = job_data(values)
     base = {name: section for name, section in data.items() if name != "tools"}
@@ -72,16 +73,12 @@ def validate(values: dict[str, dict[str, object]], source: str = "job") -> Valid
     except SpurCadError as exc:
         message = _strip_source(str(exc), source)
         return Validation(None, {group_of(message): message}, recommend_tools(spec, blank, clearance))
-    rec = recommend_tools(spec, blank, clearance, job.tools.finishing)
-    roughing, finishing = job.tools.roughing, job.tools.finishing
     try:
-        check_tools(spec, rec, roughing, finishing)
-        if roughing is not None and finishing is not None:
-            levels = roughing_levels(spec, roughing, job.roughing, blank)
-            check_roughing_reach(roughing, levels.lowest_height_mm - spec.root_radius_mm, rec)
+        rec, _ = check_cam_inputs(cam_inputs(job))
     except SpurCadError as exc:
         message = str(exc)
-        return Validation(None, {group_of(message): message}, rec)
+        return Validation(None, {group_of(message): message}, recommend_tools(spec, blank, clearance,
+                                                                              job.tools.finishing))
     return Validation(job, {}, rec)
 
 
