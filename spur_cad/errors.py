@@ -4,7 +4,15 @@ from __future__ import annotations
 
 
 class SpurCadError(Exception):
-    """Base class for errors caused by user input; the CLI and GUI show the message only."""
+    """Base class for errors caused by user input; the CLI and GUI show the message only.
+
+    `field` names the offending input (a job-file key of the section the error is about) when
+    one input is to blame; the job loader then points at that key's line.
+    """
+
+    def __init__(self, *args: object, field: str | None = None):
+        super().__init__(*args)
+        self.field = field
 
 
 class GearSpecError(SpurCadError, ValueError):
@@ -14,8 +22,7 @@ class GearSpecError(SpurCadError, ValueError):
     """
 
     def __init__(self, message: str, field: str | None = None):
-        super().__init__(message)
-        self.field = field
+        super().__init__(message, field=field)
 
 
 class JobFileError(SpurCadError, ValueError):
