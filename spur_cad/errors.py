@@ -6,13 +6,21 @@ from __future__ import annotations
 class SpurCadError(Exception):
     """Base class for errors caused by user input; the CLI and GUI show the message only.
 
-    `key` names the job-file key to blame as "section.key" (e.g. "finishing.target_scallop_mm")
-    when the error is raised after the job file was read, so front ends can point at its line.
+    `field` names the offending input (a job-file key of the section the error is about) when
+    one input is to blame; the job loader then points at that key's line. Errors raised after
+    the job file was read (CAM limits, simulation bounds) also name the `section`, so front ends
+    can still point at the key's line.
     """
 
-    def __init__(self, message: str = "", *, key: str | None = None):
-        super().__init__(message)
-        self.key = key
+    def __init__(self, *args: object, field: str | None = None, section: str | None = None):
+        super().__init__(*args)
+        self.field = field
+        self.section = section
+
+    @property
+    def key(self) -> str | None:
+        """"section.field" when both are known (e.g. "finishing.target_scallop_mm"), else None."""
+        return f"{self.section}.{self.field}" if self.section and self.field else None
 
 
 class GearSpecError(SpurCadError, ValueError):
@@ -22,16 +30,14 @@ class GearSpecError(SpurCadError, ValueError):
     """
 
     def __init__(self, message: str, field: str | None = None):
-        super().__init__(message)
-        self.field = field
+        super().__init__(message, field=field)
 
 
 class StockError(SpurCadError, ValueError):
     """A stock (blank, margins, holding stub) that cannot be made; `field` names the StockSpec field."""
 
     def __init__(self, message: str, field: str | None = None):
-        super().__init__(message)
-        self.field = field
+        super().__init__(message, field=field, section="stock")
 
 
 class WorkLimitError(SpurCadError, ValueError):

@@ -1,17 +1,21 @@
 """Job files: one TOML file describes one gear job (gear, stock, tools, strategies, machine, post).
 
-Every section is a small typed dataclass; the loader rejects unknown sections and keys, wrong
-types and missing required values with a JobFileError that names the key and, where the
-file has it, the line. Units are in the key names (mm, deg, percent, m_min, ...).
-Sections beyond [job] and [gear] are validated now and consumed by the CAD/CAM/post layers.
+Every section is a small typed dataclass whose fields are the section's keys, each declared once
+with `spur_cad.keys.key` (type, unit, default, range or choices, meaning, workbench label and
+group). The loader rejects unknown sections and keys, wrong types, missing required values and
+values outside the declared ranges with a JobFileError that names the key and, where the file
+has it, the key's line; then it runs the sections' cross-field checks (`validate()`) and builds
+the GearSpec. Units are in the key names (mm, deg, percent, m_min, ...).
+
+`job_file_reference_markdown()` writes docs/job-file.md from the same declarations
+(`python -m spur_cad.job --markdown > docs/job-file.md`).
 """
 
 from __future__ import annotations
 
-import dataclasses
 import re
+import sys
 import tomllib
-import typing
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -19,37 +23,51 @@ from spur_cad.cad.specs import BlankFeatures, StockSpec
 from spur_cad.cam.machine import FinishingParams, Machine, RoughingParams
 from spur_cad.cam.tools import Tool
 from spur_cad.errors import GearSpecError, JobFileError, SpurCadError, StockError
-from spur_cad.geometry.spec import GearSpec
+from spur_cad.geometry.spec import MAX_TEETH, MIN_TEETH, GearSpec
+from spur_cad.keys import check_section, coerce, key, keys_of, section_problems, toml_literal, type_problem
 from spur_cad.post.settings import PostSettings
-
-REQUIRED = object()  # marker default for keys the file must give
 
 
 @dataclass(frozen=True)
 class JobSection:
     """[job]: name and the chordal tolerance of sampled profiles."""
 
-    name: str = "gear job"
-    profile_tolerance_mm: float = 0.001
+    name: str = key("gear job", label="JobName", group="Job", meaning="job name (summary, program headers)")
+    profile_tolerance_mm: float = key(0.001, unit="mm", low=0.0001, high=0.1, label="ProfileTolerance", group="Job",
+                                      meaning="chordal tolerance of sampled profiles (profile.csv)")
 
 
 @dataclass(frozen=True)
 class GearSection:
     """[gear]: the gear as ISO 21771 names it, plus the blank's bore and keyway."""
 
-    teeth: int = REQUIRED  # type: ignore[assignment]
-    module_mm: float = REQUIRED  # type: ignore[assignment]
-    face_width_mm: float = REQUIRED  # type: ignore[assignment]
-    pressure_angle_deg: float = 20.0
-    profile_shift_coefficient: float = 0.0
-    addendum_coefficient: float = 1.0
-    dedendum_coefficient: float = 1.25
-    rack_tip_radius_mm: float = 0.0
-    thickness_allowance_percent: float = 0.0
-    thickness_allowance_mm: float = 0.0
-    bore_diameter_mm: float = 0.0
-    keyway_width_mm: float = 0.0
-    keyway_depth_mm: float = 0.0
+    teeth: int = key(low=MIN_TEETH, high=MAX_TEETH, label="Teeth", group="Gear", meaning="number of teeth z")
+    module_mm: float = key(unit="mm", low=0.05, high=100.0, label="Module", group="Gear", meaning="module m")
+    face_width_mm: float = key(unit="mm", low=0.5, high=2000.0, label="FaceWidth", group="Gear",
+                               meaning="face width b, along the rotary axis X")
+    pressure_angle_deg: float = key(20.0, unit="deg", low=10.0, high=35.0, label="PressureAngle", group="Gear",
+                                    meaning="pressure angle alpha")
+    profile_shift_coefficient: float = key(0.0, low=-2.0, high=3.0, label="ProfileShift", group="Gear",
+                                           meaning="profile shift coefficient x")
+    addendum_coefficient: float = key(1.0, low=0.5, high=2.0, label="AddendumCoefficient", group="Rack",
+                                      meaning="addendum coefficient h_a* of the generated gear")
+    dedendum_coefficient: float = key(1.25, low=0.5, high=2.5, label="DedendumCoefficient", group="Rack",
+                                      meaning="dedendum coefficient h_f* of the generated gear")
+    rack_tip_radius_mm: float = key(0.0, unit="mm", low=0.0, high=60.0, label="RackTipRadius", group="Rack",
+                                    meaning="tip corner radius rho of the generating rack (at most 0.6 x module)")
+    thickness_allowance_percent: float = key(0.0, unit="%", low=0.0, high=20.0, label="ThicknessAllowancePercent",
+                                             group="Allowance",
+                                             meaning="nominal tooth thickness reduced by this percentage "
+                                                     "(the reference process's profile clearance, 0-5 % typical)")
+    thickness_allowance_mm: float = key(0.0, unit="mm", low=0.0, high=50.0, label="ThicknessAllowance",
+                                        group="Allowance",
+                                        meaning="further absolute tooth thickness reduction (at most 0.5 x module)")
+    bore_diameter_mm: float = key(0.0, unit="mm", low=0.0, high=2000.0, label="BoreDiameter", group="Bore",
+                                  meaning="through bore diameter, 0: none")
+    keyway_width_mm: float = key(0.0, unit="mm", low=0.0, high=500.0, label="KeywayWidth", group="Bore",
+                                 meaning="hub keyway width, 0: none")
+    keyway_depth_mm: float = key(0.0, unit="mm", low=0.0, high=200.0, label="KeywayDepth", group="Bore",
+                                 meaning="hub keyway depth from the bore surface, 0: none")
 
     def to_spec(self) -> GearSpec:
         return GearSpec(
@@ -67,16 +85,21 @@ class GearSection:
 
 @dataclass(frozen=True)
 class SimulationSection:
-    """[simulation]: verification by simulated cutting (spur_cad.sim) and its resolution."""
+    """[simulation]: verification by simulated cutting (see docs/simulation.md)."""
 
-    enabled: bool = True
-    resolution_mm: float = 0.005
+    enabled: bool = key(True, label="SimulationEnabled", group="Simulation",
+                        meaning="cut the stock with the roughing and finishing IR and measure it against the design "
+                                "(summary simulation.*, deviation map in report.html)")
+    # The simulator's blades reach 0.5 mm into the material, at least 10 x the resolution: 0.05 mm at most.
+    resolution_mm: float = key(0.005, unit="mm", low=0.0005, high=0.05, label="SimulationResolution",
+                               group="Simulation",
+                               meaning="bound of the simulation's own error; finer is slower (about 4 x per halving)")
 
     def validate(self) -> None:
-        """Raise SimulationError for a resolution the simulator does not accept."""
-        from spur_cad.sim.simulate import SimSettings
+        """Raise SimulationError for a value outside its declared range (e.g. a resolution given to Simulate)."""
+        from spur_cad.sim.simulate import SimulationError
 
-        SimSettings(resolution_mm=self.resolution_mm).validate()
+        check_section(self, "simulation", SimulationError)
 
 
 @dataclass(frozen=True)
@@ -103,79 +126,93 @@ class Job:
     post: PostSettings = field(default_factory=PostSettings)
     simulation: SimulationSection = field(default_factory=SimulationSection)
 
+    def section(self, name: str):
+        """The dataclass of section `name` ('gear', 'tools.roughing', ...); None for an absent tool."""
+        if name == "gear":
+            return self.gear_section
+        if name.startswith("tools."):
+            return getattr(self.tools, name.removeprefix("tools."))
+        return getattr(self, name)
 
-_SECTIONS: dict[str, type] = {
+
+# Every section of the job file and its dataclass, in the order of the documentation and the workbench.
+SECTIONS: dict[str, type] = {
     "job": JobSection,
     "gear": GearSection,
     "stock": StockSpec,
+    "tools.roughing": Tool,
+    "tools.finishing": Tool,
     "roughing": RoughingParams,
     "finishing": FinishingParams,
     "machine": Machine,
-    "post": PostSettings,
     "simulation": SimulationSection,
+    "post": PostSettings,
 }
-_TOOL_SECTIONS = ("roughing", "finishing")
+_TOOL_ROLES = ("roughing", "finishing")
 
 
-def _line_of(text: str, table: str, key: str | None) -> int | None:
-    """1-based line where `key` is set inside `[table]` (or the table header if key is None)."""
+def _line_of(text: str, table: str, key_name: str | None) -> int | None:
+    """1-based line where `key_name` is set inside `[table]` (or the table header if key_name is None)."""
     current = ""
     header = re.compile(r"^\s*\[\s*([A-Za-z0-9_.\- ]+?)\s*\]\s*(#.*)?$")
     for number, line in enumerate(text.splitlines(), start=1):
         m = header.match(line)
         if m:
             current = re.sub(r"\s+", "", m.group(1))
-            if key is None and current == table:
+            if key_name is None and current == table:
                 return number
             continue
-        if key is not None and current == table and re.match(rf"^\s*{re.escape(key)}\s*=", line):
+        if key_name is not None and current == table and re.match(rf"^\s*[\"']?{re.escape(key_name)}[\"']?\s*=",
+                                                                 line):
             return number
     return None
 
 
-def _where(source: str, text: str, table: str, key: str | None = None) -> str:
-    line = _line_of(text, table, key)
+def _where(source: str, text: str, table: str, key_name: str | None = None) -> str:
+    """'file:line' of the key (its section's header when the file does not set it), or 'source'."""
+    line = (_line_of(text, table, key_name) if key_name else None) or _line_of(text, table, None)
     return f"{source}:{line}" if line else source
 
 
-def _check_value(value: object, expected: object) -> bool:
-    """Whether a TOML value fits a field annotation (int is accepted for float, bool is not a number)."""
-    if expected is float:
-        return isinstance(value, (int, float)) and not isinstance(value, bool)
-    if expected is int:
-        return isinstance(value, int) and not isinstance(value, bool)
-    if expected is bool:
-        return isinstance(value, bool)
-    if expected is str:
-        return isinstance(value, str)
-    return False
+def _blamed_key(exc: SpurCadError, name: str, given: dict) -> str | None:
+    """The key of section `name` a cross-field error is about, for its line: the error's `field` when the
+    file sets it, else the first key the message names that the file sets, else the `field` (not set)."""
+    names = [k.name for k in keys_of(SECTIONS[name])]
+    if exc.field in names and exc.field in given:
+        return exc.field
+    message = str(exc)
+    positions = {k: m.start() for k in names if (m := re.search(rf"\b{re.escape(k)}\b", message))}
+    for k in sorted(positions, key=positions.get):
+        if k in given:
+            return k
+    return exc.field if exc.field in names else None
 
 
-_TYPE_NAMES = {float: "a number", int: "a whole number", bool: "true or false", str: "a string"}
-
-
-def _load_section(table: object, cls: type, name: str, source: str, text: str):
-    """Build section dataclass `cls` from a TOML table, checking keys and types."""
+def _load_section(table: object, name: str, source: str, text: str):
+    """Build section `name`'s dataclass from its TOML table, checking keys, types, ranges and choices."""
+    cls = SECTIONS[name]
     if not isinstance(table, dict):
         raise JobFileError(f"{_where(source, text, name)}: [{name}] must be a table")
-    hints = typing.get_type_hints(cls)
-    known = {f.name: f for f in dataclasses.fields(cls)}
-    for key in table:
-        if key not in known:
-            allowed = ", ".join(sorted(known))
-            raise JobFileError(f"{_where(source, text, name, key)}: unknown key '{key}' in [{name}] "
-                               f"(known keys: {allowed})")
+    known = {k.name: k for k in keys_of(cls)}
+    for key_name in table:
+        if key_name not in known:
+            raise JobFileError(f"{_where(source, text, name, key_name)}: unknown key '{key_name}' in [{name}] "
+                               f"(known keys: {', '.join(sorted(known))})")
     values = {}
-    for key, f in known.items():
-        if key not in table:
-            if f.default is REQUIRED or (f.default is dataclasses.MISSING and f.default_factory is dataclasses.MISSING):
-                raise JobFileError(f"{_where(source, text, name)}: [{name}] is missing the required key '{key}'")
+    for k in known.values():
+        if k.name not in table:
+            if k.required:
+                raise JobFileError(f"{_where(source, text, name)}: [{name}] is missing the required key '{k.name}'")
+            values[k.name] = k.default
             continue
-        expected = hints[key]
-        if not _check_value(table[key], expected):
-            raise JobFileError(f"{_where(source, text, name, key)}: [{name}] {key} must be "
-                               f"{_TYPE_NAMES.get(expected, expected)}, got {table[key]!r}")
-        values[key] = float(table[key]) if expected is float else table[key]
+        problem = type_problem(k, table[k.name])
+        if problem:
+            raise JobFileError(f"{_where(source, text, name, k.name)}: [{name}] {k.name} {problem}")
+        values[k.name] = coerce(k, table[k.name])
+    problems = section_problems(cls, values)
+    if problems:
+        key_name, problem = problems[0]
+        raise JobFileError(f"{_where(source, text, name, key_name)}: [{name}] {key_name} {problem}")
     return cls(**values)
 
 
@@ -196,65 +233,70 @@ def job_from_dict(data: dict, source: str) -> Job:
     return _job_from_data(data, source, "")
 
 
-def _job_from_data(data: dict, source: str, text: str) -> Job:
-    """Validate parsed job data; `text` (the file's text, or "") only locates keys for messages."""
+def _tables(data: dict, source: str, text: str) -> dict[str, object]:
+    """{section name: its table} of the sections `data` has; unknown sections are errors."""
     if not isinstance(data, dict):
         raise JobFileError(f"{source}: a job must be a table of sections")
-    allowed = sorted(list(_SECTIONS) + ["tools"])
-    for name in data:
-        if name not in _SECTIONS and name != "tools":
+    top = sorted({name.split(".")[0] for name in SECTIONS})
+    tables: dict[str, object] = {}
+    for name, table in data.items():
+        children = [s for s in SECTIONS if s.startswith(name + ".")]
+        if name in SECTIONS:
+            tables[name] = table
+        elif children:
+            if not isinstance(table, dict):
+                raise JobFileError(f"{_where(source, text, name)}: [{name}] must be a table")
+            for child, child_table in table.items():
+                if f"{name}.{child}" not in SECTIONS:
+                    known = ", ".join(f"[{s}]" for s in children)
+                    raise JobFileError(f"{_where(source, text, name + '.' + child)}: unknown section "
+                                       f"[{name}.{child}] (known: {known})")
+                tables[f"{name}.{child}"] = child_table
+        else:
             raise JobFileError(f"{_where(source, text, name)}: unknown section [{name}] "
-                               f"(known sections: {', '.join(allowed)})")
-    if "gear" not in data:
+                               f"(known sections: {', '.join(top)})")
+    if "gear" not in tables:
         raise JobFileError(f"{source}: the job file has no [gear] section")
-    sections = {name: _load_section(data[name], cls, name, source, text)
-                for name, cls in _SECTIONS.items() if name in data}
-    tools_table = data.get("tools", {})
-    if not isinstance(tools_table, dict):
-        raise JobFileError(f"{_where(source, text, 'tools')}: [tools] must be a table")
-    for name in tools_table:
-        if name not in _TOOL_SECTIONS:
-            raise JobFileError(f"{_where(source, text, 'tools.' + name)}: unknown section [tools.{name}] "
-                               "(known: [tools.roughing], [tools.finishing])")
-    tools = ToolsSection(**{name: _load_section(tools_table[name], Tool, f"tools.{name}", source, text)
-                            for name in _TOOL_SECTIONS if name in tools_table})
+    return tables
+
+
+def _job_from_data(data: dict, source: str, text: str) -> Job:
+    """Validate parsed job data; `text` (the file's text, or "") only locates keys for messages."""
+    tables = _tables(data, source, text)
+    sections = {name: _load_section(tables[name], name, source, text) for name in SECTIONS if name in tables}
+
+    def where(name: str, key_name: str | None) -> str:
+        return _where(source, text, name, key_name)
+
     gear_section: GearSection = sections["gear"]
     try:
         spec = gear_section.to_spec()
     except GearSpecError as exc:
-        key = {"thickness_allowance_fraction": "thickness_allowance_percent"}.get(exc.field or "", exc.field)
-        where = _where(source, text, "gear", key) if key in {f.name for f in dataclasses.fields(GearSection)} \
-            else source
-        message = str(exc).replace("thickness_allowance_fraction", "thickness_allowance_percent / 100")
-        raise JobFileError(f"{where}: invalid gear: {message}") from None
-    for check, table in ((gear_section.blank_features().validate, "gear"),
-                         (sections.get("stock", StockSpec()).validate, "stock")):
+        raise JobFileError(f"{where('gear', _blamed_key(exc, 'gear', tables['gear']))}: invalid gear: {exc}") from None
+    for check, name in ((gear_section.blank_features().validate, "gear"),
+                        (sections.get("stock", StockSpec()).validate, "stock")):
         try:
             check(spec)
         except (GearSpecError, StockError) as exc:
-            raise JobFileError(f"{_where(source, text, table, exc.field)}: invalid [{table}]: {exc}") from None
-    for name, check in (("machine", lambda m: m.validate()), ("roughing", lambda r: r.validate()),
-                        ("finishing", lambda f: f.validate()), ("post", lambda p: p.validate()),
-                        ("simulation", lambda s: s.validate())):
-        if name in sections:
-            try:
-                check(sections[name])
-            except SpurCadError as exc:
-                raise JobFileError(f"{_where(source, text, name)}: {exc}") from None
-    for role in _TOOL_SECTIONS:
-        tool = getattr(tools, role)
-        if tool is not None:
-            try:
-                tool.validate(role)
-            except SpurCadError as exc:
-                raise JobFileError(f"{_where(source, text, 'tools.' + role)}: [tools.{role}] {exc}") from None
-    job_section: JobSection = sections.get("job", JobSection())
-    if not job_section.profile_tolerance_mm > 0.0 or job_section.profile_tolerance_mm > 0.1:
-        raise JobFileError(f"{_where(source, text, 'job', 'profile_tolerance_mm')}: [job] profile_tolerance_mm "
-                           f"must be in (0, 0.1] mm, got {job_section.profile_tolerance_mm:g}")
+            blamed = _blamed_key(exc, name, tables.get(name, {}))
+            raise JobFileError(f"{where(name, blamed)}: invalid [{name}]: {exc}") from None
+    for name in ("machine", "roughing", "finishing", "post", *(f"tools.{role}" for role in _TOOL_ROLES)):
+        if name not in sections:
+            continue
+        is_tool = name.startswith("tools.")
+        try:
+            if is_tool:
+                sections[name].validate(name.removeprefix("tools."))
+            else:
+                sections[name].validate()
+        except SpurCadError as exc:
+            prefix = f"[{name}] " if is_tool else ""
+            raise JobFileError(f"{where(name, _blamed_key(exc, name, tables[name]))}: {prefix}{exc}") from None
+    tools = ToolsSection(**{role: sections.get(f"tools.{role}") for role in _TOOL_ROLES})
     optional = {name: sections[name] for name in ("stock", "roughing", "finishing", "machine", "post", "simulation")
                 if name in sections}
-    return Job(source=source, job=job_section, gear_section=gear_section, gear=spec, tools=tools, **optional)
+    return Job(source=source, job=sections.get("job", JobSection()), gear_section=gear_section, gear=spec,
+               tools=tools, **optional)
 
 
 def load_job(path: str | Path) -> Job:
@@ -272,3 +314,110 @@ def load_job(path: str | Path) -> Job:
         raise JobFileError(f"{path}: the job file is not UTF-8 text") from None
     return parse_job(text, str(path))
 
+
+# --- docs/job-file.md -------------------------------------------------------------------------------------
+
+_DOC_INTRO = """\
+# Job file reference
+
+<!-- Generated from the key declarations (spur_cad.keys.key fields of the section dataclasses) by
+     `python -m spur_cad.job --markdown > docs/job-file.md`; edit those, not this file. -->
+
+A job file is TOML. Units are in key names. Unknown sections or keys, wrong types,
+missing required keys and values outside the accepted range are errors naming the key and the
+line. Without `[tools.*]` the job stops after the CAD stage (tool recommendations are still
+reported, no G-code is written).
+
+Every number must be finite (`nan` and `inf` are rejected) and inside its range: `[a, b]`
+includes both ends, `(a, b]` excludes a; `a..b` is a range of whole numbers. An integer is
+accepted where a number is expected; `true`/`false` only where a flag is. The last column names
+the FreeCAD workbench's property holding the key (see [workbench.md](workbench.md)).
+"""
+
+_DOC_NOTES = """\
+Notes:
+
+- `[gear] thickness_allowance_percent` thins the nominal tooth thickness on the reference
+  circle by that percentage (the reference process's "profile clearance", 0-5 %);
+  `thickness_allowance_mm` subtracts a further absolute amount (see [geometry.md](geometry.md)).
+  The gear itself must be cuttable by rack generation: `rack_tip_radius_mm` at most 0.6 x module,
+  `thickness_allowance_mm` at most 0.5 x module, a positive root radius, no pointed tooth.
+- `[gear] bore_diameter_mm`, `keyway_width_mm`, `keyway_depth_mm` (0 = none): a through bore and
+  a hub keyway on the bore's +Z side (under tooth space 0); depth is measured from the bore
+  surface. At least one module of wall must remain under the root circle; a keyway needs a bore
+  and both its width (below the bore diameter) and depth.
+- `[stock]`: the blank is a cylinder of tip radius + `radial_allowance_mm` from
+  X = -`front_margin_mm` to face width + `back_margin_mm`; a holding stub (`stub_diameter_mm`,
+  `stub_length_mm`, both or neither, not wider than the blank) continues it toward the chuck (+X).
+- `[tools.*]`: `flute_length_mm` / `stick_out_mm` of 0 mean "not given"; when given they are
+  checked against what the job needs (summary `tools.required_flute_length_mm`,
+  `tools.required_stick_out_mm`). See [cam.md](cam.md) for every limit.
+- `[roughing] finish_stock_mm` must be below `flank_allowance_mm`.
+- `[machine]` travel limits: each low limit must be below its high limit.
+  `rotary_clamp_code` / `rotary_unclamp_code` are needed when `[roughing] clamp_rotary`
+  is true; `rotary_continuous = false` makes finishing unwind A after every station.
+- `[post] folded = true` needs `rotary_mode = "unwound"`.
+"""
+
+_TYPE_WORDS = {float: "number", int: "integer", bool: "boolean", str: "string"}
+
+
+def _doc_text(text: str) -> str:
+    """Docstring or meaning text for markdown: docs/<name>.md becomes a link."""
+    return re.sub(r"docs/([\w-]+\.md)", r"[\1](\1)", text)
+
+
+def _section_summary(cls: type) -> str:
+    """The first paragraph of a section dataclass's docstring, without its '[section]: ' prefix."""
+    first = " ".join(line.strip() for line in (cls.__doc__ or "").strip().split("\n\n")[0].splitlines())
+    first = re.sub(r"^\[[^\]]+\](\s*/\s*\[[^\]]+\])*:\s*", "", first)
+    return _doc_text(first[:1].upper() + first[1:])
+
+
+def _accepted(k) -> str:
+    if k.type is bool:
+        return "`true`, `false`"
+    if k.names:
+        return ", ".join(f"`{n}`" for n in k.names)
+    if k.low is not None:
+        text = k.interval()
+        return text.removesuffix(f" {k.unit}") if k.unit else text
+    return "any"
+
+
+def job_file_reference_markdown() -> str:
+    """docs/job-file.md: the introduction, one table per section from its key declarations, the notes."""
+    parts = [_DOC_INTRO]
+    done: set[type] = set()
+    for cls in SECTIONS.values():
+        if cls in done:
+            continue
+        done.add(cls)
+        names = [n for n, c in SECTIONS.items() if c is cls]
+        parts.append(f"## {' / '.join(f'[{n}]' for n in names)}\n\n{_section_summary(cls)}\n")
+        if len(names) > 1:
+            roles = " or ".join(n.split(".")[-1].capitalize() for n in names)
+            parts.append(f"In the workbench property names, `{{Role}}` is {roles}.\n")
+        rows = ["| key | type | unit | default | accepted | meaning | workbench property |",
+                "| --- | --- | --- | --- | --- | --- | --- |"]
+        for k in keys_of(cls):
+            default = "**required**" if k.required else f"`{toml_literal(k.default)}`"
+            rows.append(f"| `{k.name}` | {_TYPE_WORDS[k.type]} | {k.unit or '-'} | {default} | {_accepted(k)} | "
+                        f"{_doc_text(k.meaning)} | `{k.label}` |")
+        parts.append("\n".join(rows) + "\n")
+    parts.append(_DOC_NOTES)
+    return "\n".join(parts)
+
+
+def main(argv: list[str] | None = None) -> int:
+    """`python -m spur_cad.job --markdown`: print docs/job-file.md."""
+    argv = sys.argv[1:] if argv is None else argv
+    if argv != ["--markdown"]:
+        print("usage: python -m spur_cad.job --markdown > docs/job-file.md", file=sys.stderr)
+        return 2
+    sys.stdout.write(job_file_reference_markdown())
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

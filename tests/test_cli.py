@@ -24,7 +24,8 @@ def run_cli(*args: str) -> subprocess.CompletedProcess:
     """Run the installed console script as a user would."""
     exe = Path(sys.executable).with_name("spur-cad")
     command = [str(exe)] if exe.exists() else [sys.executable, "-m", "spur_cad.cli"]
-    return subprocess.run(command + list(args), capture_output=True, text=True, cwd=ROOT, timeout=300)
+    return subprocess.run(command + list(args), capture_output=True, text=True, cwd=ROOT, timeout=300,
+                          check=False)
 
 
 def test_reference_job_writes_profile_summary_and_plot(tmp_path):
@@ -91,19 +92,20 @@ BAD_JOBS = {
                      "bad.toml:5: invalid gear: rack tip radius 2.3 mm is too large"),
     "bad toml": ("[gear\nteeth = 23\n", "not valid TOML"),
     "unknown section": ("[gears]\nteeth = 23\n", "unknown section [gears]"),
-    "too few teeth": ("[gear]\nteeth = 3\nmodule_mm = 4.0\nface_width_mm = 20\n", "too few teeth"),
+    "too few teeth": ("[gear]\nteeth = 3\nmodule_mm = 4.0\nface_width_mm = 20\n",
+                      "bad.toml:2: [gear] teeth must be in 5..1000, got 3"),
     "bore through the root": ("[gear]\nteeth = 23\nmodule_mm = 4.0\nface_width_mm = 20\nbore_diameter_mm = 80\n",
                               "bad.toml:5: invalid [gear]: bore diameter 80 mm leaves less than one module"),
-    "finishing tool too wide": ("[gear]\nteeth = 23\nmodule_mm = 4.0\nface_width_mm = 20\nrack_tip_radius_mm = 0.8\n"
-                                "[tools.finishing]\nkind = 'bull_nose'\ndiameter_mm = 3.0\ncorner_radius_mm = 0.5\n",
+    "finishing tool too wide": (("[gear]\nteeth = 23\nmodule_mm = 4.0\nface_width_mm = 20\nrack_tip_radius_mm = 0.8\n"
+                                 "[tools.finishing]\nkind = 'bull_nose'\ndiameter_mm = 3.0\ncorner_radius_mm = 0.5\n"),
                                 "finishing tool flat width 2.0000 mm (D - 2 r_t) exceeds finishing_max_flat_width_mm"),
     "unknown strategy": ("[gear]\nteeth = 23\nmodule_mm = 4.0\nface_width_mm = 20\n[finishing]\nstrategy = 'spiral'\n",
-                         "bad.toml:5: [finishing] strategy 'spiral' is unknown"),
+                         "bad.toml:6: [finishing] strategy 'spiral' is unknown"),
     "unknown post dialect": ("[gear]\nteeth = 23\nmodule_mm = 4.0\nface_width_mm = 20\n[post]\ndialect = 'heidenhain'\n",
-                             "bad.toml:5: [post] dialect = 'heidenhain' is not known (known: linuxcnc, fanuc, haas, "
-                             "siemens, okuma)"),
-    "folded wrapped program": ("[gear]\nteeth = 23\nmodule_mm = 4.0\nface_width_mm = 20\n[post]\n"
-                               "rotary_mode = 'wrapped'\n", "bad.toml:5: [post] folded = true needs rotary_mode"),
+                             ("bad.toml:6: [post] dialect = 'heidenhain' is not known (known: linuxcnc, fanuc, "
+                              "haas, siemens, okuma)")),
+    "folded wrapped program": (("[gear]\nteeth = 23\nmodule_mm = 4.0\nface_width_mm = 20\n[post]\n"
+                                "rotary_mode = 'wrapped'\n"), "bad.toml:6: [post] folded = true needs rotary_mode"),
     "stub without length": ("[gear]\nteeth = 23\nmodule_mm = 4.0\nface_width_mm = 20\n[stock]\nstub_diameter_mm = 60\n",
                             "bad.toml:6: invalid [stock]: a holding stub needs both"),
 }

@@ -145,7 +145,8 @@ RESULT["gear"] = dict(teeth=gear.Teeth, module=gear.Module.Value, rho=gear.RackT
 RESULT["stock"] = dict(stub=stock.StubDiameter.Value, back=stock.BackMargin.Value)
 RESULT["job"] = dict(label=job.Label, rough_d=job.RoughingToolDiameter.Value, kind=job.FinishingToolKind,
                      corner=job.FinishingCornerRadius.Value, scallop=job.TargetScallop.Value,
-                     clearance=job.Clearance.Value, block=job.BlockTime)
+                     clearance=job.Clearance.Value, block=job.BlockTime,
+                     max_feed=float(job.MaxFeed.getValueAs("mm/min")))
 RESULT["toolpaths"] = {tp.Operation: dict(moves=tp.Moves, shown=tp.DisplayedMoves, size=tp.Path.Size)
                        for tp in (job.RoughingToolpath, job.FinishingToolpath)}
 """
@@ -160,13 +161,14 @@ def test_reference_job_file_maps_onto_the_document(freecadcmd, tmp_path):
     assert _all_up_to_date(result["states"]), result["states"]
     data = tomllib.loads(REFERENCE_JOB.read_text())
     gear, tools = data["gear"], data["tools"]
-    assert result["gear"] == dict(teeth=gear["teeth"], module=gear["module_mm"], rho=gear["rack_tip_radius_mm"],
-                                  allowance=gear["thickness_allowance_percent"], b=gear["face_width_mm"])
-    assert result["stock"] == dict(stub=data["stock"]["stub_diameter_mm"], back=data["stock"]["back_margin_mm"])
-    assert result["job"] == dict(label=data["job"]["name"], rough_d=tools["roughing"]["diameter_mm"],
-                                 kind=tools["finishing"]["kind"], corner=tools["finishing"]["corner_radius_mm"],
-                                 scallop=data["finishing"]["target_scallop_mm"],
-                                 clearance=data["machine"]["clearance_mm"], block=data["machine"]["block_time_s"])
+    assert result["gear"] == {"teeth": gear["teeth"], "module": gear["module_mm"], "rho": gear["rack_tip_radius_mm"],
+                              "allowance": gear["thickness_allowance_percent"], "b": gear["face_width_mm"]}
+    assert result["stock"] == {"stub": data["stock"]["stub_diameter_mm"], "back": data["stock"]["back_margin_mm"]}
+    assert result["job"] == {"label": data["job"]["name"], "rough_d": tools["roughing"]["diameter_mm"],
+                             "kind": tools["finishing"]["kind"], "corner": tools["finishing"]["corner_radius_mm"],
+                             "scallop": data["finishing"]["target_scallop_mm"],
+                             "clearance": data["machine"]["clearance_mm"], "block": data["machine"]["block_time_s"],
+                             "max_feed": data["machine"]["max_feed_mm_min"]}
     plan = plan_cam(load_job(REFERENCE_JOB))  # the same file through the library
     roughing, finishing = result["toolpaths"]["roughing"], result["toolpaths"]["finishing"]
     assert roughing["moves"] == len(plan.roughing.toolpath) and roughing["shown"] == roughing["moves"]
@@ -176,14 +178,26 @@ def test_reference_job_file_maps_onto_the_document(freecadcmd, tmp_path):
 
 SAVE_BODY = STATES + """
 import FreeCAD
-from spur_cad_workbench import commands
+from spur_cad_workbench import commands, features, schema
 doc = FreeCAD.newDocument("Saved")
 gear = commands.make_gear(doc, **PROPS["gear"])
 stock = commands.make_stock(gear, **PROPS["stock"])
 job = commands.make_job(gear, stock, **PROPS["job"])
 doc.recompute()
+RESULT["new_types"] = {p: job.getTypeIdOfProperty(p) for p in ("MaxFeed", "AMin", "FinishingStrategy")}
+RESULT["new_max_feed"] = [job.MaxFeed.Value, job.MaxFeed.UserString]
 gear.removeProperty("KeywayDepth")      # as if saved by an older schema without this property
 gear.SchemaVersion = 0
+# as saved by schema 1: MaxFeed a plain float, AMin an angle (which clamped -99999 to -360), and a shorter list
+job.removeProperty("MaxFeed")
+job.addProperty("App::PropertyFloat", "MaxFeed", "Machine", "linear feed limit (mm/min)")
+job.MaxFeed = 4321.5
+job.removeProperty("AMin")
+job.addProperty("App::PropertyAngle", "AMin", "Machine", "A travel limit, low (deg)")
+job.AMin = -99999.0
+job.FinishingStrategy = ["perimeter"]
+job.SchemaVersion = 1
+RESULT["saved_values"] = features.read_values(job, schema.JOB_FIELDS)
 doc.saveAs(FILE)
 FreeCAD.closeDocument("Saved")
 doc = FreeCAD.openDocument(FILE)
@@ -191,17 +205,27 @@ RESULT["restored"] = states(doc)
 gear = doc.getObject("Gear")
 RESULT["migrated"] = dict(version=gear.SchemaVersion, has=("KeywayDepth" in gear.PropertiesList),
                           value=gear.KeywayDepth.Value)
+job = doc.getObject("Job")
+RESULT["schema_version"] = schema.SCHEMA_VERSION
+RESULT["job_version"] = job.SchemaVersion
+RESULT["migrated_types"] = {p: job.getTypeIdOfProperty(p) for p in ("MaxFeed", "AMin", "FinishingStrategy")}
+RESULT["strategies"] = job.getEnumerationsOfProperty("FinishingStrategy")
+RESULT["restored_values"] = features.read_values(job, schema.JOB_FIELDS)
 for obj in doc.Objects:
     obj.touch()
 doc.recompute()
 RESULT["recomputed"] = states(doc)
-job = doc.getObject("Job")
 RESULT["moves"] = [job.RoughingMoves, job.FinishingMoves, job.FinishingToolpath.Moves]
 RESULT["links"] = [job.Gear.Name, job.Stock.Name, doc.getObject("Stock").Gear.Name]
 doc.save()
+FreeCAD.closeDocument(doc.Name)
+doc = FreeCAD.openDocument(FILE)                 # reopened again: nothing left to migrate
+RESULT["second_restore"] = states(doc)
+RESULT["reopened_values"] = features.read_values(doc.getObject("Job"), schema.JOB_FIELDS)
 """
 
 PRIMITIVE_PROPERTIES = {"App::PropertyAngle", "App::PropertyBool", "App::PropertyDistance", "App::PropertyEnumeration",
+                        "App::PropertySpeed",
                         "App::PropertyExpressionEngine", "App::PropertyFloat", "App::PropertyInteger",
                         "App::PropertyLength", "App::PropertyLink", "App::PropertyMap", "App::PropertyPlacement",
                         "App::PropertyString", "App::PropertyStringList", "App::PropertyUUID",
@@ -218,7 +242,19 @@ def test_documents_save_and_reopen_without_pickles(freecadcmd, tmp_path):
     restored = result["restored"]  # the migrated gear is touched (a property was added), nothing is invalid
     assert all("Invalid" not in state and status == "ok" for state, status in restored.values()), restored
     assert _all_up_to_date(result["recomputed"]), result
-    assert result["migrated"] == dict(version=1, has=True, value=0.0)
+    assert result["schema_version"] == 2
+    assert result["migrated"] == {"version": 2, "has": True, "value": 0.0}
+    # unit-carrying types: a feed is a speed shown in FreeCAD's units (mm/s) and read back in mm/min
+    types = {"MaxFeed": "App::PropertySpeed", "AMin": "App::PropertyFloat", "FinishingStrategy": "App::PropertyEnumeration"}
+    assert result["new_types"] == types
+    assert result["new_max_feed"][0] == pytest.approx(5000.0 / 60.0) and "mm/s" in result["new_max_feed"][1]
+    # schema-1 types re-created with the values they held, the drop-down list brought up to date
+    assert result["job_version"] == 2 and result["migrated_types"] == types
+    assert result["strategies"] == ["perimeter", "along_x"]
+    before = result["saved_values"]
+    assert before["MaxFeed"] == 4321.5 and before["AMin"] == -360.0  # the angle had clamped
+    assert result["restored_values"] == before and result["reopened_values"] == before
+    assert _all_up_to_date(result["second_restore"]), result["second_restore"]
     assert result["moves"][0] > 0 and result["moves"][1] == result["moves"][2] > 0
     assert result["links"] == ["Gear", "Stock", "Gear"]
     with zipfile.ZipFile(saved) as archive:

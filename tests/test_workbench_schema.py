@@ -6,7 +6,6 @@ from __future__ import annotations
 import dataclasses
 import json
 import math
-import re
 import sys
 import tomllib
 import typing
@@ -15,12 +14,15 @@ from types import SimpleNamespace
 import numpy as np
 import pytest
 
+from spur_cad.cad.specs import StockSpec
 from spur_cad.cam.ir import MoveKind, Operation, ToolpathBuilder
+from spur_cad.cam.machine import FinishingParams, Machine, RoughingParams
 from spur_cad.cam.recommend import check_roughing_reach, check_tools, recommend_tools
 from spur_cad.cam.roughing import roughing_levels
 from spur_cad.cam.tools import Tool
 from spur_cad.errors import JobFileError, SpurCadError
-from spur_cad.job import Job, job_from_dict, load_job, parse_job
+from spur_cad.job import GearSection, Job, JobSection, SimulationSection, job_from_dict, load_job, parse_job
+from spur_cad.post.settings import PostSettings
 from tests.gears import GEAR_CASES
 from tests.workbench_helper import REFERENCE_JOB, ROOT, small_job_text
 
@@ -37,32 +39,96 @@ def wb(monkeypatch):
 
 # --- job_from_dict -------------------------------------------------------------------------------
 
+# The reference job file's values, written out by hand (keys the file omits have the documented defaults).
+REFERENCE_VALUES = {
+    "job": JobSection(name="reference gear z23 m4", profile_tolerance_mm=0.001),
+    "gear": GearSection(teeth=23, module_mm=4.0, face_width_mm=20.0, pressure_angle_deg=20.0,
+                        profile_shift_coefficient=0.0, addendum_coefficient=1.0, dedendum_coefficient=1.25,
+                        rack_tip_radius_mm=0.8, thickness_allowance_percent=5.0, thickness_allowance_mm=0.0),
+    "stock": StockSpec(radial_allowance_mm=0.5, front_margin_mm=1.0, back_margin_mm=2.0, stub_diameter_mm=80.0,
+                       stub_length_mm=40.0),
+    "tools.roughing": Tool(diameter_mm=3.5, kind="flat", flutes=3, flute_length_mm=12.0, stick_out_mm=15.0,
+                           tool_number=1, cutting_speed_m_min=80.0, feed_per_tooth_mm=0.015),
+    "tools.finishing": Tool(diameter_mm=2.0, kind="bull_nose", corner_radius_mm=0.5, flutes=2, flute_length_mm=12.0,
+                            stick_out_mm=15.0, tool_number=2, cutting_speed_m_min=120.0, feed_per_tooth_mm=0.02),
+    "roughing": RoughingParams(flank_allowance_mm=0.3, finish_stock_mm=0.02, step_over_fraction=0.5,
+                               max_level_depth_fraction=0.5, clamp_rotary=False),
+    "finishing": FinishingParams(strategy="perimeter", target_scallop_mm=0.005, step_over_mm=0.0),
+    "machine": Machine(name="vertical machining centre with rotary table (reference process)",
+                       max_spindle_rpm=7000.0, max_feed_mm_min=5000.0, max_rotary_speed_deg_min=3600.0,
+                       clearance_mm=1.0, block_time_s=0.004),
+    "post": PostSettings(dialect="linuxcnc", folded=True, line_numbers=False),
+    "simulation": SimulationSection(enabled=True, resolution_mm=0.005),
+}
 
-def test_job_from_dict_is_parse_job_without_text():
+
+@pytest.mark.parametrize("load", ["parse_job", "job_from_dict"])
+def test_the_reference_job_holds_the_values_written_in_the_file(load):
     text = REFERENCE_JOB.read_text()
-    assert job_from_dict(tomllib.loads(text), "doc") == dataclasses.replace(parse_job(text, "x"), source="doc")
+    job = parse_job(text, "doc") if load == "parse_job" else job_from_dict(tomllib.loads(text), "doc")
+    assert job.source == "doc"
+    for name, expected in REFERENCE_VALUES.items():
+        assert job.section(name) == expected, name
+    # and every key in the file, as tomllib reads it, with the type the job file declares (int -> float)
+    data = tomllib.loads(text)
+    tables = {**{k: v for k, v in data.items() if k != "tools"}, **{f"tools.{k}": v for k, v in data["tools"].items()}}
+    for name, table in tables.items():
+        for key, value in table.items():
+            held = getattr(job.section(name), key)
+            assert held == value and type(held) is type(getattr(REFERENCE_VALUES[name], key)), (name, key)
+    assert job.gear.thickness_allowance_fraction == pytest.approx(0.05)
 
 
-@pytest.mark.parametrize("old, new, message", [
-    ("flutes = 3", "flutes = 3.5", "doc: [tools.roughing] flutes must be a whole number, got 3.5"),
-    ("teeth = 23", "teeth = 3", "doc: invalid gear: teeth = 3: too few teeth"),
-    ("max_spindle_rpm = 7000.0", "max_spindle_rmp = 7000.0", "doc: unknown key 'max_spindle_rmp' in [machine]"),
-    ('strategy = "perimeter"', 'strategy = "spiral"', "doc: [finishing] strategy 'spiral' is unknown"),
-])
-def test_job_from_dict_messages_are_parse_jobs_without_line(old, new, message):
+# (old text, new text, the message after "doc:<line>: " / "doc: ", the key whose line it names)
+MESSAGES = [
+    ("flutes = 3", "flutes = 3.5", "[tools.roughing] flutes must be a whole number, got 3.5", "flutes"),
+    ("teeth = 23", "teeth = 3", "[gear] teeth must be in 5..1000, got 3", "teeth"),
+    ("max_spindle_rpm = 7000.0", "max_spindle_rmp = 7000.0", "unknown key 'max_spindle_rmp' in [machine]",
+     "max_spindle_rmp"),
+    ('strategy = "perimeter"', 'strategy = "spiral"', "[finishing] strategy 'spiral' is unknown", "strategy"),
+    ("feed_per_tooth_mm = 0.015", "feed_per_tooth_mm = inf",
+     "[tools.roughing] feed_per_tooth_mm must be a finite number, got inf", "feed_per_tooth_mm"),
+    ("finish_stock_mm = 0.02 ", "finish_stock_mm = 0.5 ",
+     "[roughing] finish_stock_mm = 0.5 must be below flank_allowance_mm = 0.3", "finish_stock_mm"),
+    ("rack_tip_radius_mm = 0.8", "rack_tip_radius_mm = 2.5",
+     "invalid gear: rack_tip_radius_mm = 2.5 mm is outside the accepted range [0, 2.4] mm", "rack_tip_radius_mm"),
+    ("stub_diameter_mm = 80.0", "stub_diameter_mm = 200.0",
+     "invalid [stock]: stub diameter 200 mm is larger than the blank", "stub_diameter_mm"),
+]
+
+
+@pytest.mark.parametrize("old, new, message, key", MESSAGES)
+def test_messages_name_the_key_and_its_line(old, new, message, key):
     text = REFERENCE_JOB.read_text()
     assert old in text
     bad = text.replace(old, new)
+    line = next(n for n, content in enumerate(bad.splitlines(), start=1) if content.startswith(new.strip()))
+    assert bad.splitlines()[line - 1].startswith(key)
     with pytest.raises(JobFileError) as from_file:
         parse_job(bad, "doc")
     with pytest.raises(JobFileError) as from_dict:
         job_from_dict(tomllib.loads(bad), "doc")
-    assert str(from_dict.value).startswith(message)
-    assert re.match(r"doc:\d+: ", str(from_file.value))
-    assert re.sub(r"^doc:\d+: ", "doc: ", str(from_file.value)) == str(from_dict.value)
+    assert str(from_file.value).startswith(f"doc:{line}: {message}"), str(from_file.value)
+    assert str(from_dict.value).startswith(f"doc: {message}"), str(from_dict.value)
 
 
 # --- schema --------------------------------------------------------------------------------------
+
+# Every input property name of schema version 1: saved documents use them, so they never change.
+V1_PROPERTIES = {
+    "gear": "Teeth Module PressureAngle ProfileShift FaceWidth AddendumCoefficient DedendumCoefficient RackTipRadius "
+            "ThicknessAllowancePercent ThicknessAllowance BoreDiameter KeywayWidth KeywayDepth",
+    "stock": "RadialAllowance FrontMargin BackMargin StubDiameter StubLength",
+    "job": "JobName ProfileTolerance UseRoughingTool RoughingToolKind RoughingToolDiameter RoughingCornerRadius "
+           "RoughingFlutes RoughingFluteLength RoughingStickOut RoughingToolNumber RoughingCuttingSpeed "
+           "RoughingFeedPerTooth UseFinishingTool FinishingToolKind FinishingToolDiameter FinishingCornerRadius "
+           "FinishingFlutes FinishingFluteLength FinishingStickOut FinishingToolNumber FinishingCuttingSpeed "
+           "FinishingFeedPerTooth FlankAllowance FinishStock StepOverFraction MaxLevelDepthFraction ClampRotary "
+           "FinishingStrategy TargetScallop FinishingStepOver MachineName MaxSpindleRpm MaxFeed RapidFeed "
+           "MaxRotarySpeed Clearance BlockTime RotaryContinuous AMin AMax XMin XMax YMin YMax ZMin ZMax "
+           "RotaryClampCode RotaryUnclampCode SimulationEnabled SimulationResolution PostDialect LineNumbers "
+           "LineNumberStep MaxLineNumber LineNumberOverflow Folded RotarySign RotaryMode ProgramNumber Coolant",
+}
 
 
 def _section_classes() -> dict[str, type]:
@@ -74,29 +140,75 @@ def _section_classes() -> dict[str, type]:
     return sections
 
 
-def test_every_job_file_key_has_exactly_one_property(wb):
+def test_every_job_file_key_has_exactly_one_property_with_its_old_name(wb):
     fields = [f for fs in wb.schema.FIELDS.values() for f in fs if f.key]
     pairs = [(f.section, f.key) for f in fields]
     expected = {(name, field.name) for name, cls in _section_classes().items() for field in dataclasses.fields(cls)}
     assert sorted(pairs) == sorted(expected)
     props = [f.prop for fs in (*wb.schema.FIELDS.values(), *wb.schema.OUTPUTS.values()) for f in fs]
     assert len(props) == len(set(props))
-    assert all(f.kind in wb.schema.PROPERTY_TYPES for fs in wb.schema.FIELDS.values() for f in fs)
+    for role, names in V1_PROPERTIES.items():  # new keys may add properties; none of these may go or move
+        assert set(names.split()) <= {f.prop for f in wb.schema.FIELDS[role]}, role
 
 
-def test_property_kinds_match_the_job_files_types(wb):
-    """int keys are integer properties, bool keys booleans, str keys strings or choices, numbers numeric."""
-    numeric = {"length", "distance", "angle", "float"}
-    for role, fields in wb.schema.FIELDS.items():
-        for f in fields:
-            if not f.key:
-                assert f.kind == "bool"
-                continue
-            annotation = typing.get_type_hints(_section_classes()[f.section])[f.key]
-            allowed = {int: {"int"}, bool: {"bool"}, str: {"string", "choice"}, float: numeric}[annotation]
-            assert f.kind in allowed, f
-            if f.key.endswith("_deg"):
-                assert f.kind == "angle", f
+def test_properties_carry_the_keys_meaning_group_and_unit(wb):
+    """Tooltip = the key's meaning (with its unit where the property type has none), group = the key's group."""
+    from spur_cad.keys import keys_of
+
+    for f in (f for fs in wb.schema.FIELDS.values() for f in fs if f.key):
+        k = next(k for k in keys_of(_section_classes()[f.section]) if k.name == f.key)
+        assert f.doc.startswith(k.meaning) and f.group == k.group.format(Role=f.section[6:].capitalize()), f
+        assert f.unit == k.unit
+
+
+# The documented mapping (schema.py's docstring), checked on properties of every row.
+EXPECTED_TYPES = {
+    "Module": "App::PropertyLength", "FaceWidth": "App::PropertyLength", "RoughingFeedPerTooth": "App::PropertyLength",
+    "XMin": "App::PropertyDistance", "ZMax": "App::PropertyDistance",
+    "PressureAngle": "App::PropertyAngle", "AMin": "App::PropertyFloat", "AMax": "App::PropertyFloat",
+    "MaxFeed": "App::PropertySpeed", "RapidFeed": "App::PropertySpeed",
+    "RoughingCuttingSpeed": "App::PropertyFloat", "MaxSpindleRpm": "App::PropertyFloat",
+    "MaxRotarySpeed": "App::PropertyFloat", "BlockTime": "App::PropertyFloat",
+    "ThicknessAllowancePercent": "App::PropertyFloat", "ProfileShift": "App::PropertyFloat",
+    "Teeth": "App::PropertyInteger", "RotarySign": "App::PropertyInteger", "ClampRotary": "App::PropertyBool",
+    "PostDialect": "App::PropertyEnumeration", "FinishingStrategy": "App::PropertyEnumeration",
+    "RoughingToolKind": "App::PropertyEnumeration", "RotaryMode": "App::PropertyEnumeration",
+    "JobName": "App::PropertyString", "RotaryClampCode": "App::PropertyString",
+}
+
+
+def test_property_types_follow_the_documented_unit_mapping(wb):
+    for prop, expected in EXPECTED_TYPES.items():
+        assert wb.schema.field_by_prop(prop).property_type == expected, prop
+    numeric = {"length", "distance", "angle", "speed", "float"}
+    for f in (f for fs in wb.schema.FIELDS.values() for f in fs):
+        if not f.key:
+            assert f.kind == "bool"
+            continue
+        annotation = typing.get_type_hints(_section_classes()[f.section])[f.key]
+        allowed = {int: {"int"}, bool: {"bool"}, str: {"string", "choice"}, float: numeric}[annotation]
+        assert f.kind in allowed, f
+        if f.kind == "length":
+            assert f.unit == "mm"
+        if f.kind == "angle":
+            assert f.unit == "deg"
+
+
+def test_plain_values_convert_freecads_quantities(wb):
+    class Quantity:  # what FreeCAD returns for unit-carrying properties: Value in mm, deg or mm/s
+        def __init__(self, value):
+            self.Value = value
+
+        def getValueAs(self, unit):
+            assert unit == "mm/min"
+            return self.Value * 60.0
+
+    speed, length = wb.schema.field_by_prop("MaxFeed"), wb.schema.field_by_prop("Module")
+    assert wb.schema.plain_value(speed, Quantity(5000.0 / 60.0)) == 5000.0
+    for feed in (5000.0, 777.7, 1000.1, 12345.6):  # as a document saves the speed: 16 digits in mm/s
+        assert wb.schema.plain_value(speed, Quantity(float(f"{feed / 60.0:.16g}"))) == feed
+    assert wb.schema.plain_value(length, Quantity(4.0)) == 4.0
+    assert wb.schema.plain_value(speed, 4000.0) == 4000.0  # a PropertyFloat of a schema-1 document
 
 
 def test_defaults_are_in_the_choices(wb):
@@ -174,7 +286,7 @@ def test_gear_errors_are_filed_under_gear(wb):
     values["gear"]["Teeth"] = 3
     result = wb.validation.validate(values, "doc")
     assert list(result.messages) == ["Gear"]
-    assert result.messages["Gear"].startswith("invalid gear: teeth = 3: too few teeth")
+    assert result.messages["Gear"] == "[gear] teeth must be in 5..1000, got 3"
 
 
 @pytest.mark.parametrize("name", sorted(GEAR_CASES))

@@ -10,6 +10,7 @@ from dataclasses import dataclass
 
 from spur_cad.errors import GearSpecError, StockError
 from spur_cad.geometry.spec import GearSpec
+from spur_cad.keys import check_section, key
 
 
 @dataclass(frozen=True)
@@ -55,18 +56,20 @@ class StockSpec:
     """[stock]: blank cylinder of tip diameter + 2 x radial allowance, from X = -front margin to
     face width + back margin, optionally continued by a holding stub toward the chuck (+X)."""
 
-    radial_allowance_mm: float = 0.5
-    front_margin_mm: float = 1.0
-    back_margin_mm: float = 1.0
-    stub_diameter_mm: float = 0.0
-    stub_length_mm: float = 0.0
+    radial_allowance_mm: float = key(0.5, unit="mm", low=0.0, high=50.0, label="RadialAllowance", group="Stock",
+                                     meaning="blank radius = tip radius + this allowance")
+    front_margin_mm: float = key(1.0, unit="mm", low=0.0, high=500.0, label="FrontMargin", group="Stock",
+                                 meaning="blank beyond the front face X = 0")
+    back_margin_mm: float = key(1.0, unit="mm", low=0.0, high=500.0, label="BackMargin", group="Stock",
+                                meaning="blank beyond the back face X = b")
+    stub_diameter_mm: float = key(0.0, unit="mm", low=0.0, high=2000.0, label="StubDiameter", group="Holding stub",
+                                  meaning="diameter of the holding stub toward the chuck (+X), 0: none")
+    stub_length_mm: float = key(0.0, unit="mm", low=0.0, high=1000.0, label="StubLength", group="Holding stub",
+                                meaning="length of the holding stub, 0: none")
 
     def validate(self, spec: GearSpec) -> None:
-        for name in ("radial_allowance_mm", "front_margin_mm", "back_margin_mm", "stub_diameter_mm",
-                     "stub_length_mm"):
-            value = getattr(self, name)
-            if not math.isfinite(value) or value < 0.0:
-                raise StockError(f"{name} = {value:g} mm must not be negative", field=name)
+        """Raise StockError for keys outside their ranges, a half-given stub or one wider than the blank."""
+        check_section(self, "stock", StockError)
         if (self.stub_diameter_mm > 0.0) != (self.stub_length_mm > 0.0):
             raise StockError("a holding stub needs both stub_diameter_mm and stub_length_mm",
                                 field="stub_diameter_mm")

@@ -5,6 +5,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from spur_cad.errors import SpurCadError
+from spur_cad.keys import check_section, key
 
 
 class MachineError(SpurCadError, ValueError):
@@ -15,35 +16,49 @@ class MachineError(SpurCadError, ValueError):
 class Machine:
     """[machine]: limits and habits of the machining centre and its rotary table (4th axis A)."""
 
-    name: str = "generic 4-axis VMC"
-    max_spindle_rpm: float = 7000.0
-    max_feed_mm_min: float = 5000.0
-    rapid_feed_mm_min: float = 15000.0
-    max_rotary_speed_deg_min: float = 3600.0
-    clearance_mm: float = 1.0
-    block_time_s: float = 0.004
-    rotary_continuous: bool = True
-    a_min_deg: float = -99999.0
-    a_max_deg: float = 99999.0
-    x_min_mm: float = -1000.0
-    x_max_mm: float = 1000.0
-    y_min_mm: float = -1000.0
-    y_max_mm: float = 1000.0
-    z_min_mm: float = -1000.0
-    z_max_mm: float = 1000.0
-    rotary_clamp_code: str = ""
-    rotary_unclamp_code: str = ""
+    name: str = key("generic 4-axis VMC", label="MachineName", group="Machine",
+                    meaning="machine name (summary, program headers)")
+    max_spindle_rpm: float = key(7000.0, unit="1/min", low=100.0, high=100000.0, label="MaxSpindleRpm",
+                                 group="Machine", meaning="spindle speed limit")
+    max_feed_mm_min: float = key(5000.0, unit="mm/min", low=10.0, high=100000.0, label="MaxFeed", group="Machine",
+                                 meaning="linear feed limit")
+    rapid_feed_mm_min: float = key(15000.0, unit="mm/min", low=10.0, high=200000.0, label="RapidFeed",
+                                   group="Machine", meaning="rapid traverse rate (cycle-time estimate)")
+    max_rotary_speed_deg_min: float = key(3600.0, unit="deg/min", low=1.0, high=500000.0, label="MaxRotarySpeed",
+                                          group="Machine", meaning="rotary axis speed limit")
+    clearance_mm: float = key(1.0, unit="mm", low=0.0, high=100.0, label="Clearance", group="Machine",
+                              meaning="clearance of non-cutting moves from the stock")
+    block_time_s: float = key(0.004, unit="s", low=0.0, high=1.0, label="BlockTime", group="Machine",
+                              meaning="the control's block processing time (cycle-time estimate)")
+    rotary_continuous: bool = key(True, label="RotaryContinuous", group="Machine",
+                                  meaning="A turns without limits (false: finishing unwinds A after every station)")
+    a_min_deg: float = key(-99999.0, unit="deg", low=-99999.0, high=99999.0, label="AMin", group="Machine",
+                           meaning="A travel limit, low (used when rotary_continuous = false)")
+    a_max_deg: float = key(99999.0, unit="deg", low=-99999.0, high=99999.0, label="AMax", group="Machine",
+                           meaning="A travel limit, high (used when rotary_continuous = false)")
+    x_min_mm: float = key(-1000.0, unit="mm", low=-10000.0, high=10000.0, label="XMin", group="Machine",
+                          meaning="X travel limit, low")
+    x_max_mm: float = key(1000.0, unit="mm", low=-10000.0, high=10000.0, label="XMax", group="Machine",
+                          meaning="X travel limit, high")
+    y_min_mm: float = key(-1000.0, unit="mm", low=-10000.0, high=10000.0, label="YMin", group="Machine",
+                          meaning="Y travel limit, low")
+    y_max_mm: float = key(1000.0, unit="mm", low=-10000.0, high=10000.0, label="YMax", group="Machine",
+                          meaning="Y travel limit, high")
+    z_min_mm: float = key(-1000.0, unit="mm", low=-10000.0, high=10000.0, label="ZMin", group="Machine",
+                          meaning="Z travel limit, low")
+    z_max_mm: float = key(1000.0, unit="mm", low=-10000.0, high=10000.0, label="ZMax", group="Machine",
+                          meaning="Z travel limit, high")
+    rotary_clamp_code: str = key("", label="RotaryClampCode", group="Machine",
+                                 meaning="M code clamping A (needed by [roughing] clamp_rotary)")
+    rotary_unclamp_code: str = key("", label="RotaryUnclampCode", group="Machine",
+                                   meaning="M code unclamping A (needed by [roughing] clamp_rotary)")
 
     def validate(self) -> None:
-        for name in ("max_spindle_rpm", "max_feed_mm_min", "rapid_feed_mm_min", "max_rotary_speed_deg_min"):
-            if not getattr(self, name) > 0.0:
-                raise MachineError(f"[machine] {name} = {getattr(self, name):g} must be positive")
-        if self.clearance_mm < 0.0 or self.block_time_s < 0.0:
-            raise MachineError("[machine] clearance_mm and block_time_s must not be negative")
+        check_section(self, "machine", MachineError)
         for low, high in (("a_min_deg", "a_max_deg"), ("x_min_mm", "x_max_mm"), ("y_min_mm", "y_max_mm"),
                           ("z_min_mm", "z_max_mm")):
             if not getattr(self, low) < getattr(self, high):
-                raise MachineError(f"[machine] {low} must be below {high}")
+                raise MachineError(f"[machine] {low} must be below {high}", field=low)
 
 
 def check_travel(machine: Machine, x, y, z, a, operation: str) -> None:
@@ -67,36 +82,46 @@ def check_travel(machine: Machine, x, y, z, a, operation: str) -> None:
 class RoughingParams:
     """[roughing]: METHOD.md 4. Allowances are measured from the designed flank."""
 
-    flank_allowance_mm: float = 0.1  # largest staircase left on the flanks (ofst)
-    finish_stock_mm: float = 0.02  # roughing never comes closer than this to the design
-    step_over_fraction: float = 0.5  # Y step between passes of a level, x D
-    max_level_depth_fraction: float = 0.5  # slotting depth limit per level, x D
-    clamp_rotary: bool = False  # clamp A around each space (needs the machine's codes)
+    flank_allowance_mm: float = key(0.1, unit="mm", low=0.0, high=5.0, low_open=True, label="FlankAllowance",
+                                    group="Roughing strategy",
+                                    meaning="largest staircase roughing leaves on the flanks (ofst)")
+    finish_stock_mm: float = key(0.02, unit="mm", low=0.0, high=2.0, label="FinishStock", group="Roughing strategy",
+                                 meaning="roughing never comes closer than this to the design "
+                                         "(below flank_allowance_mm)")
+    step_over_fraction: float = key(0.5, low=0.0, high=1.0, low_open=True, label="StepOverFraction",
+                                    group="Roughing strategy", meaning="Y step between passes of a level, x D")
+    max_level_depth_fraction: float = key(0.5, low=0.0, high=2.0, low_open=True, label="MaxLevelDepthFraction",
+                                          group="Roughing strategy", meaning="slotting depth limit per level, x D")
+    clamp_rotary: bool = key(False, label="ClampRotary", group="Roughing strategy",
+                             meaning="clamp A around each tooth space (needs the machine's clamp codes)")
 
     def validate(self) -> None:
-        if not 0.0 <= self.finish_stock_mm < self.flank_allowance_mm:
-            raise MachineError(f"[roughing] finish_stock_mm = {self.finish_stock_mm:g} must be at least 0 and below "
-                               f"flank_allowance_mm = {self.flank_allowance_mm:g}")
-        if not 0.0 < self.step_over_fraction <= 1.0:
-            raise MachineError(f"[roughing] step_over_fraction = {self.step_over_fraction:g} must be in (0, 1]")
-        if not 0.0 < self.max_level_depth_fraction <= 2.0:
-            raise MachineError(f"[roughing] max_level_depth_fraction = {self.max_level_depth_fraction:g} "
-                               "must be in (0, 2]")
+        check_section(self, "roughing", MachineError)
+        if not self.finish_stock_mm < self.flank_allowance_mm:
+            raise MachineError(f"[roughing] finish_stock_mm = {self.finish_stock_mm:g} must be below "
+                               f"flank_allowance_mm = {self.flank_allowance_mm:g}", field="finish_stock_mm")
+
+
+def _strategy_names() -> tuple[str, ...]:
+    """The finishing strategies' names, from the registry (which imports this module, hence the late import)."""
+    from spur_cad.cam.strategies import strategy_names
+
+    return strategy_names()
 
 
 @dataclass(frozen=True)
 class FinishingParams:
     """[finishing]: METHOD.md 5."""
 
-    strategy: str = "perimeter"  # a name in spur_cad.cam.strategies.REGISTRY
-    target_scallop_mm: float = 0.005
-    step_over_mm: float = 0.0  # X step between stations; 0: derived from the target scallop
+    strategy: str = key("perimeter", label="FinishingStrategy", group="Finishing strategy",
+                        meaning="a finishing strategy name (see docs/cam.md)", names_from=_strategy_names)
+    target_scallop_mm: float = key(0.005, unit="mm", low=0.0001, high=0.1, label="TargetScallop",
+                                   group="Finishing strategy", meaning="target scallop height")
+    step_over_mm: float = key(0.0, unit="mm", low=0.0, high=2000.0, label="FinishingStepOver",
+                              group="Finishing strategy", meaning="X step between stations, 0: from the target scallop")
 
     def validate(self) -> None:
+        check_section(self, "finishing", MachineError)
         from spur_cad.cam.strategies import get_strategy  # the registry imports this module
 
         get_strategy(self.strategy)
-        if not 0.0 < self.target_scallop_mm <= 0.1:
-            raise MachineError(f"[finishing] target_scallop_mm = {self.target_scallop_mm:g} must be in (0, 0.1]")
-        if self.step_over_mm < 0.0:
-            raise MachineError(f"[finishing] step_over_mm = {self.step_over_mm:g} must not be negative")

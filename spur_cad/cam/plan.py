@@ -93,7 +93,7 @@ def check_cam_inputs(inputs: CamInputs) -> tuple[ToolRecommendations, RoughingLe
     tool = inputs.roughing_tool
     inputs.roughing.validate()
     moves, driver = estimated_roughing_moves(spec, tool, inputs.roughing, blank)
-    check_moves("roughing", moves, f"raise [roughing] {driver}", f"roughing.{driver}")
+    check_moves("roughing", moves, "roughing", driver)
     levels = roughing_levels(spec, tool, inputs.roughing, blank)
     if inputs.finishing_tool is not None:
         check_roughing_reach(tool, levels.lowest_height_mm - spec.root_radius_mm, rec)
@@ -115,11 +115,11 @@ def plan_cam(inputs: CamInputs) -> CamPlan:
     return CamPlan(rec, roughing, finishing, tuple(warnings))
 
 
-def check_moves(operation: str, moves: int, remedy: str, key: str) -> None:
-    """Refuse (WorkLimitError naming `key`) an operation whose estimated moves exceed MAX_TOOLPATH_MOVES."""
+def check_moves(operation: str, moves: int, section: str, field: str) -> None:
+    """Refuse (WorkLimitError naming [section] field) an operation whose estimated moves exceed MAX_TOOLPATH_MOVES."""
     if moves > MAX_TOOLPATH_MOVES:
         raise WorkLimitError(f"{operation} would need about {moves:.2g} moves (limit {MAX_TOOLPATH_MOVES:.0e}); "
-                             f"{remedy}", key=key)
+                             f"raise [{section}] {field}", field=field, section=section)
 
 
 def _plan_roughing(inputs: CamInputs, levels: RoughingLevels, blank: float) -> RoughingPlan:
@@ -142,10 +142,9 @@ def check_finishing_work(spec: GearSpec, tool: Tool, section: FinishingParams, *
     if counts.flank > MAX_CONTACTS_PER_FLANK:
         raise WorkLimitError(f"finishing would need more than {MAX_CONTACTS_PER_FLANK:,} contact points per flank "
                              f"for target_scallop_mm = {params.target_scallop_mm:.3g}; raise [finishing] "
-                             "target_scallop_mm", key="finishing.target_scallop_mm")
+                             "target_scallop_mm", field="target_scallop_mm", section="finishing")
     driver = "step_over_mm" if getattr(params, "step_over_mm", 0.0) > 0.0 else "target_scallop_mm"
-    check_moves("finishing", strategy.estimate_moves(spec, tool, params), f"raise [finishing] {driver}",
-                f"finishing.{driver}")
+    check_moves("finishing", strategy.estimate_moves(spec, tool, params), "finishing", driver)
 
 
 def _plan_finishing(inputs: CamInputs, blank: float) -> FinishingPlan:

@@ -7,6 +7,7 @@ from dataclasses import dataclass
 
 from spur_cad.cam.machine import Machine
 from spur_cad.errors import SpurCadError
+from spur_cad.keys import check_section, key
 
 TOOL_KINDS = ("flat", "bull_nose", "ball")
 
@@ -20,38 +21,40 @@ class Tool:
     """[tools.roughing] / [tools.finishing]: an end mill. `corner_radius_mm` is r_t of a bull-nose
     (0 for flat, D/2 for ball); flat width d = D - 2 r_t."""
 
-    diameter_mm: float
-    kind: str = "flat"
-    corner_radius_mm: float = 0.0
-    flutes: int = 2
-    flute_length_mm: float = 0.0  # 0: not given (no check)
-    stick_out_mm: float = 0.0  # 0: not given (no check)
-    tool_number: int = 1
-    cutting_speed_m_min: float = 100.0
-    feed_per_tooth_mm: float = 0.02
+    diameter_mm: float = key(unit="mm", low=0.1, high=100.0, label="{Role}ToolDiameter", group="{Role} tool",
+                             meaning="tool diameter D")
+    kind: str = key("flat", label="{Role}ToolKind", group="{Role} tool", names_from=lambda: TOOL_KINDS,
+                    meaning="end mill shape: flat, bull_nose or ball")
+    corner_radius_mm: float = key(0.0, unit="mm", low=0.0, high=50.0, label="{Role}CornerRadius", group="{Role} tool",
+                                  meaning="corner radius r_t: 0 flat, in (0, D/2) bull-nose, D/2 (or 0) ball")
+    flutes: int = key(2, low=1, high=20, label="{Role}Flutes", group="{Role} tool", meaning="number of flutes")
+    flute_length_mm: float = key(0.0, unit="mm", low=0.0, high=500.0, label="{Role}FluteLength", group="{Role} tool",
+                                 meaning="flute length, 0: not given (not checked)")
+    stick_out_mm: float = key(0.0, unit="mm", low=0.0, high=1000.0, label="{Role}StickOut", group="{Role} tool",
+                              meaning="stick-out from the holder, 0: not given (not checked)")
+    tool_number: int = key(1, low=1, high=9999, label="{Role}ToolNumber", group="{Role} tool",
+                           meaning="tool number in the machine's magazine (T word)")
+    cutting_speed_m_min: float = key(100.0, unit="m/min", low=1.0, high=3000.0, label="{Role}CuttingSpeed",
+                                     group="{Role} tool", meaning="cutting speed V_c (catalogue value)")
+    feed_per_tooth_mm: float = key(0.02, unit="mm", low=0.0005, high=2.0, label="{Role}FeedPerTooth",
+                                   group="{Role} tool", meaning="feed per tooth f_z (catalogue value)")
 
     def validate(self, role: str) -> None:
         """Raise ToolError for a tool that cannot exist; `role` names it in the message."""
+        check_section(self, f"tools.{role}", ToolError)
         if self.kind not in TOOL_KINDS:
-            raise ToolError(f"{role} tool kind '{self.kind}' is unknown (use one of {', '.join(TOOL_KINDS)})")
-        if not (math.isfinite(self.diameter_mm) and self.diameter_mm > 0.0):
-            raise ToolError(f"{role} tool diameter_mm = {self.diameter_mm:g} must be positive")
+            raise ToolError(f"{role} tool kind '{self.kind}' is unknown (use one of {', '.join(TOOL_KINDS)})",
+                            field="kind")
         r = self.corner_radius_mm
         if self.kind == "flat" and r != 0.0:
-            raise ToolError(f"{role} tool is flat but corner_radius_mm = {r:g}; use kind = \"bull_nose\"")
+            raise ToolError(f"{role} tool is flat but corner_radius_mm = {r:g}; use kind = \"bull_nose\"",
+                            field="corner_radius_mm")
         if self.kind == "bull_nose" and not 0.0 < r < self.diameter_mm / 2.0:
-            raise ToolError(f"{role} bull-nose corner_radius_mm = {r:g} must be in (0, {self.diameter_mm / 2:g})")
+            raise ToolError(f"{role} bull-nose corner_radius_mm = {r:g} must be in (0, {self.diameter_mm / 2:g})",
+                            field="corner_radius_mm")
         if self.kind == "ball" and abs(r - self.diameter_mm / 2.0) > 1e-9 and r != 0.0:
-            raise ToolError(f"{role} ball tool corner_radius_mm = {r:g} must equal diameter / 2 (or be omitted)")
-        for name in ("flutes", "tool_number"):
-            if getattr(self, name) < 1:
-                raise ToolError(f"{role} tool {name} = {getattr(self, name)} must be at least 1")
-        for name in ("cutting_speed_m_min", "feed_per_tooth_mm"):
-            if not getattr(self, name) > 0.0:
-                raise ToolError(f"{role} tool {name} = {getattr(self, name):g} must be positive")
-        for name in ("flute_length_mm", "stick_out_mm"):
-            if getattr(self, name) < 0.0:
-                raise ToolError(f"{role} tool {name} = {getattr(self, name):g} must not be negative")
+            raise ToolError(f"{role} ball tool corner_radius_mm = {r:g} must equal diameter / 2 (or be omitted)",
+                            field="corner_radius_mm")
 
     @property
     def effective_corner_radius_mm(self) -> float:

@@ -5,6 +5,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from spur_cad.errors import SpurCadError
+from spur_cad.keys import check_section, key
 
 DIALECT_NAMES = ("linuxcnc", "fanuc", "haas", "siemens", "okuma")
 
@@ -15,7 +16,7 @@ class PostError(SpurCadError, ValueError):
 
 @dataclass(frozen=True)
 class PostSettings:
-    """[post]: G-code dialect and formatting.
+    """[post]: G-code dialect and formatting (see docs/post.md).
 
     `rotary_sign` -1 is for tables whose A turns the other way (CONVENTIONS.md); `rotary_mode`
     "unwound" writes A as the toolpath has it, "wrapped" writes it in [0, 360) (flat programs only).
@@ -23,35 +24,33 @@ class PostSettings:
     the count, "stop" stops numbering).
     """
 
-    dialect: str = "linuxcnc"
-    line_numbers: bool = False
-    line_number_step: int = 1
-    max_line_number: int = 99999
-    line_number_overflow: str = "wrap"
-    folded: bool = True
-    rotary_sign: int = 1
-    rotary_mode: str = "unwound"
-    program_number: int = 1000
-    coolant: bool = True
+    dialect: str = key("linuxcnc", label="PostDialect", group="Post", names_from=lambda: DIALECT_NAMES,
+                       meaning="G-code dialect: linuxcnc (.ngc), fanuc (.nc), haas (.nc), siemens (.mpf, 840D), "
+                               "okuma (.min, OSP); see docs/post.md")
+    line_numbers: bool = key(False, label="LineNumbers", group="Post", meaning="write N block numbers")
+    line_number_step: int = key(1, low=1, high="max_line_number", label="LineNumberStep", group="Post",
+                                meaning="increment of the N words")
+    max_line_number: int = key(99999, low=1, high=99_999_999, label="MaxLineNumber", group="Post",
+                               meaning="N never passes this (the controller's limit)")
+    line_number_overflow: str = key("wrap", choices=("wrap", "stop"), label="LineNumberOverflow", group="Post",
+                                    meaning="at the limit: wrap restarts at the step, stop stops numbering")
+    folded: bool = key(True, label="Folded", group="Post",
+                       meaning="each tooth space written once as a subprogram / repeat section, called per space")
+    rotary_sign: int = key(1, choices=(1, -1), label="RotarySign", group="Post",
+                           meaning="-1 for a table whose A turns the other way")
+    rotary_mode: str = key("unwound", choices=("unwound", "wrapped"), label="RotaryMode", group="Post",
+                           meaning="unwound writes A as the toolpath has it, wrapped in [0, 360) "
+                                   "(flat programs only; Okuma adds M15/M16)")
+    program_number: int = key(1000, low=1, high=9999, label="ProgramNumber", group="Post",
+                              meaning="O number (Fanuc, Haas, Okuma); subprograms take the next numbers")
+    coolant: bool = key(True, label="Coolant", group="Post", meaning="M8 after the spindle starts, M9 before it stops")
 
     def validate(self) -> None:
+        check_section(self, "post", PostError)
         if self.dialect not in DIALECT_NAMES:
-            raise PostError(f"[post] dialect = {self.dialect!r} is not known (known: {', '.join(DIALECT_NAMES)})")
-        if self.rotary_sign not in (1, -1):
-            raise PostError(f"[post] rotary_sign must be 1 or -1, got {self.rotary_sign}")
-        if self.rotary_mode not in ("unwound", "wrapped"):
-            raise PostError(f"[post] rotary_mode must be 'unwound' or 'wrapped', got {self.rotary_mode!r}")
-        if self.line_number_overflow not in ("wrap", "stop"):
-            raise PostError(f"[post] line_number_overflow must be 'wrap' or 'stop', got {self.line_number_overflow!r}")
-        if not 1 <= self.max_line_number <= 99_999_999:
-            raise PostError(f"[post] max_line_number must be in 1..99999999, got {self.max_line_number}")
-        if not 1 <= self.line_number_step <= self.max_line_number:
-            raise PostError(f"[post] line_number_step must be in 1..max_line_number ({self.max_line_number}), "
-                            f"got {self.line_number_step}")
-        if not 1 <= self.program_number <= 9999:
-            raise PostError(f"[post] program_number must be in 1..9999 (it numbers the subprograms after it), "
-                            f"got {self.program_number}")
+            raise PostError(f"[post] dialect = {self.dialect!r} is not known (known: {', '.join(DIALECT_NAMES)})",
+                            field="dialect")
         if self.folded and self.rotary_mode == "wrapped":
             raise PostError("[post] folded = true needs rotary_mode = 'unwound': a folded space pattern adds "
                             "its angles to the space's base angle, which cannot stay inside [0, 360); "
-                            "set folded = false to write a wrapped program")
+                            "set folded = false to write a wrapped program", field="folded")

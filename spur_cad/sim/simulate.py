@@ -281,7 +281,8 @@ def check_design_size(spec: GearSpec, spacing_mm: float, length_mm: float, extra
     if values > MAX_DESIGN_VALUES:
         raise SimulationError(f"the simulation would measure about {values:.2g} design points (limit "
                               f"{MAX_DESIGN_VALUES:.0e}); raise [simulation] resolution_mm (now {resolution_mm:g} mm) "
-                              "or set [simulation] enabled = false", key="simulation.resolution_mm")
+                              "or set [simulation] enabled = false", field="resolution_mm",
+                              section="simulation")
 
 
 def point_spacing_mm(corner_radius_mm: float, resolution_mm: float) -> float:

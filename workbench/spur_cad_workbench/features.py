@@ -23,41 +23,64 @@ PROP_READ_ONLY = 1
 PROP_OUTPUT = 8
 
 
-def add_fields(obj, fields, values: dict | None = None, outputs: bool = False) -> None:
-    """Add the properties of `fields` that `obj` lacks; set them from `values` (inputs) when given."""
+def property_value(field, value):
+    """A job-file value as the property takes it: a speed as a Quantity in its key's unit (mm/min)."""
+    if field.kind == "speed":
+        return FreeCAD.Units.Quantity(f"{float(value)!r} {field.unit}")
+    return value
+
+
+def _set_choices(obj, field) -> bool:
+    """Give a drop-down property its list (keeping a value still in it); False if it had that list already."""
+    if list(obj.getEnumerationsOfProperty(field.prop) or []) == list(field.choices):
+        return False
+    current = getattr(obj, field.prop)
+    setattr(obj, field.prop, list(field.choices))
+    if current in field.choices:
+        setattr(obj, field.prop, current)
+    return True
+
+
+def add_fields(obj, fields, values: dict | None = None, outputs: bool = False) -> list[str]:
+    """Add the properties of `fields` that `obj` lacks, set them from `values` (inputs) when given;
+    re-create those whose saved type differs from the schema's (keeping the value) and update
+    drop-down lists. Returns the names of the properties added or changed."""
     attr = PROP_READ_ONLY | PROP_OUTPUT if outputs else 0
+    changed = []
     for field in fields:
+        value = values.get(field.prop) if values is not None else None
         if field.prop in obj.PropertiesList:
-            continue
+            if obj.getTypeIdOfProperty(field.prop) == field.property_type:
+                if field.kind == "choice" and _set_choices(obj, field):
+                    changed.append(field.prop)
+                continue
+            value = schema.plain_value(field, getattr(obj, field.prop))  # a type of an older schema
+            obj.removeProperty(field.prop)
         obj.addProperty(field.property_type, field.prop, field.group, field.doc, attr)
+        changed.append(field.prop)
         if field.kind == "choice":
             setattr(obj, field.prop, list(field.choices))
-        if values is not None and field.prop in values:
-            setattr(obj, field.prop, values[field.prop])
-
-
-def _plain(value):
-    """A property value as plain Python (Quantity -> float in mm or deg)."""
-    return float(value.Value) if hasattr(value, "Value") else value
+        if value is not None and not outputs:
+            setattr(obj, field.prop, property_value(field, value))
+    return changed
 
 
 def read_values(obj, fields) -> dict:
-    """{property name: plain value} of `fields` on `obj`."""
-    return {field.prop: _plain(getattr(obj, field.prop)) for field in fields}
+    """{property name: plain value in the job file's unit} of `fields` on `obj`."""
+    return {field.prop: schema.plain_value(field, getattr(obj, field.prop)) for field in fields}
 
 
 def write_values(obj, values: dict) -> None:
     """Set properties whose value differs (setting an equal value would still touch the object)."""
     for prop, value in values.items():
-        if _plain(getattr(obj, prop)) != value:
-            setattr(obj, prop, value)
+        field = schema.field_by_prop(prop)
+        if schema.plain_value(field, getattr(obj, prop)) != value:
+            setattr(obj, prop, property_value(field, value))
 
 
 def write_outputs(obj, values: dict) -> None:
     """Set read-only computed properties."""
-    for prop, value in values.items():
-        if _plain(getattr(obj, prop)) != value:
-            setattr(obj, prop, value)
+    write_values(obj, values)
 
 
 def add_bookkeeping(obj) -> None:
@@ -169,19 +192,20 @@ class _Proxy(_Stateless):
         obj.Proxy = self
 
     def onDocumentRestored(self, obj):
-        """Migrate an older document: add the properties this schema has and the document lacks."""
+        """Migrate an older document: add the properties this schema has and the document lacks, re-create
+        those whose type changed (keeping their values) and update drop-down lists."""
         version = obj.SchemaVersion if "SchemaVersion" in obj.PropertiesList else 0
         if version > schema.SCHEMA_VERSION:
             FreeCAD.Console.PrintWarning(f"{obj.Label}: saved by a newer spur_cad (schema {version}); "
                                          "properties it added are kept but not used\n")
             return
-        if version < schema.SCHEMA_VERSION:
-            defaults = schema.default_values().get(self.KIND, {})
-            add_fields(obj, self.FIELDS, defaults)
-            add_fields(obj, self.OUTPUTS, outputs=True)
+        defaults = schema.default_values().get(self.KIND, {})
+        changed = add_fields(obj, self.FIELDS, defaults) + add_fields(obj, self.OUTPUTS, outputs=True)
+        if changed or version < schema.SCHEMA_VERSION:
             add_bookkeeping(obj)
             obj.SchemaVersion = schema.SCHEMA_VERSION
-            FreeCAD.Console.PrintMessage(f"{obj.Label}: migrated from schema {version} to {schema.SCHEMA_VERSION}\n")
+            FreeCAD.Console.PrintMessage(f"{obj.Label}: migrated from schema {version} to {schema.SCHEMA_VERSION}"
+                                         f" ({', '.join(changed) or 'no property changed'})\n")
 
 
 class GearFeature(_Proxy):

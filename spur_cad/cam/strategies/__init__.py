@@ -28,7 +28,8 @@ def get_strategy(name: str) -> FinishingStrategy:
     try:
         return REGISTRY[name]
     except KeyError:
-        raise MachineError(f"[finishing] strategy '{name}' is unknown (use one of {', '.join(REGISTRY)})") from None
+        raise MachineError(f"[finishing] strategy '{name}' is unknown (use one of {', '.join(REGISTRY)})",
+                           field="strategy", section="finishing") from None
 
 
 __all__ = ["REGISTRY", "FinishingResult", "FinishingStrategy", "get_strategy", "params_from_section",
