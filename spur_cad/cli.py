@@ -10,6 +10,7 @@ from __future__ import annotations
 import argparse
 import shutil
 import sys
+import warnings
 from pathlib import Path
 
 from spur_cad import __version__
@@ -83,8 +84,13 @@ def _install_freecad(uninstall: bool) -> int:
 
 def main(argv: list[str] | None = None) -> int:
     args = _parser().parse_args(argv)
+    if not getattr(args, "debug", False):
+        # Numerical warnings (overflow in an intermediate, ...) are not messages for the user: an input
+        # problem is reported as one line, and results are checked, not warned about.
+        warnings.simplefilter("ignore", RuntimeWarning)
     if args.command == "install-freecad":
         return _install_freecad(args.uninstall)
+    job = None
     try:
         job = load_job(args.job)
         bars = ProgressBars(sys.stderr) if not args.quiet and sys.stderr.isatty() else None
@@ -101,7 +107,8 @@ def main(argv: list[str] | None = None) -> int:
         except OSError as exc:
             raise SpurCadError(f"cannot write to {out_dir}: {exc.strerror or exc}") from None
     except SpurCadError as exc:
-        print(f"spur-cad: error: {exc}", file=sys.stderr)
+        message = job.located(exc) if job is not None and exc.section else str(exc)
+        print(f"spur-cad: error: {message}", file=sys.stderr)
         return EXIT_INPUT_ERROR
     except Exception as exc:  # noqa: BLE001 - the CLI never shows a traceback unless asked
         if getattr(args, "debug", False):

@@ -125,6 +125,13 @@ class Job:
     machine: Machine = field(default_factory=Machine)
     post: PostSettings = field(default_factory=PostSettings)
     simulation: SimulationSection = field(default_factory=SimulationSection)
+    text: str = field(default="", repr=False, compare=False)  # the file's text, to point at lines
+
+    def located(self, error: SpurCadError) -> str:
+        """An error raised after loading, prefixed with 'file:line' of the key it blames (its section's
+        header when the file does not set the key, the file alone when the error names no key)."""
+        where = _where(self.source, self.text, error.section, error.field) if error.section else self.source
+        return f"{where}: {error}"
 
     def section(self, name: str):
         """The dataclass of section `name` ('gear', 'tools.roughing', ...); None for an absent tool."""
@@ -149,6 +156,8 @@ SECTIONS: dict[str, type] = {
     "post": PostSettings,
 }
 _TOOL_ROLES = ("roughing", "finishing")
+MAX_JOB_FILE_BYTES = 1024 * 1024
+"""Job files larger than this are refused before they are parsed."""
 
 
 def _line_of(text: str, table: str, key_name: str | None) -> int | None:
@@ -216,12 +225,29 @@ def _load_section(table: object, name: str, source: str, text: str):
     return cls(**values)
 
 
+def _deepest_value(text: str, source: str) -> str:
+    """'file:line: key' of the most deeply nested value (for the one error tomllib gives no position for)."""
+    best, where = 0, source
+    for number, line in enumerate(text.splitlines(), start=1):
+        name, sep, value = line.partition("=")
+        depth = len(value) - len(value.lstrip("[{ "))
+        if sep and depth > best:
+            best, where = depth, f"{source}:{number}: {name.strip()}"
+    return where
+
+
 def parse_job(text: str, source: str = "<job>") -> Job:
     """Validate a job file's text; raises JobFileError (or GearSpecError wrapped into it)."""
+    if len(text) > MAX_JOB_FILE_BYTES:
+        raise JobFileError(f"{source}: the job file is larger than {MAX_JOB_FILE_BYTES // 1024} KiB; a job file is "
+                           "a few kilobytes of TOML")
     try:
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
         raise JobFileError(f"{source}: not valid TOML: {exc}") from None
+    except RecursionError:
+        raise JobFileError(f"{_deepest_value(text, source)}: arrays or tables nested too deeply for a job file") \
+            from None
     return _job_from_data(data, source, text)
 
 
@@ -296,22 +322,28 @@ def _job_from_data(data: dict, source: str, text: str) -> Job:
     optional = {name: sections[name] for name in ("stock", "roughing", "finishing", "machine", "post", "simulation")
                 if name in sections}
     return Job(source=source, job=sections.get("job", JobSection()), gear_section=gear_section, gear=spec,
-               tools=tools, **optional)
+               tools=tools, **optional, text=text)
 
 
 def load_job(path: str | Path) -> Job:
     """Read and validate a job file from disk."""
     path = Path(path)
     try:
-        raw = path.read_bytes()
+        with path.open("rb") as handle:  # read no more than the limit (a device such as /dev/zero never ends)
+            raw = handle.read(MAX_JOB_FILE_BYTES + 1)
     except FileNotFoundError:
         raise JobFileError(f"{path}: job file not found") from None
     except OSError as exc:
         raise JobFileError(f"{path}: cannot read the job file: {exc.strerror}") from None
+    if len(raw) > MAX_JOB_FILE_BYTES:
+        raise JobFileError(f"{path}: the job file is larger than {MAX_JOB_FILE_BYTES // 1024} KiB; a job file is "
+                           "a few kilobytes of TOML")
     try:
         text = raw.decode("utf-8")
     except UnicodeDecodeError:
         raise JobFileError(f"{path}: the job file is not UTF-8 text") from None
+    if "\x00" in text:
+        raise JobFileError(f"{path}: the job file contains NUL characters (not a text file)")
     return parse_job(text, str(path))
 
 

@@ -156,7 +156,9 @@ def type_problem(k: Key, value: object) -> str | None:
         ok = isinstance(value, int) and not isinstance(value, bool)
     else:
         ok = isinstance(value, k.type)
-    return None if ok else f"must be {_TYPE_NAMES[k.type]}, got {value!r}"
+    if ok and isinstance(value, int) and not isinstance(value, bool) and abs(value) > MAX_INTEGER:
+        return f"must be a number of sensible size, got {_shown(value)}"
+    return None if ok else f"must be {_TYPE_NAMES[k.type]}, got {_shown(value)}"
 
 
 def coerce(k: Key, value: object) -> object:
@@ -215,6 +217,18 @@ def check_section(obj: object, section: str, error: type[Exception]) -> None:
 
 
 # --- formatting --------------------------------------------------------------------------------------------
+
+
+MAX_INTEGER = 10**15
+"""Integers beyond this are refused for every key (beyond a float's exact range; no key means them)."""
+
+
+def _shown(value: object, limit: int = 40) -> str:
+    """A value as a message shows it: no 400-digit integers, long text shortened."""
+    if isinstance(value, int) and not isinstance(value, bool) and abs(value) > MAX_INTEGER:
+        return f"a {len(str(abs(value)))}-digit number"
+    text = repr(value)
+    return text if len(text) <= limit else text[:limit - 3] + "..."
 
 
 def _number(value: object) -> str:

@@ -116,7 +116,7 @@ def _corner_poses(points: np.ndarray, normals: np.ndarray, tool: Tool, design: n
             else:
                 raise ToolError(f"finishing: the flank point at radius {radius[i]:.4f} mm cannot be reached by the "
                                 f"tool's corner without gouging (undercut); use a tool with a smaller diameter or "
-                                "corner radius")
+                                "corner radius", field="diameter_mm", section="tools.finishing")
         turns[i], (ys[i], zs[i]) = preferred, tip
     return TransversePoses(ys, zs, np.degrees(turns), radius)
 

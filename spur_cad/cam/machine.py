@@ -74,8 +74,10 @@ def check_travel(machine: Machine, x, y, z, a, operation: str) -> None:
         values = np.asarray(values)
         if len(values) and (values.min() < low or values.max() > high):
             worst = values.min() if values.min() < low else values.max()
+            bound = ("x", "y", "z", "a")["XYZA".index(name)] + ("_min" if worst < low else "_max") + \
+                ("_deg" if name == "A" else "_mm")
             raise MachineError(f"{operation} needs {name} = {worst:.3f} {unit}, outside the machine's travel "
-                               f"[{low:g}, {high:g}] {unit}")
+                               f"[{low:g}, {high:g}] {unit}", field=bound, section="machine")
 
 
 @dataclass(frozen=True)

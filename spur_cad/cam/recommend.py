@@ -1,4 +1,4 @@
-"""Tool recommendations and limits (METHOD.md 3), and the tooth space's width at a height.
+"""Tool recommendations and limits (docs/method.md), and the tooth space's width at a height.
 
 Heights are measured along the space's symmetry axis in the gap frame (y), as the tool sees
 them when the space axis points up the tool axis.
@@ -57,7 +57,7 @@ class ToolRecommendations:
 
 def recommend_tools(spec: GearSpec, blank_radius_mm: float, clearance_mm: float,
                     finishing_tool: Tool | None = None) -> ToolRecommendations:
-    """METHOD.md 3; A_p uses the chosen finishing tool's flat width, else the largest allowed."""
+    """docs/method.md; A_p uses the chosen finishing tool's flat width, else the largest allowed."""
     profile = spec.tooth_space_profile()
     max_flat = 2.0 * profile.root_arc_half_angle_rad * spec.root_radius_mm
     max_corner = profile.min_fillet_curvature_radius_mm
@@ -78,40 +78,45 @@ def check_tools(spec: GearSpec, recommendations: ToolRecommendations, roughing: 
         finishing.validate("finishing")
         if finishing.kind == "flat":
             raise ToolError("finishing tool must have a corner radius (bull_nose or ball): a sharp corner "
-                            "cannot follow the root fillet")
+                            "cannot follow the root fillet", field="kind", section="tools.finishing")
         if finishing.flat_width_mm > rec.finishing_max_flat_width_mm + 1e-9:
             raise ToolError(f"finishing tool flat width {finishing.flat_width_mm:.4f} mm (D - 2 r_t) exceeds "
                             f"finishing_max_flat_width_mm = {rec.finishing_max_flat_width_mm:.4f} mm "
-                            "(root arc length 2 v r_f)")
+                            "(root arc length 2 v r_f)", field="diameter_mm", section="tools.finishing")
         if finishing.effective_corner_radius_mm > rec.finishing_max_corner_radius_mm + 1e-9:
             raise ToolError(f"finishing tool corner radius {finishing.effective_corner_radius_mm:.4f} mm exceeds "
                             f"finishing_max_corner_radius_mm = {rec.finishing_max_corner_radius_mm:.4f} mm "
-                            "(smallest curvature radius of the root fillet)")
+                            "(smallest curvature radius of the root fillet)", field="corner_radius_mm",
+                            section="tools.finishing")
         _check_lengths(finishing, "finishing", rec)
     if roughing is not None:
         roughing.validate("roughing")
         if roughing.kind != "flat":
-            raise ToolError(f"roughing tool kind '{roughing.kind}': roughing uses a flat end mill (METHOD.md 4)")
+            raise ToolError(f"roughing tool kind '{roughing.kind}': roughing uses a flat end mill (docs/method.md)",
+                            field="kind", section="tools.roughing")
         if roughing.diameter_mm > rec.roughing_max_diameter_mm + 1e-9:
             raise ToolError(f"roughing tool diameter {roughing.diameter_mm:.4f} mm exceeds roughing_max_diameter_mm = "
                             f"{rec.roughing_max_diameter_mm:.4f} mm (space width at root radius + "
-                            f"A_p = {rec.plunge_allowance_mm:.4f} mm)")
+                            f"A_p = {rec.plunge_allowance_mm:.4f} mm)", field="diameter_mm", section="tools.roughing")
         _check_lengths(roughing, "roughing", rec)
 
 
 def check_roughing_reach(roughing: Tool, lowest_level_above_root_mm: float, rec: ToolRecommendations) -> None:
     """The material roughing leaves above the root must be within the finishing tool's plunge
-    capacity A_p (METHOD.md 3); raise ToolError otherwise."""
+    capacity A_p (docs/method.md); raise ToolError otherwise."""
     if lowest_level_above_root_mm > rec.plunge_allowance_mm + 1e-9:
         raise ToolError(f"roughing tool diameter {roughing.diameter_mm:g} mm leaves {lowest_level_above_root_mm:.3f} mm "
                         f"above the root, more than the finishing tool can plunge (A_p = "
-                        f"{rec.plunge_allowance_mm:.3f} mm); use a smaller roughing tool")
+                        f"{rec.plunge_allowance_mm:.3f} mm); use a smaller roughing tool", field="diameter_mm",
+                        section="tools.roughing")
 
 
 def _check_lengths(tool: Tool, role: str, rec: ToolRecommendations) -> None:
     if tool.flute_length_mm and tool.flute_length_mm < rec.required_flute_length_mm:
         raise ToolError(f"{role} tool flute_length_mm = {tool.flute_length_mm:g} is shorter than the "
-                        f"required_flute_length_mm = {rec.required_flute_length_mm:.3f} mm")
+                        f"required_flute_length_mm = {rec.required_flute_length_mm:.3f} mm", field="flute_length_mm",
+                        section=f"tools.{role}")
     if tool.stick_out_mm and tool.stick_out_mm < rec.required_stick_out_mm:
         raise ToolError(f"{role} tool stick_out_mm = {tool.stick_out_mm:g} is shorter than the "
-                        f"required_stick_out_mm = {rec.required_stick_out_mm:.3f} mm")
+                        f"required_stick_out_mm = {rec.required_stick_out_mm:.3f} mm", field="stick_out_mm",
+                        section=f"tools.{role}")

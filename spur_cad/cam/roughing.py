@@ -86,7 +86,8 @@ def roughing_levels(spec: GearSpec, tool: Tool, params: RoughingParams, blank_ra
     low, high = float(flank[:, 1].min()), tip_edge_height
     if width(high) < radius:
         raise ToolError(f"roughing tool diameter {tool.diameter_mm:g} mm does not fit the tooth space even at the tip "
-                        f"(space width {2 * width(high):.3f} mm there, finish stock included)")
+                        f"(space width {2 * width(high):.3f} mm there, finish stock included)", field="diameter_mm",
+                        section="tools.roughing")
     for _ in range(100):
         mid = 0.5 * (low + high)
         low, high = (mid, high) if width(mid) < radius else (low, mid)
@@ -131,7 +132,8 @@ def roughing_levels(spec: GearSpec, tool: Tool, params: RoughingParams, blank_ra
             lo, hi = (mid, hi) if staircase(h, mid) <= budget else (lo, mid)
         if lo - h < 1e-6:
             raise MachineError(f"[roughing] flank_allowance_mm = {params.flank_allowance_mm:g} is too small for "
-                               "this flank: the levels would be less than 1 nm apart")
+                               "this flank: the levels would be less than 1 nm apart", field="flank_allowance_mm",
+                               section="roughing")
         heights.append(lo)
     levels = np.array(heights[::-1])
     half_widths = np.array([width(h) for h in levels])
@@ -146,7 +148,8 @@ def roughing_toolpath(spec: GearSpec, tool: Tool, machine: Machine, params: Roug
     machine.validate()
     tool.validate("roughing")
     if params.clamp_rotary and not (machine.rotary_clamp_code and machine.rotary_unclamp_code):
-        raise MachineError("[roughing] clamp_rotary needs [machine] rotary_clamp_code and rotary_unclamp_code")
+        raise MachineError("[roughing] clamp_rotary needs [machine] rotary_clamp_code and rotary_unclamp_code",
+                           field="clamp_rotary", section="roughing")
     if levels is None:
         levels = roughing_levels(spec, tool, params, blank_radius_mm)
     radius = tool.diameter_mm / 2.0
@@ -154,7 +157,8 @@ def roughing_toolpath(spec: GearSpec, tool: Tool, machine: Machine, params: Roug
     x_back = spec.face_width_mm + radius + machine.clearance_mm
     if stub_radius_mm > levels.lowest_height_mm and back_margin_mm < radius + machine.clearance_mm:
         raise MachineError(f"the roughing tool would cut into the holding stub: its passes run to X = {x_back:.3f} mm; "
-                           f"make [stock] back_margin_mm at least {radius + machine.clearance_mm:.3f} mm")
+                           f"make [stock] back_margin_mm at least {radius + machine.clearance_mm:.3f} mm",
+                           field="back_margin_mm", section="stock")
     safe_z = safe_height_mm(blank_radius_mm, machine)
     feed = tool.feed_mm_min(machine)
     step = params.step_over_fraction * tool.diameter_mm
