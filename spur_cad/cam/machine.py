@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import re
 from dataclasses import dataclass
 
 from spur_cad.errors import SpurCadError
@@ -59,6 +60,20 @@ class Machine:
                           ("z_min_mm", "z_max_mm")):
             if not getattr(self, low) < getattr(self, high):
                 raise MachineError(f"[machine] {low} must be below {high}", field=low)
+        check_rotary_code(self.rotary_clamp_code, "rotary_clamp_code")
+        check_rotary_code(self.rotary_unclamp_code, "rotary_unclamp_code")
+
+
+ROTARY_CODE = re.compile(r"M\d{1,4}")
+"""A rotary clamp/unclamp code is one M code and nothing else (the post writes it as its own block)."""
+
+
+def check_rotary_code(code: str, key: str) -> None:
+    """Refuse a clamp/unclamp code that is anything but a single M code ("" means none)."""
+    if code and not ROTARY_CODE.fullmatch(code):
+        shown = repr(code if len(code) <= 20 else code[:17] + "...")
+        raise MachineError(f"[machine] {key} = {shown} must be a single M code such as 'M10' (the programs "
+                           "write it as a block of its own)", field=key, section="machine")
 
 
 def check_travel(machine: Machine, x, y, z, a, operation: str) -> None:

@@ -13,13 +13,31 @@ Runs whose text, written relative to their X and A base, is identical become one
 from __future__ import annotations
 
 import functools
+import math
+import re
 from dataclasses import dataclass
 
 import numpy as np
 
 from spur_cad.cam.ir import MoveKind, Toolpath
+from spur_cad.cam.machine import check_rotary_code
 from spur_cad.post.dialects import Dialect, dialect
 from spur_cad.post.settings import PostError, PostSettings
+
+MAX_COORDINATE_MM = 100_000.0
+"""Largest |X|, |Y|, |Z| a program may command (100 m: beyond any machining centre, far inside every
+control's number format); larger or non-finite values are refused."""
+
+_COMMENT_TRANSLATION = str.maketrans({"(": "[", ")": "]", ";": ",", "%": "?"})
+
+
+def inert_comment_text(text: str, max_length: int) -> str:
+    """User text made safe inside one comment of any dialect: printable ASCII only (white space and line
+    breaks become one space, anything else non-printable or non-ASCII becomes '?'), no comment delimiter,
+    no '%' (the end of a Fanuc tape), at most `max_length` characters ('...' marks a cut)."""
+    text = re.sub(r"\s+", " ", text)
+    text = "".join(c if " " <= c <= "~" else "?" for c in text).translate(_COMMENT_TRANSLATION).strip()
+    return text if len(text) <= max_length else text[:max_length - 3] + "..."
 
 
 @dataclass(frozen=True)
@@ -56,6 +74,7 @@ def post_program(path: Toolpath, settings: PostSettings, info: ProgramInfo) -> P
     d = dialect(settings.dialect)
     if len(path) == 0:
         raise PostError(f"{info.title}: the toolpath is empty")
+    _check_numbers(path, info)
     if settings.rotary_mode == "wrapped" and d.direction_codes is None:
         _check_shortest_path(path)
     lin, rot = 10 ** d.linear_decimals, 10 ** d.rotary_decimals
@@ -90,6 +109,23 @@ def post_program(path: Toolpath, settings: PostSettings, info: ProgramInfo) -> P
     text = writer.program(body, sub_bodies)
     return PostedProgram(text=text, extension=d.extension, lines=text.count("\n"), bytes=len(text.encode()),
                          subprograms=len(sub_bodies), calls=sum(1 for kind, _ in body if kind == "call"))
+
+
+def _check_numbers(path: Toolpath, info: ProgramInfo) -> None:
+    """Refuse what a control must never be given: non-finite or absurd coordinates, a tool number outside
+    1..9999, a spindle speed below 1 rpm, clamp codes that are more than one M code."""
+    for axis in ("x", "y", "z", "a"):
+        values = getattr(path, axis)
+        limit = MAX_COORDINATE_MM if axis != "a" else 360.0 * 1e6
+        if not np.all(np.isfinite(values)) or np.abs(values).max() > limit:
+            raise PostError(f"{info.title}: the toolpath has an {axis.upper()} value that is not a finite number "
+                            f"within +-{limit:g}")
+    if not 1 <= path.tool_number <= 9999:
+        raise PostError(f"{info.title}: tool number {path.tool_number} must be in 1..9999")
+    if not (math.isfinite(path.spindle_rpm) and path.spindle_rpm >= 1.0):
+        raise PostError(f"{info.title}: spindle speed {path.spindle_rpm:g} rpm would be written as S0")
+    check_rotary_code(info.rotary_clamp_code, "rotary_clamp_code")
+    check_rotary_code(info.rotary_unclamp_code, "rotary_unclamp_code")
 
 
 def _check_shortest_path(path: Toolpath) -> None:
@@ -155,7 +191,8 @@ class _Writer:
         self.tool, self.rpm = tool, rpm
 
     def comment(self, text: str) -> str:
-        text = text.replace("(", "[").replace(")", "]").replace(";", ",")
+        """One inert comment line (see inert_comment_text)."""
+        text = inert_comment_text(text, self.d.max_line_length - 4)
         if self.d.uppercase_comments:
             text = text.upper()
         return f"({text})" if self.d.comment_style == "paren" else f"; {text}"
@@ -228,9 +265,11 @@ class _Writer:
                     head.append("G1")
                     motion = "G1"
                 decimals = d.inverse_feed_decimals if inverse else d.feed_decimals
-                if not feed > 0.0:
+                if not (math.isfinite(feed) and feed > 0.0):
                     raise PostError(f"{self.info.title}: move {i} has no usable feed ({feed!r})")
                 f = int(round(feed * 10 ** decimals))
+                if f < 1:
+                    raise PostError(f"{self.info.title}: move {i}'s feed {feed:g} would be written as F0")
                 if inverse or f != last_f:  # G93 needs F in every feed block
                     words.append("F" + _number(f, decimals))
                     last_f = f
@@ -291,10 +330,16 @@ class _Writer:
         if s.line_numbers:
             lines = self._numbered(lines, min(sub_ids) - 1 if d.fold_style == "local_sub" and sub_ids
                                    else s.max_line_number)
+        too_long = [n for n, line in enumerate(lines, start=1) if len(line) > d.max_line_length]
+        if too_long:
+            raise PostError(f"{info.title}: line {too_long[0]} would have {len(lines[too_long[0] - 1])} characters, "
+                            f"more than the {d.name} limit of {d.max_line_length}")
         return "\n".join(lines) + "\n"
 
     def _title(self) -> str:
-        return self.comment(self.info.title)[1:-1] if self.d.comment_style == "paren" else self.info.title
+        """The title inside the program-start block (room left for the O number and the parentheses)."""
+        text = inert_comment_text(self.info.title, self.d.max_line_length - 16)
+        return text.upper() if self.d.uppercase_comments else text
 
     def _sub_ids(self, count: int) -> list[int]:
         """Subprogram numbers: after the program number; Haas labels (N numbers) at the top of the range."""
