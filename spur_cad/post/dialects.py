@@ -49,7 +49,8 @@ class Dialect:
 
 
 LINUXCNC = Dialect(
-    name="linuxcnc", extension="ngc", max_line_length=250, percent_delimited=False, program_start="", comment_style="paren",
+    name="linuxcnc", extension="ngc", max_line_length=250,
+    percent_delimited=False, program_start="", comment_style="paren",
     uppercase_comments=False, setup="G21 G90 G94 G17 G40 G49 G80 G64 P0.001", tool_change=("T{tool} M6",
                                                                                            "G43 H{tool}"),
     spindle_on="S{rpm} M3", coolant_on="M8", coolant_off="M9", spindle_off="M5", program_end="M30",
@@ -73,7 +74,8 @@ HAAS = replace(FANUC, name="haas", program_start="O{number:05d} ({title})", fold
                x_param="#101", a_param="#102", sub_start="N{sub}", call=("#101={x}", "#102={a}", "M97 P{sub}"))
 
 SIEMENS = Dialect(
-    name="siemens", extension="mpf", max_line_length=200, percent_delimited=False, program_start="", comment_style="semicolon",
+    name="siemens", extension="mpf", max_line_length=200,
+    percent_delimited=False, program_start="", comment_style="semicolon",
     uppercase_comments=False, setup="G71 G90 G94 G17 G40", tool_change=("T{tool} D1", "M6"),
     spindle_on="S{rpm} M3", coolant_on="M8", coolant_off="M9", spindle_off="M5", program_end="M30",
     linear_decimals=4, rotary_decimals=4, feed_decimals=1, inverse_feed_decimals=4, inverse_time=True,
