@@ -42,6 +42,8 @@ UNITS = {
     "m/min": "metres per minute (cutting speed)",
     "deg/min": "degrees per minute (rotary speed)",
     "1/min": "revolutions per minute (spindle speed)",
+    "mm/s^2": "millimetres per second squared (linear axis acceleration)",
+    "deg/s^2": "degrees per second squared (rotary axis acceleration)",
 }
 
 _TYPE_NAMES = {float: "a number", int: "a whole number", bool: "true or false", str: "a string"}

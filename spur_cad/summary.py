@@ -104,7 +104,7 @@ def tool_section(tool: Tool | None, machine: Machine) -> dict | None:
 
 def _estimate_facts(est: Estimate) -> dict:
     return {"moves": est.moves, "cutting_length_mm": est.cutting_length_mm, "rapid_length_mm": est.rapid_length_mm,
-            "estimated_time_s": est.time_s}
+            "estimated_time_s": est.time_s, "estimated_time_with_acceleration_s": est.time_with_acceleration_s}
 
 
 def roughing_section(roughing: RoughingPlan) -> dict:
@@ -119,7 +119,8 @@ def finishing_section(finishing: FinishingPlan) -> dict:
     return {"strategy": result.strategy, "stations": result.stations, "station_step_mm": result.station_step_mm,
             "points_per_flank": result.points_per_flank, **_estimate_facts(finishing.estimate),
             "reference_strategy_moves": finishing.reference_estimate.moves,
-            "reference_strategy_time_s": finishing.reference_estimate.time_s}
+            "reference_strategy_time_s": finishing.reference_estimate.time_s,
+            "reference_strategy_time_with_acceleration_s": finishing.reference_estimate.time_with_acceleration_s}
 
 
 def post_section(settings: PostSettings, programs: dict[str, PostedProgram]) -> dict:

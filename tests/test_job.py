@@ -195,7 +195,7 @@ def test_declarations_are_complete_and_consistent():
     from spur_cad.keys import value_problem
 
     suffix_units = {"_mm": "mm", "_deg": "deg", "_percent": "%", "_s": "s", "_mm_min": "mm/min", "_m_min": "m/min",
-                    "_deg_min": "deg/min", "_rpm": "1/min"}
+                    "_deg_min": "deg/min", "_rpm": "1/min", "_mm_s2": "mm/s^2", "_deg_s2": "deg/s^2"}
     labels = []
     for section, cls in SECTIONS.items():
         keys = keys_of(cls)

@@ -1,12 +1,23 @@
-"""Path lengths, move counts and cycle time of a toolpath on a machine.
+"""Path lengths, move counts and two cycle-time estimates of a toolpath on a machine.
 
-Each move takes max(length / feed, rotary angle / rotary speed, block processing time): the
-length is the tool tip's path relative to the part; rapids run at the machine's rapid feed;
-inverse-time moves take 1 / F minutes as programmed.
+Feed-bound: each move takes max(length / feed, rotary angle / rotary speed, block processing
+time): the length is the tool tip's path relative to the part; rapids run at the machine's
+rapid feed; inverse-time moves take 1 / F minutes as programmed.
+
+With acceleration: the moves' feed-bound speeds are the cruise limits of a look-ahead velocity
+plan as machine controllers make it: every move is a trapezoidal speed profile (constant
+acceleration, cruise, constant braking) along its straight line in joint space (X, Y, Z mm, A
+deg), with the largest acceleration that keeps every axis within `[machine] x/y/z_acceleration_mm_s2`
+and `a_acceleration_deg_s2`; the speed through a junction is limited by the corner the control may
+round within `path_tolerance_mm` (centripetal acceleration on that arc, the junction-deviation rule
+of look-ahead planners such as grbl's) and by both moves' speeds; markers and the ends of the
+program are exact stops; a backward and a forward pass make every profile reachable. Jerk limits
+and the control's own block look-ahead depth are not modelled (docs/cam.md).
 """
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -22,17 +33,15 @@ class Estimate:
     moves: int
     cutting_length_mm: float
     rapid_length_mm: float
-    time_s: float
-
-    def as_dict(self) -> dict[str, float | int]:
-        return dict(self.__dict__)
+    time_s: float  # feed-bound: every move at its programmed feed from start to end
+    time_with_acceleration_s: float  # look-ahead trapezoidal profiles with the machine's accelerations
 
 
 def estimate(path: Toolpath, machine: Machine) -> Estimate:
     """Cycle-time estimate of one operation (pure function)."""
     motion = path.motion_mask
     if not motion.any():
-        return Estimate(int(len(path)), 0.0, 0.0, len(path) * machine.block_time_s)
+        return Estimate(int(len(path)), 0.0, 0.0, len(path) * machine.block_time_s, len(path) * machine.block_time_s)
 
     x0, y0, z0, a0 = path.start_poses().T
     length = relative_path_lengths(x0, y0, z0, a0, path.x, path.y, path.z, path.a, substeps=8)
@@ -47,4 +56,86 @@ def estimate(path: Toolpath, machine: Machine) -> Estimate:
     minutes[plain] = length[plain] / path.feed[plain]
     minutes = np.maximum(minutes, rotary / machine.max_rotary_speed_deg_min)
     seconds = np.maximum(minutes * 60.0, machine.block_time_s)
-    return Estimate(int(len(path)), float(length[linear].sum()), float(length[rapid].sum()), float(seconds.sum()))
+    with_acceleration = acceleration_aware_seconds(path, machine, np.where(path.motion_mask, minutes * 60.0, 0.0))
+    return Estimate(int(len(path)), float(length[linear].sum()), float(length[rapid].sum()), float(seconds.sum()),
+                    float(with_acceleration.sum()))
+
+
+def _plan_velocities(lengths, nominal, accel, junction, stops):  # pragma: no cover - numba
+    """Look-ahead velocity planning over a move sequence: the largest entry/exit speeds that respect each
+    move's nominal speed and acceleration and each junction's speed limit (backward, then forward pass)."""
+    n = len(lengths)
+    entry = np.zeros(n)
+    exit_ = np.zeros(n)
+    following = 0.0
+    for i in range(n - 1, -1, -1):
+        limit = 0.0 if (i == n - 1 or stops[i]) else min(junction[i], following)
+        exit_[i] = min(limit, nominal[i])
+        entry[i] = min(nominal[i], math.sqrt(exit_[i] ** 2 + 2.0 * accel[i] * lengths[i]))
+        following = entry[i]
+    previous = 0.0
+    for i in range(n):
+        start = 0.0 if (i == 0 or stops[i - 1]) else previous
+        entry[i] = min(entry[i], start)
+        exit_[i] = min(exit_[i], math.sqrt(entry[i] ** 2 + 2.0 * accel[i] * lengths[i]))
+        previous = exit_[i]
+    return entry, exit_
+
+
+def _trapezoid_seconds(lengths, nominal, accel, entry, exit_):  # pragma: no cover - numba
+    """Time of each move under a trapezoidal speed profile from `entry` to `exit_`, cruising at most at `nominal`."""
+    seconds = np.zeros(len(lengths))
+    for i in range(len(lengths)):
+        length, v0, v1, vmax, a = lengths[i], entry[i], exit_[i], nominal[i], accel[i]
+        if length <= 0.0:
+            continue
+        accelerating = (vmax * vmax - v0 * v0) / (2.0 * a)
+        braking = (vmax * vmax - v1 * v1) / (2.0 * a)
+        if accelerating + braking <= length:
+            seconds[i] = (vmax - v0) / a + (vmax - v1) / a + (length - accelerating - braking) / vmax
+        else:
+            peak = math.sqrt((2.0 * a * length + v0 * v0 + v1 * v1) / 2.0)
+            seconds[i] = (peak - v0) / a + (peak - v1) / a
+    return seconds
+
+
+def acceleration_aware_seconds(path: Toolpath, machine: Machine, feed_bound_seconds: np.ndarray) -> np.ndarray:
+    """Seconds of every move when the axes accelerate as the machine allows (see the module docstring).
+
+    Each move is a straight line in joint space (X, Y, Z in mm, A in deg) run at its feed-bound nominal
+    speed at most; its acceleration along the line is the largest that keeps every axis within its
+    limit. At a junction the speed is limited as a controller that rounds corners within the path
+    tolerance limits it (centripetal acceleration on the largest arc within the tolerance: the "junction
+    deviation" rule of look-ahead planners); markers (clamp codes) and the ends are exact stops.
+    """
+    from numba import njit
+
+    plan, profile = njit(cache=True)(_plan_velocities), njit(cache=True)(_trapezoid_seconds)
+    start = path.start_poses()
+    delta = path.poses() - start
+    lengths = np.linalg.norm(delta, axis=1)
+    limits = np.array([machine.x_acceleration_mm_s2, machine.y_acceleration_mm_s2, machine.z_acceleration_mm_s2,
+                       machine.a_acceleration_deg_s2])
+    with np.errstate(divide="ignore", invalid="ignore"):
+        direction = np.where(lengths[:, None] > 0.0, delta / lengths[:, None], 0.0)
+        accel = np.min(np.where(np.abs(direction) > 0.0, limits / np.abs(direction), np.inf), axis=1)
+        nominal = np.where(feed_bound_seconds > 0.0, lengths / feed_bound_seconds, 0.0)
+    accel = np.where(np.isfinite(accel), accel, limits.min())
+    motion = path.motion_mask & (lengths > 0.0) & (nominal > 0.0)
+    cos_turn = np.einsum("ij,ij->i", direction[:-1], direction[1:])  # between move i and i + 1
+    sin_half = np.sqrt(np.clip((1.0 + cos_turn) / 2.0, 0.0, 1.0))  # of the angle between -u_i and u_{i+1}
+    with np.errstate(divide="ignore"):
+        junction = np.sqrt(np.minimum(accel[:-1], accel[1:]) * machine.path_tolerance_mm * sin_half
+                           / np.maximum(1.0 - sin_half, 1e-12))
+    junction = np.where(sin_half >= 1.0 - 1e-12, np.inf, junction)  # straight on: no corner to round
+    junction = np.append(junction, 0.0)
+    stops = ~motion | np.append(~motion[1:], True)
+    idx = np.nonzero(motion)[0]
+    seconds = np.full(len(path), machine.block_time_s)
+    if len(idx):
+        keep = np.zeros(len(path), bool)
+        keep[idx] = True
+        # Junction limits between consecutive motion rows; a stop wherever the next row is not motion.
+        entry, exit_ = plan(lengths[idx], nominal[idx], accel[idx], junction[idx], stops[idx])
+        seconds[idx] = np.maximum(profile(lengths[idx], nominal[idx], accel[idx], entry, exit_), machine.block_time_s)
+    return seconds

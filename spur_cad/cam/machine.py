@@ -49,6 +49,17 @@ class Machine:
                           meaning="Z travel limit, low")
     z_max_mm: float = key(1000.0, unit="mm", low=-10000.0, high=10000.0, label="ZMax", group="Machine",
                           meaning="Z travel limit, high")
+    x_acceleration_mm_s2: float = key(1000.0, unit="mm/s^2", low=10.0, high=100000.0, label="XAcceleration",
+                                      group="Machine", meaning="X axis acceleration limit (cycle-time estimate)")
+    y_acceleration_mm_s2: float = key(1000.0, unit="mm/s^2", low=10.0, high=100000.0, label="YAcceleration",
+                                      group="Machine", meaning="Y axis acceleration limit (cycle-time estimate)")
+    z_acceleration_mm_s2: float = key(1000.0, unit="mm/s^2", low=10.0, high=100000.0, label="ZAcceleration",
+                                      group="Machine", meaning="Z axis acceleration limit (cycle-time estimate)")
+    a_acceleration_deg_s2: float = key(1500.0, unit="deg/s^2", low=1.0, high=1000000.0, label="AAcceleration",
+                                       group="Machine", meaning="A axis acceleration limit (cycle-time estimate)")
+    path_tolerance_mm: float = key(0.005, unit="mm", low=0.0, high=1.0, label="PathTolerance", group="Machine",
+                                   meaning="how far the control may round a corner between moves (G64 P; "
+                                           "cycle-time estimate)")
     rotary_clamp_code: str = key("", label="RotaryClampCode", group="Machine",
                                  meaning="M code clamping A (needed by [roughing] clamp_rotary)")
     rotary_unclamp_code: str = key("", label="RotaryUnclampCode", group="Machine",

@@ -11,6 +11,8 @@ import base64
 import html
 from typing import Iterable
 
+from spur_cad.cam.plan import REFERENCE_CONTACT_SPACING_MM, REFERENCE_STATION_STEP_MM
+
 _CSS = """
 body { font-family: sans-serif; margin: 2em auto; max-width: 62em; color: #222; }
 h1 { font-size: 1.5em; } h2 { font-size: 1.2em; border-bottom: 1px solid #ccc; margin-top: 1.8em; }
@@ -51,7 +53,9 @@ def _image(png: bytes | None, alt: str) -> str:
     return f'<p><img alt="{_e(alt)}" src="data:image/png;base64,{data}"></p>'
 
 
-def _minutes(seconds: float) -> str:
+def _minutes(seconds: float | None) -> str:
+    if seconds is None:
+        return "-"
     return f"{seconds / 3600.0:.2f} h ({seconds / 60.0:.0f} min)"
 
 
@@ -126,17 +130,22 @@ def _program(summary: dict) -> str:
             size = post.get(f"{name}_bytes") if post else None
             rows.append((name, facts["moves"], "-" if lines is None else str(lines),
                          "-" if size is None else f"{size / 1000:.1f} kB", f"{facts['cutting_length_mm'] / 1000:.2f} m",
-                         _minutes(facts["estimated_time_s"])))
+                         _minutes(facts["estimated_time_s"]),
+                         _minutes(facts.get("estimated_time_with_acceleration_s"))))
     text = "<h2>Programs and cycle time</h2>"
     if post:
         text += f"<p>Post: {_e(post.get('dialect', '-'))}" + (", folded into subprograms" if post.get("folded") else "")
         text += "</p>"
-    text += _table(rows, ("", "moves (IR)", "G-code lines", "G-code size", "cutting path", "estimated time"))
+    text += _table(rows, ("", "moves (IR)", "G-code lines", "G-code size", "cutting path", "time at feed",
+                          "time with acceleration"))
     if finish and "reference_strategy_time_s" in finish:
-        text += _table([("this job's finishing", finish["moves"], _minutes(finish["estimated_time_s"])),
-                        ("reference process's strategy (0.08 mm contacts, 0.14 mm X step)",
-                         finish["reference_strategy_moves"], _minutes(finish["reference_strategy_time_s"]))],
-                       ("finishing", "moves", "estimated time"))
+        reference = (f"reference process's strategy ({REFERENCE_CONTACT_SPACING_MM:g} mm contacts, "
+                     f"{REFERENCE_STATION_STEP_MM:g} mm X step)")
+        text += _table([("this job's finishing", finish["moves"], _minutes(finish["estimated_time_s"]),
+                         _minutes(finish.get("estimated_time_with_acceleration_s"))),
+                        (reference, finish["reference_strategy_moves"], _minutes(finish["reference_strategy_time_s"]),
+                         _minutes(finish.get("reference_strategy_time_with_acceleration_s")))],
+                       ("finishing", "moves", "time at feed", "time with acceleration"))
     if rough:
         text += (f"<p>Roughing: {rough['levels_per_space']} levels per space, lowest level "
                  f"{rough['lowest_level_height_mm']:.3f} mm above the root circle.</p>")
