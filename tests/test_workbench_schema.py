@@ -135,7 +135,7 @@ def _section_classes() -> dict[str, type]:
     """Job-file sections and their dataclasses, read from spur_cad.job.Job's fields (so new sections count)."""
     hints = typing.get_type_hints(Job)
     sections = {("gear" if f.name == "gear_section" else f.name): hints[f.name] for f in dataclasses.fields(Job)
-                if f.name not in ("source", "gear", "tools")}
+                if f.name not in ("source", "gear", "tools", "text")}
     sections["tools.roughing"] = sections["tools.finishing"] = Tool
     return sections
 

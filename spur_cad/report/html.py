@@ -170,7 +170,8 @@ def _simulation(summary: dict) -> str:
                                                            f"{1000 * sim['scallop_p95_mm']:.2f} / "
                                                            f"{1000 * sim['scallop_p99_mm']:.2f}"),
             ("removed volume [mm^3]", f"{sim['removed_volume_mm3']:.1f}"),
-            ("design points x rows (all spaces)", sim["design_points"]), ("simulation time [s]", f"{sim['seconds']:.1f}")]
+            ("design points x rows (all spaces)", sim["design_points"]),
+            ("simulation time [s]", f"{sim['seconds']:.1f}")]
     text = "<h2>Simulated cut</h2>" + _table(rows)
     verdict = "ok" if gouge_ok else "warn"
     text += (f'<p class="{verdict}">Largest gouge {1000 * sim["max_gouge_mm"]:.2f} um '
@@ -208,7 +209,8 @@ def render_report(summary: dict, images: dict[str, bytes]) -> bytes:
         f"<p>Job file {_e(job.get('file', '-'))}, spur_cad {_e(summary.get('spur_cad_version', ''))}.</p>",
         _warnings(summary), _gear(summary), _image(images.get("profile"), "tooth space profile"),
         _inspection(summary), _tools(summary), _program(summary),
-        "<h2>Roughing levels</h2>" + _image(images.get("roughing"), "roughing levels") if images.get("roughing") else "",
+        "<h2>Roughing levels</h2>" + _image(images.get("roughing"), "roughing levels")
+        if images.get("roughing") else "",
         "<h2>Finishing contacts and cutter locations</h2>" + _image(images.get("finishing"), "finishing poses")
         if images.get("finishing") else "",
         _simulation(summary), _image(images.get("deviation"), "deviation map"),
