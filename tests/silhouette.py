@@ -3,7 +3,7 @@
 The checker knows only the toolpath IR arrays, the tool's dimensions, shapely and the designed
 gear outline; it repeats none of the generators' mathematics (no contact points, no normals).
 
-Frame (CONVENTIONS.md): gear axis = X = rotary axis A; Y, Z span the transverse plane with the
+Frame (docs/architecture.md): gear axis = X = rotary axis A; Y, Z span the transverse plane with the
 rotary axis at Y = Z = 0; the tool axis is +Z and the programmed point is the centre of the tool
 tip. A point fixed to the part at p (as at A = 0) is at R(A) p when A is commanded, so a machine
 point (Y, Z) at angle A is the part-frame point R(-A) (Y, Z) = (Y cos A + Z sin A, -Y sin A + Z cos A).

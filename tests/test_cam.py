@@ -1,4 +1,4 @@
-"""CAM: tool recommendations against METHOD.md 3 computed independently, tool limits, the
+"""CAM: tool recommendations against docs/method.md computed independently, tool limits, the
 A-motion rule, inverse-time feeds from the true relative path, and the time estimator."""
 
 from __future__ import annotations
@@ -41,7 +41,7 @@ def test_recommendations_match_method_formulas(name):
     spec, g = spec_of(name), textbook_of(name)
     _, finishing = tools_for(name)
     rec = recommend_tools(spec, spec.tip_radius_mm + 0.5, 1.0, finishing)
-    # Root arc length 2 v r_f with v = d_1 / r (METHOD.md 2-3, textbook rack).
+    # Root arc length 2 v r_f with v = d_1 / r (docs/method.md-3, textbook rack).
     assert rec.finishing_max_flat_width_mm == pytest.approx(2 * g.corner_offset / g.r * g.rf, abs=1e-9)
     # Smallest fillet curvature radius: circumradius of close triples of dense fillet samples.
     samples = sample_profile(spec.tooth_space_profile(), 1e-7)
@@ -108,7 +108,7 @@ def test_a_moves_only_above_the_gear_or_in_designed_finishing_moves(name):
 
 def test_inverse_time_feed_matches_relative_path_length():
     """For simultaneous moves, 1/F (min) x feed = the tool tip's path length relative to the part,
-    integrated here independently with the rotation convention of CONVENTIONS.md."""
+    integrated here independently with the rotation convention of docs/architecture.md."""
     spec = spec_of("reference_z23_m4")
     tool = Tool(diameter_mm=2.0, kind="bull_nose", corner_radius_mm=0.5, cutting_speed_m_min=120,
                 feed_per_tooth_mm=0.02)
@@ -146,7 +146,7 @@ def test_stations_cover_the_face_width_with_the_scallop_step():
     tool = Tool(diameter_mm=2.0, kind="bull_nose", corner_radius_mm=0.5)
     params = FinishingParams(target_scallop_mm=0.005)
     step = station_step_mm(tool, params.target_scallop_mm, params.step_over_mm)
-    # Worst case of METHOD.md 5: flat width d at the root, corner radius elsewhere.
+    # Worst case of docs/method.md: flat width d at the root, corner radius elsewhere.
     h, d, r_t = 0.005, 1.0, 0.5
     assert d / 2 - math.sqrt((d / 2) ** 2 - (step / 2) ** 2) <= h + 1e-12
     assert r_t - math.sqrt(r_t**2 - (step / 2) ** 2) <= h + 1e-12

@@ -42,7 +42,7 @@ def test_reference_job_writes_profile_summary_and_plot(tmp_path):
     assert gear["root_radius_mm"] == pytest.approx(41.0)
     assert gear["base_radius_mm"] < gear["form_radius_mm"] < gear["reference_radius_mm"]
     assert gear["undercut"] is False
-    # Root arc half angle from METHOD.md: v = d_1 / r, d_1 = e/2 - B tan(a) - rho / cos(a).
+    # Root arc half angle from docs/method.md: v = d_1 / r, d_1 = e/2 - B tan(a) - rho / cos(a).
     a = math.radians(20)
     e = 4 * math.pi - 0.95 * 2 * math.pi
     d1 = e / 2 - (46 - 41 - 0.8) * math.tan(a) - 0.8 / math.cos(a)

@@ -60,7 +60,7 @@ def test_segments_join_and_root_arc_matches_rack_flat(name):
         start = after.points(np.array([after.start]))[0]
         assert np.linalg.norm(end - start) < 1e-9, (before.label, after.label)
     root = profile.segment("root")
-    # The flat rack tip spans d_1 each side of its axis: root arc half-angle d_1 / r (METHOD.md).
+    # The flat rack tip spans d_1 each side of its axis: root arc half-angle d_1 / r (docs/method.md).
     assert root.end == pytest.approx(g.corner_offset / g.r, abs=1e-12)
     assert root.radius_mm == pytest.approx(g.rf, abs=1e-12)
     tip = profile.segment("tip")

@@ -1,7 +1,7 @@
 """Tests of the 2-D silhouette checker itself (tests/silhouette.py), on synthetic poses with known answers.
 
 Every expected value below is derived by hand (support functions of the tool, sagitta of two
-tangents to a circle, the CONVENTIONS.md rotation written out), never by the checker's own code.
+tangents to a circle, the docs/architecture.md rotation written out), never by the checker's own code.
 """
 
 from __future__ import annotations
@@ -37,7 +37,7 @@ def reference_spec() -> GearSpec:
 
 
 def machine_from_part(p: np.ndarray, a_deg: float) -> np.ndarray:
-    """CONVENTIONS.md, literally: a part point (y, z) is at (y cos A - z sin A, y sin A + z cos A)."""
+    """docs/architecture.md, literally: a part point (y, z) is at (y cos A - z sin A, y sin A + z cos A)."""
     a = math.radians(a_deg)
     y, z = np.asarray(p, float).T
     return np.stack([y * math.cos(a) - z * math.sin(a), y * math.sin(a) + z * math.cos(a)], axis=-1)
@@ -130,7 +130,7 @@ def test_pose_with_a_30_degrees_lands_where_hand_computation_says():
     assert corners[:2].mean(axis=0) == pytest.approx(tip, abs=1e-12)
     # The tool (seen from the part) sits 30 deg clockwise from +Z: the part turned 30 deg counter-clockwise.
     assert math.degrees(math.atan2(tip[0], tip[1])) == pytest.approx(30.0 + math.degrees(math.atan2(3.0, 50.0)))
-    # Turning the part back by +A (CONVENTIONS' forward formula) gives the tool at its machine pose.
+    # Turning the part back by +A (the forward rotation of docs/architecture.md) gives the tool at its machine pose.
     machine = machine_from_part(corners, 30.0)
     assert machine == pytest.approx(np.array([[1.0, 50.0], [5.0, 50.0], [5.0, 60.0], [1.0, 60.0]]), abs=1e-12)
 

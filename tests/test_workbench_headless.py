@@ -107,7 +107,7 @@ def test_commands_recompute_follow_changes_and_export_like_the_cli(freecadcmd, t
     assert radii["span"] == pytest.approx(span_iso(book, radii["k"]), abs=1e-9)
     assert radii["blank"] == pytest.approx(book.ra + 0.5)
 
-    # placed per CONVENTIONS.md: axis X, front face X = 0, tooth space 0 symmetric about +Z
+    # placed per docs/architecture.md: axis X, front face X = 0, tooth space 0 symmetric about +Z
     x0, x1, y0, y1, z0, z1 = result["bbox"]
     assert (x0, x1) == pytest.approx((0.0, 6.0), abs=1e-6)
     assert max(abs(y0), y1, abs(z0), z1) == pytest.approx(book.ra, abs=1e-3)

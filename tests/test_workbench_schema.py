@@ -310,7 +310,7 @@ def test_suggested_tools_pass_the_tool_limits(wb, name):
 
 
 def _machine_pose(p_y: float, p_z: float, a_deg: float) -> tuple[float, float]:
-    """Where a point fixed to the part at (p_y, p_z) is when A is commanded (CONVENTIONS.md)."""
+    """Where a point fixed to the part at (p_y, p_z) is when A is commanded (docs/architecture.md)."""
     a = math.radians(a_deg)
     return p_y * math.cos(a) - p_z * math.sin(a), p_y * math.sin(a) + p_z * math.cos(a)
 

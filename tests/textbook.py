@@ -75,7 +75,7 @@ class Textbook:
         return math.pi / self.z - self.s / (2 * self.r) - inv(self.alpha)
 
     def thickness_at(self, ry: float) -> float:
-        """METHOD.md: s_y = 2 r_y (s/(2r) + inv(alpha) - inv(alpha_y))."""
+        """docs/method.md: s_y = 2 r_y (s/(2r) + inv(alpha) - inv(alpha_y))."""
         ay = math.acos(self.rb / ry)
         return 2 * ry * (self.s / (2 * self.r) + inv(self.alpha) - inv(ay))
 

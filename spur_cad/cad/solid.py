@@ -1,4 +1,4 @@
-"""Exact B-rep gear solid and stock with OCP/CadQuery, in the machine frame of CONVENTIONS.md.
+"""Exact B-rep gear solid and stock with OCP/CadQuery, in the machine frame of docs/architecture.md.
 
 Machine frame: gear axis = X, front face at X = 0, the gear occupies 0 <= X <= b; the
 transverse plane is (Y, Z) with the gap frame's x -> Y and y -> Z, so tooth space 0 is

@@ -89,7 +89,7 @@ def _gouge(design: np.ndarray, turn: float, tip: tuple[float, float], tool: Tool
 def _corner_poses(points: np.ndarray, normals: np.ndarray, tool: Tool, design: np.ndarray) -> TransversePoses:
     """Cutter locations touching right-flank contact points with the tool's right corner.
 
-    The part is turned by the contact's polar angle (METHOD.md 5) when that puts the contact on
+    The part is turned by the contact's polar angle (docs/method.md) when that puts the contact on
     the corner (-n' pointing down and outward) and the tool clear of the rest of the space
     (`design`: dense exact points of the space and its tooth tips). Otherwise (overhanging
     undercut flanks) the turn is searched within the range where the corner touches, nearest

@@ -108,7 +108,7 @@ def check_travel(machine: Machine, x, y, z, a, operation: str) -> None:
 
 @dataclass(frozen=True)
 class RoughingParams:
-    """[roughing]: METHOD.md 4. Allowances are measured from the designed flank."""
+    """[roughing]: docs/method.md. Allowances are measured from the designed flank."""
 
     flank_allowance_mm: float = key(0.1, unit="mm", low=0.0, high=5.0, low_open=True, label="FlankAllowance",
                                     group="Roughing strategy",
@@ -139,7 +139,7 @@ def _strategy_names() -> tuple[str, ...]:
 
 @dataclass(frozen=True)
 class FinishingParams:
-    """[finishing]: METHOD.md 5."""
+    """[finishing]: docs/method.md."""
 
     strategy: str = key("perimeter", label="FinishingStrategy", group="Finishing strategy",
                         meaning="a finishing strategy name (see docs/cam.md)", names_from=_strategy_names)

@@ -1,4 +1,4 @@
-"""Roughing (METHOD.md 4): per tooth space, horizontal levels, zig-zag passes along X.
+"""Roughing (docs/method.md): per tooth space, horizontal levels, zig-zag passes along X.
 
 The tool works on the design profile offset by the finish stock (so it never comes closer
 than that to the design). Levels are chosen bottom-up on that offset flank so that the

@@ -1,4 +1,4 @@
-"""Cutting tools and their cutting data (catalogue values: V_c, f_z), METHOD.md 3 and 6."""
+"""Cutting tools and their cutting data (catalogue values: V_c, f_z), docs/method.md."""
 
 from __future__ import annotations
 

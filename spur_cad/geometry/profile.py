@@ -1,4 +1,4 @@
-"""The exact rack-generated tooth-space profile (METHOD.md section 2), numpy only.
+"""The exact rack-generated tooth-space profile (docs/method.md), numpy only.
 
 Frame ("gap-symmetric"): origin at the gear centre, +y along the symmetry axis of a tooth
 space, x to the right. Polar angles `theta` are measured from +y toward +x (clockwise).
@@ -220,7 +220,7 @@ class ToothSpaceProfile:
 
 @dataclass(frozen=True)
 class RackCorner:
-    """The generating rack's right tip corner relative to the rolling line (METHOD.md 2)."""
+    """The generating rack's right tip corner relative to the rolling line (docs/method.md)."""
 
     half_thickness_on_rolling_line_mm: float  # e / 2
     corner_offset_mm: float  # d_1

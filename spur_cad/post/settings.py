@@ -18,7 +18,7 @@ class PostError(SpurCadError, ValueError):
 class PostSettings:
     """[post]: G-code dialect and formatting (see docs/post.md).
 
-    `rotary_sign` -1 is for tables whose A turns the other way (CONVENTIONS.md); `rotary_mode`
+    `rotary_sign` -1 is for tables whose A turns the other way (docs/architecture.md); `rotary_mode`
     "unwound" writes A as the toolpath has it, "wrapped" writes it in [0, 360) (flat programs only).
     Block numbers are off by default; when on they never pass `max_line_number` ("wrap" restarts
     the count, "stop" stops numbering).

@@ -85,7 +85,7 @@ def sample_space(profile: ToothSpaceProfile, spacing_mm: float) -> tuple[np.ndar
     side = np.concatenate([np.full(len(right_p), RIGHT), np.full(len(right_p) - 1, LEFT)])
     side[len(right_p) - 1] = CENTRE  # root centre
     side[0] = CENTRE  # tooth centre
-    # Gap frame (x, y) is machine (Y, Z) at A = 0 for space 0 (CONVENTIONS.md).
+    # Gap frame (x, y) is machine (Y, Z) at A = 0 for space 0 (docs/architecture.md).
     return points[:-1], normals[:-1], feature[:-1], side[:-1]
 
 
