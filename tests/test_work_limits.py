@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from spur_cad.cam.plan import MAX_TOOLPATH_MOVES
-from spur_cad.errors import WorkLimitError
+from spur_cad.errors import SpurCadError, WorkLimitError
 from spur_cad.geometry.sampling import sample_profile
 from spur_cad.job import load_job
 from spur_cad.pipeline import plan_cam
@@ -76,3 +76,15 @@ def test_simulation_grid_is_bounded(small_job):
         check_design_size(dataclasses.replace(spec, teeth=1000, face_width_mm=2000.0), spacing, 2003.0, 0, 0.005)
     assert info.value.key == "simulation.resolution_mm"
     assert np.isfinite(spacing)
+
+
+@pytest.mark.parametrize("strategy", ["perimeter", "along_x"])
+def test_index_only_tables_refuse_strategies_that_turn_a_while_cutting(small_job, strategy):
+    machine = dataclasses.replace(small_job.machine, rotary_simultaneous=False)
+    job = dataclasses.replace(small_job, machine=machine,
+                              finishing=dataclasses.replace(small_job.finishing, strategy=strategy))
+    with pytest.raises(SpurCadError) as info:
+        plan_cam(job)
+    assert info.value.key == "finishing.strategy"
+    assert strategy in str(info.value) and "rotary_simultaneous" in str(info.value)
+    plan_cam(dataclasses.replace(job, tools=dataclasses.replace(job.tools, finishing=None)))  # roughing indexes only

@@ -31,6 +31,9 @@ class Machine:
                               meaning="clearance of non-cutting moves from the stock")
     block_time_s: float = key(0.004, unit="s", low=0.0, high=1.0, label="BlockTime", group="Machine",
                               meaning="the control's block processing time (cycle-time estimate)")
+    rotary_simultaneous: bool = key(True, label="RotarySimultaneous", group="Machine",
+                                    meaning="A can move together with X/Y/Z while cutting (false: the table only "
+                                            "indexes; strategies that need simultaneous A are refused)")
     rotary_continuous: bool = key(True, label="RotaryContinuous", group="Machine",
                                   meaning="A turns without limits (false: finishing unwinds A after every station)")
     a_min_deg: float = key(-99999.0, unit="deg", low=-99999.0, high=99999.0, label="AMin", group="Machine",

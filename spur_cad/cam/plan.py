@@ -5,6 +5,7 @@ workbench read it (docs/architecture.md)."""
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass
 
 from spur_cad.cad.specs import StockSpec
@@ -12,7 +13,7 @@ from spur_cad.cam.contacts import ContactCounts, contact_counts
 from spur_cad.cam.estimate import Estimate, estimate
 from spur_cad.cam.finishing import plan_finishing
 from spur_cad.cam.ir import Toolpath
-from spur_cad.cam.machine import FinishingParams, Machine, RoughingParams, check_travel
+from spur_cad.cam.machine import FinishingParams, Machine, MachineError, RoughingParams, check_travel
 from spur_cad.cam.recommend import ToolRecommendations, check_roughing_reach, check_tools, recommend_tools
 from spur_cad.cam.roughing import RoughingLevels, estimated_roughing_moves, roughing_levels, roughing_toolpath
 from spur_cad.cam.strategies import FinishingResult, get_strategy, params_from_section
@@ -82,12 +83,15 @@ class CamInputs:
 
 def check_cam_inputs(inputs: CamInputs) -> tuple[ToolRecommendations, RoughingLevels | None]:
     """Every check that needs no toolpath (cheap enough for a GUI to run while the user types): tool
-    recommendations, tool limits, the roughing work bound and the roughing reach. Returns the
+    recommendations, tool limits, the finishing strategy's fit to the machine and its work bound, the
+    roughing work bound and the roughing reach. Returns the
     recommendations and the roughing levels (None without a roughing tool)."""
     spec, machine, stock = inputs.spec, inputs.machine, inputs.stock
     blank = stock.blank_radius_mm(spec)
     rec = recommend_tools(spec, blank, machine.clearance_mm, inputs.finishing_tool)
     check_tools(spec, rec, inputs.roughing_tool, inputs.finishing_tool)
+    if inputs.finishing_tool is not None:
+        check_finishing_work(spec, inputs.finishing_tool, machine, inputs.finishing)
     if inputs.roughing_tool is None:
         return rec, None
     tool = inputs.roughing_tool
@@ -131,10 +135,15 @@ def _plan_roughing(inputs: CamInputs, levels: RoughingLevels, blank: float) -> R
     return RoughingPlan(tool, levels, lowest_above_root, path, estimate(path, inputs.machine))
 
 
-def check_finishing_work(spec: GearSpec, tool: Tool, section: FinishingParams, **overrides) -> None:
+def check_finishing_work(spec: GearSpec, tool: Tool, machine: Machine, section: FinishingParams,
+                         **overrides) -> None:
     """Refuse finishing whose contacts per flank or moves exceed the limits, before generating it."""
     strategy = get_strategy(section.strategy)
     params = params_from_section(strategy, section, **overrides)
+    if strategy.simultaneous_rotary and not machine.rotary_simultaneous:
+        raise MachineError(f"finishing strategy '{strategy.name}' turns A while cutting, but [machine] "
+                           "rotary_simultaneous = false (the table only indexes); choose a strategy that keeps A "
+                           "fixed while cutting", field="strategy", section="finishing")
     try:
         counts = contact_counts(spec, tool, params.target_scallop_mm, overrides.get("contact_spacing_mm"))
     except WorkLimitError:
@@ -149,12 +158,12 @@ def check_finishing_work(spec: GearSpec, tool: Tool, section: FinishingParams, *
 
 def _plan_finishing(inputs: CamInputs, blank: float) -> FinishingPlan:
     spec, tool, machine = inputs.spec, inputs.finishing_tool, inputs.machine
-    check_finishing_work(spec, tool, inputs.finishing)
     path, result = plan_finishing(spec, tool, machine, inputs.finishing, blank)
     check_travel(machine, path.x, path.y, path.z, path.a, "finishing")
     reference_section = FinishingParams(strategy="perimeter", target_scallop_mm=inputs.finishing.target_scallop_mm,
                                         step_over_mm=REFERENCE_STATION_STEP_MM)
-    check_finishing_work(spec, tool, reference_section, contact_spacing_mm=REFERENCE_CONTACT_SPACING_MM)
+    check_finishing_work(spec, tool, dataclasses.replace(machine, rotary_simultaneous=True), reference_section,
+                         contact_spacing_mm=REFERENCE_CONTACT_SPACING_MM)
     reference, _ = plan_finishing(spec, tool, machine, reference_section, blank,
                                   contact_spacing_mm=REFERENCE_CONTACT_SPACING_MM)
     return FinishingPlan(tool, result, path, estimate(path, machine), estimate(reference, machine))

@@ -28,6 +28,7 @@ class AlongXStrategy:
     name = "along_x"
     description = "one pass along X per contact pose, A fixed during each pass"
     params_type = AlongXParams
+    simultaneous_rotary = True  # the steps between poses beside the part turn A at feed
 
     def estimate_moves(self, spec: GearSpec, tool: Tool, params: AlongXParams) -> int:
         params.validate()

@@ -58,6 +58,7 @@ class FinishingStrategy(Protocol):
     name: str
     description: str
     params_type: type
+    simultaneous_rotary: bool  # feed moves turn A (needs [machine] rotary_simultaneous = true)
 
     def estimate_moves(self, spec: GearSpec, tool: Tool, params: Any) -> int:
         """How many IR moves `generate` would make, counted cheaply beforehand (the plan refuses

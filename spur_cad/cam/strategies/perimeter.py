@@ -38,6 +38,7 @@ class PerimeterStrategy:
     name = "perimeter"
     description = "transverse stations along X, once around the gear at each (simultaneous Y/Z/A)"
     params_type = PerimeterParams
+    simultaneous_rotary = True
 
     def estimate_moves(self, spec: GearSpec, tool: Tool, params: PerimeterParams) -> int:
         params.validate()
