@@ -111,7 +111,7 @@ def check_travel(machine: Machine, x, y, z, a, operation: str) -> None:
 
 @dataclass(frozen=True)
 class RoughingParams:
-    """[roughing]: docs/method.md. Allowances are measured from the designed flank."""
+    """[roughing]: roughing by levels (docs/method.md); allowances are measured from the designed flank."""
 
     flank_allowance_mm: float = key(0.1, unit="mm", low=0.0, high=5.0, low_open=True, label="FlankAllowance",
                                     group="Roughing strategy",
@@ -142,7 +142,7 @@ def _strategy_names() -> tuple[str, ...]:
 
 @dataclass(frozen=True)
 class FinishingParams:
-    """[finishing]: docs/method.md."""
+    """[finishing]: the finishing strategy and its parameters (docs/cam.md)."""
 
     strategy: str = key("perimeter", label="FinishingStrategy", group="Finishing strategy",
                         meaning="a finishing strategy name (see docs/cam.md)", names_from=_strategy_names)

@@ -1,7 +1,8 @@
 """The three frames of the project and the one rotation convention that links them.
 
 - Gap frame of tooth space k: origin at the gear centre, +y along the space's symmetry axis,
-  x to the right (looking at the front face). Profiles are computed here for space 0.
+  x to the right as seen from +X (the chuck side; seen from the front face, x points left).
+  Profiles are computed here for space 0.
 - Part frame: fixed to the part, machine (Y, Z) when A = 0. Space 0's gap frame *is* the
   part frame (gap x = machine Y, gap y = machine Z); space k's is turned by k * 360/z in the
   positive A direction.

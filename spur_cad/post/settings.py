@@ -7,7 +7,15 @@ from dataclasses import dataclass
 from spur_cad.errors import SpurCadError
 from spur_cad.keys import check_section, key
 
-DIALECT_NAMES = ("linuxcnc", "fanuc", "haas", "siemens", "okuma")
+
+
+def dialect_names() -> tuple[str, ...]:
+    """The dialects' names, from the table in spur_cad.post.dialects (which imports this module, hence the
+    late import): adding a dialect there is all it takes."""
+    from spur_cad.post.dialects import DIALECTS
+
+    return tuple(DIALECTS)
+
 
 
 class PostError(SpurCadError, ValueError):
@@ -24,7 +32,7 @@ class PostSettings:
     the count, "stop" stops numbering).
     """
 
-    dialect: str = key("linuxcnc", label="PostDialect", group="Post", names_from=lambda: DIALECT_NAMES,
+    dialect: str = key("linuxcnc", label="PostDialect", group="Post", names_from=dialect_names,
                        meaning="G-code dialect: linuxcnc (.ngc), fanuc (.nc), haas (.nc), siemens (.mpf, 840D), "
                                "okuma (.min, OSP); see docs/post.md")
     line_numbers: bool = key(False, label="LineNumbers", group="Post", meaning="write N block numbers")
@@ -47,8 +55,8 @@ class PostSettings:
 
     def validate(self) -> None:
         check_section(self, "post", PostError)
-        if self.dialect not in DIALECT_NAMES:
-            raise PostError(f"[post] dialect = {self.dialect!r} is not known (known: {', '.join(DIALECT_NAMES)})",
+        if self.dialect not in dialect_names():
+            raise PostError(f"[post] dialect = {self.dialect!r} is not known (known: {', '.join(dialect_names())})",
                             field="dialect")
         if self.folded and self.rotary_mode == "wrapped":
             raise PostError("[post] folded = true needs rotary_mode = 'unwound': a folded space pattern adds "
