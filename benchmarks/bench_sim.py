@@ -11,12 +11,10 @@ import numpy as np
 
 from spur_cad.cam.ir import Feature
 from spur_cad.job import load_job
-from spur_cad.pipeline import plan_cam
-from spur_cad.sim import Cut, SimSettings, simulate, subset
+from spur_cad.pipeline import job_stock, plan_cam
+from spur_cad.sim import Cut, SimSettings, finishing_stations, simulate, subset
 from spur_cad.sim.occ_check import cross_check
-from spur_cad.pipeline import job_stock
 from spur_cad.summary import simulation_section
-from spur_cad.sim import finishing_stations
 
 REFERENCE_JOB = Path(__file__).resolve().parents[1] / "resources" / "examples" / "reference_gear.toml"
 
@@ -46,7 +44,8 @@ def occ_ratio(runs: int) -> dict:
     fin, rough = plan.finishing.toolpath, plan.roughing.toolpath
     x = finishing_stations(fin)
     finishing = np.zeros(len(fin), bool)
-    finishing[np.nonzero((fin.station == 70) & (fin.space == 3) & (fin.feature == Feature.RIGHT_FLANK))[0][40:46]] = True
+    window = (fin.station == 70) & (fin.space == 3) & (fin.feature == Feature.RIGHT_FLANK)
+    finishing[np.nonzero(window)[0][40:46]] = True
     roughing = np.zeros(len(rough), bool)
     roughing[np.nonzero(rough.space == 0)[0][:5]] = True
     out = {}

@@ -6,6 +6,7 @@ Each benchmark reports the median of several runs and describes the machine.
 from __future__ import annotations
 
 import argparse
+import functools
 import json
 import os
 import platform
@@ -100,12 +101,14 @@ def bench_cam(runs: int) -> dict:
     job = load_job(Path(__file__).resolve().parents[1] / "resources" / "examples" / "reference_gear.toml")
     spec, machine, blank = job.gear, job.machine, job.stock.blank_radius_mm(job.gear)
     rough = lambda: roughing_toolpath(spec, job.tools.roughing, machine, job.roughing, blank,  # noqa: E731
-                                      job.stock.back_margin_mm, job.stock.stub_diameter_mm / 2, job.stock.front_margin_mm)
+                                      job.stock.back_margin_mm, job.stock.stub_diameter_mm / 2,
+                                      job.stock.front_margin_mm)
     finish = lambda: finishing_toolpath(spec, job.tools.finishing, machine, job.finishing, blank)  # noqa: E731
     reference = finishing_toolpath(spec, job.tools.finishing, machine, FinishingParams(step_over_mm=0.14), blank,
                                    contact_spacing_mm=0.08)
     r, f, ref = estimate(rough(), machine), estimate(finish(), machine), estimate(reference, machine)
-    return {"roughing_generation_s": median_seconds(rough, runs), "finishing_generation_s": median_seconds(finish, runs),
+    return {"roughing_generation_s": median_seconds(rough, runs),
+            "finishing_generation_s": median_seconds(finish, runs),
             "roughing_moves": r.moves, "roughing_time_s": r.time_s, "finishing_moves": f.moves,
             "finishing_time_s": f.time_s, "reference_strategy_moves": ref.moves,
             "reference_strategy_time_s": ref.time_s}
@@ -130,8 +133,8 @@ def bench_post(runs: int) -> dict:
             result[label] = {"finishing_lines": finishing.lines, "finishing_bytes": finishing.bytes,
                              "roughing_lines": roughing.lines, "roughing_bytes": roughing.bytes}
         for folded in (False, True):
-            seconds = median_seconds(lambda: post_program(plan.finishing.toolpath, PostSettings(dialect=dialect,  # noqa: B023
-                                                                                          folded=folded), info), runs)
+            settings = PostSettings(dialect=dialect, folded=folded)
+            seconds = median_seconds(functools.partial(post_program, plan.finishing.toolpath, settings, info), runs)
             result[f"{dialect}_{'folded' if folded else 'flat'}"]["finishing_post_s"] = seconds
     return result
 

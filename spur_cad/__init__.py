@@ -17,7 +17,8 @@ __version__ = "0.1.0"
 
 _CAD_ENTRY_POINTS = {"make_gear", "make_stock", "to_build123d", "BlankFeatures", "StockSpec"}
 
-__all__ = ["GearSpec", "GearSpecError", "JobFileError", "SpurCadError", "StockError", "__version__", *sorted(_CAD_ENTRY_POINTS)]
+__all__ = ["GearSpec", "GearSpecError", "JobFileError", "SpurCadError", "StockError", "__version__",
+           *sorted(_CAD_ENTRY_POINTS)]
 
 
 def __getattr__(name: str):

@@ -115,7 +115,8 @@ def program_comments(job: Job, plan: CamPlan, operation: str) -> tuple[str, ...]
         f"gear: z = {spec.teeth}, m = {spec.module_mm:g} mm, alpha = {spec.pressure_angle_deg:g} deg, "
         f"x = {spec.profile_shift_coefficient:g}, b = {spec.face_width_mm:g} mm, rho = {spec.rack_tip_radius_mm:g} mm",
         f"radii: tip {spec.tip_radius_mm:.4f} mm, root {spec.root_radius_mm:.4f} mm",
-        f"tool T{tool.tool_number}: {tool.kind} D {tool.diameter_mm:g} mm, corner radius {tool.effective_corner_radius_mm:g} mm, "
+        f"tool T{tool.tool_number}: {tool.kind} D {tool.diameter_mm:g} mm, "
+        f"corner radius {tool.effective_corner_radius_mm:g} mm, "
         f"S {tool.spindle_rpm(job.machine):.0f} rpm, F {tool.feed_mm_min(job.machine):.0f} mm/min",
         strategy,
         f"estimated time: {minutes:.1f} min ({planned.estimate.moves} moves)",

@@ -25,8 +25,8 @@ from OCP.TopoDS import TopoDS
 import spur_cad
 from spur_cad.cad.solid import build_gear_shape, build_stock_shape, solid_volume_mm3
 from spur_cad.cad.specs import BlankFeatures, StockSpec
-from spur_cad.errors import StockError
 from spur_cad.cad.step import step_files
+from spur_cad.errors import StockError
 from spur_cad.geometry import gear_outline, sample_profile
 from spur_cad.geometry.inspection import recommended_span_teeth, span_measurement
 from spur_cad.geometry.sampling import polygon_area

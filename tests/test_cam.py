@@ -10,8 +10,8 @@ import pytest
 import shapely
 from shapely.geometry import LineString, Polygon
 
-from spur_cad.cam.estimate import estimate
 from spur_cad.cam.contacts import station_positions, station_step_mm
+from spur_cad.cam.estimate import estimate
 from spur_cad.cam.finishing import finishing_toolpath
 from spur_cad.cam.ir import Feature, MoveKind, Operation, ToolpathBuilder
 from spur_cad.cam.machine import FinishingParams, Machine, RoughingParams

@@ -94,7 +94,8 @@ def test_rapids_never_touch_the_stock(name):
                        (finishing_toolpath(spec, finishing, machine, FinishingParams(step_over_mm=2.0), blank),
                         finishing)):
         assert np.any(path.kind == MoveKind.RAPID)
-        clearance = silhouette.rapids_clear_of_circle(path, tool.diameter_mm, tool.effective_corner_radius_mm, TOOL_LENGTH,
+        clearance = silhouette.rapids_clear_of_circle(path, tool.diameter_mm, tool.effective_corner_radius_mm,
+                                                      TOOL_LENGTH,
                                                       blank)
         assert clearance >= machine.clearance_mm - 1e-6
 
@@ -107,10 +108,12 @@ def test_along_x_strategy_is_as_safe_and_warns_about_marks(name, design_polygons
                               spec.tip_radius_mm + 0.5)
     assert any("parallel to the contact lines" in w for w in path.warnings)
     rows = path.motion_mask & (path.space == 0)
-    sils = silhouette.silhouettes_in_part_frame(path, tool.diameter_mm, tool.effective_corner_radius_mm, TOOL_LENGTH, mask=rows)
+    sils = silhouette.silhouettes_in_part_frame(path, tool.diameter_mm, tool.effective_corner_radius_mm, TOOL_LENGTH,
+                                                mask=rows)
     assert silhouette.max_penetration_mm(design_polygons[name], sils) <= HALF_MICRON
     points, _ = silhouette.design_boundary(spec, [0])
     assert silhouette.leftover_mm(points, sils).max() <= SCALLOP + HALF_MICRON
     # Every pass along X covers the whole face width plus the tool radius at both ends.
     passes = (path.kind == MoveKind.LINEAR) & (path.x != np.concatenate([[path.x[0]], path.x[:-1]]))
-    assert path.x[passes].min() < -tool.diameter_mm / 2 and path.x[passes].max() > spec.face_width_mm + tool.diameter_mm / 2
+    assert path.x[passes].min() < -tool.diameter_mm / 2
+    assert path.x[passes].max() > spec.face_width_mm + tool.diameter_mm / 2

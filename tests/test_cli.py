@@ -56,7 +56,8 @@ def test_reference_job_writes_profile_summary_and_plot(tmp_path):
     pts = np.array(rows[1:], dtype=float)
     assert pts[0] == pytest.approx([0.0, 41.0])
     assert np.hypot(*pts[-1]) == pytest.approx(50.0)
-    assert np.all(np.diff(np.hypot(pts[:, 0], pts[:, 1])) >= -1e-8)  # root to tip: radius never falls (csv has 1e-9 mm digits)
+    # root to tip: radius never falls (csv has 1e-9 mm digits)
+    assert np.all(np.diff(np.hypot(pts[:, 0], pts[:, 1])) >= -1e-8)
     assert (out / "profile.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
     tools, roughing, finishing = summary["tools"], summary["roughing"], summary["finishing"]
     for key in ("finishing_max_flat_width_mm", "finishing_max_corner_radius_mm", "roughing_max_diameter_mm",
@@ -101,7 +102,8 @@ BAD_JOBS = {
                                 "finishing tool flat width 2.0000 mm (D - 2 r_t) exceeds finishing_max_flat_width_mm"),
     "unknown strategy": ("[gear]\nteeth = 23\nmodule_mm = 4.0\nface_width_mm = 20\n[finishing]\nstrategy = 'spiral'\n",
                          "bad.toml:6: [finishing] strategy 'spiral' is unknown"),
-    "unknown post dialect": ("[gear]\nteeth = 23\nmodule_mm = 4.0\nface_width_mm = 20\n[post]\ndialect = 'heidenhain'\n",
+    "unknown post dialect": ("[gear]\nteeth = 23\nmodule_mm = 4.0\nface_width_mm = 20\n"
+                             "[post]\ndialect = 'heidenhain'\n",
                              ("bad.toml:6: [post] dialect = 'heidenhain' is not known (known: linuxcnc, fanuc, "
                               "haas, siemens, okuma)")),
     "folded wrapped program": (("[gear]\nteeth = 23\nmodule_mm = 4.0\nface_width_mm = 20\n[post]\n"

@@ -8,7 +8,6 @@ from pathlib import Path
 import pytest
 
 import spur_cad
-
 from tests.freecad_helper import describe, run_freecad_code
 from tests.rs274_helper import canon_args, run_rs274
 

@@ -86,7 +86,8 @@ def test_reference_gear_inspection_values_by_hand():
     spec = spec_of("reference_z23_m4")
     sheet = inspection_sheet(spec)
     inv20 = math.tan(math.radians(20)) - math.radians(20)
-    expected = 4 * math.cos(math.radians(20)) * (2.5 * math.pi + 23 * inv20) - 0.05 * 2 * math.pi * math.cos(math.radians(20))
+    cos20 = math.cos(math.radians(20))
+    expected = 4 * cos20 * (2.5 * math.pi + 23 * inv20) - 0.05 * 2 * math.pi * cos20
     assert sheet["span_teeth_k"] == 3
     assert sheet["span_measurement_mm"] == pytest.approx(expected, abs=1e-9)
     assert sheet["min_teeth_without_undercut"] == 20

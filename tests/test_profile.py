@@ -7,8 +7,8 @@ import math
 
 import numpy as np
 import pytest
-from scipy.optimize import brentq
 import shapely
+from scipy.optimize import brentq
 from shapely.geometry import Polygon
 from shapely.ops import unary_union
 
@@ -108,7 +108,7 @@ def test_fillet_obeys_willis_camus_law(name):
     assert len(pts) > 3
     for p, n in zip(pts, normals):
         # Signed distance of the pitch point P(phi) = (r sin phi, r cos phi) from the normal line.
-        def off_line(phi):
+        def off_line(phi, p=p, n=n):
             q = g.pitch_point(phi) - p
             return q[0] * n[1] - q[1] * n[0]
 

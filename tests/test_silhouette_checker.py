@@ -164,7 +164,8 @@ def test_mask_and_substeps_select_poses():
     rows_1_3 = silhouettes_in_part_frame(tp, 4.0, 0.0, 10.0, mask=np.array([1, 3]))
     tips = [np.asarray(p.exterior.coords)[:2].mean(axis=0) for p in rows_1_3]
     assert tips == [pytest.approx([0.0, 50.0], abs=1e-12),
-                    pytest.approx([50.0 * math.sin(math.radians(40.0)), 50.0 * math.cos(math.radians(40.0))], abs=1e-12)]
+                    pytest.approx([50.0 * math.sin(math.radians(40.0)), 50.0 * math.cos(math.radians(40.0))],
+                                  abs=1e-12)]
     with pytest.raises(ValueError):
         silhouettes_in_part_frame(tp, 4.0, 0.0, 10.0, mask=np.array([True, False]))
 

@@ -13,12 +13,10 @@ from spur_cad.cam.ir import Feature, MoveKind, Operation, ToolpathBuilder
 from spur_cad.cam.tools import Tool
 from spur_cad.geometry.sampling import full_space_points, sample_profile
 from spur_cad.job import load_job
-from spur_cad.pipeline import plan_cam
-from spur_cad.sim import Cut, SimSettings, StockCylinder, simulate, simulate_grid, subset
+from spur_cad.pipeline import job_stock, plan_cam
+from spur_cad.sim import Cut, SimSettings, StockCylinder, finishing_stations, simulate, simulate_grid, subset
 from spur_cad.sim.design import DesignGrid, row_positions
-from spur_cad.pipeline import job_stock
 from spur_cad.summary import simulation_section
-from spur_cad.sim import finishing_stations
 
 ROOT = Path(__file__).resolve().parents[1]
 REFERENCE_JOB = ROOT / "resources" / "examples" / "reference_gear.toml"

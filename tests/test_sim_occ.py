@@ -9,11 +9,9 @@ import pytest
 
 from spur_cad.cam.ir import Feature
 from spur_cad.job import load_job
-from spur_cad.pipeline import plan_cam
-from spur_cad.sim import SimSettings, subset
+from spur_cad.pipeline import job_stock, plan_cam
+from spur_cad.sim import SimSettings, finishing_stations, subset
 from spur_cad.sim.occ_check import cross_check
-from spur_cad.pipeline import job_stock
-from spur_cad.sim import finishing_stations
 
 ROOT = Path(__file__).resolve().parents[1]
 RES = 0.005

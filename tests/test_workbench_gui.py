@@ -186,7 +186,8 @@ def test_workbench_commands_panel_and_screenshot_in_the_gui(freecad_gui, tmp_pat
 
     # the task panel: suggested tools are valid; the command line's messages beside the right group
     assert result["panel_open"] and result["suggested_messages"] == {} and result["valid_messages"] == {}
-    assert "at most" in result["notes"]["RoughingToolDiameter"] and "at most" in result["notes"]["FinishingCornerRadius"]
+    assert "at most" in result["notes"]["RoughingToolDiameter"]
+    assert "at most" in result["notes"]["FinishingCornerRadius"]
     assert result["too_wide"] == {"Finishing tool": _expected(small_job_text(finishing_diameter=9.0))}
     assert result["accept_too_wide"] is False and result["unchanged"] and result["still_open"]
     negative = small_job_text().replace("diameter_mm = 2.0", "diameter_mm = -1.0")

@@ -70,7 +70,8 @@ RESULT["job"] = dict(roughing=job.RoughingMoves, finishing=job.FinishingMoves,
 # Toolpath points in the part frame must lie outside the gear, and finishing ones hug its surface.
 for name, obj in (("roughing", job.RoughingToolpath), ("finishing", job.FinishingToolpath)):
     cuts = [c for c in obj.Path.Commands if c.Name == "G1"]
-    pts = [FreeCAD.Vector(c.Parameters["X"], c.Parameters["Y"], c.Parameters["Z"]) for c in cuts[::max(1, len(cuts) // 80)]]
+    pts = [FreeCAD.Vector(c.Parameters["X"], c.Parameters["Y"], c.Parameters["Z"])
+           for c in cuts[::max(1, len(cuts) // 80)]]
     if name == "roughing":  # passes run along X across the face at constant (Y, Z): check them mid-face
         pts = [FreeCAD.Vector(b / 2, p.y, p.z) for p in pts]
     pts = [p for p in pts if 0.0 < p.x < b]
@@ -245,7 +246,8 @@ def test_documents_save_and_reopen_without_pickles(freecadcmd, tmp_path):
     assert result["schema_version"] == 2
     assert result["migrated"] == {"version": 2, "has": True, "value": 0.0}
     # unit-carrying types: a feed is a speed shown in FreeCAD's units (mm/s) and read back in mm/min
-    types = {"MaxFeed": "App::PropertySpeed", "AMin": "App::PropertyFloat", "FinishingStrategy": "App::PropertyEnumeration"}
+    types = {"MaxFeed": "App::PropertySpeed", "AMin": "App::PropertyFloat",
+             "FinishingStrategy": "App::PropertyEnumeration"}
     assert result["new_types"] == types
     assert result["new_max_feed"][0] == pytest.approx(5000.0 / 60.0) and "mm/s" in result["new_max_feed"][1]
     # schema-1 types re-created with the values they held, the drop-down list brought up to date
@@ -268,7 +270,7 @@ def test_documents_save_and_reopen_without_pickles(freecadcmd, tmp_path):
     assert len(proxies) == 5
     import base64
 
-    for module, cls, value in proxies:
+    for module, _, value in proxies:
         assert module == "spur_cad_workbench.features"
         assert base64.b64decode(value) == b"null"  # JSON null: no pickled state
 

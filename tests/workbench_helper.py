@@ -100,6 +100,21 @@ def _without_date_comments(text: str) -> list[str]:
     return [line for line in text.splitlines() if not (_DATE.search(line) and ("(" in line or ";" in line))]
 
 
+def _summary_differences(cli: Path, wb: Path) -> list[str]:
+    """summary.json: equal apart from timings, the job's source and the STEP sizes."""
+    a, b = json.loads(cli.read_text()), json.loads(wb.read_text())
+    for data in (a, b):
+        data.pop("timings_s", None)
+        data.get("job", {}).pop("file", None)
+        data.get("simulation", {}).pop("seconds", None)
+        # STEP sizes: OCCT names each product "Open CASCADE STEP translator 7.9 <n>" with a
+        # per-process export counter, so the size depends on how many exports ran before.
+        data.get("cad", {}).pop("step_bytes", None)
+    if a != b:
+        return [f"summary.json differs in {sorted(k for k in set(a) | set(b) if a.get(k) != b.get(k))}"]
+    return []
+
+
 def output_differences(cli_dir: Path, workbench_dir: Path, sources: tuple[str, ...] = ()) -> list[str]:
     """How the workbench's files differ from the CLI's for the same job (empty: the same content).
 
@@ -119,17 +134,7 @@ def output_differences(cli_dir: Path, workbench_dir: Path, sources: tuple[str, .
             if len(a) != len(b) or any(abs(x - y) > 1e-9 * abs(x) for x, y in zip(a, b)):
                 problems.append(f"{name}: volumes {a} vs {b}")
         elif name == "summary.json":
-            a, b = json.loads(cli.read_text()), json.loads(wb.read_text())
-            for data in (a, b):
-                data.pop("timings_s", None)
-                data.get("job", {}).pop("file", None)
-                data.get("simulation", {}).pop("seconds", None)
-                # STEP sizes: OCCT names each product "Open CASCADE STEP translator 7.9 <n>" with a
-                # per-process export counter, so the size depends on how many exports ran before.
-                data.get("cad", {}).pop("step_bytes", None)
-            if a != b:
-                keys = sorted(k for k in set(a) | set(b) if a.get(k) != b.get(k))
-                problems.append(f"summary.json differs in {keys}")
+            problems += _summary_differences(cli, wb)
         elif Path(name).suffix in GCODE_SUFFIXES:
             if _without_date_comments(cli.read_text()) != _without_date_comments(wb.read_text()):
                 problems.append(f"{name}: G-code differs")

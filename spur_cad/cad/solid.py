@@ -31,8 +31,8 @@ from OCP.BRepPrimAPI import BRepPrimAPI_MakeBox, BRepPrimAPI_MakeCylinder, BRepP
 from OCP.GC import GC_MakeArcOfCircle
 from OCP.Geom import Geom_BSplineCurve, Geom_Curve
 from OCP.GeomAPI import GeomAPI_Interpolate, GeomAPI_ProjectPointOnCurve
-from OCP.GProp import GProp_GProps
 from OCP.gp import gp_Ax1, gp_Ax2, gp_Dir, gp_Pnt, gp_Trsf, gp_Vec
+from OCP.GProp import GProp_GProps
 from OCP.TColgp import TColgp_Array1OfVec, TColgp_HArray1OfPnt
 from OCP.TColStd import TColStd_HArray1OfBoolean
 from OCP.TopoDS import TopoDS, TopoDS_Edge, TopoDS_Shape

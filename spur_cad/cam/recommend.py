@@ -105,7 +105,8 @@ def check_roughing_reach(roughing: Tool, lowest_level_above_root_mm: float, rec:
     """The material roughing leaves above the root must be within the finishing tool's plunge
     capacity A_p (docs/method.md); raise ToolError otherwise."""
     if lowest_level_above_root_mm > rec.plunge_allowance_mm + 1e-9:
-        raise ToolError(f"roughing tool diameter {roughing.diameter_mm:g} mm leaves {lowest_level_above_root_mm:.3f} mm "
+        raise ToolError(f"roughing tool diameter {roughing.diameter_mm:g} mm leaves "
+                        f"{lowest_level_above_root_mm:.3f} mm "
                         f"above the root, more than the finishing tool can plunge (A_p = "
                         f"{rec.plunge_allowance_mm:.3f} mm); use a smaller roughing tool", field="diameter_mm",
                         section="tools.roughing")

@@ -71,72 +71,88 @@ def estimated_roughing_moves(spec: GearSpec, tool: Tool, params: RoughingParams,
     return moves, driver
 
 
-def roughing_levels(spec: GearSpec, tool: Tool, params: RoughingParams, blank_radius_mm: float) -> RoughingLevels:
-    """Levels as described in the module docstring (pure function)."""
-    flank, labels, junction = offset_flank(spec, params.finish_stock_mm)
-    radius = tool.diameter_mm / 2.0
-    budget = params.flank_allowance_mm - params.finish_stock_mm
-    max_depth = params.max_level_depth_fraction * tool.diameter_mm
-    tip_edge_height = float(flank[-1, 1])
+@dataclass(frozen=True)
+class _OffsetFlank:
+    """The right flank offset by the finish stock (root to tip edge) and what the levels ask of it."""
 
-    def width(h: float) -> float:
-        return space_half_width_mm(flank, h)
+    points: np.ndarray
+    junction: float | None  # height of the fillet/involute junction
 
-    # Lowest level: the offset space is exactly as wide as the tool (bisection on a monotone test).
-    low, high = float(flank[:, 1].min()), tip_edge_height
-    if width(high) < radius:
-        raise ToolError(f"roughing tool diameter {tool.diameter_mm:g} mm does not fit the tooth space even at the tip "
-                        f"(space width {2 * width(high):.3f} mm there, finish stock included)", field="diameter_mm",
-                        section="tools.roughing")
-    for _ in range(100):
-        mid = 0.5 * (low + high)
-        low, high = (mid, high) if width(mid) < radius else (low, mid)
-    lowest = high
+    @property
+    def tip_edge_height(self) -> float:
+        return float(self.points[-1, 1])
 
-    def flank_point(h: float) -> np.ndarray:
+    def width(self, h: float) -> float:
+        return space_half_width_mm(self.points, h)
+
+    def point(self, h: float) -> np.ndarray:
         """Point of the offset flank at height h (first crossing from the root, tip edge above it)."""
-        y = flank[:, 1]
-        if h >= tip_edge_height:
+        flank, y = self.points, self.points[:, 1]
+        if h >= self.tip_edge_height:
             return flank[-1]
         i = int(np.nonzero((y[:-1] <= h) & (y[1:] >= h))[0][0]) if np.any((y[:-1] <= h) & (y[1:] >= h)) else 0
         t = (h - y[i]) / (y[i + 1] - y[i]) if y[i + 1] != y[i] else 0.0
         return flank[i] + t * (flank[i + 1] - flank[i])
 
-    def staircase(h_low: float, h_high: float) -> float:
+    def staircase(self, h_low: float, h_high: float) -> float:
         """Material left between two levels: horizontal on the involute, straight on the fillet."""
-        p_low, p_high = flank_point(h_low), flank_point(min(h_high, tip_edge_height))
-        on_fillet = junction is not None and h_high <= junction + 1e-12
+        p_low, p_high = self.point(h_low), self.point(min(h_high, self.tip_edge_height))
+        on_fillet = self.junction is not None and h_high <= self.junction + 1e-12
         if on_fillet:
             return float(np.hypot(*(p_high - p_low)))
         return float(p_high[0] - p_low[0])
 
-    heights = [lowest]
+
+def _lowest_level(flank: _OffsetFlank, tool: Tool) -> float:
+    """Where the offset space is exactly as wide as the tool (bisection on a monotone test)."""
+    radius = tool.diameter_mm / 2.0
+    low, high = float(flank.points[:, 1].min()), flank.tip_edge_height
+    if flank.width(high) < radius:
+        raise ToolError(f"roughing tool diameter {tool.diameter_mm:g} mm does not fit the tooth space even at the tip "
+                        f"(space width {2 * flank.width(high):.3f} mm there, finish stock included)",
+                        field="diameter_mm", section="tools.roughing")
+    for _ in range(100):
+        mid = 0.5 * (low + high)
+        low, high = (mid, high) if flank.width(mid) < radius else (low, mid)
+    return high
+
+
+def _next_level(flank: _OffsetFlank, h: float, max_depth: float, budget: float, params: RoughingParams) -> float:
+    """The highest level above `h` whose staircase stays within the budget (the junction is always a level)."""
+    ceiling = min(h + max_depth, flank.tip_edge_height)
+    if flank.junction is not None and h < flank.junction - 1e-9:
+        ceiling = min(ceiling, flank.junction)
+    if flank.staircase(h, ceiling) <= budget:
+        return ceiling
+    lo, hi = h, ceiling  # largest height whose staircase is within budget (it grows with height)
+    for _ in range(60):
+        mid = 0.5 * (lo + hi)
+        lo, hi = (mid, hi) if flank.staircase(h, mid) <= budget else (lo, mid)
+    if lo - h < 1e-6:
+        raise MachineError(f"[roughing] flank_allowance_mm = {params.flank_allowance_mm:g} is too small for "
+                           "this flank: the levels would be less than 1 nm apart", field="flank_allowance_mm",
+                           section="roughing")
+    return lo
+
+
+def roughing_levels(spec: GearSpec, tool: Tool, params: RoughingParams, blank_radius_mm: float) -> RoughingLevels:
+    """Levels as described in the module docstring (pure function)."""
+    points, _, junction = offset_flank(spec, params.finish_stock_mm)
+    flank = _OffsetFlank(points, junction)
+    budget = params.flank_allowance_mm - params.finish_stock_mm
+    max_depth = params.max_level_depth_fraction * tool.diameter_mm
+    heights = [_lowest_level(flank, tool)]
     top = blank_radius_mm - max_depth  # the first level cuts at most max_depth below the blank
     while True:
         h = heights[-1]
-        flank_done = h >= tip_edge_height - 1e-9 or staircase(h, tip_edge_height) <= budget
-        if flank_done:
+        if h >= flank.tip_edge_height - 1e-9 or flank.staircase(h, flank.tip_edge_height) <= budget:
             if h >= top - 1e-9:
                 break
             heights.append(min(h + max_depth, top))  # only the depth limit is left to satisfy
             continue
-        ceiling = min(h + max_depth, tip_edge_height)
-        if junction is not None and h < junction - 1e-9:
-            ceiling = min(ceiling, junction)
-        if staircase(h, ceiling) <= budget:
-            heights.append(ceiling)
-            continue
-        lo, hi = h, ceiling  # largest height whose staircase is within budget (it grows with height)
-        for _ in range(60):
-            mid = 0.5 * (lo + hi)
-            lo, hi = (mid, hi) if staircase(h, mid) <= budget else (lo, mid)
-        if lo - h < 1e-6:
-            raise MachineError(f"[roughing] flank_allowance_mm = {params.flank_allowance_mm:g} is too small for "
-                               "this flank: the levels would be less than 1 nm apart", field="flank_allowance_mm",
-                               section="roughing")
-        heights.append(lo)
+        heights.append(_next_level(flank, h, max_depth, budget, params))
     levels = np.array(heights[::-1])
-    half_widths = np.array([width(h) for h in levels])
+    half_widths = np.array([flank.width(h) for h in levels])
     return RoughingLevels(levels, half_widths, junction)
 
 

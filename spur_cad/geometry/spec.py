@@ -162,7 +162,8 @@ class GearSpec:
     @property
     def nominal_tooth_thickness_mm(self) -> float:
         """Tooth thickness on the reference circle without allowance: m (pi/2 + 2 x tan(alpha))."""
-        return self.module_mm * (math.pi / 2.0 + 2.0 * self.profile_shift_coefficient * math.tan(self.pressure_angle_rad))
+        shift = self.profile_shift_coefficient
+        return self.module_mm * (math.pi / 2.0 + 2.0 * shift * math.tan(self.pressure_angle_rad))
 
     @property
     def thickness_reduction_mm(self) -> float:

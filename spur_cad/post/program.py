@@ -183,6 +183,17 @@ def _number(units: int, decimals: int) -> str:
     return f"{sign}{whole}.{digits}"
 
 
+@dataclass
+class _Modal:
+    """What the control holds between blocks of one run: motion and feed mode, F, the last position."""
+
+    motion: str | None = None
+    feed_mode: str | None = None
+    feed_units: int | None = None
+    position: tuple = (None, None, None, None)  # X, Y, Z, A-relative in output units
+    a_exact: float | None = None
+
+
 class _Writer:
     """Writes runs and the program frame for one dialect (holds no state between calls)."""
 
@@ -210,15 +221,11 @@ class _Writer:
 
     def run_lines(self, run: _Run, *, folded: bool) -> list[str]:
         """One run's blocks; folded: X and A written relative to the dialect's base parameters."""
-        d, c = self.d, self.c
-        lin_dec, rot_dec, rot = d.linear_decimals, d.rotary_decimals, c.rot
-        wrapped = self.settings.rotary_mode == "wrapped"
+        c = self.c
         lines: list[str] = []
-        motion = feed_mode = None
-        last_f = last_x = last_y = last_z = last_a = None
-        last_a_exact = None
+        modal = _Modal()
         sl = slice(run.start, run.stop)
-        a_rels = np.rint((c.a[sl] - c.a[run.start]) * rot).astype(np.int64).tolist()
+        a_rels = np.rint((c.a[sl] - c.a[run.start]) * c.rot).astype(np.int64).tolist()
         rows = zip(range(run.start, run.stop), c.kind[sl].tolist(), c.x[sl].tolist(), c.y[sl].tolist(),
                    c.z[sl].tolist(), a_rels, c.a[sl].tolist(), c.inverse[sl].tolist(), c.feed[sl].tolist())
         for i, kind, x, y, z, a_rel, a_exact, inverse_move, feed in rows:
@@ -227,83 +234,122 @@ class _Writer:
                 if code:
                     lines.append(code)
                 continue
-            words: list[str] = []
-            if x != last_x:
-                words.append(d.param_word.format(address="X", param=d.x_param)
-                             if folded and run.x_base is not None else "X" + _number(x, lin_dec))
-            if y != last_y:
-                words.append("Y" + _number(y, lin_dec))
-            if z != last_z:
-                words.append("Z" + _number(z, lin_dec))
-            direction = None
-            if a_rel != last_a:
-                if folded:
-                    offset = ("+" if a_rel > 0 else "") + _number(a_rel, rot_dec)
-                    words.append(d.param_word.format(address="A", param=d.a_param) if a_rel == 0 else
-                                 d.param_offset_word.format(address="A", param=d.a_param, offset=offset))
-                else:
-                    total = run.a_base + a_rel
-                    words.append("A" + _number(total % (360 * rot) if wrapped else total, rot_dec))
-                    if wrapped and d.direction_codes and last_a_exact is not None:
-                        direction = d.direction_codes[0] if a_exact > last_a_exact else d.direction_codes[1]
+            words, direction = self._position_words(run, folded, modal, (x, y, z, a_rel), a_exact)
             if not words:
                 continue  # nothing moves at the output's precision
-            last_x, last_y, last_z, last_a, last_a_exact = x, y, z, a_rel, a_exact
-            head: list[str] = []
-            if kind == MoveKind.RAPID:
-                if motion != "G0":
-                    head.append("G0")
-                    motion = "G0"
-            else:
-                inverse = inverse_move and d.inverse_time
-                mode = "G93" if inverse else "G94"
-                if mode != feed_mode:
-                    head.append(mode)
-                    feed_mode = mode
-                    last_f = None
-                if motion != "G1":
-                    head.append("G1")
-                    motion = "G1"
-                decimals = d.inverse_feed_decimals if inverse else d.feed_decimals
-                if not (math.isfinite(feed) and feed > 0.0):
-                    raise PostError(f"{self.info.title}: move {i} has no usable feed ({feed!r})")
-                f = int(round(feed * 10 ** decimals))
-                if f < 1:
-                    raise PostError(f"{self.info.title}: move {i}'s feed {feed:g} would be written as F0")
-                if inverse or f != last_f:  # G93 needs F in every feed block
-                    words.append("F" + _number(f, decimals))
-                    last_f = f
+            modal.position, modal.a_exact = (x, y, z, a_rel), a_exact
+            head = self._motion_words(kind, inverse_move, feed, i, modal, words)
             if direction:
                 words.append(direction)
             lines.append(" ".join(head + words))
-        if feed_mode == "G93":
+        if modal.feed_mode == "G93":
             lines.append("G94")
         return lines
 
+    def _position_words(self, run: _Run, folded: bool, modal: "_Modal", position: tuple[int, int, int, int],
+                        a_exact: float) -> tuple[list[str], str | None]:
+        """The X/Y/Z/A words of a move (only the axes that change) and the rotary direction code, if any."""
+        d = self.d
+        lin_dec, rot_dec = d.linear_decimals, d.rotary_decimals
+        x, y, z, a_rel = position
+        last_x, last_y, last_z, last_a = modal.position
+        words: list[str] = []
+        if x != last_x:
+            words.append(d.param_word.format(address="X", param=d.x_param)
+                         if folded and run.x_base is not None else "X" + _number(x, lin_dec))
+        if y != last_y:
+            words.append("Y" + _number(y, lin_dec))
+        if z != last_z:
+            words.append("Z" + _number(z, lin_dec))
+        direction = None
+        if a_rel != last_a:
+            if folded:
+                offset = ("+" if a_rel > 0 else "") + _number(a_rel, rot_dec)
+                words.append(d.param_word.format(address="A", param=d.a_param) if a_rel == 0 else
+                             d.param_offset_word.format(address="A", param=d.a_param, offset=offset))
+            else:
+                wrapped = self.settings.rotary_mode == "wrapped"
+                total = run.a_base + a_rel
+                words.append("A" + _number(total % (360 * self.c.rot) if wrapped else total, rot_dec))
+                if wrapped and d.direction_codes and modal.a_exact is not None:
+                    direction = d.direction_codes[0] if a_exact > modal.a_exact else d.direction_codes[1]
+        return words, direction
+
+    def _motion_words(self, kind: int, inverse_move: bool, feed: float, index: int, modal: "_Modal",
+                      words: list[str]) -> list[str]:
+        """The modal G words a move needs in front (G0/G1, G93/G94); appends its F word to `words`."""
+        d = self.d
+        head: list[str] = []
+        if kind == MoveKind.RAPID:
+            if modal.motion != "G0":
+                head.append("G0")
+                modal.motion = "G0"
+            return head
+        inverse = inverse_move and d.inverse_time
+        mode = "G93" if inverse else "G94"
+        if mode != modal.feed_mode:
+            head.append(mode)
+            modal.feed_mode = mode
+            modal.feed_units = None
+        if modal.motion != "G1":
+            head.append("G1")
+            modal.motion = "G1"
+        decimals = d.inverse_feed_decimals if inverse else d.feed_decimals
+        if not (math.isfinite(feed) and feed > 0.0):
+            raise PostError(f"{self.info.title}: move {index} has no usable feed ({feed!r})")
+        f = int(round(feed * 10 ** decimals))
+        if f < 1:
+            raise PostError(f"{self.info.title}: move {index}'s feed {feed:g} would be written as F0")
+        if inverse or f != modal.feed_units:  # G93 needs F in every feed block
+            words.append("F" + _number(f, decimals))
+            modal.feed_units = f
+        return head
+
     def program(self, body: list[tuple[str, object]], sub_bodies: list[list[str]]) -> str:
+        """The whole program: header, subprogram definitions (before or after the main body, per dialect),
+        the main body with its calls, the end; block numbers and the line-length check last."""
         d, s, info = self.d, self.settings, self.info
         sub_ids = self._sub_ids(len(sub_bodies))
-        lin_dec, rot_dec = d.linear_decimals, d.rotary_decimals
-
-        def call_lines(index: int, run: _Run) -> list[str]:
-            x = _number(run.x_base if run.x_base is not None else 0, lin_dec)
-            a = _number(run.a_base, rot_dec)
-            return [line.format(sub=sub_ids[index], x=x, a=a) for line in d.call]
-
         head: list[str] = ["%"] if d.percent_delimited else []
         if d.program_start:
             head.append(d.program_start.format(number=s.program_number, title=self._title()))
         titled = (info.comments if d.program_start and "{title}" in d.program_start else (info.title, *info.comments))
         head += [self.comment(line) for line in titled]
-        definitions: list[str] = []
-        if not d.subprograms_after_end and d.fold_style != "repeat":
-            for index, lines in enumerate(sub_bodies):
-                definitions += [d.sub_start.format(sub=sub_ids[index]), *lines,
-                                d.sub_end.format(sub=sub_ids[index])]
-        main = [d.setup, *[t.format(tool=self.tool) for t in d.tool_change],
-                d.spindle_on.format(rpm=self.rpm)]
+        definitions = [] if d.subprograms_after_end or d.fold_style == "repeat" else \
+            self._definitions(sub_bodies, sub_ids)
+        main = [d.setup, *[t.format(tool=self.tool) for t in d.tool_change], d.spindle_on.format(rpm=self.rpm)]
         if s.coolant:
             main.append(d.coolant_on)
+        main += self._main_body(body, sub_bodies, sub_ids)
+        if s.coolant:
+            main.append(d.coolant_off)
+        main += [d.spindle_off, d.program_end]
+        tail = self._definitions(sub_bodies, sub_ids) if d.subprograms_after_end else []
+        if d.percent_delimited:
+            tail.append("%")
+        lines = head + definitions + main + tail
+        if s.line_numbers:
+            lines = self._numbered(lines, min(sub_ids) - 1 if d.fold_style == "local_sub" and sub_ids
+                                   else s.max_line_number)
+        too_long = [n for n, line in enumerate(lines, start=1) if len(line) > d.max_line_length]
+        if too_long:
+            raise PostError(f"{info.title}: line {too_long[0]} would have {len(lines[too_long[0] - 1])} characters, "
+                            f"more than the {d.name} limit of {d.max_line_length}")
+        return "\n".join(lines) + "\n"
+
+    def _definitions(self, sub_bodies: list[list[str]], sub_ids: list[int]) -> list[str]:
+        """Every subprogram, framed by the dialect's start and end blocks."""
+        d = self.d
+        lines: list[str] = []
+        for index, body in enumerate(sub_bodies):
+            lines += [d.sub_start.format(sub=sub_ids[index]), *body, d.sub_end.format(sub=sub_ids[index])]
+        return lines
+
+    def _main_body(self, body: list[tuple[str, object]], sub_bodies: list[list[str]], sub_ids: list[int]) -> list[str]:
+        """Inline runs and subprogram calls in order; a repeat-style dialect writes each section at its first use."""
+        d = self.d
+        lin_dec, rot_dec = d.linear_decimals, d.rotary_decimals
+        main: list[str] = []
         written: set[int] = set()
         for kind, item in body:
             if kind == "lines":
@@ -316,25 +362,9 @@ class _Writer:
                          d.sub_start.format(sub=sub_ids[index]), *sub_bodies[index],
                          d.sub_end.format(sub=sub_ids[index])]
             else:
-                main += call_lines(index, run)
-        if s.coolant:
-            main.append(d.coolant_off)
-        main += [d.spindle_off, d.program_end]
-        tail: list[str] = []
-        if d.subprograms_after_end:
-            for index, lines in enumerate(sub_bodies):
-                tail += [d.sub_start.format(sub=sub_ids[index]), *lines, d.sub_end.format(sub=sub_ids[index])]
-        if d.percent_delimited:
-            tail.append("%")
-        lines = head + definitions + main + tail
-        if s.line_numbers:
-            lines = self._numbered(lines, min(sub_ids) - 1 if d.fold_style == "local_sub" and sub_ids
-                                   else s.max_line_number)
-        too_long = [n for n, line in enumerate(lines, start=1) if len(line) > d.max_line_length]
-        if too_long:
-            raise PostError(f"{info.title}: line {too_long[0]} would have {len(lines[too_long[0] - 1])} characters, "
-                            f"more than the {d.name} limit of {d.max_line_length}")
-        return "\n".join(lines) + "\n"
+                x = _number(run.x_base if run.x_base is not None else 0, lin_dec)
+                main += [line.format(sub=sub_ids[index], x=x, a=_number(run.a_base, rot_dec)) for line in d.call]
+        return main
 
     def _title(self) -> str:
         """The title inside the program-start block (room left for the O number and the parentheses)."""

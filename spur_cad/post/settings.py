@@ -8,7 +8,6 @@ from spur_cad.errors import SpurCadError
 from spur_cad.keys import check_section, key
 
 
-
 def dialect_names() -> tuple[str, ...]:
     """The dialects' names, from the table in spur_cad.post.dialects (which imports this module, hence the
     late import): adding a dialect there is all it takes."""

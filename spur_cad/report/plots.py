@@ -49,7 +49,8 @@ def tooth_space_png(spec: GearSpec, samples: ProfileSamples) -> bytes:
     ax.set_aspect("equal")
     ax.set_xlabel("x [mm]")
     ax.set_ylabel("y [mm] (space axis)")
-    title = (f"z={spec.teeth}  m={spec.module_mm:g}  alpha={spec.pressure_angle_deg:g} deg  x={spec.profile_shift_coefficient:g}"
+    title = (f"z={spec.teeth}  m={spec.module_mm:g}  alpha={spec.pressure_angle_deg:g} deg  "
+             f"x={spec.profile_shift_coefficient:g}"
              f"  rho={spec.rack_tip_radius_mm:g} mm" + ("  UNDERCUT" if profile.undercut else ""))
     ax.set_title(title, fontsize=9)
     ax.legend(loc="upper center", fontsize=8, ncols=4)

@@ -19,5 +19,6 @@ from spur_cad.sim.simulate import (
     subset,
 )
 
-__all__ = ["Cut", "SimResult", "SimSettings", "SimulationError", "StockCylinder", "decompose", "finishing_stations", "shifted",
+__all__ = ["Cut", "SimResult", "SimSettings", "SimulationError", "StockCylinder", "decompose", "finishing_stations",
+           "shifted",
            "simulate", "simulate_grid", "subset"]

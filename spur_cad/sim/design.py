@@ -68,7 +68,7 @@ def sample_space(profile: ToothSpaceProfile, spacing_mm: float) -> tuple[np.ndar
     The last point (left tooth centre) is left out: it is the next space's first point.
     """
     pts, nrm, feat = [], [], []
-    for index, segment in enumerate(profile.segments):  # right half, root -> tip
+    for segment in profile.segments:  # right half, root -> tip
         if segment.end <= segment.start:
             continue
         params = even_arc_length_parameters(segment, spacing_mm)
@@ -89,7 +89,7 @@ def sample_space(profile: ToothSpaceProfile, spacing_mm: float) -> tuple[np.ndar
     return points[:-1], normals[:-1], feature[:-1], side[:-1]
 
 
-def row_positions(x_min: float, x_max: float, spacing_mm: float, extra: np.ndarray = np.zeros(0),
+def row_positions(x_min: float, x_max: float, spacing_mm: float, extra: np.ndarray | None = None,
                   face_width_mm: float | None = None) -> tuple[np.ndarray, np.ndarray]:
     """Row X positions: an even grid over [x_min, x_max] (through X = 0 and X = b when given), plus `extra`
     positions (finishing stations and the midpoints between them, where scallop ridges stand); returns
@@ -100,7 +100,7 @@ def row_positions(x_min: float, x_max: float, spacing_mm: float, extra: np.ndarr
         step = face_width_mm / math.ceil(face_width_mm / spacing_mm)
     grid = np.arange(math.floor((x_min - anchors[0]) / step), math.ceil((x_max - anchors[0]) / step) + 1) * step
     grid = grid[(grid >= x_min - 1e-9) & (grid <= x_max + 1e-9)]
-    extra = np.asarray(extra, float)
+    extra = np.asarray(extra if extra is not None else (), float)
     extra = extra[(extra >= x_min) & (extra <= x_max)]
     if len(extra) > 1:  # the grid only fills where the extra rows leave gaps wider than the spacing
         nearest = np.abs(grid[:, None] - extra[None, :]).min(axis=1)
@@ -112,7 +112,7 @@ def row_positions(x_min: float, x_max: float, spacing_mm: float, extra: np.ndarr
 
 
 def design_grid(spec: GearSpec, spacing_mm: float, x_min: float, x_max: float,
-                extra_rows: np.ndarray = np.zeros(0)) -> DesignGrid:
+                extra_rows: np.ndarray | None = None) -> DesignGrid:
     """The design grid of `spec`: points every `spacing_mm` along the space, rows over [x_min, x_max]."""
     points, normals, feature, side = sample_space(spec.tooth_space_profile(), spacing_mm)
     arc = np.concatenate([[0.0], np.cumsum(np.hypot(*np.diff(points, axis=0).T))])

@@ -181,7 +181,8 @@ def _clip_at_pose(x, y, z, a, x_end, h, h_top, points, normals, chunk_start, chu
                 if reach_x2 <= 0.0:
                     continue
                 reach_x = math.sqrt(reach_x2)
-                cuts += _walk_rows(hrow, rows, r_out, r_hi, 1, x_end, reach_x, deepest, ay, az, ny, nz, radius, half_flat, rt)
+                cuts += _walk_rows(hrow, rows, r_out, r_hi, 1, x_end, reach_x, deepest, ay, az, ny, nz, radius,
+                                   half_flat, rt)
                 cuts += _walk_rows(hrow, rows, r_in - 1, r_lo - 1, -1, x, reach_x, deepest, ay, az, ny, nz, radius,
                                    half_flat, rt)
     return cuts

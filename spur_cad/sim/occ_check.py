@@ -64,7 +64,8 @@ def _silhouette_prism(tool: Tool, height: float, length: float):
     half_flat = radius - rt
     wp = cq.Workplane("YZ").moveTo(-radius, height).lineTo(-radius, rt)
     if rt > 0.0:
-        wp = wp.threePointArc((-half_flat - rt * math.sin(math.pi / 4), rt - rt * math.cos(math.pi / 4)), (-half_flat, 0.0))
+        wp = wp.threePointArc((-half_flat - rt * math.sin(math.pi / 4), rt - rt * math.cos(math.pi / 4)),
+                              (-half_flat, 0.0))
     if half_flat > 0.0:
         wp = wp.lineTo(half_flat, 0.0)
     if rt > 0.0:
@@ -104,7 +105,8 @@ def swept_solids(path: Toolpath, tool: Tool, stock: StockCylinder, resolution_mm
         reach = max(math.hypot(y0, z0), math.hypot(y[i], z[i])) + tool.diameter_mm
         travel = abs(x[i] - x0) + math.hypot(y[i] - y0, z[i] - z0) + reach * abs(math.radians(a[i] - a0))
         here = step
-        if tool.effective_corner_radius_mm == 0.0 and z0 == z[i] and a0 == a[i]:  # flat bottom translating: its round edge
+        # flat bottom translating: its round edge
+        if tool.effective_corner_radius_mm == 0.0 and z0 == z[i] and a0 == a[i]:
             here = math.sqrt(8.0 * radius * resolution_mm / 2.0) / refine
         pieces = max(1, math.ceil(travel / here))
         for f in np.arange(1, pieces + 1) / pieces:
@@ -140,7 +142,7 @@ def probe_blades(shape, origins: np.ndarray, directions: np.ndarray, t_min: floa
 
 
 def cross_check(spec: GearSpec, stock: StockCylinder, path: Toolpath, tool: Tool, settings: SimSettings,
-                rows_x_range: tuple[float, float], station_x: np.ndarray = np.zeros(0), refine: int = 2,
+                rows_x_range: tuple[float, float], station_x: np.ndarray | None = None, refine: int = 2,
                 max_blades: int = 400, seed: int = 0) -> CrossCheck:
     """Remove `path` from the stock both ways and compare the blades it cut (a random sample of at most
     `max_blades`, plus as many uncut blades near them, which must stay uncut in both)."""

@@ -254,7 +254,8 @@ def simulate(spec: GearSpec, stock: StockCylinder, operations: Sequence[Cut],
     """
     settings.validate()
     started = time.perf_counter()
-    corner_radii = [op.tool.effective_corner_radius_mm for op in operations if op.tool.effective_corner_radius_mm > 0.0] or [0.5]
+    corner_radii = [op.tool.effective_corner_radius_mm for op in operations
+                    if op.tool.effective_corner_radius_mm > 0.0] or [0.5]
     spacing = point_spacing_mm(min(corner_radii), settings.resolution_mm)
     stations = np.unique(np.asarray(station_x if station_x is not None else np.zeros(0), float))
     extra = np.concatenate([stations, 0.5 * (stations[1:] + stations[:-1])]) if len(stations) else np.zeros(0)
@@ -293,7 +294,7 @@ def point_spacing_mm(corner_radius_mm: float, resolution_mm: float) -> float:
 
 
 def simulate_grid(grid: DesignGrid, stock: StockCylinder, operations: Sequence[Cut],
-                  settings: SimSettings = SimSettings(), *, face_width_mm: float, station_x: np.ndarray = np.zeros(0),
+                  settings: SimSettings = SimSettings(), *, face_width_mm: float, station_x: np.ndarray | None = None,
                   progress: Callable[[float], None] | None = None, started: float | None = None) -> SimResult:
     """`simulate` on a given design grid (any outline with normals, e.g. a plain cylinder in tests)."""
     from spur_cad.sim.kernel import clip_poses
@@ -333,7 +334,7 @@ def simulate_grid(grid: DesignGrid, stock: StockCylinder, operations: Sequence[C
     stock_area = math.pi * stock.radius_mm**2
     removed = float(((stock_area - section_areas(grid, h)) * grid.row_width).sum())
     return SimResult(grid, h, initial, stock, face_width_mm, settings, removed, time.perf_counter() - started,
-                     total, sweeps, moves, np.asarray(station_x, float))
+                     total, sweeps, moves, np.asarray(station_x if station_x is not None else (), float))
 
 
 def shifted(path: Toolpath, mask: np.ndarray, dy: np.ndarray | float = 0.0, dz: np.ndarray | float = 0.0) -> Toolpath:

@@ -18,7 +18,8 @@ from spur_cad_workbench.schema import TOOL_SWITCHES, job_data
 SECTION_GROUPS = {"tools.roughing": "Roughing tool", "tools.finishing": "Finishing tool",
                   "roughing": "Roughing strategy", "finishing": "Finishing strategy", "machine": "Machine",
                   "post": "Post", "job": "Job", "gear": "Gear", "stock": "Stock", "simulation": "Simulation"}
-_SECTION_RE = re.compile(r"\[(tools\.roughing|tools\.finishing|roughing|finishing|machine|post|job|gear|stock|simulation)\]")
+_SECTION_RE = re.compile(
+    r"\[(tools\.roughing|tools\.finishing|roughing|finishing|machine|post|job|gear|stock|simulation)\]")
 
 
 @dataclass(frozen=True)
@@ -121,7 +122,8 @@ def suggest_tools(values: dict[str, dict[str, object]]) -> dict[str, object]:
     flat = _floor_to(0.9 * rec.finishing_max_flat_width_mm, 0.05)
     if corner <= 0.0 or flat <= 0.0:
         return {}
-    chosen = {"UseFinishingTool": True, "FinishingToolKind": "bull_nose", "FinishingToolDiameter": round(flat + 2 * corner, 6),
+    chosen = {"UseFinishingTool": True, "FinishingToolKind": "bull_nose",
+              "FinishingToolDiameter": round(flat + 2 * corner, 6),
               "FinishingCornerRadius": round(corner, 6)}
     from spur_cad.cam.tools import Tool
 
@@ -130,7 +132,8 @@ def suggest_tools(values: dict[str, dict[str, object]]) -> dict[str, object]:
     limit = recommend_tools(spec, blank, check.job.machine.clearance_mm, finishing).roughing_max_diameter_mm
     diameter = _floor_to(limit, 0.1)
     while diameter >= 0.2:
-        candidate = {**chosen, "UseRoughingTool": True, "RoughingToolKind": "flat", "RoughingToolDiameter": round(diameter, 6),
+        candidate = {**chosen, "UseRoughingTool": True, "RoughingToolKind": "flat",
+                     "RoughingToolDiameter": round(diameter, 6),
                      "RoughingCornerRadius": 0.0}
         if validate({**values, "job": {**values["job"], **candidate}}).ok:
             return candidate
