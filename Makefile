@@ -1,11 +1,14 @@
-# spur_cad developer tasks. `make test` is the command CI runs (see .ci/run).
+# spur_cad developer tasks. `make test`: the fast tier, before every commit (ruff + the tests not marked
+# slow/freecad/linuxcnc, a few minutes). `make test-all`: everything (what CI runs through .ci/run).
 
 VENV        := .venv
 PYTHON      := $(VENV)/bin/python
 STAMP       := $(VENV)/.installed
 PYTEST_ARGS ?=
 
-.PHONY: venv demo test bench clean
+FAST_TIER   := not slow and not freecad and not linuxcnc
+
+.PHONY: venv demo test test-all lint bench clean
 
 venv: $(STAMP)
 
@@ -21,7 +24,13 @@ $(STAMP): pyproject.toml | $(PYTHON)
 demo: venv
 	$(VENV)/bin/spur-cad run resources/examples/reference_gear.toml --out out/
 
-test: venv
+lint: venv
+	$(VENV)/bin/ruff check .
+
+test: lint
+	$(PYTHON) -m pytest -q -m "$(FAST_TIER)" $(PYTEST_ARGS)
+
+test-all: lint
 	$(PYTHON) -m pytest -q $(PYTEST_ARGS)
 
 bench: venv
