@@ -11,7 +11,6 @@ package loads nothing heavy: the CAD entry points below import CadQuery on first
 """
 
 from spur_cad.errors import GearSpecError, JobFileError, SpurCadError, StockError
-from spur_cad.geometry.spec import GearSpec
 
 __version__ = "0.1.0"
 
@@ -22,7 +21,12 @@ __all__ = ["GearSpec", "GearSpecError", "JobFileError", "SpurCadError", "StockEr
 
 
 def __getattr__(name: str):
-    """Lazy access to the CAD entry points, so `import spur_cad` does not load the CAD kernel."""
+    """Lazy access to GearSpec and the CAD entry points: `import spur_cad` loads neither numpy nor the
+    CAD kernel (the command line installs its signal handling before anything heavy is imported)."""
+    if name == "GearSpec":
+        from spur_cad.geometry.spec import GearSpec
+
+        return GearSpec
     if name in {"BlankFeatures", "StockSpec"}:
         from spur_cad.cad import specs
 

@@ -2,25 +2,33 @@
 
 Errors in the user's input print one line (`spur-cad: error: ...`) and exit 2 with nothing
 written; an unexpected failure prints a one-line internal error (traceback only with --debug)
-and exits 3.
+and exits 3; SIGINT (Ctrl-C) and SIGTERM print one line and exit 130 and 143. The output folder
+always keeps a complete set (spur_cad.outputs).
 """
 
 from __future__ import annotations
 
 import argparse
 import shutil
+import signal
 import sys
 import warnings
-from pathlib import Path
 
 from spur_cad import __version__
 from spur_cad.errors import SpurCadError
-from spur_cad.job import load_job
-from spur_cad.outputs import write_files_atomically
-from spur_cad.pipeline import run_job
 
 EXIT_INPUT_ERROR = 2
 EXIT_INTERNAL_ERROR = 3
+EXIT_INTERRUPTED = 130  # 128 + SIGINT, as shells report it
+EXIT_TERMINATED = 143  # 128 + SIGTERM
+
+
+class Terminated(BaseException):
+    """SIGTERM arrived: stop like an interrupt (the output folder keeps its set)."""
+
+
+def _terminate(signum, frame) -> None:
+    raise Terminated()
 
 
 def _parser() -> argparse.ArgumentParser:
@@ -83,6 +91,17 @@ def _install_freecad(uninstall: bool) -> int:
 
 
 def main(argv: list[str] | None = None) -> int:
+    """The command line; SIGINT and SIGTERM anywhere in a run give one line and exit 130 / 143."""
+    signal.signal(signal.SIGTERM, _terminate)
+    try:
+        return _main(argv)
+    except (KeyboardInterrupt, Terminated) as exc:
+        print("spur-cad: interrupted (the output folder holds a complete set: its previous one, or this run's "
+              "if writing had finished)", file=sys.stderr)
+        return EXIT_TERMINATED if isinstance(exc, Terminated) else EXIT_INTERRUPTED
+
+
+def _main(argv: list[str] | None) -> int:
     args = _parser().parse_args(argv)
     if not getattr(args, "debug", False):
         # Numerical warnings (overflow in an intermediate, ...) are not messages for the user: an input
@@ -92,6 +111,11 @@ def main(argv: list[str] | None = None) -> int:
         return _install_freecad(args.uninstall)
     job = None
     try:
+        from spur_cad.job import load_job  # heavy imports after the signal handling is in place
+        from spur_cad.outputs import check_output_folder, write_output_set
+        from spur_cad.pipeline import run_job
+
+        out_dir = check_output_folder(args.out)  # before any computation
         job = load_job(args.job)
         bars = ProgressBars(sys.stderr) if not args.quiet and sys.stderr.isatty() else None
         try:
@@ -99,11 +123,8 @@ def main(argv: list[str] | None = None) -> int:
         finally:
             if bars is not None:
                 bars.close()
-        out_dir = Path(args.out)
-        if out_dir.exists() and not out_dir.is_dir():
-            raise SpurCadError(f"--out {out_dir}: exists and is not a folder")
         try:
-            paths = write_files_atomically(out_dir, files)
+            paths = write_output_set(out_dir, files)
         except OSError as exc:
             raise SpurCadError(f"cannot write to {out_dir}: {exc.strerror or exc}") from None
     except SpurCadError as exc:

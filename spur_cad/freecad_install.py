@@ -20,7 +20,7 @@ from pathlib import Path
 
 from spur_cad import __version__
 from spur_cad.errors import SpurCadError
-from spur_cad.outputs import write_files_atomically
+from spur_cad.outputs import write_file_atomically
 
 ADDON_NAME = "spur_cad"
 RECORD_NAME = "spur_cad_environment.json"  # = spur_cad_workbench.environment.RECORD_NAME
@@ -81,7 +81,7 @@ def install(env: Mapping[str, str]) -> list[str]:
         record = {"spur_cad_version": __version__, "addon": str(root), "python": sys.executable,
                   "python_version": f"{sys.version_info[0]}.{sys.version_info[1]}",
                   "site_packages": site_packages()}
-        write_files_atomically(where.user_data_dir, {RECORD_NAME: (json.dumps(record, indent=2) + "\n").encode()})
+        write_file_atomically(Path(where.user_data_dir) / RECORD_NAME, (json.dumps(record, indent=2) + "\n").encode())
     except OSError as exc:
         raise SpurCadError(f"cannot install into {where.user_data_dir}: {exc.strerror or exc}") from None
     return [f"linked {where.link} -> {root}",

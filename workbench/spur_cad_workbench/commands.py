@@ -147,16 +147,14 @@ def find_job(doc):
 def export_job(job_obj, out_dir: str) -> list[str]:
     """Write the job's files (STEP gear/stock/assembly, G-code, profile, summary) as `spur-cad run` does."""
     from spur_cad.errors import SpurCadError
-    from spur_cad.outputs import write_files_atomically
+    from spur_cad.outputs import write_output_set
     from spur_cad.pipeline import run_job
 
     job = job_of(job_obj)
     files = run_job(job)
     out = Path(out_dir)
-    if out.exists() and not out.is_dir():
-        raise SpurCadError(f"{out}: exists and is not a folder")
     try:
-        paths = write_files_atomically(out, files)
+        paths = write_output_set(out, files)
     except OSError as exc:
         raise SpurCadError(f"cannot write to {out}: {exc.strerror or exc}") from None
     FreeCAD.Console.PrintMessage(f"{job_obj.Label}: wrote {len(paths)} files to {out}\n")
