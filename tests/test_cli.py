@@ -28,6 +28,7 @@ def run_cli(*args: str) -> subprocess.CompletedProcess:
                           check=False)
 
 
+@pytest.mark.slow
 def test_reference_job_writes_profile_summary_and_plot(tmp_path):
     out = tmp_path / "out"
     result = run_cli("run", str(REFERENCE_JOB), "--out", str(out))
@@ -79,6 +80,7 @@ def test_reference_job_writes_profile_summary_and_plot(tmp_path):
     assert "wrote" in result.stdout
 
 
+@pytest.mark.slow
 def test_quiet_prints_nothing(tmp_path):
     result = run_cli("run", str(REFERENCE_JOB), "--out", str(tmp_path / "o"), "--quiet")
     assert result.returncode == 0 and result.stdout == "" and result.stderr == ""
@@ -132,6 +134,7 @@ def test_missing_job_file(tmp_path):
     assert result.returncode == 2 and "job file not found" in result.stderr
 
 
+@pytest.mark.slow
 def test_out_path_that_is_a_file_is_an_error(tmp_path):
     blocker = tmp_path / "file"
     blocker.write_text("x")
@@ -139,6 +142,7 @@ def test_out_path_that_is_a_file_is_an_error(tmp_path):
     assert blocker.read_text() == "x"
 
 
+@pytest.mark.slow
 def test_existing_outputs_are_replaced_whole(tmp_path):
     out = tmp_path / "o"
     assert main(["run", str(REFERENCE_JOB), "--out", str(out), "--quiet"]) == 0
@@ -172,6 +176,7 @@ def run_cli_on_a_terminal(*args: str) -> tuple[int, str, str]:
     return proc.wait(timeout=300), stdout, b"".join(chunks).decode(errors="replace")
 
 
+@pytest.mark.slow
 def test_progress_bars_on_the_terminal_and_nothing_with_quiet(tmp_path):
     job = tmp_path / "coarse.toml"
     job.write_text(REFERENCE_JOB.read_text() + "\n[simulation]\nresolution_mm = 0.02\n")

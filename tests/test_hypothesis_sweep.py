@@ -7,6 +7,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
+import pytest
 import shapely
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
@@ -14,6 +15,8 @@ from shapely.geometry import Polygon
 
 from spur_cad.errors import GearSpecError
 from spur_cad.geometry import GearSpec, gear_outline
+
+pytestmark = pytest.mark.slow  # make test-all
 
 gear_parameters = st.fixed_dictionaries({
     "teeth": st.integers(6, 200),

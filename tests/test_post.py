@@ -145,6 +145,7 @@ def test_rs274_g93_feed_gives_the_relative_path_time(name, cam_paths, tmp_path):
 
 
 @pytest.mark.linuxcnc
+@pytest.mark.slow
 def test_folded_reference_finishing_is_15x_smaller_and_runs_the_same(tmp_path):
     from spur_cad.job import load_job
     from spur_cad.pipeline import plan_cam

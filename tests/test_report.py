@@ -13,6 +13,8 @@ from spur_cad.job import load_job
 from spur_cad.pipeline import run_job
 from spur_cad.report.html import render_report
 
+pytestmark = pytest.mark.slow  # make test-all
+
 ROOT = Path(__file__).resolve().parents[1]
 REFERENCE_JOB = ROOT / "resources" / "examples" / "reference_gear.toml"
 PNG = b"\x89PNG\r\n\x1a\n"

@@ -129,6 +129,7 @@ def reference():
     return job, plan_cam(job)
 
 
+@pytest.mark.slow
 def test_reference_job_is_cut_to_the_design_within_scallop_and_resolution(reference):
     job, plan = reference
     ops = [Cut(plan.roughing.toolpath, job.tools.roughing), Cut(plan.finishing.toolpath, job.tools.finishing)]

@@ -13,6 +13,8 @@ from spur_cad.pipeline import job_stock, plan_cam
 from spur_cad.sim import SimSettings, finishing_stations, subset
 from spur_cad.sim.occ_check import cross_check
 
+pytestmark = pytest.mark.slow  # make test-all
+
 ROOT = Path(__file__).resolve().parents[1]
 RES = 0.005
 
