@@ -91,11 +91,19 @@ class FinishingParams:
     strategy: str = "perimeter"  # a name in spur_cad.cam.strategies.REGISTRY
     target_scallop_mm: float = 0.005
     step_over_mm: float = 0.0  # X step between stations; 0: derived from the target scallop
+    cutting_direction: str = "climb"  # generating: "climb" or "conventional" (spindle clockwise, M3)
+    flank_tool_end: str = "rack"  # generating: "rack" (corner at the rack's point T) or "raised" (per pass)
 
     def validate(self) -> None:
         from spur_cad.cam.strategies import get_strategy  # the registry imports this module
 
         get_strategy(self.strategy)
+        if self.cutting_direction not in ("climb", "conventional"):
+            raise MachineError(f"[finishing] cutting_direction = {self.cutting_direction!r} is unknown "
+                               "(use one of climb, conventional)")
+        if self.flank_tool_end not in ("rack", "raised"):
+            raise MachineError(f"[finishing] flank_tool_end = {self.flank_tool_end!r} is unknown "
+                               "(use one of rack, raised)")
         if not 0.0 < self.target_scallop_mm <= 0.1:
             raise MachineError(f"[finishing] target_scallop_mm = {self.target_scallop_mm:g} must be in (0, 0.1]")
         if self.step_over_mm < 0.0:
