@@ -386,6 +386,15 @@ def test_strategy_is_registered_but_not_the_default_and_the_job_file_takes_its_k
         GeneratingParams(flank_tool_end="low").validate()
 
 
+def test_tiny_target_is_refused_before_planning():
+    from spur_cad.errors import WorkLimitError
+
+    spec = _gear("reference_z23_m4")
+    with pytest.raises(WorkLimitError, match="passes per tooth space") as caught:
+        get_strategy("generating").estimate_moves(spec, _tool(2.0, 0.5), GeneratingParams(target_scallop_mm=1e-9))
+    assert caught.value.key == "finishing.target_scallop_mm"
+
+
 def test_estimate_counts_the_moves():
     spec, tool = _gear("pa25_z31_negative_shift"), _tool(1.13, 0.5)
     strategy = get_strategy("generating")

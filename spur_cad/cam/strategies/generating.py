@@ -85,6 +85,7 @@ from spur_cad.cam.ir import Feature, MoveKind, Operation, Toolpath, ToolpathBuil
 from spur_cad.cam.machine import Machine, MachineError
 from spur_cad.cam.strategies.base import FinishingResult
 from spur_cad.cam.tools import Tool, ToolError
+from spur_cad.errors import WorkLimitError
 from spur_cad.geometry.frames import turn_points
 from spur_cad.geometry.profile import rack_corner
 from spur_cad.geometry.sampling import full_space_points, sample_profile
@@ -101,6 +102,9 @@ TIP_MODE_SAFETY = 0.95
 _FLANK_SAFETY = 0.999
 _LEFTOVER_SAMPLES = 33
 MOVES_PER_PASS = 5
+"""Index (rapid at the safe height), approach, plunge, cut, retract (4 when the machine's clearance is 0)."""
+MAX_PASSES_PER_SPACE = 20_000
+"""Largest number of passes per tooth space planned (estimated in closed form first)."""
 
 
 @dataclass(frozen=True)
@@ -375,12 +379,33 @@ def _gouges(design: np.ndarray, a: np.ndarray, y: np.ndarray, z: np.ndarray, too
     return out
 
 
+def rough_passes_per_space(spec: GearSpec, tool: Tool, target_mm: float) -> float:
+    """Closed-form estimate of the passes per space (before planning them): flanks from the midpoint
+    deviation r_b t dt^2 / 8, fillet and root from the cusp l^2 / (8 r_t) over their arc lengths."""
+    involute = spec.tooth_space_profile().segment("involute")
+    rb, t0, t1 = spec.base_radius_mm, involute.start, involute.end
+    flank = math.sqrt(rb / (8.0 * target_mm)) * (2.0 / 3.0) * (t1**1.5 - t0**1.5) + 1.0
+    fillet = spec.tooth_space_profile().segment("fillet")
+    length = 0.0
+    if fillet is not None:
+        pts = fillet.points(np.linspace(fillet.start, fillet.end, 257))
+        length = float(np.sum(np.hypot(*np.diff(pts, axis=0).T)))
+    length += spec.root_radius_mm * spec.tooth_space_profile().root_arc_half_angle_rad
+    tip = length / math.sqrt(8.0 * target_mm * max(tool.effective_corner_radius_mm, 1e-3)) + 1.0
+    return 2.0 * (flank + tip)
+
+
 def plan_generating(spec: GearSpec, tool: Tool, params: GeneratingParams, *, check: bool = True) -> GeneratingPlan:
     """The passes of tooth space 0 (both flanks, fillets and root), in cutting order."""
     params.validate()
     check_generating_tool(spec, tool)
     profile = spec.tooth_space_profile()
     target = params.target_scallop_mm
+    rough = rough_passes_per_space(spec, tool, target)
+    if rough > MAX_PASSES_PER_SPACE:
+        raise WorkLimitError(f"generating finishing would need about {rough:.3g} passes per tooth space (limit "
+                             f"{MAX_PASSES_PER_SPACE:,}) for target_scallop_mm = {target:.3g}; raise [finishing] "
+                             "target_scallop_mm", key="finishing.target_scallop_mm")
     t_rolls, flat_height = flank_rolls(spec, target)
     betas, roots, tip_leftover = _tip_rolls(spec, tool, TIP_MODE_SAFETY * target)
     fa, fy, fz = flank_poses(spec, tool, t_rolls, params.flank_tool_end)
@@ -556,4 +581,4 @@ def _passes(builder: ToolpathBuilder, spec: GearSpec, tool: Tool, machine: Machi
 
 __all__ = ["GeneratingParams", "GeneratingPass", "GeneratingPlan", "GeneratingStrategy", "GeneratingToolLimits",
            "check_generating_tool", "flank_poses", "flank_rolls", "flat_deviation_mm", "generating_tool_limits",
-           "plan_generating"]
+           "plan_generating", "rough_passes_per_space"]
