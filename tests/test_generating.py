@@ -386,6 +386,14 @@ def test_strategy_is_registered_but_not_the_default_and_the_job_file_takes_its_k
         GeneratingParams(flank_tool_end="low").validate()
 
 
+def test_warns_that_the_tip_land_is_not_cut():
+    spec, tool = _gear("reference_z23_m4"), _tool(2.0, 0.5)
+    path, _ = _plan(spec, tool)
+    assert any("stays on the tip lands" in w and "0.500 mm" in w for w in path.warnings)
+    path, _ = get_strategy("generating").generate(spec, tool, MACHINE, GeneratingParams(), spec.tip_radius_mm)
+    assert not path.warnings
+
+
 def test_tiny_target_is_refused_before_planning():
     from spur_cad.errors import WorkLimitError
 

@@ -103,6 +103,8 @@ _FLANK_SAFETY = 0.999
 _LEFTOVER_SAMPLES = 33
 MOVES_PER_PASS = 5
 """Index (rapid at the safe height), approach, plunge, cut, retract (4 when the machine's clearance is 0)."""
+TIP_LAND_WARNING = ("finishing strategy generating cuts flanks, fillets and root only: the blank's {allowance:.3f} mm "
+                    "above the tip circle stays on the tip lands (turn the blank to the tip diameter)")
 MAX_PASSES_PER_SPACE = 20_000
 """Largest number of passes per tooth space planned (estimated in closed form first)."""
 
@@ -548,6 +550,8 @@ class GeneratingStrategy:
         plan = plan_generating(spec, tool, params)
         builder = ToolpathBuilder(Operation.FINISHING, tool.tool_number, tool.spindle_rpm(machine))
         _passes(builder, spec, tool, machine, plan, params, safe_height_mm(blank_radius_mm, machine))
+        if blank_radius_mm > spec.tip_radius_mm + 1e-6:
+            builder.warnings.append(TIP_LAND_WARNING.format(allowance=blank_radius_mm - spec.tip_radius_mm))
         result = FinishingResult(self.name, params, _space_poses(plan), 1, 0.0, np.zeros(0),
                                  passes_per_space=plan.passes_per_space, flat_height_mm=plan.flat_height_mm,
                                  passes=plan.passes)
