@@ -150,6 +150,11 @@ class FinishingParams:
                                    group="Finishing strategy", meaning="target scallop height")
     step_over_mm: float = key(0.0, unit="mm", low=0.0, high=2000.0, label="FinishingStepOver",
                               group="Finishing strategy", meaning="X step between stations, 0: from the target scallop")
+    cutting_direction: str = key("climb", label="CuttingDirection", group="Finishing strategy",
+                                 choices=("climb", "conventional"),
+                                 meaning="generating: climb or conventional milling (spindle clockwise, M3)")
+    flank_tool_end: str = key("rack", label="FlankToolEnd", group="Finishing strategy", choices=("rack", "raised"),
+                              meaning="generating: tool end on the rack's tip round (rack) or raised per pass (raised)")
 
     def validate(self) -> None:
         check_section(self, "finishing", MachineError)

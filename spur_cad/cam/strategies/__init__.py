@@ -10,11 +10,13 @@ from __future__ import annotations
 from spur_cad.cam.machine import MachineError
 from spur_cad.cam.strategies.along_x import AlongXStrategy
 from spur_cad.cam.strategies.base import FinishingResult, FinishingStrategy, params_from_section
+from spur_cad.cam.strategies.generating import GeneratingStrategy
 from spur_cad.cam.strategies.perimeter import PerimeterStrategy
 
 REGISTRY: dict[str, FinishingStrategy] = {
     PerimeterStrategy.name: PerimeterStrategy(),
     AlongXStrategy.name: AlongXStrategy(),
+    GeneratingStrategy.name: GeneratingStrategy(),
 }
 
 

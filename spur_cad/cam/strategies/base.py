@@ -32,6 +32,9 @@ class FinishingResult:
     stations: int  # transverse stations across the face width (1 when the strategy has none)
     station_step_mm: float
     station_x_mm: np.ndarray  # X of the stations, where the simulation puts extra rows (empty: none)
+    passes_per_space: int = 0  # straight passes per tooth space (strategies with A clamped per pass)
+    flat_height_mm: float = 0.0  # largest generating-flat deviation left on the involute (generating)
+    passes: tuple = ()  # the strategy's passes of one space, typed by the strategy (generating: GeneratingPass)
 
     @property
     def points_per_flank(self) -> int:
