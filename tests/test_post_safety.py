@@ -22,7 +22,7 @@ from tests.gcode_reader import read_program
 from tests.rs274_helper import canon_args, run_rs274
 
 HOSTILE = ("evil\nG0 X0 Y0 Z-50\nM30", "cr\rG0 Z-50", "nul\x00G0 Z-50", "tab\tG1 Z-50 F1", "(paren) G0 Z-50",
-           "semi; G0 Z-50", "%\nG0 Z-50", "Zahnrad \u00e4\u00f6\u00fc \u2699 G0 Z-50", "x" * 10_000 + " G0 Z-50")
+           "semi; G0 Z-50", "%\nG0 Z-50", "MSG,hello", " logopen,/tmp/x.txt", "ABORT, stop", "py,import os", "Zahnrad \u00e4\u00f6\u00fc \u2699 G0 Z-50", "x" * 10_000 + " G0 Z-50")
 
 
 def two_space_toolpath():
@@ -72,6 +72,8 @@ def test_rs274_reads_the_same_moves_with_hostile_text(hostile, tmp_path):
         ok, canon, messages = run_rs274(program)
         assert ok, messages
         results.append([canon_args(line)[:4] for line in canon if line.startswith(("STRAIGHT_", "ARC_"))])
+        active = [line for line in canon if line.startswith(("MESSAGE", "LOG", "PROBE", "PY", "ABORT"))]
+        assert not active, active  # a comment the interpreter would act on
     assert results[0] == results[1]
 
 

@@ -28,15 +28,21 @@ MAX_COORDINATE_MM = 100_000.0
 """Largest |X|, |Y|, |Z| a program may command (100 m: beyond any machining centre, far inside every
 control's number format); larger or non-finite values are refused."""
 
+_ACTIVE_COMMENT = re.compile(r"(msg|debug|print|log\w*|probe\w*|abort|py\w*)\s*,", re.IGNORECASE)
+"""Comment words a LinuxCNC interpreter acts on (messages, log files, probe files, aborts, Python)."""
+
 _COMMENT_TRANSLATION = str.maketrans({"(": "[", ")": "]", ";": ",", "%": "?"})
 
 
 def inert_comment_text(text: str, max_length: int) -> str:
     """User text made safe inside one comment of any dialect: printable ASCII only (white space and line
     breaks become one space, anything else non-printable or non-ASCII becomes '?'), no comment delimiter,
-    no '%' (the end of a Fanuc tape), at most `max_length` characters ('...' marks a cut)."""
+    no '%' (the end of a Fanuc tape), never a comment the control acts on (LinuxCNC's MSG, LOGOPEN,
+    ABORT, PY, ...: an '_' goes in front), at most `max_length` characters ('...' marks a cut)."""
     text = re.sub(r"\s+", " ", text)
     text = "".join(c if " " <= c <= "~" else "?" for c in text).translate(_COMMENT_TRANSLATION).strip()
+    if _ACTIVE_COMMENT.match(text):  # LinuxCNC acts on (MSG,...), (LOGOPEN,...), (ABORT,...), (PY,...), ...
+        text = "_" + text
     return text if len(text) <= max_length else text[:max_length - 3] + "..."
 
 
