@@ -188,7 +188,8 @@ def test_rs274_accepts_line_numbers_at_the_limit(cam_paths, tmp_path):
 # --- every dialect, read back independently -------------------------------------------------------
 
 @pytest.mark.parametrize("dialect", DIALECT_NAMES)
-@pytest.mark.parametrize("name", ["reference_z23_m4", "undercut_z8", "many_teeth_z120"])
+@pytest.mark.parametrize("name", ["reference_z23_m4", "undercut_z8",
+                                  pytest.param("many_teeth_z120", marks=pytest.mark.slow)])
 def test_every_dialect_reads_back_as_the_ir_with_its_invariants(dialect, name, cam_paths):
     spec, _, _, roughing, finishing = cam_paths[name]
     linear, rotary = DECIMALS[dialect]

@@ -12,7 +12,7 @@ from tests.textbook import point_polyline_distance
 
 
 @pytest.mark.parametrize("name", list(GEAR_CASES))
-@pytest.mark.parametrize("tolerance", [1e-2, 1e-3, 1e-4, 1e-5])
+@pytest.mark.parametrize("tolerance", [1e-2, 1e-3, 1e-4, pytest.param(1e-5, marks=pytest.mark.slow)])
 def test_polyline_within_tolerance_of_dense_exact_curve(name, tolerance):
     profile = spec_of(name).tooth_space_profile()
     worst = 0.0
