@@ -22,7 +22,8 @@ from tests.gcode_reader import read_program
 from tests.rs274_helper import canon_args, run_rs274
 
 HOSTILE = ("evil\nG0 X0 Y0 Z-50\nM30", "cr\rG0 Z-50", "nul\x00G0 Z-50", "tab\tG1 Z-50 F1", "(paren) G0 Z-50",
-           "semi; G0 Z-50", "%\nG0 Z-50", "MSG,hello", " logopen,/tmp/x.txt", "ABORT, stop", "py,import os", "Zahnrad \u00e4\u00f6\u00fc \u2699 G0 Z-50", "x" * 10_000 + " G0 Z-50")
+           "semi; G0 Z-50", "%\nG0 Z-50", "MSG,hello", " logopen,/tmp/x.txt", "ABORT, stop",
+           "py,import os", "Zahnrad \u00e4\u00f6\u00fc \u2699 G0 Z-50", "x" * 10_000 + " G0 Z-50")
 
 
 def two_space_toolpath():
