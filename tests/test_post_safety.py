@@ -78,7 +78,8 @@ def test_rs274_reads_the_same_moves_with_hostile_text(hostile, tmp_path):
     assert results[0] == results[1]
 
 
-@pytest.mark.parametrize("code", ["M10\nG0 Z-50", "M10 G0 Z-50", "(x)", "G0", "M", "M10;", "M100000"])
+@pytest.mark.parametrize("code", ["M10\nG0 Z-50", "M10 G0 Z-50", "(x)", "G0", "M", "M10;", "M100000", "M30", "M2",
+                                  "M0", "M99", "M98", "M6", "M10\n", "M\u0661\u0660"])
 def test_clamp_codes_other_than_one_m_code_are_refused(code):
     with pytest.raises(MachineError, match="rotary_clamp_code"):
         Machine(rotary_clamp_code=code).validate()

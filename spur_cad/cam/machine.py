@@ -78,12 +78,21 @@ class Machine:
         check_rotary_code(self.rotary_unclamp_code, "rotary_unclamp_code")
 
 
-ROTARY_CODE = re.compile(r"M\d{1,4}")
+ROTARY_CODE = re.compile(r"M[0-9]{1,4}")
 """A rotary clamp/unclamp code is one M code and nothing else (the post writes it as its own block)."""
 
 
+RESERVED_M_CODES = frozenset({0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 30, 60, 96, 97, 98, 99, 198})
+"""M codes that stop, end or call programs, or drive the spindle, tool or coolant: never a clamp code."""
+
+
 def check_rotary_code(code: str, key: str) -> None:
-    """Refuse a clamp/unclamp code that is anything but a single M code ("" means none)."""
+    """Refuse a clamp/unclamp code that is anything but a single M code ("" means none), or an M code that
+    stops, ends or calls a program or drives the spindle, tool or coolant."""
+    if code and ROTARY_CODE.fullmatch(code) and int(code[1:]) in RESERVED_M_CODES:
+        raise MachineError(f"[machine] {key} = {code!r} is an M code that stops, ends or calls a program or "
+                           "drives the spindle, tool or coolant; use the machine's rotary clamp code (e.g. M10)",
+                           field=key, section="machine")
     if code and not ROTARY_CODE.fullmatch(code):
         shown = repr(code if len(code) <= 20 else code[:17] + "...")
         raise MachineError(f"[machine] {key} = {shown} must be a single M code such as 'M10' (the programs "
