@@ -13,6 +13,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from scipy.optimize import brentq
 
 from spur_cad.cli import main
 
@@ -49,8 +50,17 @@ def test_reference_job_writes_profile_summary_and_plot(tmp_path):
     d1 = e / 2 - (46 - 41 - 0.8) * math.tan(a) - 0.8 / math.cos(a)
     assert gear["root_arc_half_angle_deg"] == pytest.approx(math.degrees(d1 / 46), abs=1e-9)
     assert inspection["span_teeth_k"] == 3
-    for key in ("span_measurement_mm", "pin_diameter_mm", "dimension_over_pins_mm"):
-        assert inspection[key] > 0
+    # Textbook W_k = (k - 1) p_b + s_b with s_b = r_b (s / r + 2 inv a), s thinned by the 5 % allowance.
+    rb, s = 46.0 * math.cos(a), 0.95 * 2 * math.pi
+    invo = math.tan(a) - a
+    assert inspection["span_measurement_mm"] == pytest.approx(2 * math.pi * 4 * math.cos(a) + rb * (s / 46 + 2 * invo))
+    # Over pins (odd z): inv(a_M) = D / d_b + s / (m z) + inv(a) - pi / z, M = d_b / cos(a_M) cos(pi / 2z) + D.
+    pin = inspection["pin_diameter_mm"]
+    assert 1.2 * 4 <= pin <= 2.2 * 4
+    target = pin / (2 * rb) + s / (4 * 23) + invo - math.pi / 23
+    a_m = brentq(lambda x: math.tan(x) - x - target, 1e-6, 1.5)
+    assert inspection["dimension_over_pins_mm"] == pytest.approx(2 * rb / math.cos(a_m) * math.cos(math.pi / 46)
+                                                                 + pin)
     with open(out / "profile.csv", newline="") as handle:
         rows = list(csv.reader(handle))
     assert rows[0] == ["x_mm", "y_mm"]
@@ -61,16 +71,22 @@ def test_reference_job_writes_profile_summary_and_plot(tmp_path):
     assert np.all(np.diff(np.hypot(pts[:, 0], pts[:, 1])) >= -1e-8)
     assert (out / "profile.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
     tools, roughing, finishing = summary["tools"], summary["roughing"], summary["finishing"]
-    for key in ("finishing_max_flat_width_mm", "finishing_max_corner_radius_mm", "roughing_max_diameter_mm",
-                "required_flute_length_mm"):
-        assert tools[key] > 0
+    assert tools["finishing_max_corner_radius_mm"] >= 0.8 - 1e-9  # the fillet is never tighter than the rack's round
+    assert tools["required_flute_length_mm"] == pytest.approx(50.0 + 0.5 - 41.0)  # blank radius - root radius
+    assert 3.5 <= tools["roughing_max_diameter_mm"] < 2 * (math.pi * 4 / 2)  # the chosen 3.5 mm fits; under a pitch
     assert tools["finishing_max_flat_width_mm"] == pytest.approx(2 * d1 / 46 * 41, abs=1e-9)
     assert roughing["levels_per_space"] >= 2 and 0 < roughing["lowest_level_height_mm"] <= 0.5 * 1.0
-    for key in ("moves", "cutting_length_mm", "estimated_time_s"):
-        assert roughing[key] > 0 and finishing[key] > 0
-    assert finishing["stations"] >= 2 and finishing["points_per_flank"] > 10
-    assert finishing["reference_strategy_moves"] > finishing["moves"] > 0
-    assert finishing["reference_strategy_time_s"] > 0
+    # Every level cuts at least once across the face width plus the tool at both ends, in every space.
+    assert roughing["cutting_length_mm"] >= 23 * roughing["levels_per_space"] * (20.0 + 3.5)
+    # Every station cuts both flanks (at least the tip-to-root depth each) in every space.
+    assert finishing["cutting_length_mm"] >= finishing["stations"] * 23 * 2 * (50.0 - 41.0)
+    for section in (roughing, finishing):  # no faster than the cutting length at the machine's largest feed
+        assert section["estimated_time_s"] >= section["cutting_length_mm"] / 5000.0 * 60.0
+        assert section["estimated_time_with_acceleration_s"] >= section["estimated_time_s"] * 0.999
+    assert finishing["stations"] == math.ceil(20.0 / finishing["station_step_mm"] - 1e-9) + 1
+    assert finishing["points_per_flank"] > 10
+    assert finishing["reference_strategy_moves"] > finishing["moves"]
+    assert 0.5 < finishing["reference_strategy_time_s"] / finishing["estimated_time_s"] < 2.0
     post = summary["post"]
     assert post["dialect"] == "linuxcnc"
     for name in ("roughing", "finishing"):
@@ -144,12 +160,22 @@ def test_out_path_that_is_a_file_is_an_error(tmp_path):
 
 @pytest.mark.slow
 def test_existing_outputs_are_replaced_whole(tmp_path):
+    """A LinuxCNC set replaced by a Fanuc set of another gear: the folder then holds exactly the new set
+    (no .ngc left), the new summary, and no temporaries."""
+    text = REFERENCE_JOB.read_text().replace("face_width_mm = 20.0", "face_width_mm = 3.0") + \
+        "\n[simulation]\nenabled = false\n"
+    first, second = tmp_path / "first.toml", tmp_path / "second.toml"
+    first.write_text(text)
+    second.write_text(text.replace("teeth = 23", "teeth = 25").replace('dialect = "linuxcnc"', 'dialect = "fanuc"'))
     out = tmp_path / "o"
-    assert main(["run", str(REFERENCE_JOB), "--out", str(out), "--quiet"]) == 0
-    first = (out / "summary.json").read_text()
-    assert main(["run", str(REFERENCE_JOB), "--out", str(out), "--quiet"]) == 0
-    assert json.loads((out / "summary.json").read_text())["gear"] == json.loads(first)["gear"]
-    assert not [p for p in os.listdir(out) if p.startswith(".")]  # no temporaries left behind
+    assert main(["run", str(first), "--out", str(out), "--quiet"]) == 0
+    assert {"roughing.ngc", "finishing.ngc"} <= set(os.listdir(out))
+    assert main(["run", str(second), "--out", str(out), "--quiet"]) == 0
+    names = sorted(p for p in os.listdir(out) if not p.startswith("."))
+    assert names == sorted(["profile.csv", "profile.png", "gear.step", "stock.step", "job.step", "roughing.nc",
+                            "finishing.nc", "report.html", "summary.json"])
+    assert json.loads((out / "summary.json").read_text())["gear"]["teeth"] == 25
+    assert sorted(p for p in os.listdir(out) if p.startswith(".")) == [".spur_cad-set.json"]  # no temporaries
 
 
 def run_cli_on_a_terminal(*args: str) -> tuple[int, str, str]:

@@ -35,8 +35,7 @@ def test_finishing_flank_moves_agree_with_ocp_booleans(reference):
     check = cross_check(job.gear, job_stock(job), subset(fin, mask), job.tools.finishing,
                         SimSettings(resolution_mm=RES), (x[64], x[76]), x)
     assert check.cut_blades > 100
-    assert check.max_difference_mm <= RES
-    assert check.speed_ratio > 0
+    assert check.max_difference_mm <= RES  # (the speed ratio is a benchmark figure: docs/benchmarks.md)
 
 
 def test_roughing_passes_agree_with_ocp_booleans(reference):

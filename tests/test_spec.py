@@ -56,7 +56,7 @@ def test_involute_function_inverse_round_trip():
         (dict(profile_shift_coefficient=1.5), "profile_shift_coefficient", "pointed"),
         (dict(thickness_allowance_fraction=0.6), "thickness_allowance_fraction", "thickness_allowance_fraction"),
         (dict(dedendum_coefficient=2.0, addendum_coefficient=0.05, rack_tip_radius_mm=0.0, teeth=6,
-              profile_shift_coefficient=-0.5), None, ""),
+              profile_shift_coefficient=-0.5), "addendum_coefficient", "no involute flank"),
         (dict(module_mm="4"), "module_mm", "must be a number"),
     ],
 )
