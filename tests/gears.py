@@ -2,8 +2,17 @@
 
 from __future__ import annotations
 
+from pathlib import Path
+
+from hypothesis import strategies as st
+
+from spur_cad.cam.recommend import recommend_tools
+from spur_cad.cam.tools import Tool
+from spur_cad.errors import GearSpecError
 from spur_cad.geometry import GearSpec
 from tests.textbook import Textbook
+
+REFERENCE_JOB = Path(__file__).resolve().parents[1] / "resources" / "examples" / "reference_gear.toml"
 
 # name: (teeth, module, pressure angle, shift, rack tip radius, allowance fraction, allowance mm)
 GEAR_CASES = {
@@ -29,3 +38,45 @@ def spec_of(name: str) -> GearSpec:
 def textbook_of(name: str) -> Textbook:
     z, m, pa, x, rho, frac, mm = GEAR_CASES[name]
     return Textbook(z=z, m=m, alpha_deg=pa, x=x, rho=rho, allowance_fraction=frac, allowance_mm=mm)
+
+
+# --- CAM test gears and their tools (shared by the CAM, silhouette and post tests) ---------------------
+
+CAM_GEARS = ["reference_z23_m4", "undercut_z8", "many_teeth_z120", "shifted_z12", "small_module_z30"]
+
+
+def tools_for(name: str) -> tuple[Tool, Tool]:
+    """Roughing and finishing tools sized from each gear's limits (as a user would pick them)."""
+    spec = spec_of(name)
+    rec = recommend_tools(spec, spec.tip_radius_mm + 0.5, 1.0)
+    r_t = round(0.6 * min(rec.finishing_max_corner_radius_mm, spec.rack_tip_radius_mm), 3)
+    d = round(0.6 * rec.finishing_max_flat_width_mm, 3)
+    finishing = Tool(diameter_mm=d + 2 * r_t, kind="bull_nose", corner_radius_mm=r_t)
+    rec_f = recommend_tools(spec, spec.tip_radius_mm + 0.5, 1.0, finishing)
+    roughing = Tool(diameter_mm=round(0.8 * rec_f.roughing_max_diameter_mm, 3), kind="flat", flutes=3)
+    return roughing, finishing
+
+
+# --- swept gear parameters (shared by the geometry and CAD sweeps) -------------------------------------
+
+gear_parameters = st.fixed_dictionaries({
+    "teeth": st.integers(6, 200),
+    "module_mm": st.floats(0.3, 20.0),
+    "pressure_angle_deg": st.floats(14.5, 30.0),
+    "profile_shift_coefficient": st.floats(-0.5, 1.0),
+    "rack_tip_fraction": st.floats(0.0, 0.45),
+    "thickness_allowance_fraction": st.floats(0.0, 0.05),
+})
+
+
+def spec_or_category(params: dict, face_width_mm: float) -> GearSpec | tuple[str, str]:
+    """The GearSpec for swept parameters (rack tip radius given as a fraction of the module), or
+    the failure category: ('rejected', message) or ('crash', repr)."""
+    params = dict(params)
+    params["rack_tip_radius_mm"] = params.pop("rack_tip_fraction") * params["module_mm"]
+    try:
+        return GearSpec(face_width_mm=face_width_mm, **params)
+    except GearSpecError as exc:
+        return ("rejected", str(exc)) if str(exc) else ("crash", "empty GearSpecError message")
+    except Exception as exc:  # noqa: BLE001 - the category is the point
+        return "crash", f"{type(exc).__name__}: {exc}"

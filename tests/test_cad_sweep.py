@@ -9,7 +9,7 @@ from hypothesis import HealthCheck, given, settings
 from spur_cad.cad.solid import build_gear_shape, solid_volume_mm3
 from spur_cad.geometry import gear_outline
 from spur_cad.geometry.sampling import polygon_area
-from tests.test_hypothesis_sweep import gear_parameters, spec_or_category
+from tests.gears import gear_parameters, spec_or_category
 
 pytestmark = pytest.mark.slow  # make test-all
 

@@ -19,21 +19,7 @@ from spur_cad.cam.recommend import check_tools, recommend_tools
 from spur_cad.cam.roughing import roughing_levels, roughing_toolpath
 from spur_cad.cam.tools import Tool, ToolError
 from spur_cad.geometry import gear_outline, sample_profile
-from tests.gears import spec_of, textbook_of
-
-CAM_GEARS = ["reference_z23_m4", "undercut_z8", "many_teeth_z120", "shifted_z12", "small_module_z30"]
-
-
-def tools_for(name: str) -> tuple[Tool, Tool]:
-    """Roughing and finishing tools sized from each gear's limits (as a user would pick them)."""
-    spec = spec_of(name)
-    rec = recommend_tools(spec, spec.tip_radius_mm + 0.5, 1.0)
-    r_t = round(0.6 * min(rec.finishing_max_corner_radius_mm, spec.rack_tip_radius_mm), 3)
-    d = round(0.6 * rec.finishing_max_flat_width_mm, 3)
-    finishing = Tool(diameter_mm=d + 2 * r_t, kind="bull_nose", corner_radius_mm=r_t)
-    rec_f = recommend_tools(spec, spec.tip_radius_mm + 0.5, 1.0, finishing)
-    roughing = Tool(diameter_mm=round(0.8 * rec_f.roughing_max_diameter_mm, 3), kind="flat", flutes=3)
-    return roughing, finishing
+from tests.gears import CAM_GEARS, spec_of, textbook_of, tools_for
 
 
 @pytest.mark.parametrize("name", CAM_GEARS)
@@ -41,7 +27,7 @@ def test_recommendations_match_method_formulas(name):
     spec, g = spec_of(name), textbook_of(name)
     _, finishing = tools_for(name)
     rec = recommend_tools(spec, spec.tip_radius_mm + 0.5, 1.0, finishing)
-    # Root arc length 2 v r_f with v = d_1 / r (docs/method.md-3, textbook rack).
+    # Root arc length 2 v r_f with v = d_1 / r (docs/method.md, textbook rack).
     assert rec.finishing_max_flat_width_mm == pytest.approx(2 * g.corner_offset / g.r * g.rf, abs=1e-9)
     # Smallest fillet curvature radius: circumradius of close triples of dense fillet samples.
     samples = sample_profile(spec.tooth_space_profile(), 1e-7)

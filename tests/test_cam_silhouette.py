@@ -15,8 +15,7 @@ from spur_cad.cam.recommend import recommend_tools
 from spur_cad.cam.roughing import roughing_levels, roughing_toolpath
 from spur_cad.geometry import gear_outline
 from tests import silhouette
-from tests.gears import spec_of
-from tests.test_cam import CAM_GEARS, tools_for
+from tests.gears import CAM_GEARS, spec_of, tools_for
 
 HALF_MICRON = 0.5e-3
 SCALLOP = 0.005

@@ -10,36 +10,12 @@ import numpy as np
 import pytest
 import shapely
 from hypothesis import HealthCheck, given, settings
-from hypothesis import strategies as st
 from shapely.geometry import Polygon
 
-from spur_cad.errors import GearSpecError
-from spur_cad.geometry import GearSpec, gear_outline
+from spur_cad.geometry import gear_outline
+from tests.gears import gear_parameters, spec_or_category
 
 pytestmark = pytest.mark.slow  # make test-all
-
-gear_parameters = st.fixed_dictionaries({
-    "teeth": st.integers(6, 200),
-    "module_mm": st.floats(0.3, 20.0),
-    "pressure_angle_deg": st.floats(14.5, 30.0),
-    "profile_shift_coefficient": st.floats(-0.5, 1.0),
-    "rack_tip_fraction": st.floats(0.0, 0.45),
-    "thickness_allowance_fraction": st.floats(0.0, 0.05),
-})
-
-
-def spec_or_category(params: dict, face_width_mm: float) -> GearSpec | tuple[str, str]:
-    """The GearSpec for swept parameters (rack tip radius given as a fraction of the module), or
-    the failure category: ('rejected', message) or ('crash', repr)."""
-    params = dict(params)
-    params["rack_tip_radius_mm"] = params.pop("rack_tip_fraction") * params["module_mm"]
-    try:
-        return GearSpec(face_width_mm=face_width_mm, **params)
-    except GearSpecError as exc:
-        return ("rejected", str(exc)) if str(exc) else ("crash", "empty GearSpecError message")
-    except Exception as exc:  # noqa: BLE001 - the category is the point
-        return "crash", f"{type(exc).__name__}: {exc}"
-
 
 def classify(params: dict) -> tuple[str, str]:
     """('rejected', message) | ('valid', '') | ('crash', repr) | ('invalid outline', why)."""

@@ -16,9 +16,8 @@ from spur_cad.cam.machine import FinishingParams, Machine, RoughingParams
 from spur_cad.cam.roughing import roughing_toolpath
 from spur_cad.post import DIALECT_NAMES, PostError, PostSettings, ProgramInfo, post_program
 from tests.gcode_reader import read_program
-from tests.gears import spec_of
+from tests.gears import CAM_GEARS, spec_of, tools_for
 from tests.rs274_helper import canon_args, run_rs274
-from tests.test_cam import CAM_GEARS, tools_for
 
 DECIMALS = {"linuxcnc": (4, 4), "fanuc": (3, 3), "haas": (3, 3), "siemens": (4, 4), "okuma": (3, 3)}
 INFO = ProgramInfo("spur_cad test (program)", ("gear: z = test",))
@@ -149,7 +148,7 @@ def test_rs274_g93_feed_gives_the_relative_path_time(name, cam_paths, tmp_path):
 def test_folded_reference_finishing_is_15x_smaller_and_runs_the_same(tmp_path):
     from spur_cad.job import load_job
     from spur_cad.pipeline import plan_cam
-    from tests.test_cli import REFERENCE_JOB
+    from tests.gears import REFERENCE_JOB
 
     job = load_job(REFERENCE_JOB)
     assert job.gear.face_width_mm == 20.0  # full face width, as the shop cut it
