@@ -11,8 +11,7 @@ from shapely.geometry import Polygon
 from spur_cad.cam.finishing import finishing_toolpath
 from spur_cad.cam.ir import Feature, MoveKind
 from spur_cad.cam.machine import FinishingParams, Machine, RoughingParams
-from spur_cad.cam.recommend import recommend_tools
-from spur_cad.cam.roughing import roughing_levels, roughing_toolpath
+from spur_cad.cam.roughing import roughing_toolpath
 from spur_cad.geometry import gear_outline
 from tests import silhouette
 from tests.gears import CAM_GEARS, spec_of, tools_for
@@ -71,15 +70,16 @@ def test_roughing_respects_finish_stock_and_flank_allowance(name, design_polygon
     # Never closer than the finish stock to the design: no reach into the design grown by it.
     grown = design_polygons[name].buffer(params.finish_stock_mm - 1e-6, quad_segs=256)
     assert silhouette.max_penetration_mm(grown, sils) <= HALF_MICRON
-    # At most the flank allowance left on the flanks above the lowest level.
-    levels = roughing_levels(spec, tool, params, blank)
+    # At most the flank allowance left on the flanks above the lowest pass, read from the toolpath itself
+    # (space 0 is cut at A = 0, so a pass's Z is its height on the space axis).
+    lowest = float(path.z[rows & (path.feature == Feature.LEVEL)].min())
     points, labels = silhouette.design_boundary(spec, [0], labels=("fillet", "involute"))
-    above = points[:, 1] >= levels.lowest_height_mm
+    above = points[:, 1] >= lowest
     leftover = silhouette.leftover_mm(points[above], sils)
     assert leftover.max() <= params.flank_allowance_mm + HALF_MICRON
-    # What stays below the lowest level is within what the finishing tool's bottom can take.
-    rec = recommend_tools(spec, blank, 1.0, finishing)
-    assert levels.lowest_height_mm - spec.root_radius_mm <= rec.plunge_allowance_mm + 1e-9
+    # What stays below the lowest pass is within what the finishing tool's bottom can take when it
+    # plunges: A_p = half its flat width (the method's catalogue rule).
+    assert lowest - spec.root_radius_mm <= 0.5 * finishing.flat_width_mm + 1e-9
 
 
 @pytest.mark.parametrize("name", CAM_GEARS)
