@@ -24,6 +24,7 @@ from spur_cad.errors import JobFileError, SpurCadError
 from spur_cad.job import GearSection, Job, JobSection, SimulationSection, job_from_dict, load_job, parse_job
 from spur_cad.post.settings import PostSettings
 from tests.gears import GEAR_CASES
+from tests.textbook import Textbook
 from tests.workbench_helper import REFERENCE_JOB, ROOT, small_job_text
 
 
@@ -248,9 +249,15 @@ def _small_values(wb, **job_changes):
 def test_valid_job_has_no_messages_and_the_recommendations(wb):
     result = wb.validation.validate(_small_values(wb))
     assert result.ok and result.messages == {}
-    job = result.job
-    rec = recommend_tools(job.gear, job.stock.blank_radius_mm(job.gear), job.machine.clearance_mm, job.tools.finishing)
-    assert result.recommendations == rec
+    job, rec = result.job, result.recommendations
+    g = job.gear
+    book = Textbook(g.teeth, g.module_mm, g.pressure_angle_deg, g.profile_shift_coefficient, g.addendum_coefficient,
+                    g.dedendum_coefficient, g.rack_tip_radius_mm, g.thickness_allowance_fraction,
+                    g.thickness_allowance_mm)
+    # Independent of the code under test: root arc 2 v r_f with v = d_1 / r, flute length = blank - root.
+    assert rec.finishing_max_flat_width_mm == pytest.approx(2 * book.corner_offset / book.r * book.rf, abs=1e-9)
+    assert rec.required_flute_length_mm == pytest.approx(book.ra + job.stock.radial_allowance_mm - book.rf)
+    assert rec.plunge_allowance_mm == pytest.approx(0.5 * job.tools.finishing.flat_width_mm)
     notes = wb.validation.recommendation_notes(rec)
     assert f"{rec.roughing_max_diameter_mm:.3f} mm" in notes["RoughingToolDiameter"]
     assert f"{rec.finishing_max_flat_width_mm:.3f} mm" in notes["FinishingToolDiameter"]
