@@ -28,6 +28,8 @@ class BlankFeatures:
         """Raise GearSpecError unless the features leave a wall of at least one module under the root."""
         for name in ("bore_diameter_mm", "keyway_width_mm", "keyway_depth_mm"):
             value = getattr(self, name)
+            if isinstance(value, bool) or not isinstance(value, (int, float)):
+                raise GearSpecError(f"{name} must be a number, got {type(value).__name__}", field=name)
             if not math.isfinite(value) or value < 0.0:
                 raise GearSpecError(f"{name} = {value:g} mm must be zero (none) or positive", field=name)
         wall = spec.module_mm
