@@ -12,6 +12,7 @@ import argparse
 import shutil
 import signal
 import sys
+import threading
 import warnings
 
 from spur_cad import __version__
@@ -91,14 +92,19 @@ def _install_freecad(uninstall: bool) -> int:
 
 
 def main(argv: list[str] | None = None) -> int:
-    """The command line; SIGINT and SIGTERM anywhere in a run give one line and exit 130 / 143."""
-    signal.signal(signal.SIGTERM, _terminate)
+    """The command line; SIGINT and SIGTERM anywhere in a run give one line and exit 130 / 143. The SIGTERM
+    handler is the caller's again when main returns (main may be called in-process, e.g. by tests)."""
+    in_main_thread = threading.current_thread() is threading.main_thread()
+    previous = signal.signal(signal.SIGTERM, _terminate) if in_main_thread else None
     try:
         return _main(argv)
     except (KeyboardInterrupt, Terminated) as exc:
         print("spur-cad: interrupted (the output folder holds a complete set: its previous one, or this run's "
               "if writing had finished)", file=sys.stderr)
         return EXIT_TERMINATED if isinstance(exc, Terminated) else EXIT_INTERRUPTED
+    finally:
+        if in_main_thread:
+            signal.signal(signal.SIGTERM, previous)
 
 
 def _main(argv: list[str] | None) -> int:
