@@ -1,7 +1,7 @@
-"""Finishing by generation (METHOD.md 5b), accepted by checks that repeat none of its mathematics:
+"""Finishing by generation (docs/method.md), accepted by checks that repeat none of its mathematics:
 the independent 2-D silhouette checker (tests/silhouette.py) against the designed gear, the IR's
 own arrays, LinuxCNC's interpreter on the posted program, planted faults that must be caught,
-and the pass counts METHOD.md 5b reports from an independent check of the reference gear."""
+and the pass counts docs/method.md reports from an independent check of the reference gear."""
 
 from __future__ import annotations
 
@@ -32,7 +32,7 @@ MACHINE = Machine()
 
 def _gear(name: str) -> GearSpec:
     extra = {
-        # METHOD.md 5b's other checked gears: a shifted 12-tooth gear and a 25 deg gear with negative shift.
+        # docs/method.md's other checked gears: a shifted 12-tooth gear and a 25 deg gear with negative shift.
         "shifted_z12_x04": (12, 3.0, 20.0, 0.4, 0.5, 0.03),
         "pa25_z31_negative_shift": (31, 2.0, 25.0, -0.2, 0.5, 0.02),
     }
@@ -43,7 +43,7 @@ def _gear(name: str) -> GearSpec:
     return spec_of(name)
 
 
-# (gear, tool diameter, corner radius): the reference gear's D2 r0.5 (METHOD.md 5b) and r_t = rho,
+# (gear, tool diameter, corner radius): the reference gear's D2 r0.5 (docs/method.md) and r_t = rho,
 # the others with r_t = rho and r_t = 0.6 rho, diameters inside the gear's limits.
 CASES = [
     ("reference_z23_m4", 2.0, 0.5),
@@ -120,12 +120,12 @@ def test_reference_gear_at_one_micron(end):
 
 
 def test_raised_end_fits_a_tool_the_rack_end_cannot_take():
-    """METHOD.md 5b: a raised end lets a larger tool finish the reference gear's flanks."""
+    """docs/method.md: a raised end lets a larger tool finish the reference gear's flanks."""
     name = "reference_z23_m4"
     spec = _gear(name)
     limits = generating_tool_limits(spec, 0.5, 0.005, spec.tip_radius_mm + 0.5)
-    assert 3.8 <= limits.flank_mode_max_diameter_mm <= 4.0  # METHOD.md 5b: 3.9 mm
-    assert 4.8 <= limits.flank_mode_max_diameter_raised_mm <= 5.1  # METHOD.md 5b: 4.9 mm
+    assert 3.8 <= limits.flank_mode_max_diameter_mm <= 4.0  # docs/method.md: 3.9 mm
+    assert 4.8 <= limits.flank_mode_max_diameter_raised_mm <= 5.1  # docs/method.md: 4.9 mm
     big = _tool(4.4, 0.5)
     # One tool does both modes, and tip mode cannot take this flat (2 d_1 + 2 r_t = 2.84 mm) ...
     assert limits.tip_mode_max_diameter_mm < big.diameter_mm
@@ -335,11 +335,11 @@ def test_smaller_corner_tolerates_a_lower_flank_end():
     assert penetration <= 1e-4
 
 
-# --------------------------------------------------------------------------- METHOD.md 5b's figures
+# --------------------------------------------------------------------------- docs/method.md's figures
 
 
 def test_pass_counts_match_method_figures():
-    """METHOD.md 5b (independent check, reference gear): about 22 passes per flank at 1 um and 10 at 5 um
+    """docs/method.md (independent check, reference gear): about 22 passes per flank at 1 um and 10 at 5 um
     (D2 r0.5); tip mode with r_t = rho about 62 rolls per space at 1 um and 30 at 5 um.
 
     Ours: 22 and 11 per flank (rolls from the form circle to the tip inclusive, chosen greedily from the

@@ -1,4 +1,4 @@
-"""Finishing by generation (METHOD.md 5b): the end mill plays the generating rack, A is clamped
+"""Finishing by generation (docs/method.md): the end mill plays the generating rack, A is clamped
 for every pass and every pass is one straight move along X.
 
 Frames (spur_cad.geometry.frames): a part point p of tooth space 0 (gap frame = part frame) is
@@ -199,7 +199,7 @@ class GeneratingToolLimits:
 
 def flat_deviation_mm(base_radius_mm: float, t_i: float, t: np.ndarray | float) -> np.ndarray | float:
     """D_i(t) = r_b [t_i (1 - cos d) + sin d - d cos d], d = t - t_i: distance of the involute point
-    at roll t from the tangent line (generating flat) at roll t_i (METHOD.md 5b)."""
+    at roll t from the tangent line (generating flat) at roll t_i (docs/method.md)."""
     d = np.asarray(t, dtype=float) - t_i
     return base_radius_mm * (t_i * (1.0 - np.cos(d)) + np.sin(d) - d * np.cos(d))
 
