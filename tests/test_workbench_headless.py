@@ -11,6 +11,7 @@ from pathlib import Path
 
 import pytest
 
+from spur_cad.cam.strategies import strategy_names
 from spur_cad.cli import main
 from spur_cad.job import load_job, parse_job
 from spur_cad.pipeline import plan_cam
@@ -253,7 +254,7 @@ def test_documents_save_and_reopen_without_pickles(freecadcmd, tmp_path):
     assert result["new_max_feed"][0] == pytest.approx(5000.0 / 60.0) and "mm/s" in result["new_max_feed"][1]
     # schema-1 types re-created with the values they held, the drop-down list brought up to date
     assert result["job_version"] == 2 and result["migrated_types"] == types
-    assert result["strategies"] == ["perimeter", "along_x"]
+    assert result["strategies"] == list(strategy_names())  # the registry's list, brought up to date
     before = result["saved_values"]
     assert before["MaxFeed"] == 4321.5 and before["AMin"] == -360.0  # the angle had clamped
     assert result["restored_values"] == before and result["reopened_values"] == before
