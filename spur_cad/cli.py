@@ -28,10 +28,6 @@ class Terminated(BaseException):
     """SIGTERM arrived: stop like an interrupt (the output folder keeps its set)."""
 
 
-def _terminate(signum, frame) -> None:
-    raise Terminated()
-
-
 def _parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(prog="spur-cad", description="Spur gears cut on a 4-axis machining centre.")
     parser.add_argument("--version", action="version", version=f"spur-cad {__version__}")
@@ -94,20 +90,26 @@ def _install_freecad(uninstall: bool) -> int:
 def main(argv: list[str] | None = None) -> int:
     """The command line; SIGINT and SIGTERM anywhere in a run give one line and exit 130 / 143. The SIGTERM
     handler is the caller's again when main returns (main may be called in-process, e.g. by tests)."""
+    received: list[int] = []  # the signals that arrived (a library may turn the exception into another one)
+
+    def on_signal(signum, frame) -> None:
+        received.append(signum)
+        raise Terminated() if signum == signal.SIGTERM else KeyboardInterrupt()
+
     in_main_thread = threading.current_thread() is threading.main_thread()
-    previous = signal.signal(signal.SIGTERM, _terminate) if in_main_thread else None
+    previous = {s: signal.signal(s, on_signal) for s in (signal.SIGINT, signal.SIGTERM)} if in_main_thread else {}
     try:
-        return _main(argv)
-    except (KeyboardInterrupt, Terminated) as exc:
+        return _main(argv, received)
+    except (KeyboardInterrupt, Terminated):
         print("spur-cad: interrupted (the output folder holds a complete set: its previous one, or this run's "
               "if writing had finished)", file=sys.stderr)
-        return EXIT_TERMINATED if isinstance(exc, Terminated) else EXIT_INTERRUPTED
+        return EXIT_TERMINATED if signal.SIGTERM in received else EXIT_INTERRUPTED
     finally:
-        if in_main_thread:
-            signal.signal(signal.SIGTERM, previous)
+        for signum, handler in previous.items():
+            signal.signal(signum, handler)
 
 
-def _main(argv: list[str] | None) -> int:
+def _main(argv: list[str] | None, received: list[int]) -> int:
     args = _parser().parse_args(argv)
     if not getattr(args, "debug", False):
         # Numerical warnings (overflow in an intermediate, ...) are not messages for the user: an input
@@ -138,6 +140,8 @@ def _main(argv: list[str] | None) -> int:
         print(f"spur-cad: error: {message}", file=sys.stderr)
         return EXIT_INPUT_ERROR
     except Exception as exc:  # noqa: BLE001 - the CLI never shows a traceback unless asked
+        if received:  # an interrupt that a library turned into another exception (e.g. an ImportError)
+            raise KeyboardInterrupt from None
         if getattr(args, "debug", False):
             raise
         print(f"spur-cad: internal error: {type(exc).__name__}: {exc} (run with --debug for details; "
