@@ -94,7 +94,11 @@ def test_interrupted_runs_leave_a_complete_set_and_no_strays_after_the_next(kind
         child.send_signal(getattr(signal, kind))
         code = child.wait(timeout=300)
         stderr = child.stderr.read()
-        if kind == "SIGINT" and code != 0:
+        if kind == "SIGINT" and code == -signal.SIGINT:
+            # The signal came after spur-cad's main had returned (the run had finished): Python's default
+            # handling ends the process at exit, and nothing more is written.
+            assert stderr == "", stderr
+        elif kind == "SIGINT" and code != 0:
             assert code == 130, stderr
             assert len(stderr.strip().splitlines()) == 1 and stderr.startswith("spur-cad: interrupted"), stderr
         if (out / JOURNAL).exists():  # SIGKILL inside the switch's milliseconds: the next run completes it
