@@ -17,7 +17,7 @@ from spur_cad.cam.finishing import plan_finishing
 from spur_cad.cam.ir import Feature, MoveKind
 from spur_cad.cam.machine import FinishingParams, Machine
 from spur_cad.cam.strategies import get_strategy, strategy_names
-from spur_cad.cam.strategies.generating import GeneratingParams, generating_tool_limits
+from spur_cad.cam.strategies.generating import MOVES_PER_PASS, GeneratingParams, generating_tool_limits
 from spur_cad.cam.tools import Tool, ToolError
 from spur_cad.geometry import GearSpec, gear_outline
 from spur_cad.post import PostSettings, ProgramInfo, post_program
@@ -81,15 +81,18 @@ def _design(name: str, spec: GearSpec) -> Polygon:
     return _OUTLINES[name]
 
 
-def _check(name, spec, tool, path, spaces, rows=None):
-    """(deepest reach into the design, largest leftover, its label) for the motion rows of `spaces`."""
-    mask = path.motion_mask & np.isin(path.space, spaces)
+def _check(name, spec, tool, path, spaces, rows=None, labels=("root", "fillet", "involute", "tip")):
+    """(deepest reach into the design, largest leftover, its label) of the design points of `spaces`
+    (with the given segment labels) against the motion rows of `spaces` and their neighbours (a space's
+    passes also finish the tip land of a neighbouring tooth)."""
+    near = {(k + d) % spec.teeth for k in spaces for d in (-1, 0, 1)}
+    mask = path.motion_mask & np.isin(path.space, sorted(near))
     if rows is not None:
         mask &= rows
     sils = silhouette.silhouettes_in_part_frame(path, tool.diameter_mm, tool.effective_corner_radius_mm, TOOL_LENGTH,
                                                 mask=mask)
     penetration = silhouette.max_penetration_mm(_design(name, spec), sils)
-    points, labels = silhouette.design_boundary(spec, spaces)
+    points, labels = silhouette.design_boundary(spec, spaces, labels)
     leftover = silhouette.leftover_mm(points, sils)
     worst = int(np.argmax(leftover))
     return penetration, float(leftover[worst]), str(labels[worst]), leftover, labels
@@ -352,8 +355,9 @@ def test_pass_counts_match_method_figures():
             _, result = _plan(spec, _tool(diameter, corner), scallop)
             flank = sum(1 for p in result.passes if p.mode == "flank" and p.feature == Feature.RIGHT_FLANK)
             tip = sum(1 for p in result.passes if p.mode == "tip")
+            land = sum(1 for p in result.passes if p.mode == "land")
             counts[corner, scallop] = (flank, tip)
-            assert result.passes_per_space == 2 * flank + tip
+            assert result.passes_per_space == 2 * flank + tip + land
             assert 0.9 * scallop <= result.flat_height_mm <= scallop
     assert abs(counts[0.5, 0.001][0] - 22) <= 2 and abs(counts[0.5, 0.005][0] - 10) <= 2
     assert abs(counts[0.8, 0.001][1] - 62) <= 5 and abs(counts[0.8, 0.005][1] - 30) <= 3
@@ -386,12 +390,20 @@ def test_strategy_is_registered_but_not_the_default_and_the_job_file_takes_its_k
         GeneratingParams(flank_tool_end="low").validate()
 
 
-def test_warns_that_the_tip_land_is_not_cut():
-    spec, tool = _gear("reference_z23_m4"), _tool(2.0, 0.5)
-    path, _ = _plan(spec, tool)
-    assert any("stays on the tip lands" in w and "0.500 mm" in w for w in path.warnings)
-    path, _ = get_strategy("generating").generate(spec, tool, MACHINE, GeneratingParams(), spec.tip_radius_mm)
-    assert not path.warnings
+def test_tip_lands_are_cut_only_when_the_blank_stands_above_the_tip_circle():
+    name, spec, tool = "reference_z23_m4", _gear("reference_z23_m4"), _tool(2.0, 0.5)
+    strategy = get_strategy("generating")
+    above, result = strategy.generate(spec, tool, MACHINE, GeneratingParams(), spec.tip_radius_mm + 0.5)
+    lands = [p for p in result.passes if p.mode == "land"]
+    assert len(lands) >= 2 and all(p.z_mm == spec.tip_radius_mm for p in lands)
+    penetration, leftover, label, *_ = _check(name, spec, tool, above, [0], labels=("tip",))
+    assert penetration <= HALF_MICRON and leftover <= 0.005 + HALF_MICRON, (penetration, leftover)
+    turned, result = strategy.generate(spec, tool, MACHINE, GeneratingParams(), spec.tip_radius_mm)
+    assert not [p for p in result.passes if p.mode == "land"]
+    assert len(turned) == len(above) - MOVES_PER_PASS * spec.teeth * len(lands)
+    # planted fault: without the land passes the blank's allowance stays on the land
+    land_rows = (np.abs(above.y) < 1e-9) & (above.z >= spec.tip_radius_mm - 1e-9)  # plunge, cut and retract
+    assert _check(name, spec, tool, above, [0], rows=~land_rows, labels=("tip",))[1] > 0.1
 
 
 def test_tiny_target_is_refused_before_planning():

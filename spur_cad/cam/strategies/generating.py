@@ -54,6 +54,13 @@ Tip mode (fillet and root), right half of space 0:
   profile points between the two contacts of their distance to the nearer of the two tools'
   exact sections -- stays within 95 % of the target.
 
+Land mode (tip lands, when the blank stands above the tip circle): A = psi turns the part so
+that its direction psi (from the space axis toward +Y) points up; the tool's flat bottom lies on
+the tip circle's tangent plane there (Y = 0, Z = r_a). A plane tangent to the tip circle never
+enters the gear, so these passes cannot gouge; the angles psi run over the land of the tooth on
+the +Y side of space 0 (every space finishes the land beside it), chosen greedily like the tip
+mode's rolls. A blank turned to the tip diameter needs none.
+
 Every pass of space 0 is also checked against dense exact points of the space (and its tooth
 tips) with the tool's exact section: a pass that would reach into the design beyond
 `GOUGE_TOLERANCE_MM` is a ToolError naming the largest tool diameter that fits.
@@ -103,8 +110,8 @@ _FLANK_SAFETY = 0.999
 _LEFTOVER_SAMPLES = 33
 MOVES_PER_PASS = 5
 """Index (rapid at the safe height), approach, plunge, cut, retract (4 when the machine's clearance is 0)."""
-TIP_LAND_WARNING = ("finishing strategy generating cuts flanks, fillets and root only: the blank's {allowance:.3f} mm "
-                    "above the tip circle stays on the tip lands (turn the blank to the tip diameter)")
+LAND_ALLOWANCE_MM = 1e-6
+"""A blank standing less than this above the tip circle is taken as turned to the tip diameter (no land passes)."""
 MAX_PASSES_PER_SPACE = 20_000
 """Largest number of passes per tooth space planned (estimated in closed form first)."""
 
@@ -144,7 +151,7 @@ class GeneratingPass:
     `beta_rad` is the contact angle on the rack's tip round, NaN on the root).
     """
 
-    mode: str  # "flank" or "tip"
+    mode: str  # "flank", "tip" or "land"
     feature: Feature
     roll_rad: float
     beta_rad: float
@@ -163,8 +170,9 @@ class GeneratingPlan:
     flank_rolls_rad: np.ndarray  # involute rolls t, form circle -> tip (each flank)
     fillet_betas_rad: np.ndarray  # contact angles on the rack round, junction -> 0 (each fillet)
     root_rolls_rad: np.ndarray  # rack rolls phi of the root passes, v -> -v
+    land_angles_rad: np.ndarray  # part directions psi of the land passes (empty: blank at the tip diameter)
     flat_height_mm: float  # largest generating-flat deviation left on the involute (closed form)
-    tip_leftover_mm: float  # largest sampled leftover on fillet and root
+    tip_leftover_mm: float  # largest sampled leftover on fillet, root and lands
 
     @property
     def passes_per_space(self) -> int:
@@ -177,6 +185,10 @@ class GeneratingPlan:
     @property
     def tip_passes_per_space(self) -> int:
         return sum(1 for p in self.passes if p.mode == "tip")
+
+    @property
+    def land_passes_per_space(self) -> int:
+        return sum(1 for p in self.passes if p.mode == "land")
 
 
 @dataclass(frozen=True)
@@ -283,6 +295,28 @@ def _root_pose(spec: GearSpec, tool: Tool, phi: np.ndarray) -> tuple[np.ndarray,
     phi = np.asarray(phi, float)
     y = np.clip(0.0, -d1 + d / 2.0 - r * phi, d1 - d / 2.0 - r * phi)
     return phi, y, np.full(len(phi), spec.root_radius_mm)
+
+
+def _land_pose(spec: GearSpec, psi: np.ndarray) -> tuple[np.ndarray, ...]:
+    """(A rad, Y, Z) of land passes: part direction psi turned up, the flat bottom on the tip circle's tangent."""
+    psi = np.asarray(psi, float)
+    return psi, np.zeros(len(psi)), np.full(len(psi), spec.tip_radius_mm)
+
+
+def land_angles(spec: GearSpec, tool: Tool, goal: float) -> tuple[np.ndarray, float]:
+    """Directions psi of the land passes over the tooth on the +Y side of space 0, and the leftover."""
+    tip = spec.tooth_space_profile().segment("tip")
+    if tip is None:  # pointed teeth: no land
+        return np.zeros(0), 0.0
+    ra = spec.tip_radius_mm
+    first, last = tip.start, 2.0 * math.pi / spec.teeth - tip.start
+
+    def land_points(p: float, q: float) -> np.ndarray:
+        theta = np.linspace(p, q, _LEFTOVER_SAMPLES)
+        return np.stack([ra * np.sin(theta), ra * np.cos(theta)], axis=-1)
+
+    angles, worst = _greedy_rolls(first, last, lambda psi: _land_pose(spec, psi), land_points, tool, goal)
+    return np.array(angles), worst
 
 
 def _distances(points: np.ndarray, a: float, y: float, z: float, tool: Tool) -> np.ndarray:
@@ -399,8 +433,30 @@ def rough_passes_per_space(spec: GearSpec, tool: Tool, target_mm: float) -> floa
     return 2.0 * (flank + tip)
 
 
-def plan_generating(spec: GearSpec, tool: Tool, params: GeneratingParams, *, check: bool = True) -> GeneratingPlan:
-    """The passes of tooth space 0 (both flanks, fillets and root), in cutting order."""
+def _refuse_gouging_passes(spec: GearSpec, tool: Tool, params: GeneratingParams, poses: dict) -> None:
+    """ToolError naming the largest tools that fit when a pass of `poses` (name -> (A rad, Y, Z)) reaches
+    into the dense exact design points beyond GOUGE_TOLERANCE_MM."""
+    design = _design_points(spec)
+    for name, (a, y, z) in poses.items():
+        if len(a) == 0:
+            continue
+        depth = _gouges(design, a, y, z, tool)
+        if depth.max() > GOUGE_TOLERANCE_MM:
+            limits = generating_tool_limits(spec, tool.effective_corner_radius_mm, params.target_scallop_mm,
+                                            spec.tip_radius_mm)
+            best = (limits.flank_mode_max_diameter_mm if params.flank_tool_end == "rack"
+                    else limits.flank_mode_max_diameter_raised_mm)
+            raise ToolError(f"finishing strategy generating: a {name} pass of the {tool.diameter_mm:g} mm tool "
+                            f"reaches {1000 * depth.max():.2f} um into the gear; largest diameter for flank mode "
+                            f"with r_t = {tool.effective_corner_radius_mm:g} mm and flank_tool_end = "
+                            f"'{params.flank_tool_end}': {best:.3f} mm, for tip mode: "
+                            f"{limits.tip_mode_max_diameter_mm:.3f} mm")
+
+
+def plan_generating(spec: GearSpec, tool: Tool, params: GeneratingParams, *, lands: bool = True,
+                    check: bool = True) -> GeneratingPlan:
+    """The passes of tooth space 0 (the land beside it when `lands`, both flanks, fillets and root), in
+    cutting order."""
     params.validate()
     check_generating_tool(spec, tool)
     profile = spec.tooth_space_profile()
@@ -415,19 +471,11 @@ def plan_generating(spec: GearSpec, tool: Tool, params: GeneratingParams, *, che
     fa, fy, fz = flank_poses(spec, tool, t_rolls, params.flank_tool_end)
     ba, by, bz = _fillet_pose(spec, tool, betas)
     ra, ry, rz = _root_pose(spec, tool, roots)
+    psis, land_leftover = land_angles(spec, tool, TIP_MODE_SAFETY * target) if lands else (np.zeros(0), 0.0)
+    la, ly, lz = _land_pose(spec, psis)
     if check:
-        design = _design_points(spec)
-        for name, (a, y, z) in (("flank", (fa, fy, fz)), ("fillet", (ba, by, bz)), ("root", (ra, ry, rz))):
-            depth = _gouges(design, a, y, z, tool)
-            if depth.max() > GOUGE_TOLERANCE_MM:
-                limits = generating_tool_limits(spec, tool.effective_corner_radius_mm, target, spec.tip_radius_mm)
-                best = (limits.flank_mode_max_diameter_mm if params.flank_tool_end == "rack"
-                        else limits.flank_mode_max_diameter_raised_mm)
-                raise ToolError(f"finishing strategy generating: a {name} pass of the {tool.diameter_mm:g} mm tool "
-                                f"reaches {1000 * depth.max():.2f} um into the gear; largest diameter for flank mode "
-                                f"with r_t = {tool.effective_corner_radius_mm:g} mm and flank_tool_end = "
-                                f"'{params.flank_tool_end}': {best:.3f} mm, for tip mode: "
-                                f"{limits.tip_mode_max_diameter_mm:.3f} mm")
+        _refuse_gouging_passes(spec, tool, params, {"flank": (fa, fy, fz), "fillet": (ba, by, bz),
+                                                    "root": (ra, ry, rz), "land": (la, ly, lz)})
     rb = spec.base_radius_mm
     fillet = profile.segment("fillet")
     passes: list[GeneratingPass] = []
@@ -439,7 +487,9 @@ def plan_generating(spec: GearSpec, tool: Tool, params: GeneratingParams, *, che
     flank_radius = rb * np.sqrt(1.0 + t_rolls**2)
     fillet_radius = (np.hypot(*fillet.points(betas).T) if fillet is not None and len(betas) > 1
                      else np.full(len(betas), spec.root_radius_mm))
-    # right flank, tip -> root
+    # land of the tooth on the +Y side, then right flank, tip -> root
+    for i in range(len(psis)):
+        add("land", Feature.TIP, psis[i], math.nan, la[i], ly[i], lz[i], 1, spec.tip_radius_mm)
     for i in range(len(t_rolls) - 1, -1, -1):
         add("flank", Feature.RIGHT_FLANK, t_rolls[i], math.nan, fa[i], fy[i], fz[i], 1, flank_radius[i])
     # right fillet, junction -> root (its last pose, beta = 0, is the root's first)
@@ -456,8 +506,8 @@ def plan_generating(spec: GearSpec, tool: Tool, params: GeneratingParams, *, che
     # left flank, root -> tip
     for i in range(len(t_rolls)):
         add("flank", Feature.LEFT_FLANK, t_rolls[i], math.nan, -fa[i], -fy[i], fz[i], -1, flank_radius[i])
-    return GeneratingPlan(tuple(passes), t_rolls, betas, np.concatenate([roots, -roots[-2::-1]]), flat_height,
-                          tip_leftover)
+    return GeneratingPlan(tuple(passes), t_rolls, betas, np.concatenate([roots, -roots[-2::-1]]), psis,
+                          flat_height, max(tip_leftover, land_leftover))
 
 
 # --------------------------------------------------------------------------- tool advice
@@ -543,6 +593,7 @@ class GeneratingStrategy:
     simultaneous_rotary = False  # A is clamped for every pass; it indexes only at the safe height
 
     def estimate_moves(self, spec: GearSpec, tool: Tool, params: GeneratingParams) -> int:
+        """Counted with the land passes (an upper bound when the blank is turned to the tip diameter)."""
         plan = plan_generating(spec, tool, params, check=False)
         return spec.teeth * MOVES_PER_PASS * plan.passes_per_space
 
@@ -550,11 +601,9 @@ class GeneratingStrategy:
                  blank_radius_mm: float) -> tuple[Toolpath, FinishingResult]:
         params.validate()
         machine.validate()
-        plan = plan_generating(spec, tool, params)
+        plan = plan_generating(spec, tool, params, lands=blank_radius_mm > spec.tip_radius_mm + LAND_ALLOWANCE_MM)
         builder = ToolpathBuilder(Operation.FINISHING, tool.tool_number, tool.spindle_rpm(machine))
         _passes(builder, spec, tool, machine, plan, params, safe_height_mm(blank_radius_mm, machine))
-        if blank_radius_mm > spec.tip_radius_mm + 1e-6:
-            builder.warnings.append(TIP_LAND_WARNING.format(allowance=blank_radius_mm - spec.tip_radius_mm))
         result = FinishingResult(self.name, params, _space_poses(plan), 1, 0.0, np.zeros(0),
                                  passes_per_space=plan.passes_per_space, flat_height_mm=plan.flat_height_mm,
                                  passes=plan.passes)
