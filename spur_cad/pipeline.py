@@ -107,8 +107,8 @@ def program_comments(job: Job, plan: CamPlan, operation: str) -> tuple[str, ...]
     else:
         planned = plan.finishing
         result = planned.result
-        strategy = (f"strategy: {result.strategy}, {result.stations} stations, {result.points_per_flank} "
-                    f"contacts per flank, target scallop {job.finishing.target_scallop_mm * 1000:g} um")
+        strategy = (f"strategy: {result.strategy}, {result.describe()}, target scallop "
+                    f"{job.finishing.target_scallop_mm * 1000:g} um")
     tool = planned.tool
     minutes = planned.estimate.time_s / 60.0
     return (

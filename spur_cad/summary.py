@@ -77,6 +77,8 @@ def cam_sections(plan: CamPlan, machine: Machine, roughing_tool: Tool | None, fi
     sections: dict = {"tools": {**recommendations_section(plan.recommendations),
                                 "roughing": tool_section(roughing_tool, machine),
                                 "finishing": tool_section(finishing_tool, machine)}}
+    if plan.finishing is not None and plan.finishing.result.tool_advice:
+        sections["tools"][f"{plan.finishing.result.strategy}_advice"] = dict(plan.finishing.result.tool_advice)
     if plan.roughing is not None:
         sections["roughing"] = roughing_section(plan.roughing)
     if plan.finishing is not None:
@@ -115,12 +117,15 @@ def roughing_section(roughing: RoughingPlan) -> dict:
 
 
 def finishing_section(finishing: FinishingPlan) -> dict:
+    """The strategy and its facts, its estimate, and the comparison estimates (null when left out)."""
     result = finishing.result
-    return {"strategy": result.strategy, "stations": result.stations, "station_step_mm": result.station_step_mm,
-            "points_per_flank": result.points_per_flank, **_estimate_facts(finishing.estimate),
-            "reference_strategy_moves": finishing.reference_estimate.moves,
-            "reference_strategy_time_s": finishing.reference_estimate.time_s,
-            "reference_strategy_time_with_acceleration_s": finishing.reference_estimate.time_with_acceleration_s}
+    facts = {"strategy": result.strategy, **result.summary_facts(), **_estimate_facts(finishing.estimate)}
+    for prefix, other in (("perimeter", finishing.perimeter_estimate),
+                          ("reference_strategy", finishing.reference_estimate)):
+        facts[f"{prefix}_moves"] = other.moves if other else None
+        facts[f"{prefix}_time_s"] = other.time_s if other else None
+        facts[f"{prefix}_time_with_acceleration_s"] = other.time_with_acceleration_s if other else None
+    return facts
 
 
 def post_section(settings: PostSettings, programs: dict[str, PostedProgram]) -> dict:

@@ -1,7 +1,7 @@
 """The CAM plan of a job, typed: tool recommendations, roughing (levels, toolpath, estimate),
-finishing (strategy result, toolpath, estimate, and the reference process's strategy for
-comparison) and warnings. Computed once per job; summary, posts, simulation, report and the
-workbench read it (docs/architecture.md)."""
+finishing (strategy result, toolpath, estimate, and for comparison the estimates of the
+perimeter strategy and of the reference process's strategy) and warnings. Computed once per
+job; summary, posts, simulation, report and the workbench read it (docs/architecture.md)."""
 
 from __future__ import annotations
 
@@ -17,7 +17,7 @@ from spur_cad.cam.machine import FinishingParams, Machine, MachineError, Roughin
 from spur_cad.cam.recommend import ToolRecommendations, check_roughing_reach, check_tools, recommend_tools
 from spur_cad.cam.roughing import RoughingLevels, estimated_roughing_moves, roughing_levels, roughing_toolpath
 from spur_cad.cam.strategies import FinishingResult, get_strategy, params_from_section
-from spur_cad.cam.tools import Tool
+from spur_cad.cam.tools import Tool, ToolError
 from spur_cad.errors import WorkLimitError
 from spur_cad.geometry.spec import GearSpec
 
@@ -35,6 +35,10 @@ REFERENCE_STATION_STEP_MM = 0.14
 """X step between the reference process's finishing stations. With the spacing above it defines
 "the reference process's strategy" (perimeter finishing) whose time is reported beside ours."""
 
+MAX_COMPARISON_MOVES = 2_000_000
+"""Largest toolpath built only to estimate a comparison time (perimeter, reference process's strategy);
+beyond it the comparison is left out (None) rather than slowing the job down."""
+
 
 @dataclass(frozen=True)
 class RoughingPlan:
@@ -49,13 +53,16 @@ class RoughingPlan:
 
 @dataclass(frozen=True)
 class FinishingPlan:
-    """Finishing: the strategy's result and toolpath, its estimate, and the reference process's."""
+    """Finishing: the strategy's result and toolpath, its estimate, and comparison estimates (None when
+    beyond MAX_COMPARISON_MOVES): perimeter finishing at the job's target scallop (the chosen strategy's
+    own estimate when that is perimeter) and the reference process's strategy."""
 
     tool: Tool
     result: FinishingResult
     toolpath: Toolpath
     estimate: Estimate
-    reference_estimate: Estimate
+    reference_estimate: Estimate | None
+    perimeter_estimate: Estimate | None = None
 
 
 @dataclass(frozen=True)
@@ -160,10 +167,30 @@ def _plan_finishing(inputs: CamInputs, blank: float) -> FinishingPlan:
     spec, tool, machine = inputs.spec, inputs.finishing_tool, inputs.machine
     path, result = plan_finishing(spec, tool, machine, inputs.finishing, blank)
     check_travel(machine, path.x, path.y, path.z, path.a, "finishing")
-    reference_section = FinishingParams(strategy="perimeter", target_scallop_mm=inputs.finishing.target_scallop_mm,
-                                        step_over_mm=REFERENCE_STATION_STEP_MM)
-    check_finishing_work(spec, tool, dataclasses.replace(machine, rotary_simultaneous=True), reference_section,
-                         contact_spacing_mm=REFERENCE_CONTACT_SPACING_MM)
-    reference, _ = plan_finishing(spec, tool, machine, reference_section, blank,
-                                  contact_spacing_mm=REFERENCE_CONTACT_SPACING_MM)
-    return FinishingPlan(tool, result, path, estimate(path, machine), estimate(reference, machine))
+    own = estimate(path, machine)
+    target = inputs.finishing.target_scallop_mm
+    reference = _comparison_estimate(spec, tool, machine, blank,
+                                     FinishingParams(strategy="perimeter", target_scallop_mm=target,
+                                                     step_over_mm=REFERENCE_STATION_STEP_MM),
+                                     contact_spacing_mm=REFERENCE_CONTACT_SPACING_MM)
+    perimeter = own if inputs.finishing.strategy == "perimeter" else _comparison_estimate(
+        spec, tool, machine, blank, FinishingParams(strategy="perimeter", target_scallop_mm=target))
+    return FinishingPlan(tool, result, path, own, reference, perimeter)
+
+
+def _comparison_estimate(spec: GearSpec, tool: Tool, machine: Machine, blank: float, section: FinishingParams,
+                         **overrides) -> Estimate | None:
+    """The estimate of another finishing with the same tool, for comparison; None when it would exceed
+    MAX_COMPARISON_MOVES (or cannot be planned with this tool). A table that only indexes is taken as
+    simultaneous here: the figure says what that strategy would take."""
+    simultaneous = dataclasses.replace(machine, rotary_simultaneous=True)
+    strategy = get_strategy(section.strategy)
+    try:
+        check_finishing_work(spec, tool, simultaneous, section, **overrides)
+        if strategy.estimate_moves(spec, tool, params_from_section(strategy, section, **overrides)) \
+                > MAX_COMPARISON_MOVES:
+            return None
+        path, _ = plan_finishing(spec, tool, simultaneous, section, blank, **overrides)
+    except (WorkLimitError, MachineError, ToolError):
+        return None
+    return estimate(path, machine)

@@ -107,6 +107,10 @@ def _tools(summary: dict) -> str:
         return ""
     rec = [(k, v) for k, v in tools.items() if k not in ("roughing", "finishing") and not isinstance(v, (dict, list))]
     text = "<h2>Tools</h2><h3>Recommendations</h3>" + _table(rec)
+    for key, advice in tools.items():
+        if key.endswith("_advice") and isinstance(advice, dict):
+            strategy = key.removesuffix("_advice")
+            text += f"<h3>For finishing strategy {_e(strategy)}</h3>" + _table(advice.items())
     chosen = []
     for role in ("roughing", "finishing"):
         tool = tools.get(role)
@@ -138,22 +142,49 @@ def _program(summary: dict) -> str:
         text += "</p>"
     text += _table(rows, ("", "moves (IR)", "G-code lines", "G-code size", "cutting path", "time at feed",
                           "time with acceleration"))
-    if finish and "reference_strategy_time_s" in finish:
-        reference = (f"reference process's strategy ({REFERENCE_CONTACT_SPACING_MM:g} mm contacts, "
-                     f"{REFERENCE_STATION_STEP_MM:g} mm X step)")
-        text += _table([("this job's finishing", finish["moves"], _minutes(finish["estimated_time_s"]),
-                         _minutes(finish.get("estimated_time_with_acceleration_s"))),
-                        (reference, finish["reference_strategy_moves"], _minutes(finish["reference_strategy_time_s"]),
-                         _minutes(finish.get("reference_strategy_time_with_acceleration_s")))],
-                       ("finishing", "moves", "time at feed", "time with acceleration"))
+    if finish:
+        text += _finishing_comparison(finish)
     if rough:
         text += (f"<p>Roughing: {rough['levels_per_space']} levels per space, lowest level "
                  f"{rough['lowest_level_height_mm']:.3f} mm above the root circle.</p>")
     if finish:
-        text += (f"<p>Finishing: {_e(finish['strategy'])}, {finish['stations']} stations "
-                 f"({finish['station_step_mm']:.4f} mm apart), {finish['points_per_flank']} contact points per "
-                 "flank.</p>")
+        text += _finishing_words(finish)
     return text
+
+
+def _finishing_comparison(finish: dict) -> str:
+    """This job's finishing beside perimeter finishing and the reference process's strategy (same tool)."""
+    reference = (f"reference process's strategy (perimeter, {REFERENCE_CONTACT_SPACING_MM:g} mm contacts, "
+                 f"{REFERENCE_STATION_STEP_MM:g} mm X step)")
+    rows = [(f"this job's finishing ({_e(finish['strategy'])})", finish["moves"], _minutes(finish["estimated_time_s"]),
+             _minutes(finish.get("estimated_time_with_acceleration_s")))]
+    others = [("perimeter", "perimeter finishing at this job's target scallop")] if finish["strategy"] != "perimeter" \
+        else []
+    others.append(("reference_strategy", reference))
+    for prefix, label in others:
+        if finish.get(f"{prefix}_time_s") is None:
+            rows.append((label, "-", "not estimated (too large to build for comparison)", "-"))
+        else:
+            rows.append((label, finish[f"{prefix}_moves"], _minutes(finish[f"{prefix}_time_s"]),
+                         _minutes(finish.get(f"{prefix}_time_with_acceleration_s"))))
+    return _table(rows, ("finishing (same tool)", "moves", "time at feed", "time with acceleration"))
+
+
+def _finishing_words(finish: dict) -> str:
+    """One paragraph: stations and contacts, or the generating passes and what they leave."""
+    if "passes_per_space" in finish:
+        text = (f"<p>Finishing: {_e(finish['strategy'])}, {finish['passes_per_space']} straight passes per tooth "
+                f"space with A clamped")
+        if "flank_passes_per_flank" in finish:
+            text += (f": {finish['flank_passes_per_flank']} per flank (generating flat height "
+                     f"{1000 * finish['flat_height_mm']:.2f} um), {finish['tip_mode_passes_per_space']} on fillets and "
+                     f"root (largest sampled leftover {1000 * finish['tip_mode_leftover_mm']:.2f} um), "
+                     f"{finish['land_passes_per_space']} on the tip land; {_e(finish['cutting_direction'])} milling, "
+                     f"flank tool end '{_e(finish['flank_tool_end'])}'")
+        return text + ".</p>"
+    return (f"<p>Finishing: {_e(finish['strategy'])}, {finish['stations']} stations "
+            f"({finish['station_step_mm']:.4f} mm apart), {finish['points_per_flank']} contact points per "
+            "flank.</p>")
 
 
 def _simulation(summary: dict) -> str:

@@ -17,14 +17,16 @@ if TYPE_CHECKING:
 def report_html(summary: dict, profile_png: bytes, spec: GearSpec, blank_radius_mm: float, plan: CamPlan,
                 sim: SimResult | None) -> bytes:
     """report.html for a job (pure: bytes out); levels and contact poses come from the plan, not recomputed."""
-    from spur_cad.report.figures import deviation_map_png, finishing_png, roughing_levels_png
+    from spur_cad.report.figures import deviation_map_png, finishing_png, passes_png, roughing_levels_png
 
     images = {"profile": profile_png}
     if plan.roughing is not None:
         levels = plan.roughing.levels
         images["roughing"] = roughing_levels_png(spec, levels.heights_mm, levels.half_widths_mm, plan.roughing.tool,
                                                  blank_radius_mm)
-    if plan.finishing is not None:
+    if plan.finishing is not None and plan.finishing.result.passes:
+        images["finishing"] = passes_png(spec, plan.finishing.tool, plan.finishing.result.passes, blank_radius_mm)
+    elif plan.finishing is not None:
         poses = plan.finishing.result.poses
         parts = (poses.right_flank, poses.root, poses.left_flank, poses.tip)
         y = np.concatenate([p.y for p in parts])

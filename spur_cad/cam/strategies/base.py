@@ -10,7 +10,7 @@ there.
 from __future__ import annotations
 
 import dataclasses
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any, Protocol
 
 import numpy as np
@@ -35,10 +35,27 @@ class FinishingResult:
     passes_per_space: int = 0  # straight passes per tooth space (strategies with A clamped per pass)
     flat_height_mm: float = 0.0  # largest generating-flat deviation left on the involute (generating)
     passes: tuple = ()  # the strategy's passes of one space, typed by the strategy (generating: GeneratingPass)
+    facts: dict = field(default_factory=dict)  # strategy-specific facts for summary.json's `finishing` section
+    tool_advice: dict = field(default_factory=dict)  # strategy-specific tool advice (summary `tools.<strategy>`)
 
     @property
     def points_per_flank(self) -> int:
         return self.poses.points_per_flank
+
+    def describe(self) -> str:
+        """What was planned, in a few words (program header, report)."""
+        if self.passes_per_space:
+            return f"{self.passes_per_space} straight passes per space with A clamped"
+        return f"{self.stations} stations, {self.points_per_flank} contacts per flank"
+
+    def summary_facts(self) -> dict:
+        """summary.json's strategy-specific finishing facts: stations and contacts, or passes, and `facts`."""
+        if self.passes_per_space:
+            counted = {"passes_per_space": self.passes_per_space, "flat_height_mm": self.flat_height_mm}
+        else:
+            counted = {"stations": self.stations, "station_step_mm": self.station_step_mm,
+                       "points_per_flank": self.points_per_flank}
+        return {**counted, **self.facts}
 
 
 @dataclass(frozen=True)

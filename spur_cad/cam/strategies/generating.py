@@ -562,6 +562,40 @@ def generating_tool_limits(spec: GearSpec, corner_radius_mm: float, target_scall
     return GeneratingToolLimits(rho, rho, tip_max, flank_rack, flank_raised, flute)
 
 
+def passes_flute_length_mm(passes: tuple[GeneratingPass, ...], tool: Tool, blank_radius_mm: float) -> float:
+    """Flute length the passes need: for each pass, from the tool end up to the blank circle above the
+    tool's point nearest the axis (conservative: the stock before roughing)."""
+    y = np.array([p.y_mm for p in passes])
+    z = np.array([p.z_mm for p in passes])
+    half = tool.diameter_mm / 2.0
+    near = np.maximum(np.abs(y) - half, 0.0)
+    return float(np.max(np.sqrt(np.maximum(blank_radius_mm**2 - near**2, 0.0)) - z))
+
+
+def tool_advice(spec: GearSpec, tool: Tool, params: GeneratingParams, plan: GeneratingPlan,
+                blank_radius_mm: float) -> dict[str, float]:
+    """summary.json's `tools.generating_advice`: limits for this tool's corner radius, the largest tool
+    with the advised corner radius (rho), and the flute length this tool's passes need."""
+    end = params.flank_tool_end
+    own = generating_tool_limits(spec, tool.effective_corner_radius_mm, params.target_scallop_mm, blank_radius_mm,
+                                 end)
+    advised = generating_tool_limits(spec, spec.rack_tip_radius_mm, params.target_scallop_mm, blank_radius_mm, end)
+
+    def largest(limits: GeneratingToolLimits) -> float:
+        flank = limits.flank_mode_max_diameter_mm if end == "rack" else limits.flank_mode_max_diameter_raised_mm
+        return min(flank, limits.tip_mode_max_diameter_mm)
+
+    return {"advised_corner_radius_mm": advised.advised_corner_radius_mm,
+            "max_corner_radius_mm": own.max_corner_radius_mm,
+            "flank_mode_max_diameter_mm": own.flank_mode_max_diameter_mm,
+            "flank_mode_max_diameter_raised_end_mm": own.flank_mode_max_diameter_raised_mm,
+            "tip_mode_max_diameter_mm": own.tip_mode_max_diameter_mm,
+            "max_diameter_mm": largest(own),
+            "recommended_diameter_mm": largest(advised),
+            "recommended_flute_length_mm": advised.required_flute_length_mm,
+            "required_flute_length_mm": passes_flute_length_mm(plan.passes, tool, blank_radius_mm)}
+
+
 # --------------------------------------------------------------------------- the strategy
 
 
@@ -604,9 +638,19 @@ class GeneratingStrategy:
         plan = plan_generating(spec, tool, params, lands=blank_radius_mm > spec.tip_radius_mm + LAND_ALLOWANCE_MM)
         builder = ToolpathBuilder(Operation.FINISHING, tool.tool_number, tool.spindle_rpm(machine))
         _passes(builder, spec, tool, machine, plan, params, safe_height_mm(blank_radius_mm, machine))
+        advice = tool_advice(spec, tool, params, plan, blank_radius_mm)
+        if tool.flute_length_mm and tool.flute_length_mm < advice["required_flute_length_mm"]:
+            raise ToolError(f"finishing tool flute_length_mm = {tool.flute_length_mm:g} is shorter than the "
+                            f"{advice['required_flute_length_mm']:.3f} mm the generating passes need",
+                            field="flute_length_mm", section="tools.finishing")
+        facts = {"flank_passes_per_flank": plan.flank_passes_per_flank,
+                 "tip_mode_passes_per_space": plan.tip_passes_per_space,
+                 "land_passes_per_space": plan.land_passes_per_space,
+                 "tip_mode_leftover_mm": plan.tip_leftover_mm,
+                 "cutting_direction": params.cutting_direction, "flank_tool_end": params.flank_tool_end}
         result = FinishingResult(self.name, params, _space_poses(plan), 1, 0.0, np.zeros(0),
                                  passes_per_space=plan.passes_per_space, flat_height_mm=plan.flat_height_mm,
-                                 passes=plan.passes)
+                                 passes=plan.passes, facts=facts, tool_advice=advice)
         return builder.build(), result
 
 
@@ -637,4 +681,5 @@ def _passes(builder: ToolpathBuilder, spec: GearSpec, tool: Tool, machine: Machi
 
 __all__ = ["GeneratingParams", "GeneratingPass", "GeneratingPlan", "GeneratingStrategy", "GeneratingToolLimits",
            "check_generating_tool", "flank_poses", "flank_rolls", "flat_deviation_mm", "generating_tool_limits",
+           "land_angles", "passes_flute_length_mm", "tool_advice",
            "plan_generating", "rough_passes_per_space"]
