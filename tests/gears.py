@@ -14,6 +14,13 @@ from tests.textbook import Textbook
 
 REFERENCE_JOB = Path(__file__).resolve().parents[1] / "resources" / "examples" / "reference_gear.toml"
 
+
+def reference_job_text(strategy: str) -> str:
+    """The reference job file with another finishing strategy (it ships with "generating")."""
+    text = REFERENCE_JOB.read_text()
+    line = next(line for line in text.splitlines() if line.startswith("strategy = "))
+    return text.replace(line, f'strategy = "{strategy}"')
+
 # name: (teeth, module, pressure angle, shift, rack tip radius, allowance fraction, allowance mm)
 GEAR_CASES = {
     "reference_z23_m4": (23, 4.0, 20.0, 0.0, 0.8, 0.05, 0.0),

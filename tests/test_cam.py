@@ -82,7 +82,8 @@ def test_a_moves_only_above_the_gear_or_in_designed_finishing_moves(name):
     paths = [roughing_toolpath(spec, roughing, machine, RoughingParams(flank_allowance_mm=0.1 * spec.module_mm,
                                                                        finish_stock_mm=0.005 * spec.module_mm),
                                blank),
-             finishing_toolpath(spec, finishing, machine, FinishingParams(step_over_mm=spec.face_width_mm), blank)]
+             finishing_toolpath(spec, finishing, machine,
+                                FinishingParams(strategy="perimeter", step_over_mm=spec.face_width_mm), blank)]
     for path in paths:
         moving = np.abs(path.a - _previous(path.a)) > 1e-12
         designed = np.isin(path.feature, [Feature.RIGHT_FLANK, Feature.LEFT_FLANK, Feature.ROOT, Feature.TIP])
@@ -99,7 +100,7 @@ def test_inverse_time_feed_matches_relative_path_length():
     tool = Tool(diameter_mm=2.0, kind="bull_nose", corner_radius_mm=0.5, cutting_speed_m_min=120,
                 feed_per_tooth_mm=0.02)
     machine = Machine()
-    path = finishing_toolpath(spec, tool, machine, FinishingParams(step_over_mm=100.0), 50.5)
+    path = finishing_toolpath(spec, tool, machine, FinishingParams(strategy="perimeter", step_over_mm=100.0), 50.5)
     feed = tool.feed_mm_min(machine)
     idx = np.nonzero(path.inverse_time)[0]
     assert len(idx) > 100
@@ -130,7 +131,7 @@ def test_estimate_of_a_small_program_by_hand():
 
 def test_stations_cover_the_face_width_with_the_scallop_step():
     tool = Tool(diameter_mm=2.0, kind="bull_nose", corner_radius_mm=0.5)
-    params = FinishingParams(target_scallop_mm=0.005)
+    params = FinishingParams(strategy="perimeter", target_scallop_mm=0.005)
     step = station_step_mm(tool, params.target_scallop_mm, params.step_over_mm)
     # Worst case of docs/method.md: flat width d at the root, corner radius elsewhere.
     h, d, r_t = 0.005, 1.0, 0.5
@@ -164,7 +165,7 @@ def test_travel_limits_name_the_axis():
     spec = spec_of("reference_z23_m4")
     tool = Tool(diameter_mm=2.0, kind="bull_nose", corner_radius_mm=0.5)
     machine = Machine(z_max_mm=50.0, rotary_continuous=False, a_min_deg=-90.0, a_max_deg=90.0)
-    path = finishing_toolpath(spec, tool, machine, FinishingParams(step_over_mm=20.0), 50.5)
+    path = finishing_toolpath(spec, tool, machine, FinishingParams(strategy="perimeter", step_over_mm=20.0), 50.5)
     with pytest.raises(MachineError, match=r"finishing needs Z = 51.500 mm, outside the machine's travel"):
         check_travel(machine, path.x, path.y, path.z, path.a, "finishing")
     limited = Machine(rotary_continuous=False, a_min_deg=-90.0, a_max_deg=90.0)

@@ -34,7 +34,7 @@ def design_polygons():
 def test_finishing_never_gouges_and_leaves_at_most_the_scallop(name, design_polygons):
     spec = spec_of(name)
     _, tool = tools_for(name)
-    path = finishing_toolpath(spec, tool, Machine(), FinishingParams(target_scallop_mm=SCALLOP,
+    path = finishing_toolpath(spec, tool, Machine(), FinishingParams(strategy="perimeter", target_scallop_mm=SCALLOP,
                                                                       step_over_mm=spec.face_width_mm),
                               spec.tip_radius_mm + 0.5)
     spaces = _spaces(spec.teeth)
@@ -51,7 +51,8 @@ def test_finishing_never_gouges_and_leaves_at_most_the_scallop(name, design_poly
 def test_finishing_cuts_every_flank_downward(name):
     spec = spec_of(name)
     _, tool = tools_for(name)
-    path = finishing_toolpath(spec, tool, Machine(), FinishingParams(target_scallop_mm=SCALLOP, step_over_mm=2.0),
+    path = finishing_toolpath(spec, tool, Machine(),
+                              FinishingParams(strategy="perimeter", target_scallop_mm=SCALLOP, step_over_mm=2.0),
                               spec.tip_radius_mm + 0.5)
     for feature in (Feature.RIGHT_FLANK, Feature.LEFT_FLANK):
         runs = silhouette.cutting_direction_ok(path, feature)
@@ -90,7 +91,8 @@ def test_rapids_never_touch_the_stock(name):
     machine = Machine()
     params = RoughingParams(flank_allowance_mm=0.1 * spec.module_mm, finish_stock_mm=0.005 * spec.module_mm)
     for path, tool in ((roughing_toolpath(spec, roughing, machine, params, blank), roughing),
-                       (finishing_toolpath(spec, finishing, machine, FinishingParams(step_over_mm=2.0), blank),
+                       (finishing_toolpath(spec, finishing, machine,
+                                           FinishingParams(strategy="perimeter", step_over_mm=2.0), blank),
                         finishing)):
         assert np.any(path.kind == MoveKind.RAPID)
         clearance = silhouette.rapids_clear_of_circle(path, tool.diameter_mm, tool.effective_corner_radius_mm,

@@ -375,11 +375,12 @@ def test_tool_errors_name_the_values():
         strategy.generate(spec, _tool(3.0, 0.5), MACHINE, GeneratingParams(), spec.tip_radius_mm + 0.5)
 
 
-def test_strategy_is_registered_but_not_the_default_and_the_job_file_takes_its_keys():
+def test_strategy_is_registered_and_the_default_and_the_job_file_takes_its_keys():
     from spur_cad.cam.machine import MachineError
     from spur_cad.job import JobFileError, parse_job
 
-    assert "generating" in strategy_names() and FinishingParams().strategy == "perimeter"
+    assert "generating" in strategy_names() and FinishingParams().strategy == "generating"
+    assert parse_job("[gear]\nteeth = 23\nmodule_mm = 4.0\nface_width_mm = 20\n").finishing.strategy == "generating"
     text = ("[gear]\nteeth = 23\nmodule_mm = 4.0\nface_width_mm = 20\n[finishing]\nstrategy = 'generating'\n"
             "cutting_direction = 'conventional'\nflank_tool_end = 'raised'\n")
     job = parse_job(text)

@@ -34,7 +34,7 @@ def cam_paths():
         blank = spec.tip_radius_mm + 0.5
         roughing = roughing_toolpath(spec, roughing_tool, Machine(), RoughingParams(
             flank_allowance_mm=0.1 * spec.module_mm, finish_stock_mm=0.005 * spec.module_mm), blank)
-        finishing = finishing_toolpath(spec, finishing_tool, Machine(), FinishingParams(
+        finishing = finishing_toolpath(spec, finishing_tool, Machine(), FinishingParams(strategy="perimeter",
             target_scallop_mm=0.005, step_over_mm=spec.face_width_mm / 2), blank)
         paths[name] = (spec, roughing_tool, finishing_tool, roughing, finishing)
     return paths

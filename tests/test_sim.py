@@ -12,11 +12,12 @@ import pytest
 from spur_cad.cam.ir import Feature, MoveKind, Operation, ToolpathBuilder
 from spur_cad.cam.tools import Tool
 from spur_cad.geometry.sampling import full_space_points, sample_profile
-from spur_cad.job import load_job
+from spur_cad.job import parse_job
 from spur_cad.pipeline import job_stock, plan_cam
 from spur_cad.sim import Cut, SimSettings, StockCylinder, finishing_stations, simulate, simulate_grid, subset
 from spur_cad.sim.design import DesignGrid, row_positions
 from spur_cad.summary import simulation_section
+from tests.gears import reference_job_text
 
 ROOT = Path(__file__).resolve().parents[1]
 REFERENCE_JOB = ROOT / "resources" / "examples" / "reference_gear.toml"
@@ -125,7 +126,8 @@ def test_plunge_of_a_curved_tool_matches_brute_force_membership(kind, diameter, 
 
 @pytest.fixture(scope="module")
 def reference():
-    job = load_job(REFERENCE_JOB)
+    """The reference job finished by the perimeter strategy (stations: the window tests need them)."""
+    job = parse_job(reference_job_text("perimeter"), str(REFERENCE_JOB))
     return job, plan_cam(job)
 
 

@@ -26,7 +26,7 @@ def small_job():
 
 
 @pytest.mark.parametrize("section, values, key", [
-    ("finishing", {"step_over_mm": 1e-9}, "finishing.step_over_mm"),
+    ("finishing", {"strategy": "perimeter", "step_over_mm": 1e-9}, "finishing.step_over_mm"),
     ("finishing", {"target_scallop_mm": 1e-9}, "finishing.target_scallop_mm"),
     ("roughing", {"step_over_fraction": 1e-9}, "roughing.step_over_fraction"),
     ("roughing", {"max_level_depth_fraction": 1e-9}, "roughing.max_level_depth_fraction"),

@@ -153,7 +153,7 @@ def _strategy_names() -> tuple[str, ...]:
 class FinishingParams:
     """[finishing]: the finishing strategy and its parameters (docs/cam.md)."""
 
-    strategy: str = key("perimeter", label="FinishingStrategy", group="Finishing strategy",
+    strategy: str = key("generating", label="FinishingStrategy", group="Finishing strategy",
                         meaning="a finishing strategy name (see docs/cam.md)", names_from=_strategy_names)
     target_scallop_mm: float = key(0.005, unit="mm", low=0.0001, high=0.1, label="TargetScallop",
                                    group="Finishing strategy", meaning="target scallop height")
