@@ -438,3 +438,31 @@ def test_plan_cam_runs_the_generating_strategy():
     assert plan.finishing.result.strategy == "generating"
     assert plan.finishing.estimate.moves == len(plan.finishing.toolpath)
     assert plan.finishing.estimate.time_s < plan.finishing.reference_estimate.time_s
+
+
+# --------------------------------------------------------------------------- what it buys (estimator)
+
+
+def test_generating_takes_a_fraction_of_the_perimeter_time_on_the_reference_job():
+    """Issue's acceptance bounds (feed-bound estimates, not timed): the reference job's own tools at 5 um at
+    most 1/4 of perimeter finishing at 5 um, at 1 um at most 1/2 of it, with the advised tool (r_t = rho,
+    the advice's diameter rounded down to 0.1 mm, four flutes) at most 1/8."""
+    import dataclasses
+
+    from spur_cad.job import load_job
+    from spur_cad.pipeline import plan_cam
+    from tests.gears import REFERENCE_JOB
+
+    job = load_job(REFERENCE_JOB)
+    plan = plan_cam(job)
+    perimeter_s = plan.finishing.perimeter_estimate.time_s
+    assert plan.finishing.perimeter_estimate.moves > 50 * plan.finishing.estimate.moves
+    assert plan.finishing.estimate.time_s <= perimeter_s / 4
+    fine = dataclasses.replace(job, finishing=dataclasses.replace(job.finishing, target_scallop_mm=0.001))
+    assert plan_cam(fine).finishing.estimate.time_s <= perimeter_s / 2
+    advice = plan.finishing.result.tool_advice
+    diameter = math.floor(10 * advice["recommended_diameter_mm"]) / 10
+    advised = dataclasses.replace(job.tools.finishing, diameter_mm=diameter,
+                                  corner_radius_mm=advice["advised_corner_radius_mm"], flutes=4)
+    big = dataclasses.replace(job, tools=dataclasses.replace(job.tools, finishing=advised))
+    assert plan_cam(big).finishing.estimate.time_s <= perimeter_s / 8

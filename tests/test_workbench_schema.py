@@ -15,6 +15,7 @@ import numpy as np
 import pytest
 
 from spur_cad.cad.specs import StockSpec
+from spur_cad.cam.finishing import plan_finishing
 from spur_cad.cam.ir import MoveKind, Operation, ToolpathBuilder
 from spur_cad.cam.machine import FinishingParams, Machine, RoughingParams
 from spur_cad.cam.recommend import check_roughing_reach, check_tools, recommend_tools
@@ -296,18 +297,32 @@ def test_gear_errors_are_filed_under_gear(wb):
     assert result.messages["Gear"] == "[gear] teeth must be in 5..1000, got 3"
 
 
+@pytest.mark.parametrize("strategy", ["generating", "perimeter"])
 @pytest.mark.parametrize("name", sorted(GEAR_CASES))
-def test_suggested_tools_pass_the_tool_limits(wb, name):
+def test_suggested_tools_pass_the_tool_limits(wb, name, strategy):
     z, m, pa, x, rho, frac, mm = GEAR_CASES[name]
     values = wb.schema.default_values()
     values["gear"].update(Teeth=z, Module=m, PressureAngle=pa, ProfileShift=x, RackTipRadius=rho,
                           ThicknessAllowancePercent=frac * 100, ThicknessAllowance=mm, FaceWidth=10.0)
-    values["job"].update(wb.validation.suggest_tools(values))
+    values["job"]["FinishingStrategy"] = strategy
+    suggested = wb.validation.suggest_tools(values)
+    if strategy == "generating" and rho == 0.0:
+        # a sharp rack cannot be played by a tool with a corner: nothing to suggest, and the check says why
+        assert suggested == {}
+        values["job"].update(UseFinishingTool=True, FinishingToolKind="bull_nose", FinishingToolDiameter=2.0,
+                             FinishingCornerRadius=0.2)
+        message = wb.validation.validate(values).messages["Finishing tool"]
+        assert "larger than the rack tip radius rho = 0 mm" in message
+        return
+    values["job"].update(suggested)
     job = job_from_dict(wb.schema.job_data(values), name)
     assert job.tools.finishing is not None and job.tools.finishing.kind == "bull_nose"
     blank = job.stock.blank_radius_mm(job.gear)
     rec = recommend_tools(job.gear, blank, job.machine.clearance_mm, job.tools.finishing)
     check_tools(job.gear, rec, job.tools.roughing, job.tools.finishing)
+    assert job.finishing.strategy == strategy  # the suggested tool must fit the strategy, flanks included
+    plan_finishing(job.gear, job.tools.finishing, job.machine, dataclasses.replace(job.finishing, step_over_mm=10.0),
+                   blank)
     if job.tools.roughing is not None:
         levels = roughing_levels(job.gear, job.tools.roughing, job.roughing, blank)
         check_roughing_reach(job.tools.roughing, levels.lowest_height_mm - job.gear.root_radius_mm, rec)

@@ -15,6 +15,7 @@ def plan_finishing(spec: GearSpec, tool: Tool, machine: Machine, section: Finish
     the section (`overrides` replace some, e.g. the reference process's contact spacing)."""
     strategy = get_strategy(section.strategy)
     params = params_from_section(strategy, section, **overrides)
+    strategy.check_tool(spec, tool)
     return strategy.generate(spec, tool, machine, params, blank_radius_mm)
 
 

@@ -147,6 +147,7 @@ def check_finishing_work(spec: GearSpec, tool: Tool, machine: Machine, section: 
     """Refuse finishing whose contacts per flank or moves exceed the limits, before generating it."""
     strategy = get_strategy(section.strategy)
     params = params_from_section(strategy, section, **overrides)
+    strategy.check_tool(spec, tool)
     if strategy.simultaneous_rotary and not machine.rotary_simultaneous:
         raise MachineError(f"finishing strategy '{strategy.name}' turns A while cutting, but [machine] "
                            "rotary_simultaneous = false (the table only indexes); choose a strategy that keeps A "

@@ -72,17 +72,14 @@ def recommend_tools(spec: GearSpec, blank_radius_mm: float, clearance_mm: float,
 
 def check_tools(spec: GearSpec, recommendations: ToolRecommendations, roughing: Tool | None,
                 finishing: Tool | None) -> None:
-    """Raise ToolError naming the violated limit and its value."""
+    """Raise ToolError naming the violated limit and its value (the finishing strategy's own tool rule,
+    e.g. the flat width, is its `check_tool`)."""
     rec = recommendations
     if finishing is not None:
         finishing.validate("finishing")
         if finishing.kind == "flat":
             raise ToolError("finishing tool must have a corner radius (bull_nose or ball): a sharp corner "
                             "cannot follow the root fillet", field="kind", section="tools.finishing")
-        if finishing.flat_width_mm > rec.finishing_max_flat_width_mm + 1e-9:
-            raise ToolError(f"finishing tool flat width {finishing.flat_width_mm:.4f} mm (D - 2 r_t) exceeds "
-                            f"finishing_max_flat_width_mm = {rec.finishing_max_flat_width_mm:.4f} mm "
-                            "(root arc length 2 v r_f)", field="diameter_mm", section="tools.finishing")
         if finishing.effective_corner_radius_mm > rec.finishing_max_corner_radius_mm + 1e-9:
             raise ToolError(f"finishing tool corner radius {finishing.effective_corner_radius_mm:.4f} mm exceeds "
                             f"finishing_max_corner_radius_mm = {rec.finishing_max_corner_radius_mm:.4f} mm "

@@ -89,8 +89,9 @@ def recommendation_notes(rec) -> dict[str, str]:
         return {}
     notes = {
         "RoughingToolDiameter": f"at most {rec.roughing_max_diameter_mm:.3f} mm (space width at root + A_p)",
-        "FinishingToolDiameter": f"flat width D - 2 r_t at most {rec.finishing_max_flat_width_mm:.3f} mm "
-                                 "(root arc length)",
+        "FinishingToolDiameter": f"perimeter, along_x: flat width D - 2 r_t at most "
+                                 f"{rec.finishing_max_flat_width_mm:.3f} mm (root arc length); generating: within "
+                                 "the rack's tip flat and the flank limit (report: generating advice)",
         "FinishingCornerRadius": f"at most {rec.finishing_max_corner_radius_mm:.3f} mm (smallest fillet radius)",
     }
     for role in ("Roughing", "Finishing"):
@@ -103,11 +104,27 @@ def _floor_to(value: float, step: float) -> float:
     return math.floor(value / step + 1e-9) * step
 
 
+def _generating_finishing_tool(job) -> tuple[float, float]:
+    """(corner radius, flat width) for finishing by generation: the advised corner radius (the rack tip
+    radius: tip mode exact) and a diameter at 95 % of the largest that fits both modes with the rack end,
+    in 0.05 mm steps."""
+    from spur_cad.cam.strategies.generating import generating_tool_limits
+
+    spec = job.gear
+    corner = spec.rack_tip_radius_mm
+    if corner <= 0.0:  # a sharp rack: no tool with a corner can play it
+        return 0.0, 0.0
+    limits = generating_tool_limits(spec, corner, job.finishing.target_scallop_mm, job.stock.blank_radius_mm(spec))
+    diameter = _floor_to(0.95 * min(limits.tip_mode_max_diameter_mm, limits.flank_mode_max_diameter_mm), 0.05)
+    return corner, diameter - 2.0 * corner
+
+
 def suggest_tools(values: dict[str, dict[str, object]]) -> dict[str, object]:
     """Job property values choosing tools within the recommendations (for a new job); {} if none fits.
 
-    Finishing: bull-nose with r_t at 90 % of the smallest fillet radius (0.05 mm steps, at most
-    1 mm) and flat width at 90 % of the root arc; roughing: the largest 0.1 mm diameter that
+    Finishing by generation (the default): r_t = rho and 95 % of the largest diameter that fits;
+    other strategies: bull-nose with r_t at 90 % of the smallest fillet radius (0.05 mm steps, at
+    most 1 mm) and flat width at 90 % of the root arc. Roughing: the largest 0.1 mm diameter that
     passes the tool limits and the roughing-reach rule.
     """
     from spur_cad.cam.recommend import recommend_tools
@@ -118,8 +135,11 @@ def suggest_tools(values: dict[str, dict[str, object]]) -> dict[str, object]:
         return {}
     spec = check.job.gear
     rec = check.recommendations
-    corner = min(_floor_to(0.9 * rec.finishing_max_corner_radius_mm, 0.05), 1.0)
-    flat = _floor_to(0.9 * rec.finishing_max_flat_width_mm, 0.05)
+    if check.job.finishing.strategy == "generating":
+        corner, flat = _generating_finishing_tool(check.job)
+    else:
+        corner = min(_floor_to(0.9 * rec.finishing_max_corner_radius_mm, 0.05), 1.0)
+        flat = _floor_to(0.9 * rec.finishing_max_flat_width_mm, 0.05)
     if corner <= 0.0 or flat <= 0.0:
         return {}
     chosen = {"UseFinishingTool": True, "FinishingToolKind": "bull_nose",

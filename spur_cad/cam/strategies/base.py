@@ -18,7 +18,7 @@ import numpy as np
 from spur_cad.cam.contacts import SpacePoses
 from spur_cad.cam.ir import Operation, Toolpath, ToolpathBuilder
 from spur_cad.cam.machine import Machine, MachineError
-from spur_cad.cam.tools import Tool
+from spur_cad.cam.tools import Tool, ToolError
 from spur_cad.geometry.spec import GearSpec
 
 
@@ -85,10 +85,26 @@ class FinishingStrategy(Protocol):
         work beyond its limits before generating)."""
         ...
 
+    def check_tool(self, spec: GearSpec, tool: Tool) -> None:
+        """ToolError (naming the tool key) when the tool's shape cannot do this strategy on this gear;
+        cheap (the plan's and the workbench's checks run it before generating)."""
+        ...
+
     def generate(self, spec: GearSpec, tool: Tool, machine: Machine, params: Any,
                  blank_radius_mm: float) -> tuple[Toolpath, FinishingResult]:
         """The finishing operation as IR plus its facts (pure function)."""
         ...
+
+
+def check_flat_fits_root_arc(spec: GearSpec, tool: Tool) -> None:
+    """Strategies that sweep the root arc with the flat bottom (perimeter, along_x): the flat must fit in
+    the root arc, D - 2 r_t <= 2 v r_f (summary `tools.finishing_max_flat_width_mm`)."""
+    profile = spec.tooth_space_profile()
+    max_flat = 2.0 * profile.root_arc_half_angle_rad * spec.root_radius_mm
+    if tool.flat_width_mm > max_flat + 1e-9:
+        raise ToolError(f"finishing tool flat width {tool.flat_width_mm:.4f} mm (D - 2 r_t) exceeds "
+                        f"finishing_max_flat_width_mm = {max_flat:.4f} mm (root arc length 2 v r_f)",
+                        field="diameter_mm", section="tools.finishing")
 
 
 def finishing_builder(tool: Tool, machine: Machine, params: Any) -> ToolpathBuilder:

@@ -393,15 +393,18 @@ def check_generating_tool(spec: GearSpec, tool: Tool) -> None:
     if r_t > rho + 1e-12:
         raise ToolError(f"finishing strategy generating: tool corner radius r_t = {r_t:g} mm is larger than the rack "
                         f"tip radius rho = {rho:g} mm (smallest fillet curvature radius {fillet_limit:.4g} mm); the "
-                        "tool's corner must fit inside the rack's tip round: use r_t <= rho (r_t = rho is exact)")
+                        "tool's corner must fit inside the rack's tip round: use r_t <= rho (r_t = rho is exact)",
+                        field="corner_radius_mm", section="tools.finishing")
     if r_t > fillet_limit + 1e-12:
         raise ToolError(f"finishing strategy generating: tool corner radius r_t = {r_t:g} mm exceeds the smallest "
-                        f"fillet curvature radius {fillet_limit:.4g} mm")
+                        f"fillet curvature radius {fillet_limit:.4g} mm", field="corner_radius_mm",
+                        section="tools.finishing")
     d1 = rack_corner(spec).corner_offset_mm
     if tool.flat_width_mm > 2.0 * d1 + 1e-12:
         raise ToolError(f"finishing strategy generating: tool flat width d = {tool.flat_width_mm:g} mm (D - 2 r_t) is "
                         f"wider than the rack's tip flat 2 d_1 = {2 * d1:.4f} mm; largest diameter for tip mode with "
-                        f"this corner radius: {2 * d1 + 2 * r_t:.4f} mm")
+                        f"this corner radius: {2 * d1 + 2 * r_t:.4f} mm", field="diameter_mm",
+                        section="tools.finishing")
 
 
 def _design_points(spec: GearSpec) -> np.ndarray:
@@ -625,6 +628,9 @@ class GeneratingStrategy:
     description = "the tool as the generating rack: A clamped, one straight pass along X per roll"
     params_type = GeneratingParams
     simultaneous_rotary = False  # A is clamped for every pass; it indexes only at the safe height
+
+    def check_tool(self, spec: GearSpec, tool: Tool) -> None:
+        check_generating_tool(spec, tool)
 
     def estimate_moves(self, spec: GearSpec, tool: Tool, params: GeneratingParams) -> int:
         """Counted with the land passes (an upper bound when the blank is turned to the tip diameter)."""

@@ -20,7 +20,7 @@ from spur_cad.cam.contacts import (
 )
 from spur_cad.cam.ir import Feature, MoveKind, Toolpath, ToolpathBuilder
 from spur_cad.cam.machine import Machine
-from spur_cad.cam.strategies.base import FinishingResult, ScallopParams, finishing_builder
+from spur_cad.cam.strategies.base import FinishingResult, ScallopParams, check_flat_fits_root_arc, finishing_builder
 from spur_cad.cam.tools import Tool
 from spur_cad.geometry.spec import GearSpec
 
@@ -39,6 +39,9 @@ class PerimeterStrategy:
     description = "transverse stations along X, once around the gear at each (simultaneous Y/Z/A)"
     params_type = PerimeterParams
     simultaneous_rotary = True
+
+    def check_tool(self, spec: GearSpec, tool: Tool) -> None:
+        check_flat_fits_root_arc(spec, tool)
 
     def estimate_moves(self, spec: GearSpec, tool: Tool, params: PerimeterParams) -> int:
         params.validate()
