@@ -466,3 +466,35 @@ def test_generating_takes_a_fraction_of_the_perimeter_time_on_the_reference_job(
                                   corner_radius_mm=advice["advised_corner_radius_mm"], flutes=4)
     big = dataclasses.replace(job, tools=dataclasses.replace(job.tools, finishing=advised))
     assert plan_cam(big).finishing.estimate.time_s <= perimeter_s / 8
+
+
+@pytest.mark.parametrize("folded", [False, True])
+def test_the_table_is_clamped_for_every_pass_when_the_machine_has_clamp_codes(folded):
+    import re
+
+    spec, tool = _gear("shifted_z12_x04"), _tool(2.1, 0.5)
+    machine = Machine(rotary_clamp_code="M10", rotary_unclamp_code="M11")
+    path, result = get_strategy("generating").generate(spec, tool, machine, GeneratingParams(),
+                                                       spec.tip_radius_mm + 0.5)
+    info = ProgramInfo("clamped", (), rotary_clamp_code="M10", rotary_unclamp_code="M11")
+    text = post_program(path, PostSettings(folded=folded), info).text
+    lines = []
+    if folded:  # inline the subprogram text at each call, in order
+        sub = re.search(r"^o(\d+) sub\n(.*?)^o\1 endsub\n", text, flags=re.M | re.S)
+        for line in text[sub.end():].splitlines():
+            lines += sub.group(2).splitlines() if line.startswith(f"o{sub.group(1)} call") else [line]
+    else:
+        lines = text.splitlines()
+    clamped, clamps, cuts = False, 0, 0
+    for line in lines:
+        if line == "M10":
+            assert not clamped
+            clamped, clamps = True, clamps + 1
+        elif line == "M11":
+            clamped = False
+        elif re.search(r"\bA", line):
+            assert not clamped, f"A moves while the table is clamped: {line}"
+        elif re.match(r"X-?[\d.]+( F[\d.]+)?$", line):  # a pass along the face width
+            assert clamped, f"cutting with the table unclamped: {line}"
+            cuts += 1
+    assert clamps == cuts == spec.teeth * result.passes_per_space

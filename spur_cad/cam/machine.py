@@ -64,7 +64,8 @@ class Machine:
                                    meaning="how far the control may round a corner between moves (G64 P; "
                                            "cycle-time estimate)")
     rotary_clamp_code: str = key("", label="RotaryClampCode", group="Machine",
-                                 meaning="M code clamping A (needed by [roughing] clamp_rotary)")
+                                 meaning="M code clamping A (needed by [roughing] clamp_rotary; "
+                                         "generating clamps for every pass when both codes are given)")
     rotary_unclamp_code: str = key("", label="RotaryUnclampCode", group="Machine",
                                    meaning="M code unclamping A (needed by [roughing] clamp_rotary)")
 

@@ -65,7 +65,8 @@ Every pass of space 0 is also checked against dense exact points of the space (a
 tips) with the tool's exact section: a pass that would reach into the design beyond
 `GOUGE_TOLERANCE_MM` is a ToolError naming the largest tool diameter that fits.
 
-Passes: each pass indexes A (and Y) at the safe height beside the part, goes down beside the
+Passes: each pass indexes A (and Y) at the safe height beside the part (then clamps the table
+when the machine has clamp codes, unclamping it after the retract), goes down beside the
 part at the machine's maximum linear feed to `clearance_mm` above the cut, plunges the rest at
 the plunge feed, cuts along X over the face width plus tool radius and clearance at both ends
 at the tool's feed with A fixed, and retracts beside the part at the machine's maximum linear
@@ -109,7 +110,8 @@ TIP_MODE_SAFETY = 0.95
 _FLANK_SAFETY = 0.999
 _LEFTOVER_SAMPLES = 33
 MOVES_PER_PASS = 5
-"""Index (rapid at the safe height), approach, plunge, cut, retract (4 when the machine's clearance is 0)."""
+"""Index (rapid at the safe height), approach, plunge, cut, retract (4 when the machine's clearance is 0;
+2 more, clamp after the index and unclamp after the retract, when the machine has clamp codes)."""
 LAND_ALLOWANCE_MM = 1e-6
 """A blank standing less than this above the tip circle is taken as turned to the tip diameter (no land passes)."""
 MAX_PASSES_PER_SPACE = 20_000
@@ -633,7 +635,8 @@ class GeneratingStrategy:
         check_generating_tool(spec, tool)
 
     def estimate_moves(self, spec: GearSpec, tool: Tool, params: GeneratingParams) -> int:
-        """Counted with the land passes (an upper bound when the blank is turned to the tip diameter)."""
+        """Counted with the land passes (an upper bound when the blank is turned to the tip diameter), without
+        the clamp rows (which are no motion)."""
         plan = plan_generating(spec, tool, params, check=False)
         return spec.teeth * MOVES_PER_PASS * plan.passes_per_space
 
@@ -667,16 +670,21 @@ def _passes(builder: ToolpathBuilder, spec: GearSpec, tool: Tool, machine: Machi
     fast = machine.max_feed_mm_min
     margin = tool.diameter_mm / 2.0 + machine.clearance_mm
     x_front, x_back = -margin, spec.face_width_mm + margin
+    clamp = bool(machine.rotary_clamp_code and machine.rotary_unclamp_code)
     rows = []
     for p in plan.passes:
         direction = _pass_direction(p.side, params.cutting_direction)
         x0, x1 = (x_front, x_back) if direction > 0 else (x_back, x_front)
         rows.append((MoveKind.RAPID, x0, p.y_mm, safe_z, p.a_deg, math.nan, Feature.NONE))
+        if clamp:
+            rows.append((MoveKind.CLAMP_ROTARY, x0, p.y_mm, safe_z, p.a_deg, math.nan, Feature.NONE))
         if machine.clearance_mm > 0.0:
             rows.append((MoveKind.LINEAR, x0, p.y_mm, p.z_mm + machine.clearance_mm, p.a_deg, fast, Feature.NONE))
         rows.append((MoveKind.LINEAR, x0, p.y_mm, p.z_mm, p.a_deg, PLUNGE_FEED_FRACTION * feed, Feature.NONE))
         rows.append((MoveKind.LINEAR, x1, p.y_mm, p.z_mm, p.a_deg, feed, p.feature))
         rows.append((MoveKind.LINEAR, x1, p.y_mm, safe_z, p.a_deg, fast, Feature.NONE))
+        if clamp:
+            rows.append((MoveKind.UNCLAMP_ROTARY, x1, p.y_mm, safe_z, p.a_deg, math.nan, Feature.NONE))
     kind, x, y, z, a_rel, feeds, feature = (np.array(c) for c in zip(*rows))
     teeth, pitch_deg, per_space = spec.teeth, 360.0 / spec.teeth, len(rows)
     space = np.repeat(np.arange(teeth), per_space)
