@@ -17,6 +17,7 @@ from spur_cad.cam.ir import Feature, MoveKind, Operation, ToolpathBuilder
 from spur_cad.cam.machine import FinishingParams, Machine, RoughingParams
 from spur_cad.cam.recommend import check_tools, recommend_tools
 from spur_cad.cam.roughing import roughing_levels, roughing_toolpath
+from spur_cad.cam.strategies import get_strategy
 from spur_cad.cam.tools import Tool, ToolError
 from spur_cad.geometry import gear_outline, sample_profile
 from tests.gears import CAM_GEARS, spec_of, textbook_of, tools_for
@@ -51,7 +52,6 @@ def test_recommendations_match_method_formulas(name):
 
 
 @pytest.mark.parametrize("change, words", [
-    (dict(finishing=Tool(diameter_mm=3.0, kind="bull_nose", corner_radius_mm=0.5)), "finishing_max_flat_width_mm"),
     (dict(finishing=Tool(diameter_mm=3.0, kind="bull_nose", corner_radius_mm=1.3)), "finishing_max_corner_radius_mm"),
     (dict(finishing=Tool(diameter_mm=2.0, kind="flat")), "must have a corner radius"),
     (dict(roughing=Tool(diameter_mm=5.0, kind="flat")), "roughing_max_diameter_mm"),
@@ -67,6 +67,26 @@ def test_tool_limits_are_clear_errors(change, words):
     rec = recommend_tools(spec, 50.5, 1.0, finishing)
     with pytest.raises(ToolError, match=words):
         check_tools(spec, rec, roughing, finishing)
+
+
+@pytest.mark.parametrize("strategy, words", [
+    ("perimeter", r"flat width 2.0000 mm \(D - 2 r_t\) exceeds finishing_max_flat_width_mm = 1.6376 mm"),
+    ("along_x", r"flat width 2.0000 mm \(D - 2 r_t\) exceeds finishing_max_flat_width_mm = 1.6376 mm"),
+    ("generating", r"flat width d = 2 mm \(D - 2 r_t\) is wider than the rack's tip flat 2 d_1 = 1.8373 mm"),
+])
+def test_each_strategy_has_its_own_flat_width_rule(strategy, words):
+    """Root arc 2 v r_f = 1.6376 mm (summary figure) for the root sweepers; the rack's tip flat for
+    generating: 2 d_1 = 2 (s_rack / 2 - h_f tan(alpha) - rho (1 - sin(alpha)) / cos(alpha)), the rack's
+    tooth s_rack = 1.05 pi m / 2 (the gear's tooth is 5 % thinner)."""
+    spec = spec_of("reference_z23_m4")
+    alpha, m, rho = math.radians(20.0), 4.0, 0.8
+    d1 = 1.05 * math.pi * m / 4 - 1.25 * m * math.tan(alpha) - rho * (1 - math.sin(alpha)) / math.cos(alpha)
+    assert 2 * d1 == pytest.approx(1.8373, abs=1e-4)
+    wide = Tool(diameter_mm=3.0, kind="bull_nose", corner_radius_mm=0.5)
+    with pytest.raises(ToolError, match=words) as caught:
+        get_strategy(strategy).check_tool(spec, wide)
+    assert caught.value.key == "tools.finishing.diameter_mm"
+    get_strategy(strategy).check_tool(spec, Tool(diameter_mm=2.0, kind="bull_nose", corner_radius_mm=0.5))
 
 
 def _previous(values: np.ndarray) -> np.ndarray:

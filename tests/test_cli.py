@@ -117,7 +117,18 @@ BAD_JOBS = {
                               "bad.toml:5: invalid [gear]: bore diameter 80 mm leaves less than one module"),
     "finishing tool too wide": (("[gear]\nteeth = 23\nmodule_mm = 4.0\nface_width_mm = 20\nrack_tip_radius_mm = 0.8\n"
                                  "[tools.finishing]\nkind = 'bull_nose'\ndiameter_mm = 3.0\ncorner_radius_mm = 0.5\n"),
-                                "finishing tool flat width 2.0000 mm (D - 2 r_t) exceeds finishing_max_flat_width_mm"),
+                                "bad.toml:8: finishing strategy generating: tool flat width d = 2 mm (D - 2 r_t) is "
+                                "wider than the rack's tip flat 2 d_1 = 1.5232 mm"),
+    "finishing tool too wide for perimeter": (
+        ("[gear]\nteeth = 23\nmodule_mm = 4.0\nface_width_mm = 20\nrack_tip_radius_mm = 0.8\n"
+         "[tools.finishing]\nkind = 'bull_nose'\ndiameter_mm = 3.0\ncorner_radius_mm = 0.5\n"
+         "[finishing]\nstrategy = 'perimeter'\n"),
+        "bad.toml:8: finishing tool flat width 2.0000 mm (D - 2 r_t) exceeds finishing_max_flat_width_mm"),
+    "finishing corner above the rack tip radius": (
+        ("[gear]\nteeth = 23\nmodule_mm = 4.0\nface_width_mm = 20\nrack_tip_radius_mm = 0.5\n"
+         "[tools.finishing]\nkind = 'bull_nose'\ndiameter_mm = 2.0\ncorner_radius_mm = 0.6\n"),
+        "bad.toml:9: finishing strategy generating: tool corner radius r_t = 0.6 mm is larger than the rack tip "
+        "radius rho = 0.5 mm"),
     "unknown strategy": ("[gear]\nteeth = 23\nmodule_mm = 4.0\nface_width_mm = 20\n[finishing]\nstrategy = 'spiral'\n",
                          "bad.toml:6: [finishing] strategy 'spiral' is unknown"),
     "unknown post dialect": ("[gear]\nteeth = 23\nmodule_mm = 4.0\nface_width_mm = 20\n"
