@@ -88,3 +88,36 @@ def test_index_only_tables_refuse_strategies_that_turn_a_while_cutting(small_job
     assert info.value.key == "finishing.strategy"
     assert strategy in str(info.value) and "rotary_simultaneous" in str(info.value)
     plan_cam(dataclasses.replace(job, tools=dataclasses.replace(job.tools, finishing=None)))  # roughing indexes only
+
+
+def test_an_index_only_table_finishes_by_generation_and_still_sees_the_comparisons(small_job):
+    machine = dataclasses.replace(small_job.machine, rotary_simultaneous=False)
+    plan = plan_cam(dataclasses.replace(small_job, machine=machine))
+    assert small_job.finishing.strategy == "generating"
+    path = plan.finishing.toolpath
+    feed = path.kind == 1
+    assert not path.inverse_time.any() and np.all(np.diff(path.a)[feed[1:]] == 0.0)
+    assert plan.finishing.perimeter_estimate.time_s > plan.finishing.estimate.time_s
+    assert plan.finishing.reference_estimate is not None
+
+
+def test_comparisons_too_large_to_build_are_left_out_not_refused(small_job):
+    """A 60 mm face: perimeter finishing would need some 2.5 million moves (over MAX_COMPARISON_MOVES), so
+    it is not built for comparison; the job's own finishing by generation is planned as usual."""
+    from spur_cad.cam.plan import MAX_COMPARISON_MOVES
+    from spur_cad.cam.strategies import get_strategy, params_from_section
+    from spur_cad.report.html import render_report
+    from spur_cad.summary import finishing_section
+
+    job = dataclasses.replace(small_job, gear=dataclasses.replace(small_job.gear, face_width_mm=60.0))
+    perimeter = get_strategy("perimeter")
+    section = dataclasses.replace(job.finishing, strategy="perimeter")
+    assert perimeter.estimate_moves(job.gear, job.tools.finishing,
+                                    params_from_section(perimeter, section)) > MAX_COMPARISON_MOVES
+    plan = plan_cam(job)
+    assert plan.finishing.perimeter_estimate is None and plan.finishing.reference_estimate is None
+    assert plan.finishing.estimate.moves == len(plan.finishing.toolpath)
+    facts = finishing_section(plan.finishing)
+    assert facts["perimeter_time_s"] is None and facts["reference_strategy_moves"] is None
+    html = render_report({"finishing": facts}, {}).decode()
+    assert html.count("not estimated (too large to build for comparison)") == 2
