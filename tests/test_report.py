@@ -62,3 +62,20 @@ def test_report_without_tools_simulation_or_post_still_renders(outputs):
     html = render_report(bare, {}).decode("utf-8")
     assert "Inspection sheet" in html and "Simulated cut" not in html and "<img" not in html
     assert f"{summary['inspection']['span_measurement_mm']:.4f}" in html
+
+
+def test_report_shows_the_generating_passes_advice_and_all_three_cycle_times(outputs):
+    html, summary = outputs
+    finishing, advice = summary["finishing"], summary["tools"]["generating_advice"]
+    assert finishing["strategy"] == "generating"
+    assert f"{finishing['passes_per_space']} straight passes per tooth space" in html
+    assert f"generating flat height {1000 * finishing['flat_height_mm']:.2f} um" in html
+    assert f"{finishing['land_passes_per_space']} on the tip land" in html
+    for prefix in ("estimated", "perimeter", "reference_strategy"):
+        for suffix in ("time_s", "time_with_acceleration_s"):
+            key = f"{prefix}_{suffix}" if prefix != "estimated" else f"estimated_{suffix}"
+            assert f"{finishing[key] / 3600:.2f} h" in html, key
+    assert "For finishing strategy generating" in html
+    for key in ("recommended_diameter_mm", "tip_mode_max_diameter_mm", "required_flute_length_mm"):
+        assert key in html and f"{advice[key]:.4f}" in html, key
+    assert len(re.findall(r'<img alt="finishing poses" src="data:image/png;base64,', html)) == 1
