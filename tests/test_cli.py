@@ -78,15 +78,20 @@ def test_reference_job_writes_profile_summary_and_plot(tmp_path):
     assert roughing["levels_per_space"] >= 2 and 0 < roughing["lowest_level_height_mm"] <= 0.5 * 1.0
     # Every level cuts at least once across the face width plus the tool at both ends, in every space.
     assert roughing["cutting_length_mm"] >= 23 * roughing["levels_per_space"] * (20.0 + 3.5)
-    # Every station cuts both flanks (at least the tip-to-root depth each) in every space.
-    assert finishing["cutting_length_mm"] >= finishing["stations"] * 23 * 2 * (50.0 - 41.0)
+    # Finishing by generation (the reference job's choice): every pass runs the face width plus the tool
+    # radius and the clearance at both ends, in every space.
+    assert finishing["strategy"] == "generating"
+    assert finishing["cutting_length_mm"] >= 23 * finishing["passes_per_space"] * (20.0 + 2 * (1.0 + 1.0))
+    assert finishing["passes_per_space"] == (2 * finishing["flank_passes_per_flank"]
+                                             + finishing["tip_mode_passes_per_space"]
+                                             + finishing["land_passes_per_space"])
+    assert 0.0 < finishing["flat_height_mm"] <= 0.005
     for section in (roughing, finishing):  # no faster than the cutting length at the machine's largest feed
         assert section["estimated_time_s"] >= section["cutting_length_mm"] / 5000.0 * 60.0
         assert section["estimated_time_with_acceleration_s"] >= section["estimated_time_s"] * 0.999
-    assert finishing["stations"] == math.ceil(20.0 / finishing["station_step_mm"] - 1e-9) + 1
-    assert finishing["points_per_flank"] > 10
-    assert finishing["reference_strategy_moves"] > finishing["moves"]
-    assert 0.5 < finishing["reference_strategy_time_s"] / finishing["estimated_time_s"] < 2.0
+    assert finishing["reference_strategy_moves"] > 50 * finishing["moves"]
+    assert finishing["perimeter_time_s"] > 4 * finishing["estimated_time_s"]
+    assert 0.9 < finishing["reference_strategy_time_s"] / finishing["perimeter_time_s"] < 1.1
     post = summary["post"]
     assert post["dialect"] == "linuxcnc"
     for name in ("roughing", "finishing"):

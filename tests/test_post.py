@@ -145,12 +145,13 @@ def test_rs274_g93_feed_gives_the_relative_path_time(name, cam_paths, tmp_path):
 
 @pytest.mark.linuxcnc
 @pytest.mark.slow
-def test_folded_reference_finishing_is_15x_smaller_and_runs_the_same(tmp_path):
-    from spur_cad.job import load_job
+@pytest.mark.parametrize("strategy, least_moves", [("perimeter", 700_000), ("generating", 7_000)])
+def test_folded_reference_finishing_is_15x_smaller_and_runs_the_same(tmp_path, strategy, least_moves):
+    from spur_cad.job import parse_job
     from spur_cad.pipeline import plan_cam
-    from tests.gears import REFERENCE_JOB
+    from tests.gears import reference_job_text
 
-    job = load_job(REFERENCE_JOB)
+    job = parse_job(reference_job_text(strategy))
     assert job.gear.face_width_mm == 20.0  # full face width, as the shop cut it
     path = plan_cam(job).finishing.toolpath
     flat = post_program(path, PostSettings(folded=False), INFO)
@@ -161,7 +162,7 @@ def test_folded_reference_finishing_is_15x_smaller_and_runs_the_same(tmp_path):
         ok, lines, messages = run_rs274(write(tmp_path, f"{label}.ngc", program.text), timeout_s=300)
         assert ok, messages
         canon[label] = [line for line in lines if line.startswith("STRAIGHT")]
-    assert len(canon["flat"]) > 700_000
+    assert len(canon["flat"]) > least_moves
     assert canon["folded"] == canon["flat"]
 
 

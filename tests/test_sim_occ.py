@@ -8,10 +8,11 @@ import numpy as np
 import pytest
 
 from spur_cad.cam.ir import Feature
-from spur_cad.job import load_job
+from spur_cad.job import parse_job
 from spur_cad.pipeline import job_stock, plan_cam
 from spur_cad.sim import SimSettings, finishing_stations, subset
 from spur_cad.sim.occ_check import cross_check
+from tests.gears import reference_job_text
 
 pytestmark = pytest.mark.slow  # make test-all
 
@@ -21,7 +22,8 @@ RES = 0.005
 
 @pytest.fixture(scope="module")
 def reference():
-    job = load_job(ROOT / "resources" / "examples" / "reference_gear.toml")
+    """The reference job with perimeter finishing (the window below is one of its stations)."""
+    job = parse_job(reference_job_text("perimeter"))
     return job, plan_cam(job)
 
 
