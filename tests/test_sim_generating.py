@@ -79,3 +79,31 @@ def test_a_root_pass_20um_too_low_is_a_20um_gouge_in_that_root(reference):
     assert worst["space"] == SPACE and worst["feature"] in ("root", "right fillet", "left fillet"), worst
     others = [k for k in range(job.gear.teeth) if k != SPACE]
     assert -dev[others].min() <= RES
+
+
+# (gear, tool diameter, corner radius): the other gears of the acceptance (tests/test_generating.py's CASES)
+OTHER_GEARS = [("undercut_z8", 1.45, 0.6), ("many_teeth_z120", 0.77, 0.25), ("shifted_z12_x04", 2.1, 0.5),
+               ("pa25_z31_negative_shift", 1.13, 0.5)]
+
+
+@pytest.mark.parametrize("name, diameter, corner", OTHER_GEARS)
+def test_finishing_by_generation_alone_cuts_other_gears_from_the_blank_within_target(name, diameter, corner):
+    """No roughing: the blank (tip radius + 0.5 mm) cut by the generating passes alone must come out as the
+    design, every feature within the target + resolution, no gouge beyond the resolution."""
+    from spur_cad.cam.finishing import plan_finishing
+    from spur_cad.cam.machine import FinishingParams, Machine
+    from spur_cad.cam.tools import Tool
+    from spur_cad.sim import StockCylinder
+    from tests.test_generating import _gear
+
+    spec = _gear(name)
+    tool = Tool(diameter_mm=diameter, kind="bull_nose", corner_radius_mm=corner, flutes=2)
+    blank = spec.tip_radius_mm + 0.5
+    path, _ = plan_finishing(spec, tool, Machine(), FinishingParams(strategy="generating"), blank)
+    result = simulate(spec, StockCylinder(blank, 0.0, spec.face_width_mm), [Cut(path, tool)],
+                      SimSettings(resolution_mm=RES))
+    facts = simulation_section(result, RES)
+    assert facts["uncut_points"] == 0
+    for feature, values in facts["per_feature"].items():
+        assert values["max_gouge_mm"] <= RES, (feature, values)
+        assert values["max_leftover_mm"] <= 0.005 + RES, (feature, values)
