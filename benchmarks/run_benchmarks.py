@@ -144,12 +144,18 @@ def main() -> None:
     parser.add_argument("--runs", type=int, default=21)
     parser.add_argument("--cad-runs", type=int, default=5)
     parser.add_argument("--sim-runs", type=int, default=5)
+    parser.add_argument("--run-runs", type=int, default=3, help="spur-cad run end to end, generating and perimeter")
     args = parser.parse_args()
+    from benchmarks.bench_generating import REFERENCE_JOB, end_to_end_seconds, figures
     from benchmarks.bench_sim import bench_sim
+    from spur_cad.job import load_job
 
     results = {"machine": machine(), "runs": args.runs, "profile": bench_profile(args.runs),
                "cad_runs": args.cad_runs, "cad": bench_cad(args.cad_runs), "cam": bench_cam(args.cad_runs),
-               "post": bench_post(args.cad_runs), "sim_runs": args.sim_runs, "sim": bench_sim(args.sim_runs)}
+               "post": bench_post(args.cad_runs), "sim_runs": args.sim_runs, "sim": bench_sim(args.sim_runs),
+               "generating": figures(load_job(REFERENCE_JOB)),
+               "run_s": {strategy: end_to_end_seconds(strategy, args.run_runs)
+                         for strategy in ("generating", "perimeter")}}
     print(json.dumps(results, indent=2))
 
 
