@@ -51,12 +51,19 @@ def base_thickness_mm(spec: GearSpec) -> float:
 
 
 def span_measurement(spec: GearSpec, teeth_spanned: int) -> SpanMeasurement:
-    """W_k = (k - 1) p_b + s_b; the anvils touch the flanks at radius sqrt(r_b^2 + (W_k/2)^2)."""
+    """W_k = (k - 1) p_b + s_b (transverse); the anvils touch the flanks at radius sqrt(r_b^2 + (W_k/2)^2).
+    Helical gears are measured in the normal section: W_kn = W_kt cos(beta_b)."""
     if not 1 <= teeth_spanned < spec.teeth:
         raise ValueError(f"teeth spanned must be between 1 and {spec.teeth - 1}, got {teeth_spanned}")
-    length = (teeth_spanned - 1) * spec.base_pitch_mm + base_thickness_mm(spec)
-    contact = math.hypot(spec.base_radius_mm, length / 2.0)
+    transverse = (teeth_spanned - 1) * spec.base_pitch_mm + base_thickness_mm(spec)
+    contact = math.hypot(spec.base_radius_mm, transverse / 2.0)
+    length = transverse * math.cos(spec.base_helix_angle_rad) if spec.is_helical else transverse
     return SpanMeasurement(teeth_spanned, length, contact)
+
+
+def span_min_face_width_mm(spec: GearSpec, span: SpanMeasurement) -> float:
+    """Face width a helical gear needs for the anvils to sit on both flanks: b > W_kn sin(beta_b) (0: spur)."""
+    return span.length_mm * math.sin(spec.base_helix_angle_rad)
 
 
 def recommended_span_teeth(spec: GearSpec) -> int:
@@ -90,7 +97,10 @@ def over_pins(spec: GearSpec, pin_diameter_mm: float) -> OverPinsMeasurement:
     if pin_diameter_mm <= 0.0:
         raise ValueError(f"pin diameter must be positive, got {pin_diameter_mm}")
     rb = spec.base_radius_mm
-    inv_alpha_m = (pin_diameter_mm / (2.0 * rb) + spec.tooth_thickness_mm / (2.0 * spec.reference_radius_mm)
+    # Helical gears (balls): the ball's transverse section is an ellipse; its effective size on the base
+    # circle is D / cos(beta_b) (ISO 21771: inv(a_Mt) = D / (m_n z cos(a_n)) + ...).
+    ball = pin_diameter_mm / math.cos(spec.base_helix_angle_rad) if spec.is_helical else pin_diameter_mm
+    inv_alpha_m = (ball / (2.0 * rb) + spec.tooth_thickness_mm / (2.0 * spec.reference_radius_mm)
                    + involute_function(spec.pressure_angle_rad) - math.pi / spec.teeth)
     alpha_m = inverse_involute_function(inv_alpha_m)
     centre_radius = rb / math.cos(alpha_m)
@@ -117,12 +127,24 @@ def recommended_pin_diameter_mm(spec: GearSpec) -> float:
         target = 0.5 * (spec.form_radius_mm + spec.tip_radius_mm)
     roll = math.sqrt((target / rb) ** 2 - 1.0)
     diameter = 2.0 * rb * (math.tan(spec.base_half_space_angle_rad + roll) - roll)
+    if spec.is_helical:
+        diameter *= math.cos(spec.base_helix_angle_rad)
     return max(PIN_DIAMETER_STEP_MM, round(diameter / PIN_DIAMETER_STEP_MM) * PIN_DIAMETER_STEP_MM)
 
 
 def chordal_thickness(spec: GearSpec, measuring_radius_mm: float | None = None) -> ChordalThickness:
-    """Chord across the tooth at a radius (default: reference circle) and its height below the tip."""
+    """Chord across the tooth at a radius (default: reference circle) and its height below the tip.
+
+    Helical gears, at the reference circle: the normal chordal thickness, measured on the virtual
+    spur gear of radius r_v = r / cos^2(beta) with the normal thickness s_n = s_t cos(beta):
+    chord 2 r_v sin(psi), height h_a + r_v (1 - cos(psi)), psi = s_n / (2 r_v)."""
     radius = spec.reference_radius_mm if measuring_radius_mm is None else measuring_radius_mm
+    if spec.is_helical and measuring_radius_mm is None:
+        cos_beta = math.cos(spec.helix_angle_rad)
+        virtual = radius / cos_beta**2
+        psi = spec.tooth_thickness_mm * cos_beta / (2.0 * virtual)
+        return ChordalThickness(radius, 2.0 * virtual * math.sin(psi),
+                                spec.tip_radius_mm - radius + virtual * (1.0 - math.cos(psi)))
     half_angle = spec.tooth_thickness_at_radius_mm(radius) / (2.0 * radius)
     return ChordalThickness(radius, 2.0 * radius * math.sin(half_angle),
                             spec.tip_radius_mm - radius * math.cos(half_angle))
@@ -135,24 +157,35 @@ def minimum_teeth_without_undercut(spec: GearSpec) -> float:
     point: (h_f* - x) m - rho (1 - sin(alpha)) <= r sin^2(alpha), with r = m z / 2.
     """
     alpha = spec.pressure_angle_rad
+    if spec.is_helical:  # the rack's round in the normal section, the flank at alpha_t, r = z m_n / (2 cos beta)
+        height = ((spec.dedendum_coefficient - spec.profile_shift_coefficient) * spec.module_mm
+                  - spec.rack_tip_radius_mm * (1.0 - math.sin(spec.normal_pressure_angle_rad)))
+        return 2.0 * height * math.cos(spec.helix_angle_rad) / (spec.module_mm * math.sin(alpha) ** 2)
     height = ((spec.dedendum_coefficient - spec.profile_shift_coefficient) * spec.module_mm
               - spec.rack_tip_radius_mm * (1.0 - math.sin(alpha)))
     return 2.0 * height / (spec.module_mm * math.sin(alpha) ** 2)
 
 
-def inspection_sheet(spec: GearSpec) -> dict[str, float | int]:
-    """The inspection values a report or summary shows."""
+def inspection_sheet(spec: GearSpec) -> dict[str, float | int | None]:
+    """The inspection values a report or summary shows. Helical gears: span and chordal thickness in the
+    normal section, over balls; the span's k is lowered until the anvils fit the face width (b > W sin(beta_b)),
+    and the span is None when not even k = 1 fits (measure over balls)."""
     require_instance(spec, GearSpec, "spec")
     k = recommended_span_teeth(spec)
     span = span_measurement(spec, k)
+    while k > 1 and span_min_face_width_mm(spec, span) >= spec.face_width_mm:  # helical: the anvils must fit
+        k -= 1
+        span = span_measurement(spec, k)
+    span_fits = span_min_face_width_mm(spec, span) < spec.face_width_mm
     pin = recommended_pin_diameter_mm(spec)
     pins = over_pins(spec, pin)
     chord = chordal_thickness(spec)
     z_min = minimum_teeth_without_undercut(spec)
     return {
         "span_teeth_k": k,
-        "span_measurement_mm": span.length_mm,
+        "span_measurement_mm": span.length_mm if span_fits else None,
         "span_contact_radius_mm": span.contact_radius_mm,
+        "span_min_face_width_mm": span_min_face_width_mm(spec, span),
         "pin_diameter_mm": pins.pin_diameter_mm,
         "dimension_over_pins_mm": pins.dimension_mm,
         "pin_contact_radius_mm": pins.contact_radius_mm,

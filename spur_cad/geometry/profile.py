@@ -190,7 +190,105 @@ class TrochoidalFillet:
         return speed_high * (b - a)
 
 
-Segment = CircularArc | Involute | TrochoidalFillet
+@dataclass(frozen=True)
+class EllipticFillet:
+    """Root fillet of a helical gear's transverse section: envelope of the rack tip round's transverse
+    section, an ellipse with semi-axes rho / cos(beta_h) along the rolling line and rho radially
+    (`stretch` s = 1 / cos(beta_h)); parameter beta as for TrochoidalFillet, the angle on the round in
+    the rack's normal section. The rack point at beta is (s (d_n + rho sin b), r - B - rho cos b) with
+    inward normal along (-sin b, s cos b); its normal meets the rolling line at
+    x_0 = s d_n + (s - 1/s) rho sin b - (B / s) tan b, so it generates the fillet at phi = x_0 / r:
+    P = R(-phi) (u, y), u = (B / s) tan b + (rho / s) sin b, y = r - B - rho cos b (s = 1: the
+    trochoidal fillet). Derivatives are analytic; the chord-error bound samples curvature and speed
+    at 9 points per interval with a 25 % margin (not an interval-arithmetic bound).
+    """
+
+    label: str
+    reference_radius_mm: float
+    corner_offset_mm: float  # d_n: the round's centre from the rack tooth axis, normal section
+    corner_depth_mm: float  # B
+    corner_radius_mm: float  # rho
+    stretch: float  # s = 1 / cos(beta_h)
+    start: float
+    end: float
+
+    def roll_angle(self, beta: np.ndarray) -> np.ndarray:
+        beta = np.asarray(beta, dtype=float)
+        s, d, B, rho = self.stretch, self.corner_offset_mm, self.corner_depth_mm, self.corner_radius_mm
+        return (s * d + (s - 1.0 / s) * rho * np.sin(beta) - (B / s) * np.tan(beta)) / self.reference_radius_mm
+
+    def _terms(self, beta: np.ndarray):
+        """u, y, phi and their first and second derivatives in beta."""
+        beta = np.asarray(beta, dtype=float)
+        s, B, rho, r = self.stretch, self.corner_depth_mm, self.corner_radius_mm, self.reference_radius_mm
+        sin, cos, tan = np.sin(beta), np.cos(beta), np.tan(beta)
+        sec2 = 1.0 / cos**2
+        u = (B / s) * tan + (rho / s) * sin
+        du = (B / s) * sec2 + (rho / s) * cos
+        ddu = (2.0 * B / s) * sec2 * tan - (rho / s) * sin
+        y = r - B - rho * cos
+        dy, ddy = rho * sin, rho * cos
+        phi = self.roll_angle(beta)
+        dphi = ((s - 1.0 / s) * rho * cos - (B / s) * sec2) / r
+        ddphi = (-(s - 1.0 / s) * rho * sin - (2.0 * B / s) * sec2 * tan) / r
+        return u, du, ddu, y, dy, ddy, phi, dphi, ddphi
+
+    def points(self, beta: np.ndarray) -> np.ndarray:
+        u, _, _, y, _, _, phi, _, _ = self._terms(beta)
+        return _rotate_clockwise(phi, u, y)
+
+    def normals(self, beta: np.ndarray) -> np.ndarray:
+        """Into the space: the ellipse's inward normal (-sin b, s cos b), normalised, turned with the gear."""
+        beta = np.asarray(beta, dtype=float)
+        nx, ny = -np.sin(beta), self.stretch * np.cos(beta)
+        length = np.hypot(nx, ny)
+        return _rotate_clockwise(self.roll_angle(beta), nx / length, ny / length)
+
+    def _velocity(self, beta: np.ndarray):
+        """dP/dbeta in the turned frame, w = (u' + phi' y, y' - phi' u), and its derivative."""
+        u, du, ddu, y, dy, ddy, _, dphi, ddphi = self._terms(beta)
+        wx, wy = du + dphi * y, dy - dphi * u
+        dwx = ddu + ddphi * y + dphi * dy
+        dwy = ddy - ddphi * u - dphi * du
+        return wx, wy, dwx, dwy, dphi
+
+    def speeds(self, beta: np.ndarray) -> np.ndarray:
+        wx, wy, *_ = self._velocity(beta)
+        return np.hypot(wx, wy)
+
+    def turning_rates(self, beta: np.ndarray) -> np.ndarray:
+        """d(tangent angle)/dbeta: the turned velocity's angle rate minus phi'."""
+        wx, wy, dwx, dwy, dphi = self._velocity(beta)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            return (wx * dwy - wy * dwx) / (wx * wx + wy * wy) - dphi
+
+    def curvature_radii(self, beta: np.ndarray) -> np.ndarray:
+        with np.errstate(divide="ignore"):
+            return self.speeds(beta) / self.turning_rates(beta)
+
+    def _sampled(self, a: np.ndarray, b: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        a, b = np.atleast_1d(np.asarray(a, float)), np.atleast_1d(np.asarray(b, float))
+        grid = a[:, None] + (b - a)[:, None] * np.linspace(0.0, 1.0, 9)[None, :]
+        speed = self.speeds(grid)
+        turning = np.abs(self.turning_rates(grid))
+        return speed, turning, b - a
+
+    def chord_error_bound(self, a: np.ndarray, b: np.ndarray) -> np.ndarray:
+        speed, turning, width = self._sampled(a, b)
+        speed_low, speed_high = 0.8 * speed.min(axis=1), 1.25 * speed.max(axis=1)
+        length = speed_high * width
+        with np.errstate(divide="ignore", invalid="ignore"):
+            curvature = np.where(speed_low > 0.0, 1.25 * turning.max(axis=1) / speed_low, np.inf)
+            bound = curvature * length * length / 8.0
+        return np.where(length == 0.0, 0.0, bound)
+
+    def arc_length_bound(self, a: np.ndarray, b: np.ndarray) -> np.ndarray:
+        speed, _, width = self._sampled(a, b)
+        return 1.25 * speed.max(axis=1) * width
+
+
+Fillet = TrochoidalFillet | EllipticFillet
+Segment = CircularArc | Involute | TrochoidalFillet | EllipticFillet
 
 
 @dataclass(frozen=True)
@@ -220,22 +318,34 @@ class ToothSpaceProfile:
 
 @dataclass(frozen=True)
 class RackCorner:
-    """The generating rack's right tip corner relative to the rolling line (docs/method.md)."""
+    """The generating rack's right tip corner relative to the rolling line (docs/method.md), transverse
+    section; for a helical gear the round is an ellipse (`stretch` = 1 / cos(beta) along the rolling line)."""
 
-    half_thickness_on_rolling_line_mm: float  # e / 2
-    corner_offset_mm: float  # d_1
+    half_thickness_on_rolling_line_mm: float  # e / 2 (transverse)
+    corner_offset_mm: float  # d_1 (transverse: the round's centre from the rack tooth axis)
     corner_depth_mm: float  # B
     corner_radius_mm: float  # rho
+    stretch: float = 1.0  # 1 / cos(beta): 1 for a spur gear
+
+    @property
+    def normal_corner_offset_mm(self) -> float:
+        """d_n = d_1 / s: the round's centre from the tooth axis in the rack's normal section."""
+        return self.corner_offset_mm / self.stretch
 
 
 def rack_corner(spec: GearSpec) -> RackCorner:
-    """d_1 and B of the generating rack: B = r - r_f - rho, d_1 = e/2 - B tan(a) - rho / cos(a)."""
+    """d_1 and B of the generating rack: B = r - r_f - rho, d_1 = e/2 - B tan(a) - rho / cos(a); helical:
+    transverse e and alpha_t, and the elliptic round's offset s rho / cos(alpha_n) from the flank line."""
     alpha = spec.pressure_angle_rad
     rho = spec.rack_tip_radius_mm
     half_e = spec.space_width_mm / 2.0
     depth = spec.reference_radius_mm - spec.root_radius_mm - rho
-    offset = half_e - depth * math.tan(alpha) - rho / math.cos(alpha)
-    return RackCorner(half_e, offset, depth, rho)
+    if not spec.is_helical:
+        offset = half_e - depth * math.tan(alpha) - rho / math.cos(alpha)
+        return RackCorner(half_e, offset, depth, rho)
+    stretch = 1.0 / math.cos(spec.helix_angle_rad)
+    offset = half_e - depth * math.tan(alpha) - stretch * rho / math.cos(spec.normal_pressure_angle_rad)
+    return RackCorner(half_e, offset, depth, rho, stretch)
 
 
 def build_tooth_space_profile(spec: GearSpec) -> ToothSpaceProfile:
@@ -251,7 +361,7 @@ def build_tooth_space_profile(spec: GearSpec) -> ToothSpaceProfile:
                             field="thickness_allowance_mm")
     if d1 < -1e-12:
         max_rho = (corner.half_thickness_on_rolling_line_mm - (r - rf) * math.tan(alpha)) / (
-            1.0 / math.cos(alpha) - math.tan(alpha))
+            corner.stretch / math.cos(spec.normal_pressure_angle_rad) - math.tan(alpha))
         raise GearSpecError(
             f"rack tip radius {rho:g} mm is too large for the rack tooth: the two tip corners overlap "
             f"(d_1 = {d1:.4f} mm < 0); at most {max(max_rho, 0.0):.4f} mm fits this module, pressure angle, "
@@ -259,13 +369,11 @@ def build_tooth_space_profile(spec: GearSpec) -> ToothSpaceProfile:
     d1 = max(d1, 0.0)
     theta_b = spec.base_half_space_angle_rad
     root_half_angle = d1 / r
-    beta_max = math.pi / 2.0 - alpha
+    beta_max = math.pi / 2.0 - spec.normal_pressure_angle_rad
 
-    # Where the rack flank's lowest straight point T (the corner's tangent point) generates:
-    # its distance from the pitch point along the line of action is B / sin(a) + rho.
-    t_dist = B / math.sin(alpha) + rho
+    t_dist = _flank_point_t_distance(spec, corner)
     undercut = t_dist > r * math.sin(alpha) + 1e-12
-    fillet: TrochoidalFillet | None = TrochoidalFillet("fillet", r, d1, B, rho, 0.0, beta_max)
+    fillet: Fillet | None = _rack_fillet(spec, corner, d1, beta_max)
     if rho == 0.0 and abs(B) < 1e-12:
         fillet = None  # a sharp rack corner on the rolling line generates no fillet
     else:
@@ -306,7 +414,7 @@ def build_tooth_space_profile(spec: GearSpec) -> ToothSpaceProfile:
         segments.append(CircularArc("root", rf, 0.0, root_half_angle))
     min_fillet_radius = math.inf
     if fillet is not None and beta_junction > 0.0:
-        fillet = TrochoidalFillet("fillet", r, d1, B, rho, 0.0, beta_junction)
+        fillet = _rack_fillet(spec, corner, d1, beta_junction)
         _check_fillet_inside_tooth(fillet, half_tooth_angle)
         min_fillet_radius = float(np.min(np.abs(fillet.curvature_radii(np.linspace(0.0, beta_junction, 4097)))))
         segments.append(fillet)
@@ -320,7 +428,25 @@ def build_tooth_space_profile(spec: GearSpec) -> ToothSpaceProfile:
     )
 
 
-def _fillet_minus_involute_angle(fillet: TrochoidalFillet, rb: float, theta_b: float, beta: float) -> float:
+def _flank_point_t_distance(spec: GearSpec, corner: RackCorner) -> float:
+    """Where the rack flank's lowest straight point T (the round's tangent point) generates: its distance from
+    the pitch point along the line of action, B / sin(a) + rho (helical: T lies B + rho sin(alpha_n) below the
+    rolling line and the transverse flank is at alpha_t)."""
+    B, rho, alpha = corner.corner_depth_mm, corner.corner_radius_mm, spec.pressure_angle_rad
+    if spec.is_helical:
+        return (B + rho * math.sin(spec.normal_pressure_angle_rad)) / math.sin(alpha)
+    return B / math.sin(alpha) + rho
+
+
+def _rack_fillet(spec: GearSpec, corner: RackCorner, d1: float, end: float) -> Fillet:
+    """The fillet generated by the rack's round up to parameter `end` (elliptic section for a helical gear)."""
+    r, B, rho = spec.reference_radius_mm, corner.corner_depth_mm, corner.corner_radius_mm
+    if spec.is_helical:
+        return EllipticFillet("fillet", r, d1 / corner.stretch, B, rho, corner.stretch, 0.0, end)
+    return TrochoidalFillet("fillet", r, d1, B, rho, 0.0, end)
+
+
+def _fillet_minus_involute_angle(fillet: Fillet, rb: float, theta_b: float, beta: float) -> float:
     """Polar angle of the fillet point minus that of the involute at the same radius (+inf inside r_b)."""
     x, y = fillet.points(np.array([beta]))[0]
     radius = math.hypot(x, y)
@@ -329,7 +455,7 @@ def _fillet_minus_involute_angle(fillet: TrochoidalFillet, rb: float, theta_b: f
     return math.atan2(x, y) - theta_b - involute_function(math.acos(rb / radius))
 
 
-def _undercut_junction(fillet: TrochoidalFillet, rb: float, theta_b: float,
+def _undercut_junction(fillet: Fillet, rb: float, theta_b: float,
                        beta_max: float) -> tuple[float, float, float]:
     """Transverse fillet/involute intersection of an undercut gear, by bracketing and Brent's method.
 
@@ -371,7 +497,7 @@ def _undercut_junction(fillet: TrochoidalFillet, rb: float, theta_b: float,
     return beta_j, t_j, depth
 
 
-def _check_fillet_inside_tooth(fillet: TrochoidalFillet, half_tooth_angle: float) -> None:
+def _check_fillet_inside_tooth(fillet: Fillet, half_tooth_angle: float) -> None:
     """The fillet must stay between the space axis and the tooth's centre line."""
     pts = fillet.points(np.linspace(fillet.start, fillet.end, 2049))
     theta = np.arctan2(pts[:, 0], pts[:, 1])
