@@ -29,8 +29,8 @@ class GearSpecError(SpurCadError, ValueError):
     `field` names the offending input (a GearSpec field name) when one input is to blame.
     """
 
-    def __init__(self, message: str, field: str | None = None):
-        super().__init__(message, field=field)
+    def __init__(self, message: str, field: str | None = None, section: str | None = None):
+        super().__init__(message, field=field, section=section)
 
 
 class StockError(SpurCadError, ValueError):

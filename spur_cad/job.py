@@ -62,6 +62,12 @@ class GearSection:
     thickness_allowance_mm: float = key(0.0, unit="mm", low=0.0, high=50.0, label="ThicknessAllowance",
                                         group="Allowance",
                                         meaning="further absolute tooth thickness reduction (at most 0.5 x module)")
+    helix_angle_deg: float = key(0.0, unit="deg", low=0.0, high=45.0, label="HelixAngle", group="Gear",
+                                 meaning="helix angle beta on the reference cylinder, 0: spur gear (module, pressure "
+                                         "angle, shift, coefficients and rack tip radius are then normal-section "
+                                         "values)")
+    hand: str = key("right", label="Hand", group="Gear", choices=("right", "left"),
+                    meaning="hand of the helix (helical gears)")
     bore_diameter_mm: float = key(0.0, unit="mm", low=0.0, high=2000.0, label="BoreDiameter", group="Bore",
                                   meaning="through bore diameter, 0: none")
     keyway_width_mm: float = key(0.0, unit="mm", low=0.0, high=500.0, label="KeywayWidth", group="Bore",
@@ -77,6 +83,7 @@ class GearSection:
             rack_tip_radius_mm=self.rack_tip_radius_mm,
             thickness_allowance_fraction=self.thickness_allowance_percent / 100.0,
             thickness_allowance_mm=self.thickness_allowance_mm, face_width_mm=self.face_width_mm,
+            helix_angle_deg=self.helix_angle_deg, hand=self.hand,
         )
 
     def blank_features(self) -> BlankFeatures:

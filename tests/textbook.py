@@ -150,3 +150,94 @@ def point_polyline_distance(points: np.ndarray, polyline: np.ndarray) -> np.ndar
         proj = a[None] + t[..., None] * ab[None]
         best[start:start + 2000] = np.sqrt(((p - proj) ** 2).sum(-1)).min(axis=1)
     return best
+
+
+@dataclass(frozen=True)
+class HelicalTextbook:
+    """A helical gear's textbook quantities from its normal-section (rack) values (ISO 21771), written
+    here from scratch; the transverse rack is the normal rack stretched along the rolling line by
+    1 / cos(beta) (so its tip rounds are ellipses)."""
+
+    z: int
+    mn: float
+    alpha_n_deg: float
+    beta_deg: float
+    x: float = 0.0
+    ha: float = 1.0
+    hf: float = 1.25
+    rho: float = 0.0
+    allowance_fraction: float = 0.0
+
+    @property
+    def beta(self) -> float:
+        return math.radians(self.beta_deg)
+
+    @property
+    def alpha_n(self) -> float:
+        return math.radians(self.alpha_n_deg)
+
+    @property
+    def mt(self) -> float:
+        return self.mn / math.cos(self.beta)
+
+    @property
+    def alpha_t(self) -> float:
+        return math.atan(math.tan(self.alpha_n) / math.cos(self.beta))
+
+    @property
+    def r(self) -> float:
+        return self.z * self.mt / 2
+
+    @property
+    def rb(self) -> float:
+        return self.r * math.cos(self.alpha_t)
+
+    @property
+    def ra(self) -> float:
+        return self.r + (self.ha + self.x) * self.mn
+
+    @property
+    def rf(self) -> float:
+        return self.r - (self.hf - self.x) * self.mn
+
+    @property
+    def beta_b(self) -> float:
+        return math.atan(math.tan(self.beta) * math.cos(self.alpha_t))
+
+    @property
+    def lead(self) -> float:
+        return math.pi * self.z * self.mn / math.sin(self.beta)
+
+    @property
+    def st(self) -> float:  # transverse tooth thickness on the reference circle, allowance applied
+        return (1 - self.allowance_fraction) * self.mt * (math.pi / 2 + 2 * self.x * math.tan(self.alpha_n))
+
+    @property
+    def delta_st(self) -> float:
+        return self.allowance_fraction * self.mt * (math.pi / 2 + 2 * self.x * math.tan(self.alpha_n))
+
+    def transverse_rack_outline(self, height: float, corner_points: int = 64) -> np.ndarray:
+        """One tooth of the transverse rack (rolling-line coordinates, tip down): the normal rack tooth with
+        circular tip corners, every x stretched by 1 / cos(beta)."""
+        an, s = self.alpha_n, 1.0 / math.cos(self.beta)
+        e_n = math.pi * self.mn - self.st * math.cos(self.beta)  # normal space width of the gear
+        depth = self.r - self.rf - self.rho  # B, the same in both sections
+        d_n = e_n / 2 - depth * math.tan(an) - self.rho / math.cos(an)
+        yc = self.r - depth
+        pts = []
+        for ang in np.linspace(-math.pi / 2, -an, corner_points):
+            pts.append((d_n + self.rho * math.cos(ang), yc + self.rho * math.sin(ang)))
+        top = self.r + height
+        pts.append((e_n / 2 + height * math.tan(an), top))
+        pts.append((-(e_n / 2 + height * math.tan(an)), top))
+        for ang in np.linspace(math.pi + an, 1.5 * math.pi, corner_points):
+            pts.append((-d_n + self.rho * math.cos(ang), yc + self.rho * math.sin(ang)))
+        out = np.array(pts)
+        out[:, 0] *= s
+        return out
+
+    def to_gear(self, phi: float, q: np.ndarray) -> np.ndarray:
+        """Transverse rack point q (rolling-line coordinates at phi = 0) in the gear frame after rolling by phi."""
+        q = np.atleast_2d(q) - np.array([self.r * phi, 0.0])
+        c, s = math.cos(phi), math.sin(phi)
+        return np.stack([q[:, 0] * c + q[:, 1] * s, -q[:, 0] * s + q[:, 1] * c], axis=-1)

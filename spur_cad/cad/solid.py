@@ -4,6 +4,10 @@ Machine frame: gear axis = X, front face at X = 0, the gear occupies 0 <= X <= b
 transverse plane is (Y, Z) with the gap frame's x -> Y and y -> Z, so tooth space 0 is
 symmetric about +Z and space k is turned by k * 360/z degrees about +X (positive A).
 
+A helical gear is the transverse outline swept along X while turning with the helix (OCP pipe
+shell with an auxiliary helix of the gear's lead and hand), so its section at X is the outline
+turned by X tan(beta) / r.
+
 Transverse profile of one space: root arc and tip arcs are exact circles; fillet and involute
 are B-splines interpolated by OCP (GeomAPI_Interpolate) through exact points with their exact
 tangents, refined until the largest distance from the exact curve (checked by OCP's point
@@ -27,6 +31,7 @@ from OCP.BRepBuilderAPI import (
 )
 from OCP.BRepCheck import BRepCheck_Analyzer
 from OCP.BRepGProp import BRepGProp
+from OCP.BRepOffsetAPI import BRepOffsetAPI_MakePipeShell
 from OCP.BRepPrimAPI import BRepPrimAPI_MakeBox, BRepPrimAPI_MakeCylinder, BRepPrimAPI_MakePrism
 from OCP.GC import GC_MakeArcOfCircle
 from OCP.Geom import Geom_BSplineCurve, Geom_Curve
@@ -201,6 +206,28 @@ def _extrude(edges: list[TopoDS_Edge], length: float) -> TopoDS_Shape:
     return BRepPrimAPI_MakePrism(face.Face(), gp_Vec(length, 0.0, 0.0)).Shape()
 
 
+def _sweep_helical(edges: list[TopoDS_Edge], spec: GearSpec) -> TopoDS_Shape:
+    """The transverse outline swept along X over the face width while turning with the helix: OCP's pipe
+    shell along a straight spine, the twist taken from an auxiliary helix of the gear's lead and hand
+    (each section at X is the outline turned by spec.section_turn_rad(X))."""
+    wire_maker = BRepBuilderAPI_MakeWire()
+    for edge in edges:
+        wire_maker.Add(edge)
+    if not wire_maker.IsDone():
+        raise RuntimeError("the transverse outline did not close into a wire")
+    b = spec.face_width_mm
+    spine = cq.Wire.assembleEdges([cq.Edge.makeLine(cq.Vector(0.0, 0.0, 0.0), cq.Vector(b, 0.0, 0.0))]).wrapped
+    helix = cq.Wire.makeHelix(spec.lead_mm, b, spec.reference_radius_mm, center=cq.Vector(0.0, 0.0, 0.0),
+                              dir=cq.Vector(1.0, 0.0, 0.0), lefthand=spec.hand == "left").wrapped
+    pipe = BRepOffsetAPI_MakePipeShell(spine)
+    pipe.SetMode(helix, False)
+    pipe.Add(wire_maker.Wire())
+    pipe.Build()
+    if not pipe.IsDone() or not pipe.MakeSolid():
+        raise RuntimeError("the helical sweep of the transverse outline failed")
+    return pipe.Shape()
+
+
 def _cut(shape: TopoDS_Shape, tool: TopoDS_Shape) -> TopoDS_Shape:
     cut = BRepAlgoAPI_Cut(shape, tool)
     cut.Build()
@@ -224,7 +251,7 @@ def build_gear_shape(spec: GearSpec, features: BlankFeatures = BlankFeatures(),
     tolerance = default_fit_tolerance_mm(spec) if fit_tolerance_mm is None else fit_tolerance_mm
     edges, report = gear_face_edges(spec, tolerance)
     b = spec.face_width_mm
-    shape = _extrude(edges, b)
+    shape = _sweep_helical(edges, spec) if spec.is_helical else _extrude(edges, b)
     if features.bore_diameter_mm > 0.0:
         shape = _cut(shape, _x_cylinder(features.bore_diameter_mm / 2.0, -1.0, b + 1.0))
     if features.keyway_width_mm > 0.0:

@@ -18,7 +18,7 @@ from spur_cad.cam.recommend import ToolRecommendations, check_roughing_reach, ch
 from spur_cad.cam.roughing import RoughingLevels, estimated_roughing_moves, roughing_levels, roughing_toolpath
 from spur_cad.cam.strategies import FinishingResult, get_strategy, params_from_section
 from spur_cad.cam.tools import Tool, ToolError
-from spur_cad.errors import WorkLimitError
+from spur_cad.errors import GearSpecError, WorkLimitError
 from spur_cad.geometry.spec import GearSpec
 
 MAX_TOOLPATH_MOVES = 10_000_000
@@ -94,6 +94,11 @@ def check_cam_inputs(inputs: CamInputs) -> tuple[ToolRecommendations, RoughingLe
     roughing work bound and the roughing reach. Returns the
     recommendations and the roughing levels (None without a roughing tool)."""
     spec, machine, stock = inputs.spec, inputs.machine, inputs.stock
+    if spec.is_helical and (inputs.roughing_tool is not None or inputs.finishing_tool is not None):
+        raise GearSpecError(f"helix_angle_deg = {spec.helix_angle_deg:g}: toolpaths for helical gears are not "
+                            "implemented yet (geometry, inspection, B-rep and STEP are); remove [tools.roughing] "
+                            "and [tools.finishing] for those, or set helix_angle_deg = 0",
+                            field="helix_angle_deg", section="gear")
     blank = stock.blank_radius_mm(spec)
     rec = recommend_tools(spec, blank, machine.clearance_mm, inputs.finishing_tool)
     check_tools(spec, rec, inputs.roughing_tool, inputs.finishing_tool)
