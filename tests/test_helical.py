@@ -271,16 +271,25 @@ def test_job_file_takes_helix_and_hand_and_refuses_bad_values():
 @pytest.mark.slow
 def test_spur_cad_run_writes_the_helical_geometry_and_refuses_toolpaths_naming_the_key(tmp_path):
     import json
+    from pathlib import Path
 
     from tests.test_cli import run_cli
 
-    job = tmp_path / "helical.toml"
-    job.write_text(HELICAL_JOB)
-    result = run_cli("run", str(job), "--out", str(tmp_path / "out"))
+    example = Path(__file__).resolve().parents[1] / "resources" / "examples" / "helical_gear.toml"
+    result = run_cli("run", str(example), "--out", str(tmp_path / "out"))
     assert result.returncode == 0, result.stderr
     summary = json.loads((tmp_path / "out" / "summary.json").read_text())
-    assert summary["gear"]["helix_angle_deg"] == 15.0 and summary["gear"]["hand"] == "left"
-    assert summary["cad"]["gear_volume_mm3"] > 0 and "finishing" not in summary
+    assert summary["gear"]["helix_angle_deg"] == 15.0 and summary["gear"]["hand"] == "right"
+    g = book_of("reference_15_right")
+    assert summary["gear"]["lead_mm"] == pytest.approx(g.lead) and "finishing" not in summary
+    assert summary["inspection"]["span_measurement_mm"] == pytest.approx(
+        span_measurement(spec_of("reference_15_right"), summary["inspection"]["span_teeth_k"]).length_mm)
+    area = Polygon(gear_outline(spec_of("reference_15_right"), 1e-6)).area
+    assert summary["cad"]["gear_volume_mm3"] == pytest.approx(area * 20.0, rel=1e-6)
+    assert (tmp_path / "out" / "gear.step").stat().st_size > 100_000
+    report = (tmp_path / "out" / "report.html").read_text()
+    assert "normal section; needs face width" in report and "lead_mm" in report
+    job = tmp_path / "helical.toml"
     with_tools = HELICAL_JOB + "[tools.finishing]\nkind = 'bull_nose'\ndiameter_mm = 2.0\ncorner_radius_mm = 0.5\n"
     job.write_text(with_tools)
     result = run_cli("run", str(job), "--out", str(tmp_path / "out2"))

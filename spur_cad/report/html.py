@@ -65,7 +65,14 @@ def _gear(summary: dict) -> str:
             "dedendum_coefficient", "rack_tip_radius_mm", "face_width_mm", "reference_radius_mm", "base_radius_mm",
             "tip_radius_mm", "root_radius_mm", "form_radius_mm", "tooth_thickness_mm", "space_width_mm",
             "tip_thickness_mm", "root_arc_length_mm", "undercut")
-    return "<h2>Gear</h2>" + _table((k, gear[k]) for k in keys if k in gear)
+    if gear.get("helix_angle_deg"):
+        keys += ("helix_angle_deg", "hand", "transverse_module_mm", "transverse_pressure_angle_deg",
+                 "base_helix_angle_deg", "lead_mm", "overlap_ratio")
+    text = "<h2>Gear</h2>" + _table((k, gear[k]) for k in keys if k in gear)
+    if gear.get("helix_angle_deg"):
+        text += ("<p>Helical gear: module, pressure angle, shift, coefficients and rack tip radius are normal-section "
+                 "values; radii, thicknesses and the profile are transverse.</p>")
+    return text
 
 
 def _inspection(summary: dict) -> str:
@@ -74,13 +81,19 @@ def _inspection(summary: dict) -> str:
         return ""
     sim = summary.get("simulation", {})
     nominal = ins["tooth_thickness_mm"] + ins["thickness_reduction_mm"]
+    helical = bool(summary.get("gear", {}).get("helix_angle_deg"))
+    span_label = f"span measurement W_k over k = {ins['span_teeth_k']} teeth [mm]"
+    if helical:
+        span_label += (f" (normal section; needs face width > {ins['span_min_face_width_mm']:.2f} mm"
+                       + ("" if ins["span_measurement_mm"] is not None else ": too narrow, measure over balls") + ")")
     rows = [
-        (f"span measurement W_k over k = {ins['span_teeth_k']} teeth [mm]", ins["span_measurement_mm"]),
+        (span_label, ins["span_measurement_mm"]),
         ("  anvils touch the flanks at radius [mm]", ins["span_contact_radius_mm"]),
         ("pin (ball) diameter [mm]", ins["pin_diameter_mm"]),
         ("dimension over pins [mm]", ins["dimension_over_pins_mm"]),
         ("  pins touch the flanks at radius [mm]", ins["pin_contact_radius_mm"]),
-        ("chordal tooth thickness [mm]", ins["chordal_thickness_mm"]),
+        ("normal chordal tooth thickness [mm]" if helical else "chordal tooth thickness [mm]",
+         ins["chordal_thickness_mm"]),
         (f"  at chordal height [mm] (measuring radius {ins['chordal_measuring_radius_mm']:g} mm)",
          ins["chordal_height_mm"]),
         ("tooth thickness on the reference circle s [mm]", ins["tooth_thickness_mm"]),
@@ -90,7 +103,7 @@ def _inspection(summary: dict) -> str:
     ]
     text = "<h2>Inspection sheet</h2>" + _table(rows)
     flanks = [sim.get("per_feature", {}).get(f"{side} involute") for side in ("right", "left")]
-    if sim.get("enabled") and all(flanks):
+    if sim.get("enabled") and all(flanks) and ins["span_measurement_mm"] is not None:
         low = -max(f["max_gouge_mm"] for f in flanks)
         high = max(f["max_leftover_mm"] for f in flanks)
         text += ("<p>Tolerance expected from the simulated cut (involute flanks, normal deviation "
