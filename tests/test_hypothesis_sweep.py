@@ -13,7 +13,7 @@ from hypothesis import HealthCheck, given, settings
 from shapely.geometry import Polygon
 
 from spur_cad.geometry import gear_outline
-from tests.gears import gear_parameters, spec_or_category
+from tests.gears import gear_parameters, helical_parameters, spec_or_category
 
 pytestmark = pytest.mark.slow  # make test-all
 
@@ -43,6 +43,14 @@ def test_every_spec_is_valid_or_rejected_with_a_message(params):
     assert category in ("valid", "rejected"), f"{category}: {detail} for {params}"
 
 
+@settings(max_examples=200, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(helical_parameters)
+def test_every_helical_spec_is_valid_or_rejected_with_a_message(params):
+    """The same property with a helix angle of 0 to 45 deg and either hand (transverse outline)."""
+    category, detail = classify(params)
+    assert category in ("valid", "rejected"), f"{category}: {detail} for {params}"
+
+
 def test_sweep_exercises_both_outcomes():
     """The sweep space contains accepted, undercut and rejected gears (so the property test is not vacuous)."""
     base = dict(teeth=20, module_mm=2.0, pressure_angle_deg=20.0, profile_shift_coefficient=0.0,
@@ -51,3 +59,6 @@ def test_sweep_exercises_both_outcomes():
     assert classify({**base, "teeth": 6})[0] == "valid"
     assert classify({**base, "rack_tip_fraction": 0.45, "pressure_angle_deg": 30.0})[0] == "rejected"
     assert classify({**base, "teeth": 6, "profile_shift_coefficient": 1.0})[0] == "rejected"
+    assert classify({**base, "helix_angle_deg": 30.0, "hand": "left"})[0] == "valid"
+    assert classify({**base, "helix_angle_deg": 30.0, "rack_tip_fraction": 0.45, "pressure_angle_deg": 30.0})[0] == \
+        "rejected"
