@@ -221,3 +221,15 @@ def read_program(text: str, dialect: str) -> ReadProgram:
 
     result.ended = execute(0, end_index + 1, 0)
     return result
+
+
+def inlined_lines(text: str) -> list[str]:
+    """A LinuxCNC program's lines with its one subprogram's text put in at each call, in call order (a flat
+    program's lines as they are): for checks on the order of M codes and moves by text."""
+    sub = re.search(r"^o(\d+) sub\n(.*?)^o\1 endsub\n", text, flags=re.M | re.S)
+    if sub is None:
+        return text.splitlines()
+    lines: list[str] = []
+    for line in text[sub.end():].splitlines():
+        lines += sub.group(2).splitlines() if line.startswith(f"o{sub.group(1)} call") else [line]
+    return lines

@@ -66,25 +66,17 @@ def tools_for(name: str) -> tuple[Tool, Tool]:
 
 # --- swept gear parameters (shared by the geometry and CAD sweeps) -------------------------------------
 
-gear_parameters = st.fixed_dictionaries({
+_SPUR_PARAMETERS = {
     "teeth": st.integers(6, 200),
     "module_mm": st.floats(0.3, 20.0),
     "pressure_angle_deg": st.floats(14.5, 30.0),
     "profile_shift_coefficient": st.floats(-0.5, 1.0),
     "rack_tip_fraction": st.floats(0.0, 0.45),
     "thickness_allowance_fraction": st.floats(0.0, 0.05),
-})
-
-helical_parameters = st.fixed_dictionaries({
-    "teeth": st.integers(6, 200),
-    "module_mm": st.floats(0.3, 20.0),
-    "pressure_angle_deg": st.floats(14.5, 30.0),
-    "profile_shift_coefficient": st.floats(-0.5, 1.0),
-    "rack_tip_fraction": st.floats(0.0, 0.45),
-    "thickness_allowance_fraction": st.floats(0.0, 0.05),
-    "helix_angle_deg": st.floats(0.0, 45.0),
-    "hand": st.sampled_from(["right", "left"]),
-})
+}
+gear_parameters = st.fixed_dictionaries(_SPUR_PARAMETERS)
+helical_parameters = st.fixed_dictionaries({**_SPUR_PARAMETERS, "helix_angle_deg": st.floats(0.0, 45.0),
+                                            "hand": st.sampled_from(["right", "left"])})
 
 
 def spec_or_category(params: dict, face_width_mm: float) -> GearSpec | tuple[str, str]:

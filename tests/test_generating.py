@@ -22,6 +22,7 @@ from spur_cad.cam.tools import Tool, ToolError
 from spur_cad.geometry import GearSpec, gear_outline
 from spur_cad.post import PostSettings, ProgramInfo, post_program
 from tests import silhouette
+from tests.gcode_reader import inlined_lines
 from tests.gears import spec_of
 from tests.rs274_helper import canon_args, run_rs274
 
@@ -478,13 +479,7 @@ def test_the_table_is_clamped_for_every_pass_when_the_machine_has_clamp_codes(fo
                                                        spec.tip_radius_mm + 0.5)
     info = ProgramInfo("clamped", (), rotary_clamp_code="M10", rotary_unclamp_code="M11")
     text = post_program(path, PostSettings(folded=folded), info).text
-    lines = []
-    if folded:  # inline the subprogram text at each call, in order
-        sub = re.search(r"^o(\d+) sub\n(.*?)^o\1 endsub\n", text, flags=re.M | re.S)
-        for line in text[sub.end():].splitlines():
-            lines += sub.group(2).splitlines() if line.startswith(f"o{sub.group(1)} call") else [line]
-    else:
-        lines = text.splitlines()
+    lines = inlined_lines(text)  # the subprogram's text at each call, in order
     clamped, clamps, cuts = False, 0, 0
     for line in lines:
         if line == "M10":

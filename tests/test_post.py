@@ -15,7 +15,7 @@ from spur_cad.cam.ir import MoveKind
 from spur_cad.cam.machine import FinishingParams, Machine, RoughingParams
 from spur_cad.cam.roughing import roughing_toolpath
 from spur_cad.post import DIALECT_NAMES, PostError, PostSettings, ProgramInfo, post_program
-from tests.gcode_reader import read_program
+from tests.gcode_reader import inlined_lines, read_program
 from tests.gears import CAM_GEARS, spec_of, tools_for
 from tests.rs274_helper import canon_args, run_rs274
 
@@ -372,13 +372,8 @@ def test_rotary_clamp_codes_hold_the_table_while_roughing_cuts(folded, cam_paths
     program = read_program(text, "linuxcnc")
     assert_same_moves([(m.rapid, np.array(m.end)) for m in program.moves], path, 4, 4)
     assert "M10" in text and "M11" in text
-    clamped, cuts, lines = False, 0, []
-    if folded:  # inline the subprogram text at each call, in order
-        sub = re.search(r"^o(\d+) sub\n(.*?)^o\1 endsub\n", text, flags=re.M | re.S)
-        for line in text[sub.end():].splitlines():
-            lines += sub.group(2).splitlines() if line.startswith(f"o{sub.group(1)} call") else [line]
-    else:
-        lines = text.splitlines()
+    clamped, cuts = False, 0
+    lines = inlined_lines(text)  # the subprogram's text at each call, in order
     for line in lines:
         if line == "M10":
             clamped = True
