@@ -493,3 +493,30 @@ def test_the_table_is_clamped_for_every_pass_when_the_machine_has_clamp_codes(fo
             assert clamped, f"cutting with the table unclamped: {line}"
             cuts += 1
     assert clamps == cuts == spec.teeth * result.passes_per_space
+
+
+@pytest.mark.parametrize("dialect", ["linuxcnc", "fanuc", "haas", "siemens", "okuma"])
+@pytest.mark.parametrize("name, diameter, corner", [CASES[0], CASES[2]])
+def test_every_dialect_reads_back_the_generating_passes_flat_and_folded(dialect, name, diameter, corner):
+    """Each dialect's program, read back by the tests' own G-code reader: the IR's moves in order (flat and
+    folded the same), no inverse-time feed, and A changes only in rapids at the safe height."""
+    from tests.gcode_reader import read_program
+    from tests.test_post import DECIMALS, INFO, assert_same_moves
+
+    spec, tool = _gear(name), _tool(diameter, corner)
+    path, _ = _plan(spec, tool)
+    linear, rotary = DECIMALS[dialect]
+    moves_by_mode = {}
+    for folded in (False, True):
+        program = read_program(post_program(path, PostSettings(dialect=dialect, folded=folded), INFO).text, dialect)
+        assert program.ended
+        for move in program.moves:
+            assert not move.inverse_time, move.words
+            if move.start[0] is not None and move.end[3] != move.start[3]:
+                assert move.rapid and min(move.start[2], move.end[2]) >= _safe_z(spec) - 1e-9, move.words
+        moves = [(m.rapid, np.array(m.end)) for m in program.moves]
+        assert_same_moves(moves, path, linear, rotary)
+        moves_by_mode[folded] = moves
+    assert len(moves_by_mode[True]) == len(moves_by_mode[False])
+    for (r1, p1), (r2, p2) in zip(moves_by_mode[True], moves_by_mode[False]):
+        assert r1 == r2 and np.allclose(p1, p2, atol=1e-9)
