@@ -165,6 +165,9 @@ def _program(summary: dict) -> str:
     return text
 
 
+NOT_ESTIMATED = "not estimated (too large to build for comparison, or the tool does not fit that strategy)"
+
+
 def _finishing_comparison(finish: dict) -> str:
     """This job's finishing beside perimeter finishing and the reference process's strategy (same tool)."""
     reference = (f"reference process's strategy (perimeter, {REFERENCE_CONTACT_SPACING_MM:g} mm contacts, "
@@ -176,7 +179,7 @@ def _finishing_comparison(finish: dict) -> str:
     others.append(("reference_strategy", reference))
     for prefix, label in others:
         if finish.get(f"{prefix}_time_s") is None:
-            rows.append((label, "-", "not estimated (too large to build for comparison)", "-"))
+            rows.append((label, "-", NOT_ESTIMATED, "-"))
         else:
             rows.append((label, finish[f"{prefix}_moves"], _minutes(finish[f"{prefix}_time_s"]),
                          _minutes(finish.get(f"{prefix}_time_with_acceleration_s"))))
