@@ -61,7 +61,8 @@ class GearSection:
                                                      "(the reference process's profile clearance, 0-5 % typical)")
     thickness_allowance_mm: float = key(0.0, unit="mm", low=0.0, high=50.0, label="ThicknessAllowance",
                                         group="Allowance",
-                                        meaning="further absolute tooth thickness reduction (at most 0.5 x module)")
+                                        meaning="further absolute tooth thickness reduction (at most 0.5 x module; "
+                                                "normal section for helical gears)")
     helix_angle_deg: float = key(0.0, unit="deg", low=0.0, high=45.0, label="HelixAngle", group="Gear",
                                  meaning="helix angle beta on the reference cylinder, 0: spur gear (module, pressure "
                                          "angle, shift, coefficients and rack tip radius are then normal-section "
