@@ -178,6 +178,6 @@ def passes_png(spec: GearSpec, tool: Tool, passes: tuple, blank_radius_mm: float
     counts = {mode: sum(1 for p in passes if p.mode == mode) for mode in _PASS_COLOURS}
     ax.set_title(f"finishing passes of one tooth space: {len(passes)} ({counts['flank']} flank, {counts['tip']} fillet "
                  f"and root, {counts['land']} land), {tool.kind} D {tool.diameter_mm:g} mm r {r_t:g} mm", fontsize=9)
-    ax.legend(fontsize=8, loc="upper left")
+    ax.legend(fontsize=8, loc="best")
     ax.grid(True, lw=0.3)
     return _png(fig)
