@@ -117,15 +117,25 @@ def post_program(path: Toolpath, settings: PostSettings, info: ProgramInfo) -> P
                          subprograms=len(sub_bodies), calls=sum(1 for kind, _ in body if kind == "call"))
 
 
+MAX_FEED_VALUE = 1e9
+"""Largest feed word value accepted (mm/min, or 1/min in inverse time): far beyond any machine, small
+enough to be written without overflow."""
+
+
 def _check_numbers(path: Toolpath, info: ProgramInfo) -> None:
-    """Refuse what a control must never be given: non-finite or absurd coordinates, a tool number outside
-    1..9999, a spindle speed below 1 rpm, clamp codes that are more than one M code."""
+    """Refuse what a control must never be given: non-finite, absurd or missing feeds and coordinates, a tool
+    number outside 1..9999, a spindle speed below 1 rpm, clamp codes that are more than one M code."""
     for axis in ("x", "y", "z", "a"):
         values = getattr(path, axis)
         limit = MAX_COORDINATE_MM if axis != "a" else 360.0 * 1e6
         if not np.all(np.isfinite(values)) or np.abs(values).max() > limit:
             raise PostError(f"{info.title}: the toolpath has an {axis.upper()} value that is not a finite number "
                             f"within +-{limit:g}")
+    feeds = path.feed[path.kind == MoveKind.LINEAR]
+    bad = ~(np.isfinite(feeds) & (feeds > 0.0) & (feeds <= MAX_FEED_VALUE))
+    if bad.any():
+        index = int(np.nonzero(path.kind == MoveKind.LINEAR)[0][np.argmax(bad)])
+        raise PostError(f"{info.title}: move {index} has no usable feed ({float(path.feed[index])!r})")
     if not 1 <= path.tool_number <= 9999:
         raise PostError(f"{info.title}: tool number {path.tool_number} must be in 1..9999")
     if not (math.isfinite(path.spindle_rpm) and path.spindle_rpm >= 1.0):
