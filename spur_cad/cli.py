@@ -2,7 +2,8 @@
 
 Errors in the user's input print one line (`spur-cad: error: ...`) and exit 2 with nothing
 written; an unexpected failure prints a one-line internal error (traceback only with --debug)
-and exits 3; SIGINT (Ctrl-C) and SIGTERM print one line and exit 130 and 143. The output folder
+and exits 3; SIGINT (Ctrl-C) and SIGTERM print one line and exit 130 and 143 (at the run's next
+checkpoint, never inside a library). The output folder
 always keeps a complete set (spur_cad.outputs).
 """
 
@@ -88,13 +89,16 @@ def _install_freecad(uninstall: bool) -> int:
 
 
 def main(argv: list[str] | None = None) -> int:
-    """The command line; SIGINT and SIGTERM anywhere in a run give one line and exit 130 / 143. The SIGTERM
-    handler is the caller's again when main returns (main may be called in-process, e.g. by tests)."""
-    received: list[int] = []  # the signals that arrived (a library may turn the exception into another one)
+    """The command line; SIGINT and SIGTERM anywhere in a run give one line and exit 130 / 143. The signal
+    handlers only record the signal; the run stops at its next checkpoint (between stages, and in the
+    simulation's progress), never inside a library: an exception raised in the middle of native code or of
+    an import can be swallowed there ("Exception ignored in ...") or leave a C++ object half-built that
+    crashes the process later. The handlers are the caller's again when main returns (main may be called
+    in-process, e.g. by tests)."""
+    received: list[int] = []  # the signals that arrived
 
     def on_signal(signum, frame) -> None:
         received.append(signum)
-        raise Terminated() if signum == signal.SIGTERM else KeyboardInterrupt()
 
     in_main_thread = threading.current_thread() is threading.main_thread()
     previous = {s: signal.signal(s, on_signal) for s in (signal.SIGINT, signal.SIGTERM)} if in_main_thread else {}
@@ -109,6 +113,45 @@ def main(argv: list[str] | None = None) -> int:
             signal.signal(signum, handler)
 
 
+def _checkpoint(received: list[int]) -> None:
+    """Stop here (one line, 130 / 143) when a signal has arrived since the run began."""
+    if received:
+        raise Terminated() if signal.SIGTERM in received else KeyboardInterrupt()
+
+
+def _run(args: argparse.Namespace, received: list[int], loaded: list) -> list:
+    """Load, compute and write the job's output set; the job goes into `loaded` (for locating errors)."""
+    from spur_cad.job import load_job  # heavy imports after the signal handling is in place
+    from spur_cad.outputs import check_output_folder, write_output_set
+    from spur_cad.pipeline import run_job
+
+    def checkpoint() -> None:
+        _checkpoint(received)
+
+    checkpoint()
+    out_dir = check_output_folder(args.out)  # before any computation
+    loaded.append(load_job(args.job))
+    bars = ProgressBars(sys.stderr) if not args.quiet and sys.stderr.isatty() else None
+
+    def progress(stage: str, fraction: float) -> None:
+        checkpoint()
+        if bars is not None:
+            bars(stage, fraction)
+
+    try:
+        files = run_job(loaded[0], progress, checkpoint)
+    finally:
+        if bars is not None:
+            bars.close()
+    checkpoint()
+    try:
+        paths = write_output_set(out_dir, files)
+    except OSError as exc:
+        raise SpurCadError(f"cannot write to {out_dir}: {exc.strerror or exc}") from None
+    checkpoint()  # a signal while the set was switched: it is this run's set, and the message says so
+    return paths
+
+
 def _main(argv: list[str] | None, received: list[int]) -> int:
     args = _parser().parse_args(argv)
     if not getattr(args, "debug", False):
@@ -117,31 +160,15 @@ def _main(argv: list[str] | None, received: list[int]) -> int:
         warnings.simplefilter("ignore", RuntimeWarning)
     if args.command == "install-freecad":
         return _install_freecad(args.uninstall)
-    job = None
+    loaded: list = []
     try:
-        from spur_cad.job import load_job  # heavy imports after the signal handling is in place
-        from spur_cad.outputs import check_output_folder, write_output_set
-        from spur_cad.pipeline import run_job
-
-        out_dir = check_output_folder(args.out)  # before any computation
-        job = load_job(args.job)
-        bars = ProgressBars(sys.stderr) if not args.quiet and sys.stderr.isatty() else None
-        try:
-            files = run_job(job, bars)
-        finally:
-            if bars is not None:
-                bars.close()
-        try:
-            paths = write_output_set(out_dir, files)
-        except OSError as exc:
-            raise SpurCadError(f"cannot write to {out_dir}: {exc.strerror or exc}") from None
+        paths = _run(args, received, loaded)
     except SpurCadError as exc:
-        message = job.located(exc) if job is not None and exc.section else str(exc)
+        message = loaded[0].located(exc) if loaded and exc.section else str(exc)
         print(f"spur-cad: error: {message}", file=sys.stderr)
         return EXIT_INPUT_ERROR
     except Exception as exc:  # noqa: BLE001 - the CLI never shows a traceback unless asked
-        if received:  # an interrupt that a library turned into another exception (e.g. an ImportError)
-            raise KeyboardInterrupt from None
+        _checkpoint(received)  # a failure after a signal arrived (e.g. a library's own SIGINT handling)
         if getattr(args, "debug", False):
             raise
         print(f"spur-cad: internal error: {type(exc).__name__}: {exc} (run with --debug for details; "

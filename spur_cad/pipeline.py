@@ -35,9 +35,11 @@ def profile_csv(samples: ProfileSamples) -> bytes:
     return buffer.getvalue().encode()
 
 
-def run_job(job: Job, progress: Callable[[str, float], None] | None = None) -> dict[str, bytes]:
+def run_job(job: Job, progress: Callable[[str, float], None] | None = None,
+            checkpoint: Callable[[], None] | None = None) -> dict[str, bytes]:
     """Compute every output of the job in memory (no file I/O). `progress(stage, fraction)` is told how
-    far each long stage is (the CLI draws progress bars with it)."""
+    far each long stage is (the CLI draws progress bars with it); `checkpoint()` is called before every
+    stage (the CLI stops there when a signal has arrived, never inside a library)."""
     from spur_cad.report.plots import tooth_space_png
     from spur_cad.report.stage import report_html
 
@@ -48,6 +50,8 @@ def run_job(job: Job, progress: Callable[[str, float], None] | None = None) -> d
     seconds: dict[str, float] = {}
 
     def timed(name: str, stage: str | None, compute: Callable):
+        if checkpoint is not None:
+            checkpoint()
         start = time.perf_counter()
         if stage:
             tell(stage, 0.0)
@@ -60,8 +64,8 @@ def run_job(job: Job, progress: Callable[[str, float], None] | None = None) -> d
     samples = timed("profile", None, lambda: sample_profile(job.gear.tooth_space_profile(),
                                                             job.job.profile_tolerance_mm))
     png = timed("plot", None, lambda: tooth_space_png(job.gear, samples))
-    cad, step = timed("cad_and_step", "CAD and STEP", lambda: build_cad(job))
-    plan = timed("cam", "toolpaths", lambda: plan_cam(job))
+    cad, step = timed("cad_and_step", "CAD and STEP", lambda: build_cad(job, checkpoint))
+    plan = timed("cam", "toolpaths", lambda: plan_cam(job, checkpoint))
     programs, program_files = timed("post", None, lambda: build_programs(job, plan))
     sim_result = timed("simulation", "simulation",
                        lambda: simulate_stage(job, plan, lambda fraction: tell("simulation", fraction)))
@@ -124,14 +128,16 @@ def program_comments(job: Job, plan: CamPlan, operation: str) -> tuple[str, ...]
     )
 
 
-def build_cad(job: Job) -> tuple[CadResult, dict[str, bytes]]:
-    """Gear solid, stock and STEP files; returns (CAD facts, files)."""
+def build_cad(job: Job, checkpoint: Callable[[], None] | None = None) -> tuple[CadResult, dict[str, bytes]]:
+    """Gear solid, stock and STEP files; returns (CAD facts, files). `checkpoint()` between the steps."""
     import cadquery as cq
 
     from spur_cad.cad.solid import build_gear_shape, make_stock, solid_volume_mm3
     from spur_cad.cad.step import step_files
 
     shape, report = build_gear_shape(job.gear, job.gear_section.blank_features())
+    if checkpoint is not None:
+        checkpoint()
     gear = cq.Workplane("YZ").add(cq.Solid(shape))
     stock = make_stock(job.gear, job.stock)
     files = step_files(gear, stock)
@@ -146,9 +152,9 @@ def cam_inputs(job: Job) -> CamInputs:
                      job.machine)
 
 
-def plan_cam(job: Job) -> CamPlan:
+def plan_cam(job: Job, checkpoint: Callable[[], None] | None = None) -> CamPlan:
     """The job's CAM plan (spur_cad.cam.plan.plan_cam on the job's inputs)."""
-    return plan_cam_inputs(cam_inputs(job))
+    return plan_cam_inputs(cam_inputs(job), checkpoint)
 
 
 def job_stock(job: Job) -> StockCylinder:

@@ -99,8 +99,10 @@ def test_interrupted_runs_leave_a_complete_set_and_no_strays_after_the_next(kind
             # handling ends the process at exit, and nothing more is written.
             assert stderr == "", stderr
         elif kind == "SIGINT" and code != 0:
-            assert code == 130, stderr
+            assert code == 130, stderr  # never a crash (-11: an interrupt raised inside native code, once)
             assert len(stderr.strip().splitlines()) == 1 and stderr.startswith("spur-cad: interrupted"), stderr
+        elif kind == "SIGINT":  # the signal came after the run's last checkpoint: it finished, and said nothing
+            assert stderr == "", stderr  # (once: "Exception ignored in ..." from an interrupt inside an import)
         if (out / JOURNAL).exists():  # SIGKILL inside the switch's milliseconds: the next run completes it
             assert kind == "SIGKILL"
             recover(out)

@@ -6,6 +6,7 @@ job; summary, posts, simulation, report and the workbench read it (docs/architec
 from __future__ import annotations
 
 import dataclasses
+from collections.abc import Callable
 from dataclasses import dataclass
 
 from spur_cad.cad.specs import StockSpec
@@ -116,17 +117,21 @@ def check_cam_inputs(inputs: CamInputs) -> tuple[ToolRecommendations, RoughingLe
     return rec, levels
 
 
-def plan_cam(inputs: CamInputs) -> CamPlan:
-    """Tool recommendations always; toolpaths and estimates for the tools the job gives (pure)."""
+def plan_cam(inputs: CamInputs, checkpoint: Callable[[], None] | None = None) -> CamPlan:
+    """Tool recommendations always; toolpaths and estimates for the tools the job gives (pure).
+    `checkpoint()` is called between the steps (a front end may stop there)."""
+    check = checkpoint if checkpoint is not None else (lambda: None)
     rec, levels = check_cam_inputs(inputs)
     blank = inputs.stock.blank_radius_mm(inputs.spec)
     roughing = finishing = None
     warnings: list[str] = []
     if levels is not None:
+        check()
         roughing = _plan_roughing(inputs, levels, blank)
         warnings.extend(roughing.toolpath.warnings)
     if inputs.finishing_tool is not None:
-        finishing = _plan_finishing(inputs, blank)
+        check()
+        finishing = _plan_finishing(inputs, blank, check)
         warnings.extend(finishing.toolpath.warnings)
     return CamPlan(rec, roughing, finishing, tuple(warnings))
 
@@ -169,16 +174,18 @@ def check_finishing_work(spec: GearSpec, tool: Tool, machine: Machine, section: 
     check_moves("finishing", strategy.estimate_moves(spec, tool, params), "finishing", driver)
 
 
-def _plan_finishing(inputs: CamInputs, blank: float) -> FinishingPlan:
+def _plan_finishing(inputs: CamInputs, blank: float, check: Callable[[], None]) -> FinishingPlan:
     spec, tool, machine = inputs.spec, inputs.finishing_tool, inputs.machine
     path, result = plan_finishing(spec, tool, machine, inputs.finishing, blank)
     check_travel(machine, path.x, path.y, path.z, path.a, "finishing")
     own = estimate(path, machine)
+    check()
     target = inputs.finishing.target_scallop_mm
     reference = _comparison_estimate(spec, tool, machine, blank,
                                      FinishingParams(strategy="perimeter", target_scallop_mm=target,
                                                      step_over_mm=REFERENCE_STATION_STEP_MM),
                                      contact_spacing_mm=REFERENCE_CONTACT_SPACING_MM)
+    check()
     perimeter = own if inputs.finishing.strategy == "perimeter" else _comparison_estimate(
         spec, tool, machine, blank, FinishingParams(strategy="perimeter", target_scallop_mm=target))
     return FinishingPlan(tool, result, path, own, reference, perimeter)
