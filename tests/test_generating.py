@@ -501,7 +501,7 @@ def test_every_dialect_reads_back_the_generating_passes_flat_and_folded(dialect,
     """Each dialect's program, read back by the tests' own G-code reader: the IR's moves in order (flat and
     folded the same), no inverse-time feed, and A changes only in rapids at the safe height."""
     from tests.gcode_reader import read_program
-    from tests.test_post import DECIMALS, INFO, assert_same_moves
+    from tests.test_post import DECIMALS, INFO, assert_folded_moves_as_flat, assert_same_moves
 
     spec, tool = _gear(name), _tool(diameter, corner)
     path, _ = _plan(spec, tool)
@@ -517,6 +517,4 @@ def test_every_dialect_reads_back_the_generating_passes_flat_and_folded(dialect,
         moves = [(m.rapid, np.array(m.end)) for m in program.moves]
         assert_same_moves(moves, path, linear, rotary)
         moves_by_mode[folded] = moves
-    assert len(moves_by_mode[True]) == len(moves_by_mode[False])
-    for (r1, p1), (r2, p2) in zip(moves_by_mode[True], moves_by_mode[False]):
-        assert r1 == r2 and np.allclose(p1, p2, atol=1e-9)
+    assert_folded_moves_as_flat(moves_by_mode)

@@ -46,6 +46,13 @@ def motion_rows(path, rotary_sign: int = 1) -> list[tuple[bool, np.ndarray]]:
     return [(bool(path.kind[i] == MoveKind.RAPID), pose) for i, pose in zip(rows, poses)]
 
 
+def assert_folded_moves_as_flat(moves_by_mode: dict[bool, list[tuple[bool, np.ndarray]]]) -> None:
+    """The folded program's moves (read back, calls expanded) are the flat program's, one for one."""
+    assert len(moves_by_mode[True]) == len(moves_by_mode[False])
+    for (r1, p1), (r2, p2) in zip(moves_by_mode[True], moves_by_mode[False]):
+        assert r1 == r2 and np.allclose(p1, p2, atol=1e-9)
+
+
 def assert_same_moves(written: list[tuple[bool, np.ndarray]], path, linear_decimals: int, rotary_decimals: int,
                       rotary_sign: int = 1, wrapped: bool = False) -> None:
     """Every IR move appears, in order, within the output precision; IR moves missing from the
@@ -220,9 +227,7 @@ def test_every_dialect_reads_back_as_the_ir_with_its_invariants(dialect, name, c
             moves = [(m.rapid, np.array(m.end)) for m in program.moves]
             assert_same_moves(moves, path, linear, rotary)
             moves_by_mode[folded] = moves
-        assert len(moves_by_mode[True]) == len(moves_by_mode[False])
-        for (r1, p1), (r2, p2) in zip(moves_by_mode[True], moves_by_mode[False]):
-            assert r1 == r2 and np.allclose(p1, p2, atol=1e-9)
+        assert_folded_moves_as_flat(moves_by_mode)
 
 
 @pytest.mark.parametrize("dialect", DIALECT_NAMES)
