@@ -129,7 +129,7 @@ NUMBER_KEYS = [  # ... and keys a user could set to anything
     ("stock", "radial_allowance_mm"), ("stock", "back_margin_mm"), ("tools.roughing", "diameter_mm"),
     ("tools.finishing", "corner_radius_mm"), ("tools.finishing", "diameter_mm"), ("roughing", "flank_allowance_mm"),
     ("roughing", "step_over_fraction"), ("finishing", "target_scallop_mm"), ("machine", "clearance_mm"),
-    ("machine", "max_spindle_rpm"), ("tools.roughing", "tool_number"),
+    ("machine", "max_spindle_rpm"), ("tools.roughing", "tool_number"), ("gear", "helix_angle_deg"),
 ]
 HOSTILE_NUMBERS = st.one_of(
     st.sampled_from(["nan", "inf", "-inf", "1e300", "-1e300", "1e-300", "0", "-1", "1" + "0" * 30, '"4"', "true"]),

@@ -47,6 +47,9 @@ CASES = [
     ("clamp_code_injection", "machine", "rotary_clamp_code", '"M10\\nG0 Z-50"', "error"),
     ("clamp_code_with_motion", "machine", "rotary_clamp_code", '"M10 G0 Z-50"', "error"),
     ("nested_arrays", "job", "name", "[" * 5000 + "]" * 5000, "error"),
+    ("helix_angle_nan", "gear", "helix_angle_deg", "nan", "error"),
+    ("helix_angle_huge", "gear", "helix_angle_deg", "1e300", "error"),
+    ("hand_injection", "gear", "hand", '"right\\nG0 Z-50"', "error"),
 ]
 
 
