@@ -269,7 +269,7 @@ def test_job_file_takes_helix_and_hand_and_refuses_bad_values():
 
 
 @pytest.mark.slow
-def test_spur_cad_run_writes_the_helical_geometry_and_refuses_toolpaths_naming_the_key(tmp_path):
+def test_spur_cad_run_writes_the_helical_geometry_and_roughing_and_refuses_finishing_naming_the_key(tmp_path):
     import json
     from pathlib import Path
 
@@ -282,6 +282,8 @@ def test_spur_cad_run_writes_the_helical_geometry_and_refuses_toolpaths_naming_t
     assert summary["gear"]["helix_angle_deg"] == 15.0 and summary["gear"]["hand"] == "right"
     g = book_of("reference_15_right")
     assert summary["gear"]["lead_mm"] == pytest.approx(g.lead) and "finishing" not in summary
+    assert summary["roughing"]["moves"] > 1000 and summary["simulation"]["max_gouge_mm"] == 0.0
+    assert "G93" in (tmp_path / "out" / "roughing.ngc").read_text()
     assert summary["inspection"]["span_measurement_mm"] == pytest.approx(
         span_measurement(spec_of("reference_15_right"), summary["inspection"]["span_teeth_k"]).length_mm)
     area = Polygon(gear_outline(spec_of("reference_15_right"), 1e-6)).area
@@ -294,5 +296,5 @@ def test_spur_cad_run_writes_the_helical_geometry_and_refuses_toolpaths_naming_t
     job.write_text(with_tools)
     result = run_cli("run", str(job), "--out", str(tmp_path / "out2"))
     assert result.returncode == 2 and len(result.stderr.strip().splitlines()) == 1
-    assert "helical.toml:8: helix_angle_deg = 15: toolpaths for helical gears are not implemented yet" in result.stderr
+    assert "helical.toml:8: helix_angle_deg = 15: finishing of helical gears is not implemented yet" in result.stderr
     assert not (tmp_path / "out2").exists()

@@ -95,11 +95,10 @@ def check_cam_inputs(inputs: CamInputs) -> tuple[ToolRecommendations, RoughingLe
     roughing work bound and the roughing reach. Returns the
     recommendations and the roughing levels (None without a roughing tool)."""
     spec, machine, stock = inputs.spec, inputs.machine, inputs.stock
-    if spec.is_helical and (inputs.roughing_tool is not None or inputs.finishing_tool is not None):
-        raise GearSpecError(f"helix_angle_deg = {spec.helix_angle_deg:g}: toolpaths for helical gears are not "
-                            "implemented yet (geometry, inspection, B-rep and STEP are); remove [tools.roughing] "
-                            "and [tools.finishing] for those, or set helix_angle_deg = 0",
-                            field="helix_angle_deg", section="gear")
+    if spec.is_helical and inputs.finishing_tool is not None:
+        raise GearSpecError(f"helix_angle_deg = {spec.helix_angle_deg:g}: finishing of helical gears is not "
+                            "implemented yet (roughing is); remove [tools.finishing] for those, or set "
+                            "helix_angle_deg = 0", field="helix_angle_deg", section="gear")
     blank = stock.blank_radius_mm(spec)
     rec = recommend_tools(spec, blank, machine.clearance_mm, inputs.finishing_tool)
     check_tools(spec, rec, inputs.roughing_tool, inputs.finishing_tool)

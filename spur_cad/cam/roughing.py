@@ -6,6 +6,15 @@ staircase left between two levels is at most (flank allowance - finish stock): h
 on the involute, as a straight distance on the concave fillet; the fillet/involute junction
 is always a level, and no level is deeper than the slotting limit below the one above.
 The lowest level is where the offset space is exactly as wide as the tool.
+
+Helical gears: the same levels and passes in the transverse section, each move following the lead
+(A falls by the section turn of its X advance, Y and Z fixed; inverse-time feed), so the tool
+keeps its place in the turning tooth space. A slice of the tool at a distance dx from its axis meets
+a section turned by dx tan(beta) / r against the slice through the axis: seen in one section, the
+tool sweeps a width of D sqrt(1 + (r_blank tan(beta) / r)^2) (largest at the blank radius), and the
+levels and passes are planned for that width (`transverse_radius_mm`). The turn also lowers a slice's
+corner at y from the space's centre line by up to |y| D tan(beta) / (2 r): each level only fills the
+space as wide as it is that much lower (`_OffsetFlank.reach_width`).
 """
 
 from __future__ import annotations
@@ -15,7 +24,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from spur_cad.cam.common import PLUNGE_FEED_FRACTION, safe_height_mm
+from spur_cad.cam.common import PLUNGE_FEED_FRACTION, apply_inverse_time, safe_height_mm
 from spur_cad.cam.ir import Feature, MoveKind, Operation, Toolpath, ToolpathBuilder
 from spur_cad.cam.machine import Machine, MachineError, RoughingParams
 from spur_cad.cam.recommend import space_half_width_mm
@@ -77,6 +86,13 @@ class _OffsetFlank:
 
     points: np.ndarray
     junction: float | None  # height of the fillet/involute junction
+    sag: float = 0.0  # helical: a slice turned by phi lowers a corner at y by |y phi|, at most sag * |y|
+
+    def reach_width(self, h: float) -> float:
+        """Half-width the tool may fill at level h: the width where its corners can sink to (`sag`)."""
+        if self.sag == 0.0:
+            return self.width(h)
+        return self.width(h - self.sag * self.width(h))
 
     @property
     def tip_edge_height(self) -> float:
@@ -103,9 +119,16 @@ class _OffsetFlank:
         return float(p_high[0] - p_low[0])
 
 
-def _lowest_level(flank: _OffsetFlank, tool: Tool) -> float:
-    """Where the offset space is exactly as wide as the tool (bisection on a monotone test)."""
-    radius = tool.diameter_mm / 2.0
+def transverse_radius_mm(spec: GearSpec, tool: Tool, blank_radius_mm: float) -> float:
+    """Half the width the tool sweeps in one transverse section while it follows the lead (its radius for a
+    spur gear): the slice at dx from the axis is turned by dx * twist, an arc of up to r_blank * twist * dx."""
+    stretch = blank_radius_mm * abs(spec.section_turn_rad(1.0))
+    return tool.diameter_mm / 2.0 * math.sqrt(1.0 + stretch * stretch)
+
+
+def _lowest_level(flank: _OffsetFlank, tool: Tool, radius: float) -> float:
+    """Where the offset space is exactly as wide as the tool's transverse width 2 radius (bisection on a
+    monotone test)."""
     low, high = float(flank.points[:, 1].min()), flank.tip_edge_height
     if flank.width(high) < radius:
         raise ToolError(f"roughing tool diameter {tool.diameter_mm:g} mm does not fit the tooth space even at the tip "
@@ -113,7 +136,7 @@ def _lowest_level(flank: _OffsetFlank, tool: Tool) -> float:
                         field="diameter_mm", section="tools.roughing")
     for _ in range(100):
         mid = 0.5 * (low + high)
-        low, high = (mid, high) if flank.width(mid) < radius else (low, mid)
+        low, high = (mid, high) if flank.reach_width(mid) < radius else (low, mid)
     return high
 
 
@@ -138,10 +161,11 @@ def _next_level(flank: _OffsetFlank, h: float, max_depth: float, budget: float, 
 def roughing_levels(spec: GearSpec, tool: Tool, params: RoughingParams, blank_radius_mm: float) -> RoughingLevels:
     """Levels as described in the module docstring (pure function)."""
     points, _, junction = offset_flank(spec, params.finish_stock_mm)
-    flank = _OffsetFlank(points, junction)
+    # A slice at dx from the tool axis is turned by dx * twist, |dx| <= D / 2 (module docstring).
+    flank = _OffsetFlank(points, junction, abs(spec.section_turn_rad(1.0)) * tool.diameter_mm / 2.0)
     budget = params.flank_allowance_mm - params.finish_stock_mm
     max_depth = params.max_level_depth_fraction * tool.diameter_mm
-    heights = [_lowest_level(flank, tool)]
+    heights = [_lowest_level(flank, tool, transverse_radius_mm(spec, tool, blank_radius_mm))]
     top = blank_radius_mm - max_depth  # the first level cuts at most max_depth below the blank
     while True:
         h = heights[-1]
@@ -152,8 +176,20 @@ def roughing_levels(spec: GearSpec, tool: Tool, params: RoughingParams, blank_ra
             continue
         heights.append(_next_level(flank, h, max_depth, budget, params))
     levels = np.array(heights[::-1])
-    half_widths = np.array([flank.width(h) for h in levels])
+    half_widths = np.array([flank.reach_width(h) for h in levels])
     return RoughingLevels(levels, half_widths, junction)
+
+
+def _check_clamp(spec: GearSpec, machine: Machine, params: RoughingParams) -> None:
+    """Clamping the table for each space needs the machine's codes and a table that stays still (spur gears)."""
+    if not params.clamp_rotary:
+        return
+    if not (machine.rotary_clamp_code and machine.rotary_unclamp_code):
+        raise MachineError("[roughing] clamp_rotary needs [machine] rotary_clamp_code and rotary_unclamp_code",
+                           field="clamp_rotary", section="roughing")
+    if spec.is_helical:
+        raise MachineError("[roughing] clamp_rotary cannot be used for a helical gear: its passes turn A along the "
+                           "lead", field="clamp_rotary", section="roughing")
 
 
 def roughing_toolpath(spec: GearSpec, tool: Tool, machine: Machine, params: RoughingParams,
@@ -163,12 +199,11 @@ def roughing_toolpath(spec: GearSpec, tool: Tool, machine: Machine, params: Roug
     params.validate()
     machine.validate()
     tool.validate("roughing")
-    if params.clamp_rotary and not (machine.rotary_clamp_code and machine.rotary_unclamp_code):
-        raise MachineError("[roughing] clamp_rotary needs [machine] rotary_clamp_code and rotary_unclamp_code",
-                           field="clamp_rotary", section="roughing")
+    _check_clamp(spec, machine, params)
     if levels is None:
         levels = roughing_levels(spec, tool, params, blank_radius_mm)
     radius = tool.diameter_mm / 2.0
+    sweep_radius = transverse_radius_mm(spec, tool, blank_radius_mm)
     x_front = -(front_margin_mm + radius + machine.clearance_mm)
     x_back = spec.face_width_mm + radius + machine.clearance_mm
     if stub_radius_mm > levels.lowest_height_mm and back_margin_mm < radius + machine.clearance_mm:
@@ -189,7 +224,7 @@ def roughing_toolpath(spec: GearSpec, tool: Tool, machine: Machine, params: Roug
             builder.move(MoveKind.CLAMP_ROTARY, x_front, 0.0, safe_z, a, space=k)
         x_here = x_front
         for index, (height, half_width) in enumerate(zip(levels.heights_mm, levels.half_widths_mm)):
-            reach = max(half_width - radius, 0.0)
+            reach = max(half_width - sweep_radius, 0.0)
             n = max(1, math.ceil(2.0 * reach / step - 1e-9)) if reach > 0.0 else 0
             offsets = np.linspace(-reach, reach, n + 1) if n else np.array([0.0])
             if x_here != x_front:  # come back to the front, above the cleared level, before going down
@@ -206,4 +241,14 @@ def roughing_toolpath(spec: GearSpec, tool: Tool, machine: Machine, params: Roug
                 builder.move(MoveKind.LINEAR, x_here, y, height, a, feed, space=k, station=index,
                              feature=Feature.LEVEL)
         builder.move(MoveKind.LINEAR, x_here, builder.last_pose()[1], safe_z, a, feed, space=k)
-    return builder.build()
+    path = builder.build()
+    if spec.is_helical:
+        path = follow_lead(path, spec, machine)
+    return path
+
+
+def follow_lead(path: Toolpath, spec: GearSpec, machine: Machine) -> Toolpath:
+    """The moves with A turned by the helix at their X (A - turn(X), the same space under the tool at every X),
+    feeds of moves that now turn A in inverse time; markers follow their pose."""
+    turn_deg = np.degrees(spec.section_turn_rad(1.0)) * path.x
+    return apply_inverse_time(path.replace(a=path.a - turn_deg), machine)

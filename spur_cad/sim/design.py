@@ -5,7 +5,8 @@ fillet, root arc, left fillet, left involute, left tip land) is sampled at even 
 spacing from the exact profile of `spur_cad.geometry`; every tooth space k uses the same
 points turned by k * 360/z degrees (counter-clockwise in machine (Y, Z), as the part sits at
 A = 0). Each point carries its exact unit normal pointing out of the material (into the space).
-The same transverse points are repeated on rows along X.
+The same transverse points are repeated on rows along X; for a helical gear row x holds them
+turned by the helix (`GearSpec.section_turn_rad(x)`), which the simulation kernel applies.
 """
 
 from __future__ import annotations
@@ -43,6 +44,7 @@ class DesignGrid:
     rows_x: np.ndarray
     row_width: np.ndarray
     spacing_mm: float
+    twist_rad_per_mm: float = 0.0  # helical gears: row x holds the points turned by twist * x (positive A sense)
 
     @property
     def pitch_rad(self) -> float:
@@ -118,4 +120,4 @@ def design_grid(spec: GearSpec, spacing_mm: float, x_min: float, x_max: float,
     arc = np.concatenate([[0.0], np.cumsum(np.hypot(*np.diff(points, axis=0).T))])
     rows, width = row_positions(x_min, x_max, spacing_mm, extra_rows, spec.face_width_mm)
     return DesignGrid(spec.teeth, points, normals, feature.astype(np.int8), side.astype(np.int8), arc, rows, width,
-                      spacing_mm)
+                      spacing_mm, spec.section_turn_rad(1.0))

@@ -221,3 +221,135 @@ def clip_poses(poses, x_end, h, h_top, points, normals, chunk_start, chunk_centr
                               chunk_start, chunk_centre, chunk_radius, rows, t_min, t_max, radius, half_flat, rt, reach,
                               blade_len, pitch, teeth)
     return cuts
+
+
+# --- Helical gears: the design of row r is the transverse design turned by twist * rows[r] ---------------------
+#
+# A tool pose (x, y, z, a) meets row r at dx = rows[r] - x with the row's design turned by
+# a + twist * rows[r] = c0 + twist * dx (c0 = a + twist * x) into the machine frame. A move that
+# follows the lead (A falls by twist * dX while X rises, Y and Z fixed) keeps c0: every row then
+# sees the same tool slices at the same angles, as a function of dx alone, so one table of entries
+# per blade over dx in [-R, R] serves every row (the helical counterpart of the sweep along X).
+
+
+@njit(cache=True)
+def _twisted_sector_range(y, z, c0, spread, radius, blade_len, pitch, teeth):
+    """Sectors that may meet the tool when the design turns by c0 +- spread."""
+    if z - blade_len <= 0.0:
+        return 0, teeth - 1
+    half = math.atan2(abs(y) + radius + blade_len, z - blade_len) + spread
+    first = math.ceil((-half - c0) / pitch - 0.5)
+    last = math.floor((half - c0) / pitch + 0.5)
+    if last - first + 1 >= teeth:
+        return 0, teeth - 1
+    return first, last
+
+
+@njit(cache=True)
+def _blade_entry(dx, theta, px, pz_, nx, nz_, y, z, lo, hi, radius, half_flat, rt):
+    """First entry of one blade (design point p, normal n, turned by theta) into the tool slice at dx."""
+    c = math.cos(theta)
+    s = math.sin(theta)
+    ay = c * px - s * pz_ - y
+    az = s * px + c * pz_ - z
+    ny = c * nx - s * nz_
+    nz = s * nx + c * nz_
+    return first_entry(dx, ay, az, ny, nz, lo, hi, radius, half_flat, rt)
+
+
+@njit(cache=True)
+def _clip_twisted_pose(x, y, z, a, x_end, h, h_top, points, normals, chunk_start, chunk_centre, chunk_radius,
+                       rows, t_min, radius, half_flat, rt, reach, blade_len, pitch, teeth, twist, dx_step):
+    """Clip the blades of a helical design by the tool at (x, y, z, a) or, with x_end > x, by the tool
+    following the lead from x to x_end (entries sampled every dx_step over the tool's width)."""
+    if z > reach:
+        return 0
+    spread = abs(twist) * radius
+    c0 = a + twist * x
+    first, last = _twisted_sector_range(y, z, c0, spread, radius, blade_len, pitch, teeth)
+    r_lo = np.searchsorted(rows, x - radius, side="right")
+    r_hi = np.searchsorted(rows, x_end + radius, side="left")
+    if r_lo >= r_hi:
+        return 0
+    sweep = x_end > x
+    n_samples = 0
+    if sweep:
+        n_samples = int(math.ceil(2.0 * radius / dx_step)) + 1
+    samples = np.empty(max(n_samples, 1))
+    cuts = 0
+    n_chunks = len(chunk_radius)
+    for k in range(first, last + 1):
+        sector = k % teeth
+        theta0 = c0 + k * pitch
+        c = math.cos(theta0)
+        s = math.sin(theta0)
+        for ci in range(n_chunks):
+            py = chunk_centre[ci, 0]
+            pz = chunk_centre[ci, 1]
+            cy = c * py - s * pz
+            cz = s * py + c * pz
+            ddy = abs(cy - y) - half_flat
+            ddz = z + rt - cz
+            out = math.sqrt(max(ddy, 0.0) ** 2 + max(ddz, 0.0) ** 2)
+            inside = min(max(ddy, ddz), 0.0)
+            if out + inside - rt > chunk_radius[ci] + spread * math.hypot(py, pz):
+                continue
+            for j in range(chunk_start[ci], chunk_start[ci + 1]):
+                px = points[j, 0]
+                pz_ = points[j, 1]
+                nx = normals[j, 0]
+                nz_ = normals[j, 1]
+                top = h_top[sector, j]
+                hrow = h[sector, j]
+                if not sweep:
+                    for r in range(r_lo, r_hi):
+                        dx = rows[r] - x
+                        entry = _blade_entry(dx, theta0 + twist * dx, px, pz_, nx, nz_, y, z, t_min, min(top, hrow[r]),
+                                             radius, half_flat, rt)
+                        if entry < hrow[r]:
+                            hrow[r] = entry
+                            cuts += 1
+                    continue
+                deepest = INF
+                for i in range(n_samples):
+                    dx = -radius + 2.0 * radius * i / (n_samples - 1)
+                    samples[i] = _blade_entry(dx, theta0 + twist * dx, px, pz_, nx, nz_, y, z, t_min, top, radius,
+                                              half_flat, rt)
+                    if samples[i] < deepest:
+                        deepest = samples[i]
+                if deepest == INF:
+                    continue
+                for r in range(r_lo, r_hi):
+                    lo_dx = max(rows[r] - x_end, -radius)  # the slices this row sees during the move
+                    hi_dx = min(rows[r] - x, radius)
+                    if lo_dx <= -radius and hi_dx >= radius:
+                        entry = deepest
+                    else:
+                        entry = INF
+                        i_lo = int(math.ceil((lo_dx + radius) / (2.0 * radius) * (n_samples - 1) - 1e-9))
+                        i_hi = int(math.floor((hi_dx + radius) / (2.0 * radius) * (n_samples - 1) + 1e-9))
+                        for i in range(max(i_lo, 0), min(i_hi, n_samples - 1) + 1):
+                            if samples[i] < entry:
+                                entry = samples[i]
+                        for dx in (lo_dx, hi_dx):  # the move's own end poses, exactly
+                            e = _blade_entry(dx, theta0 + twist * dx, px, pz_, nx, nz_, y, z, t_min, top, radius,
+                                             half_flat, rt)
+                            if e < entry:
+                                entry = e
+                    if entry < hrow[r]:
+                        hrow[r] = entry
+                        cuts += 1
+    return cuts
+
+
+@njit(cache=True)
+def clip_poses_twisted(poses, x_end, h, h_top, points, normals, chunk_start, chunk_centre, chunk_radius, rows, t_min,
+                       radius, half_flat, rt, reach, blade_len, pitch, teeth, twist, dx_step):
+    """`clip_poses` for a helical design (row r turned by twist * rows[r], rad/mm); x_end[i] > x[i] is a move
+    following the lead from x to x_end (A falling by twist * dX)."""
+    cuts = 0
+    for i in range(poses.shape[0]):
+        cuts += _clip_twisted_pose(poses[i, 0], poses[i, 1], poses[i, 2], poses[i, 3], x_end[i], h, h_top, points,
+                                   normals, chunk_start, chunk_centre, chunk_radius, rows, t_min, radius, half_flat, rt,
+                                   reach, blade_len, pitch, teeth, twist, dx_step)
+    return cuts

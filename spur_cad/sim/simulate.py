@@ -153,11 +153,14 @@ def _tool_shape(tool: Tool) -> tuple[float, float, float]:
 
 def decompose(path: Toolpath, tool: Tool, resolution_mm: float, reach_mm: float,
               flat_step_mm: float | None = None,
-              x_range: tuple[float, float] = (-np.inf, np.inf)) -> tuple[np.ndarray, np.ndarray, int]:
+              x_range: tuple[float, float] = (-np.inf, np.inf),
+              twist_rad_per_mm: float = 0.0) -> tuple[np.ndarray, np.ndarray, int]:
     """Poses (N, 4: x, y, z, a rad) and their X-sweep ends (N,) that together remove what the moves remove.
 
-    Returns (poses, x_end, number of moves along X only). Markers carry no motion and are skipped;
-    the first row's start is unknown (the IR says so): it is clipped at its end pose only.
+    Returns (poses, x_end, number of sweeps). Markers carry no motion and are skipped; the first
+    row's start is unknown (the IR says so): it is clipped at its end pose only. A sweep is a move
+    along X only (spur design) or a move following the lead (helical design: A falls by
+    twist * dX, Y and Z fixed); its pose is its end with the smaller X.
     """
     motion = path.motion_mask
     if not motion.any():
@@ -171,13 +174,18 @@ def decompose(path: Toolpath, tool: Tool, resolution_mm: float, reach_mm: float,
     radius = tool.diameter_mm / 2.0
     above = (np.minimum(z0, z) > reach_mm) | (np.maximum(x0, x) < x_range[0] - radius) \
         | (np.minimum(x0, x) > x_range[1] + radius)
-    still_yza = (dy == 0.0) & (dz == 0.0) & (da == 0.0)
-    along_x = ~above & still_yza & (dx != 0.0)
+    if twist_rad_per_mm == 0.0:
+        lead = da == 0.0
+    else:  # the generators compute A from X; allow for rounding only
+        lead = np.abs(da + twist_rad_per_mm * dx) <= 1e-9 * np.maximum(1.0, np.abs(da))
+    along_x = ~above & (dy == 0.0) & (dz == 0.0) & lead & (dx != 0.0)
     only_z = ~above & (dx == 0.0) & (dy == 0.0) & (da == 0.0)
     general = ~above & ~along_x & ~only_z
     general[0] = False
     only_z[0] = not above[0]  # first row: its end pose only
-    sweeps = np.stack([np.minimum(x0, x)[along_x], y[along_x], z[along_x], a[along_x]], axis=-1)
+    backwards = along_x & (x < x0)
+    sweep_a = np.where(backwards, a, a0)[along_x]
+    sweeps = np.stack([np.minimum(x0, x)[along_x], y[along_x], z[along_x], sweep_a], axis=-1)
     sweep_end = np.maximum(x0, x)[along_x]
     lows = np.stack([x[only_z], y[only_z], np.minimum(z0, z)[only_z], a[only_z]], axis=-1)
     idx = np.nonzero(general)[0]
@@ -187,8 +195,8 @@ def decompose(path: Toolpath, tool: Tool, resolution_mm: float, reach_mm: float,
         # its flat bottom; its round edge (radius D/2) does, as a corner of that radius.
         step[(dz[idx] == 0.0) & (da[idx] == 0.0)] = flat_step_mm
     radius_from_axis = np.maximum(np.hypot(y0[idx], z0[idx]), np.hypot(y[idx], z[idx])) + tool.diameter_mm / 2.0
-    travel = (np.abs(dx[idx]) + np.hypot(dy[idx], dz[idx]) + np.minimum(radius_from_axis, reach_mm)
-              * np.abs(da[idx]))
+    turn = np.abs(da[idx]) + abs(twist_rad_per_mm) * np.abs(dx[idx])  # a helical design also turns along X
+    travel = np.abs(dx[idx]) + np.hypot(dy[idx], dz[idx]) + np.minimum(radius_from_axis, reach_mm) * turn
     pieces = np.maximum(1, np.ceil(travel / step)).astype(np.int64)
     move_of = np.repeat(idx, pieces)
     offsets = np.arange(len(move_of)) - np.repeat(np.cumsum(pieces) - pieces, pieces)
@@ -297,7 +305,7 @@ def simulate_grid(grid: DesignGrid, stock: StockCylinder, operations: Sequence[C
                   settings: SimSettings = SimSettings(), *, face_width_mm: float, station_x: np.ndarray | None = None,
                   progress: Callable[[float], None] | None = None, started: float | None = None) -> SimResult:
     """`simulate` on a given design grid (any outline with normals, e.g. a plain cylinder in tests)."""
-    from spur_cad.sim.kernel import clip_poses
+    from spur_cad.sim.kernel import clip_poses, clip_poses_twisted
 
     settings.validate()
     started = time.perf_counter() if started is None else started
@@ -310,12 +318,15 @@ def simulate_grid(grid: DesignGrid, stock: StockCylinder, operations: Sequence[C
     blade_ends = np.concatenate([grid.points + t_min * grid.normals, grid.points + t_max * grid.normals])
     reach = float(np.hypot(*blade_ends.T).max()) + 1e-9
     blade_len = max(settings.gouge_range_mm, settings.leftover_range_mm)
+    twist = grid.twist_rad_per_mm
+    # Lead sweeps sample the tool's slices so that the design turns by at most resolution / 2 between them.
+    dx_step = 0.5 * res / (reach * abs(twist)) if twist else 0.0
     batches = []
     sweeps = moves = 0
     for op in operations:
         radius, half_flat, rt = _tool_shape(op.tool)
         flat_step = math.sqrt(8.0 * radius * res / 2.0)
-        poses, x_end, n_sweeps = decompose(op.path, op.tool, res, reach, flat_step, (x_lo, x_hi))
+        poses, x_end, n_sweeps = decompose(op.path, op.tool, res, reach, flat_step, (x_lo, x_hi), twist)
         sweeps += n_sweeps
         moves += len(op.path)
         for lo in range(0, len(poses), POSE_BATCH):
@@ -324,9 +335,14 @@ def simulate_grid(grid: DesignGrid, stock: StockCylinder, operations: Sequence[C
     done = 0
     for poses, x_end, radius, half_flat, rt in batches:
         h_top = np.ascontiguousarray(h.max(axis=2))
-        clip_poses(np.ascontiguousarray(poses), np.ascontiguousarray(x_end), h, h_top, grid.points, grid.normals,
-                   chunk_start, chunk_centre, chunk_radius, grid.rows_x, t_min, t_max, radius, half_flat, rt, reach,
-                   blade_len, grid.pitch_rad, grid.teeth)
+        if twist:
+            clip_poses_twisted(np.ascontiguousarray(poses), np.ascontiguousarray(x_end), h, h_top, grid.points,
+                               grid.normals, chunk_start, chunk_centre, chunk_radius, grid.rows_x, t_min, radius,
+                               half_flat, rt, reach, blade_len, grid.pitch_rad, grid.teeth, twist, dx_step)
+        else:
+            clip_poses(np.ascontiguousarray(poses), np.ascontiguousarray(x_end), h, h_top, grid.points, grid.normals,
+                       chunk_start, chunk_centre, chunk_radius, grid.rows_x, t_min, t_max, radius, half_flat, rt, reach,
+                       blade_len, grid.pitch_rad, grid.teeth)
         done += len(poses)
         if progress is not None:
             progress(done / max(total, 1))
