@@ -19,7 +19,7 @@ from spur_cad.cam.recommend import ToolRecommendations, check_roughing_reach, ch
 from spur_cad.cam.roughing import RoughingLevels, estimated_roughing_moves, roughing_levels, roughing_toolpath
 from spur_cad.cam.strategies import FinishingResult, get_strategy, params_from_section
 from spur_cad.cam.tools import Tool, ToolError
-from spur_cad.errors import GearSpecError, WorkLimitError
+from spur_cad.errors import WorkLimitError
 from spur_cad.geometry.spec import GearSpec
 
 MAX_TOOLPATH_MOVES = 10_000_000
@@ -95,10 +95,10 @@ def check_cam_inputs(inputs: CamInputs) -> tuple[ToolRecommendations, RoughingLe
     roughing work bound and the roughing reach. Returns the
     recommendations and the roughing levels (None without a roughing tool)."""
     spec, machine, stock = inputs.spec, inputs.machine, inputs.stock
-    if spec.is_helical and inputs.finishing_tool is not None:
-        raise GearSpecError(f"helix_angle_deg = {spec.helix_angle_deg:g}: finishing of helical gears is not "
-                            "implemented yet (roughing is); remove [tools.finishing] for those, or set "
-                            "helix_angle_deg = 0", field="helix_angle_deg", section="gear")
+    if spec.is_helical and inputs.finishing_tool is not None and inputs.finishing.strategy != "generating":
+        raise MachineError(f"[finishing] strategy = {inputs.finishing.strategy!r} is for spur gears; a helical gear "
+                           f"(helix_angle_deg = {spec.helix_angle_deg:g}) is finished by strategy = \"generating\"",
+                           field="strategy", section="finishing")
     blank = stock.blank_radius_mm(spec)
     rec = recommend_tools(spec, blank, machine.clearance_mm, inputs.finishing_tool)
     check_tools(spec, rec, inputs.roughing_tool, inputs.finishing_tool)
@@ -195,6 +195,8 @@ def _comparison_estimate(spec: GearSpec, tool: Tool, machine: Machine, blank: fl
     """The estimate of another finishing with the same tool, for comparison; None when it would exceed
     MAX_COMPARISON_MOVES (or cannot be planned with this tool). A table that only indexes is taken as
     simultaneous here: the figure says what that strategy would take."""
+    if spec.is_helical and section.strategy != "generating":  # perimeter is for spur gears only
+        return None
     simultaneous = dataclasses.replace(machine, rotary_simultaneous=True)
     strategy = get_strategy(section.strategy)
     try:

@@ -165,7 +165,8 @@ def _program(summary: dict) -> str:
     return text
 
 
-NOT_ESTIMATED = "not estimated (too large to build for comparison, or the tool does not fit that strategy)"
+NOT_ESTIMATED = ("not estimated (too large to build for comparison, the tool does not fit that strategy, or the "
+                 "strategy is for spur gears only)")
 
 
 def _finishing_comparison(finish: dict) -> str:

@@ -92,6 +92,13 @@ from spur_cad.cam.contacts import SpacePoses, TransversePoses, tool_signed_dista
 from spur_cad.cam.ir import Feature, MoveKind, Operation, Toolpath, ToolpathBuilder
 from spur_cad.cam.machine import Machine, MachineError
 from spur_cad.cam.strategies.base import FinishingResult
+from spur_cad.cam.strategies.generating_helical import (
+    check_helical_generating_tool,
+    face_turn_range,
+    flank_roll_step,
+    helical_passes,
+    tip_roll_step,
+)
 from spur_cad.cam.tools import Tool, ToolError
 from spur_cad.errors import WorkLimitError
 from spur_cad.geometry.frames import turn_points
@@ -106,6 +113,7 @@ GOUGE_TOLERANCE_MM = 1e-5
 RAISED_END_MARGIN_MM = 0.02
 """With flank_tool_end = "raised", the straight side starts this far below the flat's lower crossing."""
 TIP_MODE_SAFETY = 0.95
+_TIP_SAFETY_HELICAL = 0.95  # helical tip-mode rolls are spaced for this fraction of the target (closed form)
 """Tip-mode rolls keep the sampled leftover within this fraction of the target."""
 _FLANK_SAFETY = 0.999
 _LEFTOVER_SAMPLES = 33
@@ -162,6 +170,8 @@ class GeneratingPass:
     z_mm: float
     side: int
     contact_radius_mm: float
+    dy_per_x: float = 0.0  # helical gears: the pass runs along the rack tooth, Y = y_mm + X dy_per_x
+    dz_per_x: float = 0.0  # and Z = z_mm + X dz_per_x (y_mm, z_mm at X = 0)
 
 
 @dataclass(frozen=True)
@@ -387,6 +397,9 @@ def _tip_rolls(spec: GearSpec, tool: Tool, goal: float) -> tuple[np.ndarray, np.
 def check_generating_tool(spec: GearSpec, tool: Tool) -> None:
     """ToolError when the tool cannot play the rack: corner radius above the rack tip radius (or the
     fillet's smallest curvature radius), or a flat wider than the rack's tip flat 2 d_1."""
+    if spec.is_helical:
+        check_helical_generating_tool(spec, tool)
+        return
     tool.validate("finishing")
     rho = spec.rack_tip_radius_mm
     r_t = tool.effective_corner_radius_mm
@@ -464,6 +477,8 @@ def plan_generating(spec: GearSpec, tool: Tool, params: GeneratingParams, *, lan
     cutting order."""
     params.validate()
     check_generating_tool(spec, tool)
+    if spec.is_helical:
+        return _plan_helical(spec, tool, params, lands)
     profile = spec.tooth_space_profile()
     target = params.target_scallop_mm
     rough = rough_passes_per_space(spec, tool, target)
@@ -513,6 +528,32 @@ def plan_generating(spec: GearSpec, tool: Tool, params: GeneratingParams, *, lan
         add("flank", Feature.LEFT_FLANK, t_rolls[i], math.nan, -fa[i], -fy[i], fz[i], -1, flank_radius[i])
     return GeneratingPlan(tuple(passes), t_rolls, betas, np.concatenate([roots, -roots[-2::-1]]), psis,
                           flat_height, max(tip_leftover, land_leftover))
+
+
+def _plan_helical(spec: GearSpec, tool: Tool, params: GeneratingParams, lands: bool) -> GeneratingPlan:
+    """The helical gear's passes (spur_cad.cam.strategies.generating_helical) as a plan."""
+    target = params.target_scallop_mm
+    lo, hi = face_turn_range(spec)
+    rough = (spec.tooth_space_profile().segment("involute").end - spec.tooth_space_profile().segment(
+        "involute").start + hi - lo) / flank_roll_step(spec, target) + 0.5 / tip_roll_step(spec, target)
+    if 2.0 * rough > MAX_PASSES_PER_SPACE:
+        raise WorkLimitError(f"generating finishing would need about {2 * rough:.3g} passes per tooth space (limit "
+                             f"{MAX_PASSES_PER_SPACE:,}) for target_scallop_mm = {target:.3g}; raise [finishing] "
+                             "target_scallop_mm", field="target_scallop_mm", section="finishing")
+    rows = helical_passes(spec, tool, target, spec.tip_radius_mm + tool.diameter_mm, lands)
+    rb = spec.base_radius_mm
+    passes = []
+    for mode, feature, roll, a, y0, z0, sy, sz, side in rows:
+        radius = {"flank": rb * math.sqrt(1.0 + roll * roll), "land": spec.tip_radius_mm}.get(mode,
+                                                                                                spec.root_radius_mm)
+        passes.append(GeneratingPass(mode, feature, roll, math.nan, math.degrees(a), y0, z0, side, radius, sy, sz))
+    flank = np.array(sorted(p.roll_rad for p in passes if p.feature == Feature.RIGHT_FLANK and p.mode == "flank"))
+    tips = np.array(sorted({p.roll_rad for p in passes if p.mode == "tip"}, reverse=True))
+    land = np.array([p.roll_rad for p in passes if p.mode == "land"])
+    step = flank_roll_step(spec, target)
+    t_worst = spec.tooth_space_profile().segment("involute").end + hi - lo
+    return GeneratingPlan(tuple(passes), flank, np.zeros(0), tips, land,
+                          _flat_leftover(rb, t_worst - step, t_worst), _TIP_SAFETY_HELICAL * target)
 
 
 # --------------------------------------------------------------------------- tool advice
@@ -567,11 +608,12 @@ def generating_tool_limits(spec: GearSpec, corner_radius_mm: float, target_scall
     return GeneratingToolLimits(rho, rho, tip_max, flank_rack, flank_raised, flute)
 
 
-def passes_flute_length_mm(passes: tuple[GeneratingPass, ...], tool: Tool, blank_radius_mm: float) -> float:
+def passes_flute_length_mm(passes: tuple[GeneratingPass, ...], tool: Tool, blank_radius_mm: float,
+                           face_width_mm: float = 0.0) -> float:
     """Flute length the passes need: for each pass, from the tool end up to the blank circle above the
-    tool's point nearest the axis (conservative: the stock before roughing)."""
-    y = np.array([p.y_mm for p in passes])
-    z = np.array([p.z_mm for p in passes])
+    tool's point nearest the axis (conservative: the stock before roughing); helical passes at both faces."""
+    y = np.array([p.y_mm + x * p.dy_per_x for p in passes for x in (0.0, face_width_mm)])
+    z = np.array([p.z_mm + x * p.dz_per_x for p in passes for x in (0.0, face_width_mm)])
     half = tool.diameter_mm / 2.0
     near = np.maximum(np.abs(y) - half, 0.0)
     return float(np.max(np.sqrt(np.maximum(blank_radius_mm**2 - near**2, 0.0)) - z))
@@ -581,6 +623,12 @@ def tool_advice(spec: GearSpec, tool: Tool, params: GeneratingParams, plan: Gene
                 blank_radius_mm: float) -> dict[str, float]:
     """summary.json's `tools.generating_advice`: limits for this tool's corner radius, the largest tool
     with the advised corner radius (rho), and the flute length this tool's passes need."""
+    if spec.is_helical:  # the corner must be rho; the tip mode bounds the diameter (generating_helical)
+        rho, d_n = spec.rack_tip_radius_mm, rack_corner(spec).normal_corner_offset_mm
+        return {"advised_corner_radius_mm": rho, "max_corner_radius_mm": rho,
+                "tip_mode_max_diameter_mm": 2.0 * d_n + 2.0 * rho, "max_diameter_mm": 2.0 * d_n + 2.0 * rho,
+                "required_flute_length_mm": passes_flute_length_mm(plan.passes, tool, blank_radius_mm,
+                                                                   spec.face_width_mm)}
     end = params.flank_tool_end
     own = generating_tool_limits(spec, tool.effective_corner_radius_mm, params.target_scallop_mm, blank_radius_mm,
                                  end)
@@ -675,16 +723,18 @@ def _passes(builder: ToolpathBuilder, spec: GearSpec, tool: Tool, machine: Machi
     for p in plan.passes:
         direction = _pass_direction(p.side, params.cutting_direction)
         x0, x1 = (x_front, x_back) if direction > 0 else (x_back, x_front)
-        rows.append((MoveKind.RAPID, x0, p.y_mm, safe_z, p.a_deg, math.nan, Feature.NONE))
+        y0, y1 = p.y_mm + x0 * p.dy_per_x, p.y_mm + x1 * p.dy_per_x
+        z0, z1 = p.z_mm + x0 * p.dz_per_x, p.z_mm + x1 * p.dz_per_x
+        rows.append((MoveKind.RAPID, x0, y0, safe_z, p.a_deg, math.nan, Feature.NONE))
         if clamp:
-            rows.append((MoveKind.CLAMP_ROTARY, x0, p.y_mm, safe_z, p.a_deg, math.nan, Feature.NONE))
+            rows.append((MoveKind.CLAMP_ROTARY, x0, y0, safe_z, p.a_deg, math.nan, Feature.NONE))
         if machine.clearance_mm > 0.0:
-            rows.append((MoveKind.LINEAR, x0, p.y_mm, p.z_mm + machine.clearance_mm, p.a_deg, fast, Feature.NONE))
-        rows.append((MoveKind.LINEAR, x0, p.y_mm, p.z_mm, p.a_deg, PLUNGE_FEED_FRACTION * feed, Feature.NONE))
-        rows.append((MoveKind.LINEAR, x1, p.y_mm, p.z_mm, p.a_deg, feed, p.feature))
-        rows.append((MoveKind.LINEAR, x1, p.y_mm, safe_z, p.a_deg, fast, Feature.NONE))
+            rows.append((MoveKind.LINEAR, x0, y0, z0 + machine.clearance_mm, p.a_deg, fast, Feature.NONE))
+        rows.append((MoveKind.LINEAR, x0, y0, z0, p.a_deg, PLUNGE_FEED_FRACTION * feed, Feature.NONE))
+        rows.append((MoveKind.LINEAR, x1, y1, z1, p.a_deg, feed, p.feature))
+        rows.append((MoveKind.LINEAR, x1, y1, safe_z, p.a_deg, fast, Feature.NONE))
         if clamp:
-            rows.append((MoveKind.UNCLAMP_ROTARY, x1, p.y_mm, safe_z, p.a_deg, math.nan, Feature.NONE))
+            rows.append((MoveKind.UNCLAMP_ROTARY, x1, y1, safe_z, p.a_deg, math.nan, Feature.NONE))
     kind, x, y, z, a_rel, feeds, feature = (np.array(c) for c in zip(*rows))
     teeth, pitch_deg, per_space = spec.teeth, 360.0 / spec.teeth, len(rows)
     space = np.repeat(np.arange(teeth), per_space)

@@ -1,0 +1,316 @@
+"""Finishing by generation for helical gears (docs/method.md): A clamped, one straight 3-D pass per
+rack position, along the rack tooth.
+
+The generating rack of a helical gear is a prism along the tooth direction d, inclined at the
+helix angle beta in the pitch plane. With A = phi (the roll) the machine sees it with its tooth
+axis vertical; in the transverse section at X it is the transverse rack moved by -r phi - X h tan(beta)
+(h = +1 right hand, -1 left), because section X of the part is section 0 turned by
+X h tan(beta) / r: section X sees the rack at roll phi + X h tan(beta) / r ("effective roll").
+A pass turned by a further gamma about X runs along d turned by gamma:
+dY/dX = -h tan(beta) cos(gamma), dZ/dX = -h tan(beta) sin(gamma).
+
+- **No gouge, in 3-D.** A tool swept along the prism's direction stays inside the prism when the
+  tool does at one point of the pass: its projection along d must lie inside the rack's *normal*
+  section (flanks at alpha_n, tip rounds of radius rho). Every pass is checked that way against
+  the rack tooth it plays (`rack_clearance_mm`, exact signed distance to the rounded wedge).
+  The rack at any roll lies outside the gear, so such a pass cannot cut into the gear anywhere.
+- **Flank mode.** gamma = +-alpha_t (transverse pressure angle) makes the rack's flank plane
+  vertical; its trace in the XY plane runs at the base helix angle (dY/dX = -h tan(beta_b)) through
+  Y = -+r_b t at X = 0, so every transverse section sees the spur flank pass at roll t shifted by
+  its turn. The tool's side lies on that plane (axis R sqrt(1 + tan^2 beta_b) from the trace along
+  Y) and its end is the lowest at which the tool still lies inside the rack tooth (bisection on
+  the clearance). Rolls are evenly spaced so that the generating flats leave at most the target
+  at the largest roll any section sees (the flat deviation grows with the roll).
+- **Tip mode (fillets and root)** needs the tool's corner radius equal to rho: with A = phi and
+  the pass along d (gamma = 0) the tool's projection is its own profile, and its corner *is* the
+  rack's round over the whole pass. A smaller corner would touch the round at one angle, and one
+  pass along d would then generate the fillet in a single transverse section only. Per roll: the
+  tool's right corner on the right round, its left corner on the left round, and, where the tip
+  flat generates the root somewhere over the face width, flat passes between them. Rolls are
+  evenly spaced so that the cusps left by the elliptic transverse round stay within the target.
+- Rolls (and land angles) cover what every section needs: the spur ranges widened by the turn of
+  the face width, b tan(beta) / r.
+- **Lands**: passes along X at fixed A with the flat bottom on the tip cylinder's tangent plane,
+  as for spur gears, over the land angles widened by the turn.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from spur_cad.cam.ir import Feature
+from spur_cad.cam.tools import Tool, ToolError
+from spur_cad.errors import WorkLimitError
+from spur_cad.geometry.profile import rack_corner
+from spur_cad.geometry.spec import GearSpec
+
+CLEARANCE_TOLERANCE_MM = 1e-6
+"""A pass may touch its rack tooth's boundary within this (the flank side lies on it by design)."""
+CORNER_MATCH_MM = 1e-6
+"""The tool's corner radius must equal the rack tip radius within this for helical tip mode."""
+_SAFETY = 0.95
+
+
+def pass_slopes(spec: GearSpec, gamma_rad: float) -> tuple[float, float]:
+    """(dY/dX, dZ/dX) of a pass along the rack tooth turned by gamma about X."""
+    tan_h = spec.hand_sign * math.tan(spec.helix_angle_rad)
+    return -tan_h * math.cos(gamma_rad), -tan_h * math.sin(gamma_rad)
+
+
+def face_turn_range(spec: GearSpec) -> tuple[float, float]:
+    """(lowest, highest) turn of a transverse section over the face width (rad): 0 and b h tan(beta) / r."""
+    turn = spec.section_turn_rad(spec.face_width_mm)
+    return min(0.0, turn), max(0.0, turn)
+
+
+def rack_tooth_signed_distance_mm(spec: GearSpec, n: np.ndarray, z: np.ndarray) -> np.ndarray:
+    """Signed distance (< 0 inside) to the rack tooth in its normal section: n from the tooth's centre
+    plane, z machine height at A = phi. The tooth is the wedge of the round centres (z >= r_f + rho,
+    |n| <= d_n + (z - r_f - rho) tan(alpha_n)) grown by rho."""
+    corner = rack_corner(spec)
+    rho, d_n = spec.rack_tip_radius_mm, corner.normal_corner_offset_mm
+    alpha = spec.normal_pressure_angle_rad
+    z_c = spec.root_radius_mm + rho
+    m, dz = np.abs(n), np.asarray(z, float) - z_c
+    side = (m - d_n) * math.cos(alpha) - dz * math.sin(alpha)
+    inside = np.maximum(-dz, side)
+    to_bottom = np.hypot(np.maximum(m - d_n, 0.0), np.minimum(dz, 0.0))
+    along = np.maximum((m - d_n) * math.sin(alpha) + dz * math.cos(alpha), 0.0)
+    to_flank = np.hypot(m - d_n - along * math.sin(alpha), dz - along * math.cos(alpha))
+    outside = np.minimum(to_bottom, to_flank)
+    return np.where(inside <= 0.0, inside, outside) - rho
+
+
+def tool_hull_points(tool: Tool, height_mm: float, around: int = 180, corner: int = 12) -> np.ndarray:
+    """(N, 3) points relative to the tool tip centre whose convex hull is the tool up to `height_mm`."""
+    radius, r_t = tool.diameter_mm / 2.0, tool.effective_corner_radius_mm
+    theta = np.linspace(0.0, 2.0 * math.pi, around, endpoint=False)
+    psi = np.linspace(0.0, 0.5 * math.pi, corner) if r_t > 0.0 else np.array([0.5 * math.pi])
+    ring_r = np.concatenate([radius - r_t + r_t * np.sin(psi), [radius]])
+    ring_z = np.concatenate([r_t - r_t * np.cos(psi), [height_mm]])
+    x = (ring_r[:, None] * np.cos(theta)[None, :]).ravel()
+    y = (ring_r[:, None] * np.sin(theta)[None, :]).ravel()
+    z = np.repeat(ring_z, around)
+    return np.stack([x, y, z], axis=-1)
+
+
+def rack_clearance_mm(spec: GearSpec, points: np.ndarray, a_rad: float, phi: float) -> float:
+    """Largest signed distance of machine points (N, 3: X, Y, Z at A = a_rad) from the rack tooth at roll
+    phi (<= 0: all inside the rack, which never enters the gear)."""
+    turn = phi - a_rad  # the same part point with A = phi
+    c, s = math.cos(turn), math.sin(turn)
+    x, y, z = points[:, 0], points[:, 1] * c - points[:, 2] * s, points[:, 1] * s + points[:, 2] * c
+    tan_h = spec.hand_sign * math.tan(spec.helix_angle_rad)
+    axis_y = -spec.reference_radius_mm * phi - tan_h * x
+    n = (y - axis_y) * math.cos(spec.helix_angle_rad)
+    return float(rack_tooth_signed_distance_mm(spec, n, z).max())
+
+
+def check_helical_generating_tool(spec: GearSpec, tool: Tool) -> None:
+    """ToolError unless the tool's corner radius is the rack tip radius and its flat fits the rack's tip flat."""
+    tool.validate("finishing")
+    rho, r_t = spec.rack_tip_radius_mm, tool.effective_corner_radius_mm
+    if abs(r_t - rho) > CORNER_MATCH_MM:
+        raise ToolError(f"finishing strategy generating for a helical gear: tool corner radius r_t = {r_t:g} mm must "
+                        f"equal the rack tip radius rho = {rho:g} mm (the corner then is the rack's round along the "
+                        "whole pass; a smaller one would generate the fillet in one transverse section only)",
+                        field="corner_radius_mm", section="tools.finishing")
+    d_n = rack_corner(spec).normal_corner_offset_mm
+    if tool.flat_width_mm > 2.0 * d_n + 1e-12:
+        raise ToolError(f"finishing strategy generating: tool flat width d = {tool.flat_width_mm:g} mm (D - 2 r_t) is "
+                        f"wider than the rack's normal tip flat 2 d_n = {2 * d_n:.4f} mm; largest diameter: "
+                        f"{2 * d_n + 2 * r_t:.4f} mm", field="diameter_mm", section="tools.finishing")
+
+
+def _even(lo: float, hi: float, step: float) -> np.ndarray:
+    """Evenly spaced values from lo to hi, at most `step` apart (both ends included)."""
+    count = max(1, math.ceil((hi - lo) / step - 1e-12))
+    return np.linspace(lo, hi, count + 1)
+
+
+def flank_roll_step(spec: GearSpec, target_mm: float) -> float:
+    """Even roll spacing whose generating flats leave at most `target` at the largest roll any section sees."""
+    from spur_cad.cam.strategies.generating import _flat_leftover
+
+    involute = spec.tooth_space_profile().segment("involute")
+    lo, hi = face_turn_range(spec)
+    t_worst = involute.end + (hi - lo)
+    rb, goal = spec.base_radius_mm, _SAFETY * target_mm
+    step = math.sqrt(8.0 * goal / (rb * t_worst))
+    while _flat_leftover(rb, t_worst - step, t_worst) > goal:
+        step *= 0.9
+    return step
+
+
+def _rack_tip_boundary(spec: GearSpec, samples: int = 600) -> np.ndarray:
+    """Transverse outline of the rack's right tip corner at roll 0 (gear frame, rolling line at Z = r): the
+    elliptic round (semi-axes rho / cos(beta) along, rho across) from its bottom to T, and the tip line."""
+    corner = rack_corner(spec)
+    rho, s = corner.corner_radius_mm, corner.stretch
+    centre = np.array([corner.corner_offset_mm, spec.reference_radius_mm - corner.corner_depth_mm])
+    theta = np.linspace(-0.5 * math.pi, 0.0, samples)
+    round_ = centre + np.stack([s * rho * np.cos(theta), rho * np.sin(theta)], axis=-1)
+    line = np.stack([np.linspace(-centre[0], centre[0], samples // 4), np.full(samples // 4, spec.root_radius_mm)],
+                    axis=-1)
+    return np.concatenate([line, round_])
+
+
+def _tip_leftover_mm(spec: GearSpec, rolls: np.ndarray, points: np.ndarray, outline: np.ndarray) -> float:
+    """Largest distance of fillet/root points from the nearest of the rack outlines at `rolls` (transverse)."""
+    best = np.full(len(points), np.inf)
+    r = spec.reference_radius_mm
+    for phi in rolls:
+        c, s = math.cos(-phi), math.sin(-phi)
+        moved = outline - np.array([r * phi, 0.0])
+        part = np.stack([moved[:, 0] * c - moved[:, 1] * s, moved[:, 0] * s + moved[:, 1] * c], axis=-1)
+        d = np.sqrt(((points[:, None, :] - part[None, :, :]) ** 2).sum(axis=-1)).min(axis=1)
+        best = np.minimum(best, d)
+    return float(best.max())
+
+
+def tip_roll_step(spec: GearSpec, target_mm: float) -> float:
+    """Even rack-roll spacing for tip mode: the largest (from the closed-form start r_f dphi^2 / 8, shrunk by
+    10 % steps) whose rolls, at four phases, leave fillet and root points (right half, transverse) within 95 %
+    of the target from the nearest rack outline -- each section sees the rolls shifted by its turn."""
+    from spur_cad.geometry.sampling import sample_profile
+
+    samples = sample_profile(spec.tooth_space_profile(), 1e-3 * spec.module_mm)
+    keep = np.isin(samples.label_names(), ["fillet", "root"])
+    points = samples.points[keep][:: max(1, int(keep.sum()) // 200)]
+    outline = _rack_tip_boundary(spec)
+    corner = rack_corner(spec)
+    r = spec.reference_radius_mm
+    phi_t = (corner.corner_offset_mm - corner.corner_depth_mm / math.tan(spec.pressure_angle_rad)) / r
+    lo, hi = min(phi_t, -corner.corner_offset_mm / r) - 0.02, corner.corner_offset_mm / r + 0.02
+    goal = _SAFETY * target_mm
+    step = math.sqrt(8.0 * goal / spec.root_radius_mm)
+    for _ in range(40):
+        rolls = np.arange(lo, hi + step, step)
+        if all(_tip_leftover_mm(spec, rolls + phase * step, points, outline) <= goal for phase in (0.0, 0.25, 0.5,
+                                                                                                 0.75)):
+            return step
+        step *= 0.9
+    raise WorkLimitError(f"generating finishing: no roll spacing above {step:.3g} rad keeps the fillet within "
+                         f"target_scallop_mm = {target_mm:g}", field="target_scallop_mm", section="finishing")
+
+
+def _flank_passes(spec: GearSpec, tool: Tool, target_mm: float, points: np.ndarray) -> list[tuple]:
+    """(mode, feature, roll, a rad, y0, z0, dy/dx, dz/dx, side) of both flanks' passes (right tip -> root, left
+    root -> tip)."""
+    involute = spec.tooth_space_profile().segment("involute")
+    lo, hi = face_turn_range(spec)
+    step = flank_roll_step(spec, target_mm)
+    rb, alpha_t = spec.base_radius_mm, spec.pressure_angle_rad
+    theta_b = involute.base_angle_rad
+    radius = tool.diameter_mm / 2.0
+    out = []
+    for side, feature, rolls in ((1, Feature.RIGHT_FLANK, _even(involute.start - hi, involute.end - lo, step)[::-1]),
+                                 (-1, Feature.LEFT_FLANK, _even(involute.start + lo, involute.end + hi, step))):
+        gamma = side * alpha_t
+        sy, sz = pass_slopes(spec, gamma)
+        for t in rolls:
+            a = side * (theta_b + t)
+            y0 = -side * (rb * t + radius * math.sqrt(1.0 + sy * sy))
+            z0 = _lowest_end(spec, points, a, a - gamma, y0, spec.reference_radius_mm, tool)
+            out.append(("flank", feature, float(t), a, y0, z0, sy, sz, side))
+    return out
+
+
+def _lowest_end(spec: GearSpec, points: np.ndarray, a: float, phi: float, y0: float, z_high: float,
+                tool: Tool) -> float:
+    """Lowest tip Z (at X = 0) with the tool inside the rack tooth at roll phi (bisection)."""
+    def clearance(z0: float) -> float:
+        return rack_clearance_mm(spec, points + np.array([0.0, y0, z0]), a, phi)
+
+    if clearance(z_high) > CLEARANCE_TOLERANCE_MM:
+        raise ToolError(f"finishing strategy generating: the {tool.diameter_mm:g} mm tool does not fit inside the "
+                        "rack tooth of a flank pass of this helical gear; use a smaller diameter",
+                        field="diameter_mm", section="tools.finishing")
+    low = spec.root_radius_mm - tool.diameter_mm
+    for _ in range(48):
+        mid = 0.5 * (low + z_high)
+        low, z_high = (low, mid) if clearance(mid) <= CLEARANCE_TOLERANCE_MM else (mid, z_high)
+    return z_high
+
+
+def _tip_passes(spec: GearSpec, tool: Tool, target_mm: float) -> list[tuple]:
+    """Tip-mode passes (rolls descending: right fillet -> root -> left fillet)."""
+    corner = rack_corner(spec)
+    r, beta = spec.reference_radius_mm, spec.helix_angle_rad
+    d1 = corner.corner_offset_mm
+    d_n, rho = corner.normal_corner_offset_mm, spec.rack_tip_radius_mm
+    alpha_n, alpha_t = spec.normal_pressure_angle_rad, spec.pressure_angle_rad
+    half_flat = tool.flat_width_mm / 2.0
+    lo, hi = face_turn_range(spec)
+    # Transverse point T (flank/round tangency) and the roll at which its normal passes the pitch point.
+    t_y = (d_n + rho * math.cos(alpha_n)) / math.cos(beta)
+    t_z = spec.root_radius_mm + rho - rho * math.sin(alpha_n)
+    phi_t = (t_y - (r - t_z) / math.tan(alpha_t)) / r
+    phi_bottom = d1 / r
+    sy, _ = pass_slopes(spec, 0.0)
+    reach_n = math.sqrt(2.0 * max(tool.effective_corner_radius_mm, 1e-9) * 0.5 * target_mm)  # corner drop
+    spread = spec.hand_sign * spec.face_width_mm * math.sin(beta)  # the root contact's travel in n over the face
+    inner = d_n - half_flat  # tool axis offset with a corner on a round
+    out = []
+    first = min(phi_t, -phi_bottom) - hi
+    last = max(phi_bottom, -phi_t) - lo
+    for phi in _even(first, last, tip_roll_step(spec, target_mm))[::-1]:
+        positions: list[tuple[float, Feature, int]] = []
+        if phi_t - hi <= phi <= phi_bottom - lo:
+            positions.append((inner, Feature.RIGHT_FLANK, 1))
+        # The root contact (Y = 0 in every section) meets the rack's tip plane at n = r phi cos(beta) + X h sin(beta).
+        n_a = max(r * phi * math.cos(beta) + min(0.0, spread), -d_n)
+        n_b = min(r * phi * math.cos(beta) + max(0.0, spread), d_n)
+        if n_a <= n_b:
+            lo_axis = float(np.clip(min(n_a + half_flat, 0.5 * (n_a + n_b)), -inner, inner))
+            hi_axis = float(np.clip(max(n_b - half_flat, 0.5 * (n_a + n_b)), -inner, inner))
+            axes = [lo_axis] if hi_axis - lo_axis < 1e-9 else _even(lo_axis, hi_axis, 2.0 * (half_flat + reach_n))
+            side = 1 if phi >= 0.0 else -1
+            positions.extend((float(n), Feature.ROOT, side) for n in axes)
+        if -phi_bottom - hi <= phi <= -phi_t - lo:
+            positions.append((-inner, Feature.LEFT_FLANK, -1))
+        for n, feature, side in positions:
+            y0 = -r * phi + n / math.cos(beta)
+            out.append(("tip", feature, float(phi), float(phi), y0, spec.root_radius_mm, sy, 0.0, side))
+    return out
+
+
+def _land_passes(spec: GearSpec, tool: Tool, target_mm: float) -> list[tuple]:
+    """Land passes along X over the tooth on the +Y side of space 0, angles widened by the face's turn."""
+    tip = spec.tooth_space_profile().segment("tip")
+    if tip is None:
+        return []
+    lo, hi = face_turn_range(spec)
+    ra = spec.tip_radius_mm
+    reach = tool.flat_width_mm / 2.0 + math.sqrt(2.0 * max(tool.effective_corner_radius_mm, 1e-9) * 0.5 * target_mm)
+    first, last = tip.start, 2.0 * math.pi / spec.teeth - tip.start
+    return [("land", Feature.TIP, float(a), float(a), 0.0, ra, 0.0, 0.0, 1)
+            for a in _even(first - hi, last - lo, 2.0 * _SAFETY * reach / ra)]
+
+
+def helical_passes(spec: GearSpec, tool: Tool, target_mm: float, blank_radius_mm: float,
+                   lands: bool) -> list[tuple]:
+    """Every pass of tooth space 0 in cutting order: (mode, feature, roll, a rad, y0, z0, dy/dx, dz/dx, side),
+    each checked against the rack tooth it plays (ToolError when one would leave it)."""
+    check_helical_generating_tool(spec, tool)
+    points = tool_hull_points(tool, blank_radius_mm - spec.root_radius_mm + tool.diameter_mm)
+    flank = _flank_passes(spec, tool, target_mm, points)
+    right = [p for p in flank if p[8] > 0]
+    left = [p for p in flank if p[8] < 0]
+    passes = (_land_passes(spec, tool, target_mm) if lands else []) + right + _tip_passes(spec, tool, target_mm) + left
+    for mode, _, roll, a, y0, z0, _, _, side in passes:
+        if mode == "land":
+            continue
+        phi = a - side * spec.pressure_angle_rad if mode == "flank" else roll
+        clearance = rack_clearance_mm(spec, points + np.array([0.0, y0, z0]), a, phi)
+        if clearance > 10.0 * CLEARANCE_TOLERANCE_MM:
+            raise ToolError(f"finishing strategy generating: a {mode} pass of the {tool.diameter_mm:g} mm tool leaves "
+                            f"its rack tooth by {1000 * clearance:.3f} um; use a smaller diameter",
+                            field="diameter_mm", section="tools.finishing")
+    return passes
+
+
+__all__ = ["check_helical_generating_tool", "face_turn_range", "flank_roll_step", "helical_passes", "pass_slopes",
+           "rack_clearance_mm", "rack_tooth_signed_distance_mm", "tip_roll_step", "tool_hull_points"]
