@@ -269,7 +269,7 @@ def test_job_file_takes_helix_and_hand_and_refuses_bad_values():
 
 
 @pytest.mark.slow
-def test_spur_cad_run_writes_the_helical_geometry_and_roughing_and_refuses_finishing_naming_the_key(tmp_path):
+def test_spur_cad_run_writes_the_helical_job_and_refuses_a_wrong_corner_naming_the_key(tmp_path):
     import json
     from pathlib import Path
 
@@ -281,9 +281,14 @@ def test_spur_cad_run_writes_the_helical_geometry_and_roughing_and_refuses_finis
     summary = json.loads((tmp_path / "out" / "summary.json").read_text())
     assert summary["gear"]["helix_angle_deg"] == 15.0 and summary["gear"]["hand"] == "right"
     g = book_of("reference_15_right")
-    assert summary["gear"]["lead_mm"] == pytest.approx(g.lead) and "finishing" not in summary
-    assert summary["roughing"]["moves"] > 1000 and summary["simulation"]["max_gouge_mm"] == 0.0
+    assert summary["gear"]["lead_mm"] == pytest.approx(g.lead)
+    assert summary["roughing"]["moves"] > 1000 and summary["finishing"]["strategy"] == "generating"
+    simulation = summary["simulation"]
+    assert simulation["max_gouge_mm"] <= 0.005 and simulation["max_leftover_mm"] <= 0.005 + 0.005
+    assert simulation["uncut_points"] == 0
+    assert summary["finishing"]["perimeter_time_s"] is None  # perimeter is for spur gears only
     assert "G93" in (tmp_path / "out" / "roughing.ngc").read_text()
+    assert "G93" not in (tmp_path / "out" / "finishing.ngc").read_text()
     assert summary["inspection"]["span_measurement_mm"] == pytest.approx(
         span_measurement(spec_of("reference_15_right"), summary["inspection"]["span_teeth_k"]).length_mm)
     area = Polygon(gear_outline(spec_of("reference_15_right"), 1e-6)).area
@@ -296,5 +301,6 @@ def test_spur_cad_run_writes_the_helical_geometry_and_roughing_and_refuses_finis
     job.write_text(with_tools)
     result = run_cli("run", str(job), "--out", str(tmp_path / "out2"))
     assert result.returncode == 2 and len(result.stderr.strip().splitlines()) == 1
-    assert "helical.toml:8: helix_angle_deg = 15: finishing of helical gears is not implemented yet" in result.stderr
+    line = 1 + with_tools.splitlines().index("corner_radius_mm = 0.5")
+    assert f"helical.toml:{line}: " in result.stderr and "must equal the rack tip radius rho = 0.8" in result.stderr
     assert not (tmp_path / "out2").exists()

@@ -5,6 +5,7 @@ never touched, the finish stock kept), a wrong hand caught, and LinuxCNC's inter
 from __future__ import annotations
 
 import dataclasses
+import math
 from pathlib import Path
 
 import numpy as np
@@ -162,5 +163,223 @@ def test_rs274_reads_the_helical_roughing_program_with_the_lead_in_inverse_time(
                     along += 1
                 pose = end
         assert along > 1000
+        canon_by_mode[folded] = [line for line in canon if line.startswith("STRAIGHT")]
+    assert canon_by_mode[True] == canon_by_mode[False]
+
+
+# --------------------------------------------------------------------------- finishing by generation
+#
+# The independent check: the tool (a bull-nose, written here from its definition) swept along each cutting
+# move of tooth space 0, against exact design points of that space turned by the textbook helix
+# (X h tan(beta) / r) at the front, middle and back sections. The distance from a point to a convex tool
+# moving along a segment is convex along the segment: a golden-section search finds it.
+
+SECTIONS = (0.0, 10.0, 20.0)
+_GOLDEN = (math.sqrt(5.0) - 1.0) / 2.0
+
+
+@pytest.fixture(scope="module")
+def finished():
+    job = _job()
+    return job, plan_cam(job)
+
+
+def _tool_gap(p: np.ndarray, radius: float, r_t: float) -> np.ndarray:
+    """Distance from the bull-nose tool (tip centre at the origin, axis +Z, shank up) minus 0 (< 0 inside)."""
+    core = radius - r_t
+    e = np.maximum(np.hypot(p[..., 0], p[..., 1]) - core, 0.0)
+    v = np.maximum(r_t - p[..., 2], 0.0)
+    return np.hypot(e, v) - r_t
+
+
+def _sweep_gap(points: np.ndarray, starts: np.ndarray, ends: np.ndarray, radius: float, r_t: float) -> np.ndarray:
+    """(points, moves) smallest tool gap over each straight move (convex in the move parameter)."""
+    lo, hi = np.zeros((len(points), len(starts))), np.ones((len(points), len(starts)))
+
+    def gap(s):
+        at = starts[None, :, :] + s[..., None] * (ends - starts)[None, :, :]
+        return _tool_gap(points[:, None, :] - at, radius, r_t)
+
+    for _ in range(70):
+        a, b = hi - _GOLDEN * (hi - lo), lo + _GOLDEN * (hi - lo)
+        left = gap(a) < gap(b)
+        hi, lo = np.where(left, b, hi), np.where(left, lo, a)
+    return np.minimum(gap(0.5 * (lo + hi)), np.minimum(gap(np.zeros_like(lo)), gap(np.ones_like(lo))))
+
+
+def _space_points(spec):
+    """Exact points of tooth space 0 (both halves) in the part frame at section 0, and which are tip lands on
+    the +Y side (the land passes of space 0 finish that land; the other is the neighbour's)."""
+    from spur_cad.geometry import sample_profile
+
+    samples = sample_profile(spec.tooth_space_profile(), 1e-4)
+    labels = np.array(samples.label_names())
+    right = samples.points
+    points = np.concatenate([right, right * np.array([-1.0, 1.0])])
+    labels = np.concatenate([labels, labels])
+    keep = (labels != "tip") | (points[:, 0] > 0.0)
+    return points[keep][::3]
+
+
+def _cutting_moves(path, space: int = 0):
+    start = path.start_poses()
+    rows = np.nonzero((path.space == space) & (path.kind == MoveKind.LINEAR) & (path.feature != Feature.NONE))[0]
+    assert np.all(path.a[rows] == start[rows, 3])  # A clamped: no cutting move turns it
+    return start[rows], path.poses()[rows]
+
+
+def _sweep_check(job, path):
+    """(deepest penetration, largest leftover) of the design at the three sections, mm."""
+    spec, tool = job.gear, job.tools.finishing
+    book = _book(spec)
+    hand = 1.0 if spec.hand == "right" else -1.0
+    starts, ends = _cutting_moves(path)
+    a = np.radians(starts[:, 3])
+    base = _space_points(spec)
+    deepest, leftover = 0.0, 0.0
+    for x in SECTIONS:
+        section = turn_points(base, hand * x * math.tan(book.beta) / book.r)
+        gaps = np.empty((len(section), len(starts)))
+        for i, angle in enumerate(a):  # the point seen from the machine at this move's A
+            turned = turn_points(section, angle)
+            points = np.column_stack([np.full(len(turned), x), turned])
+            gaps[:, i] = _sweep_gap(points, starts[i:i + 1, :3], ends[i:i + 1, :3], tool.diameter_mm / 2.0,
+                                    tool.effective_corner_radius_mm)[:, 0]
+        deepest = max(deepest, float(-gaps.min()))
+        leftover = max(leftover, float(np.maximum(gaps, 0.0).min(axis=1).max()))
+    return deepest, leftover
+
+
+def _other_gear_job(name: str):
+    """The example job with one of tests/test_helical.py's gears and a tool of corner rho, 90 % of the widest."""
+    from spur_cad.geometry.profile import rack_corner
+    from tests.test_helical import spec_of
+
+    job = _job()
+    spec = spec_of(name)
+    rho = spec.rack_tip_radius_mm
+    diameter = 0.9 * (2.0 * rack_corner(spec).normal_corner_offset_mm + 2.0 * rho)
+    tool = dataclasses.replace(job.tools.finishing, diameter_mm=diameter, corner_radius_mm=rho)
+    return dataclasses.replace(job, gear=spec, tools=dataclasses.replace(job.tools, finishing=tool, roughing=None))
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("name", ["example_right", "example_left", "z31_30_left_shifted", "z12_20_undercut",
+                                  "z40_25pa_10"])
+def test_every_finishing_pass_against_the_design_at_three_sections(name):
+    """Acceptance: no penetration beyond 0.5 um, leftover within target + 0.5 um, at the front, middle and
+    back sections (the design turned by the textbook helix), on the example (both hands) and three more gears."""
+    job = _job(name.removeprefix("example_")) if name.startswith("example") else _other_gear_job(name)
+    job = dataclasses.replace(job, gear=dataclasses.replace(job.gear, face_width_mm=20.0))
+    deepest, leftover = _sweep_check(job, plan_cam(job).finishing.toolpath)
+    assert deepest <= 0.0005, deepest
+    assert leftover <= job.finishing.target_scallop_mm + 0.0005, leftover
+
+
+@pytest.mark.slow
+def test_the_sweep_check_finds_planted_faults(finished):
+    """A tip-mode pass 3 um too low gouges; a flank pass left out leaves more than the target."""
+    from spur_cad.sim import shifted
+
+    job, plan = finished
+    path = plan.finishing.toolpath
+    tip_rows = (path.space == 0) & (path.feature == Feature.ROOT)
+    deepest, _ = _sweep_check(job, shifted(path, tip_rows, dz=-0.003))
+    assert deepest > 0.0025
+    flank = np.nonzero((path.space == 0) & (path.feature == Feature.RIGHT_FLANK) & (path.kind == MoveKind.LINEAR)
+                       & (path.y != path.start_poses()[:, 1]) & (path.z != path.start_poses()[:, 2]))[0]
+    keep = np.ones(len(path), bool)
+    keep[flank[len(flank) // 2]] = False
+    _, leftover = _sweep_check(job, subset(path, keep))
+    assert leftover > job.finishing.target_scallop_mm + 0.001
+
+
+def test_finishing_passes_are_straight_along_the_rack_tooth(finished):
+    """Every cutting move keeps A; flank passes run at the base helix angle in plan view (dY/dX =
+    -h tan(beta_b)) and tip-mode passes along the rack tooth (dY/dX = -h tan(beta), Z fixed)."""
+    job, plan = finished
+    book = _book(job.gear)
+    starts, ends = _cutting_moves(plan.finishing.toolpath)
+    slope = (ends[:, 1] - starts[:, 1]) / (ends[:, 0] - starts[:, 0])
+    flat = ends[:, 2] == starts[:, 2]
+    assert np.allclose(slope[~flat], -math.tan(book.beta_b), rtol=1e-12)
+    steep = flat & (slope != 0.0)  # tip mode (lands run along X)
+    assert steep.sum() > 50 and np.allclose(slope[steep], -math.tan(book.beta), rtol=1e-12)
+
+
+def test_simulated_helical_job_is_within_target_and_resolution(finished):
+    """Three spaces roughed and finished, the middle one measured over the whole face width."""
+    job, plan = finished
+    spaces = [0, 1, 2]
+
+    def of(path):
+        return subset(path, np.isin(path.space, spaces))
+
+    result = simulate(job.gear, job_stock(job), [Cut(of(plan.roughing.toolpath), job.tools.roughing),
+                                                 Cut(of(plan.finishing.toolpath), job.tools.finishing)],
+                      SimSettings(resolution_mm=RES))
+    middle = result.deviation[1][:, result.gear_rows]
+    assert -middle.min() <= RES
+    assert middle.max() <= job.finishing.target_scallop_mm + RES
+
+
+def test_helical_finishing_tools_and_strategies_are_refused_with_their_reason():
+    from spur_cad.cam.tools import ToolError
+    from spur_cad.errors import SpurCadError
+
+    job = _job()
+    smaller = dataclasses.replace(job.tools.finishing, corner_radius_mm=0.5)
+    with pytest.raises(ToolError, match="must equal the rack tip radius rho = 0.8") as error:
+        plan_cam(dataclasses.replace(job, tools=dataclasses.replace(job.tools, finishing=smaller)))
+    assert error.value.field == "corner_radius_mm"
+    wide = dataclasses.replace(job.tools.finishing, diameter_mm=3.6)
+    with pytest.raises(ToolError, match="wider than the rack's normal tip flat"):
+        plan_cam(dataclasses.replace(job, tools=dataclasses.replace(job.tools, finishing=wide)))
+    perimeter = dataclasses.replace(job.finishing, strategy="perimeter")
+    with pytest.raises(SpurCadError, match="is for spur gears; a helical gear .* strategy = \"generating\""):
+        plan_cam(dataclasses.replace(job, finishing=perimeter))
+
+
+@pytest.mark.parametrize("dialect", ["linuxcnc", "fanuc", "haas", "siemens", "okuma"])
+def test_every_dialect_reads_back_the_helical_programs_flat_and_folded(dialect, finished):
+    from spur_cad.post import PostSettings, post_program
+    from tests.gcode_reader import read_program
+    from tests.test_post import DECIMALS, INFO, assert_folded_moves_as_flat, assert_same_moves
+
+    job, plan = finished
+    linear, rotary = DECIMALS[dialect]
+    for path in (plan.roughing.toolpath, plan.finishing.toolpath):
+        moves_by_mode = {}
+        for folded in (False, True):
+            program = read_program(post_program(path, PostSettings(dialect=dialect, folded=folded), INFO).text,
+                                   dialect)
+            assert program.ended
+            moves = [(m.rapid, np.array(m.end)) for m in program.moves]
+            assert_same_moves(moves, path, linear, rotary)
+            moves_by_mode[folded] = moves
+        assert_folded_moves_as_flat(moves_by_mode)
+
+
+@pytest.mark.linuxcnc
+def test_rs274_runs_the_helical_finishing_program_with_a_clamped_in_every_feed_move(finished, tmp_path):
+    from spur_cad.post import PostSettings, ProgramInfo, post_program
+    from tests.rs274_helper import run_rs274
+    from tests.test_post import assert_same_moves, canonical_moves
+
+    job, plan = finished
+    path = plan.finishing.toolpath
+    canon_by_mode = {}
+    for folded in (False, True):
+        program = post_program(path, PostSettings(folded=folded), ProgramInfo("helical finishing test", ()))
+        assert "G93" not in program.text
+        target = tmp_path / f"finishing_{folded}.ngc"
+        target.write_text(program.text)
+        ok, canon, messages = run_rs274(target)
+        assert ok, messages
+        moves = canonical_moves(canon)
+        assert_same_moves(moves, path, 4, 4)
+        for (_, before), (rapid, after) in zip(moves, moves[1:]):
+            if not rapid:
+                assert after[3] == before[3]
         canon_by_mode[folded] = [line for line in canon if line.startswith("STRAIGHT")]
     assert canon_by_mode[True] == canon_by_mode[False]

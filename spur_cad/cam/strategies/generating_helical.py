@@ -213,26 +213,46 @@ def _flank_passes(spec: GearSpec, tool: Tool, target_mm: float, points: np.ndarr
         for t in rolls:
             a = side * (theta_b + t)
             y0 = -side * (rb * t + radius * math.sqrt(1.0 + sy * sy))
-            z0 = _lowest_end(spec, points, a, a - gamma, y0, spec.reference_radius_mm, tool)
+            z0 = _lowest_end(spec, points, a, a - gamma, y0, side, tool)
             out.append(("flank", feature, float(t), a, y0, z0, sy, sz, side))
     return out
 
 
-def _lowest_end(spec: GearSpec, points: np.ndarray, a: float, phi: float, y0: float, z_high: float,
-                tool: Tool) -> float:
-    """Lowest tip Z (at X = 0) with the tool inside the rack tooth at roll phi (bisection)."""
-    def clearance(z0: float) -> float:
-        return rack_clearance_mm(spec, points + np.array([0.0, y0, z0]), a, phi)
+def _rack_point_t_z(spec: GearSpec, phi: float, gamma: float, side: int) -> float:
+    """Machine Z at X = 0 of the rack's point T (flank/round tangency) on the `side` flank, the rack at roll phi
+    turned further by gamma (transverse section: the rack round's T at r_f + rho (1 - sin alpha_n))."""
+    corner = rack_corner(spec)
+    rho, alpha_n = spec.rack_tip_radius_mm, spec.normal_pressure_angle_rad
+    t_y = (corner.normal_corner_offset_mm + rho * math.cos(alpha_n)) / math.cos(spec.helix_angle_rad)
+    t_z = spec.root_radius_mm + rho - rho * math.sin(alpha_n)
+    y = side * t_y - spec.reference_radius_mm * phi
+    return y * math.sin(gamma) + t_z * math.cos(gamma)
 
-    if clearance(z_high) > CLEARANCE_TOLERANCE_MM:
+
+def _lowest_end(spec: GearSpec, points: np.ndarray, a: float, phi: float, y0: float, side: int,
+                tool: Tool) -> float:
+    """Lowest tip Z (at X = 0) with the tool inside the rack tooth at roll phi (bisection, bracketed around
+    the rack's point T)."""
+    def fits(z0: float) -> bool:
+        return rack_clearance_mm(spec, points + np.array([0.0, y0, z0]), a, phi) <= CLEARANCE_TOLERANCE_MM
+
+    near = _rack_point_t_z(spec, phi, a - phi, side) - tool.effective_corner_radius_mm
+    span = tool.diameter_mm + spec.tip_radius_mm - spec.root_radius_mm
+    high, low = near + span, near - span
+    for _ in range(8):
+        if fits(high):
+            break
+        high += span
+    else:
         raise ToolError(f"finishing strategy generating: the {tool.diameter_mm:g} mm tool does not fit inside the "
                         "rack tooth of a flank pass of this helical gear; use a smaller diameter",
                         field="diameter_mm", section="tools.finishing")
-    low = spec.root_radius_mm - tool.diameter_mm
+    while fits(low):
+        low -= span
     for _ in range(48):
-        mid = 0.5 * (low + z_high)
-        low, z_high = (low, mid) if clearance(mid) <= CLEARANCE_TOLERANCE_MM else (mid, z_high)
-    return z_high
+        mid = 0.5 * (low + high)
+        low, high = (low, mid) if fits(mid) else (mid, high)
+    return high
 
 
 def _tip_passes(spec: GearSpec, tool: Tool, target_mm: float) -> list[tuple]:
