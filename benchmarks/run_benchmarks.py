@@ -147,6 +147,8 @@ def main() -> None:
     parser.add_argument("--run-runs", type=int, default=3, help="spur-cad run end to end, generating and perimeter")
     args = parser.parse_args()
     from benchmarks.bench_generating import REFERENCE_JOB, end_to_end_seconds, figures
+    from benchmarks.bench_helical import HELICAL_JOB
+    from benchmarks.bench_helical import figures as helical_figures
     from benchmarks.bench_sim import bench_sim
     from spur_cad.job import load_job
 
@@ -154,6 +156,7 @@ def main() -> None:
                "cad_runs": args.cad_runs, "cad": bench_cad(args.cad_runs), "cam": bench_cam(args.cad_runs),
                "post": bench_post(args.cad_runs), "sim_runs": args.sim_runs, "sim": bench_sim(args.sim_runs),
                "generating": figures(load_job(REFERENCE_JOB)),
+               "helical": helical_figures(load_job(HELICAL_JOB), args.run_runs),
                "run_s": {strategy: end_to_end_seconds(strategy, args.run_runs)
                          for strategy in ("generating", "perimeter")}}
     print(json.dumps(results, indent=2))

@@ -447,3 +447,21 @@ def test_activate_lets_preloaded_packages_find_the_environments_modules(wb, tmp_
 
     assert plot3d.NAME == "from env"
     monkeypatch.delitem(sys.modules, "wb_test_toolkit.plot3d")
+
+
+@pytest.mark.parametrize("hand", ["right", "left"])
+def test_suggested_tools_for_a_helical_gear_plan_both_operations(wb, hand):
+    """Helical: the finishing corner is the rack tip radius and the roughing tool passes the reach rule with the
+    width it sweeps along the lead; the whole plan builds."""
+    from spur_cad.pipeline import plan_cam
+
+    values = wb.schema.default_values()
+    values["gear"].update(Teeth=23, Module=4.0, RackTipRadius=0.8, FaceWidth=20.0, HelixAngle=15.0, Hand=hand)
+    values["job"]["FinishingStrategy"] = "generating"
+    suggested = wb.validation.suggest_tools(values)
+    values["job"].update(suggested)
+    job = job_from_dict(wb.schema.job_data(values), "helical")
+    assert job.gear.is_helical and job.tools.finishing.corner_radius_mm == 0.8
+    assert job.tools.roughing is not None
+    plan = plan_cam(job)
+    assert plan.roughing.toolpath.inverse_time.any() and not plan.finishing.toolpath.inverse_time.any()

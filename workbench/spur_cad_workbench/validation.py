@@ -114,8 +114,15 @@ def _generating_finishing_tool(job) -> tuple[float, float]:
     corner = spec.rack_tip_radius_mm
     if corner <= 0.0:  # a sharp rack: no tool with a corner can play it
         return 0.0, 0.0
-    limits = generating_tool_limits(spec, corner, job.finishing.target_scallop_mm, job.stock.blank_radius_mm(spec))
-    diameter = _floor_to(0.95 * min(limits.tip_mode_max_diameter_mm, limits.flank_mode_max_diameter_mm), 0.05)
+    if spec.is_helical:  # the corner must be rho; the rack's normal tip flat bounds the diameter
+        from spur_cad.geometry.profile import rack_corner
+
+        largest = 2.0 * rack_corner(spec).normal_corner_offset_mm + 2.0 * corner
+    else:
+        limits = generating_tool_limits(spec, corner, job.finishing.target_scallop_mm,
+                                        job.stock.blank_radius_mm(spec))
+        largest = min(limits.tip_mode_max_diameter_mm, limits.flank_mode_max_diameter_mm)
+    diameter = _floor_to(0.95 * largest, 0.05)
     return corner, diameter - 2.0 * corner
 
 
