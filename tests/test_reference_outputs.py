@@ -31,3 +31,18 @@ def test_reference_job_outputs_are_byte_identical() -> None:
         path = REFERENCE_DIR / (name if name == "profile.csv" else name + ".xz")
         expected = path.read_bytes() if name == "profile.csv" else lzma.decompress(path.read_bytes())
         assert content == expected, f"{name}: {_first_difference(expected, content)}"
+
+
+@pytest.mark.slow
+def test_a_zero_helix_angle_of_either_hand_gives_the_same_bytes(tmp_path) -> None:
+    """helix_angle_deg = 0 is a spur gear whatever the hand: the reference job with both keys written out
+    makes the stored files byte for byte (G-code of every dialect, profile.csv)."""
+    text = (REFERENCE_DIR / "reference_gear.toml").read_text()
+    assert "helix_angle_deg" not in text and "[gear]\n" in text
+    job = tmp_path / "reference_gear.toml"
+    job.write_text(text.replace("[gear]\n", '[gear]\nhelix_angle_deg = 0.0\nhand = "left"\n', 1))
+    files = reference_files(job)
+    for name, content in files.items():
+        path = REFERENCE_DIR / (name if name == "profile.csv" else name + ".xz")
+        expected = path.read_bytes() if name == "profile.csv" else lzma.decompress(path.read_bytes())
+        assert content == expected, f"{name}: {_first_difference(expected, content)}"
