@@ -383,3 +383,18 @@ def test_rs274_runs_the_helical_finishing_program_with_a_clamped_in_every_feed_m
                 assert after[3] == before[3]
         canon_by_mode[folded] = [line for line in canon if line.startswith("STRAIGHT")]
     assert canon_by_mode[True] == canon_by_mode[False]
+
+
+def test_a_tiny_helical_target_is_refused_quickly_naming_the_key():
+    import time
+
+    from spur_cad.errors import WorkLimitError
+
+    job = _job()
+    started = time.perf_counter()
+    for target in (1e-9, 1e-7):
+        tiny = dataclasses.replace(job.finishing, target_scallop_mm=target)
+        with pytest.raises(WorkLimitError, match="raise \\[finishing\\] target_scallop_mm") as error:
+            plan_cam(dataclasses.replace(job, finishing=tiny))
+        assert error.value.field == "target_scallop_mm"
+    assert time.perf_counter() - started < 60.0  # a bound on the refusal, not a performance target

@@ -97,7 +97,7 @@ from spur_cad.cam.strategies.generating_helical import (
     face_turn_range,
     flank_roll_step,
     helical_passes,
-    tip_roll_step,
+    helical_passes_estimate,
 )
 from spur_cad.cam.tools import Tool, ToolError
 from spur_cad.errors import WorkLimitError
@@ -533,13 +533,12 @@ def plan_generating(spec: GearSpec, tool: Tool, params: GeneratingParams, *, lan
 def _plan_helical(spec: GearSpec, tool: Tool, params: GeneratingParams, lands: bool) -> GeneratingPlan:
     """The helical gear's passes (spur_cad.cam.strategies.generating_helical) as a plan."""
     target = params.target_scallop_mm
-    lo, hi = face_turn_range(spec)
-    rough = (spec.tooth_space_profile().segment("involute").end - spec.tooth_space_profile().segment(
-        "involute").start + hi - lo) / flank_roll_step(spec, target) + 0.5 / tip_roll_step(spec, target)
-    if 2.0 * rough > MAX_PASSES_PER_SPACE:
-        raise WorkLimitError(f"generating finishing would need about {2 * rough:.3g} passes per tooth space (limit "
+    rough = helical_passes_estimate(spec, target)
+    if rough > MAX_PASSES_PER_SPACE:
+        raise WorkLimitError(f"generating finishing would need about {rough:.3g} passes per tooth space (limit "
                              f"{MAX_PASSES_PER_SPACE:,}) for target_scallop_mm = {target:.3g}; raise [finishing] "
                              "target_scallop_mm", field="target_scallop_mm", section="finishing")
+    lo, hi = face_turn_range(spec)
     rows = helical_passes(spec, tool, target, spec.tip_radius_mm + tool.diameter_mm, lands)
     rb = spec.base_radius_mm
     passes = []

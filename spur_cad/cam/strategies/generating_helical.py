@@ -51,6 +51,9 @@ CLEARANCE_TOLERANCE_MM = 1e-6
 CORNER_MATCH_MM = 1e-6
 """The tool's corner radius must equal the rack tip radius within this for helical tip mode."""
 _SAFETY = 0.95
+MAX_TIP_ROLLS = 1000
+"""Most tip-mode rolls whose leftover `tip_roll_step` checks (the helical example needs about 60 at 5 um and
+450 at 1 um); beyond, the target is refused rather than checked for minutes."""
 
 
 def pass_slopes(spec: GearSpec, gamma_rad: float) -> tuple[float, float]:
@@ -144,7 +147,7 @@ def flank_roll_step(spec: GearSpec, target_mm: float) -> float:
     return step
 
 
-def _rack_tip_boundary(spec: GearSpec, samples: int = 600) -> np.ndarray:
+def _rack_tip_boundary(spec: GearSpec, samples: int = 400) -> np.ndarray:
     """Transverse outline of the rack's right tip corner at roll 0 (gear frame, rolling line at Z = r): the
     elliptic round (semi-axes rho / cos(beta) along, rho across) from its bottom to T, and the tip line."""
     corner = rack_corner(spec)
@@ -152,8 +155,7 @@ def _rack_tip_boundary(spec: GearSpec, samples: int = 600) -> np.ndarray:
     centre = np.array([corner.corner_offset_mm, spec.reference_radius_mm - corner.corner_depth_mm])
     theta = np.linspace(-0.5 * math.pi, 0.0, samples)
     round_ = centre + np.stack([s * rho * np.cos(theta), rho * np.sin(theta)], axis=-1)
-    line = np.stack([np.linspace(-centre[0], centre[0], samples // 4), np.full(samples // 4, spec.root_radius_mm)],
-                    axis=-1)
+    line = np.array([[-centre[0], spec.root_radius_mm]])  # the tip line: one segment to the round's bottom
     return np.concatenate([line, round_])
 
 
@@ -165,35 +167,72 @@ def _tip_leftover_mm(spec: GearSpec, rolls: np.ndarray, points: np.ndarray, outl
         c, s = math.cos(-phi), math.sin(-phi)
         moved = outline - np.array([r * phi, 0.0])
         part = np.stack([moved[:, 0] * c - moved[:, 1] * s, moved[:, 0] * s + moved[:, 1] * c], axis=-1)
-        d = np.sqrt(((points[:, None, :] - part[None, :, :]) ** 2).sum(axis=-1)).min(axis=1)
+        a, edge = part[:-1], np.diff(part, axis=0)  # distance to the outline's segments, not its vertices
+        rel = points[:, None, :] - a[None, :, :]
+        u = np.clip((rel * edge[None]).sum(axis=-1) / np.maximum((edge * edge).sum(axis=-1), 1e-300), 0.0, 1.0)
+        d = np.hypot(*(rel - u[..., None] * edge[None]).transpose(2, 0, 1)).min(axis=1)
         best = np.minimum(best, d)
     return float(best.max())
 
 
 def tip_roll_step(spec: GearSpec, target_mm: float) -> float:
-    """Even rack-roll spacing for tip mode: the largest (from the closed-form start r_f dphi^2 / 8, shrunk by
-    10 % steps) whose rolls, at four phases, leave fillet and root points (right half, transverse) within 95 %
+    """Even rack-roll spacing for tip mode: the largest (from twice the closed-form spacing, shrunk by 10 %
+    steps) whose rolls, at four phases, leave fillet and root points (right half, transverse) within 95 %
     of the target from the nearest rack outline -- each section sees the rolls shifted by its turn."""
     from spur_cad.geometry.sampling import sample_profile
 
     samples = sample_profile(spec.tooth_space_profile(), 1e-3 * spec.module_mm)
     keep = np.isin(samples.label_names(), ["fillet", "root"])
-    points = samples.points[keep][:: max(1, int(keep.sum()) // 200)]
+    points = samples.points[keep][:: max(1, int(keep.sum()) // 120)]
     outline = _rack_tip_boundary(spec)
     corner = rack_corner(spec)
     r = spec.reference_radius_mm
     phi_t = (corner.corner_offset_mm - corner.corner_depth_mm / math.tan(spec.pressure_angle_rad)) / r
     lo, hi = min(phi_t, -corner.corner_offset_mm / r) - 0.02, corner.corner_offset_mm / r + 0.02
     goal = _SAFETY * target_mm
-    step = math.sqrt(8.0 * goal / spec.root_radius_mm)
+    step = 2.0 * _first_tip_step(spec, goal)  # the closed form is conservative: start above it
+    if (hi - lo) / step > MAX_TIP_ROLLS / 8.0:  # the spacing found is rarely below a third of the closed form
+        step = (hi - lo) / MAX_TIP_ROLLS
     for _ in range(40):
         rolls = np.arange(lo, hi + step, step)
+        if len(rolls) > MAX_TIP_ROLLS:
+            break
         if all(_tip_leftover_mm(spec, rolls + phase * step, points, outline) <= goal for phase in (0.0, 0.25, 0.5,
                                                                                                  0.75)):
             return step
         step *= 0.9
     raise WorkLimitError(f"generating finishing: no roll spacing above {step:.3g} rad keeps the fillet within "
-                         f"target_scallop_mm = {target_mm:g}", field="target_scallop_mm", section="finishing")
+                         f"target_scallop_mm = {target_mm:g} (checked up to {MAX_TIP_ROLLS} rolls); raise [finishing] "
+                         "target_scallop_mm", field="target_scallop_mm", section="finishing")
+
+
+def helical_passes_estimate(spec: GearSpec, target_mm: float) -> float:
+    """Passes per space from closed forms alone (before any planning, to bound the work): both flanks at the
+    largest roll any section sees, tip mode at the root's spacing sqrt(8 target / r_f) / r_f over the widened
+    fillet-to-fillet range with up to four passes per roll."""
+    involute = spec.tooth_space_profile().segment("involute")
+    lo, hi = face_turn_range(spec)
+    t_worst = involute.end + (hi - lo)
+    goal = _SAFETY * target_mm
+    flank = (involute.end - involute.start + hi - lo) / math.sqrt(8.0 * goal / (spec.base_radius_mm * t_worst))
+    corner = rack_corner(spec)
+    r = spec.reference_radius_mm
+    tip_range = 2.0 * (corner.corner_offset_mm + corner.corner_depth_mm / math.tan(spec.pressure_angle_rad)) / r
+    tip = (tip_range + hi - lo) / _first_tip_step(spec, goal)
+    return 2.0 * flank + 4.0 * tip
+
+
+def _first_tip_step(spec: GearSpec, goal: float) -> float:
+    """Closed-form tip-mode roll spacing: the root (radius r_f) leaves r_f dphi^2 / 8; the round (smallest
+    transverse curvature radius rho cos(beta)) generates points s dphi apart, s the contact's distance from the
+    pitch point, leaving about (s dphi)^2 / (8 rho cos(beta))."""
+    corner = rack_corner(spec)
+    rho = spec.rack_tip_radius_mm
+    steps = [math.sqrt(8.0 * goal / spec.root_radius_mm)]
+    if rho > 0.0:
+        reach = math.hypot(corner.corner_offset_mm + corner.stretch * rho, corner.corner_depth_mm + rho)
+        steps.append(math.sqrt(8.0 * rho * math.cos(spec.helix_angle_rad) * goal) / reach)
+    return min(steps)
 
 
 def _flank_passes(spec: GearSpec, tool: Tool, target_mm: float, points: np.ndarray) -> list[tuple]:
@@ -316,10 +355,11 @@ def helical_passes(spec: GearSpec, tool: Tool, target_mm: float, blank_radius_mm
     each checked against the rack tooth it plays (ToolError when one would leave it)."""
     check_helical_generating_tool(spec, tool)
     points = tool_hull_points(tool, blank_radius_mm - spec.root_radius_mm + tool.diameter_mm)
+    tip = _tip_passes(spec, tool, target_mm)  # first: its roll check refuses an absurd target at once
     flank = _flank_passes(spec, tool, target_mm, points)
     right = [p for p in flank if p[8] > 0]
     left = [p for p in flank if p[8] < 0]
-    passes = (_land_passes(spec, tool, target_mm) if lands else []) + right + _tip_passes(spec, tool, target_mm) + left
+    passes = (_land_passes(spec, tool, target_mm) if lands else []) + right + tip + left
     for mode, _, roll, a, y0, z0, _, _, side in passes:
         if mode == "land":
             continue
@@ -332,5 +372,6 @@ def helical_passes(spec: GearSpec, tool: Tool, target_mm: float, blank_radius_mm
     return passes
 
 
-__all__ = ["check_helical_generating_tool", "face_turn_range", "flank_roll_step", "helical_passes", "pass_slopes",
+__all__ = ["check_helical_generating_tool", "face_turn_range", "flank_roll_step", "helical_passes",
+           "helical_passes_estimate", "pass_slopes",
            "rack_clearance_mm", "rack_tooth_signed_distance_mm", "tip_roll_step", "tool_hull_points"]
