@@ -9,10 +9,9 @@ from __future__ import annotations
 
 import argparse
 import dataclasses
-import statistics
-import time
 from pathlib import Path
 
+from benchmarks.run_benchmarks import median_seconds
 from spur_cad.job import Job, load_job
 from spur_cad.pipeline import build_programs, plan_cam, simulate_stage
 from spur_cad.post import PostSettings
@@ -21,18 +20,9 @@ ROOT = Path(__file__).resolve().parents[1]
 HELICAL_JOB = ROOT / "resources" / "examples" / "helical_gear.toml"
 
 
-def _median(work, runs: int) -> float:
-    times = []
-    for _ in range(runs):
-        start = time.perf_counter()
-        work()
-        times.append(time.perf_counter() - start)
-    return statistics.median(times)
-
-
 def figures(job: Job, runs: int) -> dict:
     plan = plan_cam(job)
-    out = {"plan_s": _median(lambda: plan_cam(job), runs)}
+    out = {"plan_s": median_seconds(lambda: plan_cam(job), runs)}
     for name, op in (("roughing", plan.roughing), ("finishing", plan.finishing)):
         lines = {}
         for folded in (True, False):
@@ -44,7 +34,7 @@ def figures(job: Job, runs: int) -> dict:
     out["finishing"]["passes_per_space"] = plan.finishing.result.passes_per_space
     out["finishing"]["facts"] = plan.finishing.result.facts
     result = simulate_stage(job, plan)
-    out["sim_s"] = _median(lambda: simulate_stage(job, plan), runs)
+    out["sim_s"] = median_seconds(lambda: simulate_stage(job, plan), runs)
     out["sim"] = {"max_gouge_um": 1000 * result.max_gouge_mm, "max_leftover_um": 1000 * result.max_leftover_mm,
                   "poses": result.poses_clipped}
     return out

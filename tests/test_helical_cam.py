@@ -125,8 +125,8 @@ def _canonical(canon):
 @pytest.mark.linuxcnc
 def test_rs274_reads_the_helical_roughing_program_with_the_lead_in_inverse_time(tmp_path):
     from spur_cad.post import PostSettings, ProgramInfo, post_program
-    from tests.rs274_helper import canon_args, run_rs274
-    from tests.test_post import relative_path_length
+    from tests.rs274_helper import run_rs274
+    from tests.test_post import canonical_straight_moves, relative_path_length
 
     job = _job()
     path = plan_cam(job).roughing.toolpath
@@ -144,24 +144,15 @@ def test_rs274_reads_the_helical_roughing_program_with_the_lead_in_inverse_time(
         rounded = np.round(path.poses()[path.motion_mask], 4)
         moving = 1 + int(np.any(rounded[1:] != rounded[:-1], axis=1).sum())  # the post leaves out null moves
         assert len(_canonical(canon)) == moving
-        inverse, rate, pose, along = False, None, None, 0
-        for line in canon:
-            if "feed mode set to inverse time" in line:
-                inverse = True
-            elif "feed mode set to units per minute" in line:
-                inverse = False
-            elif line.startswith("SET_FEED_RATE"):
-                rate = canon_args(line)[0]
-            elif line.startswith(("STRAIGHT_FEED", "STRAIGHT_TRAVERSE")):
-                end = np.array(canon_args(line)[:4])
-                dx, da = (end - pose)[[0, 3]] if pose is not None else (0.0, 0.0)
-                if line.startswith("STRAIGHT_FEED") and abs(dx) > 1.0 and np.all(end[1:3] == pose[1:3]):
-                    assert da == pytest.approx(-360.0 * dx / lead, abs=2e-4)  # 4 decimals of A
-                    assert inverse  # X and A together: inverse time, taking the relative path at the tool's feed
-                    minutes = float(np.linalg.norm(end[:3] - pose[:3])) / rate  # rs274 reports a cartesian rate
-                    assert minutes == pytest.approx(relative_path_length(pose, end) / feed, rel=2e-3)
-                    along += 1
-                pose = end
+        along = 0
+        for feed_move, inverse, rate, pose, end in canonical_straight_moves(canon):
+            dx, da = (end - pose)[[0, 3]] if pose is not None else (0.0, 0.0)
+            if feed_move and abs(dx) > 1.0 and np.all(end[1:3] == pose[1:3]):
+                assert da == pytest.approx(-360.0 * dx / lead, abs=2e-4)  # 4 decimals of A
+                assert inverse  # X and A together: inverse time, taking the relative path at the tool's feed
+                minutes = float(np.linalg.norm(end[:3] - pose[:3])) / rate  # rs274 reports a cartesian rate
+                assert minutes == pytest.approx(relative_path_length(pose, end) / feed, rel=2e-3)
+                along += 1
         assert along > 1000
         canon_by_mode[folded] = [line for line in canon if line.startswith("STRAIGHT")]
     assert canon_by_mode[True] == canon_by_mode[False]

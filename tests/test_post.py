@@ -108,6 +108,23 @@ def test_rs274_accepts_every_program_and_reproduces_the_ir(name, cam_paths, tmp_
         assert canon_by_mode[True] == canon_by_mode[False]
 
 
+def canonical_straight_moves(canon: list[str]):
+    """(is a feed move, inverse time in effect, feed rate, start pose or None, end pose) for every straight move of
+    rs274's canonical output, following its feed mode and feed rate calls."""
+    inverse, rate, pose = False, None, None
+    for line in canon:
+        if "feed mode set to inverse time" in line:
+            inverse = True
+        elif "feed mode set to units per minute" in line:
+            inverse = False
+        elif line.startswith("SET_FEED_RATE"):
+            rate = canon_args(line)[0]
+        elif line.startswith(("STRAIGHT_FEED", "STRAIGHT_TRAVERSE")):
+            end = np.array(canon_args(line)[:4])
+            yield line.startswith("STRAIGHT_FEED"), inverse, rate, pose, end
+            pose = end
+
+
 def relative_path_length(start, end, substeps: int = 64) -> float:
     """Length of the tool tip's path over the part for a move interpolated linearly in X, Y, Z, A
     (the part turned back by A: p = R(-A) (y, z)), by dense polyline."""
@@ -127,26 +144,17 @@ def test_rs274_g93_feed_gives_the_relative_path_time(name, cam_paths, tmp_path):
     program = post_program(finishing, PostSettings(folded=True), INFO)
     ok, canon, messages = run_rs274(write(tmp_path, "f.ngc", program.text))
     assert ok, messages
-    inverse, rate, pose, checked = False, None, None, 0
-    for line in canon:
-        if "feed mode set to inverse time" in line:
-            inverse = True
-        elif "feed mode set to units per minute" in line:
-            inverse = False
-        elif line.startswith("SET_FEED_RATE"):
-            rate = canon_args(line)[0]
-        elif line.startswith(("STRAIGHT_FEED", "STRAIGHT_TRAVERSE")):
-            end = np.array(canon_args(line)[:4])
-            if inverse and line.startswith("STRAIGHT_FEED") and pose is not None:
-                cartesian = float(np.linalg.norm(end[:3] - pose[:3]))
-                assert cartesian > 1e-3, "a G93 move without X/Y/Z motion: its time cannot be read back"
-                minutes = cartesian / rate  # rs274 reports the inverse-time feed as a cartesian rate
-                intended = max(relative_path_length(pose, end) / feed,
-                               abs(end[3] - pose[3]) / machine.max_rotary_speed_deg_min)
-                tolerance = 4e-4 / feed + 1e-4 * intended + 0.5e-4 * intended ** 2
-                assert minutes == pytest.approx(intended, abs=tolerance), line
-                checked += 1
-            pose = end
+    checked = 0
+    for feed_move, inverse, rate, pose, end in canonical_straight_moves(canon):
+        if inverse and feed_move and pose is not None:
+            cartesian = float(np.linalg.norm(end[:3] - pose[:3]))
+            assert cartesian > 1e-3, "a G93 move without X/Y/Z motion: its time cannot be read back"
+            minutes = cartesian / rate  # rs274 reports the inverse-time feed as a cartesian rate
+            intended = max(relative_path_length(pose, end) / feed,
+                           abs(end[3] - pose[3]) / machine.max_rotary_speed_deg_min)
+            tolerance = 4e-4 / feed + 1e-4 * intended + 0.5e-4 * intended ** 2
+            assert minutes == pytest.approx(intended, abs=tolerance), (pose, end)
+            checked += 1
     assert checked > 100
 
 

@@ -105,6 +105,19 @@ def first_entry(dx, ay, az, ny, nz, lo, hi, radius, half_flat, rt):
     return t
 
 
+@njit(cache=True, inline="always")
+def _chunk_gap(c, s, py, pz, y, z, half_flat, rt):
+    """Distance from a chunk's centre (py, pz), turned by (cos, sin) = (c, s), to the tool's section at (y, z)
+    (negative inside): a chunk whose circle radius is below it cannot meet the tool."""
+    cy = c * py - s * pz
+    cz = s * py + c * pz
+    ddy = abs(cy - y) - half_flat
+    ddz = z + rt - cz
+    out = math.sqrt(max(ddy, 0.0) ** 2 + max(ddz, 0.0) ** 2)
+    inside = min(max(ddy, ddz), 0.0)
+    return out + inside - rt
+
+
 @njit(cache=True)
 def _sector_range(y, z, a, reach, radius, blade_len, pitch, teeth):
     """Sectors (tooth spaces, unreduced index range) whose blades may meet the tool at (y, z) at angle a."""
@@ -140,15 +153,7 @@ def _clip_at_pose(x, y, z, a, x_end, h, h_top, points, normals, chunk_start, chu
         c = math.cos(theta)
         s = math.sin(theta)
         for ci in range(n_chunks):
-            py = chunk_centre[ci, 0]
-            pz = chunk_centre[ci, 1]
-            cy = c * py - s * pz
-            cz = s * py + c * pz
-            ddy = abs(cy - y) - half_flat
-            ddz = z + rt - cz
-            out = math.sqrt(max(ddy, 0.0) ** 2 + max(ddz, 0.0) ** 2)
-            inside = min(max(ddy, ddz), 0.0)
-            if out + inside - rt > chunk_radius[ci]:
+            if _chunk_gap(c, s, chunk_centre[ci, 0], chunk_centre[ci, 1], y, z, half_flat, rt) > chunk_radius[ci]:
                 continue
             for j in range(chunk_start[ci], chunk_start[ci + 1]):
                 px = points[j, 0]
@@ -286,13 +291,7 @@ def _clip_twisted_pose(x, y, z, a, x_end, h, h_top, points, normals, chunk_start
         for ci in range(n_chunks):
             py = chunk_centre[ci, 0]
             pz = chunk_centre[ci, 1]
-            cy = c * py - s * pz
-            cz = s * py + c * pz
-            ddy = abs(cy - y) - half_flat
-            ddz = z + rt - cz
-            out = math.sqrt(max(ddy, 0.0) ** 2 + max(ddz, 0.0) ** 2)
-            inside = min(max(ddy, ddz), 0.0)
-            if out + inside - rt > chunk_radius[ci] + spread * math.hypot(py, pz):
+            if _chunk_gap(c, s, py, pz, y, z, half_flat, rt) > chunk_radius[ci] + spread * math.hypot(py, pz):
                 continue
             for j in range(chunk_start[ci], chunk_start[ci + 1]):
                 px = points[j, 0]
