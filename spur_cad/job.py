@@ -13,6 +13,7 @@ the GearSpec. Units are in the key names (mm, deg, percent, m_min, ...).
 
 from __future__ import annotations
 
+import dataclasses
 import re
 import sys
 import tomllib
@@ -294,6 +295,29 @@ def _tables(data: dict, source: str, text: str) -> dict[str, object]:
     return tables
 
 
+DEFAULT_FINISHING_TOOL_NUMBER = 2
+"""The finishing tool's number when its section gives none (the roughing tool's default is 1)."""
+
+
+def _tool_label(tool: Tool) -> str:
+    corner = f" r {tool.effective_corner_radius_mm:g} mm" if tool.effective_corner_radius_mm else ""
+    return f"{tool.kind} D {tool.diameter_mm:g} mm{corner}, {tool.flutes} flutes"
+
+
+def _check_tool_numbers(roughing: Tool, finishing: Tool, where: str) -> None:
+    """Two different end mills under one tool number would make the machine load the wrong one for one of the
+    programs: refuse (the same end mill may serve both, with its own cutting data)."""
+    def shape(tool: Tool) -> tuple:
+        return (tool.kind, tool.diameter_mm, tool.effective_corner_radius_mm, tool.flutes, tool.flute_length_mm,
+                tool.stick_out_mm)
+
+    if roughing.tool_number == finishing.tool_number and shape(roughing) != shape(finishing):
+        raise JobFileError(f"{where}: [tools.finishing] tool_number = {finishing.tool_number} is also the roughing "
+                           f"tool's number, but the tools differ (roughing {_tool_label(roughing)}; finishing "
+                           f"{_tool_label(finishing)}): the machine would load the wrong end mill; give each tool "
+                           "its own number")
+
+
 def _job_from_data(data: dict, source: str, text: str) -> Job:
     """Validate parsed job data; `text` (the file's text, or "") only locates keys for messages."""
     tables = _tables(data, source, text)
@@ -326,7 +350,12 @@ def _job_from_data(data: dict, source: str, text: str) -> Job:
         except SpurCadError as exc:
             prefix = f"[{name}] " if is_tool else ""
             raise JobFileError(f"{where(name, _blamed_key(exc, name, tables[name]))}: {prefix}{exc}") from None
+    if "tools.finishing" in sections and "tool_number" not in tables["tools.finishing"]:
+        sections["tools.finishing"] = dataclasses.replace(sections["tools.finishing"],
+                                                          tool_number=DEFAULT_FINISHING_TOOL_NUMBER)
     tools = ToolsSection(**{role: sections.get(f"tools.{role}") for role in _TOOL_ROLES})
+    if tools.roughing is not None and tools.finishing is not None:
+        _check_tool_numbers(tools.roughing, tools.finishing, where("tools.finishing", "tool_number"))
     optional = {name: sections[name] for name in ("stock", "roughing", "finishing", "machine", "post", "simulation")
                 if name in sections}
     return Job(source=source, job=sections.get("job", JobSection()), gear_section=gear_section, gear=spec,

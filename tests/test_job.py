@@ -230,3 +230,36 @@ def test_docs_job_file_md_is_generated_from_the_declarations():
     committed = (ROOT / "docs" / "job-file.md").read_text()
     assert committed == job_file_reference_markdown(), (
         "docs/job-file.md is out of date: run `python -m spur_cad.job --markdown > docs/job-file.md`")
+
+
+TWO_TOOLS = """[gear]
+teeth = 23
+module_mm = 4.0
+rack_tip_radius_mm = 0.8
+face_width_mm = 20.0
+
+[tools.roughing]
+diameter_mm = 3.5
+
+[tools.finishing]
+kind = "bull_nose"
+diameter_mm = 2.0
+corner_radius_mm = 0.5
+"""
+
+
+def test_two_different_tools_may_not_share_a_tool_number():
+    from spur_cad.errors import JobFileError
+    from spur_cad.job import parse_job
+
+    job = parse_job(TWO_TOOLS, "two.toml")  # no numbers given: T1 roughing, T2 finishing
+    assert (job.tools.roughing.tool_number, job.tools.finishing.tool_number) == (1, 2)
+    with pytest.raises(JobFileError) as error:
+        parse_job(TWO_TOOLS + "tool_number = 1\n", "two.toml")
+    message = str(error.value)
+    assert message.startswith("two.toml:14: [tools.finishing] tool_number = 1 is also the roughing tool's number")
+    assert "roughing flat D 3.5 mm" in message and "finishing bull_nose D 2 mm r 0.5 mm" in message
+    # the same end mill for both operations (its own cutting data each) may keep one number
+    same = TWO_TOOLS.replace('kind = "bull_nose"\ndiameter_mm = 2.0\ncorner_radius_mm = 0.5\n',
+                             "diameter_mm = 3.5\ncutting_speed_m_min = 150.0\ntool_number = 1\n")
+    assert parse_job(same, "same.toml").tools.finishing.tool_number == 1

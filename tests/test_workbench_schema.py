@@ -465,3 +465,15 @@ def test_suggested_tools_for_a_helical_gear_plan_both_operations(wb, hand):
     assert job.tools.roughing is not None
     plan = plan_cam(job)
     assert plan.roughing.toolpath.inverse_time.any() and not plan.finishing.toolpath.inverse_time.any()
+
+
+def test_new_jobs_number_the_tools_t1_t2_and_a_shared_number_is_an_error_at_the_field(wb):
+    values = wb.schema.default_values()
+    assert (values["job"]["RoughingToolNumber"], values["job"]["FinishingToolNumber"]) == (1, 2)
+    values["job"].update(wb.validation.suggest_tools(values))
+    assert wb.validation.validate(values).ok
+    values["job"]["FinishingToolNumber"] = 1
+    result = wb.validation.validate(values)
+    assert not result.ok
+    assert list(result.messages) == ["Finishing tool"]
+    assert "tool_number = 1 is also the roughing tool's number" in result.messages["Finishing tool"]

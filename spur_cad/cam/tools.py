@@ -33,7 +33,8 @@ class Tool:
     stick_out_mm: float = key(0.0, unit="mm", low=0.0, high=1000.0, label="{Role}StickOut", group="{Role} tool",
                               meaning="stick-out from the holder, 0: not given (not checked)")
     tool_number: int = key(1, low=1, high=9999, label="{Role}ToolNumber", group="{Role} tool",
-                           meaning="tool number in the machine's magazine (T word)")
+                           meaning="tool number in the machine's magazine (T word); a [tools.finishing] "
+                                   "without it takes 2; two different tools may not share one")
     cutting_speed_m_min: float = key(100.0, unit="m/min", low=1.0, high=3000.0, label="{Role}CuttingSpeed",
                                      group="{Role} tool", meaning="cutting speed V_c (catalogue value)")
     feed_per_tooth_mm: float = key(0.02, unit="mm", low=0.0005, high=2.0, label="{Role}FeedPerTooth",

@@ -202,9 +202,13 @@ def plain_value(field: Field, value):
 def _section_defaults() -> dict[str, dict[str, object]]:
     """The job file's defaults for every section; a required key without a value is 0 (a tool's
     diameter: 0 until chosen) until NEW_GEAR or the user gives one."""
+    from spur_cad.job import DEFAULT_FINISHING_TOOL_NUMBER
+
     zero = {float: 0.0, int: 0, str: "", bool: False}
-    return {section: {k.name: zero[k.type] if k.required else k.default for k in keys_of(cls)}
-            for section, cls in SECTIONS.items()}
+    defaults = {section: {k.name: zero[k.type] if k.required else k.default for k in keys_of(cls)}
+                for section, cls in SECTIONS.items()}
+    defaults["tools.finishing"]["tool_number"] = DEFAULT_FINISHING_TOOL_NUMBER  # T1 roughing, T2 finishing
+    return defaults
 
 
 # A new gear (no job file): ISO 53 basic rack profile A (tip radius 0.38 m) on the reference gear's size.
