@@ -355,7 +355,9 @@ def _job_from_data(data: dict, source: str, text: str) -> Job:
                                                           tool_number=DEFAULT_FINISHING_TOOL_NUMBER)
     tools = ToolsSection(**{role: sections.get(f"tools.{role}") for role in _TOOL_ROLES})
     if tools.roughing is not None and tools.finishing is not None:
-        _check_tool_numbers(tools.roughing, tools.finishing, where("tools.finishing", "tool_number"))
+        given = "tool_number" in tables["tools.finishing"]  # else blame the roughing tool's number (T2 given)
+        _check_tool_numbers(tools.roughing, tools.finishing,
+                            where("tools.finishing" if given else "tools.roughing", "tool_number"))
     optional = {name: sections[name] for name in ("stock", "roughing", "finishing", "machine", "post", "simulation")
                 if name in sections}
     return Job(source=source, job=sections.get("job", JobSection()), gear_section=gear_section, gear=spec,

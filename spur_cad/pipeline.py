@@ -118,7 +118,8 @@ def program_comments(job: Job, plan: CamPlan, operation: str) -> tuple[str, ...]
     helix = ()
     if spec.is_helical:  # spur headers stay as they were (byte-identical reference outputs)
         helix = (f"helix: beta = {spec.helix_angle_deg:g} deg {spec.hand} hand (m and alpha normal), lead "
-                 f"{spec.lead_mm:.4f} mm: A turns {360.0 / spec.lead_mm:.6f} deg per mm of X",)
+                 f"{spec.lead_mm:.4f} mm: along it A changes by {-spec.hand_sign * 360.0 / spec.lead_mm:+.6f} deg "
+                 "per mm of X",)
     return (
         f"gear: z = {spec.teeth}, m = {spec.module_mm:g} mm, alpha = {spec.pressure_angle_deg:g} deg, "
         f"x = {spec.profile_shift_coefficient:g}, b = {spec.face_width_mm:g} mm, rho = {spec.rack_tip_radius_mm:g} mm",

@@ -289,7 +289,8 @@ def test_spur_cad_run_writes_the_helical_job_and_refuses_a_wrong_corner_naming_t
     assert summary["finishing"]["perimeter_time_s"] is None  # perimeter is for spur gears only
     assert "G93" in (tmp_path / "out" / "roughing.ngc").read_text()
     assert "G93" not in (tmp_path / "out" / "finishing.ngc").read_text()
-    assert f"(helix: beta = 15 deg right hand [m and alpha normal], lead {g.lead:.4f} mm" in \
+    assert f"(helix: beta = 15 deg right hand [m and alpha normal], lead {g.lead:.4f} mm: along it A changes by " \
+        f"{-360.0 / g.lead:+.6f} deg per mm of X)" in \
         (tmp_path / "out" / "finishing.ngc").read_text()
     assert summary["inspection"]["span_measurement_mm"] == pytest.approx(
         span_measurement(spec_of("reference_15_right"), summary["inspection"]["span_teeth_k"]).length_mm)

@@ -389,3 +389,27 @@ def test_a_tiny_helical_target_is_refused_quickly_naming_the_key():
             plan_cam(dataclasses.replace(job, finishing=tiny))
         assert error.value.field == "target_scallop_mm"
     assert time.perf_counter() - started < 60.0  # a bound on the refusal, not a performance target
+
+
+def test_helical_roughing_needs_a_table_that_turns_while_cutting():
+    from spur_cad.errors import SpurCadError
+
+    job = _job()
+    indexing = dataclasses.replace(job.machine, rotary_simultaneous=False)
+    with pytest.raises(SpurCadError, match="rotary_simultaneous = false") as error:
+        plan_cam(dataclasses.replace(job, machine=indexing))
+    assert error.value.field == "rotary_simultaneous"
+
+
+def test_a_small_helix_angle_is_swept_as_finely_as_a_large_one():
+    """At 0.05 deg the design turns little along X: the lead sweep's slice spacing must still follow the tool
+    (an earlier spacing from the turn alone grew to the tool's width and the sweep cut nothing)."""
+    job = _job()
+    job = dataclasses.replace(job, gear=dataclasses.replace(job.gear, helix_angle_deg=0.05))
+    path = plan_cam(dataclasses.replace(job, tools=dataclasses.replace(job.tools, finishing=None))).roughing.toolpath
+    space = subset(path, path.space == 3)
+    result = simulate(job.gear, job_stock(job), [Cut(space, job.tools.roughing)], SimSettings(resolution_mm=RES))
+    dev = result.deviation[3][:, result.gear_rows]
+    flanks = np.isin(result.grid.feature_names(), ["right involute", "left involute"])
+    assert dev.min() >= job.roughing.finish_stock_mm - RES / 2
+    assert dev[flanks].max() <= 1.25 * job.roughing.flank_allowance_mm

@@ -16,7 +16,13 @@ from spur_cad.cam.finishing import plan_finishing
 from spur_cad.cam.ir import Toolpath
 from spur_cad.cam.machine import FinishingParams, Machine, MachineError, RoughingParams, check_travel
 from spur_cad.cam.recommend import ToolRecommendations, check_roughing_reach, check_tools, recommend_tools
-from spur_cad.cam.roughing import RoughingLevels, estimated_roughing_moves, roughing_levels, roughing_toolpath
+from spur_cad.cam.roughing import (
+    RoughingLevels,
+    check_helical_roughing_machine,
+    estimated_roughing_moves,
+    roughing_levels,
+    roughing_toolpath,
+)
 from spur_cad.cam.strategies import FinishingResult, get_strategy, params_from_section
 from spur_cad.cam.tools import Tool, ToolError
 from spur_cad.errors import WorkLimitError
@@ -108,6 +114,7 @@ def check_cam_inputs(inputs: CamInputs) -> tuple[ToolRecommendations, RoughingLe
         return rec, None
     tool = inputs.roughing_tool
     inputs.roughing.validate()
+    check_helical_roughing_machine(spec, machine)
     moves, driver = estimated_roughing_moves(spec, tool, inputs.roughing, blank)
     check_moves("roughing", moves, "roughing", driver)
     levels = roughing_levels(spec, tool, inputs.roughing, blank)

@@ -130,9 +130,10 @@ def _lowest_level(flank: _OffsetFlank, tool: Tool, radius: float) -> float:
     """Where the offset space is exactly as wide as the tool's transverse width 2 radius (bisection on a
     monotone test)."""
     low, high = float(flank.points[:, 1].min()), flank.tip_edge_height
-    if flank.width(high) < radius:
-        raise ToolError(f"roughing tool diameter {tool.diameter_mm:g} mm does not fit the tooth space even at the tip "
-                        f"(space width {2 * flank.width(high):.3f} mm there, finish stock included)",
+    if flank.reach_width(high) < radius:
+        swept = "" if flank.sag == 0.0 else f" (it sweeps {2 * radius:.3f} mm along the helical lead)"
+        raise ToolError(f"roughing tool diameter {tool.diameter_mm:g} mm{swept} does not fit the tooth space even at "
+                        f"the tip (space width {2 * flank.reach_width(high):.3f} mm there, finish stock included)",
                         field="diameter_mm", section="tools.roughing")
     for _ in range(100):
         mid = 0.5 * (low + high)
@@ -192,6 +193,14 @@ def _check_clamp(spec: GearSpec, machine: Machine, params: RoughingParams) -> No
                            "lead", field="clamp_rotary", section="roughing")
 
 
+def check_helical_roughing_machine(spec: GearSpec, machine: Machine) -> None:
+    """Helical roughing turns A with X while cutting: a table that only indexes cannot run it."""
+    if spec.is_helical and not machine.rotary_simultaneous:
+        raise MachineError(f"roughing a helical gear (helix_angle_deg = {spec.helix_angle_deg:g}) turns A with X "
+                           "along the lead while cutting, but [machine] rotary_simultaneous = false (the table only "
+                           "indexes)", field="rotary_simultaneous", section="machine")
+
+
 def roughing_toolpath(spec: GearSpec, tool: Tool, machine: Machine, params: RoughingParams,
                       blank_radius_mm: float, back_margin_mm: float = 0.0, stub_radius_mm: float = 0.0,
                       front_margin_mm: float = 0.0, levels: RoughingLevels | None = None) -> Toolpath:
@@ -200,6 +209,7 @@ def roughing_toolpath(spec: GearSpec, tool: Tool, machine: Machine, params: Roug
     machine.validate()
     tool.validate("roughing")
     _check_clamp(spec, machine, params)
+    check_helical_roughing_machine(spec, machine)
     if levels is None:
         levels = roughing_levels(spec, tool, params, blank_radius_mm)
     radius = tool.diameter_mm / 2.0

@@ -57,6 +57,11 @@ class DesignGrid:
     def space_normals(self, k: int) -> np.ndarray:
         return turn_points(self.normals, k * self.pitch_rad)
 
+    def row_points(self, k: int, x_mm: float) -> tuple[np.ndarray, np.ndarray]:
+        """Design points and normals of tooth space k in the row at X = x_mm (turned by the helix)."""
+        angle = k * self.pitch_rad + self.twist_rad_per_mm * x_mm
+        return turn_points(self.points, angle), turn_points(self.normals, angle)
+
     def feature_names(self) -> list[str]:
         """'right involute', 'root', ... per point."""
         side_name = {RIGHT: "right ", LEFT: "left ", CENTRE: ""}

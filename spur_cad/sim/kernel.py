@@ -279,7 +279,7 @@ def _clip_twisted_pose(x, y, z, a, x_end, h, h_top, points, normals, chunk_start
     sweep = x_end > x
     n_samples = 0
     if sweep:
-        n_samples = int(math.ceil(2.0 * radius / dx_step)) + 1
+        n_samples = 2 * int(math.ceil(radius / dx_step)) + 1  # odd: dx = 0 is a sample
     samples = np.empty(max(n_samples, 1))
     cuts = 0
     n_chunks = len(chunk_radius)

@@ -169,8 +169,8 @@ def cross_check(spec: GearSpec, stock: StockCylinder, path: Toolpath, tool: Tool
     grid = fast.grid
     origins, directions = [], []
     for k, j, r in chosen:
-        p = grid.space_points(int(k))[j]
-        n = grid.space_normals(int(k))[j]
+        points, normals = grid.row_points(int(k), grid.rows_x[r])
+        p, n = points[j], normals[j]
         origins.append((grid.rows_x[r], p[0], p[1]))
         directions.append((0.0, n[0], n[1]))
     occ_h = probe_blades(result.wrapped, np.array(origins), np.array(directions), -settings.gouge_range_mm,

@@ -319,8 +319,6 @@ def simulate_grid(grid: DesignGrid, stock: StockCylinder, operations: Sequence[C
     reach = float(np.hypot(*blade_ends.T).max()) + 1e-9
     blade_len = max(settings.gouge_range_mm, settings.leftover_range_mm)
     twist = grid.twist_rad_per_mm
-    # Lead sweeps sample the tool's slices so that the design turns by at most resolution / 2 between them.
-    dx_step = 0.5 * res / (reach * abs(twist)) if twist else 0.0
     batches = []
     sweeps = moves = 0
     for op in operations:
@@ -329,11 +327,14 @@ def simulate_grid(grid: DesignGrid, stock: StockCylinder, operations: Sequence[C
         poses, x_end, n_sweeps = decompose(op.path, op.tool, res, reach, flat_step, (x_lo, x_hi), twist)
         sweeps += n_sweeps
         moves += len(op.path)
+        # Lead sweeps sample the tool's slices so that the design turns by at most resolution / 2 between them
+        # and the slices change no more than between two clipped poses of a move.
+        dx_step = min(0.5 * res / (reach * abs(twist)), pose_step_mm(op.tool, res), radius) if twist else 0.0
         for lo in range(0, len(poses), POSE_BATCH):
-            batches.append((poses[lo:lo + POSE_BATCH], x_end[lo:lo + POSE_BATCH], radius, half_flat, rt))
+            batches.append((poses[lo:lo + POSE_BATCH], x_end[lo:lo + POSE_BATCH], radius, half_flat, rt, dx_step))
     total = sum(len(b[0]) for b in batches)
     done = 0
-    for poses, x_end, radius, half_flat, rt in batches:
+    for poses, x_end, radius, half_flat, rt, dx_step in batches:
         h_top = np.ascontiguousarray(h.max(axis=2))
         if twist:
             clip_poses_twisted(np.ascontiguousarray(poses), np.ascontiguousarray(x_end), h, h_top, grid.points,

@@ -73,8 +73,11 @@ def result_points(result) -> tuple[np.ndarray, np.ndarray]:
     per_row = grid.teeth * len(grid.points)
     stride = max(1, int(np.ceil(len(rows) * per_row / MAX_SHOWN_POINTS)))
     rows = rows[::stride]
-    transverse = np.concatenate([grid.space_points(k) for k in range(grid.teeth)])  # (teeth * M, 2)
-    points = np.concatenate([np.column_stack([np.full(len(transverse), grid.rows_x[r]), transverse]) for r in rows])
+    def row(r: int) -> np.ndarray:  # (teeth * M, 3): every space's points in this row (turned by a helix)
+        transverse = np.concatenate([grid.row_points(k, grid.rows_x[r])[0] for k in range(grid.teeth)])
+        return np.column_stack([np.full(len(transverse), grid.rows_x[r]), transverse])
+
+    points = np.concatenate([row(r) for r in rows])
     deviation = np.concatenate([result.deviation[:, :, r].reshape(-1) for r in rows])
     return points, deviation
 

@@ -114,10 +114,10 @@ def _generating_finishing_tool(job) -> tuple[float, float]:
     corner = spec.rack_tip_radius_mm
     if corner <= 0.0:  # a sharp rack: no tool with a corner can play it
         return 0.0, 0.0
-    if spec.is_helical:  # the corner must be rho; the rack's normal tip flat bounds the diameter
+    if spec.is_helical:  # the corner must be rho; 95 % of the rack's normal tip flat for the tool's flat
         from spur_cad.geometry.profile import rack_corner
 
-        largest = 2.0 * rack_corner(spec).normal_corner_offset_mm + 2.0 * corner
+        return corner, _floor_to(0.95 * 2.0 * rack_corner(spec).normal_corner_offset_mm, 0.05)
     else:
         limits = generating_tool_limits(spec, corner, job.finishing.target_scallop_mm,
                                         job.stock.blank_radius_mm(spec))
@@ -147,14 +147,15 @@ def suggest_tools(values: dict[str, dict[str, object]]) -> dict[str, object]:
     else:
         corner = min(_floor_to(0.9 * rec.finishing_max_corner_radius_mm, 0.05), 1.0)
         flat = _floor_to(0.9 * rec.finishing_max_flat_width_mm, 0.05)
-    if corner <= 0.0 or flat <= 0.0:
+    if corner <= 0.0 or flat < 0.0 or (flat == 0.0 and check.job.finishing.strategy != "generating"):
         return {}
-    chosen = {"UseFinishingTool": True, "FinishingToolKind": "bull_nose",
+    kind = "bull_nose" if flat > 0.0 else "ball"  # generating with a flat of 0: a ball end mill of radius rho
+    chosen = {"UseFinishingTool": True, "FinishingToolKind": kind,
               "FinishingToolDiameter": round(flat + 2 * corner, 6),
               "FinishingCornerRadius": round(corner, 6)}
     from spur_cad.cam.tools import Tool
 
-    finishing = Tool(diameter_mm=chosen["FinishingToolDiameter"], kind="bull_nose", corner_radius_mm=corner)
+    finishing = Tool(diameter_mm=chosen["FinishingToolDiameter"], kind=kind, corner_radius_mm=corner)
     blank = check.job.stock.blank_radius_mm(spec)
     limit = recommend_tools(spec, blank, check.job.machine.clearance_mm, finishing).roughing_max_diameter_mm
     diameter = _floor_to(limit, 0.1)

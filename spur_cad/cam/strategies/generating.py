@@ -113,8 +113,8 @@ GOUGE_TOLERANCE_MM = 1e-5
 RAISED_END_MARGIN_MM = 0.02
 """With flank_tool_end = "raised", the straight side starts this far below the flat's lower crossing."""
 TIP_MODE_SAFETY = 0.95
-_TIP_SAFETY_HELICAL = 0.95  # helical tip-mode rolls are spaced for this fraction of the target (closed form)
 """Tip-mode rolls keep the sampled leftover within this fraction of the target."""
+_TIP_SAFETY_HELICAL = 0.95  # helical tip-mode rolls are spaced for this fraction of the target
 _FLANK_SAFETY = 0.999
 _LEFTOVER_SAMPLES = 33
 MOVES_PER_PASS = 5
@@ -184,7 +184,7 @@ class GeneratingPlan:
     root_rolls_rad: np.ndarray  # rack rolls phi of the root passes, v -> -v
     land_angles_rad: np.ndarray  # part directions psi of the land passes (empty: blank at the tip diameter)
     flat_height_mm: float  # largest generating-flat deviation left on the involute (closed form)
-    tip_leftover_mm: float  # largest sampled leftover on fillet, root and lands
+    tip_leftover_mm: float  # largest sampled leftover on fillet, root and lands (helical: the bound the rolls keep)
 
     @property
     def passes_per_space(self) -> int:
