@@ -1,4 +1,4 @@
-"""Finishing by generation for helical gears (docs/method.md): A clamped, one straight 3-D pass per
+"""Finishing by generation for helical gears (docs/cam.md, "Helical gears"): A clamped, one straight 3-D pass per
 rack position, along the rack tooth.
 
 The generating rack of a helical gear is a prism along the tooth direction d, inclined at the
