@@ -328,8 +328,10 @@ def simulate_grid(grid: DesignGrid, stock: StockCylinder, operations: Sequence[C
         sweeps += n_sweeps
         moves += len(op.path)
         # Lead sweeps sample the tool's slices so that the design turns by at most resolution / 2 between them
-        # and the slices change no more than between two clipped poses of a move.
-        dx_step = min(0.5 * res / (reach * abs(twist)), pose_step_mm(op.tool, res), radius) if twist else 0.0
+        # and the slices change no more than between two clipped poses of a move (a lead sweep is horizontal:
+        # a flat tool's round edge, radius D / 2, sets its spacing, as for roughing's steps across a level).
+        pose_step = flat_step if rt == 0.0 else pose_step_mm(op.tool, res)
+        dx_step = min(0.5 * res / (reach * abs(twist)), pose_step, radius) if twist else 0.0
         for lo in range(0, len(poses), POSE_BATCH):
             batches.append((poses[lo:lo + POSE_BATCH], x_end[lo:lo + POSE_BATCH], radius, half_flat, rt, dx_step))
     total = sum(len(b[0]) for b in batches)
