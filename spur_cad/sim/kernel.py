@@ -119,11 +119,12 @@ def _chunk_gap(c, s, py, pz, y, z, half_flat, rt):
 
 
 @njit(cache=True)
-def _sector_range(y, z, a, reach, radius, blade_len, pitch, teeth):
-    """Sectors (tooth spaces, unreduced index range) whose blades may meet the tool at (y, z) at angle a."""
+def _sector_range(y, z, a, spread, radius, blade_len, pitch, teeth):
+    """Sectors (tooth spaces, unreduced index range) whose blades may meet the tool at (y, z) when the design
+    is turned by a +- spread (spread > 0: a helical design over the tool's width)."""
     if z - blade_len <= 0.0:
         return 0, teeth - 1
-    half = math.atan2(abs(y) + radius + blade_len, z - blade_len)
+    half = math.atan2(abs(y) + radius + blade_len, z - blade_len) + spread
     first = math.ceil((-half - a) / pitch - 0.5)
     last = math.floor((half - a) / pitch + 0.5)
     if last - first + 1 >= teeth:
@@ -138,7 +139,7 @@ def _clip_at_pose(x, y, z, a, x_end, h, h_top, points, normals, chunk_start, chu
     (the union of the slices is the slice nearest the axis: t_e(dx) grows with |dx|)."""
     if z > reach:
         return 0
-    first, last = _sector_range(y, z, a, reach, radius, blade_len, pitch, teeth)
+    first, last = _sector_range(y, z, a, 0.0, radius, blade_len, pitch, teeth)
     r_lo = np.searchsorted(rows, x - radius, side="right")
     r_hi = np.searchsorted(rows, x_end + radius, side="left")
     if r_lo >= r_hi:
@@ -238,19 +239,6 @@ def clip_poses(poses, x_end, h, h_top, points, normals, chunk_start, chunk_centr
 
 
 @njit(cache=True)
-def _twisted_sector_range(y, z, c0, spread, radius, blade_len, pitch, teeth):
-    """Sectors that may meet the tool when the design turns by c0 +- spread."""
-    if z - blade_len <= 0.0:
-        return 0, teeth - 1
-    half = math.atan2(abs(y) + radius + blade_len, z - blade_len) + spread
-    first = math.ceil((-half - c0) / pitch - 0.5)
-    last = math.floor((half - c0) / pitch + 0.5)
-    if last - first + 1 >= teeth:
-        return 0, teeth - 1
-    return first, last
-
-
-@njit(cache=True)
 def _blade_entry(dx, theta, px, pz_, nx, nz_, y, z, lo, hi, radius, half_flat, rt):
     """First entry of one blade (design point p, normal n, turned by theta) into the tool slice at dx."""
     c = math.cos(theta)
@@ -271,7 +259,7 @@ def _clip_twisted_pose(x, y, z, a, x_end, h, h_top, points, normals, chunk_start
         return 0
     spread = abs(twist) * radius
     c0 = a + twist * x
-    first, last = _twisted_sector_range(y, z, c0, spread, radius, blade_len, pitch, teeth)
+    first, last = _sector_range(y, z, c0, spread, radius, blade_len, pitch, teeth)
     r_lo = np.searchsorted(rows, x - radius, side="right")
     r_hi = np.searchsorted(rows, x_end + radius, side="left")
     if r_lo >= r_hi:
