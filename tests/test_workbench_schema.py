@@ -477,3 +477,44 @@ def test_new_jobs_number_the_tools_t1_t2_and_a_shared_number_is_an_error_at_the_
     assert not result.ok
     assert list(result.messages) == ["Finishing tool"]
     assert "tool_number = 1 is also the roughing tool's number" in result.messages["Finishing tool"]
+
+
+def _cut_points_inside_gear_mm(wb, path, spec, turn_back: bool = True) -> float:
+    """Deepest a drawn cutting segment's tool-tip centre goes into the gear outline, sampled along each straight
+    segment within the face width, each point turned back by the textbook helix at its X (0: never inside)."""
+    import shapely
+    from shapely.geometry import Polygon
+
+    from spur_cad.geometry import gear_outline
+    from spur_cad.sim import subset
+
+    gear = Polygon(gear_outline(spec, 1e-4))
+    drawn = wb.display.display_path(subset(path, path.space == 0))
+    points = drawn.points if turn_back else np.column_stack([path.x, path.y, path.z])[path.space == 0]
+    rapid = drawn.rapid if turn_back else path.kind[path.space == 0] == MoveKind.RAPID
+    tan_over_r = math.tan(math.radians(spec.helix_angle_deg)) / spec.reference_radius_mm
+    sign = 1.0 if spec.hand == "right" else -1.0
+    deepest = 0.0
+    for i in np.nonzero(~rapid[1:])[0] + 1:
+        for t in np.linspace(0.0, 1.0, 41):
+            x, y, z = points[i - 1] + t * (points[i] - points[i - 1])
+            if not 0.0 <= x <= spec.face_width_mm:
+                continue
+            turn = -sign * x * tan_over_r
+            q = shapely.Point(y * math.cos(turn) - z * math.sin(turn), y * math.sin(turn) + z * math.cos(turn))
+            if gear.contains(q):
+                deepest = max(deepest, gear.exterior.distance(q))
+    return deepest
+
+
+def test_helical_toolpaths_are_drawn_in_the_tooth_spaces_of_the_helical_gear(wb):
+    """Acceptance (workbench): the drawn roughing and finishing paths line up with the helical solid: every
+    tool-tip centre of a cutting segment, turned back by the helix at its X, lies outside the gear (in a space
+    or above the tip). The machine poses drawn without turning back by A land inside the teeth."""
+    from spur_cad.pipeline import plan_cam
+
+    job = load_job(ROOT / "resources" / "examples" / "helical_gear.toml")
+    plan = plan_cam(job)
+    for path in (plan.roughing.toolpath, plan.finishing.toolpath):
+        assert _cut_points_inside_gear_mm(wb, path, job.gear) <= 1e-6
+    assert _cut_points_inside_gear_mm(wb, plan.finishing.toolpath, job.gear, turn_back=False) > 1.0
