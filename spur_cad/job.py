@@ -215,22 +215,25 @@ def _load_section(table: object, name: str, source: str, text: str):
     for key_name in table:
         if key_name not in known:
             raise JobFileError(f"{_where(source, text, name, key_name)}: unknown key '{key_name}' in [{name}] "
-                               f"(known keys: {', '.join(sorted(known))})")
+                               f"(known keys: {', '.join(sorted(known))})", section=name)
     values = {}
     for k in known.values():
         if k.name not in table:
             if k.required:
-                raise JobFileError(f"{_where(source, text, name)}: [{name}] is missing the required key '{k.name}'")
+                raise JobFileError(f"{_where(source, text, name)}: [{name}] is missing the required key '{k.name}'",
+                                   section=name, field=k.name)
             values[k.name] = k.default
             continue
         problem = type_problem(k, table[k.name])
         if problem:
-            raise JobFileError(f"{_where(source, text, name, k.name)}: [{name}] {k.name} {problem}")
+            raise JobFileError(f"{_where(source, text, name, k.name)}: [{name}] {k.name} {problem}", section=name,
+                               field=k.name)
         values[k.name] = coerce(k, table[k.name])
     problems = section_problems(cls, values)
     if problems:
         key_name, problem = problems[0]
-        raise JobFileError(f"{_where(source, text, name, key_name)}: [{name}] {key_name} {problem}")
+        raise JobFileError(f"{_where(source, text, name, key_name)}: [{name}] {key_name} {problem}", section=name,
+                           field=key_name)
     return cls(**values)
 
 
@@ -315,7 +318,7 @@ def _check_tool_numbers(roughing: Tool, finishing: Tool, where: str) -> None:
         raise JobFileError(f"{where}: [tools.finishing] tool_number = {finishing.tool_number} is also the roughing "
                            f"tool's number, but the tools differ (roughing {_tool_label(roughing)}; finishing "
                            f"{_tool_label(finishing)}): the machine would load the wrong end mill; give each tool "
-                           "its own number")
+                           "its own number", section="tools.finishing", field="tool_number")
 
 
 def _job_from_data(data: dict, source: str, text: str) -> Job:
@@ -330,14 +333,15 @@ def _job_from_data(data: dict, source: str, text: str) -> Job:
     try:
         spec = gear_section.to_spec()
     except GearSpecError as exc:
-        raise JobFileError(f"{where('gear', _blamed_key(exc, 'gear', tables['gear']))}: invalid gear: {exc}") from None
+        blamed = _blamed_key(exc, 'gear', tables['gear'])
+        raise JobFileError(f"{where('gear', blamed)}: invalid gear: {exc}", section="gear", field=blamed) from None
     for check, name in ((gear_section.blank_features().validate, "gear"),
                         (sections.get("stock", StockSpec()).validate, "stock")):
         try:
             check(spec)
         except (GearSpecError, StockError) as exc:
             blamed = _blamed_key(exc, name, tables.get(name, {}))
-            raise JobFileError(f"{where(name, blamed)}: invalid [{name}]: {exc}") from None
+            raise JobFileError(f"{where(name, blamed)}: invalid [{name}]: {exc}", section=name, field=blamed) from None
     for name in ("machine", "roughing", "finishing", "post", *(f"tools.{role}" for role in _TOOL_ROLES)):
         if name not in sections:
             continue
@@ -349,7 +353,8 @@ def _job_from_data(data: dict, source: str, text: str) -> Job:
                 sections[name].validate()
         except SpurCadError as exc:
             prefix = f"[{name}] " if is_tool else ""
-            raise JobFileError(f"{where(name, _blamed_key(exc, name, tables[name]))}: {prefix}{exc}") from None
+            blamed = _blamed_key(exc, name, tables[name])
+            raise JobFileError(f"{where(name, blamed)}: {prefix}{exc}", section=name, field=blamed) from None
     if "tools.finishing" in sections and "tool_number" not in tables["tools.finishing"]:
         sections["tools.finishing"] = dataclasses.replace(sections["tools.finishing"],
                                                           tool_number=DEFAULT_FINISHING_TOOL_NUMBER)

@@ -21,8 +21,13 @@ from pathlib import Path
 
 import FreeCAD
 
-from spur_cad_workbench import schema
+from spur_cad_workbench import compat, schema
 from spur_cad_workbench.features import (
+    GEAR_ANGULAR_DEFLECTION_DEG,
+    GEAR_COLOUR,
+    GEAR_DEVIATION_PERCENT,
+    OPERATION_COLOURS,
+    STOCK_COLOUR,
     GearFeature,
     JobFeature,
     StockFeature,
@@ -30,11 +35,6 @@ from spur_cad_workbench.features import (
     ViewProvider,
     job_of,
 )
-
-GEAR_COLOUR = (0.55, 0.62, 0.72)
-STOCK_COLOUR = (0.85, 0.75, 0.45)
-ROUGHING_COLOUR = (0.85, 0.45, 0.1)
-FINISHING_COLOUR = (0.1, 0.55, 0.2)
 
 
 def _checked(values: dict, fields, what: str) -> dict:
@@ -53,8 +53,7 @@ def _view(obj, colour=None, transparency: int | None = None) -> None:
         return
     ViewProvider(obj.ViewObject)
     if colour is not None:
-        if hasattr(obj.ViewObject, "ShapeColor"):
-            obj.ViewObject.ShapeColor = colour
+        compat.set_shape_colour(obj.ViewObject, colour)
         if hasattr(obj.ViewObject, "NormalColor"):
             obj.ViewObject.NormalColor = colour
         if hasattr(obj.ViewObject, "LineColor") and obj.TypeId.startswith("Part"):
@@ -74,6 +73,9 @@ def make_gear(doc=None, **values):
     obj = doc.addObject("Part::FeaturePython", "Gear")
     GearFeature(obj, gear_values)
     _view(obj, GEAR_COLOUR)
+    if FreeCAD.GuiUp and obj.ViewObject is not None:  # a fine tessellation: the involute drawn smooth
+        obj.ViewObject.Deviation = GEAR_DEVIATION_PERCENT
+        obj.ViewObject.AngularDeflection = GEAR_ANGULAR_DEFLECTION_DEG
     return obj
 
 
@@ -88,15 +90,10 @@ def make_stock(gear, **values):
 
 def _toolpath_object(doc, operation: str):
     """A toolpath object: a FreeCAD Path object when the Path module loads, else a Part wire compound."""
-    try:
-        import Path  # noqa: F401  (FreeCAD's Path workbench module)
-
-        type_id = "Path::FeaturePython"
-    except ImportError:
-        type_id = "Part::FeaturePython"
+    type_id = compat.PATH_FEATURE_TYPE if compat.path_module() is not None else "Part::FeaturePython"
     obj = doc.addObject(type_id, f"{operation.capitalize()}Toolpath")
     ToolpathFeature(obj, operation)
-    _view(obj, ROUGHING_COLOUR if operation == "roughing" else FINISHING_COLOUR)
+    _view(obj, OPERATION_COLOURS[operation])
     return obj
 
 
@@ -129,7 +126,7 @@ def import_job_file(doc, path: str):
 
     job = load_job(path)
     values = schema.values_from_job(job)
-    doc = _document(doc)
+    doc = doc if doc is not None else FreeCAD.newDocument(document_name(path))
     gear = make_gear(doc, **values["gear"])
     stock = make_stock(gear, **values["stock"])
     job_obj = make_job(gear, stock, suggest=False, **values["job"])
@@ -163,13 +160,26 @@ def export_job(job_obj, out_dir: str) -> list[str]:
 
 def simulate(job_obj, resolution_mm: float | None = None):
     """Simulate the job's toolpaths (spur_cad.sim, at the job's SimulationResolution unless given) and show
-    the design points coloured by their deviation."""
-    from spur_cad.pipeline import plan_cam
+    the design points coloured by their deviation. Reuses the job's plan when its values have not changed."""
+    from spur_cad_workbench.features import document_values
     from spur_cad_workbench.simulation import show_result, simulate_job, simulator
+    from spur_cad_workbench.summary import values_signature
 
     simulator()  # raises SimulationUnavailable before any work
-    job = job_of(job_obj)
-    return show_result(job_obj, simulate_job(job, plan_cam(job), resolution_mm))
+    signature = values_signature(document_values(job_obj))
+    cached = getattr(job_obj.Proxy, "cached_plan", None)
+    reused = cached is not None and cached[0] == signature
+    job, plan = job_obj.Proxy.plan_for(job_obj)
+    source = "the job's plan (reused)" if reused else "planned for this simulation"
+    return show_result(job_obj, simulate_job(job, plan, resolution_mm), signature, source)
+
+
+def document_name(path: str) -> str:
+    """A FreeCAD document name for a job file: its stem with characters FreeCAD names cannot hold replaced."""
+    import re
+
+    stem = re.sub(r"[^A-Za-z0-9_]", "_", Path(path).stem) or "Job"
+    return stem if not stem[0].isdigit() else f"Job_{stem}"
 
 
 # --- GUI commands ------------------------------------------------------------------------------
@@ -303,9 +313,8 @@ class ImportJobCommand(_Command):
 
         path, _ = QtGui.QFileDialog.getOpenFileName(FreeCADGui.getMainWindow(), "Import spur_cad job file", "",
                                                     "spur_cad job (*.toml)")
-        if path:
-            run_recorded([NEW_DOCUMENT, _call("spur_cad_objects", "import_job_file", "App.ActiveDocument", repr(path))],
-                         "Import job file")
+        if path:  # a new document named after the job file
+            run_recorded([_call("spur_cad_objects", "import_job_file", "None", repr(path))], "Import job file")
 
 
 class SimulateCommand(_Command):

@@ -1,13 +1,19 @@
 """FeaturePython document objects: gear, stock, 4-axis job and its toolpaths.
 
-Every value lives in a primitive property (schema.py); the Python proxies hold no state, and
-`dumps` / `__getstate__` return None, so a saved document names the proxy classes but pickles
-nothing. `SchemaVersion` on each object lets `onDocumentRestored` migrate older documents
-(today: add properties that a newer schema introduced, with their defaults).
+Every value lives in a primitive property (schema.py); `dumps` / `__getstate__` return None, so a
+saved document names the proxy classes but pickles nothing. The one thing a proxy keeps in memory is
+the job's last plan (`JobFeature.plan_for`), so that Simulate and the panel reuse it; it is
+never saved and is planned again when the values differ. `SchemaVersion` on each object lets
+`onDocumentRestored` migrate older documents (add the properties a newer schema introduced, with
+their defaults).
 
 Shapes come from spur_cad's CadQuery/OCP solids, transferred as BREP text. Input errors
-(SpurCadError) do not raise out of `execute` (FreeCAD would print a traceback): the object's
-`Status` property says what is wrong and the report view gets the one-line message.
+(SpurCadError): the object's `Status` property says what is wrong, the report view gets the
+one-line message, computed values are cleared and what depends on the object (toolpaths,
+simulations) is marked stale and drawn grey. In the GUI `execute` then raises InputError, so that
+FreeCAD puts the object in its error state (the tree's error mark); FreeCAD reports that
+exception on its developer channel, not in the report view. Without the GUI it does not raise
+(FreeCAD would print the exception's traceback on the console); scripts read `Status`.
 """
 
 from __future__ import annotations
@@ -16,11 +22,26 @@ import io
 
 import FreeCAD
 
-from spur_cad_workbench import schema
+from spur_cad_workbench import compat, schema
 from spur_cad_workbench.resources import icon_path
 
 PROP_READ_ONLY = 1
 PROP_OUTPUT = 8
+
+GEAR_COLOUR = (0.55, 0.62, 0.72)
+STOCK_COLOUR = (0.85, 0.75, 0.45)
+ROUGHING_COLOUR = (0.85, 0.45, 0.1)
+FINISHING_COLOUR = (0.1, 0.55, 0.2)
+STALE_COLOUR = (0.62, 0.62, 0.62)  # toolpaths and simulations that no longer match their job
+OPERATION_COLOURS = {"roughing": ROUGHING_COLOUR, "finishing": FINISHING_COLOUR}
+# The gear's display tessellation: chord deviation in % of the part's size (FreeCAD's default 0.5 % is
+# 0.5 mm on a 100 mm gear: the involute looks faceted beside the toolpaths) and angular deflection.
+GEAR_DEVIATION_PERCENT = 0.02
+GEAR_ANGULAR_DEFLECTION_DEG = 5.0
+
+
+class InputError(Exception):
+    """Raised from `execute` in the GUI so that FreeCAD marks the object as in error (message: the Status)."""
 
 
 def property_value(field, value):
@@ -104,6 +125,72 @@ def report(obj, message: str | None) -> None:
         obj.Status = status
     if message is not None:
         FreeCAD.Console.PrintError(f"{obj.Label}: {message}\n")
+
+
+def fail(obj, message: str) -> None:
+    """An input error on `obj`: Status and report line, computed values cleared, dependants marked stale; in
+    the GUI raise InputError so that FreeCAD shows the object's error state."""
+    report(obj, message)
+    clear_outputs(obj)
+    for dependant in dependants(obj):
+        mark_stale(dependant, f"{obj.Label} has an error")
+    if FreeCAD.GuiUp:
+        raise InputError(obj.Status.removeprefix("error: "))
+
+
+def clear_outputs(obj) -> None:
+    """Reset the computed values of a spur_cad object (0, False, empty), so no stale figure reads as current."""
+    kind = getattr(getattr(obj, "Proxy", None), "KIND", "")
+    empty = {"length": 0.0, "distance": 0.0, "float": 0.0, "int": 0, "bool": False, "strings": [], "string": ""}
+    for field in schema.OUTPUTS.get(kind, ()):
+        if field.prop in obj.PropertiesList and field.prop != "Operation":
+            value = empty[field.kind]
+            if schema.plain_value(field, getattr(obj, field.prop)) != value:
+                setattr(obj, field.prop, value)
+
+
+def dependants(obj) -> list:
+    """The spur_cad toolpaths and simulations that depend on `obj` (directly or through stock and job)."""
+    found = []
+    for other in obj.InListRecursive:
+        kind = getattr(getattr(other, "Proxy", None), "KIND", "")
+        if kind == "job":
+            found += [path for path in (other.RoughingToolpath, other.FinishingToolpath) if path is not None]
+        if kind == "simulation":
+            found.append(other)
+    if getattr(getattr(obj, "Proxy", None), "KIND", "") == "job":
+        found += [path for path in (obj.RoughingToolpath, obj.FinishingToolpath) if path is not None]
+    return list({item.Name: item for item in found}.values())
+
+
+def mark_stale(obj, reason: str) -> None:
+    """Say on `obj` (a toolpath or simulation) that it no longer shows its job, and draw it grey."""
+    status = f"stale: {reason}"
+    if obj.Status != status:
+        obj.Status = status
+    view = obj.ViewObject if FreeCAD.GuiUp else None
+    if view is None:
+        return
+    _colour(view, STALE_COLOUR)
+    if "Points" in view.listDisplayModes():
+        view.DisplayMode = "Points"  # a simulation: plain grey points instead of the deviation colours
+
+
+def show_fresh(obj) -> None:
+    """Draw a toolpath in its operation's colour again (after mark_stale)."""
+    view = obj.ViewObject if FreeCAD.GuiUp else None
+    colour = OPERATION_COLOURS.get(getattr(obj, "Operation", ""))
+    if view is None or colour is None:
+        return
+    _colour(view, colour)
+
+
+def _colour(view, colour) -> None:
+    """Colour a view object's lines (toolpaths) and faces."""
+    for colour_property in ("NormalColor", "LineColor"):
+        if colour_property in view.PropertiesList:
+            setattr(view, colour_property, colour)
+    compat.set_shape_colour(view, colour)
 
 
 def part_shape(ocp_shape):
@@ -230,7 +317,7 @@ class GearFeature(_Proxy):
             job = job_of(obj)
             shape, _ = build_gear_shape(job.gear, job.gear_section.blank_features())
         except SpurCadError as exc:
-            report(obj, str(exc))
+            fail(obj, str(exc))
             return
         spec, sheet = job.gear, inspection_sheet(job.gear)
         write_outputs(obj, {
@@ -268,7 +355,7 @@ class StockFeature(_Proxy):
             job = job_of(obj)
             shape = build_stock_shape(job.gear, job.stock)
         except SpurCadError as exc:
-            report(obj, str(exc))
+            fail(obj, str(exc))
             return
         write_outputs(obj, {"BlankRadius": job.stock.blank_radius_mm(job.gear)})
         set_shape(obj, part_shape(shape))
@@ -293,31 +380,53 @@ class JobFeature(_Proxy):
         add_fields(obj, self.OUTPUTS, outputs=True)
         add_bookkeeping(obj)
 
+    def plan_for(self, obj):
+        """(job, plan) of the job's current values: the last plan when the values have not changed since."""
+        from spur_cad.pipeline import plan_cam
+        from spur_cad_workbench.summary import values_signature
+
+        signature = values_signature(document_values(obj))
+        cached = getattr(self, "cached_plan", None)
+        if cached is not None and cached[0] == signature:
+            return cached[1], cached[2]
+        job = job_of(obj)
+        plan = plan_cam(job)
+        self.cached_plan = (signature, job, plan)
+        return job, plan
+
     def execute(self, obj):
         from spur_cad.errors import SpurCadError
-        from spur_cad.pipeline import plan_cam
+        from spur_cad_workbench.summary import plan_figures, values_signature
 
+        self.cached_plan = None
         try:
-            job = job_of(obj)
-            plan = plan_cam(job)
+            job, plan = self.plan_for(obj)
+            figures = plan_figures(job, plan)
         except SpurCadError as exc:
-            report(obj, str(exc))
+            fail(obj, str(exc))
             return
         rec = plan.recommendations
         outputs = {"FinishingMaxFlatWidth": rec.finishing_max_flat_width_mm,
                    "FinishingMaxCornerRadius": rec.finishing_max_corner_radius_mm,
                    "PlungeAllowance": rec.plunge_allowance_mm, "RoughingMaxDiameter": rec.roughing_max_diameter_mm,
                    "RequiredFluteLength": rec.required_flute_length_mm,
-                   "RequiredStickOut": rec.required_stick_out_mm, "Warnings": list(plan.warnings)}
+                   "RequiredStickOut": rec.required_stick_out_mm, "Warnings": list(plan.warnings),
+                   "PlannedValues": values_signature(document_values(obj))}
         for name in schema.TOOL_ROLES:
             title = name.capitalize()
-            planned = getattr(plan, name)
-            outputs[f"{title}Moves"] = planned.estimate.moves if planned is not None else 0
-            outputs[f"{title}Time"] = planned.estimate.time_s / 60.0 if planned is not None else 0.0
+            planned, op = getattr(plan, name), getattr(figures, name)
+            outputs[f"{title}Moves"] = op.moves if op is not None else 0
+            outputs[f"{title}Time"] = op.seconds / 60.0 if op is not None else 0.0
+            outputs[f"{title}TimeWithAcceleration"] = op.seconds_with_acceleration / 60.0 if op is not None else 0.0
+            outputs[f"{title}ProgramLines"] = op.program_lines if op is not None else 0
             target = getattr(obj, f"{title}Toolpath")
             if target is not None:
                 update_toolpath(target, planned)
         write_outputs(obj, outputs)
+        for dependant in dependants(obj):
+            if getattr(dependant.Proxy, "KIND", "") == "simulation" and dependant.PlannedValues != \
+                    outputs["PlannedValues"]:
+                mark_stale(dependant, "the job changed after this simulation; simulate again")
         report(obj, None)
 
 
@@ -335,6 +444,12 @@ class ToolpathFeature(_Proxy):
 
     def execute(self, obj):
         return None
+
+
+def toolpath_label(operation: str, shown: int, total: int) -> str:
+    """The tree label of a toolpath; says when the 3D view shows only part of the moves."""
+    label = f"{operation.capitalize()} toolpath"
+    return label if shown >= total else f"{label} (3D view: {shown:,} of {total:,} moves)"
 
 
 def uses_path_module(obj) -> bool:
@@ -359,12 +474,10 @@ def update_toolpath(obj, planned) -> None:
                    "EstimatedTime": float(planned.estimate.time_s) / 60.0, "ToolNumber": int(path.tool_number),
                    "SpindleSpeed": float(path.spindle_rpm)}
     if uses_path_module(obj):
-        import Path
-
-        program = Path.Path()
-        if drawn is not None and len(drawn.points):
-            program.setFromGCode(gcode_text(drawn))
-        obj.Path = program
+        has_points = drawn is not None and len(drawn.points) > 0
+        obj.Path = compat.new_path(compat.path_module(), gcode_text(drawn) if has_points else "")
+        if has_points and FreeCAD.GuiUp:  # else the path is drawn from (0, 0, 0), through the gear
+            compat.set_path_start(obj.ViewObject, drawn.points[0])
     else:
         import Part
 
@@ -372,7 +485,9 @@ def update_toolpath(obj, planned) -> None:
                                           for _, run in polylines(drawn)]
         obj.Shape = Part.makeCompound(wires)
     write_outputs(obj, outputs)
+    obj.Label = toolpath_label(obj.Operation, outputs["DisplayedMoves"], outputs["Moves"])
     report(obj, None)
+    show_fresh(obj)
     obj.purgeTouched()  # set by the job's recompute: nothing left for the toolpath itself to do
 
 
@@ -387,7 +502,8 @@ class ViewProvider(_Stateless):
 
     def getIcon(self):
         kind = getattr(getattr(getattr(self, "Object", None), "Proxy", None), "KIND", "")
-        return icon_path({"gear": "gear", "stock": "stock", "job": "job", "toolpath": "toolpath"}.get(kind, "spur_cad"))
+        return icon_path({"gear": "gear", "stock": "stock", "job": "job", "toolpath": "toolpath",
+                          "simulation": "simulate"}.get(kind, "spur_cad"))
 
     def claimChildren(self):
         obj = getattr(self, "Object", None)

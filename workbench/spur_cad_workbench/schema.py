@@ -34,17 +34,19 @@ catalogues quote them in those units, and FreeCAD would show them as mm/s, Hz or
 document lacks, re-creates properties whose type changed (keeping their value) and updates
 drop-down lists, so a new key needs no migration code. Version 2: MaxFeed and RapidFeed became
 PropertySpeed (were PropertyFloat), AMin and AMax PropertyFloat (were PropertyAngle, which
-clamped the default +-99999 deg to +-360).
+clamped the default +-99999 deg to +-360). Version 3: the job's results gained the times with
+accelerations, the program lines and PlannedValues.
 """
 
 from __future__ import annotations
 
+import re
 from dataclasses import dataclass
 
 from spur_cad.job import SECTIONS
 from spur_cad.keys import keys_of
 
-SCHEMA_VERSION = 2
+SCHEMA_VERSION = 3
 TOOL_ROLES = ("roughing", "finishing")
 
 # FreeCAD property type for each kind of value (the mapping above; outputs use the same kinds).
@@ -173,6 +175,13 @@ JOB_OUTPUTS = (
     _f("RoughingTime", "float", "Results", "", "", "estimated roughing time (min)"),
     _f("FinishingMoves", "int", "Results", "", "", "moves of the finishing program"),
     _f("FinishingTime", "float", "Results", "", "", "estimated finishing time (min)"),
+    _f("RoughingTimeWithAcceleration", "float", "Results", "", "", "estimated roughing time with the machine's "
+       "accelerations (min)"),
+    _f("FinishingTimeWithAcceleration", "float", "Results", "", "", "estimated finishing time with the machine's "
+       "accelerations (min)"),
+    _f("RoughingProgramLines", "int", "Results", "", "", "lines of the roughing program as posted"),
+    _f("FinishingProgramLines", "int", "Results", "", "", "lines of the finishing program as posted"),
+    _f("PlannedValues", "string", "Results", "", "", "fingerprint of the values the results were planned for"),
     _f("Warnings", "strings", "Results", "", "", "warnings of the CAM stage"),
 )
 
@@ -266,3 +275,28 @@ def job_data(values: dict[str, dict[str, object]]) -> dict[str, dict]:
 def field_by_prop(prop: str) -> Field:
     """The Field of a property name (inputs and outputs of every object)."""
     return _BY_PROP[prop]
+
+
+# Titles that splitting the property name would not give (after dropping the tool role's word).
+_TITLES = {"UseRoughingTool": "Rough with this tool", "UseFinishingTool": "Finish with this tool",
+           "StickOut": "Stick-out", "StepOverFraction": "Step-over (fraction of D)",
+           "MaxLevelDepthFraction": "Level depth (fraction of D)", "FinishingStrategy": "Strategy",
+           "FinishingStepOver": "Step-over", "MaxSpindleRpm": "Max spindle speed", "SimulationEnabled": "Simulate",
+           "SimulationResolution": "Resolution", "PostDialect": "Dialect", "JobName": "Name",
+           "MachineName": "Name", "ThicknessAllowancePercent": "Thickness allowance (%)",
+           "ProfileShift": "Profile shift coefficient x"}
+
+
+def title(field: Field) -> str:
+    """A field's label for people: "RoughingFeedPerTooth" in group "Roughing tool" -> "Feed per tooth"."""
+    words = re.findall(r"[A-Z][a-z0-9]*|[a-z0-9]+", field.prop)
+    role = field.section.removeprefix("tools.").capitalize() if field.section.startswith("tools.") else ""
+    if role and words and words[0] == role:
+        words = words[1:]
+    if len(words) > 1 and words[0] == "Tool" and words[1] != "Number":
+        words = words[1:]
+    key = "".join(words)
+    if field.prop in _TITLES or key in _TITLES:
+        return _TITLES.get(field.prop, _TITLES.get(key))
+    text = " ".join(word if len(word) == 1 else word.lower() for word in words)
+    return text[:1].upper() + text[1:]

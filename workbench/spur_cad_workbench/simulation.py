@@ -3,8 +3,11 @@
 `simulate_job` cuts the stock with the job's toolpaths through spur_cad.sim's pipeline stage
 (`spur_cad.pipeline.simulate_stage`, as `spur-cad run` does); `show_result` draws every design
 point of the face width, in the part frame, coloured by its deviation (blue gouge, green on
-the design, red leftover). Without spur_cad.sim, `simulator()` raises SimulationUnavailable
-with the message the command shows.
+the design, red leftover) in a simulation object linked to its job. The colour scale
+(`ColourScale`, editable) starts at the largest deviation shown, so the worst point is fully
+coloured; a colour bar in the 3D view gives the scale. The object remembers the values it was
+simulated for (`PlannedValues`): when the job changes, the job marks it stale (grey). Without
+spur_cad.sim, `simulator()` raises SimulationUnavailable with the message the command shows.
 """
 
 from __future__ import annotations
@@ -52,9 +55,11 @@ def simulate_job(job, plan, resolution_mm: float | None = None):
     return result
 
 
-def colour_scale_mm(resolution_mm: float) -> float:
-    """Deviation shown fully blue (gouge) or red (leftover): five times the simulation's resolution."""
-    return 5.0 * resolution_mm
+def colour_scale_mm(deviation: np.ndarray, resolution_mm: float) -> float:
+    """Deviation shown fully blue (gouge) or red (leftover): the largest deviation, at least the resolution
+    (differences below it are the simulation's own)."""
+    largest = float(np.max(np.abs(deviation))) if len(deviation) else 0.0
+    return max(largest, resolution_mm)
 
 
 def deviation_colours(deviation: np.ndarray, scale_mm: float) -> np.ndarray:
@@ -82,41 +87,115 @@ def result_points(result) -> tuple[np.ndarray, np.ndarray]:
     return points, deviation
 
 
-def show_result(job_obj, result):
-    """A Points object '<job> simulation' with the coloured design points and the result's facts."""
+_RESULT_PROPERTIES = (
+    ("Job", "App::PropertyLink", "the job simulated"),
+    ("Color", "App::PropertyColorList", "deviation colour of each point (the Color display mode shows them)"),
+    ("PlannedValues", "App::PropertyString", "fingerprint of the job values simulated"),
+    ("Status", "App::PropertyString", "ok, or stale when the job changed after the simulation"),
+    ("ColourScale", "App::PropertyLength", "deviation shown fully blue (gouge) or red (leftover); edit to rescale"),
+    ("Deviations", "App::PropertyFloatList", "deviation of each point (mm, + leftover)"),
+    ("ResolutionMicrons", "App::PropertyFloat", "simulation resolution (um)"),
+    ("MaxGougeMicrons", "App::PropertyFloat", "largest gouge: material removed below the design (um)"),
+    ("MaxLeftoverMicrons", "App::PropertyFloat", "largest leftover: material above the design (um)"),
+    ("RemovedVolume", "App::PropertyFloat", "removed volume (mm^3)"),
+    ("Seconds", "App::PropertyFloat", "simulation time (s)"),
+    ("DesignPoints", "App::PropertyInteger", "design points of the face width (the points drawn are a subset)"),
+    ("PlanSource", "App::PropertyString", "whether the job's plan was reused or planned for the simulation"),
+    ("Legend", "App::PropertyString", "colour legend"),
+)
+_EDITABLE = {"ColourScale"}
+
+
+def legend_text(scale_mm: float, shown: int, total: int) -> str:
+    """What the colours mean, and how many of the design points are drawn."""
+    return (f"blue: gouge of {scale_mm * 1000:.3g} um or more, green: on the design, red: leftover of "
+            f"{scale_mm * 1000:.3g} um or more ({shown:,} of {total:,} design points shown)")
+
+
+class SimulationFeature:
+    """Proxy of a simulation object (Points::FeaturePython): recolours the points when ColourScale changes.
+    Stateless (saved as null); the deviations live in the Deviations property."""
+
+    KIND = "simulation"
+
+    def __init__(self, obj):
+        obj.Proxy = self
+
+    def execute(self, obj):
+        return None
+
+    def onChanged(self, obj, prop):
+        if prop == "ColourScale" and "Deviations" in obj.PropertiesList and len(obj.Deviations):
+            recolour(obj)
+
+    def dumps(self):
+        return None
+
+    def loads(self, state):
+        return None
+
+
+def recolour(obj) -> None:
+    """Colour the points by their deviation on the object's ColourScale; update the legend and the colour bar."""
+    import FreeCAD
+
+    scale = max(float(obj.ColourScale.Value), 1e-6)
+    obj.Color = [tuple(c) for c in deviation_colours(np.asarray(obj.Deviations), scale)]
+    obj.Legend = legend_text(scale, len(obj.Deviations), obj.DesignPoints)
+    if FreeCAD.GuiUp:
+        from spur_cad_workbench.colourbar import show_colour_bar
+
+        show_colour_bar(scale)
+
+
+def _simulation_object(job_obj):
+    """The job's simulation object (made when missing), linked to the job."""
+    import FreeCAD
+
+    doc = job_obj.Document
+    for obj in job_obj.InList:
+        if getattr(getattr(obj, "Proxy", None), "KIND", "") == "simulation":
+            return obj
+    obj = doc.addObject("Points::FeaturePython", "Simulation")
+    SimulationFeature(obj)
+    for prop, type_id, doc_text in _RESULT_PROPERTIES:
+        obj.addProperty(type_id, prop, "Simulation", doc_text, 0 if prop in _EDITABLE else 1)
+    for hidden in ("Deviations", "Color"):  # hundreds of thousands of numbers
+        obj.setEditorMode(hidden, 2)
+    obj.Job = job_obj
+    if FreeCAD.GuiUp and obj.ViewObject is not None:
+        from spur_cad_workbench.features import ViewProvider
+
+        ViewProvider(obj.ViewObject)
+    return obj
+
+
+def show_result(job_obj, result, planned_values: str = "", plan_source: str = ""):
+    """The job's simulation object '<job> simulation' with the coloured design points and the result's facts."""
     import FreeCAD
     import Points
 
-    doc = job_obj.Document
-    name = f"{job_obj.Label} simulation"
-    found = [obj for obj in doc.Objects if obj.TypeId == "Points::Feature" and obj.Label == name]
-    obj = found[0] if found else doc.addObject("Points::Feature", "Simulation")
-    obj.Label = name
+    obj = _simulation_object(job_obj)
+    obj.Label = f"{job_obj.Label} simulation"
     points, deviation = result_points(result)
-    scale = colour_scale_mm(result.settings.resolution_mm)
-    properties = (("Color", "App::PropertyColorList", "deviation colour per point"),
-                  ("Resolution", "App::PropertyLength", "simulation resolution"),
-                  ("MaxGouge", "App::PropertyLength", "largest gouge (material removed below the design)"),
-                  ("MaxLeftover", "App::PropertyLength", "largest leftover (material above the design)"),
-                  ("RemovedVolume", "App::PropertyFloat", "removed volume (mm^3)"),
-                  ("Seconds", "App::PropertyFloat", "simulation time (s)"),
-                  ("Legend", "App::PropertyString", "colour legend"))
-    for prop, type_id, doc_text in properties:
-        if prop not in obj.PropertiesList:
-            obj.addProperty(type_id, prop, "Simulation", doc_text, 1 if prop != "Color" else 0)
+    scale = colour_scale_mm(deviation, result.settings.resolution_mm)
     obj.Points = Points.Points([FreeCAD.Vector(*p) for p in points])
-    obj.Color = [tuple(c) for c in deviation_colours(deviation, scale)]
-    obj.Resolution = result.settings.resolution_mm
-    obj.MaxGouge = result.max_gouge_mm
-    obj.MaxLeftover = result.max_leftover_mm
+    obj.Deviations = [float(d) for d in deviation]
+    obj.PlannedValues = planned_values
+    obj.Status = "ok"
+    obj.ResolutionMicrons = result.settings.resolution_mm * 1000.0
+    obj.MaxGougeMicrons = result.max_gouge_mm * 1000.0
+    obj.MaxLeftoverMicrons = result.max_leftover_mm * 1000.0
     obj.RemovedVolume = result.removed_volume_mm3
     obj.Seconds = result.seconds
-    obj.Legend = (f"blue: gouge of {scale:g} mm or more, green: on the design, red: leftover of {scale:g} mm or "
-                  f"more ({len(points)} of {result.deviation[:, :, result.gear_rows].size} design points shown)")
-    doc.recompute()
+    obj.PlanSource = plan_source
+    obj.DesignPoints = int(result.deviation[:, :, result.gear_rows].size)
+    obj.ColourScale = scale  # recolours (onChanged)
+    recolour(obj)
+    obj.purgeTouched()
     if FreeCAD.GuiUp and obj.ViewObject is not None:
         obj.ViewObject.DisplayMode = "Color"
         obj.ViewObject.PointSize = 3
-    FreeCAD.Console.PrintMessage(f"{name}: max gouge {result.max_gouge_mm:.4f} mm, max leftover "
-                                 f"{result.max_leftover_mm:.4f} mm\n")
+    FreeCAD.Console.PrintMessage(f"{obj.Label}: max gouge {result.max_gouge_mm * 1000:.2f} um, max leftover "
+                                 f"{result.max_leftover_mm * 1000:.2f} um\n")
     return obj

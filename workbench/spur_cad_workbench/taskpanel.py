@@ -1,23 +1,44 @@
-"""The 4-axis job's task panel: tools, cutting data, strategies, machine and post, checked as you type.
+"""The 4-axis job's task panel: a summary on top, then tools, cutting data, strategies, machine and post in
+collapsible sections, checked as you type.
 
-One group box per property group of schema.JOB_FIELDS. Every change re-runs
-validation.validate (the command line's own checks) and shows each SpurCadError message
-inside the group it is about; the tool recommendations for the gear stand beside the tool
-fields. OK writes the values to the job and recomputes; with an error OK keeps the panel open.
+- Fields: titles for people (schema.title), FreeCAD's unit-aware Gui::QuantitySpinBox for lengths
+  and angles, spin boxes with the unit as suffix for the other units; each row fits FreeCAD's
+  default task dock width (labels wrap above their field when the dock is narrow).
+- Summary: validity, the tool limits (cheap, as you type), and the cycle time by both estimators,
+  moves and program lines. Those need a plan: they are shown from the job's last recompute while
+  the values are the job's, from the panel's own plan after "Plan", and marked outdated otherwise.
+- Errors: every change runs validation.validate (the command line's own checks); the problem is
+  shown in its section as what to change, and its field is highlighted. OK with a problem keeps
+  the panel open, opens the section, scrolls to the field and focuses it.
 """
 
 from __future__ import annotations
 
+import FreeCAD
 import FreeCADGui
 from PySide import QtCore, QtGui
 
-from spur_cad_workbench import schema
+from spur_cad_workbench import compat, schema
 from spur_cad_workbench.features import document_values, write_values
-from spur_cad_workbench.validation import recommendation_notes, validate
+from spur_cad_workbench.summary import (
+    figures_text,
+    limits_text,
+    long_job_advice,
+    plan_figures,
+    values_signature,
+)
+from spur_cad_workbench.validation import recommendation_notes, unusual_value_notes, validate
 
-ERROR_STYLE = "color: #b00020;"
+ERROR_COLOUR = "#b00020"
+ERROR_STYLE = f"color: {ERROR_COLOUR};"
+HIGHLIGHT_STYLE = f"border: 2px solid {ERROR_COLOUR};"
 NOTE_STYLE = "color: #555555;"
+ADVICE_STYLE = "color: #8a5a00;"
 BIG = 1e9
+COLLAPSED_GROUPS = ("Machine", "Simulation", "Post")  # rarely changed: closed until asked for
+FIELD_MIN_WIDTH_PX = 112
+PANEL_MIN_WIDTH_PX = 200  # fits FreeCAD's default task dock (about 264 px with its margins and scroll bar)
+QUANTITY_UNITS = {"length": "mm", "distance": "mm", "angle": "deg"}
 
 
 def _group_names() -> list[str]:
@@ -28,65 +49,139 @@ def _group_names() -> list[str]:
     return names
 
 
+def decimals_for(value: float, at_least: int) -> int:
+    """Decimals that show `value` exactly (at least `at_least`, at most 6): a job file's 87.5 m/min stays 87.5."""
+    for decimals in range(at_least, 7):
+        if abs(round(value, decimals) - value) <= 1e-12 * max(1.0, abs(value)):
+            return decimals
+    return 6
+
+
+class Section:
+    """A titled, collapsible part of the panel: a header button and a body with a form layout."""
+
+    def __init__(self, title: str, collapsed: bool):
+        self.widget = QtGui.QWidget()
+        layout = QtGui.QVBoxLayout(self.widget)
+        layout.setContentsMargins(0, 0, 0, 0)
+        layout.setSpacing(2)
+        self.header = QtGui.QToolButton()
+        self.header.setObjectName(f"section:{title}")
+        self.header.setText(title)
+        self.header.setCheckable(True)
+        self.header.setToolButtonStyle(QtCore.Qt.ToolButtonTextBesideIcon)
+        self.header.setSizePolicy(QtGui.QSizePolicy.Expanding, QtGui.QSizePolicy.Fixed)
+        self.header.setStyleSheet("QToolButton { border: none; font-weight: bold; text-align: left; }")
+        self.body = QtGui.QWidget()
+        self.form = QtGui.QFormLayout(self.body)
+        self.form.setRowWrapPolicy(QtGui.QFormLayout.WrapLongRows)
+        self.form.setFieldGrowthPolicy(QtGui.QFormLayout.AllNonFixedFieldsGrow)
+        self.form.setContentsMargins(8, 0, 0, 4)
+        layout.addWidget(self.header)
+        layout.addWidget(self.body)
+        self.header.toggled.connect(self.set_open)
+        self.header.setChecked(not collapsed)
+        self.set_open(not collapsed)
+
+    def set_open(self, is_open: bool) -> None:
+        self.header.setChecked(is_open)
+        self.header.setArrowType(QtCore.Qt.DownArrow if is_open else QtCore.Qt.RightArrow)
+        self.body.setVisible(is_open)
+
+    @property
+    def is_open(self) -> bool:
+        return self.header.isChecked()
+
+
+def _wrapped_label(style: str = "", name: str = "") -> QtGui.QLabel:
+    label = QtGui.QLabel()
+    label.setWordWrap(True)
+    label.setObjectName(name)
+    if style:
+        label.setStyleSheet(style)
+    label.setSizePolicy(QtGui.QSizePolicy.Ignored, QtGui.QSizePolicy.Preferred)
+    return label
+
+
 class JobTaskPanel:
-    """Task panel editing one job object; `widgets`, `notes` and `messages` are keyed for tests and macros."""
+    """Task panel editing one job object; `widgets`, `labels`, `notes`, `messages` and `sections` are keyed for
+    tests and macros (by property name, and by group for messages and sections)."""
 
     def __init__(self, job_obj):
         self.job = job_obj
         self.form = QtGui.QWidget()
         self.form.setObjectName("SpurCadJobPanel")
         self.form.setWindowTitle(f"4-axis job: {job_obj.Label}")
+        self.form.setMinimumWidth(PANEL_MIN_WIDTH_PX)
         self.widgets: dict[str, QtGui.QWidget] = {}
+        self.labels: dict[str, QtGui.QLabel] = {}
         self.notes: dict[str, QtGui.QLabel] = {}
         self.messages: dict[str, QtGui.QLabel] = {}
-        self.boxes: dict[str, QtGui.QGroupBox] = {}
+        self.sections: dict[str, Section] = {}
+        self.highlighted: str | None = None
+        self.result = None
+        self._shown: dict[str, tuple[str, float]] = {}  # quantity fields: (text shown, exact value) when set
+        self._planned: tuple[str, object] | None = None  # (values signature, PlanFigures) planned by the panel
         layout = QtGui.QVBoxLayout(self.form)
-        self.summary = QtGui.QLabel()
-        self.summary.setWordWrap(True)
-        layout.addWidget(self.summary)
-        for extra in ("Gear", "Stock"):
-            label = self._message_label(extra)
-            layout.addWidget(label)
+        layout.setContentsMargins(0, 0, 0, 0)
+        layout.addWidget(self._summary_box())
+        for extra in ("Gear", "Stock", "Job"):
+            layout.addWidget(self._message_label(extra))
         values = document_values(job_obj)
         self._gear_values, self._stock_values = values["gear"], values["stock"]
         for group in _group_names():
-            layout.addWidget(self._group_box(group, values["job"]))
+            section = Section(group, group in COLLAPSED_GROUPS)
+            self.sections[group] = section
+            if group not in self.messages:
+                section.form.addRow(self._message_label(group))
+            for field in schema.JOB_FIELDS:
+                if field.group == group:
+                    self._add_row(section, field, values["job"][field.prop])
+            layout.addWidget(section.widget)
         layout.addStretch(1)
         self.revalidate()
 
     # --- building --------------------------------------------------------------------------
+    def _summary_box(self) -> QtGui.QWidget:
+        box = QtGui.QFrame()
+        box.setObjectName("summary")
+        box.setFrameShape(QtGui.QFrame.StyledPanel)
+        layout = QtGui.QVBoxLayout(box)
+        self.summary = _wrapped_label(name="summary:status")
+        self.summary_figures = _wrapped_label(name="summary:figures")
+        self.summary_advice = _wrapped_label(ADVICE_STYLE, "summary:advice")
+        self.summary_limits = _wrapped_label(NOTE_STYLE, "summary:limits")
+        self.plan_button = QtGui.QPushButton("Plan (update the figures)")
+        self.plan_button.setObjectName("summary:plan")
+        self.plan_button.setToolTip("Plan the toolpaths for the values in this panel and show the cycle time, moves "
+                                    "and program lines (the job itself changes only on OK)")
+        self.plan_button.clicked.connect(self.plan)
+        for widget in (self.summary, self.summary_figures, self.summary_advice, self.summary_limits,
+                       self.plan_button):
+            layout.addWidget(widget)
+        return box
+
     def _message_label(self, group: str) -> QtGui.QLabel:
-        label = QtGui.QLabel()
-        label.setObjectName(f"message:{group}")
-        label.setWordWrap(True)
-        label.setStyleSheet(ERROR_STYLE)
+        label = _wrapped_label(ERROR_STYLE, f"message:{group}")
         label.setVisible(False)
         self.messages[group] = label
         return label
 
-    def _group_box(self, group: str, values: dict) -> QtGui.QGroupBox:
-        box = QtGui.QGroupBox(group)
-        grid = QtGui.QGridLayout(box)
-        row = 0
-        for field in schema.JOB_FIELDS:
-            if field.group != group:
-                continue
-            widget = self._widget(field, values[field.prop])
-            widget.setObjectName(field.prop)
-            widget.setToolTip(field.doc)
-            self.widgets[field.prop] = widget
-            note = QtGui.QLabel()
-            note.setStyleSheet(NOTE_STYLE)
-            note.setWordWrap(True)
-            self.notes[field.prop] = note
-            grid.addWidget(QtGui.QLabel(field.prop), row, 0)
-            grid.addWidget(widget, row, 1)
-            grid.addWidget(note, row, 2)
-            row += 1
-        grid.addWidget(self._message_label(group), row, 0, 1, 3)
-        grid.setColumnStretch(2, 1)
-        self.boxes[group] = box
-        return box
+    def _add_row(self, section: Section, field, value) -> None:
+        widget = self._widget(field, value)
+        widget.setObjectName(field.prop)
+        widget.setToolTip(field.doc)
+        widget.setMinimumWidth(FIELD_MIN_WIDTH_PX)
+        widget.setSizePolicy(QtGui.QSizePolicy.Ignored, QtGui.QSizePolicy.Fixed)
+        label = QtGui.QLabel(schema.title(field))
+        label.setWordWrap(True)  # a long title takes two lines rather than the field's width
+        label.setObjectName(f"label:{field.prop}")
+        label.setToolTip(field.doc)
+        note = _wrapped_label(NOTE_STYLE, f"note:{field.prop}")
+        note.setVisible(False)
+        self.widgets[field.prop], self.labels[field.prop], self.notes[field.prop] = widget, label, note
+        section.form.addRow(label, widget)
+        section.form.addRow(note)
 
     def _widget(self, field, value) -> QtGui.QWidget:
         if field.kind == "bool":
@@ -106,31 +201,51 @@ class JobTaskPanel:
             widget.setRange(-2**31 + 1, 2**31 - 1)
             widget.setValue(int(value))
             widget.valueChanged.connect(self.revalidate)
-        else:  # length, distance, angle, float: any number, so spur_cad's own messages judge it
+        elif field.kind in QUANTITY_UNITS and (widget := self._quantity_box(field, value)) is not None:
+            pass
+        else:  # other units (m/min, 1/min, mm/min, %, s, ...) and plain numbers: the unit as a suffix
             widget = QtGui.QDoubleSpinBox()
-            widget.setDecimals(6)
+            widget.setDecimals(decimals_for(float(value), 0 if field.unit else 3))
             widget.setRange(-BIG, BIG)
             widget.setValue(float(value))
+            if field.unit:
+                widget.setSuffix(f" {field.unit}")
             widget.valueChanged.connect(self.revalidate)
         return widget
 
+    def _quantity_box(self, field, value):
+        """FreeCAD's unit-aware spin box (any number: spur_cad's own messages judge it), or None without one."""
+        unit = QUANTITY_UNITS[field.kind]
+        widget = compat.quantity_spin_box(FreeCADGui.UiLoader(), unit, -BIG, BIG)
+        if widget is None:
+            return None
+        compat.set_spin_box_value(widget, FreeCAD.Units, float(value), unit)
+        # 0.20 rounds to the shown decimals: an untouched field keeps its exact value
+        self._shown[field.prop] = (widget.text(), float(value))
+        widget.lineEdit().textChanged.connect(self.revalidate)
+        return widget
+
     # --- values and checks -----------------------------------------------------------------
+    def _value(self, field):
+        widget = self.widgets[field.prop]
+        if field.kind == "bool":
+            return widget.isChecked()
+        if field.kind == "choice":
+            return widget.currentText()
+        if field.kind == "string":
+            return widget.text()
+        if field.kind == "int":
+            return int(widget.value())
+        if isinstance(widget, QtGui.QDoubleSpinBox):
+            return float(widget.value())
+        shown_text, exact = self._shown.get(field.prop, (None, 0.0))
+        if widget.text() == shown_text:
+            return exact
+        return compat.spin_box_value(widget, FreeCAD.Units, QUANTITY_UNITS[field.kind])
+
     def job_values(self) -> dict:
         """The job property values as the panel's widgets hold them."""
-        values = {}
-        for field in schema.JOB_FIELDS:
-            widget = self.widgets[field.prop]
-            if field.kind == "bool":
-                values[field.prop] = widget.isChecked()
-            elif field.kind == "choice":
-                values[field.prop] = widget.currentText()
-            elif field.kind == "string":
-                values[field.prop] = widget.text()
-            elif field.kind == "int":
-                values[field.prop] = int(widget.value())
-            else:
-                values[field.prop] = float(widget.value())
-        return values
+        return {field.prop: self._value(field) for field in schema.JOB_FIELDS}
 
     def set_value(self, prop: str, value) -> None:
         """Set a field as a user would (tests, macros)."""
@@ -141,41 +256,129 @@ class JobTaskPanel:
             widget.setCurrentIndex(widget.findText(str(value)))
         elif isinstance(widget, QtGui.QLineEdit):
             widget.setText(str(value))
-        else:
+        elif isinstance(widget, (QtGui.QSpinBox, QtGui.QDoubleSpinBox)):
+            if isinstance(widget, QtGui.QDoubleSpinBox):
+                widget.setDecimals(max(widget.decimals(), decimals_for(float(value), 0)))
             widget.setValue(value)
+        else:
+            unit = QUANTITY_UNITS[schema.field_by_prop(prop).kind]
+            compat.set_spin_box_value(widget, FreeCAD.Units, float(value), unit)
+            self._shown[prop] = (widget.text(), float(value))
+            self.revalidate()
 
     def current_messages(self) -> dict[str, str]:
-        """{group: message} shown now."""
-        return {group: label.text() for group, label in self.messages.items() if label.text()}
+        """{group: the command line's message} of the problems shown now."""
+        return {} if self.result is None else dict(self.result.messages)
+
+    def _values(self) -> dict:
+        return {"gear": self._gear_values, "stock": self._stock_values, "job": self.job_values()}
 
     def revalidate(self, *_):
-        """Check the values and show messages beside the groups and recommendations beside the fields."""
-        values = {"gear": self._gear_values, "stock": self._stock_values, "job": self.job_values()}
-        result = validate(values, self.job.Label)
+        """Check the values; show the problem in its section and highlight its field; notes, limits, summary."""
+        values = self._values()
+        result = self.result = validate(values, self.job.Label)
+        advice = {problem.group: problem.advice for problem in result.problems}
         for group, label in self.messages.items():
-            text = result.messages.get(group, "")
-            label.setText(text)
-            label.setVisible(bool(text))
-        notes = recommendation_notes(result.recommendations)
+            label.setText(advice.get(group, ""))
+            label.setVisible(group in advice)
+        self._highlight(next((p.prop for p in result.problems if p.prop), None))
+        notes = {**recommendation_notes(result.recommendations), **unusual_value_notes(values["job"])}
+        if any(problem.group == "Finishing tool" for problem in result.problems):
+            notes.pop("RoughingToolDiameter", None)  # its limit depends on the finishing tool (A_p)
         for prop, label in self.notes.items():
             label.setText(notes.get(prop, ""))
+            label.setVisible(prop in notes)
         for role, switch in schema.TOOL_SWITCHES.items():
             enabled = self.widgets[switch.prop].isChecked()
             for field in schema.JOB_FIELDS:
                 if field.section == f"tools.{role}" and field.key:
                     self.widgets[field.prop].setEnabled(enabled)
-        self.summary.setText("All values are valid." if result.ok else
-                             f"{len(result.messages)} problem(s): see the red messages below.")
+        self._show_summary(values, result)
         return result
+
+    def _highlight(self, prop: str | None) -> None:
+        if self.highlighted is not None and self.highlighted != prop:
+            self.widgets[self.highlighted].setStyleSheet("")
+        self.highlighted = prop
+        if prop is not None:
+            self.widgets[prop].setStyleSheet(HIGHLIGHT_STYLE)
+
+    def _figures(self, signature: str):
+        """(PlanFigures or None, where they come from) for the values whose signature is given."""
+        if self._planned is not None and self._planned[0] == signature:
+            return self._planned[1], "planned by this panel"
+        if getattr(self.job, "PlannedValues", "") == signature and "ok" == self.job.Status:
+            return _job_figures(self.job), "from the job's last recompute"
+        return None, ""
+
+    def _show_summary(self, values: dict, result) -> None:
+        if result.ok:
+            self.summary.setText("All values are valid.")
+            self.summary.setStyleSheet("")
+        else:
+            first = result.problems[0]
+            self.summary.setText(f"{len(result.problems)} problem: {first.advice}")
+            self.summary.setStyleSheet(ERROR_STYLE)
+        self.summary_limits.setText(limits_text(result.recommendations))
+        figures, source = self._figures(values_signature(values)) if result.ok else (None, "")
+        if figures is not None:
+            self.summary_figures.setText(f"{figures_text(figures)}\n({source})")
+            strategy = str(values["job"].get("FinishingStrategy", ""))
+            self.summary_advice.setText(long_job_advice(figures, strategy))
+        else:
+            self.summary_figures.setText("Cycle time: press Plan (or OK) for the times, moves and program lines of "
+                                         "these values." if result.ok else "")
+            self.summary_advice.setText("")
+        self.summary_advice.setVisible(bool(self.summary_advice.text()))
+        self.plan_button.setEnabled(result.ok)
+
+    # --- actions ---------------------------------------------------------------------------
+    def plan(self) -> bool:
+        """Plan the panel's values (not written to the job) and show their figures; False if invalid."""
+        from spur_cad.errors import SpurCadError
+        from spur_cad.pipeline import plan_cam
+
+        result = self.revalidate()
+        if not result.ok:
+            self.show_problem()
+            return False
+        QtGui.QApplication.setOverrideCursor(QtCore.Qt.WaitCursor)
+        try:
+            figures = plan_figures(result.job, plan_cam(result.job))
+        except SpurCadError as exc:
+            self.summary.setText(str(exc))
+            self.summary.setStyleSheet(ERROR_STYLE)
+            return False
+        finally:
+            QtGui.QApplication.restoreOverrideCursor()
+        self._planned = (values_signature(self._values()), figures)
+        self.revalidate()
+        return True
+
+    def show_problem(self) -> str | None:
+        """Open the section of the highlighted field, scroll it into view and focus it; returns the property."""
+        prop = self.highlighted
+        if prop is None:
+            return None
+        field = schema.field_by_prop(prop)
+        self.sections[field.group].set_open(True)
+        QtCore.QCoreApplication.processEvents()
+        widget = self.widgets[prop]
+        scroll = _scroll_area_of(widget)
+        if scroll is not None:
+            scroll.ensureWidgetVisible(widget, 20, 40)
+        widget.setFocus()
+        return prop
 
     # --- task dialog interface ---------------------------------------------------------------
     def getStandardButtons(self):
-        return int(QtGui.QDialogButtonBox.Ok | QtGui.QDialogButtonBox.Cancel)
+        return compat.dialog_buttons(QtGui, "Ok", "Cancel")
 
     def accept(self) -> bool:
-        """Apply the values and recompute; keep the panel open while a value is invalid."""
+        """Apply the values and recompute; with a problem keep the panel open and show its field."""
         result = self.revalidate()
         if not result.ok:
+            self.show_problem()
             return False
         doc = self.job.Document
         doc.openTransaction("Edit spur_cad job")
@@ -197,12 +400,35 @@ class JobTaskPanel:
             FreeCADGui.Control.closeDialog()
 
 
+def _scroll_area_of(widget):
+    """The nearest scroll area holding `widget` (FreeCAD's task view is one), or None."""
+    parent = widget.parentWidget()
+    while parent is not None and not isinstance(parent, QtGui.QScrollArea):
+        parent = parent.parentWidget()
+    return parent
+
+
+def _job_figures(job_obj):
+    """PlanFigures from the job object's results (its last recompute)."""
+    from spur_cad_workbench.summary import OperationFigures, PlanFigures
+
+    found = {}
+    for name in schema.TOOL_ROLES:
+        title = name.capitalize()
+        moves = int(getattr(job_obj, f"{title}Moves"))
+        if moves:
+            found[name] = OperationFigures(moves, float(getattr(job_obj, f"{title}Time")) * 60.0,
+                                           float(getattr(job_obj, f"{title}TimeWithAcceleration")) * 60.0,
+                                           int(getattr(job_obj, f"{title}ProgramLines")))
+    return PlanFigures(found.get("roughing"), found.get("finishing"), tuple(job_obj.Warnings))
+
+
 def show_job_panel(job_obj) -> JobTaskPanel:
     """Open the task panel for `job_obj` (closing any other task dialog) and return it."""
     if FreeCADGui.Control.activeDialog():
         FreeCADGui.Control.closeDialog()
     panel = JobTaskPanel(job_obj)
-    FreeCADGui.Control.showDialog(panel)
+    compat.show_task_dialog(FreeCADGui.Control, panel, job_obj.Document.Name)
     job_obj.ViewObject.Proxy.panel = panel
     QtCore.QCoreApplication.processEvents()
     return panel

@@ -23,16 +23,33 @@ _SECTION_RE = re.compile(
 
 
 @dataclass(frozen=True)
+class Problem:
+    """One invalid input: the panel group and property it is about (None: no single property), the command
+    line's message (without the job's source) and the same as advice for people (what to change)."""
+
+    group: str
+    prop: str | None
+    message: str
+    advice: str
+
+
+@dataclass(frozen=True)
 class Validation:
-    """Outcome of checking a job: the Job when valid, messages by panel group, recommendations when known."""
+    """Outcome of checking a job: the Job when valid, the problems (at most one: the first the command line
+    finds), recommendations when known."""
 
     job: object | None
-    messages: dict[str, str]
+    problems: tuple[Problem, ...]
     recommendations: object | None
 
     @property
     def ok(self) -> bool:
-        return self.job is not None and not self.messages
+        return self.job is not None and not self.problems
+
+    @property
+    def messages(self) -> dict[str, str]:
+        """{panel group: the command line's message}."""
+        return {problem.group: problem.message for problem in self.problems}
 
 
 def group_of(message: str) -> str:
@@ -53,8 +70,74 @@ def _strip_source(message: str, source: str) -> str:
     return message.removeprefix(prefix)
 
 
+def field_of(section: str | None, key: str | None):
+    """The schema Field holding job-file key `key` of `section` (None when either is unknown)."""
+    from spur_cad_workbench.schema import FIELDS
+
+    if not section or not key:
+        return None
+    return next((field for fields in FIELDS.values() for field in fields
+                 if field.section == section and field.key == key), None)
+
+
+def _with_titles(text: str, section: str) -> str:
+    """`text` with the job-file key names of `section` replaced by the panel's titles."""
+    from spur_cad_workbench.schema import FIELDS, title
+
+    for fields in FIELDS.values():
+        for field in fields:
+            if field.section == section and field.key:
+                text = re.sub(rf"\b{re.escape(field.key)}\b", title(field).lower(), text)
+    return text
+
+
+_ROUGHING_LIMIT = re.compile(r"roughing tool diameter ([\d.]+) mm exceeds roughing_max_diameter_mm = ([\d.]+) mm")
+_CORNER_LIMIT = re.compile(r"corner_radius_mm = ([\d.]+) must be in \(0, ([\d.]+)\)")
+_TIP_MODE_LIMIT = re.compile(r"largest diameter for tip mode with this corner radius: ([\d.]+) mm")
+
+
+def advice(message: str, section: str | None, key: str | None, values: dict | None = None) -> str:
+    """The message as the panel says it: the group, then what to change ("Finishing tool: diameter at most
+    3.55 mm for a corner radius of 1.52 mm ..."), with key names replaced by the field titles."""
+    from spur_cad_workbench.schema import title
+
+    group = SECTION_GROUPS.get(section or "", group_of(message))
+    field = field_of(section, key)
+    body = re.sub(r"^\[[a-z.]+\] ", "", message)
+    found = _ROUGHING_LIMIT.search(message)
+    if found:
+        return (f"{group}: diameter at most {float(found.group(2)):.3g} mm for this gear (the tooth space's width "
+                f"at the root plus the plunge allowance); now {float(found.group(1)):g} mm")
+    found = _CORNER_LIMIT.search(message)
+    if found:
+        return (f"{group}: corner radius below {float(found.group(2)):g} mm (half the diameter); "
+                f"now {float(found.group(1)):g} mm")
+    found = _TIP_MODE_LIMIT.search(message)
+    if found:
+        corner = (values or {}).get("job", {}).get("FinishingCornerRadius")
+        radius = f" for a corner radius of {corner:g} mm" if isinstance(corner, float) else ""
+        reason = _with_titles(message.split(";")[0], section or "").removeprefix("finishing strategy generating: ")
+        return f"{group}: diameter at most {float(found.group(1)):.3g} mm{radius} ({reason})"
+    if field is not None and body.startswith(f"{key} "):
+        return f"{group}: {title(field).lower()} {_with_titles(body[len(key) + 1:], section)}"
+    if field is not None:
+        return f"{group}, {title(field).lower()}: {_with_titles(body, section)}"
+    return f"{group}: {_with_titles(body, section or '')}"
+
+
+def _problem(exc: SpurCadError, source: str, values: dict) -> Problem:
+    message = _strip_source(str(exc), source)
+    field = field_of(exc.section, exc.field)
+    group = SECTION_GROUPS.get(exc.section or "", group_of(message))
+    return Problem(group, field.prop if field is not None else None, message,
+                   advice(message, exc.section, exc.field, values))
+
+
 def validate(values: dict[str, dict[str, object]], source: str = "job") -> Validation:
-    """Check gear, stock and job values as the command line would; never raises for a SpurCadError."""
+    """Check gear, stock and job values as the command line would; never raises for a SpurCadError.
+
+    Recommendations never use an invalid tool: with the finishing tool in error they are the gear's alone.
+    """
     from spur_cad.cam.plan import check_cam_inputs
     from spur_cad.cam.recommend import recommend_tools
     from spur_cad.job import job_from_dict
@@ -65,22 +148,20 @@ def validate(values: dict[str, dict[str, object]], source: str = "job") -> Valid
     try:
         without_tools = job_from_dict(base, source)
     except SpurCadError as exc:
-        message = _strip_source(str(exc), source)
-        return Validation(None, {group_of(message): message}, None)
+        return Validation(None, (_problem(exc, source, values),), None)
     spec, blank = without_tools.gear, without_tools.stock.blank_radius_mm(without_tools.gear)
     clearance = without_tools.machine.clearance_mm
     try:
         job = job_from_dict(data, source)
     except SpurCadError as exc:
-        message = _strip_source(str(exc), source)
-        return Validation(None, {group_of(message): message}, recommend_tools(spec, blank, clearance))
+        return Validation(None, (_problem(exc, source, values),), recommend_tools(spec, blank, clearance))
     try:
         rec, _ = check_cam_inputs(cam_inputs(job))
     except SpurCadError as exc:
-        message = str(exc)
-        return Validation(None, {group_of(message): message}, recommend_tools(spec, blank, clearance,
-                                                                              job.tools.finishing))
-    return Validation(job, {}, rec)
+        problem = _problem(exc, source, values)
+        finishing = None if problem.group == SECTION_GROUPS["tools.finishing"] else job.tools.finishing
+        return Validation(None, (problem,), recommend_tools(spec, blank, clearance, finishing))
+    return Validation(job, (), rec)
 
 
 def recommendation_notes(rec) -> dict[str, str]:
@@ -91,12 +172,32 @@ def recommendation_notes(rec) -> dict[str, str]:
         "RoughingToolDiameter": f"at most {rec.roughing_max_diameter_mm:.3f} mm (space width at root + A_p)",
         "FinishingToolDiameter": f"perimeter, along_x: flat width D - 2 r_t at most "
                                  f"{rec.finishing_max_flat_width_mm:.3f} mm (root arc length); generating: within "
-                                 "the rack's tip flat and the flank limit (report: generating advice)",
+                                 "the rack's tip flat and the flank limit",
         "FinishingCornerRadius": f"at most {rec.finishing_max_corner_radius_mm:.3f} mm (smallest fillet radius)",
     }
     for role in ("Roughing", "Finishing"):
         notes[f"{role}FluteLength"] = f"at least {rec.required_flute_length_mm:.3f} mm (or 0: not checked)"
         notes[f"{role}StickOut"] = f"at least {rec.required_stick_out_mm:.3f} mm (or 0: not checked)"
+    return notes
+
+
+# Machine values a machining centre rarely has: (property, test, note). Notes only: the job stays valid.
+_UNUSUAL = (
+    ("MaxSpindleRpm", lambda v: v < 2000.0, "unusually low for a machining centre (usual: 6,000 to 40,000 1/min); "
+                                            "small end mills will run far below their cutting speed"),
+    ("MaxFeed", lambda v: v < 500.0, "unusually low (usual: 2,000 to 30,000 mm/min); every feed is capped by it"),
+    ("MaxRotarySpeed", lambda v: v < 360.0, "unusually low for a rotary table (usual: 1,800 to 30,000 deg/min)"),
+    ("BlockTime", lambda v: v > 0.05, "unusually long (usual: 0.5 to 8 ms); short moves will be slow"),
+)
+
+
+def unusual_value_notes(job_values: dict[str, object]) -> dict[str, str]:
+    """Notes for machine values that are valid but unlike any machining centre (property name -> note)."""
+    notes = {prop: note for prop, unusual, note in _UNUSUAL
+             if isinstance(job_values.get(prop), float) and unusual(job_values[prop])}
+    rapid, feed = job_values.get("RapidFeed"), job_values.get("MaxFeed")
+    if isinstance(rapid, float) and isinstance(feed, float) and rapid < feed:
+        notes["RapidFeed"] = "below the max feed: rapids would be slower than cutting moves"
     return notes
 
 

@@ -1,0 +1,324 @@
+"""The job's task panel and the 3D view as a designer meets them, in FreeCAD's GUI under Xvfb (issue 16).
+
+One FreeCAD session drives the panel and the document and measures the widgets: the panel fits
+FreeCAD's default task dock (264 px) without clipping a label or a field, fields carry units,
+the summary gives the cycle time of both estimators, an error highlights its field and scrolls
+to it, tools get T1/T2 and a shared number is refused, toolpaths start where they start, a
+thinned display says so, the simulation has a colour bar and goes stale when the job changes,
+and an invalid gear is in FreeCAD's error state with its results marked stale. Screenshots of
+the panel and the 3D view go to test-artifacts/ and are checked for what they show.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from tests.freecad_helper import describe
+from tests.workbench_helper import (
+    ARTIFACTS,
+    SMALL_GEAR_PROPERTIES,
+    SMALL_STOCK_PROPERTIES,
+    run_workbench_code,
+)
+
+PANEL_SHOT = ARTIFACTS / "workbench_panel.png"
+PANEL_ERROR_SHOT = ARTIFACTS / "workbench_panel_error.png"
+VIEW_SHOT = ARTIFACTS / "workbench_simulation_view.png"
+DOCK_WIDTH_PX = 264  # FreeCAD's default width of the combo view (task panel) dock
+
+BODY = r"""
+import sys, traceback
+import FreeCAD, FreeCADGui
+from PySide import QtCore, QtGui
+
+hooked = []
+sys.excepthook = lambda kind, value, tb: hooked.append("".join(traceback.format_exception(kind, value, tb)))
+main_window = FreeCADGui.getMainWindow()
+
+def settle(times=8):
+    for _ in range(times):
+        QtGui.QApplication.processEvents()
+
+FreeCADGui.activateWorkbench("SpurCadWorkbench")
+dock = [d for d in main_window.findChildren(QtGui.QDockWidget) if d.objectName() == "Combo View"][0]
+main_window.resizeDocks([dock], [DOCK_WIDTH], QtCore.Qt.Horizontal)
+settle()
+RESULT["dock_width"] = dock.width()
+
+from spur_cad_workbench import commands
+doc = FreeCAD.newDocument("Panel")
+gear = commands.make_gear(doc, **PROPS["gear"])
+stock = commands.make_stock(gear, **PROPS["stock"])
+job = commands.make_job(gear, stock)               # suggested tools
+doc.recompute()
+RESULT["tool_numbers"] = [job.RoughingToolNumber, job.FinishingToolNumber]
+RESULT["job_times"] = [job.RoughingTimeWithAcceleration, job.FinishingTimeWithAcceleration, job.RoughingTime,
+                       job.FinishingTime]
+
+FreeCADGui.ActiveDocument.setEdit(job.Name)
+settle()
+panel = job.ViewObject.Proxy.panel
+scroll = panel.form.parentWidget()
+while scroll is not None and not isinstance(scroll, QtGui.QScrollArea):
+    scroll = scroll.parentWidget()
+viewport = scroll.viewport()
+
+def clipped():
+    # every visible label and field lies inside the task view horizontally and shows its whole text
+    problems = []
+    for prop, widget in panel.widgets.items():
+        for item in (widget, panel.labels[prop]):
+            if not item.isVisible():
+                continue
+            left = item.mapTo(viewport, QtCore.QPoint(0, 0)).x()
+            if left < 0 or left + item.width() > viewport.width():
+                problems.append([item.objectName(), left, item.width(), viewport.width()])
+        label = panel.labels[prop]  # word-wrapped: every word fits the width and every line the height
+        longest_word = max(label.fontMetrics().boundingRect(word).width() for word in label.text().split())
+        if label.isVisible() and (longest_word > label.width() or label.heightForWidth(label.width()) > label.height()):
+            problems.append([label.objectName(), "text", label.text(), label.width(), label.height()])
+        if widget.isVisible() and isinstance(widget, QtGui.QAbstractSpinBox):
+            text = widget.text()
+            if widget.fontMetrics().boundingRect(text).width() + 18 > widget.width():
+                problems.append([prop, "text", text, widget.width()])
+        if widget.isVisible() and isinstance(widget, QtGui.QComboBox):
+            if widget.fontMetrics().boundingRect(widget.currentText()).width() + 24 > widget.width():
+                problems.append([prop, "text", widget.currentText(), widget.width()])
+    return problems
+
+RESULT["viewport_width"] = viewport.width()
+RESULT["panel_width"] = panel.form.width()
+RESULT["horizontal_scroll"] = scroll.horizontalScrollBar().maximum()
+RESULT["clipped"] = clipped()
+buttons = [b for b in main_window.findChildren(QtGui.QPushButton) if b.text().replace("&", "") in ("OK", "Cancel")
+           and b.isVisible()]
+RESULT["buttons"] = [[b.text().replace("&", ""), b.mapTo(dock, QtCore.QPoint(0, 0)).x() + b.width(), dock.width()]
+                     for b in buttons]
+RESULT["labels"] = {p: panel.labels[p].text() for p in ("RoughingFeedPerTooth", "FinishingToolDiameter", "MaxFeed")}
+RESULT["texts"] = {p: panel.widgets[p].text() for p in ("FinishingToolDiameter", "PressureAngle" if False else
+                   "FinishingCornerRadius", "TargetScallop", "RoughingCuttingSpeed", "MaxFeed", "MaxSpindleRpm")}
+RESULT["types"] = {p: panel.widgets[p].metaObject().className() for p in ("FinishingToolDiameter", "MaxFeed")}
+RESULT["open_sections"] = {g: s.is_open for g, s in panel.sections.items()}
+RESULT["summary"] = [panel.summary.text(), panel.summary_figures.text(), panel.summary_limits.text()]
+panel.form.grab().save(PANEL_SHOT)
+
+# a duplicate tool number: refused at the finishing tool's number
+panel.set_value("FinishingToolNumber", 1)
+RESULT["duplicate"] = [panel.highlighted, panel.current_messages()]
+panel.set_value("FinishingToolNumber", 2)
+
+# a too-wide finishing tool: advice, highlight, no roughing advice derived from it
+panel.set_value("FinishingToolDiameter", 9.0)
+RESULT["too_wide"] = [panel.highlighted, panel.messages["Finishing tool"].text(), panel.summary.text(),
+                      panel.notes["RoughingToolDiameter"].isVisible(),
+                      panel.widgets["FinishingToolDiameter"].styleSheet()]
+panel.set_value("FinishingToolDiameter", job.FinishingToolDiameter.Value)
+
+# an invalid value in a collapsed section far down: OK keeps the panel open, opens it, scrolls, focuses
+scroll.verticalScrollBar().setValue(0)
+settle()
+panel.set_value("MaxFeed", 1.0)
+RESULT["accept_invalid"] = panel.accept()
+settle()
+widget = panel.widgets["MaxFeed"]
+top = widget.mapTo(viewport, QtCore.QPoint(0, 0)).y()
+RESULT["scrolled"] = [scroll.verticalScrollBar().value(), top, widget.height(), viewport.height(),
+                      panel.sections["Machine"].is_open, panel.highlighted, widget.hasFocus(),
+                      bool(FreeCADGui.Control.activeDialog()), panel.messages["Machine"].text()]
+RESULT["clipped_open"] = clipped()
+grabbed = scroll.grab()
+grabbed.save(PANEL_ERROR_SHOT)
+panel.set_value("MaxFeed", 5000.0)
+panel.set_value("MaxSpindleRpm", 100.0)
+RESULT["unusual"] = panel.notes["MaxSpindleRpm"].text() if panel.notes["MaxSpindleRpm"].isVisible() else ""
+panel.set_value("MaxSpindleRpm", 7000.0)
+
+# values changed from the job's: the figures are not the job's any more until Plan
+panel.set_value("TargetScallop", 0.02)
+RESULT["changed_summary"] = panel.summary_figures.text()
+RESULT["planned"] = panel.plan()
+RESULT["planned_summary"] = panel.summary_figures.text()
+
+# a job with more moves than the display draws (perimeter finishing, fine stations): it says so
+panel.set_value("FinishingStrategy", "perimeter")
+panel.set_value("FinishingToolDiameter", 2.3)  # a flat within the root arc, as perimeter finishing needs
+panel.set_value("RoughingToolDiameter", 1.6)  # and a roughing tool within the plunge allowance that leaves
+panel.set_value("FinishingStepOver", 0.05)
+RESULT["perimeter_messages"] = panel.current_messages()
+RESULT["accept_valid"] = panel.accept()
+settle()
+finishing = job.FinishingToolpath
+RESULT["thinning"] = [finishing.Label, finishing.Moves, finishing.DisplayedMoves]
+starts = []
+for path_obj in (job.RoughingToolpath, finishing):
+    first = path_obj.Path.Commands[0]
+    starts.append([list(path_obj.ViewObject.StartPosition), [first.x, first.y, first.z]])
+RESULT["starts"] = starts
+RESULT["gear_tessellation"] = [float(gear.ViewObject.Deviation), float(gear.ViewObject.AngularDeflection.Value)]
+
+# the simulation: linked to the job, reuses its plan, colour bar, adjustable scale, stale after a change
+job.FinishingStrategy = "generating"
+doc.recompute()
+sim = commands.simulate(job, resolution_mm=0.02)
+settle()
+RESULT["sim"] = [sim.Job.Name, sim.Status, sim.PlanSource, sim.ColourScale.Value, max(abs(d) for d in sim.Deviations),
+                 sim.MaxGougeMicrons, sim.MaxLeftoverMicrons, sim.Legend, sim.TypeId]
+from spur_cad_workbench.colourbar import find_colour_bar
+view = FreeCADGui.ActiveDocument.ActiveView
+RESULT["colour_bar"] = find_colour_bar(view.getSceneGraph()) is not None
+reds = sum(1 for c in sim.Color if c[0] > 0.99)
+sim.ColourScale = sim.ColourScale.Value / 4.0
+RESULT["rescaled"] = [reds, sum(1 for c in sim.Color if c[0] > 0.99), sim.Legend]
+FreeCADGui.Selection.clearSelection()
+for obj in (stock, job.RoughingToolpath, job.FinishingToolpath):
+    obj.ViewObject.Visibility = False
+view.viewIsometric()
+view.fitAll()
+settle()
+view.saveImage(VIEW_SHOT, 1000, 800, "White")
+job.TargetScallop = 0.03
+doc.recompute()
+RESULT["stale_sim"] = [sim.Status, sim.ViewObject.DisplayMode]
+
+# an invalid gear: error state in the tree, results marked stale, no old figures
+gear.Teeth = 3
+doc.recompute()
+settle()
+RESULT["invalid_gear"] = [list(gear.State), gear.Status, gear.TipRadius.Value, job.RoughingToolpath.Status,
+                          list(job.RoughingToolpath.ViewObject.NormalColor)[:3], list(job.State)]
+gear.Teeth = 12
+doc.recompute()
+RESULT["fixed_gear"] = [list(gear.State), gear.Status, job.RoughingToolpath.Status, list(job.State)]
+RESULT["hooked"] = hooked
+"""
+
+
+@pytest.fixture(scope="module")
+def panel_result(freecad_gui, tmp_path_factory):
+    ARTIFACTS.mkdir(exist_ok=True)
+    for shot in (PANEL_SHOT, PANEL_ERROR_SHOT, VIEW_SHOT):
+        shot.unlink(missing_ok=True)
+    props = {"gear": SMALL_GEAR_PROPERTIES, "stock": SMALL_STOCK_PROPERTIES}
+    body = (f"PROPS = {props!r}\nDOCK_WIDTH = {DOCK_WIDTH_PX}\nPANEL_SHOT = {str(PANEL_SHOT)!r}\n"
+            f"PANEL_ERROR_SHOT = {str(PANEL_ERROR_SHOT)!r}\nVIEW_SHOT = {str(VIEW_SHOT)!r}\n" + BODY)
+    work = tmp_path_factory.mktemp("panel")
+    result, proc = run_workbench_code(body, work, gui=freecad_gui, timeout_s=420)
+    assert result is not None and result.get("ok"), describe(proc, result)
+    assert result["hooked"] == [], result["hooked"]
+    return result
+
+
+def _image(path):
+    import matplotlib.image
+
+    return matplotlib.image.imread(path)[..., :3]
+
+
+@pytest.mark.freecad
+def test_the_panel_fits_the_default_dock_with_titles_units_and_closed_rare_sections(panel_result):
+    r = panel_result
+    assert abs(r["dock_width"] - DOCK_WIDTH_PX) <= 4
+    assert r["horizontal_scroll"] == 0 and r["panel_width"] <= r["viewport_width"]
+    assert r["clipped"] == [] and r["clipped_open"] == []
+    assert sorted(name for name, _, _ in r["buttons"]) == ["Cancel", "OK"]
+    assert all(right <= dock for _, right, dock in r["buttons"])
+    assert r["labels"] == {"RoughingFeedPerTooth": "Feed per tooth", "FinishingToolDiameter": "Diameter",
+                           "MaxFeed": "Max feed"}
+    texts = r["texts"]
+    assert texts["FinishingToolDiameter"].endswith(" mm") and texts["FinishingCornerRadius"].endswith(" mm")
+    assert texts["TargetScallop"].endswith(("µm", "mm"))
+    assert texts["RoughingCuttingSpeed"].endswith(" m/min") and texts["MaxFeed"].endswith(" mm/min")
+    assert texts["MaxSpindleRpm"].endswith(" 1/min")
+    assert r["types"]["FinishingToolDiameter"] == "Gui::QuantitySpinBox"
+    assert not any(r["open_sections"][g] for g in ("Machine", "Simulation", "Post"))
+    assert r["open_sections"]["Finishing tool"] and r["open_sections"]["Roughing tool"]
+    # the panel screenshot: no wider than the dock, text on it
+    image = _image(PANEL_SHOT)
+    assert image.shape[1] <= r["viewport_width"]
+    assert np.mean(np.all(image < 0.3, axis=-1)) > 0.005  # dark text
+
+
+@pytest.mark.freecad
+def test_the_summary_gives_cycle_times_of_both_estimators_and_the_tool_limits(panel_result):
+    r = panel_result
+    status, figures, limits = r["summary"]
+    assert status == "All values are valid."
+    rough_acc, finish_acc, rough, finish = r["job_times"]
+    assert rough_acc > 0 and finish_acc > 0 and rough_acc >= rough * 0.999
+    total_acc, total = rough_acc + finish_acc, rough + finish
+    assert figures.startswith("Cycle time ") and "with the machine's accelerations" in figures
+    assert "at the programmed feeds" in figures and "program lines" in figures
+    minutes = round(total_acc)
+    shown = f"{minutes // 60} h {minutes % 60:02d} min" if minutes >= 60 else f"{minutes} min"
+    assert figures.split(" with")[0] == f"Cycle time {shown}", (figures, total_acc, total)
+    assert "from the job's last recompute" in figures
+    assert "Roughing tool: D at most" in limits and "corner radius at most" in limits
+    assert "press Plan" in r["changed_summary"] and r["planned"] is True
+    assert "planned by this panel" in r["planned_summary"] and "Cycle time" in r["planned_summary"]
+
+
+@pytest.mark.freecad
+def test_errors_point_at_the_field_and_say_what_to_do(panel_result):
+    r = panel_result
+    assert r["tool_numbers"] == [1, 2]
+    highlighted, messages = r["duplicate"]
+    assert highlighted == "FinishingToolNumber" and "also the roughing tool's number" in messages["Finishing tool"]
+    highlighted, message, summary, roughing_note_shown, style = r["too_wide"]
+    assert highlighted == "FinishingToolDiameter" and "#b00020" in style
+    assert message.startswith("Finishing tool: diameter at most ") and " mm for a corner radius of " in message
+    assert "_mm" not in message and summary.startswith("1 problem: Finishing tool: diameter at most")
+    assert roughing_note_shown is False  # its limit would derive from the invalid finishing tool
+    assert r["accept_invalid"] is False
+    bar_value, top, height, viewport_height, machine_open, highlighted, focused, still_open, machine_message = \
+        r["scrolled"]
+    assert machine_open and highlighted == "MaxFeed" and focused and still_open
+    assert bar_value > 0 and 0 <= top and top + height <= viewport_height
+    assert machine_message.startswith("Machine: max feed must be in")
+    assert "unusually low" in r["unusual"]
+    # the error screenshot shows the red highlight
+    image = _image(PANEL_ERROR_SHOT)
+    red = np.all(np.abs(image - np.array([0xb0, 0x00, 0x20]) / 255.0) < 0.12, axis=-1)
+    assert red.sum() > 50
+
+
+@pytest.mark.freecad
+def test_the_3d_view_starts_paths_at_their_first_point_says_when_thinned_and_draws_a_smooth_gear(panel_result):
+    r = panel_result
+    assert r["perimeter_messages"] == {} and r["accept_valid"] is True
+    label, moves, shown = r["thinning"]
+    assert moves > shown > 0 and label == f"Finishing toolpath (3D view: {shown:,} of {moves:,} moves)"
+    for start, first in r["starts"]:
+        assert np.allclose(start, first, atol=1e-3) and np.linalg.norm(start) > 1.0
+    deviation, angular = r["gear_tessellation"]
+    assert deviation <= 0.05 and angular <= 10.0
+
+
+@pytest.mark.freecad
+def test_the_simulation_is_linked_scaled_with_a_colour_bar_and_goes_stale(panel_result):
+    r = panel_result
+    job_name, status, source, scale, largest, gouge, leftover, legend, type_id = r["sim"]
+    assert job_name == "Job" and status == "ok" and type_id == "Points::FeaturePython"
+    assert source == "the job's plan (reused)"
+    assert scale == pytest.approx(max(largest, 0.02), rel=1e-6)
+    assert r["colour_bar"] is True
+    reds_before, reds_after, legend_after = r["rescaled"]
+    assert reds_after > reds_before and f"{scale / 4 * 1000:.3g} um" in legend_after
+    assert r["stale_sim"] == ["stale: the job changed after this simulation; simulate again", "Points"]
+    # the view: the colour bar's blue-green-red gradient at the left edge
+    image = _image(VIEW_SHOT)
+    left = image[:, : image.shape[1] // 6]
+    for colour in ((0.0, 0.0, 1.0), (0.0, 1.0, 0.0), (1.0, 0.0, 0.0)):
+        assert np.all(np.abs(left - np.array(colour)) < 0.15, axis=-1).sum() > 100, colour
+
+
+@pytest.mark.freecad
+def test_an_invalid_gear_is_in_error_and_its_results_are_stale(panel_result):
+    r = panel_result
+    state, status, tip_radius, toolpath_status, toolpath_colour, job_state = r["invalid_gear"]
+    assert "Invalid" in state and status.startswith("error: [gear] teeth must be in")
+    assert tip_radius == 0.0
+    assert toolpath_status == "stale: Gear has an error"
+    assert np.allclose(toolpath_colour, 0.62, atol=0.01)
+    state, status, toolpath_status, job_state = r["fixed_gear"]
+    assert state == ["Up-to-date"] and status == "ok" and toolpath_status == "ok" and "Invalid" not in job_state

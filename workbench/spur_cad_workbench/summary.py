@@ -1,0 +1,117 @@
+"""What the task panel's summary says (plain Python, no FreeCAD): cycle times by both estimators, moves,
+program lines, the tool limits, and advice when a job is long.
+
+The figures need a plan (seconds for a large gear), so the panel shows them from the job's last
+recompute while the panel's values equal the job's (`values_signature`), and plans the panel's
+values only when the user asks (Plan) or on OK; the tool limits come from the cheap checks.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+from dataclasses import dataclass
+
+from spur_cad_workbench.schema import TOOL_ROLES, job_data
+
+LONG_JOB_S = 8 * 3600.0  # a shift: longer jobs get advice on what would shorten them
+
+
+@dataclass(frozen=True)
+class OperationFigures:
+    """One program's figures: moves, estimated seconds (programmed feeds; with the machine's accelerations)
+    and program lines as posted."""
+
+    moves: int
+    seconds: float
+    seconds_with_acceleration: float
+    program_lines: int
+
+
+@dataclass(frozen=True)
+class PlanFigures:
+    """The figures of a planned job, by operation (None: the job has no such operation), and its warnings."""
+
+    roughing: OperationFigures | None
+    finishing: OperationFigures | None
+    warnings: tuple[str, ...] = ()
+
+    def operations(self) -> list[tuple[str, OperationFigures]]:
+        return [(name, figures) for name in TOOL_ROLES if (figures := getattr(self, name)) is not None]
+
+    @property
+    def seconds(self) -> float:
+        return sum(figures.seconds for _, figures in self.operations())
+
+    @property
+    def seconds_with_acceleration(self) -> float:
+        return sum(figures.seconds_with_acceleration for _, figures in self.operations())
+
+
+def values_signature(values: dict[str, dict[str, object]]) -> str:
+    """A fingerprint of the job the values describe (the job file's data): equal values, equal signature."""
+    text = json.dumps(job_data(values), sort_keys=True, default=repr)
+    return hashlib.sha256(text.encode()).hexdigest()[:16]
+
+
+def plan_figures(job, plan) -> PlanFigures:
+    """Figures of a spur_cad CamPlan for `job`; posts the programs to count their lines."""
+    from spur_cad.pipeline import build_programs
+
+    programs, _ = build_programs(job, plan)
+    found = {}
+    for name in TOOL_ROLES:
+        planned = getattr(plan, name)
+        if planned is not None:
+            found[name] = OperationFigures(int(planned.estimate.moves), float(planned.estimate.time_s),
+                                           float(planned.estimate.time_with_acceleration_s),
+                                           int(programs[name].lines))
+    return PlanFigures(found.get("roughing"), found.get("finishing"), tuple(plan.warnings))
+
+
+def duration_text(seconds: float) -> str:
+    """'2 h 05 min', '14 min', '40 s'."""
+    if seconds < 60.0:
+        return f"{seconds:.0f} s"
+    minutes = round(seconds / 60.0)
+    hours, minutes = divmod(minutes, 60)
+    return f"{hours} h {minutes:02d} min" if hours else f"{minutes} min"
+
+
+def figures_text(figures: PlanFigures) -> str:
+    """Cycle time (with accelerations, and at the programmed feeds), then per operation: time, moves, lines."""
+    if not figures.operations():
+        return "No program: choose a roughing or finishing tool."
+    lines = [f"Cycle time {duration_text(figures.seconds_with_acceleration)} with the machine's accelerations "
+             f"({duration_text(figures.seconds)} at the programmed feeds)"]
+    for name, op in figures.operations():
+        lines.append(f"{name.capitalize()}: {duration_text(op.seconds_with_acceleration)}, {op.moves:,} moves, "
+                     f"{op.program_lines:,} program lines")
+    return "\n".join(lines)
+
+
+def limits_text(rec) -> str:
+    """The tool limits of the gear (spur_cad.cam.recommend.ToolRecommendations), one line each."""
+    if rec is None:
+        return ""
+    return (f"Roughing tool: D at most {rec.roughing_max_diameter_mm:.3f} mm\n"
+            f"Finishing tool: corner radius at most {rec.finishing_max_corner_radius_mm:.3f} mm, flat D - 2 r at most "
+            f"{rec.finishing_max_flat_width_mm:.3f} mm (perimeter, along X)\n"
+            f"Both: flute length at least {rec.required_flute_length_mm:.2f} mm, stick-out at least "
+            f"{rec.required_stick_out_mm:.2f} mm")
+
+
+def long_job_advice(figures: PlanFigures, strategy: str) -> str:
+    """Empty for a job within LONG_JOB_S; else which operation takes the time and what would shorten it."""
+    total = figures.seconds_with_acceleration
+    if total <= LONG_JOB_S or not figures.operations():
+        return ""
+    name, op = max(figures.operations(), key=lambda item: item[1].seconds_with_acceleration)
+    if name == "finishing":
+        ways = "a larger target scallop, a larger finishing tool (within its limits)"
+        if strategy != "generating":
+            ways += ", or the generating strategy (fewer, straight passes)"
+    else:
+        ways = "a larger roughing tool (within its limit), a larger level depth or step-over, a higher feed per tooth"
+    return (f"Long job: {duration_text(total)}, of which {name} {duration_text(op.seconds_with_acceleration)}. "
+            f"Shorter with {ways}.")
