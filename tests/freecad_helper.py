@@ -63,7 +63,8 @@ QtCore.QTimer.singleShot(0, _in_event_loop)
 def _environment(work: Path, site_packages: str | None) -> dict[str, str]:
     """Environment for FreeCAD: a fresh HOME (no user add-ons or settings)."""
     env = dict(os.environ)
-    for name in ("XDG_CONFIG_HOME", "XDG_DATA_HOME", "XDG_CACHE_HOME", "PYTHONPATH", "PYTHONHOME"):
+    for name in ("XDG_CONFIG_HOME", "XDG_DATA_HOME", "XDG_CACHE_HOME", "PYTHONPATH", "PYTHONHOME",
+                 "FREECAD_USER_DATA", "FREECAD_USER_HOME"):  # these two would replace HOME's user folder
         env.pop(name, None)
     home = work / "home"
     home.mkdir(exist_ok=True)

@@ -1,5 +1,7 @@
 """`spur-cad install-freecad [--uninstall]`: the link in FreeCAD's user Mod folder, the recorded
-environment, errors, and a real FreeCAD that then loads the workbench with spur_cad and cadquery."""
+environment, errors, the user data folder of each FreeCAD version (1.1's versioned ones,
+FREECAD_USER_DATA), Addon Manager copies, and a real FreeCAD that then loads the workbench with
+spur_cad and cadquery. The wheel route is tests/test_wheel_install.py."""
 
 from __future__ import annotations
 
@@ -10,6 +12,7 @@ from pathlib import Path
 import pytest
 
 from spur_cad.cli import main
+from spur_cad.freecad_install import user_data_dir, user_data_dirs
 from tests.freecad_helper import describe, run_freecad_code
 from tests.workbench_helper import ROOT
 
@@ -19,7 +22,8 @@ def home(tmp_path, monkeypatch):
     home = tmp_path / "home"
     home.mkdir()
     monkeypatch.setenv("HOME", str(home))
-    monkeypatch.delenv("XDG_DATA_HOME", raising=False)
+    for name in ("XDG_DATA_HOME", "FREECAD_USER_DATA", "FREECAD_USER_HOME"):
+        monkeypatch.delenv(name, raising=False)
     return home
 
 
@@ -65,8 +69,8 @@ def test_install_refuses_to_replace_a_real_folder(home, capsys):
 
 
 def test_install_without_home_is_a_clear_error(monkeypatch, capsys):
-    monkeypatch.delenv("HOME", raising=False)
-    monkeypatch.delenv("XDG_DATA_HOME", raising=False)
+    for name in ("HOME", "XDG_DATA_HOME", "FREECAD_USER_DATA", "FREECAD_USER_HOME"):
+        monkeypatch.delenv(name, raising=False)
     assert main(["install-freecad"]) == 2
     assert capsys.readouterr().err == "spur-cad: error: HOME is not set: cannot find FreeCAD's user folder\n"
 
@@ -90,6 +94,118 @@ def test_uninstall_leaves_a_real_folder(home, capsys):
     assert "is not a link made by" in capsys.readouterr().err and folder.is_dir()
 
 
+# FreeCAD 1.1 and later keep their user data in versioned subfolders (v1-1, ...) of the folder 0.20 and 1.0
+# use; the rule is FreeCAD's ApplicationDirectories.cpp (docs/install.md). These tests need no FreeCAD:
+# spur_cad.freecad_install.user_data_dir is the rule, install must reach every folder it can give.
+
+VERSIONS = [(0, 20), (0, 21), (1, 0), (1, 1), (1, 2), (1, 3)]
+
+
+def _folders(env: dict) -> dict:
+    return {version: user_data_dir(env, version) for version in VERSIONS}
+
+
+def test_user_data_folder_per_freecad_version(tmp_path):
+    """0.20-1.0: the unversioned folder; 1.1+: the newest v<major>-<minor> not newer than itself, the
+    unversioned folder when there is none, its own versioned folder when nothing exists yet."""
+    env = {"HOME": str(tmp_path)}
+    root = _data(tmp_path)
+    fresh = _folders(env)  # nothing there: 1.1 and later would create their own versioned folder
+    assert fresh[(0, 20)] == fresh[(0, 21)] == fresh[(1, 0)] == root
+    assert fresh[(1, 1)] == root / "v1-1" and fresh[(1, 3)] == root / "v1-3"
+    root.mkdir(parents=True)  # settings of 0.20 or 1.0, not migrated: 1.1 keeps using them
+    assert set(_folders(env).values()) == {root}
+    (root / "v1-2").mkdir()
+    for junk in ("v1-1-old", "v0-21", "v1-100", "V1-1", "v1-1x"):
+        (root / junk).mkdir()
+    (root / "v1-1").write_text("a file, not a folder")
+    folders = _folders(env)
+    assert folders[(1, 1)] == root  # v1-2 is newer than 1.1; the junk and the file do not count
+    assert folders[(1, 2)] == folders[(1, 3)] == root / "v1-2"
+    assert folders[(1, 0)] == root
+    assert user_data_dirs(env) == [root, root / "v1-2"]
+
+
+def test_freecad_user_data_variables_replace_every_folder(tmp_path):
+    """FREECAD_USER_DATA (else FREECAD_USER_HOME) naming an existing folder is used as it is by every version;
+    naming a missing folder it is ignored, as FreeCAD ignores it."""
+    custom, other = tmp_path / "custom", tmp_path / "other"
+    custom.mkdir()
+    other.mkdir()
+    env = {"HOME": str(tmp_path), "FREECAD_USER_DATA": str(custom), "FREECAD_USER_HOME": str(other)}
+    assert set(_folders(env).values()) == {custom} and user_data_dirs(env) == [custom]
+    env["FREECAD_USER_DATA"] = str(tmp_path / "missing")
+    assert set(_folders(env).values()) == {other}
+    del env["FREECAD_USER_HOME"]
+    assert _folders(env)[(1, 0)] == _data(tmp_path)
+
+
+def test_install_reaches_every_freecad_version(home, capsys):
+    """With the unversioned folder and v1-1, v1-2 present, every version from 0.20 on finds the link and
+    the record in the folder it takes; uninstall clears them all."""
+    for folder in ("v1-1", "v1-2"):
+        (_data(home) / folder).mkdir(parents=True)
+    assert main(["install-freecad"]) == 0
+    out = capsys.readouterr().out
+    env = {"HOME": str(home)}
+    for version, folder in _folders(env).items():
+        assert (folder / "Mod" / "spur_cad").resolve() == ROOT, version
+        assert json.loads((folder / "spur_cad_environment.json").read_text())["site_packages"], version
+    assert "for FreeCAD 1.1" in out and "for FreeCAD 1.2" in out and "for FreeCAD 0.20 and 1.0" in out
+    assert main(["install-freecad", "--uninstall"]) == 0
+    for folder in user_data_dirs(env):
+        assert not (folder / "Mod" / "spur_cad").is_symlink() and not (folder / "spur_cad_environment.json").exists()
+
+
+def test_install_on_a_new_account_is_found_by_freecad_1_1(home):
+    """Nothing of FreeCAD's yet: the unversioned folder made by the install is what 1.1 then takes
+    (it creates v1-1 only when there is no FreeCAD folder at all)."""
+    assert main(["install-freecad"]) == 0
+    assert user_data_dir({"HOME": str(home)}, (1, 1)) == _data(home)
+    assert (_data(home) / "Mod" / "spur_cad").resolve() == ROOT
+
+
+def test_install_with_freecad_user_data_writes_only_there(home, tmp_path, monkeypatch):
+    custom = tmp_path / "portable"
+    custom.mkdir()
+    monkeypatch.setenv("FREECAD_USER_DATA", str(custom))
+    assert main(["install-freecad"]) == 0
+    assert (custom / "Mod" / "spur_cad").resolve() == ROOT and (custom / "spur_cad_environment.json").is_file()
+    assert not _data(home).exists()
+
+
+def _addon_manager_copy(folder: Path) -> Path:
+    copy = folder / "Mod" / "spur_cad"
+    (copy / "workbench").mkdir(parents=True)
+    (copy / "package.xml").write_bytes((ROOT / "package.xml").read_bytes())
+    (copy / "workbench" / "InitGui.py").write_text("# the Addon Manager's copy\n")
+    return copy
+
+
+def test_install_keeps_an_addon_manager_copy_and_records_the_environment(home, capsys):
+    """The Addon Manager installs the workbench as a folder but cannot provide spur_cad: install-freecad keeps
+    that folder and writes the record beside it, so the copy's workbench imports this environment's spur_cad."""
+    copy = _addon_manager_copy(_data(home) / "v1-1")
+    assert main(["install-freecad"]) == 0
+    assert not copy.is_symlink() and (copy / "workbench" / "InitGui.py").read_text() == "# the Addon Manager's copy\n"
+    record = json.loads((_data(home) / "v1-1" / "spur_cad_environment.json").read_text())
+    assert record["addon"] == str(copy) and sysconfig.get_paths()["purelib"] in record["site_packages"]
+    assert (_data(home) / "Mod" / "spur_cad").resolve() == ROOT  # the unversioned folder gets the link
+    assert "kept the copy of the workbench in " + str(copy) in capsys.readouterr().out
+    assert main(["install-freecad", "--uninstall"]) == 0
+    assert (copy / "package.xml").is_file() and not (_data(home) / "v1-1" / "spur_cad_environment.json").exists()
+    assert "left " + str(copy) in capsys.readouterr().out
+
+
+def test_a_foreign_folder_in_any_version_stops_the_install_before_any_change(home, capsys):
+    foreign = _data(home) / "v1-1" / "Mod" / "spur_cad"
+    foreign.mkdir(parents=True)
+    (foreign / "package.xml").write_text("<package><name>other</name></package>")
+    assert main(["install-freecad"]) == 2
+    assert str(foreign) in capsys.readouterr().err
+    assert not (_data(home) / "Mod").exists() and not (_data(home) / "spur_cad_environment.json").exists()
+
+
 IMPORT_BODY = """
 import sys, FreeCAD
 RESULT["user_data"] = FreeCAD.getUserAppDataDir()
@@ -108,7 +224,8 @@ def test_freecad_loads_the_installed_workbench_and_forgets_it_after_uninstall(fr
     home = tmp_path / "home"  # the HOME run_freecad_code gives FreeCAD
     home.mkdir()
     monkeypatch.setenv("HOME", str(home))
-    monkeypatch.delenv("XDG_DATA_HOME", raising=False)
+    for name in ("XDG_DATA_HOME", "FREECAD_USER_DATA", "FREECAD_USER_HOME"):
+        monkeypatch.delenv(name, raising=False)
     assert main(["install-freecad"]) == 0
     result, proc = run_freecad_code(IMPORT_BODY, tmp_path, freecadcmd=freecadcmd)
     assert result is not None and result.get("ok"), describe(proc, result)
