@@ -35,6 +35,7 @@ STEP_TIMEOUT_S = 180
 @dataclass(frozen=True)
 class WheelInstall:
     wheel: Path
+    source: Path  # the copy of the working tree the wheel was built from
     venv: Path
     site_packages: Path  # the fresh venv's
     outside: Path  # an empty folder outside the checkout to run commands from
@@ -91,7 +92,7 @@ def wheel_install(tmp_path_factory) -> WheelInstall:
     site = Path(_run([python, "-c", "import sysconfig; print(sysconfig.get_paths()['purelib'])"],
                      cwd=outside, env=env).stdout.strip())
     (site / "spur_cad_test_dependencies.pth").write_text(sysconfig.get_paths()["purelib"] + "\n")
-    return WheelInstall(wheel, venv, site, outside)
+    return WheelInstall(wheel, source, venv, site, outside)
 
 
 PROBE = """
@@ -109,7 +110,8 @@ print(json.dumps({"spur_cad": spur_cad.__file__, "version": spur_cad.__version__
 
 
 def test_the_wheel_carries_the_addon_and_installs_apart_from_the_checkout(wheel_install):
-    """Every file git tracks in the addon's parts is in the wheel, byte for byte; the installed spur_cad and its
+    """Every file git tracks in the addon's parts is in the wheel, byte for byte as in the working tree the
+    wheel was built from (its copy: the checkout may change meanwhile); the installed spur_cad and its
     addon are real files in the venv (no link back into the checkout); the addon's resources.py finds the
     icons beside it; install-freecad from the venv links that copy and records the venv."""
     expected = _git_files(*ADDON_PARTS)
@@ -119,7 +121,7 @@ def test_the_wheel_carries_the_addon_and_installs_apart_from_the_checkout(wheel_
     missing = [name for name in expected if f"spur_cad/freecad_addon/{name}" not in shipped]
     assert missing == [], f"not in the wheel (pyproject.toml [tool.setuptools.package-data]): {missing}"
     for name in expected:
-        assert shipped[f"spur_cad/freecad_addon/{name}"] == (ROOT / name).read_bytes(), name
+        assert shipped[f"spur_cad/freecad_addon/{name}"] == (wheel_install.source / name).read_bytes(), name
 
     site = wheel_install.site_packages
     probe = json.loads(_run([wheel_install.venv / "bin" / "python", "-c", PROBE], cwd=wheel_install.outside,
