@@ -119,7 +119,7 @@ view.saveImage(SCREENSHOT, 1280, 960, "White")
 select(job)
 FreeCADGui.runCommand("SpurCad_Simulate")
 settle()
-simulations = [o for o in doc.Objects if o.TypeId == "Points::Feature"]
+simulations = [o for o in doc.Objects if getattr(getattr(o, "Proxy", None), "KIND", "") == "simulation"]
 boxes = [w for w in QtGui.QApplication.topLevelWidgets() if w.objectName() == "SpurCadMessage" and w.isVisible()]
 RESULT["simulation"] = [len(simulations), [b.text() for b in boxes]]
 
@@ -131,11 +131,13 @@ settle()
 RESULT["exported"] = sorted(os.listdir(OUT))
 
 answer_file_dialog(JOB_FILE)
-FreeCADGui.runCommand("SpurCad_ImportJob")
+FreeCADGui.runCommand("SpurCad_ImportJob")     # into a new document named after the job file
 settle()
-RESULT["imported"] = [o.Label for o in doc.Objects if getattr(getattr(o, "Proxy", None), "KIND", "") == "job"]
+imported_doc = FreeCAD.ActiveDocument
+RESULT["imported"] = [imported_doc.Name, [o.Label for o in imported_doc.Objects
+                                          if getattr(getattr(o, "Proxy", None), "KIND", "") == "job"]]
 
-imported_job = doc.getObject("Job001")         # a bad value: Export shows the message, writes nothing
+imported_job = imported_doc.getObject("Job")   # a bad value: Export shows the message, writes nothing
 imported_job.FinishingToolDiameter = 9.0
 os.makedirs(OUT + "_bad")
 answer_file_dialog(OUT + "_bad")
@@ -202,7 +204,7 @@ def test_workbench_commands_panel_and_screenshot_in_the_gui(freecad_gui, tmp_pat
     assert count == 1 or boxes == ["simulation not available: this spur_cad has no simulator (spur_cad.sim)"]
     assert {"gear.step", "stock.step", "job.step", "summary.json"} <= set(result["exported"])
     assert any(name.startswith("roughing.") for name in result["exported"])
-    assert result["imported"] == ["Job", "small quick gear"]
+    assert result["imported"] == ["small", ["small quick gear"]]
     expected = _expected(small_job_text(finishing_diameter=9.0))
     assert ["Export", expected] in result["export_error"] and result["exported_bad"] == []
     assert f"Export: {expected}" in result["report"]

@@ -198,6 +198,8 @@ RESULT["new_types"] = {p: job.getTypeIdOfProperty(p) for p in ("MaxFeed", "AMin"
 RESULT["new_max_feed"] = [job.MaxFeed.Value, job.MaxFeed.UserString]
 gear.removeProperty("KeywayDepth")      # as if saved by an older schema without this property
 gear.SchemaVersion = 0
+gear.setGroupOfProperty("TipRadius", "Computed")  # the groups of schemas 1 and 2
+gear.setGroupOfProperty("Status", "Base")
 # as saved by schema 1: MaxFeed a plain float, AMin an angle (which clamped -99999 to -360), and a shorter list
 job.removeProperty("MaxFeed")
 job.addProperty("App::PropertyFloat", "MaxFeed", "Machine", "linear feed limit (mm/min)")
@@ -215,6 +217,7 @@ RESULT["restored"] = states(doc)
 gear = doc.getObject("Gear")
 RESULT["migrated"] = dict(version=gear.SchemaVersion, has=("KeywayDepth" in gear.PropertiesList),
                           value=gear.KeywayDepth.Value)
+RESULT["migrated_groups"] = [gear.getGroupOfProperty("TipRadius"), gear.getGroupOfProperty("Status")]
 job = doc.getObject("Job")
 RESULT["schema_version"] = schema.SCHEMA_VERSION
 RESULT["job_version"] = job.SchemaVersion
@@ -252,15 +255,16 @@ def test_documents_save_and_reopen_without_pickles(freecadcmd, tmp_path):
     restored = result["restored"]  # the migrated gear is touched (a property was added), nothing is invalid
     assert all("Invalid" not in state and status == "ok" for state, status in restored.values()), restored
     assert _all_up_to_date(result["recomputed"]), result
-    assert result["schema_version"] == 2
-    assert result["migrated"] == {"version": 2, "has": True, "value": 0.0}
+    assert result["schema_version"] == 3
+    assert result["migrated"] == {"version": 3, "has": True, "value": 0.0}
     # unit-carrying types: a feed is a speed shown in FreeCAD's units (mm/s) and read back in mm/min
     types = {"MaxFeed": "App::PropertySpeed", "AMin": "App::PropertyFloat",
              "FinishingStrategy": "App::PropertyEnumeration"}
     assert result["new_types"] == types
     assert result["new_max_feed"][0] == pytest.approx(5000.0 / 60.0) and "mm/s" in result["new_max_feed"][1]
     # schema-1 types re-created with the values they held, the drop-down list brought up to date
-    assert result["job_version"] == 2 and result["migrated_types"] == types
+    assert result["job_version"] == 3 and result["migrated_types"] == types
+    assert result["migrated_groups"] == ["Values: computed", "Values: status"]
     assert result["strategies"] == list(strategy_names())  # the registry's list, brought up to date
     before = result["saved_values"]
     assert before["MaxFeed"] == 4321.5 and before["AMin"] == -360.0  # the angle had clamped
@@ -353,10 +357,13 @@ except simulation.SimulationUnavailable as exc:
 else:
     sim = commands.simulate(job, resolution_mm=0.02)
     pts = sim.Points.Points
-    RESULT.update(count=len(pts), colours=len(sim.Color), gouge=sim.MaxGouge.Value, leftover=sim.MaxLeftover.Value,
+    RESULT.update(count=len(pts), colours=len(sim.Color), gouge=sim.MaxGougeMicrons / 1000.0,
+                  leftover=sim.MaxLeftoverMicrons / 1000.0, scale=sim.ColourScale.Value,
+                  largest=max(abs(d) for d in sim.Deviations), job=sim.Job.Name, status=sim.Status,
                   legend=sim.Legend, xs=[min(p.x for p in pts), max(p.x for p in pts)],
                   radii=[min((p.y**2 + p.z**2) ** 0.5 for p in pts), max((p.y**2 + p.z**2) ** 0.5 for p in pts)],
-                  green=sum(1 for c in sim.Color if c[1] > 0.99), red=sum(1 for c in sim.Color if c[0] > 0.99))
+                  green=sum(1 for c in sim.Color if c[1] > 0.99), red=sum(1 for c in sim.Color if c[0] > 0.99),
+                  blue=sum(1 for c in sim.Color if c[2] > 0.99))
 """
 
 
@@ -374,8 +381,11 @@ def test_simulate_shows_the_design_points_coloured_by_deviation(freecadcmd, tmp_
     assert result["radii"][0] >= spec.root_radius_mm - 0.01 and result["radii"][1] <= spec.tip_radius_mm + 0.01
     assert 0.0 <= result["gouge"] <= 0.02  # within the resolution: the toolpaths do not gouge
     assert result["green"] > 0 and "blue: gouge" in result["legend"]
-    if result["leftover"] >= 0.1:  # 1.5 mm stations leave ridges: some points show full red
-        assert result["red"] > 0
+    assert result["job"] == "Job" and result["status"] == "ok"
+    # the scale is the largest deviation shown (at least the resolution): the worst point is fully coloured
+    assert result["scale"] == pytest.approx(max(result["largest"], 0.02))
+    if result["largest"] > 0.02:
+        assert result["red"] > 0 or result["blue"] > 0
 
 
 HELICAL_BODY = STATES + """

@@ -190,6 +190,27 @@ RESULT["invalid_gear"] = [list(gear.State), gear.Status, gear.TipRadius.Value, j
 gear.Teeth = 12
 doc.recompute()
 RESULT["fixed_gear"] = [list(gear.State), gear.Status, job.RoughingToolpath.Status, list(job.State)]
+
+# the property editor lists the inputs first (FreeCAD sorts groups by name; computed ones are "Values: ...")
+FreeCADGui.Selection.clearSelection()
+groups = {}
+for obj in (gear, job):
+    FreeCADGui.Selection.clearSelection()
+    FreeCADGui.Selection.addSelection(obj)
+    settle()
+    for tree in main_window.findChildren(QtGui.QTreeView):
+        model = tree.model()
+        rows = [model.data(model.index(r, 0)) for r in range(model.rowCount())] if model is not None else []
+        if "Values: computed" in rows or "Values: results" in rows:
+            groups[obj.Name] = rows
+RESULT["groups"] = groups
+
+# Gear and Simulate have different toolbar icons
+def icon_image(command):
+    action = [a for a in main_window.findChildren(QtGui.QAction) if a.objectName() == command][0]
+    image = action.icon().pixmap(32, 32).toImage()
+    return [image.pixelColor(x, y).name() for x in range(0, 32, 2) for y in range(0, 32, 2)]
+RESULT["icons"] = [icon_image("SpurCad_Gear"), icon_image("SpurCad_Simulate")]
 RESULT["hooked"] = hooked
 """
 
@@ -310,6 +331,19 @@ def test_the_simulation_is_linked_scaled_with_a_colour_bar_and_goes_stale(panel_
     left = image[:, : image.shape[1] // 6]
     for colour in ((0.0, 0.0, 1.0), (0.0, 1.0, 0.0), (1.0, 0.0, 0.0)):
         assert np.all(np.abs(left - np.array(colour)) < 0.15, axis=-1).sum() > 100, colour
+
+
+@pytest.mark.freecad
+def test_inputs_come_first_in_the_property_editor_and_commands_have_their_own_icons(panel_result):
+    groups = panel_result["groups"]
+    assert set(groups) == {"Gear", "Job"}
+    for name, rows in groups.items():
+        computed = [i for i, row in enumerate(rows) if row.startswith("Values: ")]
+        inputs = [i for i, row in enumerate(rows) if not row.startswith("Values: ") and row not in ("Toolpaths",)]
+        assert computed and max(inputs) < min(computed), (name, rows)
+    gear_icon, simulate_icon = panel_result["icons"]
+    differing = sum(a != b for a, b in zip(gear_icon, simulate_icon))
+    assert differing > len(gear_icon) // 4
 
 
 @pytest.mark.freecad

@@ -211,8 +211,9 @@ def show_message(title: str, message: str, error: bool = True) -> None:
         import FreeCADGui
         from PySide import QtGui
 
-        box = QtGui.QMessageBox(QtGui.QMessageBox.Warning if error else QtGui.QMessageBox.Information,
-                                title, message, QtGui.QMessageBox.Ok, FreeCADGui.getMainWindow())
+        icon = compat.qt_enum(QtGui.QMessageBox, "Icon", "Warning" if error else "Information")
+        ok = compat.qt_enum(QtGui.QMessageBox, "StandardButton", "Ok")
+        box = QtGui.QMessageBox(icon, title, message, ok, FreeCADGui.getMainWindow())
         box.setObjectName("SpurCadMessage")
         box.setModal(False)
         box.show()

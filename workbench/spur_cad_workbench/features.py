@@ -71,6 +71,9 @@ def add_fields(obj, fields, values: dict | None = None, outputs: bool = False) -
     for field in fields:
         value = values.get(field.prop) if values is not None else None
         if field.prop in obj.PropertiesList:
+            if obj.getGroupOfProperty(field.prop) != field.group:  # a group of an older schema
+                obj.setGroupOfProperty(field.prop, field.group)
+                changed.append(field.prop)
             if obj.getTypeIdOfProperty(field.prop) == field.property_type:
                 if field.kind == "choice" and _set_choices(obj, field):
                     changed.append(field.prop)
@@ -107,12 +110,15 @@ def write_outputs(obj, values: dict) -> None:
 def add_bookkeeping(obj) -> None:
     """SchemaVersion (for migration) and Status (last recompute's outcome), both read-only."""
     if "SchemaVersion" not in obj.PropertiesList:
-        obj.addProperty("App::PropertyInteger", "SchemaVersion", "Base", "schema of this object's properties",
-                        PROP_READ_ONLY)
+        obj.addProperty("App::PropertyInteger", "SchemaVersion", schema.STATUS_GROUP,
+                        "schema of this object's properties", PROP_READ_ONLY)
         obj.SchemaVersion = schema.SCHEMA_VERSION
     if "Status" not in obj.PropertiesList:
-        obj.addProperty("App::PropertyString", "Status", "Base", "outcome of the last recompute",
+        obj.addProperty("App::PropertyString", "Status", schema.STATUS_GROUP, "outcome of the last recompute",
                         PROP_READ_ONLY | PROP_OUTPUT)
+    for prop in ("SchemaVersion", "Status"):
+        if obj.getGroupOfProperty(prop) != schema.STATUS_GROUP:  # "Base" before schema 3
+            obj.setGroupOfProperty(prop, schema.STATUS_GROUP)
 
 
 def report(obj, message: str | None) -> None:

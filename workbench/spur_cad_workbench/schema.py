@@ -35,7 +35,8 @@ document lacks, re-creates properties whose type changed (keeping their value) a
 drop-down lists, so a new key needs no migration code. Version 2: MaxFeed and RapidFeed became
 PropertySpeed (were PropertyFloat), AMin and AMax PropertyFloat (were PropertyAngle, which
 clamped the default +-99999 deg to +-360). Version 3: the job's results gained the times with
-accelerations, the program lines and PlannedValues.
+accelerations, the program lines and PlannedValues; computed groups renamed "Values: ..." (sorted after
+the inputs; reopening moves them).
 """
 
 from __future__ import annotations
@@ -142,47 +143,51 @@ def _input_fields() -> dict[str, tuple[Field, ...]]:
 FIELDS = _input_fields()
 GEAR_FIELDS, STOCK_FIELDS, JOB_FIELDS = FIELDS["gear"], FIELDS["stock"], FIELDS["job"]
 
-# Computed properties (no job-file key).
+# Computed properties (no job-file key). FreeCAD's property editor sorts groups by name: these all start with
+# "Values", after every input group, so the inputs come first.
+COMPUTED, INSPECTION, TOOL_LIMITS, RESULTS = "Values: computed", "Values: inspection", "Values: tool limits", \
+    "Values: results"
+STATUS_GROUP = "Values: status"
 GEAR_OUTPUTS = (
-    _f("ReferenceRadius", "length", "Computed", "", "", "reference radius r = m z / 2"),
-    _f("BaseRadius", "length", "Computed", "", "", "base radius r_b"),
-    _f("TipRadius", "length", "Computed", "", "", "tip radius r_a"),
-    _f("RootRadius", "length", "Computed", "", "", "root radius r_f"),
-    _f("FormRadius", "length", "Computed", "", "", "radius where the involute starts (fillet junction)"),
-    _f("ToothThickness", "length", "Computed", "", "", "design tooth thickness on the reference circle (arc)"),
-    _f("SpanTeeth", "int", "Inspection", "", "", "teeth spanned k for the span measurement"),
-    _f("SpanMeasurement", "length", "Inspection", "", "", "span measurement (base tangent length) W_k"),
-    _f("PinDiameter", "length", "Inspection", "", "", "pin (ball) diameter for the dimension over pins"),
-    _f("DimensionOverPins", "length", "Inspection", "", "", "dimension over two pins M"),
-    _f("Undercut", "bool", "Inspection", "", "", "the rack's tip corner undercuts the involute"),
-    _f("UndercutDepth", "length", "Inspection", "", "", "depth of the undercut (0 without undercut)"),
-    _f("MinTeethWithoutUndercut", "int", "Inspection", "", "", "fewest teeth generated without undercut"),
+    _f("ReferenceRadius", "length", COMPUTED, "", "", "reference radius r = m z / 2"),
+    _f("BaseRadius", "length", COMPUTED, "", "", "base radius r_b"),
+    _f("TipRadius", "length", COMPUTED, "", "", "tip radius r_a"),
+    _f("RootRadius", "length", COMPUTED, "", "", "root radius r_f"),
+    _f("FormRadius", "length", COMPUTED, "", "", "radius where the involute starts (fillet junction)"),
+    _f("ToothThickness", "length", COMPUTED, "", "", "design tooth thickness on the reference circle (arc)"),
+    _f("SpanTeeth", "int", INSPECTION, "", "", "teeth spanned k for the span measurement"),
+    _f("SpanMeasurement", "length", INSPECTION, "", "", "span measurement (base tangent length) W_k"),
+    _f("PinDiameter", "length", INSPECTION, "", "", "pin (ball) diameter for the dimension over pins"),
+    _f("DimensionOverPins", "length", INSPECTION, "", "", "dimension over two pins M"),
+    _f("Undercut", "bool", INSPECTION, "", "", "the rack's tip corner undercuts the involute"),
+    _f("UndercutDepth", "length", INSPECTION, "", "", "depth of the undercut (0 without undercut)"),
+    _f("MinTeethWithoutUndercut", "int", INSPECTION, "", "", "fewest teeth generated without undercut"),
 )
 
 STOCK_OUTPUTS = (
-    _f("BlankRadius", "length", "Computed", "", "", "radius of the blank cylinder"),
+    _f("BlankRadius", "length", COMPUTED, "", "", "radius of the blank cylinder"),
 )
 
 
 JOB_OUTPUTS = (
-    _f("FinishingMaxFlatWidth", "length", "Recommendations", "", "", "largest finishing flat width D - 2 r_t"),
-    _f("FinishingMaxCornerRadius", "length", "Recommendations", "", "", "largest finishing corner radius r_t"),
-    _f("PlungeAllowance", "length", "Recommendations", "", "", "A_p: what the finishing tool takes by plunging"),
-    _f("RoughingMaxDiameter", "length", "Recommendations", "", "", "largest roughing diameter"),
-    _f("RequiredFluteLength", "length", "Recommendations", "", "", "flute length the job needs"),
-    _f("RequiredStickOut", "length", "Recommendations", "", "", "stick-out the job needs"),
-    _f("RoughingMoves", "int", "Results", "", "", "moves of the roughing program"),
-    _f("RoughingTime", "float", "Results", "", "", "estimated roughing time (min)"),
-    _f("FinishingMoves", "int", "Results", "", "", "moves of the finishing program"),
-    _f("FinishingTime", "float", "Results", "", "", "estimated finishing time (min)"),
-    _f("RoughingTimeWithAcceleration", "float", "Results", "", "", "estimated roughing time with the machine's "
+    _f("FinishingMaxFlatWidth", "length", TOOL_LIMITS, "", "", "largest finishing flat width D - 2 r_t"),
+    _f("FinishingMaxCornerRadius", "length", TOOL_LIMITS, "", "", "largest finishing corner radius r_t"),
+    _f("PlungeAllowance", "length", TOOL_LIMITS, "", "", "A_p: what the finishing tool takes by plunging"),
+    _f("RoughingMaxDiameter", "length", TOOL_LIMITS, "", "", "largest roughing diameter"),
+    _f("RequiredFluteLength", "length", TOOL_LIMITS, "", "", "flute length the job needs"),
+    _f("RequiredStickOut", "length", TOOL_LIMITS, "", "", "stick-out the job needs"),
+    _f("RoughingMoves", "int", RESULTS, "", "", "moves of the roughing program"),
+    _f("RoughingTime", "float", RESULTS, "", "", "estimated roughing time (min)"),
+    _f("FinishingMoves", "int", RESULTS, "", "", "moves of the finishing program"),
+    _f("FinishingTime", "float", RESULTS, "", "", "estimated finishing time (min)"),
+    _f("RoughingTimeWithAcceleration", "float", RESULTS, "", "", "estimated roughing time with the machine's "
        "accelerations (min)"),
-    _f("FinishingTimeWithAcceleration", "float", "Results", "", "", "estimated finishing time with the machine's "
+    _f("FinishingTimeWithAcceleration", "float", RESULTS, "", "", "estimated finishing time with the machine's "
        "accelerations (min)"),
-    _f("RoughingProgramLines", "int", "Results", "", "", "lines of the roughing program as posted"),
-    _f("FinishingProgramLines", "int", "Results", "", "", "lines of the finishing program as posted"),
-    _f("PlannedValues", "string", "Results", "", "", "fingerprint of the values the results were planned for"),
-    _f("Warnings", "strings", "Results", "", "", "warnings of the CAM stage"),
+    _f("RoughingProgramLines", "int", RESULTS, "", "", "lines of the roughing program as posted"),
+    _f("FinishingProgramLines", "int", RESULTS, "", "", "lines of the finishing program as posted"),
+    _f("PlannedValues", "string", RESULTS, "", "", "fingerprint of the values the results were planned for"),
+    _f("Warnings", "strings", RESULTS, "", "", "warnings of the CAM stage"),
 )
 
 TOOLPATH_OUTPUTS = (

@@ -115,3 +115,11 @@ def long_job_advice(figures: PlanFigures, strategy: str) -> str:
         ways = "a larger roughing tool (within its limit), a larger level depth or step-over, a higher feed per tooth"
     return (f"Long job: {duration_text(total)}, of which {name} {duration_text(op.seconds_with_acceleration)}. "
             f"Shorter with {ways}.")
+
+
+def decimals_for(value: float, at_least: int) -> int:
+    """Decimals that show `value` exactly (at least `at_least`, at most 6): a job file's 87.5 m/min stays 87.5."""
+    for decimals in range(at_least, 7):
+        if abs(round(value, decimals) - value) <= 1e-12 * max(1.0, abs(value)):
+            return decimals
+    return 6

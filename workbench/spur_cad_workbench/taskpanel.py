@@ -14,6 +14,8 @@ collapsible sections, checked as you type.
 
 from __future__ import annotations
 
+from collections.abc import Mapping
+
 import FreeCAD
 import FreeCADGui
 from PySide import QtCore, QtGui
@@ -21,6 +23,7 @@ from PySide import QtCore, QtGui
 from spur_cad_workbench import compat, schema
 from spur_cad_workbench.features import document_values, write_values
 from spur_cad_workbench.summary import (
+    decimals_for,
     figures_text,
     limits_text,
     long_job_advice,
@@ -41,20 +44,17 @@ PANEL_MIN_WIDTH_PX = 200  # fits FreeCAD's default task dock (about 264 px with 
 QUANTITY_UNITS = {"length": "mm", "distance": "mm", "angle": "deg"}
 
 
+def _policy(name: str):
+    """A QSizePolicy.Policy member (scoped name on PySide6, see compat.qt_enum)."""
+    return compat.qt_enum(QtGui.QSizePolicy, "Policy", name)
+
+
 def _group_names() -> list[str]:
     names: list[str] = []
     for field in schema.JOB_FIELDS:
         if field.group not in names:
             names.append(field.group)
     return names
-
-
-def decimals_for(value: float, at_least: int) -> int:
-    """Decimals that show `value` exactly (at least `at_least`, at most 6): a job file's 87.5 m/min stays 87.5."""
-    for decimals in range(at_least, 7):
-        if abs(round(value, decimals) - value) <= 1e-12 * max(1.0, abs(value)):
-            return decimals
-    return 6
 
 
 class Section:
@@ -69,13 +69,13 @@ class Section:
         self.header.setObjectName(f"section:{title}")
         self.header.setText(title)
         self.header.setCheckable(True)
-        self.header.setToolButtonStyle(QtCore.Qt.ToolButtonTextBesideIcon)
-        self.header.setSizePolicy(QtGui.QSizePolicy.Expanding, QtGui.QSizePolicy.Fixed)
+        self.header.setToolButtonStyle(compat.qt_enum(QtCore.Qt, "ToolButtonStyle", "ToolButtonTextBesideIcon"))
+        self.header.setSizePolicy(_policy("Expanding"), _policy("Fixed"))
         self.header.setStyleSheet("QToolButton { border: none; font-weight: bold; text-align: left; }")
         self.body = QtGui.QWidget()
         self.form = QtGui.QFormLayout(self.body)
-        self.form.setRowWrapPolicy(QtGui.QFormLayout.WrapLongRows)
-        self.form.setFieldGrowthPolicy(QtGui.QFormLayout.AllNonFixedFieldsGrow)
+        self.form.setRowWrapPolicy(compat.qt_enum(QtGui.QFormLayout, "RowWrapPolicy", "WrapLongRows"))
+        self.form.setFieldGrowthPolicy(compat.qt_enum(QtGui.QFormLayout, "FieldGrowthPolicy", "AllNonFixedFieldsGrow"))
         self.form.setContentsMargins(8, 0, 0, 4)
         layout.addWidget(self.header)
         layout.addWidget(self.body)
@@ -85,7 +85,8 @@ class Section:
 
     def set_open(self, is_open: bool) -> None:
         self.header.setChecked(is_open)
-        self.header.setArrowType(QtCore.Qt.DownArrow if is_open else QtCore.Qt.RightArrow)
+        arrow = "DownArrow" if is_open else "RightArrow"
+        self.header.setArrowType(compat.qt_enum(QtCore.Qt, "ArrowType", arrow))
         self.body.setVisible(is_open)
 
     @property
@@ -99,8 +100,35 @@ def _wrapped_label(style: str = "", name: str = "") -> QtGui.QLabel:
     label.setObjectName(name)
     if style:
         label.setStyleSheet(style)
-    label.setSizePolicy(QtGui.QSizePolicy.Ignored, QtGui.QSizePolicy.Preferred)
+    label.setSizePolicy(_policy("Ignored"), _policy("Preferred"))
     return label
+
+
+class FieldWidgets(Mapping):
+    """The panel's fields by property name, looked up by object name on every access.
+
+    Python wrappers of FreeCAD's Gui::QuantitySpinBox (made by FreeCADGui.UiLoader) are invalidated
+    ("Internal C++ object already deleted") after some Qt calls that take them, although the widget
+    lives on (FreeCAD 0.20, PySide2 5.15); a wrapper looked up afresh is always valid."""
+
+    def __init__(self, form: QtGui.QWidget):
+        self._form = form
+        self._props: list[str] = []
+
+    def add(self, prop: str) -> None:
+        self._props.append(prop)
+
+    def __getitem__(self, prop: str) -> QtGui.QWidget:
+        widget = self._form.findChild(QtGui.QWidget, prop) if prop in self._props else None
+        if widget is None:
+            raise KeyError(prop)
+        return widget
+
+    def __iter__(self):
+        return iter(self._props)
+
+    def __len__(self) -> int:
+        return len(self._props)
 
 
 class JobTaskPanel:
@@ -113,7 +141,7 @@ class JobTaskPanel:
         self.form.setObjectName("SpurCadJobPanel")
         self.form.setWindowTitle(f"4-axis job: {job_obj.Label}")
         self.form.setMinimumWidth(PANEL_MIN_WIDTH_PX)
-        self.widgets: dict[str, QtGui.QWidget] = {}
+        self.widgets = FieldWidgets(self.form)
         self.labels: dict[str, QtGui.QLabel] = {}
         self.notes: dict[str, QtGui.QLabel] = {}
         self.messages: dict[str, QtGui.QLabel] = {}
@@ -145,7 +173,7 @@ class JobTaskPanel:
     def _summary_box(self) -> QtGui.QWidget:
         box = QtGui.QFrame()
         box.setObjectName("summary")
-        box.setFrameShape(QtGui.QFrame.StyledPanel)
+        box.setFrameShape(compat.qt_enum(QtGui.QFrame, "Shape", "StyledPanel"))
         layout = QtGui.QVBoxLayout(box)
         self.summary = _wrapped_label(name="summary:status")
         self.summary_figures = _wrapped_label(name="summary:figures")
@@ -172,15 +200,16 @@ class JobTaskPanel:
         widget.setObjectName(field.prop)
         widget.setToolTip(field.doc)
         widget.setMinimumWidth(FIELD_MIN_WIDTH_PX)
-        widget.setSizePolicy(QtGui.QSizePolicy.Ignored, QtGui.QSizePolicy.Fixed)
+        widget.setSizePolicy(_policy("Ignored"), _policy("Fixed"))
         label = QtGui.QLabel(schema.title(field))
         label.setWordWrap(True)  # a long title takes two lines rather than the field's width
         label.setObjectName(f"label:{field.prop}")
         label.setToolTip(field.doc)
         note = _wrapped_label(NOTE_STYLE, f"note:{field.prop}")
         note.setVisible(False)
-        self.widgets[field.prop], self.labels[field.prop], self.notes[field.prop] = widget, label, note
+        self.labels[field.prop], self.notes[field.prop] = label, note
         section.form.addRow(label, widget)
+        self.widgets.add(field.prop)
         section.form.addRow(note)
 
     def _widget(self, field, value) -> QtGui.QWidget:
@@ -342,7 +371,7 @@ class JobTaskPanel:
         if not result.ok:
             self.show_problem()
             return False
-        QtGui.QApplication.setOverrideCursor(QtCore.Qt.WaitCursor)
+        QtGui.QApplication.setOverrideCursor(compat.qt_enum(QtCore.Qt, "CursorShape", "WaitCursor"))
         try:
             figures = plan_figures(result.job, plan_cam(result.job))
         except SpurCadError as exc:
@@ -363,11 +392,10 @@ class JobTaskPanel:
         field = schema.field_by_prop(prop)
         self.sections[field.group].set_open(True)
         QtCore.QCoreApplication.processEvents()
-        widget = self.widgets[prop]
-        scroll = _scroll_area_of(widget)
+        scroll = _scroll_area_of(self.form)
         if scroll is not None:
-            scroll.ensureWidgetVisible(widget, 20, 40)
-        widget.setFocus()
+            scroll.ensureWidgetVisible(self.widgets[prop], 20, 40)
+        self.widgets[prop].setFocus()
         return prop
 
     # --- task dialog interface ---------------------------------------------------------------

@@ -1,0 +1,170 @@
+"""The task panel's logic without FreeCAD: field titles, advice that names the field and what to change,
+recommendations never derived from an invalid tool, notes on unusual machine values, the summary's figures
+against the plan and the posted programs, the values' fingerprint, and the colour bar's geometry."""
+
+from __future__ import annotations
+
+import re
+from types import SimpleNamespace
+
+import numpy as np
+import pytest
+
+from spur_cad.cam.recommend import recommend_tools
+from spur_cad.cam.strategies.generating import generating_tool_limits
+from spur_cad.job import parse_job
+from spur_cad.pipeline import build_programs, plan_cam
+from tests.workbench_helper import ROOT, small_job_text
+
+
+@pytest.fixture
+def wb(monkeypatch):
+    monkeypatch.syspath_prepend(str(ROOT / "workbench"))
+    from spur_cad_workbench import colourbar, schema, simulation, summary, validation
+
+    return SimpleNamespace(schema=schema, validation=validation, summary=summary, simulation=simulation,
+                           colourbar=colourbar)
+
+
+def _values(wb, **job_changes):
+    values = wb.schema.values_from_job(parse_job(small_job_text(), "small.toml"))
+    values["job"].update(job_changes)
+    return values
+
+
+KEY_NAME = re.compile(r"\b[a-z]+(?:_[a-z0-9]+)+\b")  # a job-file key such as corner_radius_mm
+
+
+def test_titles_are_words_unique_within_their_section(wb):
+    seen: dict[str, set[str]] = {}
+    for field in wb.schema.JOB_FIELDS + wb.schema.GEAR_FIELDS + wb.schema.STOCK_FIELDS:
+        title = wb.schema.title(field)
+        assert title and title[0].isupper() and not KEY_NAME.search(title) and not re.search(r"[a-z][A-Z]", title)
+        assert title not in seen.setdefault(field.group, set()), (field.group, title)
+        seen[field.group].add(title)
+    by_prop = {f.prop: wb.schema.title(f) for f in wb.schema.JOB_FIELDS}
+    assert by_prop["RoughingFeedPerTooth"] == "Feed per tooth" and by_prop["FinishingToolDiameter"] == "Diameter"
+    assert by_prop["FinishingToolNumber"] == "Tool number" and by_prop["XMin"] == "X min"
+
+
+# (property, bad value, the job-file key the command line blames, words the advice must hold)
+BAD_VALUES = [
+    ("RoughingToolDiameter", -1.0, "tools.roughing.diameter_mm", "Roughing tool: diameter must be in"),
+    ("FinishingCornerRadius", 3.0, "tools.finishing.corner_radius_mm", "Finishing tool: corner radius below"),
+    ("TargetScallop", 1.0, "finishing.target_scallop_mm", "Finishing strategy: target scallop must be in"),
+    ("MaxFeed", 1.0, "machine.max_feed_mm_min", "Machine: max feed must be in"),
+    ("FinishingToolNumber", 1, "tools.finishing.tool_number", "Finishing tool: tool number = 1 is also"),
+    ("FinishStock", 0.5, "roughing.finish_stock_mm", "Roughing strategy: finish stock = 0.5 must be below flank "
+                                                     "allowance = 0.1"),
+    ("XMin", 2000.0, "machine.x_min_mm", "Machine: x min must be below x max"),
+]
+
+
+@pytest.mark.parametrize("prop, value, key, words", BAD_VALUES, ids=[b[0] for b in BAD_VALUES])
+def test_advice_names_the_field_the_command_line_blames_in_the_panels_words(wb, prop, value, key, words):
+    result = wb.validation.validate(_values(wb, **{prop: value}), "small.toml")
+    assert not result.ok and len(result.problems) == 1
+    problem = result.problems[0]
+    section, key_name = key.rsplit(".", 1)
+    field = wb.schema.field_by_prop(problem.prop)
+    assert (field.section, field.key) == (section, key_name)
+    assert problem.message.startswith(f"[{section}] ") and key_name in problem.message  # the CLI's message
+    assert problem.advice.startswith(words), problem.advice
+    assert not KEY_NAME.search(problem.advice.split("(")[0]), problem.advice
+
+
+def test_tool_limit_advice_gives_the_limit_the_recommendations_compute(wb):
+    job = parse_job(small_job_text(), "s")
+    spec, blank = job.gear, job.stock.blank_radius_mm(job.gear)
+    result = wb.validation.validate(_values(wb, RoughingToolDiameter=6.0))
+    limit = recommend_tools(spec, blank, job.machine.clearance_mm, job.tools.finishing).roughing_max_diameter_mm
+    assert result.problems[0].prop == "RoughingToolDiameter"
+    assert result.problems[0].advice.startswith(f"Roughing tool: diameter at most {limit:.3g} mm for this gear")
+    assert result.problems[0].advice.endswith("now 6 mm")
+
+    generating = _values(wb, FinishingStrategy="generating", FinishingToolDiameter=9.0, FinishingCornerRadius=0.9)
+    result = wb.validation.validate(generating)
+    tip = generating_tool_limits(spec, 0.9, job.finishing.target_scallop_mm, blank).tip_mode_max_diameter_mm
+    advice = result.problems[0].advice
+    assert result.problems[0].prop == "FinishingToolDiameter"
+    assert advice.startswith(f"Finishing tool: diameter at most {tip:.3g} mm for a corner radius of 0.9 mm")
+
+
+def test_recommendations_never_derive_from_an_invalid_finishing_tool(wb):
+    job = parse_job(small_job_text(), "s")
+    spec, blank = job.gear, job.stock.blank_radius_mm(job.gear)
+    result = wb.validation.validate(_values(wb, FinishingStrategy="generating", FinishingToolDiameter=9.0,
+                                            FinishingCornerRadius=0.9))
+    assert result.problems[0].group == "Finishing tool"
+    without = recommend_tools(spec, blank, job.machine.clearance_mm)
+    assert result.recommendations.roughing_max_diameter_mm == pytest.approx(without.roughing_max_diameter_mm)
+
+
+def test_unusual_machine_values_get_notes_and_usual_ones_none(wb):
+    usual = _values(wb)["job"]
+    assert wb.validation.unusual_value_notes(usual) == {}
+    notes = wb.validation.unusual_value_notes({**usual, "MaxSpindleRpm": 100.0, "RapidFeed": 1000.0})
+    assert set(notes) == {"MaxSpindleRpm", "RapidFeed"} and "unusually low" in notes["MaxSpindleRpm"]
+    assert wb.validation.validate({**_values(wb), "job": {**usual, "MaxSpindleRpm": 100.0}}).ok  # still valid
+
+
+def test_summary_figures_are_the_plans_estimates_and_the_posted_programs_lines(wb):
+    job = parse_job(small_job_text(), "s")
+    plan = plan_cam(job)
+    figures = wb.summary.plan_figures(job, plan)
+    programs, files = build_programs(job, plan)
+    for name in ("roughing", "finishing"):
+        op, planned = getattr(figures, name), getattr(plan, name)
+        assert op.moves == planned.estimate.moves and op.seconds == planned.estimate.time_s
+        assert op.seconds_with_acceleration == planned.estimate.time_with_acceleration_s
+        text = next(data for file, data in files.items() if file.startswith(name)).decode()
+        assert op.program_lines == len(text.splitlines())
+    text = wb.summary.figures_text(figures)
+    total = plan.roughing.estimate.time_with_acceleration_s + plan.finishing.estimate.time_with_acceleration_s
+    assert text.startswith(f"Cycle time {wb.summary.duration_text(total)} with the machine's accelerations")
+    assert f"{plan.finishing.estimate.moves:,} moves" in text
+
+
+def test_durations_and_long_job_advice(wb):
+    s = wb.summary
+    assert [s.duration_text(t) for t in (40.0, 14 * 60.0, 2 * 3600.0 + 5 * 60.0)] == ["40 s", "14 min", "2 h 05 min"]
+    short = s.PlanFigures(s.OperationFigures(10, 3600.0, 3700.0, 5), s.OperationFigures(10, 3600.0, 3700.0, 5))
+    assert s.long_job_advice(short, "generating") == ""
+    long_finish = s.PlanFigures(s.OperationFigures(10, 3600.0, 3700.0, 5),
+                                s.OperationFigures(10, 30 * 3600.0, 32 * 3600.0, 5))
+    advice = s.long_job_advice(long_finish, "perimeter")
+    assert advice.startswith("Long job: 33 h 02 min, of which finishing 32 h 00 min")
+    assert "target scallop" in advice and "generating strategy" in advice
+    long_rough = s.PlanFigures(s.OperationFigures(10, 9 * 3600.0, 9 * 3600.0, 5), None)
+    assert "larger roughing tool" in s.long_job_advice(long_rough, "generating")
+
+
+def test_values_fingerprint_changes_with_every_job_value(wb):
+    values = _values(wb)
+    base = wb.summary.values_signature(values)
+    assert wb.summary.values_signature(_values(wb)) == base
+    for field in wb.schema.JOB_FIELDS:
+        if not field.key or (field.section.startswith("tools.") and not values["job"][
+                wb.schema.TOOL_SWITCHES[field.section[6:]].prop]):
+            continue
+        value = values["job"][field.prop]
+        changed = (not value if field.kind == "bool" else value + 1 if field.kind in ("int",) else
+                   value + 0.5 if isinstance(value, float) else
+                   next(c for c in field.choices if c != value) if field.kind == "choice" else value + "x")
+        assert wb.summary.values_signature(_values(wb, **{field.prop: changed})) != base, field.prop
+
+
+def test_decimals_show_values_exactly(wb):
+    assert [wb.summary.decimals_for(v, 0) for v in (7000.0, 87.5, 0.004, 1 / 3)] == [0, 1, 3, 6]
+    assert wb.summary.decimals_for(0.5, 3) == 3
+
+
+def test_colour_scale_and_colour_bar(wb):
+    deviation = np.array([-0.002, 0.0, 0.0125])
+    assert wb.simulation.colour_scale_mm(deviation, 0.005) == pytest.approx(0.0125)
+    assert wb.simulation.colour_scale_mm(np.array([0.001]), 0.005) == 0.005  # below the resolution: noise
+    vertices, fraction = wb.colourbar.bar_geometry(1.6, steps=10)
+    assert vertices.shape == (22, 3) and fraction[0] == -1.0 and fraction[-1] == 1.0
+    assert np.all(np.diff(vertices[::2, 1]) > 0) and vertices[:, 0].min() > -1.6 and vertices[:, 0].max() < -1.3
+    colours = wb.simulation.deviation_colours(fraction, 1.0)
+    assert np.allclose(colours[0], (0, 0, 1)) and np.allclose(colours[-1], (1, 0, 0))
