@@ -51,6 +51,7 @@ doc = FreeCAD.newDocument("Panel")
 gear = commands.make_gear(doc, **PROPS["gear"])
 stock = commands.make_stock(gear, **PROPS["stock"])
 job = commands.make_job(gear, stock)               # suggested tools
+job.StepOverFraction = 1.0 / 3.0   # more decimals than a field shows: kept exactly unless edited
 doc.recompute()
 RESULT["tool_numbers"] = [job.RoughingToolNumber, job.FinishingToolNumber]
 RESULT["job_times"] = [job.RoughingTimeWithAcceleration, job.FinishingTimeWithAcceleration, job.RoughingTime,
@@ -96,8 +97,9 @@ buttons = [b for b in main_window.findChildren(QtGui.QPushButton) if b.text().re
 RESULT["buttons"] = [[b.text().replace("&", ""), b.mapTo(dock, QtCore.QPoint(0, 0)).x() + b.width(), dock.width()]
                      for b in buttons]
 RESULT["labels"] = {p: panel.labels[p].text() for p in ("RoughingFeedPerTooth", "FinishingToolDiameter", "MaxFeed")}
-RESULT["texts"] = {p: panel.widgets[p].text() for p in ("FinishingToolDiameter", "PressureAngle" if False else
-                   "FinishingCornerRadius", "TargetScallop", "RoughingCuttingSpeed", "MaxFeed", "MaxSpindleRpm")}
+RESULT["texts"] = {p: panel.widgets[p].text() for p in ("FinishingToolDiameter", "FinishingCornerRadius",
+                                                        "TargetScallop", "RoughingCuttingSpeed", "MaxFeed",
+                                                        "MaxSpindleRpm", "StepOverFraction")}
 RESULT["types"] = {p: panel.widgets[p].metaObject().className() for p in ("FinishingToolDiameter", "MaxFeed")}
 RESULT["open_sections"] = {g: s.is_open for g, s in panel.sections.items()}
 RESULT["summary"] = [panel.summary.text(), panel.summary_figures.text(), panel.summary_limits.text()]
@@ -130,6 +132,15 @@ RESULT["clipped_open"] = clipped()
 grabbed = scroll.grab()
 grabbed.save(PANEL_ERROR_SHOT)
 panel.set_value("MaxFeed", 5000.0)
+import time
+block = panel.widgets["BlockTime"]        # typed as a user would: checked once the typing pauses
+block.lineEdit().selectAll()
+block.lineEdit().insert("0.0005")
+block.interpretText()
+started = time.monotonic()
+while time.monotonic() - started < 1.0:
+    settle(1)
+RESULT["typed"] = [panel.job_values()["BlockTime"], block.text(), panel.current_messages()]
 panel.set_value("MaxSpindleRpm", 100.0)
 RESULT["unusual"] = panel.notes["MaxSpindleRpm"].text() if panel.notes["MaxSpindleRpm"].isVisible() else ""
 panel.set_value("MaxSpindleRpm", 7000.0)
@@ -148,6 +159,7 @@ panel.set_value("FinishingStepOver", 0.05)
 RESULT["perimeter_messages"] = panel.current_messages()
 RESULT["accept_valid"] = panel.accept()
 settle()
+RESULT["exact_after_ok"] = [job.StepOverFraction, job.BlockTime]
 finishing = job.FinishingToolpath
 RESULT["thinning"] = [finishing.Label, finishing.Moves, finishing.DisplayedMoves]
 starts = []
@@ -187,9 +199,22 @@ doc.recompute()
 settle()
 RESULT["invalid_gear"] = [list(gear.State), gear.Status, gear.TipRadius.Value, job.RoughingToolpath.Status,
                           list(job.RoughingToolpath.ViewObject.NormalColor)[:3], list(job.State)]
+RESULT["stale_job"] = [job.Status, job.RoughingTimeWithAcceleration, stock.Status, stock.BlankRadius.Value,
+                       sim.Status]
+FreeCADGui.ActiveDocument.setEdit(job.Name)   # the panel opens on a job whose gear is invalid
+settle()
+panel = job.ViewObject.Proxy.panel
+RESULT["panel_invalid_gear"] = [panel.summary.text(), panel.highlighted, panel.accept(), panel.show_problem(),
+                                panel.messages["Gear"].isVisible(), bool(FreeCADGui.Control.activeDialog())]
+panel.reject()
+settle()
 gear.Teeth = 12
 doc.recompute()
-RESULT["fixed_gear"] = [list(gear.State), gear.Status, job.RoughingToolpath.Status, list(job.State)]
+RESULT["fixed_gear"] = [list(gear.State), gear.Status, job.RoughingToolpath.Status, list(job.State), job.Status]
+job.TargetScallop = 0.02   # the simulated values again: the simulation is current again
+doc.recompute()
+RESULT["sim_current_again"] = [sim.Status, sim.ViewObject.DisplayMode,
+                               find_colour_bar(view.getSceneGraph()) is not None]
 
 # the property editor lists the inputs first (FreeCAD sorts groups by name; computed ones are "Values: ...")
 FreeCADGui.Selection.clearSelection()
@@ -250,7 +275,7 @@ def test_the_panel_fits_the_default_dock_with_titles_units_and_closed_rare_secti
     assert texts["FinishingToolDiameter"].endswith(" mm") and texts["FinishingCornerRadius"].endswith(" mm")
     assert texts["TargetScallop"].endswith(("µm", "mm"))
     assert texts["RoughingCuttingSpeed"].endswith(" m/min") and texts["MaxFeed"].endswith(" mm/min")
-    assert texts["MaxSpindleRpm"].endswith(" 1/min")
+    assert texts["MaxSpindleRpm"] == "7000 1/min" and texts["StepOverFraction"] == "0.333333"
     assert r["types"]["FinishingToolDiameter"] == "Gui::QuantitySpinBox"
     assert not any(r["open_sections"][g] for g in ("Machine", "Simulation", "Post"))
     assert r["open_sections"]["Finishing tool"] and r["open_sections"]["Roughing tool"]
@@ -297,6 +322,8 @@ def test_errors_point_at_the_field_and_say_what_to_do(panel_result):
     assert bar_value > 0 and 0 <= top and top + height <= viewport_height
     assert machine_message.startswith("Machine: max feed must be in")
     assert "unusually low" in r["unusual"]
+    typed, text, messages = r["typed"]
+    assert typed == 0.0005 and text == "0.0005 s" and messages == {}
     # the error screenshot shows the red highlight
     image = _image(PANEL_ERROR_SHOT)
     red = np.all(np.abs(image - np.array([0xb0, 0x00, 0x20]) / 255.0) < 0.12, axis=-1)
@@ -307,6 +334,7 @@ def test_errors_point_at_the_field_and_say_what_to_do(panel_result):
 def test_the_3d_view_starts_paths_at_their_first_point_says_when_thinned_and_draws_a_smooth_gear(panel_result):
     r = panel_result
     assert r["perimeter_messages"] == {} and r["accept_valid"] is True
+    assert r["exact_after_ok"] == [1.0 / 3.0, 0.0005]  # untouched: exact; typed: the typed value
     label, moves, shown = r["thinning"]
     assert moves > shown > 0 and label == f"Finishing toolpath (3D view: {shown:,} of {moves:,} moves)"
     for start, first in r["starts"]:
@@ -354,5 +382,14 @@ def test_an_invalid_gear_is_in_error_and_its_results_are_stale(panel_result):
     assert tip_radius == 0.0
     assert toolpath_status == "stale: Gear has an error"
     assert np.allclose(toolpath_colour, 0.62, atol=0.01)
-    state, status, toolpath_status, job_state = r["fixed_gear"]
+    assert "Invalid" not in job_state  # the job did not fail itself: it depends on the failed gear
+    job_status, job_time, stock_status, blank_radius, sim_status = r["stale_job"]
+    assert job_status == stock_status == "stale: Gear has an error" and job_time == 0.0 and blank_radius == 0.0
+    assert sim_status.startswith("stale: ")
+    summary, highlighted, accepted, shown, gear_message_visible, still_open = r["panel_invalid_gear"]
+    assert summary.startswith("1 problem: Gear: teeth must be in") and highlighted is None
+    assert accepted is False and shown == "Gear" and gear_message_visible and still_open
+    state, status, toolpath_status, job_state, job_status = r["fixed_gear"]
     assert state == ["Up-to-date"] and status == "ok" and toolpath_status == "ok" and "Invalid" not in job_state
+    assert job_status == "ok"
+    assert r["sim_current_again"] == ["ok", "Color", True]

@@ -154,11 +154,6 @@ def test_values_fingerprint_changes_with_every_job_value(wb):
         assert wb.summary.values_signature(_values(wb, **{field.prop: changed})) != base, field.prop
 
 
-def test_decimals_show_values_exactly(wb):
-    assert [wb.summary.decimals_for(v, 0) for v in (7000.0, 87.5, 0.004, 1 / 3)] == [0, 1, 3, 6]
-    assert wb.summary.decimals_for(0.5, 3) == 3
-
-
 def test_colour_scale_and_colour_bar(wb):
     deviation = np.array([-0.002, 0.0, 0.0125])
     assert wb.simulation.colour_scale_mm(deviation, 0.005) == pytest.approx(0.0125)

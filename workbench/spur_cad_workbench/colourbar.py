@@ -84,18 +84,30 @@ def find_colour_bar(scene):
     return None
 
 
-def show_colour_bar(scale_mm: float, view=None) -> None:
-    """Put the colour bar (replacing an older one) into `view` (default: the active 3D view)."""
+def _view_of(document):
+    """The 3D view of a FreeCAD document (None without the GUI or a 3D view)."""
     import FreeCADGui
 
+    gui_document = FreeCADGui.getDocument(document.Name)
+    view = gui_document.ActiveView if gui_document is not None else None
+    return view if view is not None and hasattr(view, "getSceneGraph") else None
+
+
+def show_colour_bar(scale_mm: float, document) -> None:
+    """Put the colour bar (replacing an older one) into the 3D view of `document`. Its width-to-height ratio
+    is the view's when shown: after resizing the view, showing it again puts it back at the left edge."""
+    view = _view_of(document)
     if view is None:
-        gui_document = FreeCADGui.ActiveDocument
-        view = gui_document.ActiveView if gui_document is not None else None
-    if view is None or not hasattr(view, "getSceneGraph"):
         return
-    scene = view.getSceneGraph()
-    old = find_colour_bar(scene)
+    remove_colour_bar(document)
+    width, height = view.getSize()
+    view.getSceneGraph().addChild(colour_bar_node(scale_mm, width / max(height, 1)))
+
+
+def remove_colour_bar(document) -> None:
+    """Take the colour bar out of the 3D view of `document` (a stale simulation has no scale to show)."""
+    view = _view_of(document)
+    scene = view.getSceneGraph() if view is not None else None
+    old = find_colour_bar(scene) if scene is not None else None
     if old is not None:
         scene.removeChild(old)
-    width, height = view.getSize()
-    scene.addChild(colour_bar_node(scale_mm, width / max(height, 1)))

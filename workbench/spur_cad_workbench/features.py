@@ -2,8 +2,9 @@
 
 Every value lives in a primitive property (schema.py); `dumps` / `__getstate__` return None, so a
 saved document names the proxy classes but pickles nothing. The one thing a proxy keeps in memory is
-the job's last plan (`JobFeature.plan_for`), so that Simulate and the panel reuse it; it is
-never saved and is planned again when the values differ. `SchemaVersion` on each object lets
+the job's last plan (`JobFeature.plan_for`, keyed by the values' fingerprint): the panel's Plan
+leaves its plan there for OK's recompute, and Simulate reuses it. It is never saved (a reopened
+document plans again) and is planned again when any value differs. `SchemaVersion` on each object lets
 `onDocumentRestored` migrate older documents (add the properties a newer schema introduced, with
 their defaults).
 
@@ -156,13 +157,14 @@ def clear_outputs(obj) -> None:
 
 
 def dependants(obj) -> list:
-    """The spur_cad toolpaths and simulations that depend on `obj` (directly or through stock and job)."""
+    """The spur_cad objects whose results depend on `obj`: stock, job, toolpaths and simulations (FreeCAD does
+    not recompute what depends on an object in error, so their old results would read as current)."""
     found = []
     for other in obj.InListRecursive:
         kind = getattr(getattr(other, "Proxy", None), "KIND", "")
         if kind == "job":
-            found += [path for path in (other.RoughingToolpath, other.FinishingToolpath) if path is not None]
-        if kind == "simulation":
+            found += [other] + [path for path in (other.RoughingToolpath, other.FinishingToolpath) if path is not None]
+        if kind in ("stock", "simulation"):
             found.append(other)
     if getattr(getattr(obj, "Proxy", None), "KIND", "") == "job":
         found += [path for path in (obj.RoughingToolpath, obj.FinishingToolpath) if path is not None]
@@ -170,16 +172,24 @@ def dependants(obj) -> list:
 
 
 def mark_stale(obj, reason: str) -> None:
-    """Say on `obj` (a toolpath or simulation) that it no longer shows its job, and draw it grey."""
+    """Say on `obj` that its results no longer match its inputs: a stock or job gets the reason in its Status
+    and its computed values cleared; a toolpath or simulation keeps its drawing, in grey."""
     status = f"stale: {reason}"
     if obj.Status != status:
         obj.Status = status
+    kind = getattr(getattr(obj, "Proxy", None), "KIND", "")
+    if kind in ("stock", "job"):
+        clear_outputs(obj)
+        return
     view = obj.ViewObject if FreeCAD.GuiUp else None
     if view is None:
         return
     _colour(view, STALE_COLOUR)
-    if "Points" in view.listDisplayModes():
-        view.DisplayMode = "Points"  # a simulation: plain grey points instead of the deviation colours
+    if kind == "simulation":
+        view.DisplayMode = "Points"  # plain grey points instead of the deviation colours
+        from spur_cad_workbench.colourbar import remove_colour_bar
+
+        remove_colour_bar(obj.Document)
 
 
 def show_fresh(obj) -> None:
@@ -404,11 +414,11 @@ class JobFeature(_Proxy):
         from spur_cad.errors import SpurCadError
         from spur_cad_workbench.summary import plan_figures, values_signature
 
-        self.cached_plan = None
         try:
-            job, plan = self.plan_for(obj)
+            job, plan = self.plan_for(obj)  # the panel's Plan may have planned these values already
             figures = plan_figures(job, plan)
         except SpurCadError as exc:
+            self.cached_plan = None
             fail(obj, str(exc))
             return
         rec = plan.recommendations
@@ -430,9 +440,14 @@ class JobFeature(_Proxy):
                 update_toolpath(target, planned)
         write_outputs(obj, outputs)
         for dependant in dependants(obj):
-            if getattr(dependant.Proxy, "KIND", "") == "simulation" and dependant.PlannedValues != \
-                    outputs["PlannedValues"]:
+            if getattr(dependant.Proxy, "KIND", "") != "simulation":
+                continue
+            if dependant.PlannedValues != outputs["PlannedValues"]:
                 mark_stale(dependant, "the job changed after this simulation; simulate again")
+            elif dependant.Status != "ok":  # the values are back to the simulated ones
+                from spur_cad_workbench.simulation import show_current
+
+                show_current(dependant)
         report(obj, None)
 
 

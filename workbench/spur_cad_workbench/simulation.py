@@ -142,10 +142,20 @@ def recolour(obj) -> None:
     scale = max(float(obj.ColourScale.Value), 1e-6)
     obj.Color = [tuple(c) for c in deviation_colours(np.asarray(obj.Deviations), scale)]
     obj.Legend = legend_text(scale, len(obj.Deviations), obj.DesignPoints)
-    if FreeCAD.GuiUp:
+    if FreeCAD.GuiUp and obj.Status == "ok":
         from spur_cad_workbench.colourbar import show_colour_bar
 
-        show_colour_bar(scale)
+        show_colour_bar(scale, obj.Document)
+
+
+def show_current(obj) -> None:
+    """A simulation whose job has the simulated values again (after being stale): its colours and colour bar."""
+    import FreeCAD
+
+    obj.Status = "ok"
+    if FreeCAD.GuiUp and obj.ViewObject is not None:
+        obj.ViewObject.DisplayMode = "Color"
+    recolour(obj)
 
 
 def _simulation_object(job_obj):
@@ -159,7 +169,8 @@ def _simulation_object(job_obj):
     obj = doc.addObject("Points::FeaturePython", "Simulation")
     SimulationFeature(obj)
     for prop, type_id, doc_text in _RESULT_PROPERTIES:
-        obj.addProperty(type_id, prop, "Simulation", doc_text, 0 if prop in _EDITABLE else 1)
+        # read-only outputs (1 | 8): setting them (stale marking) does not ask for a recompute
+        obj.addProperty(type_id, prop, "Simulation", doc_text, 0 if prop in _EDITABLE else 1 | 8)
     for hidden in ("Deviations", "Color"):  # hundreds of thousands of numbers
         obj.setEditorMode(hidden, 2)
     obj.Job = job_obj
@@ -190,8 +201,10 @@ def show_result(job_obj, result, planned_values: str = "", plan_source: str = ""
     obj.Seconds = result.seconds
     obj.PlanSource = plan_source
     obj.DesignPoints = int(result.deviation[:, :, result.gear_rows].size)
-    obj.ColourScale = scale  # recolours (onChanged)
-    recolour(obj)
+    if abs(float(obj.ColourScale.Value) - scale) > 1e-15:
+        obj.ColourScale = scale  # recolours (onChanged)
+    else:
+        recolour(obj)
     obj.purgeTouched()
     if FreeCAD.GuiUp and obj.ViewObject is not None:
         obj.ViewObject.DisplayMode = "Color"

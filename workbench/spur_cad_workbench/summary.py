@@ -90,11 +90,13 @@ def figures_text(figures: PlanFigures) -> str:
     return "\n".join(lines)
 
 
-def limits_text(rec) -> str:
-    """The tool limits of the gear (spur_cad.cam.recommend.ToolRecommendations), one line each."""
+def limits_text(rec, with_roughing_limit: bool = True) -> str:
+    """The tool limits of the gear (spur_cad.cam.recommend.ToolRecommendations), one line each; without the
+    roughing diameter when it would derive from an invalid finishing tool (its plunge allowance)."""
     if rec is None:
         return ""
-    return (f"Roughing tool: D at most {rec.roughing_max_diameter_mm:.3f} mm\n"
+    roughing = f"Roughing tool: D at most {rec.roughing_max_diameter_mm:.3f} mm\n" if with_roughing_limit else ""
+    return (f"{roughing}"
             f"Finishing tool: corner radius at most {rec.finishing_max_corner_radius_mm:.3f} mm, flat D - 2 r at most "
             f"{rec.finishing_max_flat_width_mm:.3f} mm (perimeter, along X)\n"
             f"Both: flute length at least {rec.required_flute_length_mm:.2f} mm, stick-out at least "
@@ -115,11 +117,3 @@ def long_job_advice(figures: PlanFigures, strategy: str) -> str:
         ways = "a larger roughing tool (within its limit), a larger level depth or step-over, a higher feed per tooth"
     return (f"Long job: {duration_text(total)}, of which {name} {duration_text(op.seconds_with_acceleration)}. "
             f"Shorter with {ways}.")
-
-
-def decimals_for(value: float, at_least: int) -> int:
-    """Decimals that show `value` exactly (at least `at_least`, at most 6): a job file's 87.5 m/min stays 87.5."""
-    for decimals in range(at_least, 7):
-        if abs(round(value, decimals) - value) <= 1e-12 * max(1.0, abs(value)):
-            return decimals
-    return 6

@@ -23,7 +23,6 @@ from PySide import QtCore, QtGui
 from spur_cad_workbench import compat, schema
 from spur_cad_workbench.features import document_values, write_values
 from spur_cad_workbench.summary import (
-    decimals_for,
     figures_text,
     limits_text,
     long_job_advice,
@@ -42,6 +41,8 @@ COLLAPSED_GROUPS = ("Machine", "Simulation", "Post")  # rarely changed: closed u
 FIELD_MIN_WIDTH_PX = 112
 PANEL_MIN_WIDTH_PX = 200  # fits FreeCAD's default task dock (about 264 px with its margins and scroll bar)
 QUANTITY_UNITS = {"length": "mm", "distance": "mm", "angle": "deg"}
+NUMBER_DECIMALS = 6
+REVALIDATE_DELAY_MS = 250  # typing: check once the keys pause (a check plans roughing levels: up to 0.5 s)
 
 
 def _policy(name: str):
@@ -55,6 +56,19 @@ def _group_names() -> list[str]:
         if field.group not in names:
             names.append(field.group)
     return names
+
+
+class NumberBox(QtGui.QDoubleSpinBox):
+    """A spin box for numbers with a unit suffix: six decimals can be typed, the text shows only the digits the
+    value has (87.5 m/min, 0.0005 s), not a fixed count."""
+
+    def __init__(self):
+        super().__init__()
+        self.setDecimals(NUMBER_DECIMALS)
+        self.setRange(-BIG, BIG)
+
+    def textFromValue(self, value: float) -> str:  # noqa: N802 (Qt's name)
+        return format(round(value, NUMBER_DECIMALS), f".{NUMBER_DECIMALS + 6}g")
 
 
 class Section:
@@ -156,7 +170,9 @@ class JobTaskPanel:
         for extra in ("Gear", "Stock", "Job"):
             layout.addWidget(self._message_label(extra))
         values = document_values(job_obj)
-        self._gear_values, self._stock_values = values["gear"], values["stock"]
+        self._timer = QtCore.QTimer(self.form)
+        self._timer.setSingleShot(True)
+        self._timer.timeout.connect(self.revalidate)
         for group in _group_names():
             section = Section(group, group in COLLAPSED_GROUPS)
             self.sections[group] = section
@@ -216,30 +232,29 @@ class JobTaskPanel:
         if field.kind == "bool":
             widget = QtGui.QCheckBox()
             widget.setChecked(bool(value))
-            widget.toggled.connect(self.revalidate)
+            widget.toggled.connect(self._schedule)
         elif field.kind == "choice":
             widget = QtGui.QComboBox()
             widget.addItems(list(field.choices))
             widget.setCurrentIndex(max(0, list(field.choices).index(value) if value in field.choices else 0))
-            widget.currentIndexChanged.connect(self.revalidate)
+            widget.currentIndexChanged.connect(self._schedule)
         elif field.kind == "string":
             widget = QtGui.QLineEdit(str(value))
-            widget.textChanged.connect(self.revalidate)
+            widget.textChanged.connect(self._schedule)
         elif field.kind == "int":
             widget = QtGui.QSpinBox()
             widget.setRange(-2**31 + 1, 2**31 - 1)
             widget.setValue(int(value))
-            widget.valueChanged.connect(self.revalidate)
+            widget.valueChanged.connect(self._schedule)
         elif field.kind in QUANTITY_UNITS and (widget := self._quantity_box(field, value)) is not None:
             pass
         else:  # other units (m/min, 1/min, mm/min, %, s, ...) and plain numbers: the unit as a suffix
-            widget = QtGui.QDoubleSpinBox()
-            widget.setDecimals(decimals_for(float(value), 0 if field.unit else 3))
-            widget.setRange(-BIG, BIG)
-            widget.setValue(float(value))
+            widget = NumberBox()
             if field.unit:
                 widget.setSuffix(f" {field.unit}")
-            widget.valueChanged.connect(self.revalidate)
+            widget.setValue(float(value))
+            self._shown[field.prop] = (widget.text(), float(value))  # beyond 6 decimals: kept until edited
+            widget.valueChanged.connect(self._schedule)
         return widget
 
     def _quantity_box(self, field, value):
@@ -251,7 +266,7 @@ class JobTaskPanel:
         compat.set_spin_box_value(widget, FreeCAD.Units, float(value), unit)
         # 0.20 rounds to the shown decimals: an untouched field keeps its exact value
         self._shown[field.prop] = (widget.text(), float(value))
-        widget.lineEdit().textChanged.connect(self.revalidate)
+        widget.lineEdit().textChanged.connect(self._schedule)
         return widget
 
     # --- values and checks -----------------------------------------------------------------
@@ -265,11 +280,11 @@ class JobTaskPanel:
             return widget.text()
         if field.kind == "int":
             return int(widget.value())
+        shown_text, exact = self._shown.get(field.prop, (None, 0.0))
+        if widget.text() == shown_text:  # untouched since set: the exact value, not the rounded one shown
+            return exact
         if isinstance(widget, QtGui.QDoubleSpinBox):
             return float(widget.value())
-        shown_text, exact = self._shown.get(field.prop, (None, 0.0))
-        if widget.text() == shown_text:
-            return exact
         return compat.spin_box_value(widget, FreeCAD.Units, QUANTITY_UNITS[field.kind])
 
     def job_values(self) -> dict:
@@ -285,34 +300,44 @@ class JobTaskPanel:
             widget.setCurrentIndex(widget.findText(str(value)))
         elif isinstance(widget, QtGui.QLineEdit):
             widget.setText(str(value))
-        elif isinstance(widget, (QtGui.QSpinBox, QtGui.QDoubleSpinBox)):
-            if isinstance(widget, QtGui.QDoubleSpinBox):
-                widget.setDecimals(max(widget.decimals(), decimals_for(float(value), 0)))
+        elif isinstance(widget, QtGui.QSpinBox):
             widget.setValue(value)
+        elif isinstance(widget, QtGui.QDoubleSpinBox):
+            widget.setValue(float(value))
+            self._shown[prop] = (widget.text(), float(value))
         else:
             unit = QUANTITY_UNITS[schema.field_by_prop(prop).kind]
             compat.set_spin_box_value(widget, FreeCAD.Units, float(value), unit)
             self._shown[prop] = (widget.text(), float(value))
-            self.revalidate()
+        self.revalidate()  # at once (a user's typing waits for a pause: _schedule)
 
     def current_messages(self) -> dict[str, str]:
         """{group: the command line's message} of the problems shown now."""
         return {} if self.result is None else dict(self.result.messages)
 
     def _values(self) -> dict:
-        return {"gear": self._gear_values, "stock": self._stock_values, "job": self.job_values()}
+        """Gear and stock as the document holds them now (they may be edited while the panel is open), the job
+        as the panel holds it."""
+        values = document_values(self.job)
+        return {"gear": values["gear"], "stock": values["stock"], "job": self.job_values()}
+
+    def _schedule(self, *_):
+        """A field changed: check the values once the user pauses (each check takes up to half a second)."""
+        self._timer.start(REVALIDATE_DELAY_MS)
 
     def revalidate(self, *_):
         """Check the values; show the problem in its section and highlight its field; notes, limits, summary."""
+        self._timer.stop()
         values = self._values()
         result = self.result = validate(values, self.job.Label)
         advice = {problem.group: problem.advice for problem in result.problems}
         for group, label in self.messages.items():
             label.setText(advice.get(group, ""))
             label.setVisible(group in advice)
-        self._highlight(next((p.prop for p in result.problems if p.prop), None))
+        self._highlight(next((p.prop for p in result.problems if p.prop in self.widgets), None))
         notes = {**recommendation_notes(result.recommendations), **unusual_value_notes(values["job"])}
-        if any(problem.group == "Finishing tool" for problem in result.problems):
+        finishing_invalid = any(problem.group == "Finishing tool" for problem in result.problems)
+        if finishing_invalid:
             notes.pop("RoughingToolDiameter", None)  # its limit depends on the finishing tool (A_p)
         for prop, label in self.notes.items():
             label.setText(notes.get(prop, ""))
@@ -322,7 +347,7 @@ class JobTaskPanel:
             for field in schema.JOB_FIELDS:
                 if field.section == f"tools.{role}" and field.key:
                     self.widgets[field.prop].setEnabled(enabled)
-        self._show_summary(values, result)
+        self._show_summary(values, result, with_roughing_limit=not finishing_invalid)
         return result
 
     def _highlight(self, prop: str | None) -> None:
@@ -340,7 +365,7 @@ class JobTaskPanel:
             return _job_figures(self.job), "from the job's last recompute"
         return None, ""
 
-    def _show_summary(self, values: dict, result) -> None:
+    def _show_summary(self, values: dict, result, with_roughing_limit: bool) -> None:
         if result.ok:
             self.summary.setText("All values are valid.")
             self.summary.setStyleSheet("")
@@ -348,7 +373,7 @@ class JobTaskPanel:
             first = result.problems[0]
             self.summary.setText(f"{len(result.problems)} problem: {first.advice}")
             self.summary.setStyleSheet(ERROR_STYLE)
-        self.summary_limits.setText(limits_text(result.recommendations))
+        self.summary_limits.setText(limits_text(result.recommendations, with_roughing_limit))
         figures, source = self._figures(values_signature(values)) if result.ok else (None, "")
         if figures is not None:
             self.summary_figures.setText(f"{figures_text(figures)}\n({source})")
@@ -373,26 +398,36 @@ class JobTaskPanel:
             return False
         QtGui.QApplication.setOverrideCursor(compat.qt_enum(QtCore.Qt, "CursorShape", "WaitCursor"))
         try:
-            figures = plan_figures(result.job, plan_cam(result.job))
+            plan = plan_cam(result.job)
+            figures = plan_figures(result.job, plan)
         except SpurCadError as exc:
             self.summary.setText(str(exc))
             self.summary.setStyleSheet(ERROR_STYLE)
             return False
         finally:
             QtGui.QApplication.restoreOverrideCursor()
-        self._planned = (values_signature(self._values()), figures)
+        signature = values_signature(self._values())
+        self._planned = (signature, figures)
+        self.job.Proxy.cached_plan = (signature, result.job, plan)  # OK with these values plans no more
         self.revalidate()
         return True
 
     def show_problem(self) -> str | None:
-        """Open the section of the highlighted field, scroll it into view and focus it; returns the property."""
-        prop = self.highlighted
-        if prop is None:
+        """Open the section of the highlighted field, scroll it into view and focus it; a problem of the gear or
+        stock (no field here: their properties are edited on their objects) scrolls to its message at the
+        top. Returns the property or the group shown."""
+        problems = self.result.problems if self.result is not None else ()
+        if not problems:
             return None
-        field = schema.field_by_prop(prop)
-        self.sections[field.group].set_open(True)
-        QtCore.QCoreApplication.processEvents()
+        prop = self.highlighted
         scroll = _scroll_area_of(self.form)
+        if prop is None:
+            label = self.messages.get(problems[0].group, self.messages["Job"])
+            if scroll is not None:
+                scroll.ensureWidgetVisible(label, 20, 40)
+            return problems[0].group
+        self.sections[schema.field_by_prop(prop).group].set_open(True)
+        QtCore.QCoreApplication.processEvents()
         if scroll is not None:
             scroll.ensureWidgetVisible(self.widgets[prop], 20, 40)
         self.widgets[prop].setFocus()
