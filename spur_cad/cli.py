@@ -1,4 +1,6 @@
-"""Command line: `spur-cad run JOB.toml --out DIR` computes everything in memory, then writes.
+"""Command line: `spur-cad run JOB.toml --out DIR` computes everything in memory, then writes;
+`spur-cad verify JOB.toml PROGRAM...` cuts the job's stock with G-code programs from anywhere and exits
+0 when the part is within tolerance, 1 when not (docs/verification.md).
 
 Errors in the user's input print one line (`spur-cad: error: ...`) and exit 2 with nothing
 written; an unexpected failure prints a one-line internal error (traceback only with --debug)
@@ -10,6 +12,7 @@ always keeps a complete set (spur_cad.outputs).
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import shutil
 import signal
 import sys
@@ -38,6 +41,21 @@ def _parser() -> argparse.ArgumentParser:
     run.add_argument("--out", required=True, help="output folder (created if missing)")
     run.add_argument("--quiet", action="store_true", help="print nothing but errors")
     run.add_argument("--debug", action="store_true", help="show tracebacks of internal errors")
+    verify = sub.add_parser("verify", help="cut the job's stock with G-code programs (from anywhere) and judge the "
+                                           "part: exit 0 within tolerance, 1 beyond, 2 bad input")
+    verify.add_argument("job", help="TOML job file (gear, stock, tools by number, simulation resolution)")
+    verify.add_argument("programs", nargs="+", help="G-code programs, run in the order given")
+    verify.add_argument("--out", help="folder for verify.json and deviation_map.csv (created if missing)")
+    verify.add_argument("--dialect", help="dialect of the programs (default: the job's [post] dialect)")
+    verify.add_argument("--point", default="tip", choices=("tip", "corner-centre"),
+                        help="programmed point of the tool: its tip (spur_cad's programs) or its corner-radius "
+                             "centre (a tool length offset to the ball centre)")
+    verify.add_argument("--gouge-tolerance-mm", type=float, help="largest gouge that passes (default: the "
+                        "simulation's resolution)")
+    verify.add_argument("--leftover-tolerance-mm", type=float, help="largest leftover that passes (default: the "
+                        "finishing target scallop plus the resolution)")
+    verify.add_argument("--quiet", action="store_true", help="print nothing but errors and the verdict")
+    verify.add_argument("--debug", action="store_true", help="show tracebacks of internal errors")
     freecad = sub.add_parser("install-freecad", help="make the FreeCAD workbench and this spur_cad available "
                                                      "to your FreeCAD (undo with --uninstall)")
     freecad.add_argument("--uninstall", action="store_true", help="remove what install-freecad added")
@@ -152,6 +170,54 @@ def _run(args: argparse.Namespace, received: list[int], loaded: list) -> list:
     return paths
 
 
+def _verify(args: argparse.Namespace, received: list[int], loaded: list) -> int:
+    """`spur-cad verify`: read the programs, simulate, print the verdict, write the set; 0 pass, 1 fail."""
+    from pathlib import Path
+
+    from spur_cad.job import load_job
+    from spur_cad.outputs import check_output_folder, write_output_set
+    from spur_cad.verify.reader import MAX_PROGRAM_BYTES, read_program
+    from spur_cad.verify.rs274 import rs274_verdict
+    from spur_cad.verify.verify import VerifyOptions, result_files, verify_moves
+
+    _checkpoint(received)
+    out_dir = check_output_folder(args.out) if args.out else None
+    loaded.append(load_job(args.job))
+    job = loaded[0]
+    options = VerifyOptions(args.point, args.gouge_tolerance_mm, args.leftover_tolerance_mm)
+    options.validate()
+    dialect = args.dialect or job.post.dialect
+    programs = []
+    for name in args.programs:
+        path = Path(name)
+        try:
+            if path.stat().st_size > MAX_PROGRAM_BYTES:
+                raise SpurCadError(f"{name}: larger than {MAX_PROGRAM_BYTES // 2**20} MiB")
+            text = path.read_text(encoding="utf-8")
+        except FileNotFoundError:
+            raise SpurCadError(f"{name}: program not found") from None
+        except UnicodeDecodeError as exc:
+            raise SpurCadError(f"{name}: not a text file (byte {exc.start} is not UTF-8)") from None
+        except OSError as exc:
+            raise SpurCadError(f"{name}: cannot read: {exc.strerror or exc}") from None
+        programs.append(read_program(text, dialect, name))
+        _checkpoint(received)
+    result = verify_moves(job, programs, options, progress=lambda fraction: _checkpoint(received))
+    if dialect == "linuxcnc":
+        result = dataclasses.replace(result, rs274={name: rs274_verdict(name) for name in args.programs})
+    lines = result.lines() + [f"rs274 {name}: {verdict}" for name, verdict in result.rs274.items()]
+    for line in (lines if not args.quiet else lines[-1 - len(result.rs274):]):
+        print(line)
+    if out_dir is not None:
+        _checkpoint(received)
+        try:
+            write_output_set(out_dir, result_files(result))
+        except OSError as exc:
+            raise SpurCadError(f"cannot write to {out_dir}: {exc.strerror or exc}") from None
+    rs274_failed = any(verdict.startswith("failed") for verdict in result.rs274.values())
+    return 0 if result.passed and not rs274_failed else 1
+
+
 def _main(argv: list[str] | None, received: list[int]) -> int:
     args = _parser().parse_args(argv)
     if not getattr(args, "debug", False):
@@ -162,6 +228,8 @@ def _main(argv: list[str] | None, received: list[int]) -> int:
         return _install_freecad(args.uninstall)
     loaded: list = []
     try:
+        if args.command == "verify":
+            return _verify(args, received, loaded)
         paths = _run(args, received, loaded)
     except SpurCadError as exc:
         message = loaded[0].located(exc) if loaded and exc.section else str(exc)

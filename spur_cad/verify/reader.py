@@ -1,0 +1,388 @@
+"""Read a G-code program from anywhere into the moves a controller would make (for `spur-cad verify`).
+
+Reads the five dialects spur_cad writes, with their folded forms, and plain hand-written or legacy
+programs in the same dialects:
+
+- LinuxCNC: `oN sub` / `oN endsub`, `oN call [a] [b] ...` (arguments to #1, #2, ...), `oN repeat [n]` /
+  `oN endrepeat`, `#n` and `[#n+c]` values;
+- Fanuc: subprograms `O<n> ... M99` after M30, `M98 P<n> [L<count>]`, macro calls `G65 P<n> <letter
+  arguments>` (A -> #1, B -> #2, C -> #3, I -> #4, ..., X -> #24, Y -> #25, Z -> #26, Fanuc's argument
+  specification I), `#n` variables;
+- Haas: as Fanuc, and local subprograms `M97 P<n>` jumping to block N<n> after M30;
+- Siemens 840D: `R<n>=value` parameters, labels `NAME:` and `REPEAT L1 L2 P=n`, `A=R2+1.5` expressions,
+  `;` comments;
+- Okuma OSP: subprograms `O<n> ... RTS`, `CALL O<n> NAME=value ...` with named variables, `A=NAME-1.5`.
+
+Modal motion (G0 / G1 stay in effect, so bare axis words move), one axis per block, G93 inverse time
+and G94, F, T/M6, S. Rotary direction: in a block with M15 (positive) or M16 (negative), A is an angle
+in [0, 360) reached turning that way (Okuma); elsewhere A is the absolute, unwound axis. Anything this
+reader does not execute (incremental G91, arcs, other plane or unit codes, unknown M codes, macro
+statements) is an error naming the file and line, never a silent skip.
+"""
+
+from __future__ import annotations
+
+import math
+import re
+from dataclasses import dataclass
+
+import numpy as np
+
+from spur_cad.errors import SpurCadError
+
+DIALECTS = ("linuxcnc", "fanuc", "haas", "siemens", "okuma")
+MAX_PROGRAM_BYTES = 256 * 1024 * 1024
+MAX_MOVES = 20_000_000  # about 1 GB of move arrays: refuse before reading further
+MAX_CALL_DEPTH = 8
+MAX_REPEAT = 100_000
+
+# Fanuc's argument specification I: the letter of a G65 argument -> the local variable it sets.
+FANUC_ARGUMENTS = {"A": 1, "B": 2, "C": 3, "I": 4, "J": 5, "K": 6, "D": 7, "E": 8, "F": 9, "H": 11, "M": 13,
+                   "Q": 17, "R": 18, "S": 19, "T": 20, "U": 21, "V": 22, "W": 23, "X": 24, "Y": 25, "Z": 26}
+# Codes that set up the machine without moving it; anything else is refused.
+SETUP_G = {"17", "21", "40", "49", "54", "55", "56", "57", "58", "59", "64", "71", "80", "90", "43", "61"}
+QUIET_M = {"0", "1", "3", "4", "5", "7", "8", "9", "10", "11", "2", "30", "6", "68", "69", "15", "16"}
+
+
+class ProgramReadError(SpurCadError):
+    """A program this reader cannot execute: the message names the file, the line and what is wrong."""
+
+
+@dataclass(frozen=True)
+class ProgramMoves:
+    """The moves a program commands, in program order (arrays of equal length).
+
+    `line` is the 1-based source line of each move; `tool` the tool number in the spindle (0: none yet).
+    """
+
+    source: str
+    rapid: np.ndarray  # bool
+    x: np.ndarray
+    y: np.ndarray
+    z: np.ndarray
+    a: np.ndarray  # degrees, unwound
+    feed: np.ndarray  # mm/min, or 1/min under inverse time; NaN for rapids
+    inverse_time: np.ndarray  # bool
+    line: np.ndarray  # int
+    tool: np.ndarray  # int
+    spindle_rpm: np.ndarray
+
+    def __len__(self) -> int:
+        return len(self.x)
+
+
+@dataclass
+class _Line:
+    number: int  # 1-based line in the file
+    text: str  # without comments and block number
+
+
+_UNSIGNED = r"(?:\d+\.?\d*|\.\d+)"
+_TERM = re.compile(rf"\s*([-+]?)\s*(#\d+|R\d+|[A-Z_][A-Z0-9_]*|{_UNSIGNED})\s*")
+
+
+class _Reader:
+    """Executes one program: machine state, variables, subprogram calls, recorded moves."""
+
+    def __init__(self, text: str, dialect: str, source: str):
+        self.dialect, self.source = dialect, source
+        self.lines = _clean_lines(text, dialect)
+        self.variables: dict[str, float] = {}
+        self.pose = [math.nan, math.nan, math.nan, math.nan]
+        self.motion: str | None = None
+        self.inverse = False
+        self.feed = math.nan
+        self.tool = 0
+        self.pending_tool = 0
+        self.spindle = 0.0
+        self.moves: list[tuple] = []
+        self.ended = False
+        self.subs: dict[str, tuple[int, int]] = {}
+        self.labels: dict[str, int] = {}
+
+    def error(self, line: _Line, message: str) -> ProgramReadError:
+        return ProgramReadError(f"{self.source}:{line.number}: {message} (in {line.text!r})")
+
+    # --- structure ------------------------------------------------------------------------
+    def index_structure(self) -> int:
+        """Find subprograms and labels; returns the index where the main program ends (exclusive)."""
+        lines = self.lines
+        end = next((i for i, line in enumerate(lines) if re.fullmatch(r"M0?(30|2)", line.text)), None)
+        if end is None:
+            raise ProgramReadError(f"{self.source}: no end of program (M30 or M2)")
+        for i, line in enumerate(lines):
+            if self.dialect == "linuxcnc":
+                found = re.fullmatch(r"O(\d+) SUB", line.text)
+                if found:
+                    self.subs[found.group(1)] = (i + 1, self._closing(i, f"O{found.group(1)} ENDSUB"))
+            elif self.dialect == "siemens" and re.fullmatch(r"[A-Z_][A-Z0-9_]*:", line.text):
+                self.labels[line.text[:-1]] = i
+        if self.dialect in ("fanuc", "haas", "okuma"):
+            i = end + 1
+            while i < len(lines):
+                head = re.fullmatch(r"O(\d+)|N(\d+)", lines[i].text)
+                if head is None:
+                    raise self.error(lines[i], "a block after the end of the program that is not a subprogram")
+                close = "RTS" if self.dialect == "okuma" else "M99"
+                j = self._closing(i, close)
+                self.subs[head.group(1) or head.group(2)] = (i + 1, j)
+                i = j + 1
+        return end
+
+    def _closing(self, start: int, text: str) -> int:
+        for j in range(start + 1, len(self.lines)):
+            if self.lines[j].text == text:
+                return j
+        raise self.error(self.lines[start], f"no {text} closes this subprogram")
+
+    # --- values -----------------------------------------------------------------------------
+    def value(self, text: str, line: _Line) -> float:
+        """A number, a variable, or a sum of them: '12.5', '#2', '[#2+2.5]', 'R2+2.5', 'ASP-23.9'."""
+        text = text.strip()
+        if text.startswith("[") and text.endswith("]"):
+            text = text[1:-1]
+        total, position = 0.0, 0
+        while position < len(text):
+            found = _TERM.match(text, position)
+            if found is None or found.end() == position:
+                raise self.error(line, f"cannot evaluate {text!r}")
+            sign, term = found.groups()
+            if term[0].isdigit() or term[0] == ".":
+                number = float(term)
+            elif term not in self.variables:
+                raise self.error(line, f"variable {term} is used before it is set")
+            else:
+                number = self.variables[term]
+            total += -number if sign == "-" else number
+            position = found.end()
+        if not math.isfinite(total) or abs(total) > 1e6:
+            raise self.error(line, f"value {text!r} = {total:g} is not a finite coordinate")
+        return total
+
+    # --- execution ------------------------------------------------------------------------------
+    def run(self) -> ProgramMoves:
+        end = self.index_structure()
+        self.execute(0, end + 1, 0)
+        if not self.ended:
+            raise ProgramReadError(f"{self.source}: the program never reaches its end (M30 or M2)")
+        columns = list(zip(*self.moves)) if self.moves else [[]] * 10
+        return ProgramMoves(self.source, np.array(columns[0], bool), *(np.array(c, float) for c in columns[1:6]),
+                            np.array(columns[6], bool), np.array(columns[7], int), np.array(columns[8], int),
+                            np.array(columns[9], float))
+
+    def execute(self, start: int, stop: int, depth: int) -> None:
+        if depth > MAX_CALL_DEPTH:
+            raise self.error(self.lines[start], f"subprogram calls nested deeper than {MAX_CALL_DEPTH}")
+        i = start
+        while i < stop and not self.ended:
+            line = self.lines[i]
+            i += 1
+            jump = self.control(line, i, depth)
+            if jump is not None:
+                i = jump
+                continue
+            self.block(line)
+
+    def control(self, line: _Line, after: int, depth: int) -> int | None:
+        """Subprogram definitions, calls, repeats and labels; the index to go on at, or None for a block."""
+        text = line.text
+        if self.dialect == "linuxcnc":
+            return self._linuxcnc_control(line, after, depth)
+        if self.dialect == "siemens":
+            if re.fullmatch(r"[A-Z_][A-Z0-9_]*:", text):
+                return after
+            found = re.fullmatch(r"REPEAT ([A-Z_][A-Z0-9_]*) ([A-Z_][A-Z0-9_]*)(?: P=(\d+))?", text)
+            if found:
+                first, last = (self.labels.get(found.group(k)) for k in (1, 2))
+                if first is None or last is None or last <= first:
+                    raise self.error(line, "REPEAT names labels that do not enclose a section")
+                for _ in range(self._count(found.group(3), line)):
+                    self.execute(first + 1, last, depth + 1)
+                return after
+            if re.fullmatch(r"(R\d+=\S+\s*)+", text):
+                for name, value in re.findall(r"(R\d+)=(\S+)", text):
+                    self.variables[name] = self.value(value, line)
+                return after
+            return None
+        return self._fanuc_family_control(line, after, depth)
+
+    def _count(self, text: str | None, line: _Line) -> int:
+        count = int(text) if text else 1
+        if not 0 <= count <= MAX_REPEAT:
+            raise self.error(line, f"repeat count {count} outside 0..{MAX_REPEAT}")
+        return count
+
+    def _call(self, name: str, line: _Line, depth: int, count: int = 1) -> None:
+        if name not in self.subs:
+            raise self.error(line, f"calls subprogram {name}, which the program does not define")
+        first, last = self.subs[name]
+        for _ in range(count):
+            self.execute(first, last, depth + 1)
+
+    def _linuxcnc_control(self, line: _Line, after: int, depth: int) -> int | None:
+        text = line.text
+        found = re.fullmatch(r"O(\d+) SUB", text)
+        if found:
+            return self.subs[found.group(1)][1] + 1  # a definition: skipped in the flow
+        found = re.fullmatch(r"O(\d+) CALL((?:\s*\[[^\]]*\])*)", text)
+        if found:
+            for index, argument in enumerate(re.findall(r"\[([^\]]*)\]", found.group(2)), start=1):
+                self.variables[f"#{index}"] = self.value(argument, line)
+            self._call(found.group(1), line, depth)
+            return after
+        found = re.fullmatch(r"O(\d+) REPEAT \[([^\]]*)\]", text)
+        if found:
+            close = self._closing(after - 1, f"O{found.group(1)} ENDREPEAT")
+            for _ in range(self._count(str(int(self.value(found.group(2), line))), line)):
+                self.execute(after, close, depth + 1)
+            return close + 1
+        found = re.fullmatch(r"(#\d+)\s*=\s*(.+)", text)
+        if found:
+            self.variables[found.group(1)] = self.value(found.group(2), line)
+            return after
+        return None
+
+    def _fanuc_family_control(self, line: _Line, after: int, depth: int) -> int | None:
+        text = line.text
+        if re.fullmatch(r"O\d+", text) or text == "%":
+            return after  # the program's own number (its title was a comment)
+        found = re.fullmatch(r"(#\d+)\s*=\s*(.+)", text)
+        if found:
+            self.variables[found.group(1)] = self.value(found.group(2), line)
+            return after
+        if self.dialect == "okuma":
+            found = re.fullmatch(r"CALL O(\d+)((?:\s+[A-Z][A-Z0-9]*=\S+)*)", text)
+            if found:
+                for name, value in re.findall(r"([A-Z][A-Z0-9]*)=(\S+)", found.group(2)):
+                    self.variables[name] = self.value(value, line)
+                self._call(found.group(1), line, depth)
+                return after
+            return None
+        found = re.fullmatch(r"G65 P(\d+)((?:\s*[A-Z]\s*\S+)*)", text)
+        if found:
+            for letter, value in re.findall(r"([A-Z])\s*([^\sA-Z]+)", found.group(2)):
+                if letter not in FANUC_ARGUMENTS:
+                    raise self.error(line, f"G65 argument {letter} has no local variable")
+                self.variables[f"#{FANUC_ARGUMENTS[letter]}"] = self.value(value, line)
+            self._call(found.group(1), line, depth)
+            return after
+        found = re.fullmatch(r"M9([78]) P(\d+)(?: L(\d+))?", text)
+        if found:
+            if found.group(1) == "7" and self.dialect != "haas":
+                raise self.error(line, "M97 (local subprogram) is a Haas code")
+            self._call(found.group(2), line, depth, self._count(found.group(3), line))
+            return after
+        return None
+
+    # --- one block --------------------------------------------------------------------------------
+    def block(self, line: _Line) -> None:
+        words = self.words(line)
+        target = list(self.pose)
+        direction = None
+        for letter, value in words:
+            if letter == "G":
+                self._g_code(value, line)
+            elif letter == "M":
+                direction = self._m_code(value, line) or direction
+            elif letter in "XYZ":
+                target["XYZ".index(letter)] = self.value(value, line)
+            elif letter == "A":
+                target[3] = self.value(value, line)
+            elif letter == "F":
+                self.feed = self.value(value, line)
+            elif letter == "T":
+                self.pending_tool = int(self.value(value, line))
+            elif letter == "S":
+                self.spindle = self.value(value, line)
+            elif letter in "HDP" or (letter == "N" and self.dialect == "siemens"):
+                continue  # tool offset numbers, G64 P tolerance
+            else:
+                raise self.error(line, f"word {letter}{value} is not supported by this reader")
+        if direction is not None and not math.isnan(target[3]) and target[3] != self.pose[3]:
+            target[3] = _directed(self.pose[3], target[3], direction, self, line)
+        if any(letter in "XYZA" for letter, _ in words):
+            self._move(target, line)
+
+    def words(self, line: _Line) -> list[tuple[str, str]]:
+        text = line.text
+        pattern = (r"([A-Z])\s*(=\s*[^\s]+|\[[^\]]*\]|#\d+|[-+]?(?:\d+\.?\d*|\.\d+))"
+                   if self.dialect in ("siemens", "okuma") else
+                   r"([A-Z])\s*(\[[^\]]*\]|#\d+|[-+]?(?:\d+\.?\d*|\.\d+))")
+        found = list(re.finditer(pattern, text))
+        covered = "".join(text[m.start():m.end()] for m in found)
+        if re.sub(r"\s", "", covered) != re.sub(r"\s", "", text):
+            raise self.error(line, "cannot read this block")
+        return [(m.group(1), m.group(2).lstrip("=").strip()) for m in found]
+
+    def _g_code(self, value: str, line: _Line) -> None:
+        code = value.lstrip("0") or "0"
+        if code in ("0", "1"):
+            self.motion = code
+        elif code == "93":
+            self.inverse = True
+        elif code == "94":
+            self.inverse = False
+        elif code not in SETUP_G:
+            raise self.error(line, f"G{value} is not supported by this reader (it reads G0/G1 moves, G90, G93/G94)")
+
+    def _m_code(self, value: str, line: _Line) -> str | None:
+        code = value.lstrip("0") or "0"
+        if code in ("30", "2"):
+            self.ended = True
+        elif code == "6":
+            self.tool = self.pending_tool
+        elif code in ("15", "16"):
+            return code
+        elif code not in QUIET_M:
+            raise self.error(line, f"M{value} is not supported by this reader")
+        return None
+
+    def _move(self, target: list[float], line: _Line) -> None:
+        if self.motion is None:
+            raise self.error(line, "an axis word before any G0 or G1")
+        if any(math.isnan(t) for t in target):
+            missing = "".join(axis for axis, t in zip("XYZA", target) if math.isnan(t))
+            raise self.error(line, f"the first move must give every axis ({missing} unknown)")
+        rapid = self.motion == "0"
+        if not rapid and not (math.isfinite(self.feed) and self.feed > 0.0):
+            raise self.error(line, "a feed move without a positive F")
+        if len(self.moves) >= MAX_MOVES:
+            raise self.error(line, f"the program has more than {MAX_MOVES:,} moves; split it")
+        self.moves.append((rapid, *target, math.nan if rapid else self.feed, self.inverse and not rapid,
+                           line.number, self.tool, self.spindle))
+        self.pose = target
+
+
+def _directed(current: float, target: float, direction: str, reader: _Reader, line: _Line) -> float:
+    """The unwound A reached from `current` turning positively (M15) or negatively (M16) to the angle `target`
+    in [0, 360)."""
+    if not 0.0 <= target < 360.0:
+        raise reader.error(line, f"with M{direction}, A must be an angle in [0, 360), got {target:g}")
+    if math.isnan(current):
+        return target
+    step = (target - current) % 360.0
+    return current + step if direction == "15" else current - ((360.0 - step) % 360.0)
+
+
+def _clean_lines(text: str, dialect: str) -> list[_Line]:
+    """Lines without comments, block numbers and surrounding blanks; upper case (LinuxCNC's o-words too)."""
+    lines = []
+    for number, raw in enumerate(text.splitlines(), start=1):
+        line = raw.split(";", 1)[0] if dialect == "siemens" else re.sub(r"\([^)]*\)", "", raw)
+        if dialect == "linuxcnc":
+            line = line.split(";", 1)[0]
+        line = line.strip().upper()
+        if dialect != "haas" or not re.fullmatch(r"N\d+", line):  # Haas's N<n> heads a local subprogram
+            line = re.sub(r"^N\d+\s*", "", line)
+        if line and line != "%":  # % delimits Fanuc/Haas programs (tape start and end)
+            lines.append(_Line(number, line))
+    return lines
+
+
+def read_program(text: str, dialect: str, source: str = "program") -> ProgramMoves:
+    """The moves of a program in `dialect` (one of DIALECTS); raises ProgramReadError naming `source`'s line."""
+    if dialect not in DIALECTS:
+        raise ProgramReadError(f"unknown dialect {dialect!r} (known: {', '.join(DIALECTS)})")
+    if len(text) > MAX_PROGRAM_BYTES:
+        raise ProgramReadError(f"{source}: larger than {MAX_PROGRAM_BYTES // 2**20} MiB")
+    return _Reader(text, dialect, source).run()

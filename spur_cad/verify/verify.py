@@ -1,0 +1,202 @@
+"""`spur-cad verify`: cut the job's stock with G-code programs from anywhere and judge the part.
+
+The programs are read as a controller would (spur_cad.verify.reader), each move goes to the
+simulator with the job's tool of the number in the spindle, and the deviations of the design
+points are reported per tooth space, feature and finishing station, with a deviation map. A
+program passes when no point is gouged by more than the gouge tolerance (default: the simulation's
+resolution, its own error) and none is left more than the leftover tolerance above the design
+(default: the finishing target scallop plus the resolution).
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from spur_cad.cam.ir import Feature, MoveKind, Operation, Toolpath
+from spur_cad.errors import SpurCadError
+from spur_cad.verify.reader import ProgramMoves
+
+POINTS = ("tip", "corner-centre")
+
+
+@dataclass(frozen=True)
+class VerifyOptions:
+    """How to read and judge: the programmed point, the tolerances (None: the defaults above)."""
+
+    point: str = "tip"  # "corner-centre": Z is programmed at the tool's corner-radius centre
+    gouge_tolerance_mm: float | None = None
+    leftover_tolerance_mm: float | None = None
+
+    def validate(self) -> None:
+        if self.point not in POINTS:
+            raise SpurCadError(f"--point must be one of {', '.join(POINTS)}, got {self.point!r}")
+        for name in ("gouge_tolerance_mm", "leftover_tolerance_mm"):
+            value = getattr(self, name)
+            if value is not None and not (math.isfinite(value) and 0.0 <= value <= 10.0):
+                raise SpurCadError(f"--{name.replace('_', '-')} must be in [0, 10] mm, got {value:g}")
+
+
+@dataclass(frozen=True)
+class SpaceVerdict:
+    """One tooth space: its largest gouge and leftover (mm, >= 0) and where they are."""
+
+    space: int
+    max_gouge_mm: float
+    max_leftover_mm: float
+    worst_gouge: dict
+    worst_leftover: dict
+
+
+@dataclass(frozen=True)
+class VerifyResult:
+    """The verdict: per space, overall, the tolerances used, and the rs274 verdicts of LinuxCNC programs."""
+
+    spaces: tuple[SpaceVerdict, ...]
+    max_gouge_mm: float
+    max_leftover_mm: float
+    gouge_tolerance_mm: float
+    leftover_tolerance_mm: float
+    moves: int
+    seconds: float
+    rs274: dict = field(default_factory=dict)
+    deviation_map: str = ""
+
+    @property
+    def passed(self) -> bool:
+        return self.max_gouge_mm <= self.gouge_tolerance_mm and self.max_leftover_mm <= self.leftover_tolerance_mm
+
+    def summary(self) -> dict:
+        """The verdict as JSON-ready data (verify.json)."""
+        return {"passed": self.passed, "max_gouge_mm": self.max_gouge_mm, "max_leftover_mm": self.max_leftover_mm,
+                "gouge_tolerance_mm": self.gouge_tolerance_mm, "leftover_tolerance_mm": self.leftover_tolerance_mm,
+                "moves": self.moves, "seconds": round(self.seconds, 3), "rs274": self.rs274,
+                "spaces": [vars(space) for space in self.spaces]}
+
+    def lines(self) -> list[str]:
+        """The verdict for people: one line per space beyond tolerance, then the overall line."""
+        out = []
+        for space in self.spaces:
+            for kind, value, tolerance, worst in (("gouge", space.max_gouge_mm, self.gouge_tolerance_mm,
+                                                   space.worst_gouge),
+                                                  ("leftover", space.max_leftover_mm, self.leftover_tolerance_mm,
+                                                   space.worst_leftover)):
+                if value > tolerance:
+                    station = f", station {worst['station']}" if worst["station"] >= 0 else ""
+                    out.append(f"space {space.space}: {kind} {value * 1000:.1f} um at X {worst['x_mm']:.3f} mm, "
+                               f"{worst['feature']}{station} (tolerance {tolerance * 1000:.1f} um)")
+        verdict = "PASS" if self.passed else "FAIL"
+        out.append(f"{verdict}: max gouge {self.max_gouge_mm * 1000:.1f} um (tolerance "
+                   f"{self.gouge_tolerance_mm * 1000:.1f}), max leftover {self.max_leftover_mm * 1000:.1f} um "
+                   f"(tolerance {self.leftover_tolerance_mm * 1000:.1f}), {len(self.spaces)} spaces, {self.moves:,} "
+                   "moves")
+        return out
+
+
+def toolpaths(moves: ProgramMoves, tools: dict, roughing_number: int | None, point: str) -> list:
+    """(Toolpath, Tool) per run of moves with one tool in the spindle; the job's `tools` by tool number."""
+    from spur_cad.sim.simulate import Cut
+
+    cuts = []
+    if len(moves) == 0:
+        return cuts
+    change = np.nonzero(np.diff(moves.tool))[0] + 1
+    for begin, end in zip(np.concatenate([[0], change]), np.concatenate([change, [len(moves)]])):
+        number = int(moves.tool[begin])
+        if number == 0:
+            raise SpurCadError(f"{moves.source}:{int(moves.line[begin])}: a move before any tool is loaded "
+                               "(T<number> M6)")
+        if number not in tools:
+            known = ", ".join(f"T{n}" for n in sorted(tools)) or "none"
+            raise SpurCadError(f"{moves.source}:{int(moves.line[begin])}: moves with tool T{number}, which the job "
+                               f"does not have (its tools: {known}; the job's [tools.*] tool_number)")
+        tool = tools[number]
+        part = slice(begin, end)
+        z = moves.z[part] - (tool.effective_corner_radius_mm if point == "corner-centre" else 0.0)
+        count = end - begin
+        path = Toolpath(
+            kind=np.where(moves.rapid[part], MoveKind.RAPID, MoveKind.LINEAR).astype(np.int8),
+            x=moves.x[part].copy(), y=moves.y[part].copy(), z=z, a=moves.a[part].copy(),
+            feed=moves.feed[part].copy(), inverse_time=moves.inverse_time[part].copy(),
+            space=np.full(count, -1, np.int32), station=np.full(count, -1, np.int32),
+            feature=np.full(count, Feature.NONE, np.int8),
+            operation=Operation.ROUGHING if number == roughing_number else Operation.FINISHING,
+            tool_number=number, spindle_rpm=float(moves.spindle_rpm[begin]))
+        cuts.append(Cut(path, tool))
+    return cuts
+
+
+def station_positions(path: Toolpath) -> np.ndarray:
+    """X of transverse finishing stations: feed moves in Y, Z or A that keep X (rows are added there)."""
+    start = path.start_poses()
+    feed = path.kind == MoveKind.LINEAR
+    transverse = (path.x == start[:, 0]) & ((path.y != start[:, 1]) | (path.a != start[:, 3]))
+    return np.unique(np.round(path.x[feed & transverse], 6))
+
+
+def _where(result, k: int, flat_index: int, rows: np.ndarray, names: list[str]) -> dict:
+    j, r = np.unravel_index(flat_index, result.deviation[k][:, rows].shape)
+    row = np.nonzero(rows)[0][r]
+    return {"feature": names[j], "point": int(j), "x_mm": float(result.grid.rows_x[row]),
+            "station": int(result.station_of_row()[row])}
+
+
+def space_verdicts(result) -> tuple[SpaceVerdict, ...]:
+    """The largest gouge and leftover of each tooth space inside the face width, and where they are."""
+    rows, names = result.gear_rows, result.grid.feature_names()
+    verdicts = []
+    for k in range(result.deviation.shape[0]):
+        dev = result.deviation[k][:, rows]
+        verdicts.append(SpaceVerdict(k, float(max(0.0, -dev.min())), float(max(0.0, dev.max())),
+                                     _where(result, k, int(np.argmin(dev)), rows, names),
+                                     _where(result, k, int(np.argmax(dev)), rows, names)))
+    return tuple(verdicts)
+
+
+def deviation_map_csv(result) -> str:
+    """Per space, feature and row of the face width: the smallest and largest deviation (um)."""
+    rows = np.nonzero(result.gear_rows)[0]
+    names = result.grid.feature_names()
+    features = list(dict.fromkeys(names))
+    lines = ["space,feature,x_mm,min_deviation_um,max_deviation_um"]
+    for k in range(result.deviation.shape[0]):
+        for feature in features:
+            mask = np.array([name == feature for name in names])
+            block = result.deviation[k][mask][:, rows] * 1000.0
+            lows, highs = block.min(axis=0), block.max(axis=0)
+            lines += [f"{k},{feature},{result.grid.rows_x[r]:.4f},{lo:.2f},{hi:.2f}"
+                      for r, lo, hi in zip(rows, lows, highs)]
+    return "\n".join(lines) + "\n"
+
+
+def verify_moves(job, programs: list[ProgramMoves], options: VerifyOptions = VerifyOptions(),
+                 progress=None) -> VerifyResult:
+    """Simulate the job's stock cut by `programs` in order and judge the part (see the module docstring)."""
+    from spur_cad.pipeline import job_stock
+    from spur_cad.sim.simulate import SimSettings, simulate
+
+    options.validate()
+    tools = {tool.tool_number: tool for tool in (job.tools.roughing, job.tools.finishing) if tool is not None}
+    roughing_number = job.tools.roughing.tool_number if job.tools.roughing is not None else None
+    cuts = [cut for moves in programs for cut in toolpaths(moves, tools, roughing_number, options.point)]
+    if not cuts:
+        raise SpurCadError("the programs have no moves to verify")
+    finishing = [cut.path for cut in cuts if cut.path.operation == Operation.FINISHING]
+    stations = np.unique(np.concatenate([station_positions(path) for path in finishing])) if finishing else None
+    resolution = job.simulation.resolution_mm
+    result = simulate(job.gear, job_stock(job), cuts, SimSettings(resolution_mm=resolution),
+                      station_x=stations, progress=progress)
+    gouge_tol = options.gouge_tolerance_mm if options.gouge_tolerance_mm is not None else resolution
+    leftover_tol = (options.leftover_tolerance_mm if options.leftover_tolerance_mm is not None
+                    else job.finishing.target_scallop_mm + resolution)
+    return VerifyResult(space_verdicts(result), result.max_gouge_mm, result.max_leftover_mm, gouge_tol, leftover_tol,
+                        sum(len(moves) for moves in programs), result.seconds, deviation_map=deviation_map_csv(result))
+
+
+def result_files(result: VerifyResult) -> dict[str, bytes]:
+    """The output set of a verification: verify.json and deviation_map.csv."""
+    return {"verify.json": (json.dumps(result.summary(), indent=2) + "\n").encode(),
+            "deviation_map.csv": result.deviation_map.encode()}

@@ -1,0 +1,263 @@
+"""`spur-cad verify` (issue 17, first part): programs from anywhere read as a controller would, simulated with
+the job's tools, judged per tooth space.
+
+References independent of the reader: the toolpath IR the posts wrote from (every dialect, flat and folded),
+LinuxCNC's own interpreter rs274, and planted faults of known place and size."""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+import math
+import re
+
+import numpy as np
+import pytest
+
+from spur_cad.cam.ir import Feature, MoveKind
+from spur_cad.cli import main
+from spur_cad.job import parse_job
+from spur_cad.pipeline import build_programs, plan_cam
+from spur_cad.post import ProgramInfo, post_program
+from spur_cad.verify.reader import DIALECTS, ProgramReadError, read_program
+from tests.workbench_helper import small_job_text
+
+SIM = "\n[simulation]\nresolution_mm = 0.02\n"
+RESOLUTION = 0.02
+
+
+def _job_text(strategy: str = "generating", resolution_mm: float = RESOLUTION) -> str:
+    text = small_job_text() + SIM.replace(str(RESOLUTION), str(resolution_mm))
+    return text if strategy == "generating" else text.replace("step_over_mm = 1.5", "step_over_mm = 1.5\n"
+                                                              f"strategy = \"{strategy}\"")
+
+
+@pytest.fixture(scope="module")
+def small():
+    job = parse_job(_job_text(), "small.toml")
+    return job, plan_cam(job)
+
+
+def _programs(job, plan, dialect: str, folded: bool) -> dict[str, bytes]:
+    posted = dataclasses.replace(job, post=dataclasses.replace(job.post, dialect=dialect, folded=folded))
+    return build_programs(posted, plan)[1]
+
+
+def _distinct_motion(path) -> np.ndarray:
+    poses = path.poses()[path.motion_mask]
+    keep = np.concatenate([[True], np.any(np.abs(np.diff(poses, axis=0)) > 1e-9, axis=1)])
+    return poses[keep], path.inverse_time[path.motion_mask][keep], path.kind[path.motion_mask][keep]
+
+
+@pytest.mark.parametrize("folded", [True, False], ids=["folded", "flat"])
+@pytest.mark.parametrize("dialect", DIALECTS)
+def test_the_reader_reproduces_the_toolpath_the_post_wrote(small, dialect, folded):
+    job, plan = small
+    for name, data in _programs(job, plan, dialect, folded).items():
+        planned = getattr(plan, name.split(".")[0])
+        moves = read_program(data.decode(), dialect, name)
+        poses, inverse, kind = _distinct_motion(planned.toolpath)
+        read = np.column_stack([moves.x, moves.y, moves.z, moves.a])
+        assert read.shape == poses.shape, name
+        assert np.abs(read - poses).max() <= 0.0006  # the dialects write 3 or 4 decimals
+        assert np.array_equal(moves.rapid, kind == MoveKind.RAPID)
+        assert np.array_equal(moves.inverse_time, inverse & (kind != MoveKind.RAPID))
+        assert set(moves.tool.tolist()) == {planned.toolpath.tool_number}
+
+
+@pytest.mark.linuxcnc
+def test_the_reader_agrees_with_linuxcncs_interpreter(small, rs274, tmp_path):
+    from tests.rs274_helper import canon_args, run_rs274
+
+    job, plan = small
+    for name, data in _programs(job, plan, "linuxcnc", True).items():
+        program = tmp_path / name
+        program.write_bytes(data)
+        ok, canon, messages = run_rs274(program)
+        assert ok, messages
+        ends = np.array([canon_args(line)[:4] for line in canon if line.startswith(("STRAIGHT_FEED",
+                                                                                      "STRAIGHT_TRAVERSE"))])
+        moves = read_program(data.decode(), "linuxcnc", name)
+        read = np.column_stack([moves.x, moves.y, moves.z, moves.a])
+        assert len(ends) == len(read) and np.abs(ends - read).max() < 1e-9
+
+
+def _verify(tmp_path, job_text: str, programs: dict[str, bytes], *extra: str) -> tuple[int, dict]:
+    tmp_path.mkdir(parents=True, exist_ok=True)
+    job_file = tmp_path / "job.toml"
+    job_file.write_text(job_text)
+    names = []
+    for name, data in programs.items():
+        (tmp_path / name).write_bytes(data)
+        names.append(str(tmp_path / name))
+    out = tmp_path / "verify_out"
+    code = main(["verify", str(job_file), *names, "--out", str(out), "--quiet", *extra])
+    return code, json.loads((out / "verify.json").read_text()) if (out / "verify.json").exists() else {}
+
+
+@pytest.mark.parametrize("dialect", ["linuxcnc", "okuma"])
+def test_spur_cads_own_programs_verify_clean(small, tmp_path, dialect, capsys):
+    job, plan = small
+    code, result = _verify(tmp_path, _job_text().replace("[job]", f"[post]\ndialect = \"{dialect}\"\n\n[job]"),
+                           _programs(job, plan, dialect, True))
+    assert code == 0 and result["passed"], result
+    assert result["max_gouge_mm"] <= RESOLUTION and len(result["spaces"]) == 12
+    assert capsys.readouterr().out.strip().splitlines()[0].startswith("PASS: ")
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("folded", [True, False], ids=["folded", "flat"])
+@pytest.mark.parametrize("dialect", DIALECTS)
+def test_spur_cads_own_programs_verify_clean_in_every_dialect(small, tmp_path, dialect, folded):
+    job, plan = small
+    code, result = _verify(tmp_path, _job_text(), _programs(job, plan, dialect, folded), "--dialect", dialect)
+    assert code == 0 and result["passed"], result
+
+
+def _post(path, dialect: str = "linuxcnc") -> bytes:
+    from spur_cad.post.settings import PostSettings
+
+    return post_program(path, PostSettings(dialect=dialect, folded=False), ProgramInfo("test", ())).text.encode()
+
+
+def test_a_block_moved_20_um_into_a_flank_is_found_at_its_space_and_size(small, tmp_path):
+    job, plan = small
+    path = plan.finishing.toolpath
+    # finishing by generation: a flank pass runs with the rack flank's plane vertical, so its normal is Y
+    target = (path.space == 3) & (path.feature == Feature.RIGHT_FLANK)
+    first_pass = np.nonzero(target)[0]
+    assert len(first_pass)
+    found = []
+    fine = 0.005  # the simulation's resolution here: a 20 um fault measured within 5 um
+    for shift in (-0.02, 0.02):
+        moved = path.replace(y=np.where(target, path.y + shift, path.y))
+        code, result = _verify(tmp_path / f"s{shift}", _job_text(resolution_mm=fine),
+                               {"roughing.ngc": _post(plan.roughing.toolpath), "finishing.ngc": _post(moved)})
+        found.append((code, result))
+    code, result = max(found, key=lambda item: item[1]["max_gouge_mm"])
+    assert code == 1 and not result["passed"]
+    worst = max(result["spaces"], key=lambda s: s["max_gouge_mm"])
+    # the pass's side gouges the right involute, its corner the right fillet below it: both 20 um deep
+    assert worst["space"] == 3 and worst["worst_gouge"]["feature"] in ("right involute", "right fillet")
+    assert abs(worst["max_gouge_mm"] - 0.02) <= fine
+    others = [s["max_gouge_mm"] for s in result["spaces"] if s["space"] != 3]
+    assert max(others) <= fine
+
+
+def _map(folder) -> dict[tuple[int, str, float], float]:
+    """deviation_map.csv as {(space, feature, x): largest deviation (um)}."""
+    lines = (folder / "verify_out" / "deviation_map.csv").read_text().splitlines()[1:]
+    return {(int(k), feature, float(x)): float(high) for k, feature, x, _, high in (line.split(",") for line in lines)}
+
+
+def test_a_missing_station_is_found_at_its_space_and_x(tmp_path):
+    job = parse_job(_job_text("perimeter"), "p.toml")
+    plan = plan_cam(job)
+    path = plan.finishing.toolpath
+    stations = np.unique(path.station[path.station >= 0])
+    missing = int(stations[len(stations) // 2])
+    drop = (path.station == missing) & (path.space == 5)
+    kept = dataclasses.replace(path, **{name: getattr(path, name)[~drop] for name in
+                                        ("kind", "x", "y", "z", "a", "feed", "inverse_time", "space", "station",
+                                         "feature")})
+    station_x = float(np.median(path.x[drop & (path.feature != Feature.NONE)]))
+    roughing = _post(plan.roughing.toolpath)
+    _verify(tmp_path / "intact", _job_text("perimeter"), {"roughing.ngc": roughing, "finishing.ngc": _post(path)})
+    code, result = _verify(tmp_path / "missing", _job_text("perimeter"), {"roughing.ngc": roughing,
+                                                                          "finishing.ngc": _post(kept)})
+    assert code == 1
+    intact, faulty = _map(tmp_path / "intact"), _map(tmp_path / "missing")
+    # the space's own surfaces (its tip lands belong to the teeth it shares with spaces 4 and 6 too)
+    grown = {key: faulty[key] - intact[key] for key in intact if "tip" not in key[1]}
+    (space, feature, x), growth = max(grown.items(), key=lambda item: item[1])
+    assert space == 5 and abs(x - station_x) <= 0.75 + 1e-9 and growth > 2 * RESOLUTION * 1000
+    assert max(value for (k, _, _), value in grown.items() if k != 5) <= 1e-6  # nothing else changed
+
+
+def _legacy_program(path, corner_radius_mm: float, swap_direction: bool = False) -> str:
+    """An old shop program written from a toolpath: bare modal axis words (a G-word only when the motion
+    changes), only the axes that change, A in [0, 360) with M15/M16 giving the way round, Z programmed at the
+    corner-radius centre."""
+    lines = ["O1000", "G90 G94 G17", f"T{path.tool_number} M6", f"S{path.spindle_rpm:.0f} M3"]
+    motion, previous, feed, inverse = None, [None] * 4, None, False
+    for i in np.nonzero(path.motion_mask)[0]:
+        pose = [path.x[i], path.y[i], path.z[i] + corner_radius_mm, path.a[i]]
+        words = []
+        code = "G0" if path.kind[i] == MoveKind.RAPID else "G1"
+        if code == "G1" and bool(path.inverse_time[i]) != inverse:
+            inverse = bool(path.inverse_time[i])
+            words.append("G93" if inverse else "G94")
+            feed = None
+        if code != motion:
+            words.append(code)
+            motion = code
+        for axis, value, old in zip("XYZ", pose[:3], previous[:3]):
+            if old is None or abs(value - old) > 1e-9:
+                words.append(f"{axis}{value:.4f}")
+        if previous[3] is None or abs(pose[3] - previous[3]) > 1e-9:
+            positive = previous[3] is None or pose[3] > previous[3]
+            words += [f"A{pose[3] % 360.0:.4f}", "M15" if positive != swap_direction else "M16"]
+        if code == "G1" and path.feed[i] != feed:
+            words.append(f"F{path.feed[i]:.1f}")
+            feed = path.feed[i]
+        if any(word[0] in "XYZA" for word in words):
+            lines.append(" ".join(words))
+        previous = pose
+    return "\n".join(lines + ["M30"]) + "\n"
+
+
+def test_a_legacy_program_verifies_as_the_original_and_the_wrong_rotary_direction_fails(tmp_path):
+    # perimeter finishing turns A while it cuts: the way round matters there
+    job = parse_job(_job_text("perimeter"), "p.toml")
+    plan = plan_cam(job)
+    path = plan.finishing.toolpath
+    corner = plan.finishing.tool.effective_corner_radius_mm
+    roughing = _post(plan.roughing.toolpath, "okuma")
+    _, original = _verify(tmp_path / "original", _job_text("perimeter"),
+                          {"roughing.min": roughing, "finishing.min": _post(path, "okuma")}, "--dialect", "okuma")
+    legacy = _legacy_program(path, corner)
+    assert "M15" in legacy and "M16" in legacy and re.search(r"\n[XYZ]-?\d", legacy)  # bare modal words
+    assert max(float(word[1:]) for word in re.findall(r"A-?\d+\.\d+", legacy)) < 360.0
+    _, result = _verify(tmp_path / "legacy", _job_text("perimeter"),
+                        {"roughing.min": roughing, "finishing.min": legacy.encode()},
+                        "--dialect", "okuma", "--point", "corner-centre")
+    assert abs(result["max_gouge_mm"] - original["max_gouge_mm"]) <= 0.001
+    assert abs(result["max_leftover_mm"] - original["max_leftover_mm"]) <= 0.001
+    assert [s["max_gouge_mm"] <= RESOLUTION for s in result["spaces"]] == [True] * 12
+    _, at_tip = _verify(tmp_path / "tip", _job_text("perimeter"),
+                        {"roughing.min": roughing, "finishing.min": legacy.encode()}, "--dialect", "okuma")
+    flank = [s["max_leftover_mm"] for s in at_tip["spaces"]]
+    assert min(flank) >= corner - RESOLUTION  # read at the tip, the tool is r_t too high everywhere
+    swapped = _legacy_program(path, corner, swap_direction=True)
+    code, result = _verify(tmp_path / "swap", _job_text("perimeter"),
+                           {"roughing.min": roughing, "finishing.min": swapped.encode()},
+                           "--dialect", "okuma", "--point", "corner-centre")
+    assert code == 1 and result["max_gouge_mm"] > 0.1  # the long way round cuts through the teeth
+
+
+@pytest.mark.parametrize("program, message", [
+    ("G90\nG2 X1 Y1 I1 J0\nM30\n", ":2: G2 is not supported by this reader"),
+    ("G91\nG0 X1 Y0 Z30 A0\nM30\n", ":1: G91 is not supported"),
+    ("T1 M6\nG0 X1 Y0 Z30 A0\nT7 M6\nG1 X2 F100\nM30\n", ":4: moves with tool T7, which the job does not have"),
+    ("G0 X1 Y0 Z30 A0\nM30\n", ":1: a move before any tool is loaded"),
+    ("G0 X1 Y0 Z30\nM30\n", ":1: the first move must give every axis (A unknown)"),
+    ("G0 X1 Y0 Z30 A0\nG1 X2\nM30\n", ":2: a feed move without a positive F"),
+    ("T1 M6\nG0 X1 Y0 Z30 A0\n", ": no end of program (M30 or M2)"),
+    ("o100 call\nM30\n", ":1: calls subprogram 100, which the program does not define"),
+    ("G0 X1 Y0 Z30 A[#5+1]\nM30\n", ":1: variable #5 is used before it is set"),
+    ("G0 X1 Y0 Z30 A0\nM123\nM30\n", ":2: M123 is not supported"),
+])
+def test_unsupported_or_bad_programs_are_one_line_naming_the_line(tmp_path, capsys, program, message):
+    code, result = _verify(tmp_path, _job_text(), {"bad.ngc": program.encode()}, "--dialect", "linuxcnc")
+    err = capsys.readouterr().err.strip()
+    assert code == 2 and result == {} and not (tmp_path / "verify_out").exists()
+    assert len(err.splitlines()) == 1 and err.startswith("spur-cad: error: ") and message in err, err
+
+
+def test_direction_codes_turn_the_way_they_say():
+    text = "G0 X0 Y0 Z30 A350\nA10 M15\nA350 M16\nA10 M16\nM30\n"
+    moves = read_program(text, "okuma", "p")
+    assert np.allclose(moves.a, [350.0, 370.0, 350.0, 10.0])  # +20, -20, -340: each the way its code says
+    with pytest.raises(ProgramReadError, match=r"p:2: with M15, A must be an angle in \[0, 360\)"):
+        read_program("G0 X0 Y0 Z30 A0\nA400 M15\nM30\n", "okuma", "p")
+    assert math.isclose(read_program("G0 X0 Y0 Z30 A0\nA10 M16\nM30\n", "okuma", "p").a[-1], -350.0)
