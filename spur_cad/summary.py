@@ -53,8 +53,21 @@ def build_summary(job, samples: ProfileSamples, cad: CadResult, plan: CamPlan, p
         **cam_sections(plan, job.machine, job.tools.roughing, job.tools.finishing),
         "post": post_section(post, programs),
         "simulation": simulation_section(simulation, job.simulation.resolution_mm),
+        "grading": grading_section(job.gear, simulation),
         "timings_s": seconds,
     }
+
+
+def grading_section(spec, result: SimResult | None) -> dict | None:
+    """summary.json's `grading`: the simulated gear's ISO 1328-1:2013 deviations and classes (None without a
+    simulation, or without a finished flank to measure)."""
+    from spur_cad.grade.simulated import grade_simulation
+
+    if result is None:
+        return None
+    grading = grade_simulation(spec, result)
+    grading.pop("traces")
+    return grading
 
 
 def cad_section(cad: CadResult) -> dict:

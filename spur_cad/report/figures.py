@@ -133,6 +133,41 @@ def deviation_map_png(result: SimResult) -> bytes:
     return _png(fig)
 
 
+def k_chart_png(spec: GearSpec, grading: dict) -> bytes:
+    """A gear measuring machine's chart for the tooth space with the largest total profile deviation: its
+    right and left profile traces (deviation against roll length, the three face positions) and helix traces,
+    the evaluation ranges and the tolerance band of the gear's class (the total tolerance F_aT / F_bT, drawn
+    around each trace's mean)."""
+    from spur_cad.grade.iso1328 import tolerance_um
+
+    traces = grading["traces"]
+    profile = [t for t in traces if t.kind == "profile"]
+    worst = max(profile, key=lambda t: float(np.ptp(t.deviation_um))).space
+    grade = grading["class"] or 11
+    d, b, m = 2.0 * spec.reference_radius_mm, spec.face_width_mm, spec.module_mm
+    fig = Figure(figsize=(9.0, 6.5), layout="constrained")
+    axes = fig.subplots(2, 2)
+    for column, side in enumerate(("right", "left")):
+        for row, kind in enumerate(("profile", "helix")):
+            ax = axes[row][column]
+            band = tolerance_um("F_aT" if kind == "profile" else "F_bT", grade, d, b, m)
+            for trace in (t for t in traces if t.kind == kind and t.side == side and t.space == worst):
+                label = f"X = {trace.x_mm:.2f} mm" if trace.x_mm is not None else "reference circle"
+                ax.plot(trace.position_mm, trace.deviation_um, lw=0.9, label=label)
+                mean = float(np.mean(trace.deviation_um))
+                for edge in (-0.5 * band, 0.5 * band):
+                    ax.axhline(mean + edge, color="tab:red", lw=0.6, ls="--")
+                for edge in trace.evaluation:
+                    ax.axvline(edge, color="k", lw=0.5, ls=":")
+            ax.set_title(f"space {worst}, {side} flank: {kind} (band: class {grade} "
+                         f"{'F_aT' if kind == 'profile' else 'F_bT'} = {band:g} um)", fontsize=8)
+            ax.set_xlabel("roll length [mm]" if kind == "profile" else "X (face width) [mm]", fontsize=8)
+            ax.set_ylabel("deviation [um] (+ material)", fontsize=8)
+            ax.grid(True, lw=0.3)
+            ax.legend(fontsize=6)
+    return _png(fig)
+
+
 _PASS_COLOURS = {"flank": "tab:blue", "tip": "tab:green", "land": "tab:purple"}
 
 

@@ -232,6 +232,26 @@ def _simulation(summary: dict) -> str:
     return text
 
 
+def _grading(summary: dict) -> str:
+    grading = summary.get("grading")
+    if not grading:
+        return ""
+    names = {"f_pt": "single pitch f_pt", "F_p": "total cumulative pitch F_p", "f_Ha": "profile slope f_Ha",
+             "f_fa": "profile form f_fa", "F_a": "total profile F_a", "f_Hb": "helix slope f_Hb",
+             "f_fb": "helix form f_fb", "F_b": "total helix F_b"}
+    rows = ((label, f"{grading['deviations_um'][key]:.2f}", grading["classes"][key] or "beyond 11")
+            for key, label in names.items())
+    text = ("<h2>Grade (ISO 1328-1:2013, from the simulated cut)</h2>"
+            + _table(rows, ("deviation (worst flank)", "[um]", "class")))
+    overall = grading["class"]
+    text += (f'<p>Flank tolerance class of the simulated gear: <b>{overall if overall else "beyond 11"}</b> '
+             "(the worst class of the deviations above; profiles from the form circle to 95 % of the roll "
+             "length to the tip, helix over the face width less min(5 % b, m) at each end).</p>")
+    if grading.get("validity"):
+        text += f'<p class="warn">Outside the range of the formulas: {_e("; ".join(grading["validity"]))}.</p>'
+    return text
+
+
 def _warnings(summary: dict) -> str:
     items = list(summary.get("warnings", []))
     sim = summary.get("simulation", {})
@@ -262,6 +282,7 @@ def render_report(summary: dict, images: dict[str, bytes]) -> bytes:
         "<h2>Finishing contacts and cutter locations</h2>" + _image(images.get("finishing"), "finishing poses")
         if images.get("finishing") else "",
         _simulation(summary), _image(images.get("deviation"), "deviation map"),
+        _grading(summary), _image(images.get("kchart"), "K-chart: profile and helix traces"),
         "</body></html>",
     ]
     return ("\n".join(p for p in parts if p) + "\n").encode("utf-8")

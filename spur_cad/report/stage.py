@@ -34,5 +34,9 @@ def report_html(summary: dict, profile_png: bytes, spec: GearSpec, blank_radius_
         a = np.concatenate([p.a for p in parts])
         images["finishing"] = finishing_png(spec, plan.finishing.tool, y, z, a)
     if sim is not None:
+        from spur_cad.grade.simulated import grade_simulation
+        from spur_cad.report.figures import k_chart_png
+
         images["deviation"] = deviation_map_png(sim)
+        images["kchart"] = k_chart_png(spec, grade_simulation(spec, sim))
     return render_report(summary, images)

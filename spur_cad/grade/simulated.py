@@ -1,0 +1,146 @@
+"""Grade a simulated gear by ISO 1328-1:2013: profile, helix and pitch deviations of every flank and the
+flank tolerance class each meets (spur_cad.grade.iso1328 for the tolerances and trace evaluation).
+
+The simulation's deviations are along the design normals of a transverse section (as a gear
+measuring machine's profile probe reads them), + for material above the design. For each tooth
+space and both flanks:
+
+- profile traces at three face positions (the ends and the middle of the helix evaluation range):
+  deviation against the roll length sqrt(r^2 - r_b^2) of the involute points, evaluated from the form
+  circle to 95 % of the roll length to the tip circle (the standard leaves the tip's last 5 % out);
+- a helix trace on the reference circle's point of the flank, along the face width without, at each
+  end, the smaller of 5 % of b and one module;
+- the flank's position on the reference circle at mid face: a normal deviation e moves the flank by
+  the arc e / cos(alpha_t) there; single pitch deviations are differences of neighbouring flanks of
+  one side, the total cumulative pitch deviation their spread.
+
+The gear's grade is the worst class over every deviation of every flank.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from spur_cad.grade.iso1328 import (
+    DEVIATIONS,
+    KINDS,
+    class5_um,
+    class_of,
+    evaluate_trace,
+    pitch_deviations,
+    tolerance_um,
+    validity_problems,
+)
+
+SIDES = ("right", "left")
+TIP_EXCLUDED_FRACTION = 0.05
+
+
+@dataclass(frozen=True)
+class Trace:
+    """One measured trace: where (space, side, X for a profile trace), positions (mm) and deviations (um)."""
+
+    kind: str  # "profile" or "helix"
+    space: int
+    side: str
+    x_mm: float | None
+    position_mm: np.ndarray
+    deviation_um: np.ndarray
+    evaluation: tuple[float, float]
+
+
+def helix_range_mm(face_width_mm: float, module_mm: float) -> tuple[float, float]:
+    """The helix evaluation range: the face width less, at each end, the smaller of 5 % of b and one module."""
+    cut = min(0.05 * face_width_mm, module_mm)
+    return cut, face_width_mm - cut
+
+
+def profile_range_mm(spec) -> tuple[float, float]:
+    """The profile evaluation range in roll length: form circle to 95 % of the way to the tip circle."""
+    rb = spec.base_radius_mm
+    start = math.sqrt(max(spec.form_radius_mm ** 2 - rb ** 2, 0.0))
+    tip = math.sqrt(spec.tip_radius_mm ** 2 - rb ** 2)
+    return start, start + (1.0 - TIP_EXCLUDED_FRACTION) * (tip - start)
+
+
+def _flank_points(grid, side: str) -> np.ndarray:
+    names = grid.feature_names()
+    return np.array([name == f"{side} involute" for name in names])
+
+
+def traces(spec, result) -> list[Trace]:
+    """Profile traces (three face positions) and a helix trace for both flanks of every tooth space."""
+    grid = result.grid
+    rows = np.nonzero(result.gear_rows)[0]
+    x = grid.rows_x[rows]
+    helix_lo, helix_hi = helix_range_mm(spec.face_width_mm, spec.module_mm)
+    face_rows = [rows[np.argmin(np.abs(x - target))] for target in (helix_lo, 0.5 * (helix_lo + helix_hi), helix_hi)]
+    profile_range = profile_range_mm(spec)
+    found = []
+    for side in SIDES:
+        mask = _flank_points(grid, side)
+        radius = np.hypot(grid.points[mask, 0], grid.points[mask, 1])
+        roll = np.sqrt(np.maximum(radius ** 2 - spec.base_radius_mm ** 2, 0.0))
+        order = np.argsort(roll)
+        reference = int(np.argmin(np.abs(radius - spec.reference_radius_mm)))
+        for k in range(grid.teeth):
+            deviation = result.deviation[k][mask] * 1000.0
+            for row in face_rows:
+                found.append(Trace("profile", k, side, float(grid.rows_x[row]), roll[order],
+                                   deviation[order, row], profile_range))
+            found.append(Trace("helix", k, side, None, x, deviation[reference, rows], (helix_lo, helix_hi)))
+    return found
+
+
+def flank_positions_um(spec, result, side: str) -> np.ndarray:
+    """Arc deviation of each tooth space's `side` flank on the reference circle at mid face (um)."""
+    grid = result.grid
+    mask = _flank_points(grid, side)
+    radius = np.hypot(grid.points[mask, 0], grid.points[mask, 1])
+    reference = int(np.argmin(np.abs(radius - spec.reference_radius_mm)))
+    rows = np.nonzero(result.gear_rows)[0]
+    middle = rows[np.argmin(np.abs(grid.rows_x[rows] - 0.5 * spec.face_width_mm))]
+    cos_alpha = spec.base_radius_mm / spec.reference_radius_mm
+    return np.array([result.deviation[k][mask][reference, middle] * 1000.0 / cos_alpha for k in range(grid.teeth)])
+
+
+def grade_simulation(spec, result) -> dict:
+    """The gear's ISO 1328-1 deviations (worst over all flanks), their classes, the gear's class, the class-5
+    tolerances and the validity of the formulas, as JSON-ready data; plus the traces for charts."""
+    d, b, m = 2.0 * spec.reference_radius_mm, spec.face_width_mm, spec.module_mm
+    worst = {name: 0.0 for name in DEVIATIONS.values()}
+    where = {}
+    measured = traces(spec, result)
+    for trace in measured:
+        values = evaluate_trace(trace.position_mm, trace.deviation_um, *trace.evaluation)
+        names = ("f_Ha", "f_fa", "F_a") if trace.kind == "profile" else ("f_Hb", "f_fb", "F_b")
+        for name, value in zip(names, (values.slope_um, values.form_um, values.total_um)):
+            if abs(value) > abs(worst[name]):
+                worst[name] = value
+                where[name] = {"space": trace.space, "side": trace.side, "x_mm": trace.x_mm}
+    pitch = {}
+    for side in SIDES:
+        single, f_pt, f_p = pitch_deviations(flank_positions_um(spec, result, side))
+        pitch[side] = {"single_um": [round(float(v), 3) for v in single], "f_pt_um": f_pt, "F_p_um": f_p}
+        if f_pt > worst["f_pt"]:
+            worst["f_pt"], where["f_pt"] = f_pt, {"side": side, "space": int(np.argmax(np.abs(single)))}
+        if f_p > worst["F_p"]:
+            worst["F_p"], where["F_p"] = f_p, {"side": side}
+    classes = {DEVIATIONS[kind]: class_of(kind, worst[DEVIATIONS[kind]], d, b, m) for kind in KINDS}
+    grades = [grade for grade in classes.values()]
+    overall = None if any(grade is None for grade in grades) else max(grades)
+    return {
+        "standard": "ISO 1328-1:2013",
+        "deviations_um": {name: round(value, 3) for name, value in worst.items()},
+        "where": where,
+        "classes": classes,
+        "class": overall,
+        "class5_tolerances_um": {kind: tolerance_um(kind, 5, d, b, m) for kind in KINDS},
+        "class5_unrounded_um": {kind: round(value, 3) for kind, value in class5_um(d, b, m).items()},
+        "pitch": pitch,
+        "validity": validity_problems(spec.teeth, d, m, b, math.degrees(spec.helix_angle_rad)),
+        "traces": measured,
+    }

@@ -1,0 +1,149 @@
+"""ISO 1328-1:2013 grading (issue 17, second part): the tolerance formulas against values worked out by hand
+from the standard's formulas, trace evaluation, and synthetic gears with planted deviations of known size."""
+
+from __future__ import annotations
+
+import math
+from types import SimpleNamespace
+
+import numpy as np
+import pytest
+
+from spur_cad.geometry.spec import GearSpec
+from spur_cad.grade.iso1328 import DEVIATIONS, class_of, evaluate_trace, rounded_um, tolerance_um
+from spur_cad.grade.simulated import grade_simulation, helix_range_mm, profile_range_mm
+from spur_cad.sim.design import design_grid
+
+# Worked by hand (calculator) from the class-5 formulas, times sqrt(2)^(A-5), then rounded:
+# reference gear d = 92, b = 20, m = 4 (METHOD's figures): class 5 f_pT 6.692 -> 6.5, F_pT 20.26 -> 20,
+#   F_aT hypot(5.692, 7.2) = 9.178 -> 9, F_bT hypot(6.045, 6.684) = 9.012 -> 9; class 7 (x2): 13, 41, 18, 18.
+# z 12 m 3 b 6 (d = 36): class 5 f_HaT 1.2 + 0.036 + 4 = 5.236 -> 5.0; f_faT 1.65 + 5 = 6.65 -> 6.5;
+#   class 8 (x 2.828): f_HaT 14.81 -> 15, f_pT (0.036 + 1.2 + 5) = 6.236 x 2.828 = 17.64 -> 18.
+# z 40 m 1.5 b 12 (d = 60): class 4 (/ 1.414): F_pT (0.12 + 4.260 + 1.05 + 12) = 17.43 / 1.414 = 12.33 -> 12;
+#   f_fbT (0.542 + 1.559 + 4) = 6.101 / 1.414 = 4.314 -> 4.3; class 10 (x 5.657): f_HbT (0.387 + 1.212 + 4)
+#   = 5.599 x 5.657 = 31.67 -> 32.
+BY_HAND = [
+    ((92.0, 20.0, 4.0), 5, {"f_pT": 6.5, "F_pT": 20.0, "F_aT": 9.0, "F_bT": 9.0}),
+    ((92.0, 20.0, 4.0), 7, {"f_pT": 13.0, "F_pT": 41.0, "F_aT": 18.0, "F_bT": 18.0}),
+    ((36.0, 6.0, 3.0), 5, {"f_HaT": 5.0, "f_faT": 6.5}),
+    ((36.0, 6.0, 3.0), 8, {"f_HaT": 15.0, "f_pT": 18.0}),
+    ((60.0, 12.0, 1.5), 4, {"F_pT": 12.0, "f_fbT": 4.3}),
+    ((60.0, 12.0, 1.5), 10, {"f_HbT": 32.0}),
+]
+
+
+@pytest.mark.parametrize("gear, grade, expected", BY_HAND)
+def test_tolerances_equal_values_worked_by_hand(gear, grade, expected):
+    for kind, value in expected.items():
+        assert tolerance_um(kind, grade, *gear) == value, kind
+
+
+def test_rounding_steps():
+    assert [rounded_um(v) for v in (4.26, 4.24, 7.3, 7.2, 12.5, 12.4)] == [4.3, 4.2, 7.5, 7.0, 13.0, 12.0]
+
+
+def test_a_deviation_gets_the_finest_class_that_holds_it():
+    gear = (36.0, 6.0, 3.0)
+    assert class_of("f_HaT", 5.0, *gear) == 5 and class_of("f_HaT", 5.1, *gear) == 6
+    assert class_of("f_HaT", 1e6, *gear) is None
+
+
+def test_trace_evaluation_separates_slope_form_and_total():
+    s = np.linspace(0.0, 10.0, 201)
+    ripple = 1.5 * np.cos(2 * np.pi * s / 2.5)  # whole periods of a cosine: no share in the least-squares line
+    values = evaluate_trace(s, 0.8 * s + ripple, 0.0, 10.0)
+    assert values.slope_um == pytest.approx(8.0, abs=0.2) and values.form_um == pytest.approx(3.0, abs=0.1)
+    assert values.total_um == pytest.approx(8.0 + 3.0, abs=1.0)
+
+
+GEAR = GearSpec(teeth=12, module_mm=3.0, face_width_mm=6.0, rack_tip_radius_mm=0.9)
+
+
+@pytest.fixture(scope="module")
+def grid():
+    return design_grid(GEAR, 0.02, -1.0, GEAR.face_width_mm + 1.0, np.zeros(0))
+
+
+def _result(grid, deviation):
+    rows = (grid.rows_x >= -1e-9) & (grid.rows_x <= GEAR.face_width_mm + 1e-9)
+    return SimpleNamespace(grid=grid, deviation=deviation, gear_rows=rows)
+
+
+def _flank(grid, side):
+    return np.array([name == f"{side} involute" for name in grid.feature_names()])
+
+
+def _roll(grid, mask):
+    radius = np.hypot(grid.points[mask, 0], grid.points[mask, 1])
+    return np.sqrt(np.maximum(radius ** 2 - GEAR.base_radius_mm ** 2, 0.0))
+
+
+def test_a_perfect_gear_is_class_1(grid):
+    grading = grade_simulation(GEAR, _result(grid, np.zeros((12, len(grid.points), len(grid.rows_x)))))
+    assert grading["class"] == 1 and all(abs(v) < 1e-9 for v in grading["deviations_um"].values())
+
+
+def test_planted_deviations_are_found_with_their_size_and_class(grid):
+    deviation = np.zeros((12, len(grid.points), len(grid.rows_x)))
+    start, end = profile_range_mm(GEAR)
+    right, left = _flank(grid, "right"), _flank(grid, "left")
+    roll = _roll(grid, right)
+    # space 2, right flank: profile slope +8 um over the evaluation range
+    deviation[2][right] += (8.0e-3 * (roll - start) / (end - start))[:, None]
+    # space 7, right flank: a sinusoidal form ripple of 3 um peak to peak (whole periods of a cosine over the
+    # evaluation range, so that the least-squares line stays flat and the slope 0)
+    period = (end - start) / 3.0
+    deviation[7][right] += (1.5e-3 * np.cos(2.0 * np.pi * (roll - start) / period))[:, None]
+    # space 4, left flank: the flank 10 um ahead on the reference circle (a normal deviation of 10 cos alpha)
+    cos_alpha = GEAR.base_radius_mm / GEAR.reference_radius_mm
+    deviation[4][left] += 10.0e-3 * cos_alpha
+    # space 9, left flank: helix slope 6 um over the helix evaluation range
+    lo, hi = helix_range_mm(GEAR.face_width_mm, GEAR.module_mm)
+    deviation[9][left] += (6.0e-3 * (grid.rows_x - lo) / (hi - lo))[None, :]
+    grading = grade_simulation(GEAR, _result(grid, deviation))
+    found = grading["deviations_um"]
+    assert found["f_Ha"] == pytest.approx(8.0, abs=0.5) and grading["where"]["f_Ha"]["space"] == 2
+    assert found["f_fa"] == pytest.approx(3.0, abs=0.5) and grading["where"]["f_fa"]["space"] == 7
+    assert found["f_pt"] == pytest.approx(10.0, abs=0.5) and found["F_p"] == pytest.approx(10.0, abs=0.5)
+    assert grading["where"]["f_pt"]["side"] == "left"
+    assert found["f_Hb"] == pytest.approx(6.0, abs=0.5) and grading["where"]["f_Hb"]["space"] == 9
+    # classes by the hand-worked tolerances of this gear (d = 36, b = 6, m = 3):
+    # f_HaT: class 6 = 5.236 x 1.414 = 7.40 -> 7.5 < 8, class 7 = 10.47 -> 10 >= 8: class 7
+    # f_faT: class 1 = 6.65 / 4 = 1.66 -> 1.7 < 3, class 2 = 2.35 -> 2.4 < 3, class 3 = 3.33 -> 3.3: class 3
+    # f_pT: class 7 = 6.236 x 2 = 12.47 -> 12 >= 10, class 6 = 8.82 -> 9.0 < 10: class 7
+    # f_HbT: 0.05 x 6 + 0.35 x 2.449 + 4 = 5.157; class 6 = 7.29 -> 7.5 >= 6, class 5 = 5.157 -> 5.0 < 6: class 6
+    classes = grading["classes"]
+    assert classes["f_Ha"] == 7 and classes["f_fa"] == 3 and classes["f_pt"] == 7 and classes["f_Hb"] == 6
+    assert grading["class"] == max(c for c in classes.values())
+    assert grading["validity"] == []
+
+
+def test_formulas_outside_their_range_are_flagged():
+    tiny = GearSpec(teeth=12, module_mm=0.3, face_width_mm=2.0)
+    from spur_cad.grade.iso1328 import validity_problems
+
+    problems = validity_problems(tiny.teeth, 2 * tiny.reference_radius_mm, tiny.module_mm, tiny.face_width_mm, 0.0)
+    assert any("module" in p for p in problems) and any("face width" in p for p in problems)
+    assert math.isclose(2 * tiny.reference_radius_mm, 3.6)
+
+
+def test_a_run_grades_the_simulated_gear_in_the_summary_and_the_report():
+    import json
+
+    from spur_cad.job import parse_job
+    from spur_cad.pipeline import run_job
+    from tests.workbench_helper import small_job_text
+
+    files = run_job(parse_job(small_job_text() + "\n[simulation]\nresolution_mm = 0.02\n", "small.toml"))
+    grading = json.loads(files["summary.json"])["grading"]
+    assert grading["standard"] == "ISO 1328-1:2013" and grading["validity"] == []
+    for key, grade in grading["classes"].items():  # each class is the finest that holds the deviation
+        kind = next(k for k, v in DEVIATIONS.items() if v == key)
+        assert grade is None or abs(grading["deviations_um"][key]) <= tolerance_um(kind, grade, 36.0, 6.0, 3.0)
+        assert grade in (None, 1) or abs(grading["deviations_um"][key]) > tolerance_um(kind, grade - 1, 36.0, 6.0,
+                                                                                        3.0)
+    assert grading["class"] == max(grading["classes"].values())
+    # 1.5 mm generating rolls with a 50 um target scallop: profile form is the scallop, far from class 5
+    assert grading["deviations_um"]["f_fa"] > 10.0
+    report = files["report.html"].decode()
+    assert "Grade (ISO 1328-1:2013, from the simulated cut)" in report and 'alt="K-chart' in report
