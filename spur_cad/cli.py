@@ -56,6 +56,13 @@ def _parser() -> argparse.ArgumentParser:
                         "finishing target scallop plus the resolution)")
     verify.add_argument("--quiet", action="store_true", help="print nothing but errors and the verdict")
     verify.add_argument("--debug", action="store_true", help="show tracebacks of internal errors")
+    grade = sub.add_parser("grade", help="grade a real gear by ISO 1328-1:2013 from points measured on it")
+    grade.add_argument("job", help="TOML job file (the gear's design)")
+    grade.add_argument("measured", help="CSV of measured points: x_mm,y_mm[,X_mm] in transverse planes")
+    grade.add_argument("--out", help="folder for grade.json and k_chart.png (created if missing)")
+    grade.add_argument("--required-class", type=int, choices=range(1, 12), metavar="1..11",
+                       help="exit 1 when the gear is worse than this flank tolerance class")
+    grade.add_argument("--debug", action="store_true", help="show tracebacks of internal errors")
     freecad = sub.add_parser("install-freecad", help="make the FreeCAD workbench and this spur_cad available "
                                                      "to your FreeCAD (undo with --uninstall)")
     freecad.add_argument("--uninstall", action="store_true", help="remove what install-freecad added")
@@ -218,6 +225,52 @@ def _verify(args: argparse.Namespace, received: list[int], loaded: list) -> int:
     return 0 if result.passed and not rs274_failed else 1
 
 
+def _grade(args: argparse.Namespace, received: list[int], loaded: list) -> int:
+    """`spur-cad grade`: best-fit the measured points to the design, print deviations and classes; 0, or 1 when
+    worse than --required-class."""
+    import json
+    from pathlib import Path
+
+    from spur_cad.grade.measured import grade_measured, read_points_csv
+    from spur_cad.job import load_job
+    from spur_cad.outputs import check_output_folder, write_output_set
+
+    _checkpoint(received)
+    out_dir = check_output_folder(args.out) if args.out else None
+    loaded.append(load_job(args.job))
+    spec = loaded[0].gear
+    try:
+        text = Path(args.measured).read_text(encoding="utf-8")
+    except FileNotFoundError:
+        raise SpurCadError(f"{args.measured}: measured points not found") from None
+    except (OSError, UnicodeDecodeError) as exc:
+        raise SpurCadError(f"{args.measured}: cannot read: {getattr(exc, 'strerror', None) or exc}") from None
+    grading = grade_measured(spec, read_points_csv(text, args.measured))
+    _checkpoint(received)
+    fit = grading["fit"]
+    print(f"fit: rotation {fit['rotation_deg']:.4f} deg, centre ({fit['centre_mm'][0]:.4f}, "
+          f"{fit['centre_mm'][1]:.4f}) mm, rms {fit['rms_deviation_um']:.2f} um over {grading['points']} points")
+    for name, value in grading["deviations_um"].items():
+        grade = grading["classes"][name]
+        print(f"{name}: {value:.2f} um, class {grade if grade else 'beyond 11'}")
+    overall = grading["class"]
+    print(f"ISO 1328-1:2013 flank tolerance class: {overall if overall else 'beyond 11'}")
+    if out_dir is not None:
+        from spur_cad.report.figures import k_chart_png
+
+        files = {"grade.json": (json.dumps({k: v for k, v in grading.items() if k != "traces"}, indent=2)
+                                + "\n").encode()}
+        if grading["traces"] and grading["class"] is not None:
+            files["k_chart.png"] = k_chart_png(spec, grading)
+        try:
+            write_output_set(out_dir, files)
+        except OSError as exc:
+            raise SpurCadError(f"cannot write to {out_dir}: {exc.strerror or exc}") from None
+    if args.required_class is not None and (overall is None or overall > args.required_class):
+        return 1
+    return 0
+
+
 def _main(argv: list[str] | None, received: list[int]) -> int:
     args = _parser().parse_args(argv)
     if not getattr(args, "debug", False):
@@ -230,6 +283,8 @@ def _main(argv: list[str] | None, received: list[int]) -> int:
     try:
         if args.command == "verify":
             return _verify(args, received, loaded)
+        if args.command == "grade":
+            return _grade(args, received, loaded)
         paths = _run(args, received, loaded)
     except SpurCadError as exc:
         message = loaded[0].located(exc) if loaded and exc.section else str(exc)

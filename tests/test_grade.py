@@ -12,7 +12,9 @@ import pytest
 from spur_cad.geometry.spec import GearSpec
 from spur_cad.grade.iso1328 import DEVIATIONS, class_of, evaluate_trace, rounded_um, tolerance_um
 from spur_cad.grade.simulated import grade_simulation, helix_range_mm, profile_range_mm
+from spur_cad.job import parse_job
 from spur_cad.sim.design import design_grid
+from tests.workbench_helper import small_job_text
 
 # Worked by hand (calculator) from the class-5 formulas, times sqrt(2)^(A-5), then rounded:
 # reference gear d = 92, b = 20, m = 4 (METHOD's figures): class 5 f_pT 6.692 -> 6.5, F_pT 20.26 -> 20,
@@ -56,7 +58,7 @@ def test_trace_evaluation_separates_slope_form_and_total():
     assert values.total_um == pytest.approx(8.0 + 3.0, abs=1.0)
 
 
-GEAR = GearSpec(teeth=12, module_mm=3.0, face_width_mm=6.0, rack_tip_radius_mm=0.9)
+GEAR = parse_job(small_job_text(), "small.toml").gear  # z 12, m 3, b 6, rho 0.9, 2 % thinner teeth
 
 
 @pytest.fixture(scope="module")
@@ -130,9 +132,7 @@ def test_formulas_outside_their_range_are_flagged():
 def test_a_run_grades_the_simulated_gear_in_the_summary_and_the_report():
     import json
 
-    from spur_cad.job import parse_job
     from spur_cad.pipeline import run_job
-    from tests.workbench_helper import small_job_text
 
     files = run_job(parse_job(small_job_text() + "\n[simulation]\nresolution_mm = 0.02\n", "small.toml"))
     grading = json.loads(files["summary.json"])["grading"]
@@ -147,3 +147,83 @@ def test_a_run_grades_the_simulated_gear_in_the_summary_and_the_report():
     assert grading["deviations_um"]["f_fa"] > 10.0
     report = files["report.html"].decode()
     assert "Grade (ISO 1328-1:2013, from the simulated cut)" in report and 'alt="K-chart' in report
+
+
+def _measured_csv(planted: bool, angle_deg: float = 3.0, centre=(0.05, -0.03)) -> str:
+    """Points on every flank of the small gear (a design grid sampled at another spacing than the grader's),
+    in five transverse planes, turned and shifted as a scan would be; with planted deviations: profile slope
+    +8 um (space 2 right), one flank 10 um ahead (space 4 left), helix slope 6 um (space 9 left)."""
+    grid = design_grid(GEAR, 0.037, 0.0, 0.0, np.zeros(0))
+    names = grid.feature_names()
+    start, end = profile_range_mm(GEAR)
+    lo, hi = helix_range_mm(GEAR.face_width_mm, GEAR.module_mm)
+    cos_alpha = GEAR.base_radius_mm / GEAR.reference_radius_mm
+    radius = np.hypot(grid.points[:, 0], grid.points[:, 1])
+    roll = np.sqrt(np.maximum(radius ** 2 - GEAR.base_radius_mm ** 2, 0.0))
+    lines = ["x_mm,y_mm,X_mm"]
+    turn = math.radians(angle_deg)
+    for k in range(GEAR.teeth):
+        points, normals = grid.space_points(k), grid.space_normals(k)
+        for x in np.linspace(lo, hi, 5):
+            dev = np.zeros(len(points))
+            if planted:
+                right = np.array([n == "right involute" for n in names])
+                left = np.array([n == "left involute" for n in names])
+                if k == 2:
+                    dev[right] += 8.0e-3 * (roll[right] - start) / (end - start)
+                if k == 4:
+                    dev[left] += 10.0e-3 * cos_alpha
+                if k == 9:
+                    dev[left] += 6.0e-3 * (x - lo) / (hi - lo)
+            moved = points + dev[:, None] * normals
+            y = math.cos(turn) * moved[:, 0] - math.sin(turn) * moved[:, 1] + centre[0]
+            z = math.sin(turn) * moved[:, 0] + math.cos(turn) * moved[:, 1] + centre[1]
+            lines += [f"{a:.6f},{c:.6f},{x:.4f}" for a, c in zip(y, z)]
+    return "\n".join(lines) + "\n"
+
+
+def _grade_cli(tmp_path, csv_text: str, *extra: str) -> tuple[int, dict]:
+    import json
+
+    from spur_cad.cli import main
+
+    (tmp_path / "job.toml").write_text(small_job_text())
+    (tmp_path / "measured.csv").write_text(csv_text)
+    code = main(["grade", str(tmp_path / "job.toml"), str(tmp_path / "measured.csv"), "--out",
+                 str(tmp_path / "grade"), *extra])
+    out = tmp_path / "grade" / "grade.json"
+    return code, json.loads(out.read_text()) if out.exists() else {}
+
+
+def test_measured_points_of_a_perfect_gear_fit_its_rotation_and_centre_and_grade_class_1(tmp_path):
+    code, grading = _grade_cli(tmp_path, _measured_csv(planted=False), "--required-class", "1")
+    fit = grading["fit"]
+    assert code == 0 and grading["class"] == 1 and fit["rms_deviation_um"] < 0.2
+    pitch = math.degrees(2 * math.pi / GEAR.teeth)
+    assert min(abs((fit["rotation_deg"] + 3.0) % pitch), abs((fit["rotation_deg"] + 3.0) % pitch - pitch)) < 1e-3
+    assert set(grading["deviations_um"]) == {"f_pt", "F_p", "f_Ha", "f_fa", "F_a", "f_Hb", "f_fb", "F_b"}
+
+
+def test_measured_points_give_the_planted_deviations_and_their_classes(tmp_path):
+    code, grading = _grade_cli(tmp_path, _measured_csv(planted=True), "--required-class", "6")
+    found, where = grading["deviations_um"], grading["where"]
+    assert found["f_Ha"] == pytest.approx(8.0, abs=0.5) and found["f_Hb"] == pytest.approx(6.0, abs=0.5)
+    assert found["f_pt"] == pytest.approx(10.0, abs=0.5) and found["F_p"] == pytest.approx(10.0, abs=0.5)
+    # a scan has no space 0: the fit may number the spaces from another one, but keeps their order
+    assert where["f_Ha"]["side"] == "right" and where["f_Hb"]["side"] == "left"
+    assert (where["f_Hb"]["space"] - where["f_Ha"]["space"]) % 12 == 7
+    assert grading["classes"]["f_Ha"] == 7 and grading["classes"]["f_pt"] == 7 and grading["classes"]["f_Hb"] == 6
+    assert code == 1 and grading["class"] == 7  # worse than the required class 6
+    assert (tmp_path / "grade" / "k_chart.png").read_bytes()[:4] == b"\x89PNG"
+
+
+@pytest.mark.parametrize("text, message", [
+    ("x,y\n1,2\nthree,4\n", "measured.csv:3: not numbers"),
+    ("1,2,3,4\n", "measured.csv:1: expected x_mm,y_mm[,X_mm], got 4 values"),
+    ("1,nan\n", "measured.csv:1: a value is not a finite coordinate"),
+    ("1,2\n", "measured.csv: 1 points; at least 10 are needed"),
+])
+def test_bad_measured_files_are_one_line(tmp_path, capsys, text, message):
+    code, grading = _grade_cli(tmp_path, text)
+    err = capsys.readouterr().err.strip()
+    assert code == 2 and grading == {} and len(err.splitlines()) == 1 and message in err, err

@@ -107,20 +107,30 @@ def flank_positions_um(spec, result, side: str) -> np.ndarray:
     return np.array([result.deviation[k][mask][reference, middle] * 1000.0 / cos_alpha for k in range(grid.teeth)])
 
 
-def grade_simulation(spec, result) -> dict:
-    """The gear's ISO 1328-1 deviations (worst over all flanks), their classes, the gear's class, the class-5
-    tolerances and the validity of the formulas, as JSON-ready data; plus the traces for charts."""
-    d, b, m = 2.0 * spec.reference_radius_mm, spec.face_width_mm, spec.module_mm
+def worst_deviations(measured: list[Trace]) -> tuple[dict[str, float], dict[str, dict]]:
+    """The worst (largest |value|) profile and helix slope, form and total deviation over the traces, and where
+    each is; traces with fewer than three points in their evaluation range are left out."""
     worst = {name: 0.0 for name in DEVIATIONS.values()}
-    where = {}
-    measured = traces(spec, result)
+    where: dict[str, dict] = {}
     for trace in measured:
-        values = evaluate_trace(trace.position_mm, trace.deviation_um, *trace.evaluation)
+        try:
+            values = evaluate_trace(trace.position_mm, trace.deviation_um, *trace.evaluation)
+        except ValueError:
+            continue
         names = ("f_Ha", "f_fa", "F_a") if trace.kind == "profile" else ("f_Hb", "f_fb", "F_b")
         for name, value in zip(names, (values.slope_um, values.form_um, values.total_um)):
             if abs(value) > abs(worst[name]):
                 worst[name] = value
                 where[name] = {"space": trace.space, "side": trace.side, "x_mm": trace.x_mm}
+    return worst, where
+
+
+def grade_simulation(spec, result) -> dict:
+    """The gear's ISO 1328-1 deviations (worst over all flanks), their classes, the gear's class, the class-5
+    tolerances and the validity of the formulas, as JSON-ready data; plus the traces for charts."""
+    d, b, m = 2.0 * spec.reference_radius_mm, spec.face_width_mm, spec.module_mm
+    measured = traces(spec, result)
+    worst, where = worst_deviations(measured)
     pitch = {}
     for side in SIDES:
         single, f_pt, f_p = pitch_deviations(flank_positions_um(spec, result, side))

@@ -1,0 +1,169 @@
+"""Grade a real gear from measured points (`spur-cad grade JOB MEASURED.csv`): best-fit the gear's rotation
+and centre, take each point's deviation from the design along the design normal, and evaluate profile,
+helix and pitch traces by ISO 1328-1:2013 as for a simulated gear (spur_cad.grade.simulated).
+
+CSV: one point per line, `x_mm,y_mm` in a transverse plane (any rotation and a centre near the gear's
+axis), optionally a third column `X_mm`, the axial position (several transverse planes give helix
+traces). A header line of names is allowed; `#` starts a comment. Points of several flanks and tooth
+spaces may be mixed: each point belongs to the flank of the design point nearest to it (after the fit).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from spur_cad.errors import SpurCadError
+from spur_cad.grade.iso1328 import DEVIATIONS, KINDS, class_of, pitch_deviations, validity_problems
+from spur_cad.grade.simulated import Trace, helix_range_mm, profile_range_mm
+
+MAX_POINTS = 2_000_000
+FIT_POINTS = 4000  # points used for the best fit (an even subset of the file)
+DESIGN_SPACING_MM = 0.005
+REFERENCE_BAND_MM = 0.25  # points within this radial distance of the reference circle give helix and pitch
+
+
+class MeasuredPointsError(SpurCadError):
+    """A measured-points file that cannot be read: the message names the file and line."""
+
+
+@dataclass(frozen=True)
+class MeasuredPoints:
+    """Points in a transverse plane (mm) and their axial position X (mm; 0 when the file has none)."""
+
+    y: np.ndarray
+    z: np.ndarray
+    x: np.ndarray
+
+
+def read_points_csv(text: str, source: str) -> MeasuredPoints:
+    """The points of a measured-points CSV (see the module docstring); one line naming the line on error."""
+    rows = []
+    for number, raw in enumerate(text.splitlines(), start=1):
+        line = raw.split("#", 1)[0].strip()
+        if not line:
+            continue
+        parts = [part.strip() for part in line.replace(";", ",").split(",")]
+        try:
+            values = [float(part) for part in parts]
+        except ValueError:
+            if not rows and not any(ch.isdigit() for ch in line):
+                continue  # a header of column names
+            raise MeasuredPointsError(f"{source}:{number}: not numbers: {line[:60]!r}") from None
+        if len(values) not in (2, 3):
+            raise MeasuredPointsError(f"{source}:{number}: expected x_mm,y_mm[,X_mm], got {len(values)} values")
+        if not all(math.isfinite(v) and abs(v) < 1e5 for v in values):
+            raise MeasuredPointsError(f"{source}:{number}: a value is not a finite coordinate below 1e5 mm")
+        rows.append(values + [0.0] * (3 - len(values)))
+        if len(rows) > MAX_POINTS:
+            raise MeasuredPointsError(f"{source}: more than {MAX_POINTS:,} points")
+    if len(rows) < 10:
+        raise MeasuredPointsError(f"{source}: {len(rows)} points; at least 10 are needed")
+    data = np.array(rows)
+    return MeasuredPoints(data[:, 0], data[:, 1], data[:, 2])
+
+
+def _design(spec):
+    """Every tooth space's design points, normals, roll lengths and flank labels (space, side) for the gear."""
+    from spur_cad.sim.design import design_grid
+
+    grid = design_grid(spec, DESIGN_SPACING_MM, 0.0, 0.0, np.zeros(0))
+    names = grid.feature_names()
+    side = np.array([name.split()[0] if name.endswith("involute") else "" for name in names])
+    points = np.concatenate([grid.space_points(k) for k in range(grid.teeth)])
+    normals = np.concatenate([grid.space_normals(k) for k in range(grid.teeth)])
+    space = np.repeat(np.arange(grid.teeth), len(grid.points))
+    radius = np.hypot(grid.points[:, 0], grid.points[:, 1])
+    roll = np.tile(np.sqrt(np.maximum(radius ** 2 - spec.base_radius_mm ** 2, 0.0)), grid.teeth)
+    return points, normals, space, np.tile(side, grid.teeth), roll, np.tile(radius, grid.teeth)
+
+
+def _deviations(tree, points, normals, y, z, params):
+    angle, cy, cz = params
+    c, s = math.cos(angle), math.sin(angle)
+    py, pz = c * (y - cy) - s * (z - cz), s * (y - cy) + c * (z - cz)
+    _, nearest = tree.query(np.column_stack([py, pz]))
+    deviation = (py - points[nearest, 0]) * normals[nearest, 0] + (pz - points[nearest, 1]) * normals[nearest, 1]
+    return deviation, nearest
+
+
+def fit(spec, measured: MeasuredPoints):
+    """Rotation (rad) and centre (mm) that bring the points nearest the design (least squares of the normal
+    deviations), and each point's deviation (mm, + material) and nearest design point after the fit."""
+    from scipy.optimize import least_squares
+    from scipy.spatial import cKDTree
+
+    points, normals, *_ = _design(spec)
+    tree = cKDTree(points)
+    pitch = 2.0 * math.pi / spec.teeth
+    step = max(1, len(measured.y) // FIT_POINTS)  # the fit on an even subset; deviations of every point after
+    y, z = measured.y[::step], measured.z[::step]
+    starts = np.linspace(0.0, pitch, 48, endpoint=False)  # the rotation's basin is narrower than a pitch
+    costs = [np.sum(_deviations(tree, points, normals, y, z, [a, 0.0, 0.0])[0] ** 2) for a in starts]
+    best = least_squares(lambda p: _deviations(tree, points, normals, y, z, p)[0],
+                         x0=[float(starts[int(np.argmin(costs))]), 0.0, 0.0], x_scale=[0.01, 0.01, 0.01])
+    deviation, nearest = _deviations(tree, points, normals, measured.y, measured.z, best.x)
+    return best.x, deviation, nearest
+
+
+def _flank_traces(spec, measured: MeasuredPoints, deviation, nearest):
+    """Profile traces per flank and plane, helix traces near the reference circle (three planes or more), and
+    each flank's position on the reference circle (um of arc) by side and space."""
+    _, _, space, side, roll, radius = _design(spec)
+    profile_range = profile_range_mm(spec)
+    helix_range = helix_range_mm(spec.face_width_mm, spec.module_mm)
+    cos_alpha = spec.base_radius_mm / spec.reference_radius_mm
+    found: list[Trace] = []
+    positions: dict[str, dict[int, float]] = {"right": {}, "left": {}}
+    for flank_side in ("right", "left"):
+        for k in range(spec.teeth):
+            on_flank = (side[nearest] == flank_side) & (space[nearest] == k)
+            if np.count_nonzero(on_flank) < 3:
+                continue
+            dev_um, x, flank_roll = deviation[on_flank] * 1000.0, measured.x[on_flank], roll[nearest][on_flank]
+            planes = np.round(x, 3)
+            for plane in np.unique(planes):
+                order = np.argsort(flank_roll[planes == plane])
+                found.append(Trace("profile", k, flank_side, float(plane), flank_roll[planes == plane][order],
+                                   dev_um[planes == plane][order], profile_range))
+            near = np.abs(radius[nearest][on_flank] - spec.reference_radius_mm) <= REFERENCE_BAND_MM
+            if near.any():
+                positions[flank_side][k] = float(np.mean(dev_um[near])) / cos_alpha
+            if len(np.unique(planes[near])) >= 3:
+                order = np.argsort(x[near])
+                found.append(Trace("helix", k, flank_side, None, x[near][order], dev_um[near][order], helix_range))
+    return found, positions
+
+
+def grade_measured(spec, measured: MeasuredPoints) -> dict:
+    """ISO 1328-1 deviations and classes of the measured flanks (worst over the flanks measured). Spur gears:
+    a helical gear's transverse sections turn with X, which this fit does not follow yet (refused)."""
+    from spur_cad.grade.simulated import worst_deviations
+
+    if spec.is_helical:
+        raise SpurCadError("grading measured points of a helical gear is not supported yet (spur gears only)")
+    params, deviation, nearest = fit(spec, measured)
+    d, b, m = 2.0 * spec.reference_radius_mm, spec.face_width_mm, spec.module_mm
+    found_traces, positions = _flank_traces(spec, measured, deviation, nearest)
+    worst, where = worst_deviations(found_traces)
+    complete = [(flank_side, p) for flank_side, p in positions.items() if len(p) == spec.teeth]
+    for flank_side, flank_positions in complete:  # pitch needs every flank of one side
+        single, f_pt, f_p = pitch_deviations(np.array([flank_positions[k] for k in range(spec.teeth)]))
+        if f_pt > worst["f_pt"]:
+            worst["f_pt"], where["f_pt"] = f_pt, {"side": flank_side, "space": int(np.argmax(np.abs(single)))}
+        worst["F_p"] = max(worst["F_p"], f_p)
+    kinds = {t.kind for t in found_traces}
+    measured_kinds = ({"f_Ha", "f_fa", "F_a"} if "profile" in kinds else set()) | \
+        ({"f_Hb", "f_fb", "F_b"} if "helix" in kinds else set()) | ({"f_pt", "F_p"} if complete else set())
+    classes = {DEVIATIONS[kind]: class_of(kind, worst[DEVIATIONS[kind]], d, b, m) for kind in KINDS
+               if DEVIATIONS[kind] in measured_kinds}
+    overall = None if not classes or any(c is None for c in classes.values()) else max(classes.values())
+    return {"standard": "ISO 1328-1:2013", "points": int(len(measured.y)),
+            "fit": {"rotation_deg": math.degrees(params[0]), "centre_mm": [float(params[1]), float(params[2])],
+                    "rms_deviation_um": float(np.sqrt(np.mean(deviation ** 2)) * 1000.0)},
+            "deviations_um": {name: round(value, 3) for name, value in worst.items() if name in measured_kinds},
+            "where": where, "classes": classes, "class": overall,
+            "validity": validity_problems(spec.teeth, d, m, b, math.degrees(spec.helix_angle_rad)),
+            "traces": found_traces}
