@@ -47,6 +47,9 @@ def _parser() -> argparse.ArgumentParser:
     verify.add_argument("programs", nargs="+", help="G-code programs, run in the order given")
     verify.add_argument("--out", help="folder for verify.json and deviation_map.csv (created if missing)")
     verify.add_argument("--dialect", help="dialect of the programs (default: the job's [post] dialect)")
+    verify.add_argument("--reader", default="spur_cad", choices=("spur_cad", "rs274"),
+                        help="read LinuxCNC programs with LinuxCNC's own interpreter (rs274) instead of spur_cad's "
+                             "reader")
     verify.add_argument("--point", default="tip", choices=("tip", "corner-centre"),
                         help="programmed point of the tool: its tip (spur_cad's programs) or its corner-radius "
                              "centre (a tool length offset to the ball centre)")
@@ -184,7 +187,7 @@ def _verify(args: argparse.Namespace, received: list[int], loaded: list) -> int:
     from spur_cad.job import load_job
     from spur_cad.outputs import check_output_folder, write_output_set
     from spur_cad.verify.reader import MAX_PROGRAM_BYTES, read_program
-    from spur_cad.verify.rs274 import rs274_verdict
+    from spur_cad.verify.rs274 import read_canonical, rs274_verdict
     from spur_cad.verify.verify import VerifyOptions, result_files, verify_moves
 
     _checkpoint(received)
@@ -207,7 +210,12 @@ def _verify(args: argparse.Namespace, received: list[int], loaded: list) -> int:
             raise SpurCadError(f"{name}: not a text file (byte {exc.start} is not UTF-8)") from None
         except OSError as exc:
             raise SpurCadError(f"{name}: cannot read: {exc.strerror or exc}") from None
-        programs.append(read_program(text, dialect, name))
+        if args.reader == "rs274":
+            if dialect != "linuxcnc":
+                raise SpurCadError(f"--reader rs274 reads LinuxCNC programs only (the dialect is {dialect})")
+            programs.append(read_canonical(path, name))
+        else:
+            programs.append(read_program(text, dialect, name))
         _checkpoint(received)
     result = verify_moves(job, programs, options, progress=lambda fraction: _checkpoint(received))
     if dialect == "linuxcnc":

@@ -261,3 +261,14 @@ def test_direction_codes_turn_the_way_they_say():
     with pytest.raises(ProgramReadError, match=r"p:2: with M15, A must be an angle in \[0, 360\)"):
         read_program("G0 X0 Y0 Z30 A0\nA400 M15\nM30\n", "okuma", "p")
     assert math.isclose(read_program("G0 X0 Y0 Z30 A0\nA10 M16\nM30\n", "okuma", "p").a[-1], -350.0)
+
+
+@pytest.mark.linuxcnc
+def test_linuxcncs_interpreter_as_the_reader_gives_the_same_verdict(small, rs274, tmp_path):
+    job, plan = small
+    programs = _programs(job, plan, "linuxcnc", True)
+    _, own = _verify(tmp_path / "own", _job_text(), programs, "--dialect", "linuxcnc")
+    code, by_rs274 = _verify(tmp_path / "rs274", _job_text(), programs, "--dialect", "linuxcnc", "--reader", "rs274")
+    assert code == 0 and by_rs274["passed"] and by_rs274["moves"] == own["moves"]
+    assert by_rs274["max_gouge_mm"] == pytest.approx(own["max_gouge_mm"], abs=1e-9)
+    assert by_rs274["max_leftover_mm"] == pytest.approx(own["max_leftover_mm"], abs=1e-9)

@@ -130,6 +130,27 @@ FreeCADGui.runCommand("SpurCad_Export")
 settle()
 RESULT["exported"] = sorted(os.listdir(OUT))
 
+# Verify program: the exported programs (roughing first) read back, cut and judged; shown on the gear
+import spur_cad_workbench.commands as wb_commands
+programs = sorted((os.path.join(OUT, n) for n in os.listdir(OUT) if n.startswith(("roughing.", "finishing."))),
+                  key=lambda path: "finishing" in path)
+verification = wb_commands.verify_programs(job, programs)
+settle()
+boxes = [w for w in QtGui.QApplication.topLevelWidgets() if w.objectName() == "SpurCadMessage" and w.isVisible()]
+RESULT["verification"] = [verification.Label, verification.Status, verification.MaxGougeMicrons,
+                          len(verification.Points.Points),
+                          [b.text() for b in boxes if b.windowTitle() == "Verify program"]]
+for box in boxes:
+    box.close()
+answer_file_dialog([p for p in programs if "finishing" in p][0])   # the command: finishing alone leaves the roughing
+select(job)
+FreeCADGui.runCommand("SpurCad_Verify")
+settle()
+boxes = [w for w in QtGui.QApplication.topLevelWidgets() if w.objectName() == "SpurCadMessage" and w.isVisible()]
+RESULT["verify_command"] = [b.text() for b in boxes if b.windowTitle() == "Verify program"]
+for box in boxes:
+    box.close()
+
 answer_file_dialog(JOB_FILE)
 FreeCADGui.runCommand("SpurCad_ImportJob")     # into a new document named after the job file
 settle()
@@ -181,7 +202,8 @@ def test_workbench_commands_panel_and_screenshot_in_the_gui(freecad_gui, tmp_pat
     for word in ("Traceback", "Exception", "Error"):
         assert word not in result["report"], result["report"]
 
-    names = ["SpurCad_Gear", "SpurCad_Stock", "SpurCad_Job", "SpurCad_ImportJob", "SpurCad_Simulate", "SpurCad_Export"]
+    names = ["SpurCad_Gear", "SpurCad_Stock", "SpurCad_Job", "SpurCad_ImportJob", "SpurCad_Simulate", "SpurCad_Verify",
+             "SpurCad_Export"]
     assert result["workbench"] == "SpurCadWorkbench"
     assert result["toolbar"] == names
     assert len(result["menu"]) == len(names)
@@ -203,6 +225,11 @@ def test_workbench_commands_panel_and_screenshot_in_the_gui(freecad_gui, tmp_pat
     count, boxes = result["simulation"]
     assert count == 1 or boxes == ["simulation not available: this spur_cad has no simulator (spur_cad.sim)"]
     assert {"gear.step", "stock.step", "job.step", "summary.json"} <= set(result["exported"])
+    label, status, gouge, points, texts = result["verification"]
+    assert label == "Job verification"
+    assert status == "ok" and gouge <= 5.0 and points > 0 and texts and texts[0].splitlines()[-1].startswith("PASS: ")
+    # finishing alone: the stock is never roughed, the finishing tool's reach leaves material: FAIL
+    assert result["verify_command"] and result["verify_command"][0].splitlines()[-1].startswith("FAIL: ")
     assert any(name.startswith("roughing.") for name in result["exported"])
     assert result["imported"] == ["small", ["small quick gear"]]
     expected = _expected(small_job_text(finishing_diameter=9.0))
@@ -210,7 +237,8 @@ def test_workbench_commands_panel_and_screenshot_in_the_gui(freecad_gui, tmp_pat
     assert f"Export: {expected}" in result["report"]
 
     # every command went through FreeCADGui.doCommandGui: echoed as macro lines
-    for call in ("make_gear(", "make_stock(", "make_job(", "simulate(", "export_job(", "import_job_file("):
+    for call in ("make_gear(", "make_stock(", "make_job(", "simulate(", "export_job(", "import_job_file(",
+                 "verify_programs("):
         assert f"spur_cad_workbench.commands.{call}" in result["console"], result["console"][-2000:]
 
     # the screenshot shows the gear and both toolpaths in their colours

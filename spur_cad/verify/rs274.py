@@ -15,6 +15,8 @@ from pathlib import Path
 
 RS274_LOCATIONS = ("/usr/bin/rs274", "/usr/lib/linuxcnc/bin/rs274", "/usr/local/bin/rs274")
 TIMEOUT_S = 300.0
+NUMERIC_CALLS = ("STRAIGHT_TRAVERSE", "STRAIGHT_FEED", "SET_FEED_RATE", "SET_FEED_MODE", "CHANGE_TOOL",
+                 "SET_SPINDLE_SPEED")
 
 
 def rs274_executable() -> str | None:
@@ -42,3 +44,64 @@ def rs274_verdict(program: str | os.PathLike) -> str:
     messages = [line.strip() for line in (proc.stderr + proc.stdout).splitlines()
                 if line.strip() and line.strip() != "executing"]
     return "failed: " + ("; ".join(messages[:2]) if messages else f"exit status {proc.returncode}")
+
+
+def _canonical_text(program: str | os.PathLike, source: str) -> str:
+    """rs274's canonical calls for a program (raises SpurCadError when rs274 is missing or refuses it)."""
+    from spur_cad.errors import SpurCadError
+
+    executable = rs274_executable()
+    if executable is None:
+        raise SpurCadError("--reader rs274: rs274 not found (install linuxcnc-uspace)")
+    with tempfile.TemporaryDirectory(prefix="spur-cad-rs274-") as work:
+        canon = Path(work) / "canon.txt"
+        proc = subprocess.run([executable, "-g", str(Path(program).resolve()), str(canon)], stdin=subprocess.DEVNULL,
+                              capture_output=True, text=True, cwd=work, timeout=TIMEOUT_S)
+        if proc.returncode != 0:
+            messages = [line.strip() for line in proc.stderr.splitlines() if line.strip() not in ("", "executing")]
+            raise SpurCadError(f"{source}: rs274 refuses the program: {'; '.join(messages[:2])}")
+        return canon.read_text()
+
+
+def read_canonical(program: str | os.PathLike, source: str):
+    """The moves of a LinuxCNC program as LinuxCNC's own interpreter executes them (rs274's canonical calls
+    STRAIGHT_TRAVERSE / STRAIGHT_FEED with SET_FEED_RATE, SET_FEED_MODE, CHANGE_TOOL, SET_SPINDLE_SPEED):
+    the reference reader for LinuxCNC programs. `line` holds the canonical call's number."""
+    import re
+
+    import numpy as np
+
+    from spur_cad.errors import SpurCadError
+    from spur_cad.verify.reader import MAX_MOVES, ProgramMoves
+
+    text = _canonical_text(program, source)
+    call = re.compile(r"^\s*(\d+)\s+N\S*\s+([A-Z_]+)\((.*)\)\s*$")
+    moves, feed, inverse, tool, spindle = [], float("nan"), False, 0, 0.0
+    for line in text.splitlines():
+        found = call.match(line)
+        if found is None:
+            continue
+        number, name, arguments = int(found.group(1)), found.group(2), found.group(3)
+        if name not in NUMERIC_CALLS:
+            if name in ("ARC_FEED", "STRAIGHT_PROBE", "NURBS_FEED", "RIGID_TAP"):
+                raise SpurCadError(f"{source}: rs274 call {number} is {name}, which verify does not simulate")
+            continue  # comments, coolant, offsets of 0, ...
+        values = [float(v) for v in re.split(r"[,\s]+", arguments.strip()) if v]
+        if name in ("STRAIGHT_TRAVERSE", "STRAIGHT_FEED"):
+            rapid = name == "STRAIGHT_TRAVERSE"
+            moves.append((rapid, *values[:4], float("nan") if rapid else feed, inverse and not rapid, number,
+                          tool, spindle))
+            if len(moves) > MAX_MOVES:
+                raise SpurCadError(f"{source}: the program has more than {MAX_MOVES:,} moves; split it")
+        elif name == "SET_FEED_RATE":
+            feed = values[0]
+        elif name == "SET_FEED_MODE":
+            inverse = values[-1] == 1.0
+        elif name == "CHANGE_TOOL":
+            tool = int(values[0])
+        elif name == "SET_SPINDLE_SPEED":
+            spindle = values[-1]
+    columns = list(zip(*moves)) if moves else [[]] * 10
+    return ProgramMoves(source, np.array(columns[0], bool), *(np.array(c, float) for c in columns[1:6]),
+                        np.array(columns[6], bool), np.array(columns[7], int), np.array(columns[8], int),
+                        np.array(columns[9], float))

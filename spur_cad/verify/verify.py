@@ -64,6 +64,7 @@ class VerifyResult:
     seconds: float
     rs274: dict = field(default_factory=dict)
     deviation_map: str = ""
+    simulation: object = None  # the spur_cad.sim SimResult (for drawing the deviations on the gear)
 
     @property
     def passed(self) -> bool:
@@ -193,7 +194,8 @@ def verify_moves(job, programs: list[ProgramMoves], options: VerifyOptions = Ver
     leftover_tol = (options.leftover_tolerance_mm if options.leftover_tolerance_mm is not None
                     else job.finishing.target_scallop_mm + resolution)
     return VerifyResult(space_verdicts(result), result.max_gouge_mm, result.max_leftover_mm, gouge_tol, leftover_tol,
-                        sum(len(moves) for moves in programs), result.seconds, deviation_map=deviation_map_csv(result))
+                        sum(len(moves) for moves in programs), result.seconds, deviation_map=deviation_map_csv(result),
+                        simulation=result)
 
 
 def result_files(result: VerifyResult) -> dict[str, bytes]:

@@ -174,6 +174,34 @@ def simulate(job_obj, resolution_mm: float | None = None):
     return show_result(job_obj, simulate_job(job, plan, resolution_mm), signature, source)
 
 
+def verify_programs(job_obj, paths: list[str], dialect: str | None = None, point: str = "tip"):
+    """`spur-cad verify` inside FreeCAD: read the G-code programs (from anywhere; the job's post dialect unless
+    given), cut the job's stock with them and show the deviations on the gear in '<job> verification';
+    the verdict goes to the report view and a message box. Returns the object."""
+    from spur_cad.errors import SpurCadError
+    from spur_cad.verify.reader import read_program
+    from spur_cad.verify.verify import VerifyOptions, verify_moves
+    from spur_cad_workbench.features import document_values
+    from spur_cad_workbench.simulation import show_result, simulator
+    from spur_cad_workbench.summary import values_signature
+
+    simulator()
+    job = job_of(job_obj)
+    programs = []
+    for path in paths:
+        try:
+            text = Path(path).read_text(encoding="utf-8")
+        except (OSError, UnicodeDecodeError) as exc:
+            raise SpurCadError(f"{path}: cannot read: {getattr(exc, 'strerror', None) or exc}") from None
+        programs.append(read_program(text, dialect or job.post.dialect, path))
+    result = verify_moves(job, programs, VerifyOptions(point))
+    names = ", ".join(Path(path).name for path in paths)
+    obj = show_result(job_obj, result.simulation, values_signature(document_values(job_obj)),
+                      f"verified programs: {names}", role="verification")
+    show_message("Verify program", "\n".join(result.lines()), error=not result.passed)
+    return obj
+
+
 def document_name(path: str) -> str:
     """A FreeCAD document name for a job file: its stem with characters FreeCAD names cannot hold replaced."""
     import re
@@ -337,6 +365,26 @@ class SimulateCommand(_Command):
         run_recorded([_call("spur_cad_simulation", "simulate", _object(job))], "Simulate")
 
 
+class VerifyCommand(_Command):
+    NAME, ICON, MENU = "SpurCad_Verify", "verify", "Verify program..."
+    TIP = ("Read G-code programs from anywhere, cut the job's stock with them and show gouge and leftover on the "
+           "gear (as `spur-cad verify`)")
+
+    def IsActive(self):
+        return _selected("job") is not None
+
+    def Activated(self):
+        import FreeCADGui
+        from PySide import QtGui
+
+        job = _selected("job")
+        paths, _ = QtGui.QFileDialog.getOpenFileNames(FreeCADGui.getMainWindow(), "Verify G-code programs", "",
+                                                      "G-code (*.ngc *.nc *.mpf *.min *.tap *.gcode);;All files (*)")
+        if paths:
+            run_recorded([_call("spur_cad_verification", "verify_programs", _object(job), repr(list(paths)))],
+                         "Verify program")
+
+
 class ExportCommand(_Command):
     NAME, ICON, MENU = "SpurCad_Export", "export", "Export STEP and G-code..."
     TIP = "Write the job's STEP files (gear, stock, assembly) and G-code programs, as `spur-cad run` does"
@@ -354,7 +402,7 @@ class ExportCommand(_Command):
             run_recorded([_call("spur_cad_files", "export_job", _object(job), repr(folder))], "Export")
 
 
-COMMANDS = (GearCommand, StockCommand, JobCommand, ImportJobCommand, SimulateCommand, ExportCommand)
+COMMANDS = (GearCommand, StockCommand, JobCommand, ImportJobCommand, SimulateCommand, VerifyCommand, ExportCommand)
 
 
 def register_commands() -> list[str]:

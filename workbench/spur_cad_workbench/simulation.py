@@ -158,15 +158,17 @@ def show_current(obj) -> None:
     recolour(obj)
 
 
-def _simulation_object(job_obj):
-    """The job's simulation object (made when missing), linked to the job."""
+def _simulation_object(job_obj, role: str):
+    """The job's simulation object of `role` ("simulation" of its own toolpaths, "verification" of programs;
+    made when missing), linked to the job."""
     import FreeCAD
 
     doc = job_obj.Document
     for obj in job_obj.InList:
-        if getattr(getattr(obj, "Proxy", None), "KIND", "") == "simulation":
+        if getattr(getattr(obj, "Proxy", None), "KIND", "") == "simulation" and \
+                obj.Label == f"{job_obj.Label} {role}":
             return obj
-    obj = doc.addObject("Points::FeaturePython", "Simulation")
+    obj = doc.addObject("Points::FeaturePython", role.capitalize())
     SimulationFeature(obj)
     for prop, type_id, doc_text in _RESULT_PROPERTIES:
         # read-only outputs (1 | 8): setting them (stale marking) does not ask for a recompute
@@ -181,13 +183,14 @@ def _simulation_object(job_obj):
     return obj
 
 
-def show_result(job_obj, result, planned_values: str = "", plan_source: str = ""):
-    """The job's simulation object '<job> simulation' with the coloured design points and the result's facts."""
+def show_result(job_obj, result, planned_values: str = "", plan_source: str = "", role: str = "simulation"):
+    """The job's object '<job> <role>' with the coloured design points and the result's facts (role
+    "simulation": the job's own toolpaths; "verification": programs read by `verify_programs`)."""
     import FreeCAD
     import Points
 
-    obj = _simulation_object(job_obj)
-    obj.Label = f"{job_obj.Label} simulation"
+    obj = _simulation_object(job_obj, role)
+    obj.Label = f"{job_obj.Label} {role}"
     points, deviation = result_points(result)
     scale = colour_scale_mm(deviation, result.settings.resolution_mm)
     obj.Points = Points.Points([FreeCAD.Vector(*p) for p in points])
