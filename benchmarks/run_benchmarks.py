@@ -150,6 +150,7 @@ def main() -> None:
     from benchmarks.bench_helical import HELICAL_JOB
     from benchmarks.bench_helical import figures as helical_figures
     from benchmarks.bench_sim import bench_sim
+    from benchmarks.bench_verify import figures as verify_figures
     from spur_cad.job import load_job
 
     results = {"machine": machine(), "runs": args.runs, "profile": bench_profile(args.runs),
@@ -157,6 +158,7 @@ def main() -> None:
                "post": bench_post(args.cad_runs), "sim_runs": args.sim_runs, "sim": bench_sim(args.sim_runs),
                "generating": figures(load_job(REFERENCE_JOB)),
                "helical": helical_figures(load_job(HELICAL_JOB), args.run_runs),
+               "verify": verify_figures(args.run_runs),
                "run_s": {strategy: end_to_end_seconds(strategy, args.run_runs)
                          for strategy in ("generating", "perimeter")}}
     print(json.dumps(results, indent=2))

@@ -144,10 +144,26 @@ def test_a_block_moved_20_um_into_a_flank_is_found_at_its_space_and_size(small, 
     assert max(others) <= fine
 
 
-def _map(folder) -> dict[tuple[int, str, float], float]:
-    """deviation_map.csv as {(space, feature, x): largest deviation (um)}."""
+def _map(folder, column: int = 4) -> dict[tuple[int, str, float], float]:
+    """deviation_map.csv as {(space, feature, x): largest (column 4) or smallest (3) deviation (um)}."""
     lines = (folder / "verify_out" / "deviation_map.csv").read_text().splitlines()[1:]
-    return {(int(k), feature, float(x)): float(high) for k, feature, x, _, high in (line.split(",") for line in lines)}
+    return {(int(parts[0]), parts[1], float(parts[2])): float(parts[column]) for parts in
+            (line.split(",") for line in lines)}
+
+
+def test_z_programmed_at_the_corner_centre_read_as_the_tip_gouges_the_root_by_the_corner_radius(tmp_path):
+    # a finishing tool with r_t = 0.3 mm (below the simulator's 0.5 mm gouge range, so the depth is measured)
+    text = _job_text("perimeter").replace("diameter_mm = 1.5", "diameter_mm = 1.2").replace(
+        "corner_radius_mm = 0.5", "corner_radius_mm = 0.3")
+    job = parse_job(text, "p.toml")
+    plan = plan_cam(job)
+    programs = {"roughing.ngc": _post(plan.roughing.toolpath), "finishing.ngc": _post(plan.finishing.toolpath)}
+    _, right = _verify(tmp_path / "tip", text, programs)
+    code, wrong = _verify(tmp_path / "centre", text, programs, "--point", "corner-centre")
+    assert code == 1 and wrong["max_gouge_mm"] > right["max_gouge_mm"] + 0.2
+    lowest = _map(tmp_path / "centre", column=3)
+    root = [value for (k, feature, x), value in lowest.items() if feature == "root"]
+    assert abs(-float(np.median(root)) / 1000.0 - 0.3) <= RESOLUTION  # the tool tip r_t below the root
 
 
 def test_a_missing_station_is_found_at_its_space_and_x(tmp_path):
