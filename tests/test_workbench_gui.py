@@ -142,7 +142,7 @@ RESULT["verification"] = [verification.Label, verification.Status, verification.
                           [b.text() for b in boxes if b.windowTitle() == "Verify program"]]
 for box in boxes:
     box.close()
-answer_file_dialog([p for p in programs if "finishing" in p][0])   # the command: finishing alone leaves the roughing
+answer_file_dialog([p for p in programs if "roughing" in p][0])   # the command: roughing alone leaves finish stock
 select(job)
 FreeCADGui.runCommand("SpurCad_Verify")
 settle()
@@ -228,7 +228,7 @@ def test_workbench_commands_panel_and_screenshot_in_the_gui(freecad_gui, tmp_pat
     label, status, gouge, points, texts = result["verification"]
     assert label == "Job verification"
     assert status == "ok" and gouge <= 5.0 and points > 0 and texts and texts[0].splitlines()[-1].startswith("PASS: ")
-    # finishing alone: the stock is never roughed, the finishing tool's reach leaves material: FAIL
+    # roughing alone leaves its finish stock and flank allowance on the flanks: FAIL
     assert result["verify_command"] and result["verify_command"][0].splitlines()[-1].startswith("FAIL: ")
     assert any(name.startswith("roughing.") for name in result["exported"])
     assert result["imported"] == ["small", ["small quick gear"]]
