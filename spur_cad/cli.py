@@ -23,6 +23,7 @@ from spur_cad import __version__
 from spur_cad.errors import SpurCadError
 
 EXIT_INPUT_ERROR = 2
+MAX_MEASURED_BYTES = 256 * 1024 * 1024
 EXIT_INTERNAL_ERROR = 3
 EXIT_INTERRUPTED = 130  # 128 + SIGINT, as shells report it
 EXIT_TERMINATED = 143  # 128 + SIGTERM
@@ -53,6 +54,8 @@ def _parser() -> argparse.ArgumentParser:
     verify.add_argument("--point", default="tip", choices=("tip", "corner-centre"),
                         help="programmed point of the tool: its tip (spur_cad's programs) or its corner-radius "
                              "centre (a tool length offset to the ball centre)")
+    verify.add_argument("--point-tools", type=int, nargs="+", default=(), metavar="T",
+                        help="the tool numbers --point applies to (default: every tool)")
     verify.add_argument("--gouge-tolerance-mm", type=float, help="largest gouge that passes (default: the "
                         "simulation's resolution)")
     verify.add_argument("--leftover-tolerance-mm", type=float, help="largest leftover that passes (default: the "
@@ -194,7 +197,7 @@ def _verify(args: argparse.Namespace, received: list[int], loaded: list) -> int:
     out_dir = check_output_folder(args.out) if args.out else None
     loaded.append(load_job(args.job))
     job = loaded[0]
-    options = VerifyOptions(args.point, args.gouge_tolerance_mm, args.leftover_tolerance_mm)
+    options = VerifyOptions(args.point, args.gouge_tolerance_mm, args.leftover_tolerance_mm, tuple(args.point_tools))
     options.validate()
     dialect = args.dialect or job.post.dialect
     programs = []
@@ -215,7 +218,7 @@ def _verify(args: argparse.Namespace, received: list[int], loaded: list) -> int:
                 raise SpurCadError(f"--reader rs274 reads LinuxCNC programs only (the dialect is {dialect})")
             programs.append(read_canonical(path, name))
         else:
-            programs.append(read_program(text, dialect, name))
+            programs.append(read_program(text, dialect, name, checkpoint=lambda: _checkpoint(received)))
         _checkpoint(received)
     result = verify_moves(job, programs, options, progress=lambda fraction: _checkpoint(received))
     if dialect == "linuxcnc":
@@ -248,6 +251,8 @@ def _grade(args: argparse.Namespace, received: list[int], loaded: list) -> int:
     loaded.append(load_job(args.job))
     spec = loaded[0].gear
     try:
+        if Path(args.measured).stat().st_size > MAX_MEASURED_BYTES:
+            raise SpurCadError(f"{args.measured}: larger than {MAX_MEASURED_BYTES // 2**20} MiB")
         text = Path(args.measured).read_text(encoding="utf-8")
     except FileNotFoundError:
         raise SpurCadError(f"{args.measured}: measured points not found") from None
@@ -261,14 +266,19 @@ def _grade(args: argparse.Namespace, received: list[int], loaded: list) -> int:
     for name, value in grading["deviations_um"].items():
         grade = grading["classes"][name]
         print(f"{name}: {value:.2f} um, class {grade if grade else 'beyond 11'}")
+    for note in grading["notes"]:
+        print(f"note: {note}")
     overall = grading["class"]
-    print(f"ISO 1328-1:2013 flank tolerance class: {overall if overall else 'beyond 11'}")
+    if not grading["classes"]:
+        print("not graded: no flank had three points in its evaluation range")
+    else:
+        print(f"ISO 1328-1:2013 flank tolerance class: {overall if overall else 'beyond 11'}")
     if out_dir is not None:
         from spur_cad.report.figures import k_chart_png
 
         files = {"grade.json": (json.dumps({k: v for k, v in grading.items() if k != "traces"}, indent=2)
                                 + "\n").encode()}
-        if grading["traces"] and grading["class"] is not None:
+        if any(trace.kind == "profile" for trace in grading["traces"]):
             files["k_chart.png"] = k_chart_png(spec, grading)
         try:
             write_output_set(out_dir, files)

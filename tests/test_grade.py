@@ -187,6 +187,7 @@ def _grade_cli(tmp_path, csv_text: str, *extra: str) -> tuple[int, dict]:
 
     from spur_cad.cli import main
 
+    tmp_path.mkdir(parents=True, exist_ok=True)
     (tmp_path / "job.toml").write_text(small_job_text())
     (tmp_path / "measured.csv").write_text(csv_text)
     code = main(["grade", str(tmp_path / "job.toml"), str(tmp_path / "measured.csv"), "--out",
@@ -199,8 +200,8 @@ def test_measured_points_of_a_perfect_gear_fit_its_rotation_and_centre_and_grade
     code, grading = _grade_cli(tmp_path, _measured_csv(planted=False), "--required-class", "1")
     fit = grading["fit"]
     assert code == 0 and grading["class"] == 1 and fit["rms_deviation_um"] < 0.2
-    pitch = math.degrees(2 * math.pi / GEAR.teeth)
-    assert min(abs((fit["rotation_deg"] + 3.0) % pitch), abs((fit["rotation_deg"] + 3.0) % pitch - pitch)) < 1e-3
+    assert fit["rotation_deg"] == pytest.approx(3.0, abs=1e-3)  # the scan's turn (within half a pitch)
+    assert fit["centre_mm"] == pytest.approx([0.05, -0.03], abs=1e-4) and grading["notes"] == []
     assert set(grading["deviations_um"]) == {"f_pt", "F_p", "f_Ha", "f_fa", "F_a", "f_Hb", "f_fb", "F_b"}
 
 
@@ -215,6 +216,19 @@ def test_measured_points_give_the_planted_deviations_and_their_classes(tmp_path)
     assert grading["classes"]["f_Ha"] == 7 and grading["classes"]["f_pt"] == 7 and grading["classes"]["f_Hb"] == 6
     assert code == 1 and grading["class"] == 7  # worse than the required class 6
     assert (tmp_path / "grade" / "k_chart.png").read_bytes()[:4] == b"\x89PNG"
+
+
+def test_only_what_was_measured_is_graded(tmp_path):
+    # the planted file with X shifted by 50 mm: planes outside the face width give no helix trace in range
+    shifted = "\n".join(line if line.startswith("x") else ",".join(line.split(",")[:2] + [
+        f"{float(line.split(',')[2]) + 50.0:.4f}"]) for line in _measured_csv(planted=True).strip().splitlines())
+    code, grading = _grade_cli(tmp_path, shifted + "\n")
+    assert code == 0 and "f_Hb" not in grading["deviations_um"] and "f_Hb" not in grading["classes"]
+    assert "outside the face width" in grading["notes"][0]
+    # a single plane with a few flanks: profile only, no pitch (not every flank of a side) and no helix
+    few = "\n".join(_measured_csv(planted=False).splitlines()[:800])
+    _, grading = _grade_cli(tmp_path / "few", few + "\n")
+    assert set(grading["deviations_um"]) <= {"f_Ha", "f_fa", "F_a"} and grading["deviations_um"]
 
 
 @pytest.mark.parametrize("text, message", [

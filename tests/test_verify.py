@@ -63,6 +63,11 @@ def test_the_reader_reproduces_the_toolpath_the_post_wrote(small, dialect, folde
         assert np.array_equal(moves.rapid, kind == MoveKind.RAPID)
         assert np.array_equal(moves.inverse_time, inverse & (kind != MoveKind.RAPID))
         assert set(moves.tool.tolist()) == {planned.toolpath.tool_number}
+        feeds = planned.toolpath.feed[planned.toolpath.motion_mask][np.concatenate(
+            [[True], np.any(np.abs(np.diff(planned.toolpath.poses()[planned.toolpath.motion_mask], axis=0)) > 1e-9,
+                            axis=1)])]
+        cutting = ~moves.rapid
+        assert np.allclose(moves.feed[cutting], feeds[cutting], rtol=1e-3)  # mm/min, or 1/min under G93
 
 
 @pytest.mark.linuxcnc
@@ -213,7 +218,7 @@ def _legacy_program(path, corner_radius_mm: float, swap_direction: bool = False)
         if previous[3] is None or abs(pose[3] - previous[3]) > 1e-9:
             positive = previous[3] is None or pose[3] > previous[3]
             words += [f"A{pose[3] % 360.0:.4f}", "M15" if positive != swap_direction else "M16"]
-        if code == "G1" and path.feed[i] != feed:
+        if code == "G1" and (path.feed[i] != feed or inverse):  # G93: every feed block carries its own F
             words.append(f"F{path.feed[i]:.1f}")
             feed = path.feed[i]
         if any(word[0] in "XYZA" for word in words):
@@ -288,3 +293,71 @@ def test_linuxcncs_interpreter_as_the_reader_gives_the_same_verdict(small, rs274
     assert code == 0 and by_rs274["passed"] and by_rs274["moves"] == own["moves"]
     assert by_rs274["max_gouge_mm"] == pytest.approx(own["max_gouge_mm"], abs=1e-9)
     assert by_rs274["max_leftover_mm"] == pytest.approx(own["max_leftover_mm"], abs=1e-9)
+
+
+def _read(text: str, dialect: str):
+    moves = read_program(text, dialect, "p")
+    return np.column_stack([moves.x, moves.y, moves.z, moves.a]), moves
+
+
+HAND_WRITTEN = [  # the same three moves written as shops write them by hand, one dialect each
+    ("fanuc", "%\nO0001\nG90 G94\nT2 M6\nG65P0100 X1.0 A5.0 L2\nM30\nO0100\nG0 X#24 Y0 Z30 A#1\nG1 Z20 F100\nM99\n%\n"),
+    ("haas", "%\nO01000\nT2M06\nM97P200L2\nM30\nN200\nG00X1.Y0Z30.A5.\nG01Z20.F100.\nM99\n%\n"),
+    ("siemens", "T2 D1\nM6\nR1=1 R2=5\nA1:\nG0 X=R1 Y0 Z30 A=R2\nG1 Z20 F100\nA1_END:\nREPEAT A1 A1_END P=1\nM30\n"),
+    ("okuma", "O1000\nT2 M6\nCALL O100 XS=1 AS=5\nCALL O100 XS=1 AS=5\nM30\nO100\nG0 X=XS Y0 Z30 A=AS\n"
+              "G1 Z20 F100\nRTS\n"),
+    ("linuxcnc", "#1 = 7\nT2 M6\no100 call [1] [5]\no100 call [1] [5]\nG0 X#1 Y0 Z30 A0\nM30\n"
+                 "o100 sub\nG0 X#1 Y0 Z30 A#2\nG1 Z20 F100\no100 endsub\n"),
+]
+
+
+@pytest.mark.parametrize("dialect, text", HAND_WRITTEN, ids=[d for d, _ in HAND_WRITTEN])
+def test_hand_written_forms(dialect, text):
+    poses, moves = _read(text, dialect)
+    assert np.allclose(poses[:4], [[1, 0, 30, 5], [1, 0, 20, 5], [1, 0, 30, 5], [1, 0, 20, 5]])
+    assert set(moves.tool.tolist()) == {2}
+    if dialect == "linuxcnc":  # the call's arguments are local: #1 is 7 again after it
+        assert np.allclose(poses[4], [7, 0, 30, 0])
+
+
+def test_tool_change_words_in_any_order_and_inverse_time_needs_f_in_each_block():
+    _, moves = _read("M6 T2\nG0 X0 Y0 Z30 A0\nM30\n", "linuxcnc")
+    assert moves.tool.tolist() == [2]
+    with pytest.raises(ProgramReadError, match=r"p:4: an inverse-time \(G93\) feed move needs its own F"):
+        _read("T2 M6\nG0 X0 Y0 Z30 A0\nG93 G1 X1 A5 F20\nX2\nM30\n", "linuxcnc")
+    with pytest.raises(ProgramReadError, match=r"p:4: a feed move without a positive F"):  # G94 resets F
+        _read("T2 M6\nG0 X0 Y0 Z30 A0\nG93 G1 X1 A5 F20\nG94 X2\nM30\n", "linuxcnc")
+
+
+@pytest.mark.parametrize("dialect, text, message", [
+    ("linuxcnc", "T2 M6\nG0 X0 Y0 Z30 A10 M15\nM30\n", ":2: M15 is not supported"),
+    ("fanuc", "T2 M6\nG71\nM30\n", ":2: G71 is not supported"),
+    ("linuxcnc", "T2 M6\nG0 X[1 2] Y0 Z30 A0\nM30\n", ":2: cannot evaluate '1 2': terms need + or -"),
+    ("haas", "%\nT2 M6\nM97 P5\nM30\nO5\nG0 X0 Y0 Z30 A0\nM99\n%\n", ":3: calls subprogram 5, which the program"),
+])
+def test_forms_that_mean_something_else_are_refused(dialect, text, message):
+    with pytest.raises(ProgramReadError, match=re.escape(message)):
+        _read(text, dialect)
+
+
+def test_endless_loops_are_refused_before_they_run_for_hours(monkeypatch):
+    import spur_cad.verify.reader as reader
+
+    monkeypatch.setattr(reader, "MAX_BLOCKS", 300_000)  # the limit scaled down: the same check, seconds not minutes
+    text = "o1 repeat [100000]\no2 repeat [100000]\n#1 = 1\no2 endrepeat\no1 endrepeat\nM30\n"
+    with pytest.raises(ProgramReadError, match="executes more than 300,000 blocks"):
+        _read(text, "linuxcnc")
+    monkeypatch.setattr(reader, "CHECK_EVERY_BLOCKS", 1000)
+    calls = []  # a long read offers the CLI a checkpoint (where it stops on Ctrl-C) every CHECK_EVERY_BLOCKS
+    read_program("#1 = 0\no1 repeat [3000]\n#1 = 1\no1 endrepeat\nM30\n", "linuxcnc", "p", lambda: calls.append(1))
+    assert len(calls) == 3
+
+
+def test_point_applies_to_the_tools_named(small, tmp_path):
+    job, plan = small
+    programs = _programs(job, plan, "linuxcnc", True)
+    _, everywhere = _verify(tmp_path / "all", _job_text(), programs, "--point", "corner-centre")
+    _, finishing_only = _verify(tmp_path / "t1", _job_text(), programs, "--point", "corner-centre",
+                                "--point-tools", "1")
+    assert everywhere["max_gouge_mm"] > 0.1  # the finishing tool (r 0.5) goes r_t deep
+    assert finishing_only["max_gouge_mm"] <= RESOLUTION  # only the flat roughing tool named: nothing changes

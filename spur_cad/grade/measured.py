@@ -22,7 +22,6 @@ from spur_cad.grade.simulated import Trace, helix_range_mm, profile_range_mm
 MAX_POINTS = 2_000_000
 FIT_POINTS = 4000  # points used for the best fit (an even subset of the file)
 DESIGN_SPACING_MM = 0.005
-REFERENCE_BAND_MM = 0.25  # points within this radial distance of the reference circle give helix and pitch
 
 
 class MeasuredPointsError(SpurCadError):
@@ -31,11 +30,12 @@ class MeasuredPointsError(SpurCadError):
 
 @dataclass(frozen=True)
 class MeasuredPoints:
-    """Points in a transverse plane (mm) and their axial position X (mm; 0 when the file has none)."""
+    """The file's points: coordinates in their transverse plane (mm, the file's x and y) and the axial
+    position X of the plane (mm, 0 at the gear's front face as in the job; 0 when the file has none)."""
 
-    y: np.ndarray
-    z: np.ndarray
-    x: np.ndarray
+    plane_x: np.ndarray
+    plane_y: np.ndarray
+    axial: np.ndarray
 
 
 def read_points_csv(text: str, source: str) -> MeasuredPoints:
@@ -98,23 +98,25 @@ def fit(spec, measured: MeasuredPoints):
     points, normals, *_ = _design(spec)
     tree = cKDTree(points)
     pitch = 2.0 * math.pi / spec.teeth
-    step = max(1, len(measured.y) // FIT_POINTS)  # the fit on an even subset; deviations of every point after
-    y, z = measured.y[::step], measured.z[::step]
+    step = max(1, len(measured.plane_x) // FIT_POINTS)  # the fit on an even subset; deviations of every point after
+    y, z = measured.plane_x[::step], measured.plane_y[::step]
     starts = np.linspace(0.0, pitch, 48, endpoint=False)  # the rotation's basin is narrower than a pitch
     costs = [np.sum(_deviations(tree, points, normals, y, z, [a, 0.0, 0.0])[0] ** 2) for a in starts]
     best = least_squares(lambda p: _deviations(tree, points, normals, y, z, p)[0],
                          x0=[float(starts[int(np.argmin(costs))]), 0.0, 0.0], x_scale=[0.01, 0.01, 0.01])
-    deviation, nearest = _deviations(tree, points, normals, measured.y, measured.z, best.x)
+    deviation, nearest = _deviations(tree, points, normals, measured.plane_x, measured.plane_y, best.x)
     return best.x, deviation, nearest
 
 
 def _flank_traces(spec, measured: MeasuredPoints, deviation, nearest):
-    """Profile traces per flank and plane, helix traces near the reference circle (three planes or more), and
-    each flank's position on the reference circle (um of arc) by side and space."""
-    _, _, space, side, roll, radius = _design(spec)
+    """Profile traces per flank and plane; per flank and plane the deviation at the reference circle's roll
+    length (interpolated along the profile trace), which gives helix traces (three planes or more) and the
+    flank's position on the reference circle (um of arc, mean over the planes) by side and space."""
+    _, _, space, side, roll, _ = _design(spec)
     profile_range = profile_range_mm(spec)
     helix_range = helix_range_mm(spec.face_width_mm, spec.module_mm)
     cos_alpha = spec.base_radius_mm / spec.reference_radius_mm
+    reference_roll = math.sqrt(spec.reference_radius_mm ** 2 - spec.base_radius_mm ** 2)
     found: list[Trace] = []
     positions: dict[str, dict[int, float]] = {"right": {}, "left": {}}
     for flank_side in ("right", "left"):
@@ -122,18 +124,20 @@ def _flank_traces(spec, measured: MeasuredPoints, deviation, nearest):
             on_flank = (side[nearest] == flank_side) & (space[nearest] == k)
             if np.count_nonzero(on_flank) < 3:
                 continue
-            dev_um, x, flank_roll = deviation[on_flank] * 1000.0, measured.x[on_flank], roll[nearest][on_flank]
-            planes = np.round(x, 3)
+            dev_um, flank_roll = deviation[on_flank] * 1000.0, roll[nearest][on_flank]
+            planes = np.round(measured.axial[on_flank], 3)
+            at_reference = []
             for plane in np.unique(planes):
                 order = np.argsort(flank_roll[planes == plane])
-                found.append(Trace("profile", k, flank_side, float(plane), flank_roll[planes == plane][order],
-                                   dev_um[planes == plane][order], profile_range))
-            near = np.abs(radius[nearest][on_flank] - spec.reference_radius_mm) <= REFERENCE_BAND_MM
-            if near.any():
-                positions[flank_side][k] = float(np.mean(dev_um[near])) / cos_alpha
-            if len(np.unique(planes[near])) >= 3:
-                order = np.argsort(x[near])
-                found.append(Trace("helix", k, flank_side, None, x[near][order], dev_um[near][order], helix_range))
+                trace_roll, trace_dev = flank_roll[planes == plane][order], dev_um[planes == plane][order]
+                found.append(Trace("profile", k, flank_side, float(plane), trace_roll, trace_dev, profile_range))
+                if len(trace_roll) >= 2 and trace_roll[0] <= reference_roll <= trace_roll[-1]:
+                    at_reference.append((float(plane), float(np.interp(reference_roll, trace_roll, trace_dev))))
+            if at_reference:
+                positions[flank_side][k] = float(np.mean([dev for _, dev in at_reference])) / cos_alpha
+            if len(at_reference) >= 3:
+                x, dev = np.array(at_reference).T
+                found.append(Trace("helix", k, flank_side, None, x, dev, helix_range))
     return found, positions
 
 
@@ -154,14 +158,18 @@ def grade_measured(spec, measured: MeasuredPoints) -> dict:
         if f_pt > worst["f_pt"]:
             worst["f_pt"], where["f_pt"] = f_pt, {"side": flank_side, "space": int(np.argmax(np.abs(single)))}
         worst["F_p"] = max(worst["F_p"], f_p)
-    kinds = {t.kind for t in found_traces}
-    measured_kinds = ({"f_Ha", "f_fa", "F_a"} if "profile" in kinds else set()) | \
-        ({"f_Hb", "f_fb", "F_b"} if "helix" in kinds else set()) | ({"f_pt", "F_p"} if complete else set())
+    measured_kinds = {name for name in worst if name not in ("f_pt", "F_p")} | ({"f_pt", "F_p"} if complete else set())
+    outside = sorted({float(x) for x in np.unique(np.round(measured.axial, 3))
+                      if not -1e-9 <= x <= spec.face_width_mm + 1e-9})
     classes = {DEVIATIONS[kind]: class_of(kind, worst[DEVIATIONS[kind]], d, b, m) for kind in KINDS
                if DEVIATIONS[kind] in measured_kinds}
     overall = None if not classes or any(c is None for c in classes.values()) else max(classes.values())
-    return {"standard": "ISO 1328-1:2013", "points": int(len(measured.y)),
-            "fit": {"rotation_deg": math.degrees(params[0]), "centre_mm": [float(params[1]), float(params[2])],
+    pitch = 2.0 * math.pi / spec.teeth
+    turn = -((params[0] + 0.5 * pitch) % pitch - 0.5 * pitch)  # the scan's turn from the design, within a pitch
+    return {"standard": "ISO 1328-1:2013", "points": int(len(measured.plane_x)),
+            "notes": [f"planes at X = {', '.join(f'{x:g}' for x in outside)} mm lie outside the face width "
+                      f"[0, {spec.face_width_mm:g}] mm (X is measured from the gear's front face)"] if outside else [],
+            "fit": {"rotation_deg": math.degrees(turn), "centre_mm": [float(params[1]), float(params[2])],
                     "rms_deviation_um": float(np.sqrt(np.mean(deviation ** 2)) * 1000.0)},
             "deviations_um": {name: round(value, 3) for name, value in worst.items() if name in measured_kinds},
             "where": where, "classes": classes, "class": overall,

@@ -109,9 +109,11 @@ def flank_positions_um(spec, result, side: str) -> np.ndarray:
 
 def worst_deviations(measured: list[Trace]) -> tuple[dict[str, float], dict[str, dict]]:
     """The worst (largest |value|) profile and helix slope, form and total deviation over the traces, and where
-    each is; traces with fewer than three points in their evaluation range are left out."""
+    each is; traces with fewer than three points in their evaluation range are left out, and a deviation no
+    trace gave is missing from both dicts (not 0: it was not measured)."""
     worst = {name: 0.0 for name in DEVIATIONS.values()}
     where: dict[str, dict] = {}
+    evaluated: set[str] = set()
     for trace in measured:
         try:
             values = evaluate_trace(trace.position_mm, trace.deviation_um, *trace.evaluation)
@@ -119,10 +121,11 @@ def worst_deviations(measured: list[Trace]) -> tuple[dict[str, float], dict[str,
             continue
         names = ("f_Ha", "f_fa", "F_a") if trace.kind == "profile" else ("f_Hb", "f_fb", "F_b")
         for name, value in zip(names, (values.slope_um, values.form_um, values.total_um)):
-            if abs(value) > abs(worst[name]):
+            evaluated.add(name)
+            if abs(value) >= abs(worst[name]) and (name not in where or abs(value) > abs(worst[name])):
                 worst[name] = value
                 where[name] = {"space": trace.space, "side": trace.side, "x_mm": trace.x_mm}
-    return worst, where
+    return {name: value for name, value in worst.items() if name in evaluated or name in ("f_pt", "F_p")}, where
 
 
 def grade_simulation(spec, result) -> dict:
@@ -139,7 +142,8 @@ def grade_simulation(spec, result) -> dict:
             worst["f_pt"], where["f_pt"] = f_pt, {"side": side, "space": int(np.argmax(np.abs(single)))}
         if f_p > worst["F_p"]:
             worst["F_p"], where["F_p"] = f_p, {"side": side}
-    classes = {DEVIATIONS[kind]: class_of(kind, worst[DEVIATIONS[kind]], d, b, m) for kind in KINDS}
+    classes = {DEVIATIONS[kind]: class_of(kind, worst[DEVIATIONS[kind]], d, b, m) for kind in KINDS
+               if DEVIATIONS[kind] in worst}
     grades = [grade for grade in classes.values()]
     overall = None if any(grade is None for grade in grades) else max(grades)
     return {

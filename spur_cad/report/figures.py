@@ -142,7 +142,12 @@ def k_chart_png(spec: GearSpec, grading: dict) -> bytes:
 
     traces = grading["traces"]
     profile = [t for t in traces if t.kind == "profile"]
-    worst = max(profile, key=lambda t: float(np.ptp(t.deviation_um))).space
+
+    def spread_in_range(trace) -> float:
+        inside = (trace.position_mm >= trace.evaluation[0]) & (trace.position_mm <= trace.evaluation[1])
+        return float(np.ptp(trace.deviation_um[inside])) if inside.any() else 0.0
+
+    worst = max(profile, key=spread_in_range).space
     grade = grading["class"] or 11
     d, b, m = 2.0 * spec.reference_radius_mm, spec.face_width_mm, spec.module_mm
     fig = Figure(figsize=(9.0, 6.5), layout="constrained")
@@ -150,7 +155,7 @@ def k_chart_png(spec: GearSpec, grading: dict) -> bytes:
     for column, side in enumerate(("right", "left")):
         for row, kind in enumerate(("profile", "helix")):
             ax = axes[row][column]
-            band = tolerance_um("F_aT" if kind == "profile" else "F_bT", grade, d, b, m)
+            band = tolerance_um("F_aT" if kind == "profile" else "F_bT", grade, d, b, m)  # the gear's class
             for trace in (t for t in traces if t.kind == kind and t.side == side and t.space == worst):
                 label = f"X = {trace.x_mm:.2f} mm" if trace.x_mm is not None else "reference circle"
                 ax.plot(trace.position_mm, trace.deviation_um, lw=0.9, label=label)
@@ -164,7 +169,10 @@ def k_chart_png(spec: GearSpec, grading: dict) -> bytes:
             ax.set_xlabel("roll length [mm]" if kind == "profile" else "X (face width) [mm]", fontsize=8)
             ax.set_ylabel("deviation [um] (+ material)", fontsize=8)
             ax.grid(True, lw=0.3)
-            ax.legend(fontsize=6)
+            if ax.get_legend_handles_labels()[0]:
+                ax.legend(fontsize=6)
+            else:
+                ax.text(0.5, 0.5, "not measured", transform=ax.transAxes, ha="center", fontsize=8)
     return _png(fig)
 
 

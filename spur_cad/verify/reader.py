@@ -32,16 +32,21 @@ from spur_cad.errors import SpurCadError
 
 DIALECTS = ("linuxcnc", "fanuc", "haas", "siemens", "okuma")
 MAX_PROGRAM_BYTES = 256 * 1024 * 1024
-MAX_MOVES = 20_000_000  # about 1 GB of move arrays: refuse before reading further
+MAX_MOVES = 10_000_000  # about 0.6 GB of move columns: refuse before reading further
+MAX_BLOCKS = 50_000_000  # blocks executed (loops and calls counted): some minutes of reading at most
 MAX_CALL_DEPTH = 8
 MAX_REPEAT = 100_000
+CHECK_EVERY_BLOCKS = 100_000  # how often a long read calls its checkpoint (the CLI stops there on a signal)
+LOCAL_VARIABLES = 33  # #1..#33: a call's arguments, restored when it returns
 
 # Fanuc's argument specification I: the letter of a G65 argument -> the local variable it sets.
 FANUC_ARGUMENTS = {"A": 1, "B": 2, "C": 3, "I": 4, "J": 5, "K": 6, "D": 7, "E": 8, "F": 9, "H": 11, "M": 13,
                    "Q": 17, "R": 18, "S": 19, "T": 20, "U": 21, "V": 22, "W": 23, "X": 24, "Y": 25, "Z": 26}
 # Codes that set up the machine without moving it; anything else is refused.
-SETUP_G = {"17", "21", "40", "49", "54", "55", "56", "57", "58", "59", "64", "71", "80", "90", "43", "61"}
-QUIET_M = {"0", "1", "3", "4", "5", "7", "8", "9", "10", "11", "2", "30", "6", "68", "69", "15", "16"}
+# G54..G59 select work offsets: the program's frame is taken as the job's (one offset for all of them).
+SETUP_G = {"17", "21", "40", "49", "54", "55", "56", "57", "58", "59", "64", "80", "90", "43", "61"}
+QUIET_M = {"0", "1", "3", "4", "5", "7", "8", "9", "10", "11", "2", "30", "6", "68", "69"}
+_COLUMN_TYPES = ("b", "d", "d", "d", "d", "d", "b", "q", "q", "d")  # ProgramMoves.from_columns
 
 
 class ProgramReadError(SpurCadError):
@@ -70,6 +75,20 @@ class ProgramMoves:
     def __len__(self) -> int:
         return len(self.x)
 
+    @classmethod
+    def from_columns(cls, source: str, columns: list) -> "ProgramMoves":
+        """Moves from the columns rapid, x, y, z, a, feed, inverse_time, line, tool, spindle_rpm (sequences)."""
+        return cls(source, np.array(columns[0], bool), *(np.array(c, float) for c in columns[1:6]),
+                   np.array(columns[6], bool), np.array(columns[7], int), np.array(columns[8], int),
+                   np.array(columns[9], float))
+
+
+def move_columns() -> list:
+    """Empty compact columns for moves (Python arrays: about 60 bytes a move)."""
+    from array import array
+
+    return [array(code) for code in _COLUMN_TYPES]
+
 
 @dataclass
 class _Line:
@@ -77,6 +96,7 @@ class _Line:
     text: str  # without comments and block number
 
 
+_ENDS = re.compile(r"(^|\s)M0*(30|2)(\s|$)")  # M30 or M2, anywhere in a block
 _UNSIGNED = r"(?:\d+\.?\d*|\.\d+)"
 _TERM = re.compile(rf"\s*([-+]?)\s*(#\d+|R\d+|[A-Z_][A-Z0-9_]*|{_UNSIGNED})\s*")
 
@@ -84,8 +104,9 @@ _TERM = re.compile(rf"\s*([-+]?)\s*(#\d+|R\d+|[A-Z_][A-Z0-9_]*|{_UNSIGNED})\s*")
 class _Reader:
     """Executes one program: machine state, variables, subprogram calls, recorded moves."""
 
-    def __init__(self, text: str, dialect: str, source: str):
-        self.dialect, self.source = dialect, source
+    def __init__(self, text: str, dialect: str, source: str, checkpoint=None):
+        self.dialect, self.source, self.checkpoint = dialect, source, checkpoint
+        self.blocks = 0
         self.lines = _clean_lines(text, dialect)
         self.variables: dict[str, float] = {}
         self.pose = [math.nan, math.nan, math.nan, math.nan]
@@ -95,9 +116,11 @@ class _Reader:
         self.tool = 0
         self.pending_tool = 0
         self.spindle = 0.0
-        self.moves: list[tuple] = []
+        self.feed_in_block = False
+        self.columns = move_columns()
         self.ended = False
-        self.subs: dict[str, tuple[int, int]] = {}
+        self.subs: dict[int, tuple[int, int]] = {}  # O<n> (and LinuxCNC o<n> sub) by program number
+        self.local_subs: dict[int, tuple[int, int]] = {}  # Haas N<n> local subprograms (M97)
         self.labels: dict[str, int] = {}
 
     def error(self, line: _Line, message: str) -> ProgramReadError:
@@ -107,14 +130,14 @@ class _Reader:
     def index_structure(self) -> int:
         """Find subprograms and labels; returns the index where the main program ends (exclusive)."""
         lines = self.lines
-        end = next((i for i, line in enumerate(lines) if re.fullmatch(r"M0?(30|2)", line.text)), None)
+        end = next((i for i, line in enumerate(lines) if _ENDS.search(line.text)), None)
         if end is None:
             raise ProgramReadError(f"{self.source}: no end of program (M30 or M2)")
         for i, line in enumerate(lines):
             if self.dialect == "linuxcnc":
-                found = re.fullmatch(r"O(\d+) SUB", line.text)
+                found = re.fullmatch(r"O(\d+)\s*SUB", line.text)
                 if found:
-                    self.subs[found.group(1)] = (i + 1, self._closing(i, f"O{found.group(1)} ENDSUB"))
+                    self.subs[int(found.group(1))] = (i + 1, self._closing(i, rf"O0*{int(found.group(1))}\s*ENDSUB"))
             elif self.dialect == "siemens" and re.fullmatch(r"[A-Z_][A-Z0-9_]*:", line.text):
                 self.labels[line.text[:-1]] = i
         if self.dialect in ("fanuc", "haas", "okuma"):
@@ -123,17 +146,17 @@ class _Reader:
                 head = re.fullmatch(r"O(\d+)|N(\d+)", lines[i].text)
                 if head is None:
                     raise self.error(lines[i], "a block after the end of the program that is not a subprogram")
-                close = "RTS" if self.dialect == "okuma" else "M99"
-                j = self._closing(i, close)
-                self.subs[head.group(1) or head.group(2)] = (i + 1, j)
+                j = self._closing(i, "RTS" if self.dialect == "okuma" else "M0*99")
+                target = self.subs if head.group(1) else self.local_subs
+                target[int(head.group(1) or head.group(2))] = (i + 1, j)
                 i = j + 1
         return end
 
-    def _closing(self, start: int, text: str) -> int:
+    def _closing(self, start: int, pattern: str) -> int:
         for j in range(start + 1, len(self.lines)):
-            if self.lines[j].text == text:
+            if re.fullmatch(pattern, self.lines[j].text):
                 return j
-        raise self.error(self.lines[start], f"no {text} closes this subprogram")
+        raise self.error(self.lines[start], f"nothing closes this subprogram or loop ({pattern})")
 
     # --- values -----------------------------------------------------------------------------
     def value(self, text: str, line: _Line) -> float:
@@ -147,6 +170,8 @@ class _Reader:
             if found is None or found.end() == position:
                 raise self.error(line, f"cannot evaluate {text!r}")
             sign, term = found.groups()
+            if position > 0 and not sign:
+                raise self.error(line, f"cannot evaluate {text!r}: terms need + or - between them")
             if term[0].isdigit() or term[0] == ".":
                 number = float(term)
             elif term not in self.variables:
@@ -165,10 +190,7 @@ class _Reader:
         self.execute(0, end + 1, 0)
         if not self.ended:
             raise ProgramReadError(f"{self.source}: the program never reaches its end (M30 or M2)")
-        columns = list(zip(*self.moves)) if self.moves else [[]] * 10
-        return ProgramMoves(self.source, np.array(columns[0], bool), *(np.array(c, float) for c in columns[1:6]),
-                            np.array(columns[6], bool), np.array(columns[7], int), np.array(columns[8], int),
-                            np.array(columns[9], float))
+        return ProgramMoves.from_columns(self.source, self.columns)
 
     def execute(self, start: int, stop: int, depth: int) -> None:
         if depth > MAX_CALL_DEPTH:
@@ -177,6 +199,13 @@ class _Reader:
         while i < stop and not self.ended:
             line = self.lines[i]
             i += 1
+            self.blocks += 1
+            if self.blocks % CHECK_EVERY_BLOCKS == 0:
+                if self.blocks > MAX_BLOCKS:
+                    raise self.error(line, f"the program executes more than {MAX_BLOCKS:,} blocks (loops and "
+                                           "calls counted); refused before reading further")
+                if self.checkpoint is not None:
+                    self.checkpoint()
             jump = self.control(line, i, depth)
             if jump is not None:
                 i = jump
@@ -191,7 +220,7 @@ class _Reader:
         if self.dialect == "siemens":
             if re.fullmatch(r"[A-Z_][A-Z0-9_]*:", text):
                 return after
-            found = re.fullmatch(r"REPEAT ([A-Z_][A-Z0-9_]*) ([A-Z_][A-Z0-9_]*)(?: P=(\d+))?", text)
+            found = re.fullmatch(r"REPEAT\s+([A-Z_][A-Z0-9_]*)\s+([A-Z_][A-Z0-9_]*)(?:\s*P\s*=\s*(\d+))?", text)
             if found:
                 first, last = (self.labels.get(found.group(k)) for k in (1, 2))
                 if first is None or last is None or last <= first:
@@ -212,27 +241,41 @@ class _Reader:
             raise self.error(line, f"repeat count {count} outside 0..{MAX_REPEAT}")
         return count
 
-    def _call(self, name: str, line: _Line, depth: int, count: int = 1) -> None:
-        if name not in self.subs:
-            raise self.error(line, f"calls subprogram {name}, which the program does not define")
-        first, last = self.subs[name]
+    def _call(self, number: str, line: _Line, depth: int, count: int = 1, local: bool = False,
+              arguments: dict[str, float] | None = None) -> None:
+        """Run subprogram `number` `count` times; `arguments` set local variables (#1...), restored after it
+        returns (LinuxCNC o-call and Fanuc G65 make them local to the call)."""
+        table = self.local_subs if local else self.subs
+        if int(number) not in table:
+            raise self.error(line, f"calls subprogram {number}, which the program does not define")
+        saved = None
+        if arguments is not None:
+            saved = {f"#{n}": self.variables.get(f"#{n}") for n in range(1, LOCAL_VARIABLES + 1)}
+            self.variables.update(arguments)
+        first, last = table[int(number)]
         for _ in range(count):
             self.execute(first, last, depth + 1)
+        if saved is not None:
+            for name, value in saved.items():
+                if value is None:
+                    self.variables.pop(name, None)
+                else:
+                    self.variables[name] = value
 
     def _linuxcnc_control(self, line: _Line, after: int, depth: int) -> int | None:
         text = line.text
-        found = re.fullmatch(r"O(\d+) SUB", text)
+        found = re.fullmatch(r"O(\d+)\s*SUB", text)
         if found:
-            return self.subs[found.group(1)][1] + 1  # a definition: skipped in the flow
-        found = re.fullmatch(r"O(\d+) CALL((?:\s*\[[^\]]*\])*)", text)
+            return self.subs[int(found.group(1))][1] + 1  # a definition: skipped in the flow
+        found = re.fullmatch(r"O(\d+)\s*CALL((?:\s*\[[^\]]*\])*)", text)
         if found:
-            for index, argument in enumerate(re.findall(r"\[([^\]]*)\]", found.group(2)), start=1):
-                self.variables[f"#{index}"] = self.value(argument, line)
-            self._call(found.group(1), line, depth)
+            arguments = {f"#{index}": self.value(argument, line)
+                         for index, argument in enumerate(re.findall(r"\[([^\]]*)\]", found.group(2)), start=1)}
+            self._call(found.group(1), line, depth, arguments=arguments)
             return after
-        found = re.fullmatch(r"O(\d+) REPEAT \[([^\]]*)\]", text)
+        found = re.fullmatch(r"O(\d+)\s*REPEAT\s*\[([^\]]*)\]", text)
         if found:
-            close = self._closing(after - 1, f"O{found.group(1)} ENDREPEAT")
+            close = self._closing(after - 1, rf"O0*{int(found.group(1))}\s*ENDREPEAT")
             for _ in range(self._count(str(int(self.value(found.group(2), line))), line)):
                 self.execute(after, close, depth + 1)
             return close + 1
@@ -244,41 +287,48 @@ class _Reader:
 
     def _fanuc_family_control(self, line: _Line, after: int, depth: int) -> int | None:
         text = line.text
-        if re.fullmatch(r"O\d+", text) or text == "%":
+        if re.fullmatch(r"O\d+", text):
             return after  # the program's own number (its title was a comment)
         found = re.fullmatch(r"(#\d+)\s*=\s*(.+)", text)
         if found:
             self.variables[found.group(1)] = self.value(found.group(2), line)
             return after
         if self.dialect == "okuma":
-            found = re.fullmatch(r"CALL O(\d+)((?:\s+[A-Z][A-Z0-9]*=\S+)*)", text)
+            found = re.fullmatch(r"CALL\s*O(\d+)((?:\s+[A-Z][A-Z0-9]*\s*=\s*\S+)*)", text)
             if found:
-                for name, value in re.findall(r"([A-Z][A-Z0-9]*)=(\S+)", found.group(2)):
+                for name, value in re.findall(r"([A-Z][A-Z0-9]*)\s*=\s*(\S+)", found.group(2)):
                     self.variables[name] = self.value(value, line)
                 self._call(found.group(1), line, depth)
                 return after
             return None
-        found = re.fullmatch(r"G65 P(\d+)((?:\s*[A-Z]\s*\S+)*)", text)
+        found = re.fullmatch(r"G0*65\s*P\s*(\d+)((?:\s*[A-Z]\s*[^\sA-Z]+)*)", text)
         if found:
+            arguments, count = {}, 1
             for letter, value in re.findall(r"([A-Z])\s*([^\sA-Z]+)", found.group(2)):
-                if letter not in FANUC_ARGUMENTS:
+                if letter == "L":
+                    count = self._count(str(int(self.value(value, line))), line)
+                elif letter not in FANUC_ARGUMENTS:
                     raise self.error(line, f"G65 argument {letter} has no local variable")
-                self.variables[f"#{FANUC_ARGUMENTS[letter]}"] = self.value(value, line)
-            self._call(found.group(1), line, depth)
+                else:
+                    arguments[f"#{FANUC_ARGUMENTS[letter]}"] = self.value(value, line)
+            self._call(found.group(1), line, depth, count, arguments=arguments)
             return after
-        found = re.fullmatch(r"M9([78]) P(\d+)(?: L(\d+))?", text)
+        found = re.fullmatch(r"M0*9([78])\s*P\s*(\d+)(?:\s*L\s*(\d+))?", text)
         if found:
             if found.group(1) == "7" and self.dialect != "haas":
                 raise self.error(line, "M97 (local subprogram) is a Haas code")
-            self._call(found.group(2), line, depth, self._count(found.group(3), line))
+            self._call(found.group(2), line, depth, self._count(found.group(3), line), local=found.group(1) == "7")
             return after
         return None
 
     # --- one block --------------------------------------------------------------------------------
     def block(self, line: _Line) -> None:
-        words = self.words(line)
+        # T and S before M (M6 loads the tool the block names, whatever the order), G before F (a feed mode
+        # change resets F), then the rest in order
+        words = sorted(self.words(line), key=lambda word: {"T": 0, "S": 0, "G": 1, "F": 2, "M": 3}.get(word[0], 4))
         target = list(self.pose)
         direction = None
+        self.feed_in_block = False
         for letter, value in words:
             if letter == "G":
                 self._g_code(value, line)
@@ -290,6 +340,7 @@ class _Reader:
                 target[3] = self.value(value, line)
             elif letter == "F":
                 self.feed = self.value(value, line)
+                self.feed_in_block = True
             elif letter == "T":
                 self.pending_tool = int(self.value(value, line))
             elif letter == "S":
@@ -298,7 +349,7 @@ class _Reader:
                 continue  # tool offset numbers, G64 P tolerance
             else:
                 raise self.error(line, f"word {letter}{value} is not supported by this reader")
-        if direction is not None and not math.isnan(target[3]) and target[3] != self.pose[3]:
+        if direction is not None and not math.isnan(target[3]):
             target[3] = _directed(self.pose[3], target[3], direction, self, line)
         if any(letter in "XYZA" for letter, _ in words):
             self._move(target, line)
@@ -318,11 +369,11 @@ class _Reader:
         code = value.lstrip("0") or "0"
         if code in ("0", "1"):
             self.motion = code
-        elif code == "93":
-            self.inverse = True
-        elif code == "94":
-            self.inverse = False
-        elif code not in SETUP_G:
+        elif code in ("93", "94"):
+            if self.inverse != (code == "93"):
+                self.feed = math.nan  # a feed mode change leaves no F in effect (LinuxCNC, Fanuc)
+            self.inverse = code == "93"
+        elif code not in SETUP_G and not (code == "71" and self.dialect == "siemens"):  # G71: metric on 840D
             raise self.error(line, f"G{value} is not supported by this reader (it reads G0/G1 moves, G90, G93/G94)")
 
     def _m_code(self, value: str, line: _Line) -> str | None:
@@ -331,8 +382,8 @@ class _Reader:
             self.ended = True
         elif code == "6":
             self.tool = self.pending_tool
-        elif code in ("15", "16"):
-            return code
+        elif code in ("15", "16") and self.dialect == "okuma":
+            return code  # Okuma's rotary direction (other controls use M15/M16 for other things)
         elif code not in QUIET_M:
             raise self.error(line, f"M{value} is not supported by this reader")
         return None
@@ -346,10 +397,14 @@ class _Reader:
         rapid = self.motion == "0"
         if not rapid and not (math.isfinite(self.feed) and self.feed > 0.0):
             raise self.error(line, "a feed move without a positive F")
-        if len(self.moves) >= MAX_MOVES:
+        if not rapid and self.inverse and not self.feed_in_block:
+            raise self.error(line, "an inverse-time (G93) feed move needs its own F")
+        if len(self.columns[0]) >= MAX_MOVES:
             raise self.error(line, f"the program has more than {MAX_MOVES:,} moves; split it")
-        self.moves.append((rapid, *target, math.nan if rapid else self.feed, self.inverse and not rapid,
-                           line.number, self.tool, self.spindle))
+        row = (rapid, *target, math.nan if rapid else self.feed, self.inverse and not rapid, line.number,
+               self.tool, self.spindle)
+        for column, value in zip(self.columns, row):
+            column.append(value)
         self.pose = target
 
 
@@ -379,10 +434,11 @@ def _clean_lines(text: str, dialect: str) -> list[_Line]:
     return lines
 
 
-def read_program(text: str, dialect: str, source: str = "program") -> ProgramMoves:
-    """The moves of a program in `dialect` (one of DIALECTS); raises ProgramReadError naming `source`'s line."""
+def read_program(text: str, dialect: str, source: str = "program", checkpoint=None) -> ProgramMoves:
+    """The moves of a program in `dialect` (one of DIALECTS); raises ProgramReadError naming `source`'s line.
+    `checkpoint()` is called every CHECK_EVERY_BLOCKS blocks (the CLI stops there when a signal arrived)."""
     if dialect not in DIALECTS:
         raise ProgramReadError(f"unknown dialect {dialect!r} (known: {', '.join(DIALECTS)})")
     if len(text) > MAX_PROGRAM_BYTES:
         raise ProgramReadError(f"{source}: larger than {MAX_PROGRAM_BYTES // 2**20} MiB")
-    return _Reader(text, dialect, source).run()
+    return _Reader(text, dialect, source, checkpoint).run()

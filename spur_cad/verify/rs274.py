@@ -63,13 +63,31 @@ def _canonical_text(program: str | os.PathLike, source: str) -> str:
         return canon.read_text()
 
 
+def _refuse_unsimulated(name: str, arguments: str, number: int, source: str) -> None:
+    """Calls that change what the moves mean (inch units, non-zero offsets) or moves verify cannot simulate."""
+    import re
+
+    from spur_cad.errors import SpurCadError
+
+    where = f"{source}: rs274 canonical call {number}"
+    if name in ("ARC_FEED", "STRAIGHT_PROBE", "NURBS_FEED", "RIGID_TAP"):
+        raise SpurCadError(f"{where} is {name}, which verify does not simulate")
+    if name == "USE_LENGTH_UNITS" and "MM" not in arguments:
+        raise SpurCadError(f"{where} sets {arguments} units; verify reads millimetre programs (G21)")
+    offsets = [float(v) for v in re.findall(r"[-+]?\d+\.\d+", arguments)]
+    # (tool length offsets do not show in the canonical positions: the programmed point is read, as with
+    # spur_cad's reader; test_the_reader_agrees_with_linuxcncs_interpreter compares them under G43)
+    if name in ("SET_G92_OFFSET", "SET_G5X_OFFSET", "SET_XY_ROTATION") and \
+            any(abs(v) > 1e-9 for v in offsets):
+        raise SpurCadError(f"{where} is {name}({arguments}): non-zero offsets are not applied by verify; "
+                           "program in the part frame")
+
+
 def read_canonical(program: str | os.PathLike, source: str):
     """The moves of a LinuxCNC program as LinuxCNC's own interpreter executes them (rs274's canonical calls
     STRAIGHT_TRAVERSE / STRAIGHT_FEED with SET_FEED_RATE, SET_FEED_MODE, CHANGE_TOOL, SET_SPINDLE_SPEED):
     the reference reader for LinuxCNC programs. `line` holds the canonical call's number."""
     import re
-
-    import numpy as np
 
     from spur_cad.errors import SpurCadError
     from spur_cad.verify.reader import MAX_MOVES, ProgramMoves
@@ -83,9 +101,8 @@ def read_canonical(program: str | os.PathLike, source: str):
             continue
         number, name, arguments = int(found.group(1)), found.group(2), found.group(3)
         if name not in NUMERIC_CALLS:
-            if name in ("ARC_FEED", "STRAIGHT_PROBE", "NURBS_FEED", "RIGID_TAP"):
-                raise SpurCadError(f"{source}: rs274 call {number} is {name}, which verify does not simulate")
-            continue  # comments, coolant, offsets of 0, ...
+            _refuse_unsimulated(name, arguments, number, source)
+            continue  # comments, coolant, spindle, ...
         values = [float(v) for v in re.split(r"[,\s]+", arguments.strip()) if v]
         if name in ("STRAIGHT_TRAVERSE", "STRAIGHT_FEED"):
             rapid = name == "STRAIGHT_TRAVERSE"
@@ -101,7 +118,4 @@ def read_canonical(program: str | os.PathLike, source: str):
             tool = int(values[0])
         elif name == "SET_SPINDLE_SPEED":
             spindle = values[-1]
-    columns = list(zip(*moves)) if moves else [[]] * 10
-    return ProgramMoves(source, np.array(columns[0], bool), *(np.array(c, float) for c in columns[1:6]),
-                        np.array(columns[6], bool), np.array(columns[7], int), np.array(columns[8], int),
-                        np.array(columns[9], float))
+    return ProgramMoves.from_columns(source, list(zip(*moves)) if moves else [[]] * 10)

@@ -30,6 +30,7 @@ class VerifyOptions:
     point: str = "tip"  # "corner-centre": Z is programmed at the tool's corner-radius centre
     gouge_tolerance_mm: float | None = None
     leftover_tolerance_mm: float | None = None
+    point_tools: tuple[int, ...] = ()  # the tools `point` applies to (empty: every tool)
 
     def validate(self) -> None:
         if self.point not in POINTS:
@@ -97,7 +98,8 @@ class VerifyResult:
         return out
 
 
-def toolpaths(moves: ProgramMoves, tools: dict, roughing_number: int | None, point: str) -> list:
+def toolpaths(moves: ProgramMoves, tools: dict, roughing_number: int | None, point: str,
+              point_tools: tuple[int, ...] = ()) -> list:
     """(Toolpath, Tool) per run of moves with one tool in the spindle; the job's `tools` by tool number."""
     from spur_cad.sim.simulate import Cut
 
@@ -116,7 +118,8 @@ def toolpaths(moves: ProgramMoves, tools: dict, roughing_number: int | None, poi
                                f"does not have (its tools: {known}; the job's [tools.*] tool_number)")
         tool = tools[number]
         part = slice(begin, end)
-        z = moves.z[part] - (tool.effective_corner_radius_mm if point == "corner-centre" else 0.0)
+        at_centre = point == "corner-centre" and (not point_tools or number in point_tools)
+        z = moves.z[part] - (tool.effective_corner_radius_mm if at_centre else 0.0)
         count = end - begin
         path = Toolpath(
             kind=np.where(moves.rapid[part], MoveKind.RAPID, MoveKind.LINEAR).astype(np.int8),
@@ -182,7 +185,8 @@ def verify_moves(job, programs: list[ProgramMoves], options: VerifyOptions = Ver
     options.validate()
     tools = {tool.tool_number: tool for tool in (job.tools.roughing, job.tools.finishing) if tool is not None}
     roughing_number = job.tools.roughing.tool_number if job.tools.roughing is not None else None
-    cuts = [cut for moves in programs for cut in toolpaths(moves, tools, roughing_number, options.point)]
+    cuts = [cut for moves in programs for cut in toolpaths(moves, tools, roughing_number, options.point,
+                                                           options.point_tools)]
     if not cuts:
         raise SpurCadError("the programs have no moves to verify")
     finishing = [cut.path for cut in cuts if cut.path.operation == Operation.FINISHING]
