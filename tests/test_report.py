@@ -30,7 +30,7 @@ def test_report_embeds_every_image_and_refers_to_nothing_outside(outputs):
     html, _ = outputs
     assert html.startswith("<!DOCTYPE html>")
     sources = re.findall(r'<img[^>]*\ssrc="([^"]*)"', html)
-    assert len(sources) == 4  # profile, roughing levels, finishing poses, deviation map
+    assert len(sources) == 5  # profile, roughing levels, finishing poses, deviation map, K-chart
     for src in sources:
         assert src.startswith("data:image/png;base64,")
         assert base64.b64decode(src.split(",", 1)[1], validate=True)[:8] == PNG

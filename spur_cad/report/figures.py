@@ -150,7 +150,8 @@ def k_chart_png(spec: GearSpec, grading: dict) -> bytes:
     worst = max(profile, key=spread_in_range).space
     grade = grading["class"] or 11
     d, b, m = 2.0 * spec.reference_radius_mm, spec.face_width_mm, spec.module_mm
-    fig = Figure(figsize=(9.0, 6.5), layout="constrained")
+    fig = Figure(figsize=(9.0, 6.5))  # fixed margins: a constrained layout costs a second per report
+    fig.subplots_adjust(left=0.08, right=0.98, bottom=0.08, top=0.95, wspace=0.25, hspace=0.4)
     axes = fig.subplots(2, 2)
     for column, side in enumerate(("right", "left")):
         for row, kind in enumerate(("profile", "helix")):
