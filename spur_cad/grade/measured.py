@@ -89,13 +89,14 @@ def _deviations(tree, points, normals, y, z, params):
     return deviation, nearest
 
 
-def fit(spec, measured: MeasuredPoints):
+def fit(spec, measured: MeasuredPoints, design=None):
     """Rotation (rad) and centre (mm) that bring the points nearest the design (least squares of the normal
-    deviations), and each point's deviation (mm, + material) and nearest design point after the fit."""
+    deviations), and each point's deviation (mm, + material) and nearest design point after the fit.
+    `design`: `_design(spec)` when the caller has it already."""
     from scipy.optimize import least_squares
     from scipy.spatial import cKDTree
 
-    points, normals, *_ = _design(spec)
+    points, normals, *_ = design if design is not None else _design(spec)
     tree = cKDTree(points)
     pitch = 2.0 * math.pi / spec.teeth
     step = max(1, len(measured.plane_x) // FIT_POINTS)  # the fit on an even subset; deviations of every point after
@@ -108,11 +109,11 @@ def fit(spec, measured: MeasuredPoints):
     return best.x, deviation, nearest
 
 
-def _flank_traces(spec, measured: MeasuredPoints, deviation, nearest):
+def _flank_traces(spec, measured: MeasuredPoints, deviation, nearest, design):
     """Profile traces per flank and plane; per flank and plane the deviation at the reference circle's roll
     length (interpolated along the profile trace), which gives helix traces (three planes or more) and the
     flank's position on the reference circle (um of arc, mean over the planes) by side and space."""
-    _, _, space, side, roll, _ = _design(spec)
+    _, _, space, side, roll, _ = design
     profile_range = profile_range_mm(spec)
     helix_range = helix_range_mm(spec.face_width_mm, spec.module_mm)
     cos_alpha = spec.base_radius_mm / spec.reference_radius_mm
@@ -148,9 +149,10 @@ def grade_measured(spec, measured: MeasuredPoints) -> dict:
 
     if spec.is_helical:
         raise SpurCadError("grading measured points of a helical gear is not supported yet (spur gears only)")
-    params, deviation, nearest = fit(spec, measured)
+    design = _design(spec)
+    params, deviation, nearest = fit(spec, measured, design)
     d, b, m = 2.0 * spec.reference_radius_mm, spec.face_width_mm, spec.module_mm
-    found_traces, positions = _flank_traces(spec, measured, deviation, nearest)
+    found_traces, positions = _flank_traces(spec, measured, deviation, nearest, design)
     worst, where = worst_deviations(found_traces)
     complete = [(flank_side, p) for flank_side, p in positions.items() if len(p) == spec.teeth]
     for flank_side, flank_positions in complete:  # pitch needs every flank of one side
