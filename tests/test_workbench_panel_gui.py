@@ -216,18 +216,29 @@ doc.recompute()
 RESULT["sim_current_again"] = [sim.Status, sim.ViewObject.DisplayMode,
                                find_colour_bar(view.getSceneGraph()) is not None]
 
-# the property editor lists the inputs first (FreeCAD sorts groups by name; computed ones are "Values: ...")
+# the property editor lists the inputs first (FreeCAD sorts groups by name; computed ones are "Values: ...").
+# FreeCAD's property view ignores the selection while hidden: close any task dialog and show the Model tab.
+if FreeCADGui.Control.activeDialog():
+    FreeCADGui.Control.closeDialog()
+settle()
+for tabs in dock.findChildren(QtGui.QTabWidget):
+    tabs.setCurrentIndex(0)
 FreeCADGui.Selection.clearSelection()
 groups = {}
 for obj in (gear, job):
     FreeCADGui.Selection.clearSelection()
     FreeCADGui.Selection.addSelection(obj)
-    settle()
-    for tree in main_window.findChildren(QtGui.QTreeView):
-        model = tree.model()
-        rows = [model.data(model.index(r, 0)) for r in range(model.rowCount())] if model is not None else []
-        if "Values: computed" in rows or "Values: results" in rows:
-            groups[obj.Name] = rows
+    # the property view fills itself on a timer after the selection changes: wait for it (up to 10 s)
+    for _ in range(200):
+        settle()
+        for tree in main_window.findChildren(QtGui.QTreeView):
+            model = tree.model()
+            rows = [model.data(model.index(r, 0)) for r in range(model.rowCount())] if model is not None else []
+            if "Values: computed" in rows or "Values: results" in rows:
+                groups[obj.Name] = rows
+        if obj.Name in groups:
+            break
+        time.sleep(0.05)
 RESULT["groups"] = groups
 
 # Gear and Simulate have different toolbar icons
