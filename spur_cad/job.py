@@ -22,6 +22,7 @@ from pathlib import Path
 
 from spur_cad.cad.specs import BlankFeatures, StockSpec
 from spur_cad.cam.machine import FinishingParams, Machine, RoughingParams
+from spur_cad.cam.machine_limits import check_machine_limits
 from spur_cad.cam.tools import Tool
 from spur_cad.errors import GearSpecError, JobFileError, SpurCadError, StockError
 from spur_cad.geometry.spec import MAX_TEETH, MIN_TEETH, GearSpec
@@ -312,7 +313,7 @@ def _check_tool_numbers(roughing: Tool, finishing: Tool, where: str) -> None:
     programs: refuse (the same end mill may serve both, with its own cutting data)."""
     def shape(tool: Tool) -> tuple:
         return (tool.kind, tool.diameter_mm, tool.effective_corner_radius_mm, tool.flutes, tool.flute_length_mm,
-                tool.stick_out_mm)
+                tool.stick_out_mm, tool.gauge_length_mm)
 
     if roughing.tool_number == finishing.tool_number and shape(roughing) != shape(finishing):
         raise JobFileError(f"{where}: [tools.finishing] tool_number = {finishing.tool_number} is also the roughing "
@@ -363,6 +364,11 @@ def _job_from_data(data: dict, source: str, text: str) -> Job:
         given = "tool_number" in tables["tools.finishing"]  # else blame the roughing tool's number (T2 given)
         _check_tool_numbers(tools.roughing, tools.finishing,
                             where("tools.finishing" if given else "tools.roughing", "tool_number"))
+    try:
+        check_machine_limits(spec, sections.get("stock", StockSpec()), sections.get("machine", Machine()),
+                             {role: tool for role in _TOOL_ROLES if (tool := getattr(tools, role)) is not None})
+    except SpurCadError as exc:
+        raise JobFileError(f"{where('machine', exc.field)}: {exc}", section="machine", field=exc.field) from None
     optional = {name: sections[name] for name in ("stock", "roughing", "finishing", "machine", "post", "simulation")
                 if name in sections}
     return Job(source=source, job=sections.get("job", JobSection()), gear_section=gear_section, gear=spec,

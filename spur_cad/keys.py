@@ -44,6 +44,9 @@ UNITS = {
     "1/min": "revolutions per minute (spindle speed)",
     "mm/s^2": "millimetres per second squared (linear axis acceleration)",
     "deg/s^2": "degrees per second squared (rotary axis acceleration)",
+    "mm/rev": "millimetres per spindle revolution (lathe feeds)",
+    "kg": "kilogram",
+    "kg/dm^3": "kilograms per cubic decimetre (density)",
 }
 
 _TYPE_NAMES = {float: "a number", int: "a whole number", bool: "true or false", str: "a string"}

@@ -64,6 +64,9 @@ class StockSpec:
                                  meaning="blank beyond the front face X = 0")
     back_margin_mm: float = key(1.0, unit="mm", low=0.0, high=500.0, label="BackMargin", group="Stock",
                                 meaning="blank beyond the back face X = b")
+    density_kg_dm3: float = key(7.85, unit="kg/dm^3", low=0.5, high=25.0, label="Density", group="Stock",
+                                meaning="density of the blank's material (steel 7.85), for the part weight "
+                                        "([machine] max_part_weight_kg)")
     stub_diameter_mm: float = key(0.0, unit="mm", low=0.0, high=2000.0, label="StubDiameter", group="Holding stub",
                                   meaning="diameter of the holding stub toward the chuck (+X), 0: none")
     stub_length_mm: float = key(0.0, unit="mm", low=0.0, high=1000.0, label="StubLength", group="Holding stub",

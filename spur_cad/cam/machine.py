@@ -63,6 +63,25 @@ class Machine:
     path_tolerance_mm: float = key(0.005, unit="mm", low=0.0, high=1.0, label="PathTolerance", group="Machine",
                                    meaning="how far the control may round a corner between moves (G64 P; "
                                            "cycle-time estimate)")
+    max_part_diameter_mm: float = key(0.0, unit="mm", low=0.0, high=10000.0, label="MaxPartDiameter",
+                                      group="Machine limits",
+                                      meaning="largest part diameter the rotary table swings, 0: not checked")
+    max_part_weight_kg: float = key(0.0, unit="kg", low=0.0, high=100000.0, label="MaxPartWeight",
+                                    group="Machine limits",
+                                    meaning="heaviest part the rotary table carries (the blank, before cutting), "
+                                            "0: not checked")
+    max_overhang_mm: float = key(0.0, unit="mm", low=0.0, high=10000.0, label="MaxOverhang", group="Machine limits",
+                                 meaning="longest overhang from the chuck face (the stub's shoulder) to the far face "
+                                         "of the blank, 0: not checked")
+    spindle_nose_top_mm: float = key(0.0, unit="mm", low=0.0, high=10000.0, label="SpindleNoseTop",
+                                     group="Machine limits",
+                                     meaning="height of the spindle nose above the rotary axis at the top of the Z "
+                                             "travel: a tool's gauge length plus the safe height must fit under it, "
+                                             "0: not checked")
+    smallest_end_mill_mm: float = key(1.0, unit="mm", low=0.1, high=100.0, label="SmallestEndMill",
+                                      group="Machine limits",
+                                      meaning="smallest end mill the shop buys (catalogue: 1 mm); a smaller tool or "
+                                              "a job needing one is warned about")
     rotary_clamp_code: str = key("", label="RotaryClampCode", group="Machine",
                                  meaning="M code clamping A (needed by [roughing] clamp_rotary; "
                                          "generating clamps for every pass when both codes are given)")

@@ -15,6 +15,7 @@ from spur_cad.cam.estimate import Estimate, estimate
 from spur_cad.cam.finishing import plan_finishing
 from spur_cad.cam.ir import Toolpath
 from spur_cad.cam.machine import FinishingParams, Machine, MachineError, RoughingParams, check_travel
+from spur_cad.cam.machine_limits import check_machine_limits
 from spur_cad.cam.recommend import ToolRecommendations, check_roughing_reach, check_tools, recommend_tools
 from spur_cad.cam.roughing import (
     RoughingLevels,
@@ -130,7 +131,9 @@ def plan_cam(inputs: CamInputs, checkpoint: Callable[[], None] | None = None) ->
     rec, levels = check_cam_inputs(inputs)
     blank = inputs.stock.blank_radius_mm(inputs.spec)
     roughing = finishing = None
-    warnings: list[str] = []
+    tools = {role: tool for role, tool in (("roughing", inputs.roughing_tool), ("finishing", inputs.finishing_tool))
+             if tool is not None}
+    warnings: list[str] = list(check_machine_limits(inputs.spec, inputs.stock, inputs.machine, tools))
     if levels is not None:
         check()
         roughing = _plan_roughing(inputs, levels, blank)

@@ -32,6 +32,10 @@ class Tool:
                                  meaning="flute length, 0: not given (not checked)")
     stick_out_mm: float = key(0.0, unit="mm", low=0.0, high=1000.0, label="{Role}StickOut", group="{Role} tool",
                               meaning="stick-out from the holder, 0: not given (not checked)")
+    gauge_length_mm: float = key(0.0, unit="mm", low=0.0, high=1000.0, label="{Role}GaugeLength",
+                                 group="{Role} tool",
+                                 meaning="spindle nose to tool tip, 0: not given (the stick-out stands in for it "
+                                         "in the spindle nose check)")
     tool_number: int = key(1, low=1, high=9999, label="{Role}ToolNumber", group="{Role} tool",
                            meaning="tool number in the machine's magazine (T word); a [tools.finishing] "
                                    "without it takes 2; two different tools may not share one")
