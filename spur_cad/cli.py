@@ -40,6 +40,9 @@ def _parser() -> argparse.ArgumentParser:
     run = sub.add_parser("run", help="run a job file and write its outputs")
     run.add_argument("job", help="TOML job file")
     run.add_argument("--out", required=True, help="output folder (created if missing)")
+    run.add_argument("--restart", metavar="POINT",
+                     help="also write a program restarting an operation after an alarm: roughing:space=K[,level=N], "
+                          "finishing:station=N or finishing:space=K[,pass=N] (numbered from 0; docs/shop-floor.md)")
     run.add_argument("--quiet", action="store_true", help="print nothing but errors")
     run.add_argument("--debug", action="store_true", help="show tracebacks of internal errors")
     verify = sub.add_parser("verify", help="cut the job's stock with G-code programs (from anywhere) and judge the "
@@ -152,6 +155,7 @@ def _checkpoint(received: list[int]) -> None:
 
 def _run(args: argparse.Namespace, received: list[int], loaded: list) -> list:
     """Load, compute and write the job's output set; the job goes into `loaded` (for locating errors)."""
+    from spur_cad.cam.restart import parse_restart
     from spur_cad.job import load_job  # heavy imports after the signal handling is in place
     from spur_cad.outputs import check_output_folder, write_output_set
     from spur_cad.pipeline import run_job
@@ -160,6 +164,7 @@ def _run(args: argparse.Namespace, received: list[int], loaded: list) -> list:
         _checkpoint(received)
 
     checkpoint()
+    restart = parse_restart(args.restart) if args.restart is not None else None
     out_dir = check_output_folder(args.out)  # before any computation
     loaded.append(load_job(args.job))
     bars = ProgressBars(sys.stderr) if not args.quiet and sys.stderr.isatty() else None
@@ -170,7 +175,7 @@ def _run(args: argparse.Namespace, received: list[int], loaded: list) -> list:
             bars(stage, fraction)
 
     try:
-        files = run_job(loaded[0], progress, checkpoint)
+        files = run_job(loaded[0], progress, checkpoint, restart)
     finally:
         if bars is not None:
             bars.close()

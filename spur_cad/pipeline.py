@@ -23,6 +23,7 @@ from spur_cad.job import Job
 from spur_cad.summary import CadResult, build_summary
 
 if TYPE_CHECKING:
+    from spur_cad.cam.restart import RestartPoint
     from spur_cad.post.program import PostedProgram
     from spur_cad.sim.simulate import SimResult, StockCylinder
 
@@ -36,10 +37,11 @@ def profile_csv(samples: ProfileSamples) -> bytes:
 
 
 def run_job(job: Job, progress: Callable[[str, float], None] | None = None,
-            checkpoint: Callable[[], None] | None = None) -> dict[str, bytes]:
+            checkpoint: Callable[[], None] | None = None, restart: RestartPoint | None = None) -> dict[str, bytes]:
     """Compute every output of the job in memory (no file I/O). `progress(stage, fraction)` is told how
     far each long stage is (the CLI draws progress bars with it); `checkpoint()` is called before every
-    stage (the CLI stops there when a signal has arrived, never inside a library)."""
+    stage (the CLI stops there when a signal has arrived, never inside a library). `restart` adds a program
+    restarting an operation there (restart_program)."""
     from spur_cad.report.plots import tooth_space_png
     from spur_cad.report.stage import report_html
 
@@ -67,6 +69,9 @@ def run_job(job: Job, progress: Callable[[str, float], None] | None = None,
     cad, step = timed("cad_and_step", "CAD and STEP", lambda: build_cad(job, checkpoint))
     plan = timed("cam", "toolpaths", lambda: plan_cam(job, checkpoint))
     programs, program_files = timed("post", None, lambda: build_programs(job, plan))
+    if restart is not None:
+        name, text = restart_program(job, plan, restart)
+        program_files[name] = text
     sim_result = timed("simulation", "simulation",
                        lambda: simulate_stage(job, plan, lambda fraction: tell("simulation", fraction)))
     summary = build_summary(job, samples, cad, plan, job.post, programs, sim_result, seconds)
@@ -84,7 +89,7 @@ def run_job(job: Job, progress: Callable[[str, float], None] | None = None,
 
 def build_programs(job: Job, plan: CamPlan) -> tuple[dict[str, PostedProgram], dict[str, bytes]]:
     """G-code for each toolpath the plan has: (posted programs by operation, files roughing.<ext>, ...)."""
-    from spur_cad.post import ProgramInfo, dialect, post_program
+    from spur_cad.post import dialect, post_program
 
     settings = job.post
     programs: dict[str, PostedProgram] = {}
@@ -92,13 +97,45 @@ def build_programs(job: Job, plan: CamPlan) -> tuple[dict[str, PostedProgram], d
     for name, operation in (("roughing", plan.roughing), ("finishing", plan.finishing)):
         if operation is None:
             continue
-        info = ProgramInfo(title=f"spur_cad {__version__} {name}: {job.job.name}",
-                           comments=program_comments(job, plan, name),
-                           rotary_clamp_code=job.machine.rotary_clamp_code,
-                           rotary_unclamp_code=job.machine.rotary_unclamp_code)
-        program = programs[name] = post_program(operation.toolpath, settings, info)
+        program = programs[name] = post_program(operation.toolpath, settings, program_info(job, plan, name))
         files[f"{name}.{dialect(settings.dialect).extension}"] = program.text.encode()
     return programs, files
+
+
+def program_info(job: Job, plan: CamPlan, operation: str, restart_comment: str | None = None,
+                 approach_z_mm: float | None = None, a_reference_deg: float | None = None):
+    """The header, machine codes and blank box (for Siemens WORKPIECE) of one program."""
+    from spur_cad.post import ProgramInfo
+
+    spec, stock = job.gear, job.stock
+    radius = stock.blank_radius_mm(spec)
+    box = (-stock.front_margin_mm, -radius, -radius, spec.face_width_mm + stock.back_margin_mm + stock.stub_length_mm,
+           radius, radius)
+    title = f"spur_cad {__version__} {operation}" + (" restart" if restart_comment else "") + f": {job.job.name}"
+    comments = program_comments(job, plan, operation) + ((restart_comment,) if restart_comment else ())
+    return ProgramInfo(title=title, comments=comments, rotary_clamp_code=job.machine.rotary_clamp_code,
+                       rotary_unclamp_code=job.machine.rotary_unclamp_code, blank_box_mm=box,
+                       approach_z_mm=approach_z_mm, first_space_a_reference_deg=a_reference_deg)
+
+
+def restart_program(job: Job, plan: CamPlan, point: RestartPoint) -> tuple[str, bytes]:
+    """A program that restarts `point.operation` at the point (spur_cad.cam.restart): its file name
+    (e.g. roughing_space5.ngc) and text."""
+    from spur_cad.cam.common import safe_height_mm
+    from spur_cad.cam.restart import RestartError, restart_toolpath, run_reference_a_deg
+    from spur_cad.post import dialect, post_program
+
+    planned = plan.roughing if point.operation == "roughing" else plan.finishing
+    if planned is None:
+        raise RestartError(f"--restart {point.text()}: the job has no {point.operation} (no [tools.{point.operation}])",
+                           field="restart")
+    clearance = safe_height_mm(job.stock.blank_radius_mm(job.gear), job.machine)
+    path, start = restart_toolpath(planned.toolpath, point, clearance)
+    comment = (f"restart at {point.text()}: the full program's moves from move {start} on, after a move to the "
+               f"clearance height Z {clearance:.3f} mm and to the first move's X, Y and A")
+    reference = run_reference_a_deg(planned.toolpath, start) if planned.toolpath.space[start] >= 0 else None
+    program = post_program(path, job.post, program_info(job, plan, point.operation, comment, clearance, reference))
+    return f"{point.label()}.{dialect(job.post.dialect).extension}", program.text.encode()
 
 
 def program_comments(job: Job, plan: CamPlan, operation: str) -> tuple[str, ...]:

@@ -10,9 +10,10 @@ import re
 import numpy as np
 import pytest
 
+from spur_cad.cam.restart import parse_restart
 from spur_cad.errors import SpurCadError
 from spur_cad.job import parse_job
-from spur_cad.pipeline import plan_cam
+from spur_cad.pipeline import plan_cam, restart_program
 from tests.freecad_helper import describe
 from tests.workbench_helper import (
     ARTIFACTS,
@@ -49,6 +50,19 @@ def answer_file_dialog(path):
                 QtCore.QTimer.singleShot(100, lambda: fill(left - 1))
             return
         dialog.findChild(QtGui.QLineEdit, "fileNameEdit").setText(path)
+        dialog.accept()
+    QtCore.QTimer.singleShot(100, fill)
+
+def answer_input_dialog(text, then_path):
+    # type the restart point into the next input dialog, then the path into the file dialog after it
+    def fill(left=50):
+        dialog = QtGui.QApplication.activeModalWidget()
+        if not isinstance(dialog, QtGui.QInputDialog):
+            if left:
+                QtCore.QTimer.singleShot(100, lambda: fill(left - 1))
+            return
+        dialog.setTextValue(text)
+        answer_file_dialog(then_path)
         dialog.accept()
     QtCore.QTimer.singleShot(100, fill)
 
@@ -151,6 +165,15 @@ RESULT["verify_command"] = [b.text() for b in boxes if b.windowTitle() == "Verif
 for box in boxes:
     box.close()
 
+# Restart program: roughing from tooth space 3, written where the user says
+RESTART = os.path.join(OUT + "_restart", "roughing_space3.ngc")
+os.makedirs(OUT + "_restart")
+answer_input_dialog("roughing:space=3", RESTART)
+select(job)
+FreeCADGui.runCommand("SpurCad_Restart")
+settle()
+RESULT["restart"] = open(RESTART).read() if os.path.exists(RESTART) else None
+
 answer_file_dialog(JOB_FILE)
 FreeCADGui.runCommand("SpurCad_ImportJob")     # into a new document named after the job file
 settle()
@@ -203,7 +226,7 @@ def test_workbench_commands_panel_and_screenshot_in_the_gui(freecad_gui, tmp_pat
         assert word not in result["report"], result["report"]
 
     names = ["SpurCad_Gear", "SpurCad_Stock", "SpurCad_Job", "SpurCad_ImportJob", "SpurCad_Simulate", "SpurCad_Verify",
-             "SpurCad_Export"]
+             "SpurCad_Restart", "SpurCad_Export"]
     assert result["workbench"] == "SpurCadWorkbench"
     assert result["toolbar"] == names
     assert len(result["menu"]) == len(names)
@@ -236,9 +259,13 @@ def test_workbench_commands_panel_and_screenshot_in_the_gui(freecad_gui, tmp_pat
     assert ["Export", expected] in result["export_error"] and result["exported_bad"] == []
     assert f"Export: {expected}" in result["report"]
 
+    # the restart program the command wrote is the one `spur-cad run --restart roughing:space=3` writes
+    job = parse_job(small_job_text(), "small.toml")
+    assert result["restart"] == restart_program(job, plan_cam(job), parse_restart("roughing:space=3"))[1].decode()
+
     # every command went through FreeCADGui.doCommandGui: echoed as macro lines
     for call in ("make_gear(", "make_stock(", "make_job(", "simulate(", "export_job(", "import_job_file(",
-                 "verify_programs("):
+                 "verify_programs(", "write_restart_program("):
         assert f"spur_cad_workbench.commands.{call}" in result["console"], result["console"][-2000:]
 
     # the screenshot shows the gear and both toolpaths in their colours

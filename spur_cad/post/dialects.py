@@ -46,6 +46,8 @@ class Dialect:
     subprograms_after_end: bool  # else defined before the main body
     direction_codes: tuple[str, str] | None = None  # (positive, negative) A direction for wrapped A
     max_line_length: int = 128  # longest block the control takes (every line is checked; comments are cut to fit)
+    work_offset: str = "{code}"  # selects the work offset; {code} is G54..G59, {number} 1..6 (Okuma's G15 H<n>)
+    workpiece: str = ""  # the blank for the control's own simulation; {x_min} ... {z_max} of the blank's box
 
 
 LINUXCNC = Dialect(
@@ -81,7 +83,8 @@ SIEMENS = Dialect(
     linear_decimals=4, rotary_decimals=4, feed_decimals=1, inverse_feed_decimals=4, inverse_time=True,
     fold_style="repeat", x_param="R1", a_param="R2", param_word="{address}={param}",
     param_offset_word="{address}={param}{offset}", sub_start="SPACE{sub}:", sub_end="SPACE{sub}_END:",
-    call=("R1={x} R2={a}", "REPEAT SPACE{sub} SPACE{sub}_END P=1"), subprograms_after_end=False)
+    call=("R1={x} R2={a}", "REPEAT SPACE{sub} SPACE{sub}_END P=1"), subprograms_after_end=False,
+    workpiece='WORKPIECE(,"",,"BOX",112,{z_max},{z_min},-80,{x_min},{y_min},{x_max},{y_max})')
 
 OKUMA = Dialect(
     name="okuma", extension="min", percent_delimited=False, program_start="O{number:04d} ({title})",
@@ -91,7 +94,7 @@ OKUMA = Dialect(
     inverse_feed_decimals=3, inverse_time=False, fold_style="macro_call", x_param="XST", a_param="ASP",
     param_word="{address}={param}", param_offset_word="{address}={param}{offset}", sub_start="O{sub:04d}",
     sub_end="RTS", call=("CALL O{sub:04d} XST={x} ASP={a}",), subprograms_after_end=True,
-    direction_codes=("M15", "M16"))
+    direction_codes=("M15", "M16"), work_offset="G15 H{number}")
 
 DIALECTS: dict[str, Dialect] = {d.name: d for d in (LINUXCNC, FANUC, HAAS, SIEMENS, OKUMA)}
 

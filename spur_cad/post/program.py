@@ -54,6 +54,9 @@ class ProgramInfo:
     comments: tuple[str, ...]  # gear data, tool, strategy, estimated time
     rotary_clamp_code: str = ""
     rotary_unclamp_code: str = ""
+    blank_box_mm: tuple[float, float, float, float, float, float] | None = None  # x, y, z min then max (WORKPIECE)
+    approach_z_mm: float | None = None  # restart programs: a Z-only rapid to this height before the first move
+    first_space_a_reference_deg: float | None = None  # restart programs: A of the full program's run (see _runs)
 
 
 @dataclass(frozen=True)
@@ -72,6 +75,7 @@ class _Run:
     stop: int
     x_base: int | None  # X in units when every move of the run has the same X, else None
     a_base: int  # A of the run's first move, in units (rotary sign applied)
+    a_reference: float  # the exact A (degrees, sign applied) the run's A words are written relative to
 
 
 def post_program(path: Toolpath, settings: PostSettings, info: ProgramInfo) -> PostedProgram:
@@ -89,7 +93,8 @@ def post_program(path: Toolpath, settings: PostSettings, info: ProgramInfo) -> P
     z = np.rint(path.z * lin).astype(np.int64)
     a_signed = settings.rotary_sign * path.a
     feed = _program_feeds(path, d, settings.rotary_sign)
-    runs = _runs(path, x, a_signed, rot)
+    runs = _runs(path, x, a_signed, rot, settings.rotary_sign * info.first_space_a_reference_deg
+                 if info.first_space_a_reference_deg is not None else None)
     columns = _Columns(path.kind, x, y, z, a_signed, path.inverse_time, feed, rot)
     writer = _Writer(d, settings, info, columns, path.tool_number, int(round(path.spindle_rpm)))
 
@@ -165,8 +170,11 @@ def _program_feeds(path: Toolpath, d: Dialect, rotary_sign: int) -> np.ndarray:
     return np.where(path.inverse_time, length * path.feed, feed)
 
 
-def _runs(path: Toolpath, x: np.ndarray, a_signed: np.ndarray, rot: int) -> list[_Run]:
-    """Maximal runs of consecutive moves on one tooth space (moves on no space form their own runs)."""
+def _runs(path: Toolpath, x: np.ndarray, a_signed: np.ndarray, rot: int,
+          first_space_reference: float | None = None) -> list[_Run]:
+    """Maximal runs of consecutive moves on one tooth space (moves on no space form their own runs). Each run's
+    A words are relative to its first move's A; the first run on a space uses `first_space_reference` instead
+    when given (a restart: the A its run has in the full program, so both round alike)."""
     space = path.space
     cuts = np.flatnonzero(np.diff(space) != 0) + 1
     bounds = np.concatenate([[0], cuts, [len(space)]])
@@ -174,7 +182,10 @@ def _runs(path: Toolpath, x: np.ndarray, a_signed: np.ndarray, rot: int) -> list
     for start, stop in zip(bounds[:-1], bounds[1:]):
         xs = x[start:stop]
         x_base = int(xs[0]) if np.all(xs == xs[0]) else None
-        runs.append(_Run(int(start), int(stop), x_base, int(round(a_signed[start] * rot))))
+        reference = float(a_signed[start])
+        if first_space_reference is not None and space[start] >= 0:
+            reference, first_space_reference = first_space_reference, None
+        runs.append(_Run(int(start), int(stop), x_base, int(round(reference * rot)), reference))
     return runs
 
 
@@ -227,7 +238,7 @@ class _Writer:
     def run_key(self, run: _Run) -> bytes:
         """Everything a run's folded text depends on, as bytes: equal keys give equal subprogram text."""
         c, sl = self.c, slice(run.start, run.stop)
-        a_rel = np.rint((c.a[sl] - c.a[run.start]) * c.rot).astype(np.int64)
+        a_rel = np.rint((c.a[sl] - run.a_reference) * c.rot).astype(np.int64)
         x = c.x[sl] - run.x_base if run.x_base is not None else c.x[sl]
         decimals = np.where(c.inverse[sl] & self.d.inverse_time, self.d.inverse_feed_decimals, self.d.feed_decimals)
         feed = np.rint(np.nan_to_num(c.feed[sl]) * 10.0 ** decimals).astype(np.int64)
@@ -241,7 +252,7 @@ class _Writer:
         lines: list[str] = []
         modal = _Modal()
         sl = slice(run.start, run.stop)
-        a_rels = np.rint((c.a[sl] - c.a[run.start]) * c.rot).astype(np.int64).tolist()
+        a_rels = np.rint((c.a[sl] - run.a_reference) * c.rot).astype(np.int64).tolist()
         rows = zip(range(run.start, run.stop), c.kind[sl].tolist(), c.x[sl].tolist(), c.y[sl].tolist(),
                    c.z[sl].tolist(), a_rels, c.a[sl].tolist(), c.inverse[sl].tolist(), c.feed[sl].tolist())
         for i, kind, x, y, z, a_rel, a_exact, inverse_move, feed in rows:
@@ -333,10 +344,7 @@ class _Writer:
         head += [self.comment(line) for line in titled]
         definitions = [] if d.subprograms_after_end or d.fold_style == "repeat" else \
             self._definitions(sub_bodies, sub_ids)
-        main = [d.setup, *[t.format(tool=self.tool) for t in d.tool_change], d.spindle_on.format(rpm=self.rpm)]
-        if s.coolant:
-            main.append(d.coolant_on)
-        main += self._main_body(body, sub_bodies, sub_ids)
+        main = self._start_blocks() + self._main_body(body, sub_bodies, sub_ids)
         if s.coolant:
             main.append(d.coolant_off)
         main += [d.spindle_off, d.program_end]
@@ -352,6 +360,29 @@ class _Writer:
             raise PostError(f"{info.title}: line {too_long[0]} would have {len(lines[too_long[0] - 1])} characters, "
                             f"more than the {d.name} limit of {d.max_line_length}")
         return "\n".join(lines) + "\n"
+
+    def _start_blocks(self) -> list[str]:
+        """Blank description, setup, work offset, tool, spindle, coolant, and a restart's move to the clearance
+        height (up or down, Z alone, before moving across)."""
+        d, s, info = self.d, self.settings, self.info
+        offset = d.work_offset.format(code=s.work_offset, number=int(s.work_offset[1:]) - 53)
+        lines = [*self._workpiece(), d.setup, offset, *[t.format(tool=self.tool) for t in d.tool_change],
+                 d.spindle_on.format(rpm=self.rpm)]
+        if s.coolant:
+            lines.append(d.coolant_on)
+        if info.approach_z_mm is not None:
+            lines.append("G0 Z" + _number(int(round(info.approach_z_mm * 10 ** d.linear_decimals)), d.linear_decimals))
+        return lines
+
+    def _workpiece(self) -> list[str]:
+        """The dialect's blank description for the control's simulation (Siemens WORKPIECE), if it has one."""
+        box = self.info.blank_box_mm
+        if not self.d.workpiece or box is None:
+            return []
+        names = ("x_min", "y_min", "z_min", "x_max", "y_max", "z_max")
+        units = 10 ** self.d.linear_decimals
+        return [self.d.workpiece.format(**{n: _number(int(round(v * units)), self.d.linear_decimals)
+                                           for n, v in zip(names, box)})]
 
     def _definitions(self, sub_bodies: list[list[str]], sub_ids: list[int]) -> list[str]:
         """Every subprogram, framed by the dialect's start and end blocks."""

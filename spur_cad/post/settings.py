@@ -17,6 +17,10 @@ def dialect_names() -> tuple[str, ...]:
 
 
 
+WORK_OFFSETS = ("G54", "G55", "G56", "G57", "G58", "G59")
+"""The work offsets a program may select."""
+
+
 class PostError(SpurCadError, ValueError):
     """A post setting or a toolpath the chosen controller cannot take; the message names it."""
 
@@ -50,6 +54,9 @@ class PostSettings:
                                    "(flat programs only; Okuma adds M15/M16)")
     program_number: int = key(1000, low=1, high=9999, label="ProgramNumber", group="Post",
                               meaning="O number (Fanuc, Haas, Okuma); subprograms take the next numbers")
+    work_offset: str = key("G54", choices=WORK_OFFSETS, label="WorkOffset", group="Post",
+                           meaning="work offset every program selects (Okuma: G15 H1..H6 for G54..G59; Siemens "
+                                   "also describes the blank with WORKPIECE)")
     coolant: bool = key(True, label="Coolant", group="Post", meaning="M8 after the spindle starts, M9 before it stops")
 
     def validate(self) -> None:

@@ -391,10 +391,13 @@ class _Reader:
     def _move(self, target: list[float], line: _Line) -> None:
         if self.motion is None:
             raise self.error(line, "an axis word before any G0 or G1")
-        if any(math.isnan(t) for t in target):
-            missing = "".join(axis for axis, t in zip("XYZA", target) if math.isnan(t))
-            raise self.error(line, f"the first move must give every axis ({missing} unknown)")
         rapid = self.motion == "0"
+        if any(math.isnan(t) for t in target):
+            if rapid:  # e.g. a restart's Z-only move to the clearance height: known from here on, not a move
+                self.pose = target
+                return
+            missing = "".join(axis for axis, t in zip("XYZA", target) if math.isnan(t))
+            raise self.error(line, f"a feed move before every axis is known ({missing} unknown)")
         if not rapid and not (math.isfinite(self.feed) and self.feed > 0.0):
             raise self.error(line, "a feed move without a positive F")
         if not rapid and self.inverse and not self.feed_in_block:

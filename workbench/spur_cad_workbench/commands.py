@@ -202,6 +202,25 @@ def verify_programs(job_obj, paths: list[str], dialect: str | None = None, point
     return obj
 
 
+def write_restart_program(job_obj, point: str, path: str) -> str:
+    """`spur-cad run --restart POINT` inside FreeCAD: the program restarting the job's roughing or finishing at
+    `point` (e.g. "roughing:space=5", "finishing:station=40"; docs/shop-floor.md) written to `path`."""
+    from spur_cad.cam.restart import parse_restart
+    from spur_cad.errors import SpurCadError
+    from spur_cad.outputs import write_file_atomically
+    from spur_cad.pipeline import restart_program
+
+    restart = parse_restart(point)
+    job, plan = job_obj.Proxy.plan_for(job_obj)
+    _, text = restart_program(job, plan, restart)
+    try:
+        written = write_file_atomically(path, text)
+    except OSError as exc:
+        raise SpurCadError(f"cannot write {path}: {exc.strerror or exc}") from None
+    FreeCAD.Console.PrintMessage(f"{job_obj.Label}: wrote the restart program {written}\n")
+    return str(written)
+
+
 def document_name(path: str) -> str:
     """A FreeCAD document name for a job file: its stem with characters FreeCAD names cannot hold replaced."""
     import re
@@ -385,6 +404,32 @@ class VerifyCommand(_Command):
                          "Verify program")
 
 
+class RestartCommand(_Command):
+    NAME, ICON, MENU = "SpurCad_Restart", "restart", "Restart program..."
+    TIP = ("Write a program that restarts roughing or finishing after an alarm, at a tooth space, level, station or "
+           "pass (as `spur-cad run --restart`)")
+
+    def IsActive(self):
+        return _selected("job") is not None
+
+    def Activated(self):
+        import FreeCADGui
+        from PySide import QtGui
+
+        job = _selected("job")
+        window = FreeCADGui.getMainWindow()
+        point, ok = QtGui.QInputDialog.getText(
+            window, "Restart program", "Restart at (numbered from 0): roughing:space=K[,level=N], "
+            "finishing:station=N or finishing:space=K[,pass=N]", QtGui.QLineEdit.Normal, "roughing:space=0")
+        if not ok or not point.strip():
+            return
+        path, _ = QtGui.QFileDialog.getSaveFileName(window, "Write the restart program", "",
+                                                    "G-code (*.ngc *.nc *.mpf *.min);;All files (*)")
+        if path:
+            run_recorded([_call("spur_cad_restart", "write_restart_program", _object(job), repr(point.strip()),
+                                repr(path))], "Restart program")
+
+
 class ExportCommand(_Command):
     NAME, ICON, MENU = "SpurCad_Export", "export", "Export STEP and G-code..."
     TIP = "Write the job's STEP files (gear, stock, assembly) and G-code programs, as `spur-cad run` does"
@@ -402,7 +447,8 @@ class ExportCommand(_Command):
             run_recorded([_call("spur_cad_files", "export_job", _object(job), repr(folder))], "Export")
 
 
-COMMANDS = (GearCommand, StockCommand, JobCommand, ImportJobCommand, SimulateCommand, VerifyCommand, ExportCommand)
+COMMANDS = (GearCommand, StockCommand, JobCommand, ImportJobCommand, SimulateCommand, VerifyCommand, RestartCommand,
+            ExportCommand)
 
 
 def register_commands() -> list[str]:
