@@ -60,6 +60,9 @@ class StockSpec:
 
     radial_allowance_mm: float = key(0.5, unit="mm", low=0.0, high=50.0, label="RadialAllowance", group="Stock",
                                      meaning="blank radius = tip radius + this allowance")
+    blank_diameter_mm: float = key(0.0, unit="mm", low=0.0, high=20000.0, label="BlankDiameter", group="Stock",
+                                   meaning="the blank's diameter as turned, 0: tip diameter + 2 x radial_allowance_mm; "
+                                           "smaller than the tip diameter is refused")
     front_margin_mm: float = key(1.0, unit="mm", low=0.0, high=500.0, label="FrontMargin", group="Stock",
                                  meaning="blank beyond the front face X = 0")
     back_margin_mm: float = key(1.0, unit="mm", low=0.0, high=500.0, label="BackMargin", group="Stock",
@@ -75,6 +78,12 @@ class StockSpec:
     def validate(self, spec: GearSpec) -> None:
         """Raise StockError for keys outside their ranges, a half-given stub or one wider than the blank."""
         check_section(self, "stock", StockError)
+        tip_diameter = 2.0 * spec.tip_radius_mm
+        if 0.0 < self.blank_diameter_mm < tip_diameter - 1e-9:
+            short = (tip_diameter - self.blank_diameter_mm) / 2.0
+            raise StockError(f"blank_diameter_mm = {self.blank_diameter_mm:g} is smaller than the tip diameter "
+                             f"{tip_diameter:.4f} mm: the teeth would be {short:.4f} mm short of the tip circle",
+                             field="blank_diameter_mm")
         if (self.stub_diameter_mm > 0.0) != (self.stub_length_mm > 0.0):
             raise StockError("a holding stub needs both stub_diameter_mm and stub_length_mm",
                                 field="stub_diameter_mm")
@@ -83,4 +92,7 @@ class StockSpec:
                                 f"({2 * self.blank_radius_mm(spec):.3f} mm)", field="stub_diameter_mm")
 
     def blank_radius_mm(self, spec: GearSpec) -> float:
+        """The blank's radius: half the given blank diameter, else tip radius + radial allowance."""
+        if self.blank_diameter_mm > 0.0:
+            return self.blank_diameter_mm / 2.0
         return spec.tip_radius_mm + self.radial_allowance_mm

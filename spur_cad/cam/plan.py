@@ -26,7 +26,7 @@ from spur_cad.cam.roughing import (
 )
 from spur_cad.cam.strategies import FinishingResult, get_strategy, params_from_section
 from spur_cad.cam.tools import Tool, ToolError
-from spur_cad.errors import WorkLimitError
+from spur_cad.errors import StockError, WorkLimitError
 from spur_cad.geometry.spec import GearSpec
 
 MAX_TOOLPATH_MOVES = 10_000_000
@@ -107,6 +107,7 @@ def check_cam_inputs(inputs: CamInputs) -> tuple[ToolRecommendations, RoughingLe
                            f"(helix_angle_deg = {spec.helix_angle_deg:g}) is finished by strategy = \"generating\"",
                            field="strategy", section="finishing")
     blank = stock.blank_radius_mm(spec)
+    check_blank_allowance(spec, stock, inputs.finishing_tool, inputs.roughing)
     rec = recommend_tools(spec, blank, machine.clearance_mm, inputs.finishing_tool)
     check_tools(spec, rec, inputs.roughing_tool, inputs.finishing_tool)
     if inputs.finishing_tool is not None:
@@ -122,6 +123,23 @@ def check_cam_inputs(inputs: CamInputs) -> tuple[ToolRecommendations, RoughingLe
     if inputs.finishing_tool is not None:
         check_roughing_reach(tool, levels.lowest_height_mm - spec.root_radius_mm, rec)
     return rec, levels
+
+
+def check_blank_allowance(spec: GearSpec, stock: StockSpec, finishing_tool: Tool | None,
+                          roughing: RoughingParams) -> None:
+    """The blank above the tip circle is left by roughing (it cuts the spaces only) and taken off the tips by
+    the finishing tool in one pass (land passes, the perimeter's tip sweep): refuse more than that tool's
+    slotting depth ([roughing] max_level_depth_fraction x its diameter, the limit roughing keeps per level)."""
+    if finishing_tool is None:
+        return
+    allowance = stock.blank_radius_mm(spec) - spec.tip_radius_mm
+    limit = roughing.max_level_depth_fraction * finishing_tool.diameter_mm
+    if allowance > limit + 1e-9:
+        name = "blank_diameter_mm" if stock.blank_diameter_mm > 0.0 else "radial_allowance_mm"
+        raise StockError(f"{name}: the blank stands {allowance:.3f} mm above the tip circle, more than the finishing "
+                         f"tool takes off the tips in one pass ({limit:.3f} mm: max_level_depth_fraction "
+                         f"{roughing.max_level_depth_fraction:g} x D {finishing_tool.diameter_mm:g} mm); turn the "
+                         f"blank to at most {2 * (spec.tip_radius_mm + limit):.3f} mm", field=name)
 
 
 def plan_cam(inputs: CamInputs, checkpoint: Callable[[], None] | None = None) -> CamPlan:
