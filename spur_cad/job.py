@@ -17,6 +17,7 @@ import dataclasses
 import re
 import sys
 import tomllib
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -118,6 +119,7 @@ class ToolsSection:
 
     roughing: Tool | None = None
     finishing: Tool | None = None
+    bottom: Tool | None = None  # two-stage roughing: a smaller tool for the bottom of the spaces
 
 
 @dataclass(frozen=True)
@@ -159,13 +161,14 @@ SECTIONS: dict[str, type] = {
     "stock": StockSpec,
     "tools.roughing": Tool,
     "tools.finishing": Tool,
+    "tools.bottom": Tool,
     "roughing": RoughingParams,
     "finishing": FinishingParams,
     "machine": Machine,
     "simulation": SimulationSection,
     "post": PostSettings,
 }
-_TOOL_ROLES = ("roughing", "finishing")
+_TOOL_ROLES = ("roughing", "finishing", "bottom")
 MAX_JOB_FILE_BYTES = 1024 * 1024
 """Job files larger than this are refused before they are parsed."""
 
@@ -301,6 +304,8 @@ def _tables(data: dict, source: str, text: str) -> dict[str, object]:
 
 DEFAULT_FINISHING_TOOL_NUMBER = 2
 """The finishing tool's number when its section gives none (the roughing tool's default is 1)."""
+DEFAULT_BOTTOM_TOOL_NUMBER = 3
+"""The bottom roughing tool's number when its section gives none."""
 
 
 def _tool_label(tool: Tool) -> str:
@@ -308,18 +313,35 @@ def _tool_label(tool: Tool) -> str:
     return f"{tool.kind} D {tool.diameter_mm:g} mm{corner}, {tool.flutes} flutes"
 
 
-def _check_tool_numbers(roughing: Tool, finishing: Tool, where: str) -> None:
+def _check_tool_numbers(first_role: str, first: Tool, role: str, tool: Tool, where: str, blamed: str) -> None:
     """Two different end mills under one tool number would make the machine load the wrong one for one of the
     programs: refuse (the same end mill may serve both, with its own cutting data)."""
     def shape(tool: Tool) -> tuple:
         return (tool.kind, tool.diameter_mm, tool.effective_corner_radius_mm, tool.flutes, tool.flute_length_mm,
                 tool.stick_out_mm, tool.gauge_length_mm)
 
-    if roughing.tool_number == finishing.tool_number and shape(roughing) != shape(finishing):
-        raise JobFileError(f"{where}: [tools.finishing] tool_number = {finishing.tool_number} is also the roughing "
-                           f"tool's number, but the tools differ (roughing {_tool_label(roughing)}; finishing "
-                           f"{_tool_label(finishing)}): the machine would load the wrong end mill; give each tool "
-                           "its own number", section="tools.finishing", field="tool_number")
+    if first.tool_number == tool.tool_number and shape(first) != shape(tool):
+        raise JobFileError(f"{where}: [tools.{role}] tool_number = {tool.tool_number} is also the {first_role} "
+                           f"tool's number, but the tools differ ({first_role} {_tool_label(first)}; {role} "
+                           f"{_tool_label(tool)}): the machine would load the wrong end mill; give each tool "
+                           "its own number", section=f"tools.{blamed}", field="tool_number")
+
+
+def _tools_section(sections: dict, tables: dict, where: Callable[[str, str | None], str]) -> ToolsSection:
+    """The tools, with the default numbers of tools whose sections give none (T2 finishing, T3 bottom), and no
+    two different tools under one number."""
+    for role, number in (("finishing", DEFAULT_FINISHING_TOOL_NUMBER), ("bottom", DEFAULT_BOTTOM_TOOL_NUMBER)):
+        if f"tools.{role}" in sections and "tool_number" not in tables[f"tools.{role}"]:
+            sections[f"tools.{role}"] = dataclasses.replace(sections[f"tools.{role}"], tool_number=number)
+    tools = ToolsSection(**{role: sections.get(f"tools.{role}") for role in _TOOL_ROLES})
+    present = [role for role in _TOOL_ROLES if getattr(tools, role) is not None]
+    for i, first_role in enumerate(present):
+        for role in present[i + 1:]:
+            given = "tool_number" in tables[f"tools.{role}"]  # else blame the other tool's number (the default given)
+            blamed = role if given else first_role
+            _check_tool_numbers(first_role, getattr(tools, first_role), role, getattr(tools, role),
+                                where(f"tools.{blamed}", "tool_number"), blamed)
+    return tools
 
 
 def _job_from_data(data: dict, source: str, text: str) -> Job:
@@ -356,14 +378,7 @@ def _job_from_data(data: dict, source: str, text: str) -> Job:
             prefix = f"[{name}] " if is_tool else ""
             blamed = _blamed_key(exc, name, tables[name])
             raise JobFileError(f"{where(name, blamed)}: {prefix}{exc}", section=name, field=blamed) from None
-    if "tools.finishing" in sections and "tool_number" not in tables["tools.finishing"]:
-        sections["tools.finishing"] = dataclasses.replace(sections["tools.finishing"],
-                                                          tool_number=DEFAULT_FINISHING_TOOL_NUMBER)
-    tools = ToolsSection(**{role: sections.get(f"tools.{role}") for role in _TOOL_ROLES})
-    if tools.roughing is not None and tools.finishing is not None:
-        given = "tool_number" in tables["tools.finishing"]  # else blame the roughing tool's number (T2 given)
-        _check_tool_numbers(tools.roughing, tools.finishing,
-                            where("tools.finishing" if given else "tools.roughing", "tool_number"))
+    tools = _tools_section(sections, tables, where)
     try:
         check_machine_limits(spec, sections.get("stock", StockSpec()), sections.get("machine", Machine()),
                              {role: tool for role in _TOOL_ROLES if (tool := getattr(tools, role)) is not None})

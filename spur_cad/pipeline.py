@@ -94,7 +94,8 @@ def build_programs(job: Job, plan: CamPlan) -> tuple[dict[str, PostedProgram], d
     settings = job.post
     programs: dict[str, PostedProgram] = {}
     files: dict[str, bytes] = {}
-    for name, operation in (("roughing", plan.roughing), ("finishing", plan.finishing)):
+    for name, operation in (("roughing", plan.roughing), ("roughing_bottom", plan.roughing_bottom),
+                            ("finishing", plan.finishing)):
         if operation is None:
             continue
         program = programs[name] = post_program(operation.toolpath, settings, program_info(job, plan, name))
@@ -125,7 +126,7 @@ def restart_program(job: Job, plan: CamPlan, point: RestartPoint) -> tuple[str, 
     from spur_cad.cam.restart import RestartError, restart_toolpath, run_reference_a_deg
     from spur_cad.post import dialect, post_program
 
-    planned = plan.roughing if point.operation == "roughing" else plan.finishing
+    planned = getattr(plan, point.operation)
     if planned is None:
         raise RestartError(f"--restart {point.text()}: the job has no {point.operation} (no [tools.{point.operation}])",
                            field="restart")
@@ -141,10 +142,14 @@ def restart_program(job: Job, plan: CamPlan, point: RestartPoint) -> tuple[str, 
 def program_comments(job: Job, plan: CamPlan, operation: str) -> tuple[str, ...]:
     """Header comments of a program: gear data, tool, strategy, estimated time (no date: outputs are reproducible)."""
     spec = job.gear
-    if operation == "roughing":
-        planned = plan.roughing
+    if operation in ("roughing", "roughing_bottom"):
+        planned = getattr(plan, operation)
         strategy = (f"strategy: {len(planned.levels.heights_mm)} levels per space, flank allowance "
                     f"{job.roughing.flank_allowance_mm:g} mm")
+        if plan.two_stage is not None:
+            stage = "upper levels, then roughing_bottom" if operation == "roughing" else "bottom levels, after roughing"
+            strategy += (f"; two-stage ({stage}), split {plan.two_stage.split_height_above_root_mm:.3f} mm above "
+                         "the root")
     else:
         planned = plan.finishing
         result = planned.result
@@ -192,7 +197,7 @@ def build_cad(job: Job, checkpoint: Callable[[], None] | None = None) -> tuple[C
 def cam_inputs(job: Job) -> CamInputs:
     """The part of a job the CAM stage reads."""
     return CamInputs(job.gear, job.stock, job.tools.roughing, job.tools.finishing, job.roughing, job.finishing,
-                     job.machine)
+                     job.machine, job.tools.bottom)
 
 
 def plan_cam(job: Job, checkpoint: Callable[[], None] | None = None) -> CamPlan:
@@ -213,8 +218,8 @@ def simulate_stage(job: Job, plan: CamPlan, progress: Callable[[float], None] | 
     """The job's stock cut by its roughing then finishing toolpaths (None when disabled or nothing to cut)."""
     from spur_cad.sim.simulate import Cut, SimSettings, simulate
 
-    operations = [Cut(planned.toolpath, planned.tool) for planned in (plan.roughing, plan.finishing)
-                  if planned is not None]
+    operations = [Cut(planned.toolpath, planned.tool) for planned in (plan.roughing, plan.roughing_bottom,
+                                                                      plan.finishing) if planned is not None]
     if not job.simulation.enabled or not operations:
         return None
     stations = plan.finishing.result.station_x_mm if plan.finishing is not None else np.zeros(0)

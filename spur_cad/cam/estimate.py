@@ -37,12 +37,15 @@ class Estimate:
     time_with_acceleration_s: float  # look-ahead trapezoidal profiles with the machine's accelerations
 
 
-def estimate(path: Toolpath, machine: Machine) -> Estimate:
-    """Cycle-time estimate of one operation (pure function)."""
-    motion = path.motion_mask
-    if not motion.any():
-        return Estimate(int(len(path)), 0.0, 0.0, len(path) * machine.block_time_s, len(path) * machine.block_time_s)
+def move_seconds(path: Toolpath, machine: Machine) -> np.ndarray:
+    """Feed-bound seconds of every move (at least the block time), e.g. to compare parts of a toolpath."""
+    if not path.motion_mask.any():
+        return np.full(len(path), machine.block_time_s)
+    return _lengths_and_minutes(path, machine)[2]
 
+
+def _lengths_and_minutes(path: Toolpath, machine: Machine) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Relative path length, feed-bound minutes and seconds (at least the block time) of every move."""
     x0, y0, z0, a0 = path.start_poses().T
     length = relative_path_lengths(x0, y0, z0, a0, path.x, path.y, path.z, path.a, substeps=8)
     rotary = np.abs(path.a - a0)
@@ -55,7 +58,16 @@ def estimate(path: Toolpath, machine: Machine) -> Estimate:
     minutes[inverse] = 1.0 / path.feed[inverse]
     minutes[plain] = length[plain] / path.feed[plain]
     minutes = np.maximum(minutes, rotary / machine.max_rotary_speed_deg_min)
-    seconds = np.maximum(minutes * 60.0, machine.block_time_s)
+    return length, minutes, np.maximum(minutes * 60.0, machine.block_time_s)
+
+
+def estimate(path: Toolpath, machine: Machine) -> Estimate:
+    """Cycle-time estimate of one operation (pure function)."""
+    if not path.motion_mask.any():
+        return Estimate(int(len(path)), 0.0, 0.0, len(path) * machine.block_time_s, len(path) * machine.block_time_s)
+    length, minutes, seconds = _lengths_and_minutes(path, machine)
+    rapid = path.kind == MoveKind.RAPID
+    linear = path.kind == MoveKind.LINEAR
     with_acceleration = acceleration_aware_seconds(path, machine, np.where(path.motion_mask, minutes * 60.0, 0.0))
     return Estimate(int(len(path)), float(length[linear].sum()), float(length[rapid].sum()), float(seconds.sum()),
                     float(with_acceleration.sum()))

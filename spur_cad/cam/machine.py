@@ -152,6 +152,11 @@ class RoughingParams:
                                     group="Roughing strategy", meaning="Y step between passes of a level, x D")
     max_level_depth_fraction: float = key(0.5, low=0.0, high=2.0, low_open=True, label="MaxLevelDepthFraction",
                                           group="Roughing strategy", meaning="slotting depth limit per level, x D")
+    bottom_tool_above_root_mm: float = key(0.0, unit="mm", low=0.0, high=1000.0, label="BottomToolAboveRoot",
+                                           group="Roughing strategy",
+                                           meaning="two-stage roughing ([tools.bottom]): the roughing tool's levels "
+                                                   "reach down to this height above the root circle, the bottom "
+                                                   "tool's below it; 0: the split with the shortest estimated time")
     clamp_rotary: bool = key(False, label="ClampRotary", group="Roughing strategy",
                              meaning="clamp A around each tooth space (needs the machine's clamp codes)")
 

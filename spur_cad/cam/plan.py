@@ -9,9 +9,11 @@ import dataclasses
 from collections.abc import Callable
 from dataclasses import dataclass
 
+import numpy as np
+
 from spur_cad.cad.specs import StockSpec
 from spur_cad.cam.contacts import ContactCounts, contact_counts
-from spur_cad.cam.estimate import Estimate, estimate
+from spur_cad.cam.estimate import Estimate, estimate, move_seconds
 from spur_cad.cam.finishing import plan_finishing
 from spur_cad.cam.ir import Toolpath
 from spur_cad.cam.machine import FinishingParams, Machine, MachineError, RoughingParams, check_travel
@@ -74,13 +76,29 @@ class FinishingPlan:
 
 
 @dataclass(frozen=True)
+class TwoStage:
+    """Two-stage roughing: where the bottom tool takes over and what it saves against that tool alone."""
+
+    split_height_above_root_mm: float  # the roughing tool's lowest level; the bottom tool's levels are below it
+    chosen: str  # "shortest time" or "set" ([roughing] bottom_tool_above_root_mm)
+    two_stage_time_s: float
+    bottom_tool_alone_time_s: float
+
+    @property
+    def gain_s(self) -> float:
+        return self.bottom_tool_alone_time_s - self.two_stage_time_s
+
+
+@dataclass(frozen=True)
 class CamPlan:
-    """Everything the CAM stage decided for one job."""
+    """Everything the CAM stage decided for one job (`roughing_bottom` and `two_stage`: two-stage roughing)."""
 
     recommendations: ToolRecommendations
     roughing: RoughingPlan | None
     finishing: FinishingPlan | None
     warnings: tuple[str, ...]
+    roughing_bottom: RoughingPlan | None = None
+    two_stage: TwoStage | None = None
 
 
 @dataclass(frozen=True)
@@ -94,6 +112,7 @@ class CamInputs:
     roughing: RoughingParams
     finishing: FinishingParams
     machine: Machine
+    bottom_tool: Tool | None = None  # two-stage roughing: the smaller tool for the bottom of the spaces
 
 
 def check_cam_inputs(inputs: CamInputs) -> tuple[ToolRecommendations, RoughingLevels | None]:
@@ -109,7 +128,10 @@ def check_cam_inputs(inputs: CamInputs) -> tuple[ToolRecommendations, RoughingLe
     blank = stock.blank_radius_mm(spec)
     check_blank_allowance(spec, stock, inputs.finishing_tool, inputs.roughing)
     rec = recommend_tools(spec, blank, machine.clearance_mm, inputs.finishing_tool)
-    check_tools(spec, rec, inputs.roughing_tool, inputs.finishing_tool)
+    if inputs.bottom_tool is not None:
+        check_two_stage_tools(spec, rec, inputs.roughing_tool, inputs.bottom_tool, inputs.finishing_tool)
+    else:
+        check_tools(spec, rec, inputs.roughing_tool, inputs.finishing_tool)
     if inputs.finishing_tool is not None:
         check_finishing_work(spec, inputs.finishing_tool, machine, inputs.finishing)
     if inputs.roughing_tool is None:
@@ -120,9 +142,41 @@ def check_cam_inputs(inputs: CamInputs) -> tuple[ToolRecommendations, RoughingLe
     moves, driver = estimated_roughing_moves(spec, tool, inputs.roughing, blank)
     check_moves("roughing", moves, "roughing", driver)
     levels = roughing_levels(spec, tool, inputs.roughing, blank)
+    deepest = tool
+    if inputs.bottom_tool is not None:
+        deepest = inputs.bottom_tool
+        moves, driver = estimated_roughing_moves(spec, deepest, inputs.roughing, blank)
+        check_moves("roughing with the bottom tool", moves, "roughing", driver)
     if inputs.finishing_tool is not None:
-        check_roughing_reach(tool, levels.lowest_height_mm - spec.root_radius_mm, rec)
+        lowest = levels if deepest is tool else roughing_levels(spec, deepest, inputs.roughing, blank)
+        try:
+            check_roughing_reach(deepest, lowest.lowest_height_mm - spec.root_radius_mm, rec)
+        except ToolError as exc:
+            raise ToolError(str(exc), field=exc.field,
+                            section="tools.bottom" if deepest is not tool else exc.section) from None
     return rec, levels
+
+
+def check_two_stage_tools(spec: GearSpec, rec: ToolRecommendations, roughing_tool: Tool | None, bottom: Tool,
+                          finishing: Tool | None) -> None:
+    """Two-stage roughing: the bottom tool meets the roughing tool's limits (it reaches the bottom of the space);
+    the roughing tool is a flat end mill larger than it, with no limit of its own but fitting the space."""
+    if roughing_tool is None:
+        raise ToolError("[tools.bottom] needs [tools.roughing]: the bottom tool roughs below the roughing tool's "
+                        "levels", field="diameter_mm", section="tools.bottom")
+    check_tools(spec, rec, None, finishing)
+    try:
+        check_tools(spec, rec, bottom, None)
+    except ToolError as exc:
+        raise ToolError(f"[tools.bottom] {exc}", field=exc.field, section="tools.bottom") from None
+    roughing_tool.validate("roughing")
+    if roughing_tool.kind != "flat":
+        raise ToolError(f"roughing tool kind '{roughing_tool.kind}': roughing uses a flat end mill", field="kind",
+                        section="tools.roughing")
+    if bottom.diameter_mm >= roughing_tool.diameter_mm:
+        raise ToolError(f"[tools.bottom] diameter_mm = {bottom.diameter_mm:g} must be smaller than the roughing "
+                        f"tool's {roughing_tool.diameter_mm:g} mm (two-stage roughing: the larger tool roughs the "
+                        "upper levels, the smaller one the bottom)", field="diameter_mm", section="tools.bottom")
 
 
 def check_blank_allowance(spec: GearSpec, stock: StockSpec, finishing_tool: Tool | None,
@@ -152,7 +206,12 @@ def plan_cam(inputs: CamInputs, checkpoint: Callable[[], None] | None = None) ->
     tools = {role: tool for role, tool in (("roughing", inputs.roughing_tool), ("finishing", inputs.finishing_tool))
              if tool is not None}
     warnings: list[str] = list(check_machine_limits(inputs.spec, inputs.stock, inputs.machine, tools))
-    if levels is not None:
+    bottom = two_stage = None
+    if levels is not None and inputs.bottom_tool is not None:
+        check()
+        roughing, bottom, two_stage = _plan_two_stage(inputs, levels, blank)
+        warnings.extend(roughing.toolpath.warnings + bottom.toolpath.warnings)
+    elif levels is not None:
         check()
         roughing = _plan_roughing(inputs, levels, blank)
         warnings.extend(roughing.toolpath.warnings)
@@ -160,7 +219,7 @@ def plan_cam(inputs: CamInputs, checkpoint: Callable[[], None] | None = None) ->
         check()
         finishing = _plan_finishing(inputs, blank, check)
         warnings.extend(finishing.toolpath.warnings)
-    return CamPlan(rec, roughing, finishing, tuple(warnings))
+    return CamPlan(rec, roughing, finishing, tuple(warnings), bottom, two_stage)
 
 
 def check_moves(operation: str, moves: int, section: str, field: str) -> None:
@@ -170,8 +229,60 @@ def check_moves(operation: str, moves: int, section: str, field: str) -> None:
                              f"raise [{section}] {field}", field=field, section=section)
 
 
-def _plan_roughing(inputs: CamInputs, levels: RoughingLevels, blank: float) -> RoughingPlan:
-    spec, tool, stock = inputs.spec, inputs.roughing_tool, inputs.stock
+def _levels_where(levels: RoughingLevels, keep: np.ndarray) -> RoughingLevels:
+    return RoughingLevels(levels.heights_mm[keep], levels.half_widths_mm[keep], levels.junction_height_mm)
+
+
+def _plan_two_stage(inputs: CamInputs, levels: RoughingLevels,
+                    blank: float) -> tuple[RoughingPlan, RoughingPlan, TwoStage]:
+    """The roughing tool's levels down to a split, the bottom tool's levels below it. The split is one of the
+    roughing tool's levels: the one [roughing] bottom_tool_above_root_mm names (the lowest at or above that
+    height), or the one with the shortest estimated time of both programs. Below the split the bottom tool's
+    own levels keep the staircase and depth limits (its next level above is at or above the split)."""
+    spec, bottom = inputs.spec, inputs.bottom_tool
+    bottom_levels = roughing_levels(spec, bottom, inputs.roughing, blank)
+    alone = _plan_roughing(inputs, bottom_levels, blank, bottom)
+    root, set_height = spec.root_radius_mm, inputs.roughing.bottom_tool_above_root_mm
+    splits = range(len(levels.heights_mm))
+    if set_height > 0.0:
+        at_or_above = np.flatnonzero(levels.heights_mm >= root + set_height - 1e-9)
+        if len(at_or_above) == 0:
+            raise MachineError(f"[roughing] bottom_tool_above_root_mm = {set_height:g} is above the roughing tool's "
+                               f"highest level ({levels.heights_mm[0] - root:.3f} mm above the root)",
+                               field="bottom_tool_above_root_mm", section="roughing")
+        splits = [int(at_or_above[-1])]
+    # each level's time from the two full toolpaths (a level's moves carry its index in `station`)
+    full = _plan_roughing(inputs, levels, blank)
+    upper_cost = _level_seconds(full.toolpath, inputs.machine, len(levels.heights_mm))
+    lower_cost = _level_seconds(alone.toolpath, inputs.machine, len(bottom_levels.heights_mm))
+    best = None
+    for j in splits:
+        below = bottom_levels.heights_mm < levels.heights_mm[j] - 1e-9
+        total = upper_cost[:j + 1].sum() + lower_cost[below].sum()
+        if below.any() and (best is None or total < best[0]):
+            best = (total, j, below)
+    if best is None:
+        raise MachineError(f"two-stage roughing: the roughing tool (D {inputs.roughing_tool.diameter_mm:g} mm) reaches "
+                           f"as deep as the bottom tool (D {bottom.diameter_mm:g} mm); leave out [tools.bottom]",
+                           field="diameter_mm", section="tools.bottom")
+    _, j, below = best
+    upper = _plan_roughing(inputs, _levels_where(levels, np.arange(len(levels.heights_mm)) <= j), blank)
+    lower = _plan_roughing(inputs, _levels_where(bottom_levels, below), blank, bottom)
+    chosen = "set" if set_height > 0.0 else "shortest time"
+    return upper, lower, TwoStage(float(levels.heights_mm[j] - root), chosen,
+                                  upper.estimate.time_s + lower.estimate.time_s, alone.estimate.time_s)
+
+
+def _level_seconds(path: Toolpath, machine: Machine, levels: int) -> np.ndarray:
+    """Feed-bound seconds of each roughing level's moves over all spaces."""
+    seconds = move_seconds(path, machine)
+    on_level = path.station >= 0
+    return np.bincount(path.station[on_level], weights=seconds[on_level], minlength=levels)
+
+
+def _plan_roughing(inputs: CamInputs, levels: RoughingLevels, blank: float, tool: Tool | None = None) -> RoughingPlan:
+    spec, stock = inputs.spec, inputs.stock
+    tool = tool or inputs.roughing_tool
     lowest_above_root = levels.lowest_height_mm - spec.root_radius_mm
     path = roughing_toolpath(spec, tool, inputs.machine, inputs.roughing, blank, stock.back_margin_mm,
                              stock.stub_diameter_mm / 2.0, stock.front_margin_mm, levels=levels)

@@ -21,7 +21,7 @@ import numpy as np
 from spur_cad.cam.ir import MoveKind, Toolpath, ToolpathBuilder
 from spur_cad.errors import SpurCadError
 
-OPERATIONS = ("roughing", "finishing")
+OPERATIONS = ("roughing", "roughing_bottom", "finishing")
 UNITS = {"space": "space", "level": "station", "station": "station", "pass": None}
 """Restart units and the IR column that numbers them (`pass`: the rapids of a space, one per generating pass)."""
 
@@ -45,7 +45,7 @@ class RestartPoint:
         return f"{self.operation}:" + ",".join(f"{unit}={index}" for unit, index in self.at)
 
 
-_POINT = re.compile(r"(roughing|finishing):((?:space|station)=\d{1,7})(?:,((?:level|pass)=\d{1,7}))?")
+_POINT = re.compile(r"(roughing_bottom|roughing|finishing):((?:space|station)=\d{1,7})(?:,((?:level|pass)=\d{1,7}))?")
 
 
 def parse_restart(text: str) -> RestartPoint:
@@ -58,7 +58,7 @@ def parse_restart(text: str) -> RestartPoint:
     operation = found.group(1)
     at = tuple((unit, int(index)) for unit, index in (part.split("=") for part in found.groups()[1:] if part))
     units = tuple(unit for unit, _ in at)
-    allowed = {"roughing": (("space",), ("space", "level")),
+    allowed = {"roughing": (("space",), ("space", "level")), "roughing_bottom": (("space",), ("space", "level")),
                "finishing": (("station",), ("space",), ("space", "pass"))}[operation]
     if units not in allowed:
         raise RestartError(f"--restart {text!r}: {usage}", field="restart")

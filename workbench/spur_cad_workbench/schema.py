@@ -124,7 +124,9 @@ def _key_field(section: str, k) -> Field:
 TOOL_SWITCHES = {"roughing": _f("UseRoughingTool", "bool", "Roughing tool", "tools.roughing", "",
                                 "rough with this tool (without it the job has no roughing)"),
                  "finishing": _f("UseFinishingTool", "bool", "Finishing tool", "tools.finishing", "",
-                                 "finish with this tool (without it the job has no finishing)")}
+                                 "finish with this tool (without it the job has no finishing)"),
+                 "bottom": _f("UseBottomTool", "bool", "Bottom tool", "tools.bottom", "",
+                              "two-stage roughing: this smaller tool roughs the bottom of the spaces")}
 
 # Which document object holds each section (the job object holds every other section).
 SECTION_OBJECTS = {"gear": "gear", "stock": "stock"}
@@ -216,12 +218,13 @@ def plain_value(field: Field, value):
 def _section_defaults() -> dict[str, dict[str, object]]:
     """The job file's defaults for every section; a required key without a value is 0 (a tool's
     diameter: 0 until chosen) until NEW_GEAR or the user gives one."""
-    from spur_cad.job import DEFAULT_FINISHING_TOOL_NUMBER
+    from spur_cad.job import DEFAULT_BOTTOM_TOOL_NUMBER, DEFAULT_FINISHING_TOOL_NUMBER
 
     zero = {float: 0.0, int: 0, str: "", bool: False}
     defaults = {section: {k.name: zero[k.type] if k.required else k.default for k in keys_of(cls)}
                 for section, cls in SECTIONS.items()}
     defaults["tools.finishing"]["tool_number"] = DEFAULT_FINISHING_TOOL_NUMBER  # T1 roughing, T2 finishing
+    defaults["tools.bottom"]["tool_number"] = DEFAULT_BOTTOM_TOOL_NUMBER  # T3 the bottom roughing tool
     return defaults
 
 
