@@ -25,6 +25,7 @@ from spur_cad.cad.specs import BlankFeatures, StockSpec
 from spur_cad.cam.machine import FinishingParams, Machine, RoughingParams
 from spur_cad.cam.machine_limits import check_machine_limits
 from spur_cad.cam.tools import Tool
+from spur_cad.cam.turning import LatheSection, check_lathe_blank
 from spur_cad.errors import GearSpecError, JobFileError, SpurCadError, StockError
 from spur_cad.geometry.spec import MAX_TEETH, MIN_TEETH, GearSpec
 from spur_cad.keys import check_section, coerce, key, keys_of, section_problems, toml_literal, type_problem
@@ -137,6 +138,7 @@ class Job:
     machine: Machine = field(default_factory=Machine)
     post: PostSettings = field(default_factory=PostSettings)
     simulation: SimulationSection = field(default_factory=SimulationSection)
+    lathe: LatheSection | None = None  # [lathe] present: the blank's lathe program is written too
     text: str = field(default="", repr=False, compare=False)  # the file's text, to point at lines
 
     def located(self, error: SpurCadError) -> str:
@@ -167,6 +169,7 @@ SECTIONS: dict[str, type] = {
     "machine": Machine,
     "simulation": SimulationSection,
     "post": PostSettings,
+    "lathe": LatheSection,
 }
 _TOOL_ROLES = ("roughing", "finishing", "bottom")
 MAX_JOB_FILE_BYTES = 1024 * 1024
@@ -365,7 +368,7 @@ def _job_from_data(data: dict, source: str, text: str) -> Job:
         except (GearSpecError, StockError) as exc:
             blamed = _blamed_key(exc, name, tables.get(name, {}))
             raise JobFileError(f"{where(name, blamed)}: invalid [{name}]: {exc}", section=name, field=blamed) from None
-    for name in ("machine", "roughing", "finishing", "post", *(f"tools.{role}" for role in _TOOL_ROLES)):
+    for name in ("machine", "roughing", "finishing", "post", "lathe", *(f"tools.{role}" for role in _TOOL_ROLES)):
         if name not in sections:
             continue
         is_tool = name.startswith("tools.")
@@ -384,8 +387,15 @@ def _job_from_data(data: dict, source: str, text: str) -> Job:
                              {role: tool for role in _TOOL_ROLES if (tool := getattr(tools, role)) is not None})
     except SpurCadError as exc:
         raise JobFileError(f"{where('machine', exc.field)}: {exc}", section="machine", field=exc.field) from None
-    optional = {name: sections[name] for name in ("stock", "roughing", "finishing", "machine", "post", "simulation")
-                if name in sections}
+    if "lathe" in sections:
+        try:
+            check_lathe_blank(spec, sections.get("stock", StockSpec()), sections["lathe"])
+        except SpurCadError as exc:
+            name = exc.section if exc.section in ("stock", "lathe") else "lathe"
+            blamed = _blamed_key(exc, name, tables.get(name, {}))
+            raise JobFileError(f"{where(name, blamed)}: {exc}", section=name, field=blamed) from None
+    optional = {name: sections[name] for name in ("stock", "roughing", "finishing", "machine", "post", "simulation",
+                                                  "lathe") if name in sections}
     return Job(source=source, job=sections.get("job", JobSection()), gear_section=gear_section, gear=spec,
                tools=tools, **optional, text=text)
 
@@ -454,6 +464,17 @@ Notes:
   `rotary_clamp_code` / `rotary_unclamp_code` are needed when `[roughing] clamp_rotary`
   is true; `rotary_continuous = false` makes finishing unwind A after every station.
 - `[post] folded = true` needs `rotary_mode = "unwound"`.
+- `[stock] blank_diameter_mm` (the blank as turned) replaces tip diameter + 2 x
+  `radial_allowance_mm`; it may not be below the tip diameter, and the blank may stand at most
+  `[roughing] max_level_depth_fraction` x the finishing tool's diameter above the tip circle.
+- `[machine]` physical limits (`max_part_diameter_mm`, `max_part_weight_kg`, `max_overhang_mm`,
+  `spindle_nose_top_mm`; 0 = not checked) are errors naming the limit; tools below
+  `smallest_end_mill_mm` are warnings (see [shop-floor.md](shop-floor.md)).
+- `[tools.bottom]`: two-stage roughing, a flat end mill smaller than `[tools.roughing]` for the
+  bottom of the spaces (T3 when it gives no number); the split is chosen for the shortest time
+  unless `[roughing] bottom_tool_above_root_mm` sets it.
+- `[lathe]`: with the section the blank's lathe program `blank.<ext>` is written too (see
+  [lathe.md](lathe.md)).
 """
 
 _TYPE_WORDS = {float: "number", int: "integer", bool: "boolean", str: "string"}

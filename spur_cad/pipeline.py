@@ -72,6 +72,9 @@ def run_job(job: Job, progress: Callable[[str, float], None] | None = None,
     if restart is not None:
         name, text = restart_program(job, plan, restart)
         program_files[name] = text
+    if job.lathe is not None:
+        name, text = timed("lathe", None, lambda: lathe_program(job))
+        program_files[name] = text
     sim_result = timed("simulation", "simulation",
                        lambda: simulate_stage(job, plan, lambda fraction: tell("simulation", fraction)))
     summary = build_summary(job, samples, cad, plan, job.post, programs, sim_result, seconds)
@@ -117,6 +120,19 @@ def program_info(job: Job, plan: CamPlan, operation: str, restart_comment: str |
     return ProgramInfo(title=title, comments=comments, rotary_clamp_code=job.machine.rotary_clamp_code,
                        rotary_unclamp_code=job.machine.rotary_unclamp_code, blank_box_mm=box,
                        approach_z_mm=approach_z_mm, first_space_a_reference_deg=a_reference_deg)
+
+
+def lathe_program(job: Job) -> tuple[str, bytes]:
+    """The blank's lathe program ([lathe], spur_cad.cam.turning): its file name blank.<ext> and text."""
+    from spur_cad.cam.turning import plan_lathe
+    from spur_cad.post.lathe import lathe_extension, post_lathe
+
+    spec, stock = job.gear, job.stock
+    comments = (f"gear: z = {spec.teeth}, m = {spec.module_mm:g} mm, b = {spec.face_width_mm:g} mm, tip diameter "
+                f"{2 * spec.tip_radius_mm:.4f} mm",)
+    text = post_lathe(plan_lathe(spec, stock, job.lathe), job.lathe, f"spur_cad {__version__} blank: {job.job.name}",
+                      comments)
+    return f"blank.{lathe_extension(job.lathe.dialect)}", text.encode()
 
 
 def restart_program(job: Job, plan: CamPlan, point: RestartPoint) -> tuple[str, bytes]:

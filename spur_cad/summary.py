@@ -54,8 +54,19 @@ def build_summary(job, samples: ProfileSamples, cad: CadResult, plan: CamPlan, p
         "post": post_section(post, programs),
         "simulation": simulation_section(simulation, job.simulation.resolution_mm),
         "grading": grading_section(job.gear, simulation),
+        **({"lathe": lathe_section(job)} if job.lathe is not None else {}),
         "timings_s": seconds,
     }
+
+
+def lathe_section(job) -> dict:
+    """summary.json's `lathe` (with [lathe]): the control, the bar and the part the lathe program turns."""
+    from spur_cad.cam.turning import lathe_geometry
+
+    g = lathe_geometry(job.gear, job.stock, job.lathe)
+    return {"dialect": job.lathe.dialect, "bar_diameter_mm": g.bar_diameter, "blank_diameter_mm": g.blank_diameter,
+            "blank_length_mm": g.blank_length, "stub_diameter_mm": g.stub_diameter, "stub_length_mm": g.stub_length,
+            "part_off": job.lathe.part_off, "work_offset": job.lathe.work_offset}
 
 
 def grading_section(spec, result: SimResult | None) -> dict | None:
@@ -113,7 +124,9 @@ def recommendations_section(rec: ToolRecommendations) -> dict:
             "plunge_allowance_mm": rec.plunge_allowance_mm,
             "roughing_max_diameter_mm": rec.roughing_max_diameter_mm,
             "required_flute_length_mm": rec.required_flute_length_mm,
-            "required_stick_out_mm": rec.required_stick_out_mm}
+            "required_stick_out_mm": rec.required_stick_out_mm,
+            "finishing_generating_max_diameter_mm": rec.finishing_generating_max_diameter_mm,
+            "finishing_flat_end_mill_max_diameter_mm": rec.finishing_flat_end_mill_max_diameter_mm}
 
 
 def tool_section(tool: Tool | None, machine: Machine) -> dict | None:

@@ -125,7 +125,7 @@ def test_profile_tolerance_range():
 # --- every declared range, from the declarations -----------------------------------------------------------
 
 MINIMAL = {"gear": {"teeth": 23, "module_mm": 4.0, "face_width_mm": 20.0}, "tools.roughing": {"diameter_mm": 3.0},
-           "tools.finishing": {"diameter_mm": 3.0}}
+           "tools.finishing": {"diameter_mm": 3.0}, "tools.bottom": {"diameter_mm": 2.0}}
 
 
 def _job_text(section: str, key: str, literal: str) -> tuple[str, int]:
@@ -190,12 +190,18 @@ def test_a_bound_naming_another_key():
     assert str(info.value) == "f.toml:7: [post] line_number_step must be in 1..max_line_number (= 99), got 100"
 
 
+def values_of_bound(bound, keys) -> float:
+    """A range bound as a number: a bound naming another key of the section is that key's default."""
+    return next(k.default for k in keys if k.name == bound) if isinstance(bound, str) else bound
+
+
 def test_declarations_are_complete_and_consistent():
     """Every field of a section is a declared key; its unit matches its name; its default is accepted."""
     from spur_cad.keys import value_problem
 
     suffix_units = {"_mm": "mm", "_deg": "deg", "_percent": "%", "_s": "s", "_mm_min": "mm/min", "_m_min": "m/min",
-                    "_deg_min": "deg/min", "_rpm": "1/min", "_mm_s2": "mm/s^2", "_deg_s2": "deg/s^2"}
+                    "_deg_min": "deg/min", "_rpm": "1/min", "_mm_s2": "mm/s^2", "_deg_s2": "deg/s^2", "_kg": "kg",
+                    "_kg_dm3": "kg/dm^3", "_mm_rev": "mm/rev"}
     labels = []
     for section, cls in SECTIONS.items():
         keys = keys_of(cls)
@@ -208,7 +214,10 @@ def test_declarations_are_complete_and_consistent():
                 values = {x.name: x.default for x in keys}
                 assert value_problem(k, k.default, values) is None, (section, k.name)
             if k.type is float and k.low is not None:
-                assert math.isfinite(k.low) and math.isfinite(k.high) and k.low < k.high
+                names = {x.name for x in keys}
+                low, high = (values_of_bound(b, keys) for b in (k.low, k.high))
+                assert all(b in names for b in (k.low, k.high) if isinstance(b, str)), (section, k.name)
+                assert math.isfinite(low) and math.isfinite(high) and low < high, (section, k.name)
             labels.append(k.label.format(Role=section.removeprefix("tools.")))
     assert len(labels) == len(set(labels))
 

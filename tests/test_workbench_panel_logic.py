@@ -144,8 +144,7 @@ def test_values_fingerprint_changes_with_every_job_value(wb):
     base = wb.summary.values_signature(values)
     assert wb.summary.values_signature(_values(wb)) == base
     for field in wb.schema.JOB_FIELDS:
-        if not field.key or (field.section.startswith("tools.") and not values["job"][
-                wb.schema.TOOL_SWITCHES[field.section[6:]].prop]):
+        if not field.key or not wb.schema.section_enabled(values["job"], field.section):
             continue
         value = values["job"][field.prop]
         changed = (not value if field.kind == "bool" else value + 1 if field.kind in ("int",) else

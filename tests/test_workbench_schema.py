@@ -138,8 +138,9 @@ def _section_classes() -> dict[str, type]:
     hints = typing.get_type_hints(Job)
     sections = {("gear" if f.name == "gear_section" else f.name): hints[f.name] for f in dataclasses.fields(Job)
                 if f.name not in ("source", "gear", "tools", "text")}
-    sections["tools.roughing"] = sections["tools.finishing"] = Tool
-    return sections
+    sections["tools.roughing"] = sections["tools.finishing"] = sections["tools.bottom"] = Tool
+    # an optional section (`lathe: LatheSection | None`) is its dataclass
+    return {name: next((a for a in typing.get_args(cls) if a is not type(None)), cls) for name, cls in sections.items()}
 
 
 def test_every_job_file_key_has_exactly_one_property_with_its_old_name(wb):

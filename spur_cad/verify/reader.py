@@ -17,7 +17,16 @@ Modal motion (G0 / G1 stay in effect, so bare axis words move), one axis per blo
 and G94, F, T/M6, S. Rotary direction: in a block with M15 (positive) or M16 (negative), A is an angle
 in [0, 360) reached turning that way (Okuma); elsewhere A is the absolute, unwound axis. Anything this
 reader does not execute (incremental G91, arcs, other plane or unit codes, unknown M codes, macro
-statements) is an error naming the file and line, never a silent skip.
+statements) is an error naming the file and line, never a silent skip. Siemens `WORKPIECE(...)` blank
+definitions are ignored; Okuma's work offset selection `G15 H<n>` is taken as the job's frame (like G54..G59).
+
+Lathe mode (`read_program(..., lathe=True)`, the blank's lathe program of docs/lathe.md; siemens, fanuc
+and linuxcnc): axes X (a DIAMETER) and Z only; diameter mode is required (LinuxCNC G7, Siemens DIAMON;
+Fanuc lathes take X as a diameter); feed per revolution (G95, Fanuc system A G99) is required for feed
+moves, F is recorded as written (mm/rev); G96 / G97, G18, the spindle limit (Fanuc G50 S, Siemens LIMS= or
+G26 S, LinuxCNC's G96 D) are read; a T word changes the tool at once on Siemens and Fanuc (T0101: tool 1,
+offset 1), with M6 on LinuxCNC. Moves are recorded with y = 0 and a = 0, x = the X word as written. Fanuc's
+G90 (a turning cycle in system A), G50 with axes (coordinate setting), U / W (incremental) are refused.
 """
 
 from __future__ import annotations
@@ -31,6 +40,7 @@ import numpy as np
 from spur_cad.errors import SpurCadError
 
 DIALECTS = ("linuxcnc", "fanuc", "haas", "siemens", "okuma")
+LATHE_DIALECTS = ("linuxcnc", "fanuc", "siemens")
 MAX_PROGRAM_BYTES = 256 * 1024 * 1024
 MAX_MOVES = 10_000_000  # about 0.6 GB of move columns: refuse before reading further
 MAX_BLOCKS = 50_000_000  # blocks executed (loops and calls counted): some minutes of reading at most
@@ -104,12 +114,16 @@ _TERM = re.compile(rf"\s*([-+]?)\s*(#\d+|R\d+|[A-Z_][A-Z0-9_]*|{_UNSIGNED})\s*")
 class _Reader:
     """Executes one program: machine state, variables, subprogram calls, recorded moves."""
 
-    def __init__(self, text: str, dialect: str, source: str, checkpoint=None):
-        self.dialect, self.source, self.checkpoint = dialect, source, checkpoint
+    def __init__(self, text: str, dialect: str, source: str, checkpoint=None, lathe: bool = False):
+        self.dialect, self.source, self.checkpoint, self.lathe = dialect, source, checkpoint, lathe
+        self.axes = "XZ" if lathe else "XYZA"
+        self.diameter = dialect == "fanuc"  # lathe X as a diameter: G7 (LinuxCNC), DIAMON (Siemens)
+        self.per_rev = False  # lathe feed per revolution: G95 (G99 on Fanuc)
+        self.block_codes: set[str] = set()  # G codes of the block whose words are checked together
         self.blocks = 0
         self.lines = _clean_lines(text, dialect)
         self.variables: dict[str, float] = {}
-        self.pose = [math.nan, math.nan, math.nan, math.nan]
+        self.pose = [math.nan, 0.0, math.nan, 0.0] if lathe else [math.nan, math.nan, math.nan, math.nan]
         self.motion: str | None = None
         self.inverse = False
         self.feed = math.nan
@@ -214,26 +228,29 @@ class _Reader:
 
     def control(self, line: _Line, after: int, depth: int) -> int | None:
         """Subprogram definitions, calls, repeats and labels; the index to go on at, or None for a block."""
-        text = line.text
         if self.dialect == "linuxcnc":
             return self._linuxcnc_control(line, after, depth)
         if self.dialect == "siemens":
-            if re.fullmatch(r"[A-Z_][A-Z0-9_]*:", text):
-                return after
-            found = re.fullmatch(r"REPEAT\s+([A-Z_][A-Z0-9_]*)\s+([A-Z_][A-Z0-9_]*)(?:\s*P\s*=\s*(\d+))?", text)
-            if found:
-                first, last = (self.labels.get(found.group(k)) for k in (1, 2))
-                if first is None or last is None or last <= first:
-                    raise self.error(line, "REPEAT names labels that do not enclose a section")
-                for _ in range(self._count(found.group(3), line)):
-                    self.execute(first + 1, last, depth + 1)
-                return after
-            if re.fullmatch(r"(R\d+=\S+\s*)+", text):
-                for name, value in re.findall(r"(R\d+)=(\S+)", text):
-                    self.variables[name] = self.value(value, line)
-                return after
-            return None
+            return self._siemens_control(line, after, depth)
         return self._fanuc_family_control(line, after, depth)
+
+    def _siemens_control(self, line: _Line, after: int, depth: int) -> int | None:
+        text = line.text
+        if re.fullmatch(r"[A-Z_][A-Z0-9_]*:", text) or re.fullmatch(r'WORKPIECE\([^()]*\)', text):
+            return after  # a label, or the blank for the control's simulation (ignored)
+        found = re.fullmatch(r"REPEAT\s+([A-Z_][A-Z0-9_]*)\s+([A-Z_][A-Z0-9_]*)(?:\s*P\s*=\s*(\d+))?", text)
+        if found:
+            first, last = (self.labels.get(found.group(k)) for k in (1, 2))
+            if first is None or last is None or last <= first:
+                raise self.error(line, "REPEAT names labels that do not enclose a section")
+            for _ in range(self._count(found.group(3), line)):
+                self.execute(first + 1, last, depth + 1)
+            return after
+        if re.fullmatch(r"(R\d+=\S+\s*)+", text):
+            for name, value in re.findall(r"(R\d+)=(\S+)", text):
+                self.variables[name] = self.value(value, line)
+            return after
+        return None
 
     def _count(self, text: str | None, line: _Line) -> int:
         count = int(text) if text else 1
@@ -323,36 +340,85 @@ class _Reader:
 
     # --- one block --------------------------------------------------------------------------------
     def block(self, line: _Line) -> None:
+        if self.lathe and self.dialect == "siemens":
+            line = self._siemens_lathe_words(line)
         # T and S before M (M6 loads the tool the block names, whatever the order), G before F (a feed mode
         # change resets F), then the rest in order
         words = sorted(self.words(line), key=lambda word: {"T": 0, "S": 0, "G": 1, "F": 2, "M": 3}.get(word[0], 4))
         target = list(self.pose)
         direction = None
         self.feed_in_block = False
+        self.block_codes = set()
         for letter, value in words:
-            if letter == "G":
-                self._g_code(value, line)
-            elif letter == "M":
+            if letter == "M":
                 direction = self._m_code(value, line) or direction
-            elif letter in "XYZ":
-                target["XYZ".index(letter)] = self.value(value, line)
-            elif letter == "A":
-                target[3] = self.value(value, line)
-            elif letter == "F":
-                self.feed = self.value(value, line)
-                self.feed_in_block = True
-            elif letter == "T":
-                self.pending_tool = int(self.value(value, line))
-            elif letter == "S":
-                self.spindle = self.value(value, line)
-            elif letter in "HDP" or (letter == "N" and self.dialect == "siemens"):
-                continue  # tool offset numbers, G64 P tolerance
             else:
-                raise self.error(line, f"word {letter}{value} is not supported by this reader")
+                self._word(letter, value, line, target)
+        if self.block_codes:
+            self._check_block_codes(words, line)
         if direction is not None and not math.isnan(target[3]):
             target[3] = _directed(self.pose[3], target[3], direction, self, line)
         if any(letter in "XYZA" for letter, _ in words):
             self._move(target, line)
+
+    def _word(self, letter: str, value: str, line: _Line, target: list[float]) -> None:
+        """One word other than M: G codes, axes, F, T, S; offsets and tolerances are skipped."""
+        if letter == "G":
+            self._g_code(value, line)
+        elif letter in self.axes:
+            target["XYZA".index(letter)] = self.value(value, line)
+        elif letter == "F":
+            self.feed = self.value(value, line)
+            self.feed_in_block = True
+        elif letter == "T":
+            self._t_word(value, line)
+        elif letter == "S":
+            self.spindle = self.value(value, line)
+        elif letter in "HDP" or (letter == "N" and self.dialect == "siemens"):
+            return  # tool offset numbers, G64 P tolerance, G96 D spindle limit, G15 H work offset
+        elif self.lathe and letter in "YAUW":
+            raise self.error(line, f"word {letter}{value}: a lathe program moves X and Z only (absolute, no U/W)")
+        else:
+            raise self.error(line, f"word {letter}{value} is not supported by this reader")
+
+    def _t_word(self, value: str, line: _Line) -> None:
+        """T: the tool M6 loads; on a Siemens or Fanuc lathe the turret indexes at once (Fanuc T0101: tool 1,
+        offset 1)."""
+        if not (self.lathe and self.dialect in ("siemens", "fanuc")):
+            self.pending_tool = int(self.value(value, line))
+            return
+        if self.dialect == "fanuc":
+            if not re.fullmatch(r"\d{3,4}", value):
+                raise self.error(line, f"T{value}: a Fanuc lathe T word gives the tool and its offset (T0101)")
+            self.tool = self.pending_tool = int(value) // 100
+        else:
+            self.tool = self.pending_tool = int(self.value(value, line))
+
+    def _siemens_lathe_words(self, line: _Line) -> _Line:
+        """Siemens lathe words that are not address + number: LIMS=<rpm> (spindle limit under G96), DIAMON /
+        DIAM90 (X as diameter) and DIAMOF (X as radius); the rest of the block is returned."""
+        text = line.text
+        for value in re.findall(r"\bLIMS\s*=\s*(\S+)", text):
+            self.value(value, line)  # a number (or parameter) it must be
+        for mode in re.findall(r"\bDIAM(ON|OF|90)\b", text):
+            self.diameter = mode != "OF"
+        text = re.sub(r"\bLIMS\s*=\s*\S+|\bDIAM(?:ON|OF|90)\b", " ", text)
+        return _Line(line.number, text.strip())
+
+    def _check_block_codes(self, words: list[tuple[str, str]], line: _Line) -> None:
+        """G codes read only with certain words: Fanuc G50 S and Siemens G26 S (spindle limits; with axes they
+        would set a coordinate system or a working area), Okuma G15 H<n> (work offset n >= 1)."""
+        letters = {letter for letter, _ in words}
+        for code in self.block_codes:
+            if code in ("50", "26") and (letters & set("XZUWY") or "S" not in letters):
+                raise self.error(line, f"G{code} is read only as the spindle speed limit G{code} S<rpm> "
+                                       "(with axes it sets a coordinate system or a working area)")
+            if code == "15":
+                numbers = [value for letter, value in words if letter == "H"]
+                if len(numbers) != 1 or not re.fullmatch(r"\d+", numbers[0]) or int(numbers[0]) < 1 \
+                        or letters & set("XYZA"):
+                    raise self.error(line, "G15 is read only as Okuma's work offset selection G15 H<n> "
+                                           "(n = 1, 2, ...) in a block of its own")
 
     def words(self, line: _Line) -> list[tuple[str, str]]:
         text = line.text
@@ -369,12 +435,36 @@ class _Reader:
         code = value.lstrip("0") or "0"
         if code in ("0", "1"):
             self.motion = code
+        elif self.lathe and self._lathe_g_code(code, line):
+            return
+        elif code == "15" and self.dialect == "okuma" and not self.lathe:
+            self.block_codes.add(code)  # G15 H<n>: Okuma's work offset n
         elif code in ("93", "94"):
             if self.inverse != (code == "93"):
                 self.feed = math.nan  # a feed mode change leaves no F in effect (LinuxCNC, Fanuc)
             self.inverse = code == "93"
         elif code not in SETUP_G and not (code == "71" and self.dialect == "siemens"):  # G71: metric on 840D
             raise self.error(line, f"G{value} is not supported by this reader (it reads G0/G1 moves, G90, G93/G94)")
+
+    def _lathe_g_code(self, code: str, line: _Line) -> bool:
+        """Lathe G codes; False for the codes milling and turning share (G21, G40, G54...)."""
+        per_rev, per_minute = ("99", "98") if self.dialect == "fanuc" else ("95", "94")
+        if code in (per_rev, per_minute):
+            if self.per_rev != (code == per_rev):
+                self.feed = math.nan  # a new feed mode needs a new F
+            self.per_rev = code == per_rev
+        elif code in ("96", "97", "18"):
+            pass  # constant cutting speed (S in m/min) or rpm, the ZX plane
+        elif code in ("7", "8") and self.dialect == "linuxcnc":
+            self.diameter = code == "7"
+        elif (code, self.dialect) in (("50", "fanuc"), ("26", "siemens")):
+            self.block_codes.add(code)
+        elif code == "93" or (code in ("90", "94") and self.dialect == "fanuc"):
+            raise self.error(line, f"G{code} is not read in a lathe program (Fanuc's G90 and G94 are turning "
+                                   "cycles in system A, G93 is inverse time)")
+        else:
+            return False
+        return True
 
     def _m_code(self, value: str, line: _Line) -> str | None:
         code = value.lstrip("0") or "0"
@@ -391,6 +481,8 @@ class _Reader:
     def _move(self, target: list[float], line: _Line) -> None:
         if self.motion is None:
             raise self.error(line, "an axis word before any G0 or G1")
+        if self.lathe:
+            self._check_lathe_move(line)
         rapid = self.motion == "0"
         if any(math.isnan(t) for t in target):
             if rapid:  # e.g. a restart's Z-only move to the clearance height: known from here on, not a move
@@ -409,6 +501,15 @@ class _Reader:
         for column, value in zip(self.columns, row):
             column.append(value)
         self.pose = target
+
+
+    def _check_lathe_move(self, line: _Line) -> None:
+        if not self.diameter:
+            raise self.error(line, "X is a radius here; this reader reads lathe programs in diameter mode "
+                                   + ("(G7)" if self.dialect == "linuxcnc" else "(DIAMON)"))
+        if self.motion == "1" and not self.per_rev:
+            raise self.error(line, "a lathe feed move without feed per revolution ("
+                                   + ("G99" if self.dialect == "fanuc" else "G95") + ")")
 
 
 def _directed(current: float, target: float, direction: str, reader: _Reader, line: _Line) -> float:
@@ -437,11 +538,16 @@ def _clean_lines(text: str, dialect: str) -> list[_Line]:
     return lines
 
 
-def read_program(text: str, dialect: str, source: str = "program", checkpoint=None) -> ProgramMoves:
+def read_program(text: str, dialect: str, source: str = "program", checkpoint=None,
+                 lathe: bool = False) -> ProgramMoves:
     """The moves of a program in `dialect` (one of DIALECTS); raises ProgramReadError naming `source`'s line.
-    `checkpoint()` is called every CHECK_EVERY_BLOCKS blocks (the CLI stops there when a signal arrived)."""
+    `checkpoint()` is called every CHECK_EVERY_BLOCKS blocks (the CLI stops there when a signal arrived).
+    `lathe`: a lathe program (LATHE_DIALECTS; the module docstring says what is read): x is the diameter as
+    written, y = a = 0, feed in mm/rev as written."""
     if dialect not in DIALECTS:
         raise ProgramReadError(f"unknown dialect {dialect!r} (known: {', '.join(DIALECTS)})")
+    if lathe and dialect not in LATHE_DIALECTS:
+        raise ProgramReadError(f"no lathe dialect {dialect!r} (known: {', '.join(LATHE_DIALECTS)})")
     if len(text) > MAX_PROGRAM_BYTES:
         raise ProgramReadError(f"{source}: larger than {MAX_PROGRAM_BYTES // 2**20} MiB")
-    return _Reader(text, dialect, source, checkpoint).run()
+    return _Reader(text, dialect, source, checkpoint, lathe).run()

@@ -128,6 +128,18 @@ TOOL_SWITCHES = {"roughing": _f("UseRoughingTool", "bool", "Roughing tool", "too
                  "bottom": _f("UseBottomTool", "bool", "Bottom tool", "tools.bottom", "",
                               "two-stage roughing: this smaller tool roughs the bottom of the spaces")}
 
+# Every section the job file may leave out, and the switch (a job property) that says whether it is there.
+SECTION_SWITCHES = {**{f"tools.{role}": switch for role, switch in TOOL_SWITCHES.items()},
+                    "lathe": _f("WriteLatheProgram", "bool", "Lathe", "lathe", "",
+                                "write the blank's lathe program (blank.<ext>) with the job's files")}
+
+
+def section_enabled(job_values: dict[str, object], section: str) -> bool:
+    """Whether the job has `section` (a section without a switch always is there)."""
+    switch = SECTION_SWITCHES.get(section)
+    return switch is None or bool(job_values[switch.prop])
+
+
 # Which document object holds each section (the job object holds every other section).
 SECTION_OBJECTS = {"gear": "gear", "stock": "stock"}
 
@@ -136,8 +148,8 @@ def _input_fields() -> dict[str, tuple[Field, ...]]:
     fields: dict[str, list[Field]] = {"gear": [], "stock": [], "job": []}
     for section, cls in SECTIONS.items():
         target = fields[SECTION_OBJECTS.get(section, "job")]
-        if section.startswith("tools."):
-            target.append(TOOL_SWITCHES[section.removeprefix("tools.")])
+        if section in SECTION_SWITCHES:
+            target.append(SECTION_SWITCHES[section])
         target.extend(_key_field(section, k) for k in keys_of(cls))
     return {role: tuple(found) for role, found in fields.items()}
 
@@ -271,7 +283,7 @@ def job_data(values: dict[str, dict[str, object]]) -> dict[str, dict]:
         for field in fields:
             if not field.key:
                 continue
-            if field.section.startswith("tools.") and not values["job"][TOOL_SWITCHES[field.section[6:]].prop]:
+            if role == "job" and not section_enabled(values["job"], field.section):
                 continue
             target = data
             for part in field.section.split("."):
@@ -287,6 +299,7 @@ def field_by_prop(prop: str) -> Field:
 
 # Titles that splitting the property name would not give (after dropping the tool role's word).
 _TITLES = {"UseRoughingTool": "Rough with this tool", "UseFinishingTool": "Finish with this tool",
+           "UseBottomTool": "Rough the bottom with this tool", "WriteLatheProgram": "Write the lathe program",
            "StickOut": "Stick-out", "StepOverFraction": "Step-over (fraction of D)",
            "MaxLevelDepthFraction": "Level depth (fraction of D)", "FinishingStrategy": "Strategy",
            "FinishingStepOver": "Step-over", "MaxSpindleRpm": "Max spindle speed", "SimulationEnabled": "Simulate",

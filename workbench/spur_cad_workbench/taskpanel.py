@@ -342,10 +342,10 @@ class JobTaskPanel:
         for prop, label in self.notes.items():
             label.setText(notes.get(prop, ""))
             label.setVisible(prop in notes)
-        for role, switch in schema.TOOL_SWITCHES.items():
+        for section, switch in schema.SECTION_SWITCHES.items():
             enabled = self.widgets[switch.prop].isChecked()
             for field in schema.JOB_FIELDS:
-                if field.section == f"tools.{role}" and field.key:
+                if field.section == section and field.key:
                     self.widgets[field.prop].setEnabled(enabled)
         self._show_summary(values, result, with_roughing_limit=not finishing_invalid)
         return result
