@@ -139,3 +139,28 @@ def test_an_unknown_work_offset_is_refused_naming_the_key():
         parse_job(_with(small_job_text(), "post", 'work_offset = "G92"'), "s.toml")
     with pytest.raises(SpurCadError):
         dataclasses.replace(parse_job(small_job_text(), "s.toml").post, work_offset="G53").validate()
+
+
+def test_a_job_with_a_lathe_section_writes_the_blank_program_with_the_set(tmp_path):
+    text = small_job_text() + '\n[lathe]\ndialect = "linuxcnc"\n\n[simulation]\nenabled = false\n'
+    job = tmp_path / "small.toml"
+    job.write_text(text)
+    assert main(["run", str(job), "--out", str(tmp_path / "out"), "--quiet"]) == 0
+    program = (tmp_path / "out" / "blank.ngc").read_text()
+    assert "G7" in program and "G95" in program and program.rstrip().endswith("M30")
+    import json
+
+    summary = json.loads((tmp_path / "out" / "summary.json").read_text())
+    spec = parse_job(text, "s.toml").gear
+    assert summary["lathe"]["blank_diameter_mm"] == pytest.approx(2 * spec.tip_radius_mm + 1.0)
+
+
+def test_a_bar_smaller_than_the_blank_is_one_line_naming_the_lathe_key(tmp_path, capsys):
+    text = small_job_text() + "\n[lathe]\nbar_diameter_mm = 40.0\n"
+    job = tmp_path / "small.toml"
+    job.write_text(text)
+    assert main(["run", str(job), "--out", str(tmp_path / "out")]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    line = text.splitlines().index("bar_diameter_mm = 40.0") + 1
+    assert len(err) == 1 and err[0].startswith(f"spur-cad: error: {job}:{line}: ") and "bar_diameter_mm" in err[0]
+    assert not (tmp_path / "out").exists()
