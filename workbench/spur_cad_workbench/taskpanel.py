@@ -37,7 +37,8 @@ HIGHLIGHT_STYLE = f"border: 2px solid {ERROR_COLOUR};"
 NOTE_STYLE = "color: #555555;"
 ADVICE_STYLE = "color: #8a5a00;"
 BIG = 1e9
-COLLAPSED_GROUPS = ("Machine", "Simulation", "Post")  # rarely changed: closed until asked for
+COLLAPSED_GROUPS = ("Machine", "Machine limits", "Simulation", "Post", "Bottom tool", "Lathe", "Lathe tools")
+"""Rarely changed or optional groups: closed until asked for."""
 FIELD_MIN_WIDTH_PX = 112
 PANEL_MIN_WIDTH_PX = 200  # fits FreeCAD's default task dock (about 264 px with its margins and scroll bar)
 QUANTITY_UNITS = {"length": "mm", "distance": "mm", "angle": "deg"}
