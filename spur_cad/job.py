@@ -466,7 +466,7 @@ Notes:
 - `[post] folded = true` needs `rotary_mode = "unwound"`.
 - `[stock] blank_diameter_mm` (the blank as turned) replaces tip diameter + 2 x
   `radial_allowance_mm`; it may not be below the tip diameter, and the blank may stand at most
-  `[roughing] max_level_depth_fraction` x the finishing tool's diameter above the tip circle.
+  0.5 x the finishing tool's diameter (a slot's depth) above the tip circle.
 - `[machine]` physical limits (`max_part_diameter_mm`, `max_part_weight_kg`, `max_overhang_mm`,
   `spindle_nose_top_mm`; 0 = not checked) are errors naming the limit; tools below
   `smallest_end_mill_mm` are warnings (see [shop-floor.md](shop-floor.md)).

@@ -251,7 +251,10 @@ def _other_gear_job(name: str):
     rho = spec.rack_tip_radius_mm
     diameter = 0.9 * (2.0 * rack_corner(spec).normal_corner_offset_mm + 2.0 * rho)
     tool = dataclasses.replace(job.tools.finishing, diameter_mm=diameter, corner_radius_mm=rho)
-    return dataclasses.replace(job, gear=spec, tools=dataclasses.replace(job.tools, finishing=tool, roughing=None))
+    # a blank the tool can take off the tips in one pass (at most half its diameter above the tip circle)
+    stock = dataclasses.replace(job.stock, radial_allowance_mm=min(job.stock.radial_allowance_mm, 0.4 * diameter))
+    return dataclasses.replace(job, gear=spec, stock=stock,
+                               tools=dataclasses.replace(job.tools, finishing=tool, roughing=None))
 
 
 @pytest.mark.slow

@@ -18,7 +18,13 @@ from spur_cad.cam.finishing import plan_finishing
 from spur_cad.cam.ir import Toolpath
 from spur_cad.cam.machine import FinishingParams, Machine, MachineError, RoughingParams, check_travel
 from spur_cad.cam.machine_limits import check_machine_limits
-from spur_cad.cam.recommend import ToolRecommendations, check_roughing_reach, check_tools, recommend_tools
+from spur_cad.cam.recommend import (
+    ToolRecommendations,
+    check_roughing_reach,
+    check_tools,
+    recommend_tools,
+    small_tool_warnings,
+)
 from spur_cad.cam.roughing import (
     RoughingLevels,
     check_helical_roughing_machine,
@@ -126,8 +132,9 @@ def check_cam_inputs(inputs: CamInputs) -> tuple[ToolRecommendations, RoughingLe
                            f"(helix_angle_deg = {spec.helix_angle_deg:g}) is finished by strategy = \"generating\"",
                            field="strategy", section="finishing")
     blank = stock.blank_radius_mm(spec)
-    check_blank_allowance(spec, stock, inputs.finishing_tool, inputs.roughing)
-    rec = recommend_tools(spec, blank, machine.clearance_mm, inputs.finishing_tool)
+    check_blank_allowance(spec, stock, inputs.finishing_tool)
+    rec = recommend_tools(spec, blank, machine.clearance_mm, inputs.finishing_tool,
+                          inputs.finishing.target_scallop_mm)
     if inputs.bottom_tool is not None:
         check_two_stage_tools(spec, rec, inputs.roughing_tool, inputs.bottom_tool, inputs.finishing_tool)
     else:
@@ -179,21 +186,25 @@ def check_two_stage_tools(spec: GearSpec, rec: ToolRecommendations, roughing_too
                         "upper levels, the smaller one the bottom)", field="diameter_mm", section="tools.bottom")
 
 
-def check_blank_allowance(spec: GearSpec, stock: StockSpec, finishing_tool: Tool | None,
-                          roughing: RoughingParams) -> None:
+LAND_PASS_DEPTH_FRACTION = 0.5
+"""Deepest cut a finishing tool takes off a tip land in one pass, x its diameter: the first land pass cuts a
+full-width slot, and 0.5 D is the catalogue's slotting depth (the default roughing level depth too)."""
+
+
+def check_blank_allowance(spec: GearSpec, stock: StockSpec, finishing_tool: Tool | None) -> None:
     """The blank above the tip circle is left by roughing (it cuts the spaces only) and taken off the tips by
     the finishing tool in one pass (land passes, the perimeter's tip sweep): refuse more than that tool's
-    slotting depth ([roughing] max_level_depth_fraction x its diameter, the limit roughing keeps per level)."""
+    slotting depth (LAND_PASS_DEPTH_FRACTION x its diameter)."""
     if finishing_tool is None:
         return
     allowance = stock.blank_radius_mm(spec) - spec.tip_radius_mm
-    limit = roughing.max_level_depth_fraction * finishing_tool.diameter_mm
+    limit = LAND_PASS_DEPTH_FRACTION * finishing_tool.diameter_mm
     if allowance > limit + 1e-9:
         name = "blank_diameter_mm" if stock.blank_diameter_mm > 0.0 else "radial_allowance_mm"
         raise StockError(f"{name}: the blank stands {allowance:.3f} mm above the tip circle, more than the finishing "
-                         f"tool takes off the tips in one pass ({limit:.3f} mm: max_level_depth_fraction "
-                         f"{roughing.max_level_depth_fraction:g} x D {finishing_tool.diameter_mm:g} mm); turn the "
-                         f"blank to at most {2 * (spec.tip_radius_mm + limit):.3f} mm", field=name)
+                         f"tool takes off the tips in one pass ({limit:.3f} mm: {LAND_PASS_DEPTH_FRACTION:g} x D "
+                         f"{finishing_tool.diameter_mm:g} mm, a slot's depth); turn the blank to at most "
+                         f"{2 * (spec.tip_radius_mm + limit):.3f} mm", field=name)
 
 
 def plan_cam(inputs: CamInputs, checkpoint: Callable[[], None] | None = None) -> CamPlan:
@@ -206,6 +217,7 @@ def plan_cam(inputs: CamInputs, checkpoint: Callable[[], None] | None = None) ->
     tools = {role: tool for role, tool in (("roughing", inputs.roughing_tool), ("finishing", inputs.finishing_tool))
              if tool is not None}
     warnings: list[str] = list(check_machine_limits(inputs.spec, inputs.stock, inputs.machine, tools))
+    warnings.extend(small_tool_warnings(rec, inputs.machine.smallest_end_mill_mm, inputs.finishing.strategy))
     bottom = two_stage = None
     if levels is not None and inputs.bottom_tool is not None:
         check()
@@ -300,8 +312,9 @@ def check_finishing_work(spec: GearSpec, tool: Tool, machine: Machine, section: 
         raise MachineError(f"finishing strategy '{strategy.name}' turns A while cutting, but [machine] "
                            "rotary_simultaneous = false (the table only indexes); choose a strategy that keeps A "
                            "fixed while cutting", field="strategy", section="finishing")
-    try:
-        counts = contact_counts(spec, tool, params.target_scallop_mm, overrides.get("contact_spacing_mm"))
+    try:  # a flat end mill has no corner contacts (only generating takes one: its passes are bounded below)
+        counts = (contact_counts(spec, tool, params.target_scallop_mm, overrides.get("contact_spacing_mm"))
+                  if tool.effective_corner_radius_mm > 0.0 else ContactCounts(0, 0, 0))
     except WorkLimitError:
         counts = ContactCounts(MAX_CONTACTS_PER_FLANK + 1, 0, 0)
     if counts.flank > MAX_CONTACTS_PER_FLANK:

@@ -50,14 +50,40 @@ class ToolRecommendations:
     roughing_max_diameter_mm: float  # space width at height r_f + A_p
     required_flute_length_mm: float  # deepest cut below the stock surface (finishing reaches the root)
     required_stick_out_mm: float  # flute length + clearance above the blank
+    # Finishing by generation (docs/cam.md), with either flank_tool_end; 0.0 when no such tool fits:
+    finishing_generating_max_diameter_mm: float = 0.0  # largest tool with the advised corner radius rho
+    finishing_flat_end_mill_max_diameter_mm: float = 0.0  # largest flat end mill (r_t = 0): its flat within 2 d_1
 
     def as_dict(self) -> dict[str, float]:
         return dict(self.__dict__)
 
 
+def generating_max_diameter_mm(spec: GearSpec, corner_radius_mm: float, target_scallop_mm: float,
+                               blank_radius_mm: float) -> float:
+    """Largest finishing tool with this corner radius that finishes the gear by generation (either flank tool
+    end): the smaller of the tip-mode limit (flat within the rack's tip flat) and the flank-mode limit (no flank
+    pass reaches into the design); 0.0 when none fits. Helical gears: the corner must be rho, the diameter
+    within the normal tip flat 2 d_n + 2 rho."""
+    from spur_cad.cam.strategies.generating import generating_tool_limits
+    from spur_cad.geometry.profile import rack_corner
+
+    rho = spec.rack_tip_radius_mm
+    if corner_radius_mm > rho + 1e-12:
+        return 0.0
+    if spec.is_helical:
+        if abs(corner_radius_mm - rho) > 1e-6:
+            return 0.0
+        return max(2.0 * rack_corner(spec).normal_corner_offset_mm + 2.0 * rho, 0.0)
+    limits = generating_tool_limits(spec, corner_radius_mm, target_scallop_mm, blank_radius_mm)
+    flank = max(limits.flank_mode_max_diameter_mm, limits.flank_mode_max_diameter_raised_mm)
+    largest = min(limits.tip_mode_max_diameter_mm, flank)
+    return float(largest) if largest > 2.0 * corner_radius_mm else 0.0
+
+
 def recommend_tools(spec: GearSpec, blank_radius_mm: float, clearance_mm: float,
-                    finishing_tool: Tool | None = None) -> ToolRecommendations:
-    """docs/method.md; A_p uses the chosen finishing tool's flat width, else the largest allowed."""
+                    finishing_tool: Tool | None = None, target_scallop_mm: float = 0.005) -> ToolRecommendations:
+    """docs/method.md; A_p uses the chosen finishing tool's flat width, else the largest allowed. The
+    generating limits (docs/cam.md) use the target scallop's flank rolls."""
     profile = spec.tooth_space_profile()
     max_flat = 2.0 * profile.root_arc_half_angle_rad * spec.root_radius_mm
     max_corner = profile.min_fillet_curvature_radius_mm
@@ -67,7 +93,11 @@ def recommend_tools(spec: GearSpec, blank_radius_mm: float, clearance_mm: float,
     plunge = PLUNGE_CAPACITY_FRACTION * flat
     roughing_max = 2.0 * space_half_width_mm(flank_polyline(spec), spec.root_radius_mm + plunge)
     flute = blank_radius_mm - spec.root_radius_mm
-    return ToolRecommendations(max_flat, max_corner, plunge, roughing_max, flute, flute + clearance_mm)
+    target = min(max(target_scallop_mm, 1e-4), 0.1)  # within the [finishing] key's range (advice, not a check)
+    generating = generating_max_diameter_mm(spec, spec.rack_tip_radius_mm, target, blank_radius_mm)
+    flat_end_mill = generating_max_diameter_mm(spec, 0.0, target, blank_radius_mm)
+    return ToolRecommendations(max_flat, max_corner, plunge, roughing_max, flute, flute + clearance_mm,
+                               generating, flat_end_mill)
 
 
 def check_tools(spec: GearSpec, recommendations: ToolRecommendations, roughing: Tool | None,
@@ -78,8 +108,7 @@ def check_tools(spec: GearSpec, recommendations: ToolRecommendations, roughing: 
     if finishing is not None:
         finishing.validate("finishing")
         if finishing.kind == "flat":
-            raise ToolError("finishing tool must have a corner radius (bull_nose or ball): a sharp corner "
-                            "cannot follow the root fillet", field="kind", section="tools.finishing")
+            _check_flat_finishing(spec, finishing, rec)
         if finishing.effective_corner_radius_mm > rec.finishing_max_corner_radius_mm + 1e-9:
             raise ToolError(f"finishing tool corner radius {finishing.effective_corner_radius_mm:.4f} mm exceeds "
                             f"finishing_max_corner_radius_mm = {rec.finishing_max_corner_radius_mm:.4f} mm "
@@ -96,6 +125,46 @@ def check_tools(spec: GearSpec, recommendations: ToolRecommendations, roughing: 
                             f"{rec.roughing_max_diameter_mm:.4f} mm (space width at root radius + "
                             f"A_p = {rec.plunge_allowance_mm:.4f} mm)", field="diameter_mm", section="tools.roughing")
         _check_lengths(roughing, "roughing", rec)
+
+
+def _check_flat_finishing(spec: GearSpec, tool: Tool, rec: ToolRecommendations) -> None:
+    """A flat end mill finishes only by generation, up to finishing_flat_end_mill_max_diameter_mm (the
+    strategies' own checks say why a strategy cannot take it)."""
+    largest = rec.finishing_flat_end_mill_max_diameter_mm
+    if largest <= 0.0:
+        if spec.is_helical:
+            why = (f"a helical gear is finished by generation with the corner radius equal to the rack tip radius "
+                   f"rho = {spec.rack_tip_radius_mm:g} mm")
+        else:
+            why = "by generation its flat finds no room in the rack's tip flat and the flank passes"
+        raise ToolError(f"finishing tool is a flat end mill, but no flat end mill can finish this gear "
+                        f"(finishing_flat_end_mill_max_diameter_mm = 0: {why}); the finishing tool must have a corner "
+                        "radius (bull_nose or ball)", field="kind", section="tools.finishing")
+    if tool.diameter_mm > largest + 1e-9:
+        raise ToolError(f"finishing tool is a flat end mill of diameter {tool.diameter_mm:g} mm, above "
+                        f"finishing_flat_end_mill_max_diameter_mm = {largest:.4f} mm (the largest flat end mill that "
+                        "finishes this gear, by [finishing] strategy = \"generating\": its flat within the rack's tip "
+                        "flat and its flank passes clear of the gear); a wider finishing tool must have a corner "
+                        "radius (bull_nose or ball)", field="diameter_mm", section="tools.finishing")
+
+
+def small_tool_warnings(rec: ToolRecommendations, smallest_end_mill_mm: float, strategy: str) -> tuple[str, ...]:
+    """Warnings for recommended largest tools below [machine] smallest_end_mill_mm (no catalogue tool of that
+    kind fits this gear): roughing, finishing for `strategy` (generating: the largest tool with corner radius
+    rho; perimeter, along_x: root arc flat + 2 x the fillet's smallest curvature radius) and the flat end mill.
+    Limits at 0 (no such tool at all) are errors elsewhere, not warnings."""
+    if strategy == "generating":
+        finishing = ("finishing_generating_max_diameter_mm", rec.finishing_generating_max_diameter_mm)
+    else:
+        finishing = ("finishing_max_flat_width_mm + 2 finishing_max_corner_radius_mm",
+                     rec.finishing_max_flat_width_mm + 2.0 * rec.finishing_max_corner_radius_mm)
+    limits = (("roughing tool", "roughing_max_diameter_mm", rec.roughing_max_diameter_mm),
+              (f"finishing tool for strategy {strategy}", *finishing),
+              ("flat end mill for finishing by generation", "finishing_flat_end_mill_max_diameter_mm",
+               rec.finishing_flat_end_mill_max_diameter_mm))
+    return tuple(f"this gear's largest {what} ({name} = {value:.3f} mm) is below the smallest end mill "
+                 f"([machine] smallest_end_mill_mm = {smallest_end_mill_mm:g} mm): check that such a tool can be "
+                 "bought" for what, name, value in limits if 0.0 < value < smallest_end_mill_mm)
 
 
 def check_roughing_reach(roughing: Tool, lowest_level_above_root_mm: float, rec: ToolRecommendations) -> None:

@@ -96,9 +96,24 @@ class FinishingStrategy(Protocol):
         ...
 
 
-def check_flat_fits_root_arc(spec: GearSpec, tool: Tool) -> None:
-    """Strategies that sweep the root arc with the flat bottom (perimeter, along_x): the flat must fit in
-    the root arc, D - 2 r_t <= 2 v r_f (summary `tools.finishing_max_flat_width_mm`)."""
+def check_corner_contacts_tool(tool: Tool, strategy: str) -> None:
+    """Strategies that place the tool's corner on spaced flank contacts (perimeter, along_x) need a round
+    corner: their contact spacing and X stations bound the cusps by the corner radius, and a sharp corner
+    (a flat end mill) leaves cusps thick in proportion to the spacing that no such bound covers."""
+    if tool.effective_corner_radius_mm <= 0.0:
+        raise ToolError(f"finishing strategy {strategy}: a flat end mill (corner radius 0) cannot finish the flanks "
+                        "by contacts: the scallop between contacts and stations is bounded by the corner radius, and "
+                        "a sharp corner gives no bound; use a bull_nose or ball tool, or [finishing] strategy = "
+                        "\"generating\", which takes flat end mills up to "
+                        "tools.finishing_flat_end_mill_max_diameter_mm",
+                        field="kind", section="tools.finishing")
+
+
+def check_flat_fits_root_arc(spec: GearSpec, tool: Tool, strategy: str = "perimeter or along_x") -> None:
+    """Strategies that sweep the root arc with the flat bottom (perimeter, along_x): the corner must be round
+    (`check_corner_contacts_tool`) and the flat must fit in the root arc, D - 2 r_t <= 2 v r_f (summary
+    `tools.finishing_max_flat_width_mm`)."""
+    check_corner_contacts_tool(tool, strategy)
     profile = spec.tooth_space_profile()
     max_flat = 2.0 * profile.root_arc_half_angle_rad * spec.root_radius_mm
     if tool.flat_width_mm > max_flat + 1e-9:

@@ -54,6 +54,16 @@ Tip mode (fillet and root), right half of space 0:
   profile points between the two contacts of their distance to the nearer of the two tools'
   exact sections -- stays within 95 % of the target.
 
+A flat end mill (r_t = 0, flat width d = D) plays the rack with its sharp corner; every formula above
+holds with r_t = 0. Flank mode: the corner is at T, the side on the flat from T up, the bottom inside the
+rack tooth (which widens below T). Tip mode: the corner on the round's point at beta -- the generated
+fillet point itself -- and the bottom, within the rack's tip flat (D <= 2 d_1), inside the rack tooth.
+The tool's section (tool_signed_distance with r_t = 0: the strip |Y - y| <= D/2 above Z = z) is exact.
+A sharp corner leaves wedge-shaped cusps between tip-mode rolls, thick in proportion to the spacing (not
+its square) and up to sqrt(2) thicker along the design normal than their distance to the tool: for a
+flat end mill the leftover is measured along the design normal (`_leftover_depths`), and tip mode takes
+many more rolls than with a round corner.
+
 Land mode (tip lands, when the blank stands above the tip circle): A = psi turns the part so
 that its direction psi (from the space axis toward +Y) points up; the tool's flat bottom lies on
 the tip circle's tangent plane there (Y = 0, Z = r_a). A plane tangent to the tip circle never
@@ -323,9 +333,10 @@ def land_angles(spec: GearSpec, tool: Tool, goal: float) -> tuple[np.ndarray, fl
     ra = spec.tip_radius_mm
     first, last = tip.start, 2.0 * math.pi / spec.teeth - tip.start
 
-    def land_points(p: float, q: float) -> np.ndarray:
+    def land_points(p: float, q: float) -> tuple[np.ndarray, np.ndarray]:
         theta = np.linspace(p, q, _LEFTOVER_SAMPLES)
-        return np.stack([ra * np.sin(theta), ra * np.cos(theta)], axis=-1)
+        outward = np.stack([np.sin(theta), np.cos(theta)], axis=-1)
+        return ra * outward, outward
 
     angles, worst = _greedy_rolls(first, last, lambda psi: _land_pose(spec, psi), land_points, tool, goal)
     return np.array(angles), worst
@@ -336,13 +347,45 @@ def _distances(points: np.ndarray, a: float, y: float, z: float, tool: Tool) -> 
     return np.maximum(tool_signed_distance(turn_points(points, a), y, z, tool), 0.0)
 
 
+def _flat_tool_depths(points: np.ndarray, normals: np.ndarray, a: float, y: float, z: float,
+                      tool: Tool) -> np.ndarray:
+    """Material left on part-frame points along their unit normals (into the space) by a flat end mill at pose
+    (A rad, Y, Z): the ray's entry into the section |Y' - y| <= D/2, Z' >= z (0 inside, inf when it misses)."""
+    p, n = turn_points(points, a), turn_points(normals, a)
+    enter, leave = np.zeros(len(p)), np.full(len(p), np.inf)
+    for axis, low, high in ((0, y - tool.diameter_mm / 2.0, y + tool.diameter_mm / 2.0), (1, z, np.inf)):
+        pos, step = p[:, axis], n[:, axis]
+        moving = step != 0.0
+        with np.errstate(divide="ignore", invalid="ignore"):
+            s_low = np.where(moving, (low - pos) / np.where(moving, step, 1.0), 0.0)
+            s_high = np.where(moving, (high - pos) / np.where(moving, step, 1.0), 0.0)
+        s_in = np.where(moving, np.minimum(s_low, s_high), np.where((low <= pos) & (pos <= high), -np.inf, np.inf))
+        s_out = np.where(moving, np.maximum(s_low, s_high), np.where((low <= pos) & (pos <= high), np.inf, -np.inf))
+        enter, leave = np.maximum(enter, s_in), np.minimum(leave, s_out)
+    return np.where(enter <= leave, enter, np.inf)
+
+
+def _leftover_depths(points: np.ndarray, normals: np.ndarray, a: float, y: float, z: float,
+                     tool: Tool) -> np.ndarray:
+    """What the tool at pose (A rad, Y, Z) leaves on part-frame points: for a flat end mill the thickness along
+    the design normal, as the simulation and a measuring machine see it (its sharp corner leaves wedge-shaped
+    cusps, up to sqrt(2) thicker along the normal than their distance to the tool); for a round corner the
+    distance to its section, as planned before flat end mills (along the normal its cusps read a few per cent
+    more with r_t near rho, more with small corners)."""
+    if tool.effective_corner_radius_mm > 0.0:
+        return _distances(points, a, y, z, tool)
+    return _flat_tool_depths(points, normals, a, y, z, tool)
+
+
 def _greedy_rolls(start: float, stop: float, pose, points_between, tool: Tool, goal: float) -> tuple[list, float]:
     """Parameters from `start` to `stop` (either direction): each step the largest whose sampled leftover
-    (points between the two contacts, distance to the nearer tool) is within `goal`."""
+    (points between the two contacts, `_leftover_depths` of the nearer tool) is within `goal`;
+    `points_between(p, q)` gives the points and their unit normals into the space."""
     def leftover(p: float, q: float) -> float:
-        pts = points_between(p, q)
+        pts, normals = points_between(p, q)
         (a0, a1), (y0, y1), (z0, z1) = pose(np.array([p, q]))
-        return float(np.max(np.minimum(_distances(pts, a0, y0, z0, tool), _distances(pts, a1, y1, z1, tool))))
+        return float(np.max(np.minimum(_leftover_depths(pts, normals, a0, y0, z0, tool),
+                                       _leftover_depths(pts, normals, a1, y1, z1, tool))))
 
     params, worst = [start], 0.0
     span = stop - start
@@ -375,8 +418,9 @@ def _tip_rolls(spec: GearSpec, tool: Tool, goal: float) -> tuple[np.ndarray, np.
     worst = 0.0
     betas = np.zeros(1)
     if fillet is not None and fillet.end > 0.0:
-        def fillet_points(p: float, q: float) -> np.ndarray:
-            return fillet.points(np.linspace(p, q, _LEFTOVER_SAMPLES))
+        def fillet_points(p: float, q: float) -> tuple[np.ndarray, np.ndarray]:
+            beta = np.linspace(p, q, _LEFTOVER_SAMPLES)
+            return fillet.points(beta), fillet.normals(beta)
 
         betas_list, worst = _greedy_rolls(fillet.end, 0.0, lambda b: _fillet_pose(spec, tool, b), fillet_points,
                                           tool, goal)
@@ -384,9 +428,10 @@ def _tip_rolls(spec: GearSpec, tool: Tool, goal: float) -> tuple[np.ndarray, np.
     v, rf = profile.root_arc_half_angle_rad, spec.root_radius_mm
     roots = np.array([v])
     if v > 0.0:
-        def root_points(p: float, q: float) -> np.ndarray:
+        def root_points(p: float, q: float) -> tuple[np.ndarray, np.ndarray]:
             theta = np.linspace(p, q, _LEFTOVER_SAMPLES)
-            return np.stack([rf * np.sin(theta), rf * np.cos(theta)], axis=-1)
+            outward = np.stack([np.sin(theta), np.cos(theta)], axis=-1)
+            return rf * outward, outward
 
         roots_list, root_worst = _greedy_rolls(v, 0.0, lambda phi: _root_pose(spec, tool, phi), root_points,
                                                tool, goal)
@@ -396,7 +441,8 @@ def _tip_rolls(spec: GearSpec, tool: Tool, goal: float) -> tuple[np.ndarray, np.
 
 def check_generating_tool(spec: GearSpec, tool: Tool) -> None:
     """ToolError when the tool cannot play the rack: corner radius above the rack tip radius (or the
-    fillet's smallest curvature radius), or a flat wider than the rack's tip flat 2 d_1."""
+    fillet's smallest curvature radius), or a flat wider than the rack's tip flat 2 d_1. A flat end mill
+    (r_t = 0 <= rho) plays it with its sharp corner; its flat is its whole diameter, so D <= 2 d_1."""
     if spec.is_helical:
         check_helical_generating_tool(spec, tool)
         return
@@ -416,10 +462,11 @@ def check_generating_tool(spec: GearSpec, tool: Tool) -> None:
                         section="tools.finishing")
     d1 = rack_corner(spec).corner_offset_mm
     if tool.flat_width_mm > 2.0 * d1 + 1e-12:
+        largest = (f"this corner radius: {2 * d1 + 2 * r_t:.4f} mm" if r_t > 0.0 else
+                   f"a flat end mill: {2 * d1:.4f} mm (its whole bottom is flat)")
         raise ToolError(f"finishing strategy generating: tool flat width d = {tool.flat_width_mm:g} mm (D - 2 r_t) is "
                         f"wider than the rack's tip flat 2 d_1 = {2 * d1:.4f} mm; largest diameter for tip mode with "
-                        f"this corner radius: {2 * d1 + 2 * r_t:.4f} mm", field="diameter_mm",
-                        section="tools.finishing")
+                        f"{largest}", field="diameter_mm", section="tools.finishing")
 
 
 def _design_points(spec: GearSpec) -> np.ndarray:
@@ -437,7 +484,8 @@ def _gouges(design: np.ndarray, a: np.ndarray, y: np.ndarray, z: np.ndarray, too
 
 def rough_passes_per_space(spec: GearSpec, tool: Tool, target_mm: float) -> float:
     """Closed-form estimate of the passes per space (before planning them): flanks from the midpoint
-    deviation r_b t dt^2 / 8, fillet and root from the cusp l^2 / (8 r_t) over their arc lengths."""
+    deviation r_b t dt^2 / 8, fillet and root from the cusp l^2 / (8 r_t) over their arc lengths (a flat
+    end mill: l / 2)."""
     involute = spec.tooth_space_profile().segment("involute")
     rb, t0, t1 = spec.base_radius_mm, involute.start, involute.end
     flank = math.sqrt(rb / (8.0 * target_mm)) * (2.0 / 3.0) * (t1**1.5 - t0**1.5) + 1.0
@@ -447,7 +495,10 @@ def rough_passes_per_space(spec: GearSpec, tool: Tool, target_mm: float) -> floa
         pts = fillet.points(np.linspace(fillet.start, fillet.end, 257))
         length = float(np.sum(np.hypot(*np.diff(pts, axis=0).T)))
     length += spec.root_radius_mm * spec.tooth_space_profile().root_arc_half_angle_rad
-    tip = length / math.sqrt(8.0 * target_mm * max(tool.effective_corner_radius_mm, 1e-3)) + 1.0
+    if tool.effective_corner_radius_mm > 0.0:
+        tip = length / math.sqrt(8.0 * target_mm * max(tool.effective_corner_radius_mm, 1e-3)) + 1.0
+    else:  # a sharp corner's wedge between contacts l apart is up to l/2 thick (along the normal)
+        tip = length / (2.0 * target_mm) + 1.0
     return 2.0 * (flank + tip)
 
 
@@ -583,8 +634,11 @@ def generating_tool_limits(spec: GearSpec, corner_radius_mm: float, target_scall
         lo = 2.0 * r_t + 1e-6
         if not _flank_fits(spec, tool_of(lo), rolls, end, design):
             return 0.0
+        cap = 2.0 * spec.tip_radius_mm  # no wider tool is advised (tiny undercut gears fit any below it)
         hi = max(2.0 * lo, spec.pitch_mm)
         while _flank_fits(spec, tool_of(hi), rolls, end, design):
+            if hi >= cap:
+                return hi
             lo, hi = hi, 2.0 * hi
         while hi - lo > 1e-4:
             mid = 0.5 * (lo + hi)

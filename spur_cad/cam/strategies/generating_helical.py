@@ -28,6 +28,8 @@ dY/dX = -h tan(beta) cos(gamma), dZ/dX = -h tan(beta) sin(gamma).
   tool's right corner on the right round, its left corner on the left round, and, where the tip
   flat generates the root somewhere over the face width, flat passes between them. Rolls are
   evenly spaced so that the cusps left by the elliptic transverse round stay within the target.
+  A sharp rack (rho = 0) is played by a flat end mill; its corner leaves wedge-shaped cusps, so the
+  rolls are spaced for the target / sqrt(2) measured to the outline (thicker along the normal).
 - Rolls (and land angles) cover what every section needs: the spur ranges widened by the turn of
   the face width, b tan(beta) / r.
 - **Lands**: passes along X at fixed A with the flat bottom on the tip cylinder's tangent plane,
@@ -116,9 +118,10 @@ def check_helical_generating_tool(spec: GearSpec, tool: Tool) -> None:
     tool.validate("finishing")
     rho, r_t = spec.rack_tip_radius_mm, tool.effective_corner_radius_mm
     if abs(r_t - rho) > CORNER_MATCH_MM:
+        flat = " (a flat end mill only for a sharp rack, rho = 0)" if r_t == 0.0 else ""
         raise ToolError(f"finishing strategy generating for a helical gear: tool corner radius r_t = {r_t:g} mm must "
-                        f"equal the rack tip radius rho = {rho:g} mm (the corner then is the rack's round along the "
-                        "whole pass; a smaller one would generate the fillet in one transverse section only)",
+                        f"equal the rack tip radius rho = {rho:g} mm{flat} (the corner then is the rack's round along "
+                        "the whole pass; a smaller one would generate the fillet in one transverse section only)",
                         field="corner_radius_mm", section="tools.finishing")
     d_n = rack_corner(spec).normal_corner_offset_mm
     if tool.flat_width_mm > 2.0 * d_n + 1e-12:
@@ -190,6 +193,11 @@ def tip_roll_step(spec: GearSpec, target_mm: float) -> float:
     phi_t = (corner.corner_offset_mm - corner.corner_depth_mm / math.tan(spec.pressure_angle_rad)) / r
     lo, hi = min(phi_t, -corner.corner_offset_mm / r) - 0.02, corner.corner_offset_mm / r + 0.02
     goal = _SAFETY * target_mm
+    if spec.rack_tip_radius_mm == 0.0:
+        # A sharp rack corner (played by a flat end mill) leaves wedge-shaped cusps: along the design normal up
+        # to 2 sin(45 deg - alpha/2) / cos(alpha) (< sqrt(2)) times their distance to the outline, which is what
+        # is measured here.
+        goal /= math.sqrt(2.0)
     step = 2.0 * _first_tip_step(spec, goal)  # the closed form is conservative: start above it
     if (hi - lo) / step > MAX_TIP_ROLLS / 8.0:  # the spacing found is rarely below a third of the closed form
         step = (hi - lo) / MAX_TIP_ROLLS

@@ -41,7 +41,8 @@ class PerimeterStrategy:
     simultaneous_rotary = True
 
     def check_tool(self, spec: GearSpec, tool: Tool) -> None:
-        check_flat_fits_root_arc(spec, tool)
+        """A round corner (the scallop is bounded by it) and a flat within the root arc."""
+        check_flat_fits_root_arc(spec, tool, self.name)
 
     def estimate_moves(self, spec: GearSpec, tool: Tool, params: PerimeterParams) -> int:
         params.validate()
