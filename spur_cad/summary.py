@@ -108,7 +108,8 @@ def cam_sections(plan: CamPlan, machine: Machine, roughing_tool: Tool | None, fi
     if plan.roughing_bottom is not None:
         stage = plan.two_stage
         sections["roughing"]["two_stage"] = {
-            "bottom_tool": tool_section(plan.roughing_bottom.tool, machine),
+            "bottom_tool": {**tool_section(plan.roughing_bottom.tool, machine),
+                            "tool_number": plan.roughing_bottom.tool.tool_number},
             "split_height_above_root_mm": stage.split_height_above_root_mm, "split_chosen_by": stage.chosen,
             "bottom": roughing_section(plan.roughing_bottom), "two_stage_time_s": stage.two_stage_time_s,
             "bottom_tool_alone_time_s": stage.bottom_tool_alone_time_s, "time_saved_s": stage.gain_s}

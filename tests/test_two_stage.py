@@ -166,3 +166,22 @@ def test_the_bottom_program_runs_in_rs274_with_its_own_tool(two_stage, tmp_path)
     assert ok, messages
     assert any(line.startswith("CHANGE_TOOL(") for line in canon)
     assert "two-stage" in files["roughing_bottom.ngc"].decode().splitlines()[4]
+
+
+def test_the_report_and_summary_show_both_programs_and_the_time_saved(two_stage, tmp_path):
+    from spur_cad.cli import main
+
+    job_file = tmp_path / "two.toml"
+    job_file.write_text(JOB)
+    assert main(["run", str(job_file), "--out", str(tmp_path / "out"), "--quiet"]) == 0
+    import json
+
+    summary = json.loads((tmp_path / "out" / "summary.json").read_text())
+    stage = summary["roughing"]["two_stage"]
+    _, plan = two_stage
+    assert stage["time_saved_s"] == pytest.approx(plan.two_stage.bottom_tool_alone_time_s
+                                                  - plan.two_stage.two_stage_time_s)
+    assert stage["bottom"]["moves"] == len(plan.roughing_bottom.toolpath)
+    assert summary["post"]["roughing_bottom_lines"] > 0
+    report = (tmp_path / "out" / "report.html").read_text()
+    assert "Two-stage roughing: the bottom tool (T3, D 1.5 mm)" in report and "roughing_bottom" in report

@@ -141,7 +141,8 @@ def _program(summary: dict) -> str:
     if not rough and not finish:
         return ""
     rows = []
-    for name, facts in (("roughing", rough), ("finishing", finish)):
+    bottom = rough.get("two_stage", {}).get("bottom") if rough else None
+    for name, facts in (("roughing", rough), ("roughing_bottom", bottom), ("finishing", finish)):
         if facts:
             lines = post.get(f"{name}_lines") if post else None
             size = post.get(f"{name}_bytes") if post else None
@@ -160,6 +161,14 @@ def _program(summary: dict) -> str:
     if rough:
         text += (f"<p>Roughing: {rough['levels_per_space']} levels per space, lowest level "
                  f"{rough['lowest_level_height_mm']:.3f} mm above the root circle.</p>")
+    if bottom:
+        stage = rough["two_stage"]
+        text += (f"<p>Two-stage roughing: the bottom tool (T{stage['bottom_tool']['tool_number']}, D "
+                 f"{stage['bottom_tool']['diameter_mm']:g} mm) roughs {bottom['levels_per_space']} levels per space "
+                 f"below {stage['split_height_above_root_mm']:.3f} mm above the root circle (split chosen by "
+                 f"{_e(stage['split_chosen_by'])}): {_minutes(stage['two_stage_time_s'])} in all, "
+                 f"{_minutes(stage['time_saved_s'])} less than the bottom tool alone "
+                 f"({_minutes(stage['bottom_tool_alone_time_s'])}).</p>")
     if finish:
         text += _finishing_words(finish)
     return text
