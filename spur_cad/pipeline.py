@@ -113,8 +113,8 @@ def program_info(job: Job, plan: CamPlan, operation: str, restart_comment: str |
 
     spec, stock = job.gear, job.stock
     radius = stock.blank_radius_mm(spec)
-    box = (-stock.front_margin_mm, -radius, -radius, spec.face_width_mm + stock.back_margin_mm + stock.stub_length_mm,
-           radius, radius)
+    x_front, x_back = stock.blank_x_range_mm(spec)
+    box = (x_front, -radius, -radius, x_back + stock.stub_length_mm, radius, radius)
     title = f"spur_cad {__version__} {operation}" + (" restart" if restart_comment else "") + f": {job.job.name}"
     comments = program_comments(job, plan, operation) + ((restart_comment,) if restart_comment else ())
     return ProgramInfo(title=title, comments=comments, rotary_clamp_code=job.machine.rotary_clamp_code,
@@ -226,8 +226,7 @@ def job_stock(job: Job) -> StockCylinder:
     from spur_cad.sim.simulate import StockCylinder
 
     spec, stock = job.gear, job.stock
-    return StockCylinder(stock.blank_radius_mm(spec), -stock.front_margin_mm,
-                         spec.face_width_mm + stock.back_margin_mm)
+    return StockCylinder(stock.blank_radius_mm(spec), *stock.blank_x_range_mm(spec))
 
 
 def simulate_stage(job: Job, plan: CamPlan, progress: Callable[[float], None] | None = None) -> SimResult | None:

@@ -269,9 +269,8 @@ def build_stock_shape(spec: GearSpec, stock: StockSpec = StockSpec()) -> TopoDS_
     require_instance(spec, GearSpec, "spec")
     require_instance(stock, StockSpec, "stock")
     stock.validate(spec)
-    b = spec.face_width_mm
-    x_end = b + stock.back_margin_mm
-    shape = _x_cylinder(stock.blank_radius_mm(spec), -stock.front_margin_mm, x_end)
+    x_start, x_end = stock.blank_x_range_mm(spec)
+    shape = _x_cylinder(stock.blank_radius_mm(spec), x_start, x_end)
     if stock.stub_length_mm > 0.0:
         fuse = BRepAlgoAPI_Fuse(shape, _x_cylinder(stock.stub_diameter_mm / 2.0, x_end,
                                                    x_end + stock.stub_length_mm))

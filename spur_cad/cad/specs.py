@@ -91,6 +91,11 @@ class StockSpec:
             raise StockError(f"stub diameter {self.stub_diameter_mm:g} mm is larger than the blank "
                                 f"({2 * self.blank_radius_mm(spec):.3f} mm)", field="stub_diameter_mm")
 
+    def blank_x_range_mm(self, spec: GearSpec) -> tuple[float, float]:
+        """X of the blank cylinder's front and back faces (-front margin, face width + back margin); the holding
+        stub continues it from the back face toward the chuck."""
+        return -self.front_margin_mm, spec.face_width_mm + self.back_margin_mm
+
     def blank_radius_mm(self, spec: GearSpec) -> float:
         """The blank's radius: half the given blank diameter, else tip radius + radial allowance."""
         if self.blank_diameter_mm > 0.0:

@@ -31,7 +31,8 @@ def blank_figures(spec: GearSpec, stock: StockSpec) -> BlankFigures:
     holding stub; the chuck face is at the stub's shoulder (X = b + back margin), so the overhang is the
     blank's length."""
     radius = stock.blank_radius_mm(spec)
-    length = stock.front_margin_mm + spec.face_width_mm + stock.back_margin_mm
+    x_front, x_back = stock.blank_x_range_mm(spec)
+    length = x_back - x_front
     volume_mm3 = math.pi * radius**2 * length + math.pi * (stock.stub_diameter_mm / 2.0) ** 2 * stock.stub_length_mm
     return BlankFigures(2.0 * radius, volume_mm3 * 1e-6 * stock.density_kg_dm3, length)
 

@@ -21,7 +21,6 @@ import numpy as np
 from spur_cad.cam.ir import MoveKind, Toolpath, ToolpathBuilder
 from spur_cad.errors import SpurCadError
 
-OPERATIONS = ("roughing", "roughing_bottom", "finishing")
 UNITS = {"space": "space", "level": "station", "station": "station", "pass": None}
 """Restart units and the IR column that numbers them (`pass`: the rapids of a space, one per generating pass)."""
 

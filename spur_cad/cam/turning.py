@@ -208,9 +208,10 @@ def lathe_geometry(spec: GearSpec, stock: StockSpec, lathe: LatheSection) -> Lat
     """The blank, stub and bar in the lathe frame (not checked: see check_lathe_blank)."""
     bar = bar_diameter_mm(spec, stock, lathe)
     safe = bar + 2.0 * lathe.clearance_mm
+    x_front, x_back = stock.blank_x_range_mm(spec)
     return LatheGeometry(
         blank_diameter=2.0 * stock.blank_radius_mm(spec),
-        blank_length=stock.front_margin_mm + spec.face_width_mm + stock.back_margin_mm,
+        blank_length=x_back - x_front,
         stub_diameter=stock.stub_diameter_mm if stock.stub_length_mm > 0.0 else 0.0,
         stub_length=stock.stub_length_mm if stock.stub_diameter_mm > 0.0 else 0.0,
         bar_diameter=bar, safe_x=safe,
