@@ -22,6 +22,12 @@ ROOT = Path(__file__).resolve().parents[1]
 REFERENCE_JOB = ROOT / "resources" / "examples" / "reference_gear.toml"
 
 
+def _canonical(path: Path):
+    """The moves of a program file through rs274 (spur-cad verify --reader rs274)."""
+    with open(path, "rb") as handle:
+        return read_canonical(handle, path.name)
+
+
 def figures(runs: int) -> dict:
     from spur_cad.grade.simulated import grade_simulation
 
@@ -38,7 +44,7 @@ def figures(runs: int) -> dict:
             for name, data in files.items():
                 (Path(folder) / name).write_bytes(data)
                 paths.append(Path(folder) / name)
-            out["read_rs274_s"] = median_seconds(lambda: [read_canonical(p, p.name) for p in paths], runs)
+            out["read_rs274_s"] = median_seconds(lambda: [_canonical(p) for p in paths], runs)
     programs = [read_program(texts[name], "linuxcnc", name) for name in ("roughing.ngc", "finishing.ngc")]
     out["verify_s"] = median_seconds(lambda: verify_moves(job, programs), runs)
     out["run_simulation_s"] = median_seconds(lambda: simulate_stage(job, plan), runs)

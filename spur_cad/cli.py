@@ -20,10 +20,9 @@ import threading
 import warnings
 
 from spur_cad import __version__
-from spur_cad.errors import SpurCadError
+from spur_cad.errors import SpurCadError, one_line
 
 EXIT_INPUT_ERROR = 2
-MAX_MEASURED_BYTES = 256 * 1024 * 1024
 EXIT_INTERNAL_ERROR = 3
 EXIT_INTERRUPTED = 130  # 128 + SIGINT, as shells report it
 EXIT_TERMINATED = 143  # 128 + SIGTERM
@@ -33,8 +32,16 @@ class Terminated(BaseException):
     """SIGTERM arrived: stop like an interrupt (the output folder keeps its set)."""
 
 
+class _ArgumentParser(argparse.ArgumentParser):
+    """argparse with the command line's one-line errors: `spur-cad: error: ...`, exit 2 (no usage block)."""
+
+    def error(self, message: str):
+        sys.stderr.write(f"spur-cad: error: {one_line(message)} (spur-cad --help)\n")
+        sys.exit(EXIT_INPUT_ERROR)
+
+
 def _parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(prog="spur-cad", description="Spur gears cut on a 4-axis machining centre.")
+    parser = _ArgumentParser(prog="spur-cad", description="Spur gears cut on a 4-axis machining centre.")
     parser.add_argument("--version", action="version", version=f"spur-cad {__version__}")
     sub = parser.add_subparsers(dest="command", required=True)
     run = sub.add_parser("run", help="run a job file and write its outputs")
@@ -115,20 +122,22 @@ def _install_freecad(uninstall: bool) -> int:
     try:
         lines = remove(os.environ) if uninstall else install(os.environ)
     except SpurCadError as exc:
-        print(f"spur-cad: error: {exc}", file=sys.stderr)
+        print(f"spur-cad: error: {one_line(str(exc))}", file=sys.stderr)
         return EXIT_INPUT_ERROR
     for line in lines:
         print(line)
     return 0
 
 
-def main(argv: list[str] | None = None) -> int:
+def main(argv: list[str] | None = None, *, exiting: bool = False) -> int:
     """The command line; SIGINT and SIGTERM anywhere in a run give one line and exit 130 / 143. The signal
     handlers only record the signal; the run stops at its next checkpoint (between stages, and in the
     simulation's progress), never inside a library: an exception raised in the middle of native code or of
     an import can be swallowed there ("Exception ignored in ...") or leave a C++ object half-built that
-    crashes the process later. The handlers are the caller's again when main returns (main may be called
-    in-process, e.g. by tests)."""
+    crashes the process later. A signal that arrives after the last checkpoint, up to the return, still gives
+    the one line and 130 / 143. Called in-process (tests), the handlers are the caller's again when main
+    returns; as the process's entry point (`exiting`, see `entry`) they stay until the process ends, so that
+    no signal can end it silently between the return and the exit."""
     received: list[int] = []  # the signals that arrived
 
     def on_signal(signum, frame) -> None:
@@ -137,14 +146,24 @@ def main(argv: list[str] | None = None) -> int:
     in_main_thread = threading.current_thread() is threading.main_thread()
     previous = {s: signal.signal(s, on_signal) for s in (signal.SIGINT, signal.SIGTERM)} if in_main_thread else {}
     try:
-        return _main(argv, received)
-    except (KeyboardInterrupt, Terminated):
-        print("spur-cad: interrupted (the output folder holds a complete set: its previous one, or this run's "
-              "if writing had finished)", file=sys.stderr)
-        return EXIT_TERMINATED if signal.SIGTERM in received else EXIT_INTERRUPTED
+        try:
+            code = _main(argv, received)
+        except (KeyboardInterrupt, Terminated):
+            code = EXIT_INTERRUPTED
+        if received or code == EXIT_INTERRUPTED:
+            print("spur-cad: interrupted (the output folder holds a complete set: its previous one, or this run's "
+                  "if writing had finished)", file=sys.stderr)
+            return EXIT_TERMINATED if signal.SIGTERM in received else EXIT_INTERRUPTED
+        return code
     finally:
-        for signum, handler in previous.items():
-            signal.signal(signum, handler)
+        if not exiting:
+            for signum, handler in previous.items():
+                signal.signal(signum, handler)
+
+
+def entry() -> int:
+    """The `spur-cad` program: `main` whose signal handling lasts until the process exits."""
+    return main(exiting=True)
 
 
 def _checkpoint(received: list[int]) -> None:
@@ -157,7 +176,7 @@ def _run(args: argparse.Namespace, received: list[int], loaded: list) -> list:
     """Load, compute and write the job's output set; the job goes into `loaded` (for locating errors)."""
     from spur_cad.cam.restart import parse_restart
     from spur_cad.job import load_job  # heavy imports after the signal handling is in place
-    from spur_cad.outputs import check_output_folder, write_output_set
+    from spur_cad.outputs import check_output_folder
     from spur_cad.pipeline import run_job
 
     def checkpoint() -> None:
@@ -180,21 +199,31 @@ def _run(args: argparse.Namespace, received: list[int], loaded: list) -> list:
         if bars is not None:
             bars.close()
     checkpoint()
-    try:
-        paths = write_output_set(out_dir, files)
-    except OSError as exc:
-        raise SpurCadError(f"cannot write to {out_dir}: {exc.strerror or exc}") from None
+    paths = _write(out_dir, files)
     checkpoint()  # a signal while the set was switched: it is this run's set, and the message says so
     return paths
 
 
+def _write(out_dir, files: dict[str, bytes]) -> list:
+    """The output set written (spur_cad.outputs); a failure is one line naming the folder (exit 2)."""
+    from spur_cad.errors import shown_path
+    from spur_cad.outputs import OutputError, write_output_set
+
+    try:
+        return write_output_set(out_dir, files)
+    except OutputError:
+        raise
+    except OSError as exc:
+        raise SpurCadError(f"cannot write to {shown_path(out_dir)}: {exc.strerror or exc}") from None
+
+
 def _verify(args: argparse.Namespace, received: list[int], loaded: list) -> int:
     """`spur-cad verify`: read the programs, simulate, print the verdict, write the set; 0 pass, 1 fail."""
-    from pathlib import Path
 
+    from spur_cad.errors import shown, shown_path
     from spur_cad.job import load_job
-    from spur_cad.outputs import check_output_folder, write_output_set
-    from spur_cad.verify.reader import MAX_PROGRAM_BYTES, read_program
+    from spur_cad.outputs import check_output_folder
+    from spur_cad.verify.reader import open_program_file, read_program_file
     from spur_cad.verify.rs274 import read_canonical, rs274_verdict
     from spur_cad.verify.verify import VerifyOptions, result_files, verify_moves
 
@@ -205,38 +234,26 @@ def _verify(args: argparse.Namespace, received: list[int], loaded: list) -> int:
     options = VerifyOptions(args.point, args.gouge_tolerance_mm, args.leftover_tolerance_mm, tuple(args.point_tools))
     options.validate()
     dialect = args.dialect or job.post.dialect
+    if args.reader == "rs274" and dialect != "linuxcnc":
+        raise SpurCadError(f"--reader rs274 reads LinuxCNC programs only (the dialect is {shown(dialect)})")
     programs = []
     for name in args.programs:
-        path = Path(name)
-        try:
-            if path.stat().st_size > MAX_PROGRAM_BYTES:
-                raise SpurCadError(f"{name}: larger than {MAX_PROGRAM_BYTES // 2**20} MiB")
-            text = path.read_text(encoding="utf-8")
-        except FileNotFoundError:
-            raise SpurCadError(f"{name}: program not found") from None
-        except UnicodeDecodeError as exc:
-            raise SpurCadError(f"{name}: not a text file (byte {exc.start} is not UTF-8)") from None
-        except OSError as exc:
-            raise SpurCadError(f"{name}: cannot read: {exc.strerror or exc}") from None
+        source = shown_path(name)
         if args.reader == "rs274":
-            if dialect != "linuxcnc":
-                raise SpurCadError(f"--reader rs274 reads LinuxCNC programs only (the dialect is {dialect})")
-            programs.append(read_canonical(path, name))
+            with open_program_file(name, source) as handle:  # a regular file of bounded size, checked first
+                programs.append(read_canonical(handle, source))
         else:
-            programs.append(read_program(text, dialect, name, checkpoint=lambda: _checkpoint(received)))
+            programs.append(read_program_file(name, dialect, source, checkpoint=lambda: _checkpoint(received)))
         _checkpoint(received)
     result = verify_moves(job, programs, options, progress=lambda fraction: _checkpoint(received))
     if dialect == "linuxcnc":
-        result = dataclasses.replace(result, rs274={name: rs274_verdict(name) for name in args.programs})
+        result = dataclasses.replace(result, rs274={shown_path(name): rs274_verdict(name) for name in args.programs})
     lines = result.lines() + [f"rs274 {name}: {verdict}" for name, verdict in result.rs274.items()]
     for line in (lines if not args.quiet else lines[-1 - len(result.rs274):]):
         print(line)
     if out_dir is not None:
         _checkpoint(received)
-        try:
-            write_output_set(out_dir, result_files(result))
-        except OSError as exc:
-            raise SpurCadError(f"cannot write to {out_dir}: {exc.strerror or exc}") from None
+        _write(out_dir, result_files(result))
     rs274_failed = any(verdict.startswith("failed") for verdict in result.rs274.values())
     return 0 if result.passed and not rs274_failed else 1
 
@@ -245,25 +262,16 @@ def _grade(args: argparse.Namespace, received: list[int], loaded: list) -> int:
     """`spur-cad grade`: best-fit the measured points to the design, print deviations and classes; 0, or 1 when
     worse than --required-class."""
     import json
-    from pathlib import Path
 
-    from spur_cad.grade.measured import grade_measured, read_points_csv
+    from spur_cad.grade.measured import grade_measured, read_points_file
     from spur_cad.job import load_job
-    from spur_cad.outputs import check_output_folder, write_output_set
+    from spur_cad.outputs import check_output_folder
 
     _checkpoint(received)
     out_dir = check_output_folder(args.out) if args.out else None
     loaded.append(load_job(args.job))
     spec = loaded[0].gear
-    try:
-        if Path(args.measured).stat().st_size > MAX_MEASURED_BYTES:
-            raise SpurCadError(f"{args.measured}: larger than {MAX_MEASURED_BYTES // 2**20} MiB")
-        text = Path(args.measured).read_text(encoding="utf-8")
-    except FileNotFoundError:
-        raise SpurCadError(f"{args.measured}: measured points not found") from None
-    except (OSError, UnicodeDecodeError) as exc:
-        raise SpurCadError(f"{args.measured}: cannot read: {getattr(exc, 'strerror', None) or exc}") from None
-    grading = grade_measured(spec, read_points_csv(text, args.measured))
+    grading = grade_measured(spec, read_points_file(args.measured))
     _checkpoint(received)
     fit = grading["fit"]
     print(f"fit: rotation {fit['rotation_deg']:.4f} deg, centre ({fit['centre_mm'][0]:.4f}, "
@@ -285,10 +293,7 @@ def _grade(args: argparse.Namespace, received: list[int], loaded: list) -> int:
                                 + "\n").encode()}
         if any(trace.kind == "profile" for trace in grading["traces"]):
             files["k_chart.png"] = k_chart_png(spec, grading)
-        try:
-            write_output_set(out_dir, files)
-        except OSError as exc:
-            raise SpurCadError(f"cannot write to {out_dir}: {exc.strerror or exc}") from None
+        _write(out_dir, files)
     if args.required_class is not None and (overall is None or overall > args.required_class):
         return 1
     return 0
@@ -311,14 +316,14 @@ def _main(argv: list[str] | None, received: list[int]) -> int:
         paths = _run(args, received, loaded)
     except SpurCadError as exc:
         message = loaded[0].located(exc) if loaded and exc.section else str(exc)
-        print(f"spur-cad: error: {message}", file=sys.stderr)
+        print(f"spur-cad: error: {one_line(message)}", file=sys.stderr)
         return EXIT_INPUT_ERROR
     except Exception as exc:  # noqa: BLE001 - the CLI never shows a traceback unless asked
         _checkpoint(received)  # a failure after a signal arrived (e.g. a library's own SIGINT handling)
         if getattr(args, "debug", False):
             raise
-        print(f"spur-cad: internal error: {type(exc).__name__}: {exc} (run with --debug for details; "
-              "please report it)", file=sys.stderr)
+        print(one_line(f"spur-cad: internal error: {type(exc).__name__}: {exc}") + " (run with --debug for "
+              "details; please report it)", file=sys.stderr)
         return EXIT_INTERNAL_ERROR
     if not args.quiet:
         for path in paths:
@@ -327,4 +332,4 @@ def _main(argv: list[str] | None, received: list[int]) -> int:
 
 
 if __name__ == "__main__":  # pragma: no cover
-    sys.exit(main())
+    sys.exit(entry())

@@ -2,6 +2,9 @@
 
 from __future__ import annotations
 
+import os
+import re
+
 
 class SpurCadError(Exception):
     """Base class for errors caused by user input; the CLI and GUI show the message only.
@@ -58,3 +61,57 @@ def require_instance(value: object, expected: type | tuple[type, ...], argument:
 
 class JobFileError(SpurCadError, ValueError):
     """A job file that cannot be read: bad TOML, unknown key, wrong type, missing value."""
+
+
+MAX_SHOWN_CHARS = 60
+"""User text a message echoes (a value, a key, a name) is cut to about this many characters."""
+MAX_SHOWN_PATH_CHARS = 160
+MAX_MESSAGE_CHARS = 600
+"""A whole message line is cut to this many characters (its start, which names the file and key, kept)."""
+_UNPRINTABLE = re.compile(r"[^\S ]|[\x00-\x1f\x7f-\x9f\u2028\u2029\u200b-\u200f\u202a-\u202e\u2066-\u2069"
+                          r"\ud800-\udfff]")  # controls, line and paragraph breaks, direction marks, lone surrogates
+
+
+def escaped(text: str) -> str:
+    """`text` with every control or line-breaking character written as an escape (\\n, \\x1b, \\u2028): one
+    line that no terminal interprets, and that cannot start a forged `spur-cad:` line."""
+    return _UNPRINTABLE.sub(lambda match: repr(match.group(0))[1:-1], text)
+
+
+def _cut(text: str, limit: int, keep_end: bool = False) -> str:
+    if len(text) <= limit:
+        return text
+    if keep_end:  # a path: its start and its end (the file's name) both say something
+        head = limit // 3
+        return f"{text[:head]}...{text[-(limit - head - 3):]}"
+    return f"{text[:limit - 3]}... ({len(text):,} characters)"
+
+
+def shown(value: object, limit: int = MAX_SHOWN_CHARS) -> str:
+    """A value as a message echoes it: quoted text with control characters escaped, cut to `limit`
+    characters; no 5000-digit integer is written out (Python refuses to, and nobody reads it)."""
+    if isinstance(value, bool):
+        return repr(value)
+    if isinstance(value, int):
+        digits = int(abs(value).bit_length() * 0.30103) + 1
+        return repr(value) if digits <= 20 else f"a {digits}-digit number"
+    if isinstance(value, str):
+        text = escaped(value[:limit].replace("'", "\\'"))
+        return f"'{text}'" if len(value) <= limit else f"'{text}...' ({len(value):,} characters)"
+    try:
+        text = repr(value)
+    except ValueError:  # e.g. a list holding a huge integer
+        return f"a {type(value).__name__}"
+    return _cut(escaped(text), limit)
+
+
+def shown_path(path: object, limit: int = MAX_SHOWN_PATH_CHARS) -> str:
+    """A file or folder name as a message names it: unquoted, control characters escaped, long names cut in
+    the middle."""
+    text = os.fsdecode(path) if isinstance(path, (str, bytes, os.PathLike)) else str(path)
+    return _cut(escaped(text), limit, keep_end=True)
+
+
+def one_line(message: str, limit: int = MAX_MESSAGE_CHARS) -> str:
+    """A message as the command line prints it: one line (control characters escaped), at most `limit`."""
+    return _cut(escaped(message), limit)

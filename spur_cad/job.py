@@ -26,7 +26,16 @@ from spur_cad.cam.machine import FinishingParams, Machine, RoughingParams
 from spur_cad.cam.machine_limits import check_machine_limits
 from spur_cad.cam.tools import Tool
 from spur_cad.cam.turning import LatheSection, check_lathe_blank
-from spur_cad.errors import GearSpecError, JobFileError, SpurCadError, StockError
+from spur_cad.errors import (
+    MAX_SHOWN_CHARS,
+    GearSpecError,
+    JobFileError,
+    SpurCadError,
+    StockError,
+    escaped,
+    shown,
+    shown_path,
+)
 from spur_cad.geometry.spec import MAX_TEETH, MIN_TEETH, GearSpec
 from spur_cad.keys import check_section, coerce, key, keys_of, section_problems, toml_literal, type_problem
 from spur_cad.post.settings import PostSettings
@@ -221,7 +230,7 @@ def _load_section(table: object, name: str, source: str, text: str):
     known = {k.name: k for k in keys_of(cls)}
     for key_name in table:
         if key_name not in known:
-            raise JobFileError(f"{_where(source, text, name, key_name)}: unknown key '{key_name}' in [{name}] "
+            raise JobFileError(f"{_where(source, text, name, key_name)}: unknown key {shown(key_name)} in [{name}] "
                                f"(known keys: {', '.join(sorted(known))})", section=name)
     values = {}
     for k in known.values():
@@ -251,7 +260,28 @@ def _deepest_value(text: str, source: str) -> str:
         name, sep, value = line.partition("=")
         depth = len(value) - len(value.lstrip("[{ "))
         if sep and depth > best:
-            best, where = depth, f"{source}:{number}: {name.strip()}"
+            best, where = depth, f"{source}:{number}: {shown_path(name.strip(), MAX_SHOWN_CHARS)}"
+    return where
+
+
+def _toml_error(source: str, message: str) -> str:
+    """tomllib's 'Invalid value (at line 3, column 5)' as 'file:3: not valid TOML: invalid value (column 5)'."""
+    found = re.fullmatch(r"(.*) \(at line (\d+), column (\d+)\)", message, re.DOTALL)
+    if found is None:
+        return f"{source}: not valid TOML: {escaped(message)}"
+    what, line, column = found.groups()
+    return f"{source}:{line}: not valid TOML: {escaped(what[:1].lower() + what[1:])} (column {column})"
+
+
+def _longest_number(text: str, source: str) -> str:
+    """'file:line: key' of the longest run of digits (for the error tomllib gives no position for)."""
+    best, where = 0, source
+    for number, line in enumerate(text.splitlines(), start=1):
+        digits = max((len(run) for run in re.findall(r"\d+", line)), default=0)
+        if digits > best:
+            key_name, equals, _ = line.partition("=")
+            best, where = digits, f"{source}:{number}" + (f": {shown_path(key_name.strip(), MAX_SHOWN_CHARS)}"
+                                                          if equals else "")
     return where
 
 
@@ -263,7 +293,10 @@ def parse_job(text: str, source: str = "<job>") -> Job:
     try:
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
-        raise JobFileError(f"{source}: not valid TOML: {exc}") from None
+        raise JobFileError(_toml_error(source, str(exc))) from None
+    except ValueError as exc:  # an integer of thousands of digits (Python refuses to convert it)
+        raise JobFileError(f"{_longest_number(text, source)}: a number of thousands of digits (no key takes one: "
+                           f"{escaped(str(exc).split(':')[0])})") from None
     except RecursionError:
         raise JobFileError(f"{_deepest_value(text, source)}: arrays or tables nested too deeply for a job file") \
             from None
@@ -295,10 +328,10 @@ def _tables(data: dict, source: str, text: str) -> dict[str, object]:
                 if f"{name}.{child}" not in SECTIONS:
                     known = ", ".join(f"[{s}]" for s in children)
                     raise JobFileError(f"{_where(source, text, name + '.' + child)}: unknown section "
-                                       f"[{name}.{child}] (known: {known})")
+                                       f"[{shown_path(name + '.' + child, MAX_SHOWN_CHARS)}] (known: {known})")
                 tables[f"{name}.{child}"] = child_table
         else:
-            raise JobFileError(f"{_where(source, text, name)}: unknown section [{name}] "
+            raise JobFileError(f"{_where(source, text, name)}: unknown section [{shown_path(name, MAX_SHOWN_CHARS)}] "
                                f"(known sections: {', '.join(top)})")
     if "gear" not in tables:
         raise JobFileError(f"{source}: the job file has no [gear] section")
@@ -401,25 +434,19 @@ def _job_from_data(data: dict, source: str, text: str) -> Job:
 
 
 def load_job(path: str | Path) -> Job:
-    """Read and validate a job file from disk."""
-    path = Path(path)
-    try:
-        with path.open("rb") as handle:  # read no more than the limit (a device such as /dev/zero never ends)
-            raw = handle.read(MAX_JOB_FILE_BYTES + 1)
-    except FileNotFoundError:
-        raise JobFileError(f"{path}: job file not found") from None
-    except OSError as exc:
-        raise JobFileError(f"{path}: cannot read the job file: {exc.strerror}") from None
-    if len(raw) > MAX_JOB_FILE_BYTES:
-        raise JobFileError(f"{path}: the job file is larger than {MAX_JOB_FILE_BYTES // 1024} KiB; a job file is "
-                           "a few kilobytes of TOML")
+    """Read and validate a job file from disk (a regular file of at most MAX_JOB_FILE_BYTES: a FIFO or a device
+    is refused before it is read)."""
+    from spur_cad.inputs import read_regular_file
+
+    source = shown_path(path)  # messages name the file with its control characters escaped
+    raw = read_regular_file(path, "job file", MAX_JOB_FILE_BYTES, JobFileError)
     try:
         text = raw.decode("utf-8")
     except UnicodeDecodeError:
-        raise JobFileError(f"{path}: the job file is not UTF-8 text") from None
+        raise JobFileError(f"{source}: the job file is not UTF-8 text") from None
     if "\x00" in text:
-        raise JobFileError(f"{path}: the job file contains NUL characters (not a text file)")
-    return parse_job(text, str(path))
+        raise JobFileError(f"{source}: the job file contains NUL characters (not a text file)")
+    return parse_job(text, source)
 
 
 # --- docs/job-file.md -------------------------------------------------------------------------------------

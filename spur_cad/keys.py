@@ -28,6 +28,8 @@ import typing
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
+from spur_cad.errors import shown
+
 METADATA_KEY = "spur_cad.key"
 REQUIRED = dataclasses.MISSING  # the default of a key the file must give
 
@@ -181,7 +183,7 @@ def value_problem(k: Key, value: object, values: dict) -> str | None:
     if k.choices and value not in k.choices:
         listed = [repr(c) if isinstance(c, str) else _number(c) for c in k.choices]
         options = f"{listed[0]} or {listed[1]}" if len(listed) == 2 else "one of " + ", ".join(listed)
-        return f"must be {options}, got {value!r}"
+        return f"must be {options}, got {shown(value)}"
     if k.low is None or k.type not in (float, int):
         return None
     low, high = (_bound_value(b, values) for b in (k.low, k.high))
@@ -229,11 +231,10 @@ MAX_INTEGER = 10**15
 
 
 def _shown(value: object, limit: int = 40) -> str:
-    """A value as a message shows it: no 400-digit integers, long text shortened."""
+    """A value as a message shows it: no 400-digit integers, long text shortened, control characters escaped."""
     if isinstance(value, int) and not isinstance(value, bool) and abs(value) > MAX_INTEGER:
-        return f"a {len(str(abs(value)))}-digit number"
-    text = repr(value)
-    return text if len(text) <= limit else text[:limit - 3] + "..."
+        return shown(value)
+    return shown(value, limit)
 
 
 def _number(value: object) -> str:

@@ -1,95 +1,150 @@
 """The one place that writes files. A run's outputs form a set: the output folder holds the complete
-old set or the complete new set, never a mixture, and no leftovers of ours.
+old set or the complete new set, never a mixture, and no leftovers of ours (docs/output-folder.md).
 
 How (all inside the output folder, so on one filesystem):
 
 1. A lock (flock on the folder itself) serialises runs into the same folder: a second run waits.
 2. Recovery of an interrupted earlier run: a journal (`.spur_cad-switching.json`) means a switch was
-   under way, and it is completed (every file it names is complete in its staging folder); then
-   staging folders (`.spur_cad-staging-*`) and temporary files of older versions are removed.
+   under way, and it is completed; then our staging folders (`.spur_cad-staging-XXXXXXXX`) are removed.
 3. Checks before anything changes: a target name that is a folder (or not a regular file) is an
    error naming it.
-4. Staging: every file is written and fsync'ed in a fresh staging folder; an error or interrupt
-   here removes the staging folder and leaves the old set as it was.
-5. Switch: the journal is written atomically, then every staged file is renamed into place, the
-   old set's files that the new set lacks are removed, the manifest (`.spur_cad-set.json`, the
-   names of the current set) is replaced, and the journal and staging folder are removed. SIGINT
-   and SIGTERM are held back during the switch (milliseconds), so only SIGKILL or a power cut can
-   stop it half-way; the journal then tells (and the next run completes the switch first).
+4. Staging: every file, and the journal and manifest to come, is written and fsync'ed in a fresh
+   staging folder; an error or interrupt here removes the staging folder and leaves the old set.
+5. Switch: the journal is renamed into place, then every staged file, the old set's files that the
+   new set lacks are removed, the manifest (`.spur_cad-set.json`, the names of the current set) is
+   renamed into place, and the journal and the staging folder are removed. SIGINT and SIGTERM are held
+   back during the switch (milliseconds), so only SIGKILL or a power cut can stop it half-way; the
+   journal then tells (and the next run completes the switch first).
 
-Files in the folder that never belonged to a set (the user's own) are never touched. Sets written
-by versions without a manifest are recognised by spur_cad's output names.
+Every file found in the folder is untrusted input, our own manifest and journal included (an output
+folder may be a shared folder or a colleague's unpacked archive). They are read only if they are
+regular files of a bounded size, and every name in them must be a plain file name of the set's own
+vocabulary (`OUTPUT_NAME`) and the staging folder a direct child with the staging prefix; anything
+else is refused (ForeignFileError: "... was not written by spur_cad: remove it or choose another
+folder") before anything is touched. Only files a validated manifest or journal lists are ever
+removed, and only the new set's names are overwritten: the user's own files are never touched.
 """
 
 from __future__ import annotations
 
 import contextlib
+import errno
 import fcntl
 import json
 import os
 import re
 import shutil
 import signal
+import stat
 import tempfile
+from dataclasses import dataclass
 from pathlib import Path
 
-from spur_cad.errors import SpurCadError
+from spur_cad.errors import SpurCadError, shown_path
 
 MANIFEST = ".spur_cad-set.json"
 JOURNAL = ".spur_cad-switching.json"
 STAGING_PREFIX = ".spur_cad-staging-"
-_OUTPUT_NAME = r"(profile\.(csv|png)|(gear|stock|job)\.step|report\.html|summary\.json|(roughing|finishing)\.[a-z]+)"
-_LEGACY_SET = re.compile(_OUTPUT_NAME)  # what older versions wrote (they kept no manifest)
-_LEGACY_TEMPORARY = re.compile(rf"\.{_OUTPUT_NAME}\..+\.tmp")  # their staging files
+MAX_BOOKKEEPING_BYTES = 64 * 1024  # a manifest or journal lists a few dozen names
+_PROGRAM_EXTENSION = r"(ngc|nc|mpf|min)"  # every milling and lathe dialect's (checked in tests/test_outputs.py)
+_OPERATION = r"(roughing|roughing_bottom|finishing)"
+OUTPUT_NAME = re.compile(
+    r"profile\.(csv|png)|(gear|stock|job)\.step|report\.html|summary\.json"  # spur-cad run
+    rf"|{_OPERATION}\.{_PROGRAM_EXTENSION}|blank\.{_PROGRAM_EXTENSION}"  # programs
+    rf"|{_OPERATION}_(space|station)\d{{1,7}}(_(level|pass)\d{{1,7}})?\.{_PROGRAM_EXTENSION}"  # restart programs
+    r"|verify\.json|deviation_map\.csv"  # spur-cad verify
+    r"|grade\.json|k_chart\.png")  # spur-cad grade
+"""The vocabulary of output sets: every name spur_cad writes into an output folder (fullmatch)."""
+STAGING_NAME = re.compile(re.escape(STAGING_PREFIX) + r"[a-z0-9_]{8}")  # tempfile.mkdtemp's 8 random characters
 
 
 class OutputError(SpurCadError, OSError):
     """The output folder cannot take the set (a name in the way, no permission); nothing was changed."""
 
 
-def check_output_folder(out_dir: str | Path) -> Path:
-    """Refuse, before any computation, an --out that is not a folder or cannot be created or written."""
+class ForeignFileError(OutputError):
+    """A file in the output folder that looks like spur_cad's bookkeeping but was not written by spur_cad
+    (or was changed since): nothing is touched; the user removes it or chooses another folder."""
+
+
+@dataclass(frozen=True)
+class Journal:
+    """A switch under way: the staging folder's name, the new set's names and the old set's names."""
+
+    staging: str
+    new: tuple[str, ...]
+    old: tuple[str, ...]
+
+    def to_json(self) -> bytes:
+        return json.dumps({"staging": self.staging, "new": list(self.new), "old": list(self.old)}).encode()
+
+
+def check_output_folder(out_dir: str | os.PathLike) -> Path:
+    """Refuse, before any computation, an --out that is not a folder, a symbolic link to nothing, a name
+    the system refuses (too long), or a place that cannot be created or written."""
     out = Path(out_dir)
-    if out.exists() and not out.is_dir():
-        raise OutputError(f"--out {out}: exists and is not a folder")
-    existing = next((p for p in (out, *out.parents) if p.exists()), Path("."))
-    if not existing.is_dir() or not os.access(existing, os.W_OK | os.X_OK):
-        raise OutputError(f"--out {out}: cannot write into {existing}")
+    try:
+        if any(len(os.fsencode(part)) > 255 for part in out.parts):
+            raise OutputError(f"--out {shown_path(out)}: a folder name is longer than 255 bytes")
+        if out.is_symlink() and not out.exists():
+            raise OutputError(f"--out {shown_path(out)}: a symbolic link to nothing ({shown_path(os.readlink(out))})")
+        if out.exists() and not out.is_dir():
+            raise OutputError(f"--out {shown_path(out)}: exists and is not a folder")
+        existing = next((p for p in (out, *out.parents) if p.exists()), Path("."))
+        if not existing.is_dir() or not os.access(existing, os.W_OK | os.X_OK):
+            raise OutputError(f"--out {shown_path(out)}: cannot write into {shown_path(existing)}")
+        if out.is_dir():
+            _check_bookkeeping(out)  # a foreign manifest or journal is refused now, not after the computation
+    except OutputError:
+        raise
+    except (OSError, ValueError) as exc:  # a path too long for the system, a NUL byte, ...
+        raise OutputError(f"--out {shown_path(out)}: {getattr(exc, 'strerror', None) or exc}") from None
     return out
 
 
-def write_output_set(out_dir: str | Path, files: dict[str, bytes]) -> list[Path]:
-    """Replace the set in `out_dir` (created if needed) by `files` (name -> content); returns the paths."""
+def is_output_name(name: str) -> bool:
+    """True for a plain file name of the output sets' vocabulary (no separator, no '..', no control character)."""
+    return isinstance(name, str) and OUTPUT_NAME.fullmatch(name) is not None
+
+
+def write_output_set(out_dir: str | os.PathLike, files: dict[str, bytes]) -> list[Path]:
+    """Replace the set in `out_dir` (created if needed) by `files` (name -> content; names of OUTPUT_NAME);
+    returns the paths. Raises OutputError (ForeignFileError for a file not ours) with nothing changed."""
     for name in files:
-        if Path(name).name != name or name in {"", ".", ".."} or name.startswith(".spur_cad"):
-            raise ValueError(f"output names must be plain file names, got {name!r}")
+        if not is_output_name(name):
+            raise ValueError(f"output names must be plain file names of the output vocabulary, got {name!r}")
     out = check_output_folder(out_dir)
-    out.mkdir(parents=True, exist_ok=True)
+    try:
+        out.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise OutputError(f"--out {shown_path(out)}: cannot create it: {exc.strerror or exc}") from None
     with _locked(out):
         recover(out)
-        old = _current_set(out)
+        old = _read_manifest(out)
         for name in files:
             target = out / name
-            if target.is_dir() or (target.exists() and not target.is_file()):
-                raise OutputError(f"--out {out}: {name} is in the way (a folder or special file); nothing was written")
+            if target.is_dir() or (os.path.lexists(target) and not target.is_file()):
+                raise OutputError(f"--out {shown_path(out)}: {name} is in the way (a folder or special file); "
+                                  "nothing was written")
         staging = Path(tempfile.mkdtemp(prefix=STAGING_PREFIX, dir=out))
+        journal = Journal(staging.name, tuple(sorted(files)), tuple(sorted(old)))
         try:
             for name, content in files.items():
                 _write_synced(staging / name, content)
+            _write_synced(staging / JOURNAL, journal.to_json())
+            _write_synced(staging / MANIFEST, json.dumps(list(journal.new)).encode())
             _sync_folder(staging)
         except BaseException:
-            shutil.rmtree(staging, ignore_errors=True)
+            shutil.rmtree(staging, ignore_errors=True)  # our own fresh folder
             raise
-        journal = {"staging": staging.name, "new": sorted(files), "old": sorted(old)}
         with _signals_held():
-            _write_synced(out / (JOURNAL + ".tmp"), json.dumps(journal).encode())
-            os.replace(out / (JOURNAL + ".tmp"), out / JOURNAL)
+            os.replace(staging / JOURNAL, out / JOURNAL)
             _sync_folder(out)
             _switch(out, journal)
     return [out / name for name in files]
 
 
-def write_file_atomically(path: str | Path, content: bytes) -> Path:
+def write_file_atomically(path: str | os.PathLike, content: bytes) -> Path:
     """One file replaced atomically (temporary file in the same folder, fsync, rename)."""
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
@@ -108,61 +163,154 @@ def write_file_atomically(path: str | Path, content: bytes) -> Path:
 
 
 def recover(out: Path) -> None:
-    """Complete a switch an earlier run left half-done, then remove staging folders and old temporaries."""
-    journal_path = out / JOURNAL
-    if journal_path.exists():
-        try:
-            journal = json.loads(journal_path.read_text())
-        except (OSError, ValueError):  # the journal itself was not complete: the switch had not begun
-            journal = None
-        if journal is not None:
-            _switch(out, journal)
-        journal_path.unlink(missing_ok=True)
-    for entry in out.iterdir():
-        if entry.name.startswith(STAGING_PREFIX) and entry.is_dir():
-            shutil.rmtree(entry, ignore_errors=True)
-        elif entry.name == JOURNAL + ".tmp" or (_LEGACY_TEMPORARY.fullmatch(entry.name) and entry.is_file()):
-            entry.unlink(missing_ok=True)
+    """Complete a switch an earlier run left half-done, then remove our staging folders. Everything is
+    validated first (ForeignFileError, nothing touched, when a file is not ours)."""
+    journal, strays = _check_bookkeeping(out)
+    if journal is not None:
+        _switch(out, journal)
+    for name in strays:
+        _remove_staging(out / name)
 
 
-def current_set(out_dir: str | Path) -> list[str]:
-    """Names of the set the folder holds (from its manifest; [] when it holds none)."""
+def _check_bookkeeping(out: Path) -> tuple[Journal | None, list[str]]:
+    """The journal (None without one) and the names of stray staging folders, every one of them validated with
+    the manifest (ForeignFileError when a file is not ours); nothing is changed."""
+    journal = _read_journal(out)
+    strays = [entry for entry in _entries(out) if STAGING_NAME.fullmatch(entry) and
+              (journal is None or entry != journal.staging)]
+    for name in strays:
+        _check_staging(out, name)
+    if journal is not None:
+        _check_staging(out, journal.staging)
+    _read_manifest(out)
+    return journal, strays
+
+
+def current_set(out_dir: str | os.PathLike) -> list[str]:
+    """Names of the set the folder holds (from its validated manifest; [] when it holds none)."""
     out = Path(out_dir)
-    return sorted(_current_set(out)) if out.is_dir() else []
+    return sorted(_read_manifest(out)) if out.is_dir() else []
 
 
-def _current_set(out: Path) -> set[str]:
-    manifest = out / MANIFEST
-    if manifest.exists():
-        try:
-            return set(json.loads(manifest.read_text()))
-        except (OSError, ValueError):
-            pass
-    return {p.name for p in out.iterdir() if p.is_file() and _LEGACY_SET.fullmatch(p.name)}
+def _foreign(path: Path, reason: str) -> ForeignFileError:
+    return ForeignFileError(f"{shown_path(path)} was not written by spur_cad ({reason}): remove it or choose "
+                            "another folder")
 
 
-def _switch(out: Path, journal: dict) -> None:
-    """Move the staged files into place, remove the old set's extra files, record the new set."""
-    staging = out / journal["staging"]
-    new = list(journal["new"])
-    for name in new:
-        if (staging / name).exists():
+def _entries(out: Path) -> list[str]:
+    return sorted(os.listdir(out))
+
+
+def _read_bookkeeping(path: Path) -> object | None:
+    """The JSON of our manifest or journal (None when absent), read only from a regular file of bounded size."""
+    try:
+        fd = os.open(path, os.O_RDONLY | os.O_NOFOLLOW | os.O_NONBLOCK | os.O_CLOEXEC)
+    except FileNotFoundError:
+        return None
+    except OSError as exc:
+        raise _foreign(path, "a symbolic link" if exc.errno == errno.ELOOP else
+                       f"cannot read it: {exc.strerror or exc}") from None
+    with os.fdopen(fd, "rb") as handle:
+        if not stat.S_ISREG(os.fstat(fd).st_mode):
+            raise _foreign(path, "not a regular file")
+        raw = handle.read(MAX_BOOKKEEPING_BYTES + 1)
+    if len(raw) > MAX_BOOKKEEPING_BYTES:
+        raise _foreign(path, f"larger than {MAX_BOOKKEEPING_BYTES // 1024} KiB")
+    try:
+        return json.loads(raw.decode("utf-8"))
+    except (UnicodeDecodeError, ValueError, RecursionError):
+        raise _foreign(path, "not the JSON spur_cad writes") from None
+
+
+def _names(value: object, path: Path, what: str) -> tuple[str, ...]:
+    if not isinstance(value, list):
+        raise _foreign(path, f"{what} is not a list of names")
+    for name in value:
+        if not is_output_name(name):
+            shown = shown_path(name) if isinstance(name, str) else type(name).__name__
+            raise _foreign(path, f"{what} names {shown!s}, not a file of an output set")
+    return tuple(value)
+
+
+def _read_manifest(out: Path) -> set[str]:
+    """The current set's names from the manifest; the empty set without one (files of older versions that kept
+    no manifest are left alone: they are overwritten only where the new set has the same name)."""
+    path = out / MANIFEST
+    data = _read_bookkeeping(path)
+    return set() if data is None else set(_names(data, path, "the manifest"))
+
+
+def _read_journal(out: Path) -> Journal | None:
+    path = out / JOURNAL
+    data = _read_bookkeeping(path)
+    if data is None:
+        return None
+    if not isinstance(data, dict) or set(data) != {"staging", "new", "old"}:
+        raise _foreign(path, "not a journal of staging, new and old names")
+    staging = data["staging"]
+    if not isinstance(staging, str) or STAGING_NAME.fullmatch(staging) is None:
+        raise _foreign(path, "its staging folder is not one of spur_cad's in this folder")
+    return Journal(staging, _names(data["new"], path, "its new set"), _names(data["old"], path, "its old set"))
+
+
+def _check_staging(out: Path, name: str) -> None:
+    """A staging folder must be a real folder (not a link) holding only regular files of our names."""
+    folder = out / name
+    try:
+        mode = os.lstat(folder).st_mode
+    except FileNotFoundError:
+        return
+    if not stat.S_ISDIR(mode):
+        raise _foreign(folder, "not a folder")
+    for entry in os.scandir(folder):
+        if not (entry.is_file(follow_symlinks=False) and (is_output_name(entry.name) or
+                                                           entry.name in (MANIFEST, JOURNAL))):
+            raise _foreign(folder / entry.name, "not a file of an output set")
+
+
+def _remove_staging(folder: Path) -> None:
+    """Remove a checked staging folder: its regular files, then the folder."""
+    with contextlib.suppress(FileNotFoundError):
+        for entry in os.scandir(folder):
+            if entry.is_file(follow_symlinks=False):
+                os.unlink(folder / entry.name)
+        os.rmdir(folder)
+
+
+def _switch(out: Path, journal: Journal) -> None:
+    """Move the staged files into place, remove the old set's extra files, record the new set (the journal
+    and its names were validated)."""
+    staging = out / journal.staging
+    for name in journal.new:
+        if os.path.lexists(staging / name):
             os.replace(staging / name, out / name)
-    for name in set(journal["old"]) - set(new):
-        (out / name).unlink(missing_ok=True)
-    _write_synced(out / (MANIFEST + ".tmp"), json.dumps(new).encode())
-    os.replace(out / (MANIFEST + ".tmp"), out / MANIFEST)
+    for name in set(journal.old) - set(journal.new):
+        target = out / name
+        with contextlib.suppress(FileNotFoundError):
+            if not stat.S_ISDIR(os.lstat(target).st_mode):
+                target.unlink()
+    manifest = staging / MANIFEST
+    if not os.path.lexists(manifest):  # recovering: write the manifest in a fresh folder of ours
+        fresh = Path(tempfile.mkdtemp(prefix=STAGING_PREFIX, dir=out))
+        manifest = fresh / MANIFEST
+        _write_synced(manifest, json.dumps(list(journal.new)).encode())
+    os.replace(manifest, out / MANIFEST)
     _sync_folder(out)
-    (out / JOURNAL).unlink(missing_ok=True)
-    shutil.rmtree(staging, ignore_errors=True)
+    with contextlib.suppress(FileNotFoundError):
+        (out / JOURNAL).unlink()
+    _remove_staging(staging)
+    _remove_staging(manifest.parent)
+    _sync_folder(out)
 
 
 def _write_synced(path: Path, content: bytes) -> None:
-    with open(path, "wb") as handle:
+    """A new file (never through an existing name or link) written and fsync'ed."""
+    fd = os.open(path, os.O_WRONLY | os.O_CREAT | os.O_EXCL | os.O_NOFOLLOW | os.O_CLOEXEC, 0o644)
+    with os.fdopen(fd, "wb") as handle:
+        os.fchmod(fd, 0o644)  # whatever the umask: the set is readable like any other file
         handle.write(content)
         handle.flush()
         os.fsync(handle.fileno())
-    os.chmod(path, 0o644)
 
 
 def _sync_folder(folder: Path) -> None:
@@ -176,7 +324,7 @@ def _sync_folder(folder: Path) -> None:
 @contextlib.contextmanager
 def _locked(out: Path):
     """An exclusive flock on the folder itself (no lock file is left behind)."""
-    fd = os.open(out, os.O_RDONLY)
+    fd = os.open(out, os.O_RDONLY | os.O_DIRECTORY)
     try:
         fcntl.flock(fd, fcntl.LOCK_EX)
         yield

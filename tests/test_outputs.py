@@ -42,59 +42,66 @@ def test_a_new_set_replaces_the_old_one_whole(tmp_path):
     assert current_set(out) == ["roughing.nc", "summary.json"]
 
 
-def test_a_set_written_by_an_older_version_is_recognised(tmp_path):
+def test_without_a_manifest_only_the_new_sets_names_are_overwritten(tmp_path):
+    """Files of our names in a folder without a manifest (an older version's set, or the user's own files that
+    happen to have such names) are not taken for a set: nothing but the new set's names is overwritten."""
     out = tmp_path / "out"
     out.mkdir()
-    for name in ("roughing.ngc", "finishing.ngc", "profile.csv", "notes.txt"):
+    for name in ("roughing.ngc", "finishing.ngc", "roughing.txt", "finishing.md", "notes.txt"):
         (out / name).write_bytes(b"old")
-    (out / ".finishing.ngc.abc123.tmp").write_bytes(b"half")  # a stray of the old writer
-    write_output_set(out, {"roughing.nc": b"new"})
-    assert listing(out) == ({"roughing.nc": b"new", "notes.txt": b"old"}, [])
+    (out / ".finishing.ngc.abc123.tmp").write_bytes(b"half")  # a stray of an old writer: not ours to judge
+    write_output_set(out, {"roughing.nc": b"new", "finishing.ngc": b"new f"})
+    assert listing(out)[0] == {"roughing.nc": b"new", "finishing.ngc": b"new f", "roughing.ngc": b"old",
+                               "roughing.txt": b"old", "finishing.md": b"old", "notes.txt": b"old",
+                               ".finishing.ngc.abc123.tmp": b"half"}
 
 
 def test_a_folder_in_the_way_is_found_before_anything_changes(tmp_path):
     out = tmp_path / "out"
-    write_output_set(out, {"a.txt": b"old a", "b.txt": b"old b"})
-    (out / "c.txt").mkdir()
-    with pytest.raises(OutputError, match="c.txt"):
-        write_output_set(out, {"a.txt": b"new a", "b.txt": b"new b", "c.txt": b"new c"})
-    assert listing(out) == ({"a.txt": b"old a", "b.txt": b"old b"}, ["c.txt"])
+    write_output_set(out, {"gear.step": b"old a", "stock.step": b"old b"})
+    (out / "job.step").mkdir()
+    with pytest.raises(OutputError, match="job.step"):
+        write_output_set(out, {"gear.step": b"new a", "stock.step": b"new b", "job.step": b"new c"})
+    assert listing(out) == ({"gear.step": b"old a", "stock.step": b"old b"}, ["job.step"])
 
 
 def test_failure_while_staging_leaves_the_old_set(tmp_path):
     out = tmp_path / "out"
-    write_output_set(out, {"a.txt": b"old a"})
+    write_output_set(out, {"gear.step": b"old a"})
 
     with pytest.raises(TypeError):
-        write_output_set(out, {"a.txt": b"new a", "b.txt": object()})  # the second file cannot be written
-    assert listing(out) == ({"a.txt": b"old a"}, [])
+        write_output_set(out, {"gear.step": b"new a", "stock.step": object()})  # the second file cannot be written
+    assert listing(out) == ({"gear.step": b"old a"}, [])
 
 
 def test_an_interrupted_switch_is_completed_by_the_next_run(tmp_path):
     """A journal and a half-moved staging folder, as SIGKILL during the switch leaves them."""
     out = tmp_path / "out"
-    write_output_set(out, {"a.txt": b"old a", "old.txt": b"old"})
-    staging = out / (STAGING_PREFIX + "x")
+    write_output_set(out, {"gear.step": b"old a", "finishing.ngc": b"old"})
+    staging = out / (STAGING_PREFIX + "abcd1234")
     staging.mkdir()
-    (staging / "b.txt").write_bytes(b"new b")
-    (out / "a.txt").write_bytes(b"new a")  # already moved before the kill
-    (out / JOURNAL).write_text(json.dumps({"staging": staging.name, "new": ["a.txt", "b.txt"],
-                                           "old": ["a.txt", "old.txt"]}))
+    (staging / "stock.step").write_bytes(b"new b")
+    (staging / MANIFEST).write_text(json.dumps(["gear.step", "stock.step"]))
+    (out / "gear.step").write_bytes(b"new a")  # already moved before the kill
+    (out / JOURNAL).write_text(json.dumps({"staging": staging.name, "new": ["gear.step", "stock.step"],
+                                           "old": ["finishing.ngc", "gear.step"]}))
     recover(out)
-    assert listing(out) == ({"a.txt": b"new a", "b.txt": b"new b"}, [])
-    assert current_set(out) == ["a.txt", "b.txt"]
+    assert listing(out) == ({"gear.step": b"new a", "stock.step": b"new b"}, [])
+    assert current_set(out) == ["gear.step", "stock.step"]
 
 
 def test_a_killed_writer_leaves_the_old_set_and_no_strays_after_the_next_run(tmp_path):
     """A child process stages a large set and is killed while staging; the old set stays, and the next
     run removes what the child left."""
     out = tmp_path / "out"
-    write_output_set(out, {"a.txt": b"old a"})
+    write_output_set(out, {"gear.step": b"old a"})
     code = textwrap.dedent(f"""
         import sys
         from spur_cad.outputs import write_output_set
         big = b"x" * (200 * 1024 * 1024)
-        write_output_set({str(out)!r}, {{f"f{{i}}.bin": big for i in range(20)}})
+        names = ["profile.csv", "profile.png", "stock.step", "job.step", "report.html", "summary.json",
+                 "roughing.ngc", "finishing.ngc", "verify.json", "deviation_map.csv", "grade.json", "k_chart.png"]
+        write_output_set({str(out)!r}, {{name: big for name in names}})
     """)
     child = subprocess.Popen([sys.executable, "-c", code])
     deadline = time.time() + 60
@@ -104,10 +111,10 @@ def test_a_killed_writer_leaves_the_old_set_and_no_strays_after_the_next_run(tmp
     child.kill()
     child.wait()
     files, folders = listing(out)
-    assert files == {"a.txt": b"old a"}
+    assert files == {"gear.step": b"old a"}
     assert len(folders) == 1 and folders[0].startswith(STAGING_PREFIX)  # the kill left its staging folder
-    write_output_set(out, {"b.txt": b"new b"})
-    assert listing(out) == ({"b.txt": b"new b"}, [])
+    write_output_set(out, {"stock.step": b"new b"})
+    assert listing(out) == ({"stock.step": b"new b"}, [])
 
 
 def test_concurrent_runs_do_not_mix_sets(tmp_path):
@@ -116,28 +123,31 @@ def test_concurrent_runs_do_not_mix_sets(tmp_path):
         import sys
         from spur_cad.outputs import write_output_set
         tag = sys.argv[1].encode()
+        names = {"a": ["gear.step", "stock.step", "job.step"], "b": ["roughing.nc", "finishing.nc", "report.html"]}
         for _ in range(30):
-            write_output_set(sys.argv[2], {f"{sys.argv[1]}-{i}.txt": tag * 1000 for i in range(5)} | {"s.json": tag})
+            write_output_set(sys.argv[2], {name: tag * 1000 for name in names[sys.argv[1]]} | {"summary.json": tag})
     """)
     children = [subprocess.Popen([sys.executable, "-c", code, tag, str(out)]) for tag in ("a", "b")]
     for child in children:
         assert child.wait(timeout=120) == 0
-    names = sorted(listing(out)[0])
-    tag = names[0][0]
-    assert names == sorted([f"{tag}-{i}.txt" for i in range(5)] + ["s.json"])
-    assert (out / "s.json").read_bytes() == tag.encode()
+    files = listing(out)[0]
+    tag = files["summary.json"].decode()
+    expected = {"a": ["gear.step", "stock.step", "job.step"], "b": ["roughing.nc", "finishing.nc", "report.html"]}
+    assert sorted(files) == sorted(expected[tag] + ["summary.json"])
+    assert all(content == tag.encode() * 1000 for name, content in files.items() if name != "summary.json")
 
 
-def test_rejects_path_like_names(tmp_path):
+@pytest.mark.parametrize("name", ["../evil", "a.txt", "sub/gear.step", "/tmp/gear.step", "gear.step\n", ""])
+def test_rejects_names_outside_the_vocabulary(tmp_path, name):
     with pytest.raises(ValueError):
-        write_output_set(tmp_path, {"../evil": b""})
+        write_output_set(tmp_path, {name: b""})
 
 
 def test_an_out_that_is_a_file_is_refused(tmp_path):
     target = tmp_path / "file"
     target.write_text("x")
     with pytest.raises(OutputError, match="not a folder"):
-        write_output_set(target, {"a.txt": b"a"})
+        write_output_set(target, {"gear.step": b"a"})
 
 
 def test_single_file_replaced_atomically(tmp_path):

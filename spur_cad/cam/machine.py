@@ -5,7 +5,7 @@ from __future__ import annotations
 import re
 from dataclasses import dataclass
 
-from spur_cad.errors import SpurCadError
+from spur_cad.errors import SpurCadError, shown
 from spur_cad.keys import check_section, key
 
 
@@ -110,12 +110,11 @@ def check_rotary_code(code: str, key: str) -> None:
     """Refuse a clamp/unclamp code that is anything but a single M code ("" means none), or an M code that
     stops, ends or calls a program or drives the spindle, tool or coolant."""
     if code and ROTARY_CODE.fullmatch(code) and int(code[1:]) in RESERVED_M_CODES:
-        raise MachineError(f"[machine] {key} = {code!r} is an M code that stops, ends or calls a program or "
+        raise MachineError(f"[machine] {key} = {shown(code)} is an M code that stops, ends or calls a program or "
                            "drives the spindle, tool or coolant; use the machine's rotary clamp code (e.g. M10)",
                            field=key, section="machine")
     if code and not ROTARY_CODE.fullmatch(code):
-        shown = repr(code if len(code) <= 20 else code[:17] + "...")
-        raise MachineError(f"[machine] {key} = {shown} must be a single M code such as 'M10' (the programs "
+        raise MachineError(f"[machine] {key} = {shown(code, 20)} must be a single M code such as 'M10' (the programs "
                            "write it as a block of its own)", field=key, section="machine")
 
 

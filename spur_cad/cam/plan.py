@@ -34,7 +34,7 @@ from spur_cad.cam.roughing import (
 )
 from spur_cad.cam.strategies import FinishingResult, get_strategy, params_from_section
 from spur_cad.cam.tools import Tool, ToolError
-from spur_cad.errors import StockError, WorkLimitError
+from spur_cad.errors import StockError, WorkLimitError, shown
 from spur_cad.geometry.spec import GearSpec
 
 MAX_TOOLPATH_MOVES = 10_000_000
@@ -128,8 +128,9 @@ def check_cam_inputs(inputs: CamInputs) -> tuple[ToolRecommendations, RoughingLe
     recommendations and the roughing levels (None without a roughing tool)."""
     spec, machine, stock = inputs.spec, inputs.machine, inputs.stock
     if spec.is_helical and inputs.finishing_tool is not None and inputs.finishing.strategy != "generating":
-        raise MachineError(f"[finishing] strategy = {inputs.finishing.strategy!r} is for spur gears; a helical gear "
-                           f"(helix_angle_deg = {spec.helix_angle_deg:g}) is finished by strategy = \"generating\"",
+        raise MachineError(f"[finishing] strategy = {shown(inputs.finishing.strategy)} is for spur gears; a "
+                           f"helical gear (helix_angle_deg = {spec.helix_angle_deg:g}) is finished by "
+                           "strategy = \"generating\"",
                            field="strategy", section="finishing")
     blank = stock.blank_radius_mm(spec)
     check_blank_allowance(spec, stock, inputs.finishing_tool)

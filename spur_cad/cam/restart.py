@@ -19,7 +19,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from spur_cad.cam.ir import MoveKind, Toolpath, ToolpathBuilder
-from spur_cad.errors import SpurCadError
+from spur_cad.errors import SpurCadError, shown
 
 UNITS = {"space": "space", "level": "station", "station": "station", "pass": None}
 """Restart units and the IR column that numbers them (`pass`: the rapids of a space, one per generating pass)."""
@@ -60,7 +60,7 @@ def parse_restart(text: str) -> RestartPoint:
     allowed = {"roughing": (("space",), ("space", "level")), "roughing_bottom": (("space",), ("space", "level")),
                "finishing": (("station",), ("space",), ("space", "pass"))}[operation]
     if units not in allowed:
-        raise RestartError(f"--restart {text!r}: {usage}", field="restart")
+        raise RestartError(f"--restart {shown(text)}: {usage}", field="restart")
     return RestartPoint(operation, at)
 
 

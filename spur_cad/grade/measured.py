@@ -11,6 +11,7 @@ spaces may be mixed: each point belongs to the flank of the design point nearest
 from __future__ import annotations
 
 import math
+import os
 from dataclasses import dataclass
 
 import numpy as np
@@ -20,6 +21,8 @@ from spur_cad.grade.iso1328 import DEVIATIONS, KINDS, class_of, pitch_deviations
 from spur_cad.grade.simulated import Trace, helix_range_mm, profile_range_mm
 
 MAX_POINTS = 2_000_000
+MAX_MEASURED_BYTES = 128 * 1024 * 1024  # a scan of MAX_POINTS points (about 70 MB of text) fits
+MAX_LINE_CHARS = 1024
 FIT_POINTS = 4000  # points used for the best fit (an even subset of the file)
 DESIGN_SPACING_MM = 0.005
 
@@ -39,9 +42,44 @@ class MeasuredPoints:
 
 
 def read_points_csv(text: str, source: str) -> MeasuredPoints:
-    """The points of a measured-points CSV (see the module docstring); one line naming the line on error."""
-    rows = []
-    for number, raw in enumerate(text.splitlines(), start=1):
+    """The points of a measured-points CSV text (see the module docstring); one line naming the line on error."""
+    return _points(enumerate(text.splitlines(), start=1), source)
+
+
+def read_points_file(path: str | os.PathLike, source: str | None = None) -> MeasuredPoints:
+    """The points of a measured-points CSV file, read as a stream: a regular file (a FIFO or a device is refused
+    before reading) of at most MAX_MEASURED_BYTES; memory holds a line at a time besides the points."""
+    from spur_cad.errors import shown_path
+    from spur_cad.inputs import open_regular_file
+
+    source = source if source is not None else shown_path(path)
+    with open_regular_file(path, "measured points file", MeasuredPointsError) as handle:
+        size = os.fstat(handle.fileno()).st_size
+        if size > MAX_MEASURED_BYTES:
+            raise MeasuredPointsError(f"{source}: the measured points file has {size:,} bytes; grade reads at most "
+                                      f"{MAX_MEASURED_BYTES:,} ({MAX_MEASURED_BYTES // 2**20} MiB)")
+
+        def lines():
+            for number, raw in enumerate(iter(lambda: handle.readline(MAX_LINE_CHARS + 3), b""), start=1):
+                if len(raw) > MAX_LINE_CHARS + 2:
+                    raise MeasuredPointsError(f"{source}:{number}: a line of more than {MAX_LINE_CHARS:,} "
+                                              "characters; a point is a line of two or three numbers")
+                try:
+                    yield number, raw.decode("utf-8")
+                except UnicodeDecodeError:
+                    raise MeasuredPointsError(f"{source}:{number}: not a text file (not UTF-8)") from None
+
+        return _points(lines(), source)
+
+
+def _points(lines, source: str) -> MeasuredPoints:
+    """Points from (line number, text) pairs; compact columns (24 bytes a point), at most MAX_POINTS."""
+    from array import array
+
+    from spur_cad.errors import shown
+
+    columns = (array("d"), array("d"), array("d"))
+    for number, raw in lines:
         line = raw.split("#", 1)[0].strip()
         if not line:
             continue
@@ -49,20 +87,20 @@ def read_points_csv(text: str, source: str) -> MeasuredPoints:
         try:
             values = [float(part) for part in parts]
         except ValueError:
-            if not rows and not any(ch.isdigit() for ch in line):
+            if not columns[0] and not any(ch.isdigit() for ch in line):
                 continue  # a header of column names
-            raise MeasuredPointsError(f"{source}:{number}: not numbers: {line[:60]!r}") from None
+            raise MeasuredPointsError(f"{source}:{number}: not numbers: {shown(line)}") from None
         if len(values) not in (2, 3):
             raise MeasuredPointsError(f"{source}:{number}: expected x_mm,y_mm[,X_mm], got {len(values)} values")
         if not all(math.isfinite(v) and abs(v) < 1e5 for v in values):
             raise MeasuredPointsError(f"{source}:{number}: a value is not a finite coordinate below 1e5 mm")
-        rows.append(values + [0.0] * (3 - len(values)))
-        if len(rows) > MAX_POINTS:
+        for column, value in zip(columns, values + [0.0] * (3 - len(values))):
+            column.append(value)
+        if len(columns[0]) > MAX_POINTS:
             raise MeasuredPointsError(f"{source}: more than {MAX_POINTS:,} points")
-    if len(rows) < 10:
-        raise MeasuredPointsError(f"{source}: {len(rows)} points; at least 10 are needed")
-    data = np.array(rows)
-    return MeasuredPoints(data[:, 0], data[:, 1], data[:, 2])
+    if len(columns[0]) < 10:
+        raise MeasuredPointsError(f"{source}: {len(columns[0])} points; at least 10 are needed")
+    return MeasuredPoints(*(np.frombuffer(column, np.float64).copy() for column in columns))
 
 
 def _design(spec):

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, replace
 
+from spur_cad.errors import shown
 from spur_cad.post.settings import PostError
 
 
@@ -104,4 +105,4 @@ def dialect(name: str) -> Dialect:
     try:
         return DIALECTS[name]
     except KeyError:
-        raise PostError(f"[post] dialect = {name!r} is not known (known: {', '.join(DIALECTS)})") from None
+        raise PostError(f"[post] dialect = {shown(name)} is not known (known: {', '.join(DIALECTS)})") from None

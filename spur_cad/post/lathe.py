@@ -13,7 +13,7 @@ import math
 from collections.abc import Sequence
 
 from spur_cad.cam.turning import LatheError, LathePlan, LatheSection
-from spur_cad.errors import require_instance
+from spur_cad.errors import require_instance, shown
 from spur_cad.post.program import MAX_COORDINATE_MM, inert_comment_text
 
 LATHE_EXTENSIONS = {"siemens": "mpf", "fanuc": "nc", "linuxcnc": "ngc"}
@@ -27,7 +27,7 @@ WORKPIECE_BITS = 192
 def lathe_extension(dialect: str) -> str:
     """The program file's extension for a lathe dialect: siemens mpf, fanuc nc, linuxcnc ngc."""
     if dialect not in LATHE_EXTENSIONS:
-        raise LatheError(f"[lathe] dialect = {dialect!r} is not known (known: {', '.join(LATHE_EXTENSIONS)})",
+        raise LatheError(f"[lathe] dialect = {shown(dialect)} is not known (known: {', '.join(LATHE_EXTENSIONS)})",
                          field="dialect")
     return LATHE_EXTENSIONS[dialect]
 

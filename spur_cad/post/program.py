@@ -21,6 +21,7 @@ import numpy as np
 
 from spur_cad.cam.ir import MoveKind, Toolpath
 from spur_cad.cam.machine import check_rotary_code
+from spur_cad.errors import shown
 from spur_cad.post.dialects import Dialect, dialect
 from spur_cad.post.settings import PostError, PostSettings
 
@@ -323,10 +324,10 @@ class _Writer:
             modal.motion = "G1"
         decimals = d.inverse_feed_decimals if inverse else d.feed_decimals
         if not (math.isfinite(feed) and feed > 0.0):
-            raise PostError(f"{self.info.title}: move {index} has no usable feed ({feed!r})")
+            raise PostError(f"{shown(self.info.title)}: move {index} has no usable feed ({feed!r})")
         f = int(round(feed * 10 ** decimals))
         if f < 1:
-            raise PostError(f"{self.info.title}: move {index}'s feed {feed:g} would be written as F0")
+            raise PostError(f"{shown(self.info.title)}: move {index}'s feed {feed:g} would be written as F0")
         if inverse or f != modal.feed_units:  # G93 needs F in every feed block
             words.append("F" + _number(f, decimals))
             modal.feed_units = f

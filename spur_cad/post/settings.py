@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from spur_cad.errors import SpurCadError
+from spur_cad.errors import SpurCadError, shown
 from spur_cad.keys import check_section, key
 
 
@@ -62,7 +62,8 @@ class PostSettings:
     def validate(self) -> None:
         check_section(self, "post", PostError)
         if self.dialect not in dialect_names():
-            raise PostError(f"[post] dialect = {self.dialect!r} is not known (known: {', '.join(dialect_names())})",
+            raise PostError(f"[post] dialect = {shown(self.dialect)} is not known "
+                            f"(known: {', '.join(dialect_names())})",
                             field="dialect")
         if self.folded and self.rotary_mode == "wrapped":
             raise PostError("[post] folded = true needs rotary_mode = 'unwound': a folded space pattern adds "

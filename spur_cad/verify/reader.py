@@ -31,19 +31,30 @@ G90 (a turning cycle in system A), G50 with axes (coordinate setting), U / W (in
 
 from __future__ import annotations
 
+import io
 import math
+import os
 import re
+from array import array
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
 
-from spur_cad.errors import SpurCadError
+from spur_cad.errors import SpurCadError, shown, shown_path
 
 DIALECTS = ("linuxcnc", "fanuc", "haas", "siemens", "okuma")
 LATHE_DIALECTS = ("linuxcnc", "fanuc", "siemens")
-MAX_PROGRAM_BYTES = 256 * 1024 * 1024
-MAX_MOVES = 10_000_000  # about 0.6 GB of move columns: refuse before reading further
-MAX_BLOCKS = 50_000_000  # blocks executed (loops and calls counted): some minutes of reading at most
+# The largest program read, and what reading it may do. Together they bound a verification to about a minute
+# and half a gigabyte whatever the program holds (docs/verification.md, "Limits").
+MAX_PROGRAM_BYTES = 64 * 1024 * 1024  # refused at once beyond this, naming the size
+MAX_LINE_CHARS = 4096  # controllers take 128-256 characters a block
+MAX_LINES = 20_000_000  # lines in the file (blank and comment lines included)
+MAX_LINES_READ = 40_000_000  # lines read while executing (loop bodies and subprograms each time they run)
+MAX_MOVES = 2_000_000  # moves recorded (about 60 bytes each)
+MAX_BLOCKS = 8_000_000  # blocks executed (loops and calls counted)
+MAX_CHARACTERS_READ = 100_000_000  # characters read while executing (long blocks of many words cost more)
+MAX_SUBPROGRAMS = 100_000  # subprograms, loops and labels defined
 MAX_CALL_DEPTH = 8
 MAX_REPEAT = 100_000
 CHECK_EVERY_BLOCKS = 100_000  # how often a long read calls its checkpoint (the CLI stops there on a signal)
@@ -56,7 +67,9 @@ FANUC_ARGUMENTS = {"A": 1, "B": 2, "C": 3, "I": 4, "J": 5, "K": 6, "D": 7, "E": 
 # G54..G59 select work offsets: the program's frame is taken as the job's (one offset for all of them).
 SETUP_G = {"17", "21", "40", "49", "54", "55", "56", "57", "58", "59", "64", "80", "90", "43", "61"}
 QUIET_M = {"0", "1", "3", "4", "5", "7", "8", "9", "10", "11", "2", "30", "6", "68", "69"}
-_COLUMN_TYPES = ("b", "d", "d", "d", "d", "d", "b", "q", "q", "d")  # ProgramMoves.from_columns
+# ProgramMoves columns: rapid, x, y, z, a, feed, inverse_time, line, tool, spindle_rpm (array typecode, dtype)
+_COLUMNS = (("b", np.int8), ("d", np.float64), ("d", np.float64), ("d", np.float64), ("d", np.float64),
+            ("d", np.float64), ("b", np.int8), ("l", np.int_), ("l", np.int_), ("d", np.float64))
 
 
 class ProgramReadError(SpurCadError):
@@ -87,41 +100,225 @@ class ProgramMoves:
 
     @classmethod
     def from_columns(cls, source: str, columns: list) -> "ProgramMoves":
-        """Moves from the columns rapid, x, y, z, a, feed, inverse_time, line, tool, spindle_rpm (sequences)."""
-        return cls(source, np.array(columns[0], bool), *(np.array(c, float) for c in columns[1:6]),
-                   np.array(columns[6], bool), np.array(columns[7], int), np.array(columns[8], int),
-                   np.array(columns[9], float))
+        """Moves from the columns rapid, x, y, z, a, feed, inverse_time, line, tool, spindle_rpm (sequences; the
+        arrays of `move_columns` are taken without copying)."""
+        arrays = []
+        for column, (code, dtype) in zip(columns, _COLUMNS):
+            if isinstance(column, array) and column.typecode == code:
+                values = np.frombuffer(column, dtype) if len(column) else np.zeros(0, dtype)
+            else:
+                values = np.array(column, dtype)
+            arrays.append(values)
+        return cls(source, arrays[0].astype(bool), *arrays[1:6], arrays[6].astype(bool), *arrays[7:])
 
 
 def move_columns() -> list:
     """Empty compact columns for moves (Python arrays: about 60 bytes a move)."""
-    from array import array
-
-    return [array(code) for code in _COLUMN_TYPES]
+    return [array(code) for code, _ in _COLUMNS]
 
 
 @dataclass
 class _Line:
     number: int  # 1-based line in the file
     text: str  # without comments and block number
+    offset: int = 0  # byte offset of the line in the file
 
+
+Position = tuple[int, int]  # (byte offset of a line's start, number of lines before it)
 
 _ENDS = re.compile(r"(^|\s)M0*(30|2)(\s|$)")  # M30 or M2, anywhere in a block
 _UNSIGNED = r"(?:\d+\.?\d*|\.\d+)"
 _TERM = re.compile(rf"\s*([-+]?)\s*(#\d+|R\d+|[A-Z_][A-Z0-9_]*|{_UNSIGNED})\s*")
+_PLAIN_NUMBER = re.compile(rf"[-+]?{_UNSIGNED}")
+_COMMENT = re.compile(r"\([^)]*\)")
+_BLOCK_NUMBER = re.compile(r"^N\d+\s*")
+_HAAS_LOCAL = re.compile(r"N\d+")
+_CANDIDATE = re.compile(rb"[OoMm:]")  # what a line needs to hold to end the program or open a structure
+_LINUXCNC_SUB = re.compile(r"O(\d+)\s*SUB")
+_LINUXCNC_ENDSUB = re.compile(r"O(\d+)\s*ENDSUB")
+_LINUXCNC_REPEAT = re.compile(r"O(\d+)\s*REPEAT\s*\[([^\]]*)\]")
+_LINUXCNC_ENDREPEAT = re.compile(r"O(\d+)\s*ENDREPEAT")
+_LINUXCNC_CALL = re.compile(r"O(\d+)\s*CALL((?:\s*\[[^\]]*\])*)")
+_ASSIGNMENT = re.compile(r"(#\d+)\s*=\s*(.+)")
+_LABEL = re.compile(r"[A-Z_][A-Z0-9_]*:")
+_SUB_HEAD = re.compile(r"O(\d+)|N(\d+)")
+_FANUC_CLOSE = re.compile(r"M0*99")
+_PROGRAM_NUMBER = re.compile(r"O\d+")
+_WORDS = re.compile(r"([A-Z])\s*(\[[^\]]*\]|#\d+|[-+]?(?:\d+\.?\d*|\.\d+))")
+_WORDS_ASSIGNED = re.compile(r"([A-Z])\s*(=\s*[^\s]+|\[[^\]]*\]|#\d+|[-+]?(?:\d+\.?\d*|\.\d+))")
+_ORDER = {"T": 0, "S": 0, "G": 1, "F": 2, "M": 3}  # T and S before M, G before F, then the rest in order
+
+
+def _clean(raw: bytes, dialect: str) -> str:
+    """A line without comments, block number and surrounding blanks; upper case (LinuxCNC's o-words too);
+    '' for a line with nothing to execute ('%' delimits Fanuc and Haas programs)."""
+    line = raw.decode("utf-8")  # checked while indexing
+    if dialect == "siemens":
+        line = line.split(";", 1)[0]
+    else:
+        if "(" in line:
+            line = _COMMENT.sub("", line)
+        if dialect == "linuxcnc":
+            line = line.split(";", 1)[0]
+    line = line.strip().upper()
+    if line[:1] == "N" and (dialect != "haas" or not _HAAS_LOCAL.fullmatch(line)):  # Haas's N<n> heads a local sub
+        line = _BLOCK_NUMBER.sub("", line, count=1)
+    return "" if line == "%" else line
+
+
+class _Source:
+    """The program's lines read by byte offset from a seekable binary file: nothing but the current line and the
+    file's buffer is held, however long the program."""
+
+    def __init__(self, handle):
+        self.handle = handle
+        self.at = 0
+
+    def line(self, offset: int) -> tuple[bytes, int]:
+        """The raw line starting at `offset` and the offset of the next line."""
+        if offset != self.at:
+            self.handle.seek(offset)
+        raw = self.handle.readline()
+        self.at = offset + len(raw)
+        return raw, self.at
+
+
+@dataclass
+class _Structure:
+    """Where the main program ends and where every subprogram, loop and label is (byte offsets and positions)."""
+
+    end: int = -1  # offset just after the main program's last line (its M30 or M2)
+    subs: dict = None  # O<n> (and LinuxCNC o<n> sub): n -> (body start Position, offset of the closing line)
+    local_subs: dict = None  # Haas N<n> local subprograms (M97), alike
+    skips: dict = None  # LinuxCNC: offset of an 'o<n> sub' line -> Position after its 'endsub'
+    repeats: dict = None  # LinuxCNC: offset of an 'o<n> repeat' line -> (offset of its 'endrepeat', Position after)
+    labels: dict = None  # Siemens: label -> (Position after its line, offset of its line)
+
+    def __post_init__(self):
+        self.subs, self.local_subs, self.skips, self.repeats, self.labels = {}, {}, {}, {}, {}
+
+    def count(self) -> int:
+        return len(self.subs) + len(self.local_subs) + len(self.repeats) + len(self.labels)
+
+
+def _index(handle, dialect: str, source: str) -> _Structure:
+    """One pass over the file: check every line (UTF-8, no NUL, length, count) and find the structure; linear in
+    the file's length (a line that cannot end or open a structure is not even decoded)."""
+    found = _Structure()
+    open_subs: list[tuple[int, Position, int]] = []  # LinuxCNC: (number, body start, line offset)
+    open_repeats: dict[int, list[int]] = {}  # LinuxCNC: number -> offsets of its open repeats
+    fanuc_family = dialect in ("fanuc", "haas", "okuma")
+    closing = re.compile("RTS") if dialect == "okuma" else _FANUC_CLOSE
+    current_sub: tuple[re.Match, Position, int] | None = None  # Fanuc family after the end: the open subprogram
+    offset, number = 0, 0
+    for raw in iter(lambda: handle.readline(MAX_LINE_CHARS + 3), b""):  # a line read is bounded too
+        number += 1
+        here, offset = offset, offset + len(raw)
+        _check_raw_line(raw, number, source)
+        after_end = found.end >= 0
+        if not (after_end and fanuc_family) and not _CANDIDATE.search(raw):
+            continue
+        text = _clean(raw, dialect)
+        if not text:
+            continue
+        line = _Line(number, text, here)
+        if not after_end and _ENDS.search(text):
+            found.end = offset
+            continue
+        if dialect == "linuxcnc":
+            _index_linuxcnc(found, line, (offset, number), open_subs, open_repeats)
+        elif dialect == "siemens" and _LABEL.fullmatch(text):
+            found.labels[text[:-1]] = ((offset, number), here)
+        elif fanuc_family and after_end:
+            current_sub = _index_subprogram(found, line, (offset, number), current_sub, closing, source)
+        if found.count() > MAX_SUBPROGRAMS:
+            raise _error(source, line, f"more than {MAX_SUBPROGRAMS:,} subprograms, loops and labels")
+    if found.end < 0:
+        raise ProgramReadError(f"{source}: no end of program (M30 or M2)")
+    if current_sub is not None:
+        head, _, first = current_sub
+        raise ProgramReadError(f"{source}:{first}: nothing closes this subprogram ({closing.pattern}) "
+                               f"(in {shown(head.group(0))})")
+    if open_subs:
+        sub_number, _, _ = open_subs[-1]
+        raise ProgramReadError(f"{source}: nothing closes subprogram o{sub_number} (o{sub_number} endsub)")
+    return found
+
+
+def _check_raw_line(raw: bytes, number: int, source: str) -> None:
+    """A line of a text program: bounded length and count, UTF-8, no NUL byte."""
+    if len(raw) > MAX_LINE_CHARS + 2:
+        raise ProgramReadError(f"{source}:{number}: a line of more than {MAX_LINE_CHARS:,} characters; a "
+                               "controller's block is a few hundred at most")
+    if number > MAX_LINES:
+        raise ProgramReadError(f"{source}: more than {MAX_LINES:,} lines; verify reads at most {MAX_LINES:,}")
+    if not raw.isascii():
+        try:
+            raw.decode("utf-8")
+        except UnicodeDecodeError as exc:
+            raise ProgramReadError(f"{source}:{number}: not a text file (byte {exc.start + 1} of the line is "
+                                   "not UTF-8)") from None
+    if b"\x00" in raw:
+        raise ProgramReadError(f"{source}:{number}: not a text file (a NUL byte)")
+
+
+def _index_subprogram(found: _Structure, line: _Line, after: Position, current_sub, closing: re.Pattern,
+                      source: str):
+    """Fanuc family after the end of the program: subprograms O<n> (Haas N<n>) ... M99 (Okuma RTS) and nothing
+    else; returns the subprogram still open (its head, body start, line number) or None."""
+    if current_sub is None:
+        head = _SUB_HEAD.fullmatch(line.text)
+        if head is None:
+            raise _error(source, line, "a block after the end of the program that is not a subprogram")
+        return (head, after, line.number)
+    if closing.fullmatch(line.text):
+        head, start, _ = current_sub
+        target = found.subs if head.group(1) else found.local_subs
+        target[int(head.group(1) or head.group(2))] = (start, line.offset)
+        return None
+    return current_sub
+
+
+def _index_linuxcnc(found: _Structure, line: _Line, after: Position, open_subs: list, open_repeats: dict) -> None:
+    """LinuxCNC o-word structure, paired with stacks (each opening is closed by the nearest closing of its number)."""
+    text = line.text
+    if text[:1] != "O":
+        return
+    if (head := _LINUXCNC_SUB.fullmatch(text)) is not None:
+        open_subs.append((int(head.group(1)), after, line.offset))
+    elif (head := _LINUXCNC_ENDSUB.fullmatch(text)) is not None:
+        sub_number = int(head.group(1))
+        for i in range(len(open_subs) - 1, -1, -1):
+            if open_subs[i][0] == sub_number:
+                _, start, opening = open_subs.pop(i)
+                found.subs[sub_number] = (start, line.offset)
+                found.skips[opening] = after
+                break
+    elif (head := _LINUXCNC_REPEAT.fullmatch(text)) is not None:
+        open_repeats.setdefault(int(head.group(1)), []).append(line.offset)
+    elif (head := _LINUXCNC_ENDREPEAT.fullmatch(text)) is not None and open_repeats.get(int(head.group(1))):
+        found.repeats[open_repeats[int(head.group(1))].pop()] = (line.offset, after)
+
+
+def _error(source: str, line: _Line, message: str) -> ProgramReadError:
+    return ProgramReadError(f"{source}:{line.number}: {message} (in {shown(line.text)})")
 
 
 class _Reader:
     """Executes one program: machine state, variables, subprogram calls, recorded moves."""
 
-    def __init__(self, text: str, dialect: str, source: str, checkpoint=None, lathe: bool = False):
+    def __init__(self, handle, dialect: str, source: str, checkpoint=None, lathe: bool = False):
         self.dialect, self.source, self.checkpoint, self.lathe = dialect, source, checkpoint, lathe
         self.axes = "XZ" if lathe else "XYZA"
         self.diameter = dialect == "fanuc"  # lathe X as a diameter: G7 (LinuxCNC), DIAMON (Siemens)
         self.per_rev = False  # lathe feed per revolution: G95 (G99 on Fanuc)
         self.block_codes: set[str] = set()  # G codes of the block whose words are checked together
         self.blocks = 0
-        self.lines = _clean_lines(text, dialect)
+        self.lines_read = 0
+        self.characters_read = 0
+        self.handle = handle
+        self.lines = _Source(handle)
+        self.structure = _Structure()
         self.variables: dict[str, float] = {}
         self.pose = [math.nan, 0.0, math.nan, 0.0] if lathe else [math.nan, math.nan, math.nan, math.nan]
         self.motion: str | None = None
@@ -133,118 +330,134 @@ class _Reader:
         self.feed_in_block = False
         self.columns = move_columns()
         self.ended = False
-        self.subs: dict[int, tuple[int, int]] = {}  # O<n> (and LinuxCNC o<n> sub) by program number
-        self.local_subs: dict[int, tuple[int, int]] = {}  # Haas N<n> local subprograms (M97)
-        self.labels: dict[str, int] = {}
+        self.words_pattern = _WORDS_ASSIGNED if dialect in ("siemens", "okuma") else _WORDS
 
     def error(self, line: _Line, message: str) -> ProgramReadError:
-        return ProgramReadError(f"{self.source}:{line.number}: {message} (in {line.text!r})")
-
-    # --- structure ------------------------------------------------------------------------
-    def index_structure(self) -> int:
-        """Find subprograms and labels; returns the index where the main program ends (exclusive)."""
-        lines = self.lines
-        end = next((i for i, line in enumerate(lines) if _ENDS.search(line.text)), None)
-        if end is None:
-            raise ProgramReadError(f"{self.source}: no end of program (M30 or M2)")
-        for i, line in enumerate(lines):
-            if self.dialect == "linuxcnc":
-                found = re.fullmatch(r"O(\d+)\s*SUB", line.text)
-                if found:
-                    self.subs[int(found.group(1))] = (i + 1, self._closing(i, rf"O0*{int(found.group(1))}\s*ENDSUB"))
-            elif self.dialect == "siemens" and re.fullmatch(r"[A-Z_][A-Z0-9_]*:", line.text):
-                self.labels[line.text[:-1]] = i
-        if self.dialect in ("fanuc", "haas", "okuma"):
-            i = end + 1
-            while i < len(lines):
-                head = re.fullmatch(r"O(\d+)|N(\d+)", lines[i].text)
-                if head is None:
-                    raise self.error(lines[i], "a block after the end of the program that is not a subprogram")
-                j = self._closing(i, "RTS" if self.dialect == "okuma" else "M0*99")
-                target = self.subs if head.group(1) else self.local_subs
-                target[int(head.group(1) or head.group(2))] = (i + 1, j)
-                i = j + 1
-        return end
-
-    def _closing(self, start: int, pattern: str) -> int:
-        for j in range(start + 1, len(self.lines)):
-            if re.fullmatch(pattern, self.lines[j].text):
-                return j
-        raise self.error(self.lines[start], f"nothing closes this subprogram or loop ({pattern})")
+        return _error(self.source, line, message)
 
     # --- values -----------------------------------------------------------------------------
     def value(self, text: str, line: _Line) -> float:
         """A number, a variable, or a sum of them: '12.5', '#2', '[#2+2.5]', 'R2+2.5', 'ASP-23.9'."""
-        text = text.strip()
+        if _PLAIN_NUMBER.fullmatch(text):
+            total = float(text)
+        else:
+            total = self._sum(text.strip(), line)
+        if not math.isfinite(total) or abs(total) > 1e6:
+            raise self.error(line, f"value {shown(text)} = {total:g} is not a finite coordinate")
+        return total
+
+    def _sum(self, text: str, line: _Line) -> float:
         if text.startswith("[") and text.endswith("]"):
             text = text[1:-1]
         total, position = 0.0, 0
         while position < len(text):
             found = _TERM.match(text, position)
             if found is None or found.end() == position:
-                raise self.error(line, f"cannot evaluate {text!r}")
+                raise self.error(line, f"cannot evaluate {shown(text)}")
             sign, term = found.groups()
             if position > 0 and not sign:
-                raise self.error(line, f"cannot evaluate {text!r}: terms need + or - between them")
+                raise self.error(line, f"cannot evaluate {shown(text)}: terms need + or - between them")
             if term[0].isdigit() or term[0] == ".":
                 number = float(term)
             elif term not in self.variables:
-                raise self.error(line, f"variable {term} is used before it is set")
+                raise self.error(line, f"variable {_digits(term)} is used before it is set")
             else:
                 number = self.variables[term]
             total += -number if sign == "-" else number
             position = found.end()
-        if not math.isfinite(total) or abs(total) > 1e6:
-            raise self.error(line, f"value {text!r} = {total:g} is not a finite coordinate")
         return total
 
     # --- execution ------------------------------------------------------------------------------
     def run(self) -> ProgramMoves:
-        end = self.index_structure()
-        self.execute(0, end + 1, 0)
+        self.structure = _index(self.handle, self.dialect, self.source)
+        self.handle.seek(0)
+        self.execute((0, 0), self.structure.end, 0)
         if not self.ended:
             raise ProgramReadError(f"{self.source}: the program never reaches its end (M30 or M2)")
-        return ProgramMoves.from_columns(self.source, self.columns)
+        columns, self.columns = self.columns, move_columns()
+        return ProgramMoves.from_columns(self.source, columns)
 
-    def execute(self, start: int, stop: int, depth: int) -> None:
-        if depth > MAX_CALL_DEPTH:
-            raise self.error(self.lines[start], f"subprogram calls nested deeper than {MAX_CALL_DEPTH}")
-        i = start
-        while i < stop and not self.ended:
-            line = self.lines[i]
-            i += 1
+    def execute(self, start: Position, stop: int, depth: int) -> None:
+        """Run the lines from `start` up to (not including) the line at offset `stop`."""
+        offset, number = start
+        lines, dialect = self.lines, self.dialect
+        while offset < stop and not self.ended:
+            raw, after = lines.line(offset)
+            if not raw:
+                break
+            here, offset, number = offset, after, number + 1
+            self.lines_read += 1
+            self.characters_read += len(raw)
+            if self.lines_read % CHECK_EVERY_BLOCKS == 0:
+                self._limits(number)
+            text = _clean(raw, dialect)
+            if not text:
+                continue
             self.blocks += 1
-            if self.blocks % CHECK_EVERY_BLOCKS == 0:
-                if self.blocks > MAX_BLOCKS:
-                    raise self.error(line, f"the program executes more than {MAX_BLOCKS:,} blocks (loops and "
-                                           "calls counted); refused before reading further")
-                if self.checkpoint is not None:
-                    self.checkpoint()
-            jump = self.control(line, i, depth)
+            line = _Line(number, text, here)
+            jump = self.control(line, (offset, number), depth) if _may_be_control(text, dialect) else None
             if jump is not None:
-                i = jump
+                offset, number = jump
                 continue
             self.block(line)
 
-    def control(self, line: _Line, after: int, depth: int) -> int | None:
-        """Subprogram definitions, calls, repeats and labels; the index to go on at, or None for a block."""
+    def _limits(self, number: int) -> None:
+        """The reading limits (checked every CHECK_EVERY_BLOCKS lines read) and the caller's checkpoint."""
+        if self.blocks > MAX_BLOCKS:
+            raise ProgramReadError(f"{self.source}:{number}: the program executes more than {MAX_BLOCKS:,} blocks "
+                                   "(loops and calls counted); refused before reading further")
+        for what, count, limit in (("lines", self.lines_read, MAX_LINES_READ),
+                                   ("characters", self.characters_read, MAX_CHARACTERS_READ)):
+            if count > limit:
+                raise ProgramReadError(f"{self.source}:{number}: the program reads more than {limit:,} {what} (loops "
+                                       "and calls counted); refused before reading further")
+        if self.checkpoint is not None:
+            self.checkpoint()
+
+    def _repeat(self, count: int, body: Callable[[], None], line: _Line) -> None:
+        """`body` run `count` times; after the first run the rest is estimated, and refused at once when it would
+        pass the limits on blocks, lines or moves (three nested loops of 99,999 are refused in a second)."""
+        if count <= 0:
+            return
+        before = self._work_done()
+        body()
+        if count == 1:
+            return
+        after = self._work_done()
+        for (what, verb, limit), first, now in zip(((("blocks", "executes", MAX_BLOCKS),
+                                                     ("lines", "reads", MAX_LINES_READ),
+                                                     ("characters", "reads", MAX_CHARACTERS_READ),
+                                                     ("moves", "makes", MAX_MOVES))), before, after):
+            estimate = now + (count - 1) * (now - first)
+            if estimate > limit:
+                raise self.error(line, f"the program {verb} more than {limit:,} {what} (this loop: {count:,} times "
+                                       f"{now - first:,} {what}, about {estimate:,}); refused before reading further")
+        for _ in range(count - 1):
+            body()
+
+    def _work_done(self) -> tuple[int, int, int, int]:
+        return self.blocks, self.lines_read, self.characters_read, len(self.columns[0])
+
+    def control(self, line: _Line, after: Position, depth: int) -> Position | None:
+        """Subprogram definitions, calls, repeats and labels; the position to go on at, or None for a block."""
         if self.dialect == "linuxcnc":
             return self._linuxcnc_control(line, after, depth)
         if self.dialect == "siemens":
             return self._siemens_control(line, after, depth)
         return self._fanuc_family_control(line, after, depth)
 
-    def _siemens_control(self, line: _Line, after: int, depth: int) -> int | None:
+    def _siemens_control(self, line: _Line, after: Position, depth: int) -> Position | None:
         text = line.text
-        if re.fullmatch(r"[A-Z_][A-Z0-9_]*:", text) or re.fullmatch(r'WORKPIECE\([^()]*\)', text):
+        if _LABEL.fullmatch(text) or re.fullmatch(r'WORKPIECE\([^()]*\)', text):
             return after  # a label, or the blank for the control's simulation (ignored)
         found = re.fullmatch(r"REPEAT\s+([A-Z_][A-Z0-9_]*)\s+([A-Z_][A-Z0-9_]*)(?:\s*P\s*=\s*(\d+))?", text)
         if found:
-            first, last = (self.labels.get(found.group(k)) for k in (1, 2))
-            if first is None or last is None or last <= first:
+            first, last = (self.structure.labels.get(found.group(k)) for k in (1, 2))
+            if first is None or last is None or last[1] <= first[1]:
                 raise self.error(line, "REPEAT names labels that do not enclose a section")
-            for _ in range(self._count(found.group(3), line)):
-                self.execute(first + 1, last, depth + 1)
+            if depth + 1 > MAX_CALL_DEPTH:
+                raise self.error(line, f"loops and calls nested deeper than {MAX_CALL_DEPTH}")
+            self._repeat(self._count(found.group(3), line), lambda: self.execute(first[0], last[1], depth + 1), line)
             return after
         if re.fullmatch(r"(R\d+=\S+\s*)+", text):
             for name, value in re.findall(r"(R\d+)=(\S+)", text):
@@ -253,25 +466,26 @@ class _Reader:
         return None
 
     def _count(self, text: str | None, line: _Line) -> int:
-        count = int(text) if text else 1
+        count = int(text) if text and len(text) <= 12 else 1 if not text else MAX_REPEAT + 1
         if not 0 <= count <= MAX_REPEAT:
-            raise self.error(line, f"repeat count {count} outside 0..{MAX_REPEAT}")
+            raise self.error(line, f"repeat count {_digits(text)} outside 0..{MAX_REPEAT}")
         return count
 
     def _call(self, number: str, line: _Line, depth: int, count: int = 1, local: bool = False,
               arguments: dict[str, float] | None = None) -> None:
         """Run subprogram `number` `count` times; `arguments` set local variables (#1...), restored after it
         returns (LinuxCNC o-call and Fanuc G65 make them local to the call)."""
-        table = self.local_subs if local else self.subs
-        if int(number) not in table:
-            raise self.error(line, f"calls subprogram {number}, which the program does not define")
+        table = self.structure.local_subs if local else self.structure.subs
+        if len(number) > 12 or int(number) not in table:
+            raise self.error(line, f"calls subprogram {_digits(number)}, which the program does not define")
+        if depth + 1 > MAX_CALL_DEPTH:
+            raise self.error(line, f"subprogram calls nested deeper than {MAX_CALL_DEPTH}")
         saved = None
         if arguments is not None:
             saved = {f"#{n}": self.variables.get(f"#{n}") for n in range(1, LOCAL_VARIABLES + 1)}
             self.variables.update(arguments)
-        first, last = table[int(number)]
-        for _ in range(count):
-            self.execute(first, last, depth + 1)
+        start, stop = table[int(number)]
+        self._repeat(count, lambda: self.execute(start, stop, depth + 1), line)
         if saved is not None:
             for name, value in saved.items():
                 if value is None:
@@ -279,34 +493,42 @@ class _Reader:
                 else:
                     self.variables[name] = value
 
-    def _linuxcnc_control(self, line: _Line, after: int, depth: int) -> int | None:
+    def _linuxcnc_control(self, line: _Line, after: Position, depth: int) -> Position | None:
         text = line.text
-        found = re.fullmatch(r"O(\d+)\s*SUB", text)
-        if found:
-            return self.subs[int(found.group(1))][1] + 1  # a definition: skipped in the flow
-        found = re.fullmatch(r"O(\d+)\s*CALL((?:\s*\[[^\]]*\])*)", text)
+        if text[0] == "#":
+            found = _ASSIGNMENT.fullmatch(text)
+            if found:
+                self.variables[found.group(1)] = self.value(found.group(2), line)
+                return after
+            return None
+        if _LINUXCNC_SUB.fullmatch(text):
+            skip = self.structure.skips.get(line.offset)
+            if skip is None:
+                raise self.error(line, "nothing closes this subprogram (o<n> endsub)")
+            return skip  # a definition: skipped in the flow
+        found = _LINUXCNC_CALL.fullmatch(text)
         if found:
             arguments = {f"#{index}": self.value(argument, line)
                          for index, argument in enumerate(re.findall(r"\[([^\]]*)\]", found.group(2)), start=1)}
             self._call(found.group(1), line, depth, arguments=arguments)
             return after
-        found = re.fullmatch(r"O(\d+)\s*REPEAT\s*\[([^\]]*)\]", text)
+        found = _LINUXCNC_REPEAT.fullmatch(text)
         if found:
-            close = self._closing(after - 1, rf"O0*{int(found.group(1))}\s*ENDREPEAT")
-            for _ in range(self._count(str(int(self.value(found.group(2), line))), line)):
-                self.execute(after, close, depth + 1)
-            return close + 1
-        found = re.fullmatch(r"(#\d+)\s*=\s*(.+)", text)
-        if found:
-            self.variables[found.group(1)] = self.value(found.group(2), line)
-            return after
+            closing = self.structure.repeats.get(line.offset)
+            if closing is None:
+                raise self.error(line, "nothing closes this loop (o<n> endrepeat)")
+            if depth + 1 > MAX_CALL_DEPTH:
+                raise self.error(line, f"loops and calls nested deeper than {MAX_CALL_DEPTH}")
+            count = self._count(str(int(self.value(found.group(2), line))), line)
+            self._repeat(count, lambda: self.execute(after, closing[0], depth + 1), line)
+            return closing[1]
         return None
 
-    def _fanuc_family_control(self, line: _Line, after: int, depth: int) -> int | None:
+    def _fanuc_family_control(self, line: _Line, after: Position, depth: int) -> Position | None:
         text = line.text
-        if re.fullmatch(r"O\d+", text):
+        if _PROGRAM_NUMBER.fullmatch(text):
             return after  # the program's own number (its title was a comment)
-        found = re.fullmatch(r"(#\d+)\s*=\s*(.+)", text)
+        found = _ASSIGNMENT.fullmatch(text)
         if found:
             self.variables[found.group(1)] = self.value(found.group(2), line)
             return after
@@ -338,27 +560,31 @@ class _Reader:
             return after
         return None
 
+
     # --- one block --------------------------------------------------------------------------------
     def block(self, line: _Line) -> None:
         if self.lathe and self.dialect == "siemens":
             line = self._siemens_lathe_words(line)
-        # T and S before M (M6 loads the tool the block names, whatever the order), G before F (a feed mode
-        # change resets F), then the rest in order
-        words = sorted(self.words(line), key=lambda word: {"T": 0, "S": 0, "G": 1, "F": 2, "M": 3}.get(word[0], 4))
+        words = self.words(line)
+        if len(words) > 1:
+            words.sort(key=_word_order)  # T and S before M (M6 loads the tool the block names), G before F
         target = list(self.pose)
         direction = None
         self.feed_in_block = False
         self.block_codes = set()
+        moves = False
         for letter, value in words:
             if letter == "M":
                 direction = self._m_code(value, line) or direction
             else:
+                if letter in "XYZA":
+                    moves = True
                 self._word(letter, value, line, target)
         if self.block_codes:
             self._check_block_codes(words, line)
         if direction is not None and not math.isnan(target[3]):
             target[3] = _directed(self.pose[3], target[3], direction, self, line)
-        if any(letter in "XYZA" for letter, _ in words):
+        if moves:
             self._move(target, line)
 
     def _word(self, letter: str, value: str, line: _Line, target: list[float]) -> None:
@@ -422,14 +648,12 @@ class _Reader:
 
     def words(self, line: _Line) -> list[tuple[str, str]]:
         text = line.text
-        pattern = (r"([A-Z])\s*(=\s*[^\s]+|\[[^\]]*\]|#\d+|[-+]?(?:\d+\.?\d*|\.\d+))"
-                   if self.dialect in ("siemens", "okuma") else
-                   r"([A-Z])\s*(\[[^\]]*\]|#\d+|[-+]?(?:\d+\.?\d*|\.\d+))")
-        found = list(re.finditer(pattern, text))
-        covered = "".join(text[m.start():m.end()] for m in found)
-        if re.sub(r"\s", "", covered) != re.sub(r"\s", "", text):
+        found = self.words_pattern.findall(text)
+        if self.words_pattern.sub("", text).strip():
             raise self.error(line, "cannot read this block")
-        return [(m.group(1), m.group(2).lstrip("=").strip()) for m in found]
+        if self.words_pattern is _WORDS:
+            return found
+        return [(letter, value.lstrip("=").strip()) for letter, value in found]
 
     def _g_code(self, value: str, line: _Line) -> None:
         code = value.lstrip("0") or "0"
@@ -484,7 +708,7 @@ class _Reader:
         if self.lathe:
             self._check_lathe_move(line)
         rapid = self.motion == "0"
-        if any(math.isnan(t) for t in target):
+        if math.isnan(target[0] + target[1] + target[2] + target[3]):
             if rapid:  # e.g. a restart's Z-only move to the clearance height: known from here on, not a move
                 self.pose = target
                 return
@@ -496,10 +720,17 @@ class _Reader:
             raise self.error(line, "an inverse-time (G93) feed move needs its own F")
         if len(self.columns[0]) >= MAX_MOVES:
             raise self.error(line, f"the program has more than {MAX_MOVES:,} moves; split it")
-        row = (rapid, *target, math.nan if rapid else self.feed, self.inverse and not rapid, line.number,
-               self.tool, self.spindle)
-        for column, value in zip(self.columns, row):
-            column.append(value)
+        columns = self.columns
+        columns[0].append(rapid)
+        columns[1].append(target[0])
+        columns[2].append(target[1])
+        columns[3].append(target[2])
+        columns[4].append(target[3])
+        columns[5].append(math.nan if rapid else self.feed)
+        columns[6].append(self.inverse and not rapid)
+        columns[7].append(line.number)
+        columns[8].append(self.tool)
+        columns[9].append(self.spindle)
         self.pose = target
 
 
@@ -510,6 +741,7 @@ class _Reader:
         if self.motion == "1" and not self.per_rev:
             raise self.error(line, "a lathe feed move without feed per revolution ("
                                    + ("G99" if self.dialect == "fanuc" else "G95") + ")")
+
 
 
 def _directed(current: float, target: float, direction: str, reader: _Reader, line: _Line) -> float:
@@ -523,31 +755,67 @@ def _directed(current: float, target: float, direction: str, reader: _Reader, li
     return current + step if direction == "15" else current - ((360.0 - step) % 360.0)
 
 
-def _clean_lines(text: str, dialect: str) -> list[_Line]:
-    """Lines without comments, block numbers and surrounding blanks; upper case (LinuxCNC's o-words too)."""
-    lines = []
-    for number, raw in enumerate(text.splitlines(), start=1):
-        line = raw.split(";", 1)[0] if dialect == "siemens" else re.sub(r"\([^)]*\)", "", raw)
-        if dialect == "linuxcnc":
-            line = line.split(";", 1)[0]
-        line = line.strip().upper()
-        if dialect != "haas" or not re.fullmatch(r"N\d+", line):  # Haas's N<n> heads a local subprogram
-            line = re.sub(r"^N\d+\s*", "", line)
-        if line and line != "%":  # % delimits Fanuc/Haas programs (tape start and end)
-            lines.append(_Line(number, line))
-    return lines
+
+
+def _digits(text: str) -> str:
+    """A number or a name from a program (digits, letters, '#', '_'), as a message shows it (cut when long)."""
+    return text if len(text) <= 24 else shown(text)
+
+
+def _word_order(word: tuple[str, str]) -> int:
+    return _ORDER.get(word[0], 4)
+
+
+def _may_be_control(text: str, dialect: str) -> bool:
+    """False for a block that no control statement of the dialect can be (most blocks: moves)."""
+    if dialect == "siemens":
+        return ":" in text or "=" in text or text[0] in "RW"
+    if dialect == "linuxcnc":
+        return text[0] in "O#"
+    return text[0] in "O#C" or "P" in text  # Fanuc family: O, #n =, CALL (Okuma), G65 P, M98 P, M97 P
+
+
+def _check_dialect(dialect: str, lathe: bool) -> None:
+    if dialect not in DIALECTS:
+        raise ProgramReadError(f"unknown dialect {shown(dialect)} (known: {', '.join(DIALECTS)})")
+    if lathe and dialect not in LATHE_DIALECTS:
+        raise ProgramReadError(f"no lathe dialect {shown(dialect)} (known: {', '.join(LATHE_DIALECTS)})")
 
 
 def read_program(text: str, dialect: str, source: str = "program", checkpoint=None,
                  lathe: bool = False) -> ProgramMoves:
-    """The moves of a program in `dialect` (one of DIALECTS); raises ProgramReadError naming `source`'s line.
-    `checkpoint()` is called every CHECK_EVERY_BLOCKS blocks (the CLI stops there when a signal arrived).
-    `lathe`: a lathe program (LATHE_DIALECTS; the module docstring says what is read): x is the diameter as
-    written, y = a = 0, feed in mm/rev as written."""
-    if dialect not in DIALECTS:
-        raise ProgramReadError(f"unknown dialect {dialect!r} (known: {', '.join(DIALECTS)})")
-    if lathe and dialect not in LATHE_DIALECTS:
-        raise ProgramReadError(f"no lathe dialect {dialect!r} (known: {', '.join(LATHE_DIALECTS)})")
-    if len(text) > MAX_PROGRAM_BYTES:
-        raise ProgramReadError(f"{source}: larger than {MAX_PROGRAM_BYTES // 2**20} MiB")
-    return _Reader(text, dialect, source, checkpoint, lathe).run()
+    """The moves of a program's text in `dialect` (one of DIALECTS); raises ProgramReadError naming `source`'s
+    line. `checkpoint()` is called every CHECK_EVERY_BLOCKS lines read (the CLI stops there when a signal
+    arrived). `lathe`: a lathe program (LATHE_DIALECTS; the module docstring says what is read): x is the
+    diameter as written, y = a = 0, feed in mm/rev as written. Lines end with LF (or CR LF)."""
+    _check_dialect(dialect, lathe)
+    data = text.encode("utf-8", "surrogatepass")
+    if len(data) > MAX_PROGRAM_BYTES:
+        raise ProgramReadError(f"{source}: the program has {len(data):,} bytes; verify reads at most "
+                               f"{MAX_PROGRAM_BYTES:,} ({MAX_PROGRAM_BYTES // 2**20} MiB)")
+    return _Reader(io.BytesIO(data), dialect, source, checkpoint, lathe).run()
+
+
+def open_program_file(path: str | os.PathLike, source: str | None = None):
+    """A program file opened for reading: a regular file of at most MAX_PROGRAM_BYTES (a FIFO, a device or a
+    larger file is refused with one line, before reading)."""
+    from spur_cad.inputs import open_regular_file
+
+    source = source if source is not None else shown_path(path)
+    handle = open_regular_file(path, "program", ProgramReadError)
+    size = os.fstat(handle.fileno()).st_size
+    if size > MAX_PROGRAM_BYTES:
+        handle.close()
+        raise ProgramReadError(f"{source}: the program has {size:,} bytes; verify reads at most "
+                               f"{MAX_PROGRAM_BYTES:,} ({MAX_PROGRAM_BYTES // 2**20} MiB)")
+    return handle
+
+
+def read_program_file(path: str | os.PathLike, dialect: str, source: str | None = None, checkpoint=None,
+                      lathe: bool = False) -> ProgramMoves:
+    """`read_program` of a file, read as a stream: a regular file of at most MAX_PROGRAM_BYTES (a FIFO, a device
+    or a larger file is refused before reading); memory holds a line at a time besides the moves."""
+    _check_dialect(dialect, lathe)
+    source = source if source is not None else shown_path(path)
+    with open_program_file(path, source) as handle:
+        return _Reader(handle, dialect, source, checkpoint, lathe).run()

@@ -8,15 +8,32 @@ rs274 is not installed the verdict says so (the simulation does not depend on it
 from __future__ import annotations
 
 import os
+import re
+import resource
 import shutil
+import signal
 import subprocess
 import tempfile
+from dataclasses import dataclass
 from pathlib import Path
+from typing import BinaryIO
+
+from spur_cad.errors import SpurCadError, escaped, shown
 
 RS274_LOCATIONS = ("/usr/bin/rs274", "/usr/lib/linuxcnc/bin/rs274", "/usr/local/bin/rs274")
-TIMEOUT_S = 300.0
+TIMEOUT_S = 60.0  # rs274 interprets a program of two million moves in seconds; an endless loop never ends
+MAX_OUTPUT_BYTES = 512 * 1024 * 1024  # rs274's canonical calls and messages (files of the child, limited by the OS)
 NUMERIC_CALLS = ("STRAIGHT_TRAVERSE", "STRAIGHT_FEED", "SET_FEED_RATE", "SET_FEED_MODE", "CHANGE_TOOL",
                  "SET_SPINDLE_SPEED")
+
+
+@dataclass(frozen=True)
+class Rs274Run:
+    """How rs274 ended: `problem` is None when it interpreted the whole program, else what went wrong in one
+    line; `canon` the file of its canonical calls (inside the run's temporary folder)."""
+
+    problem: str | None
+    canon: Path
 
 
 def rs274_executable() -> str | None:
@@ -27,95 +44,110 @@ def rs274_executable() -> str | None:
     return next((path for path in RS274_LOCATIONS if os.access(path, os.X_OK)), None)
 
 
+def _limit_output() -> None:  # in the child, before rs274 starts: its files stop growing at MAX_OUTPUT_BYTES
+    resource.setrlimit(resource.RLIMIT_FSIZE, (MAX_OUTPUT_BYTES, MAX_OUTPUT_BYTES))
+
+
+def _run(executable: str, program: BinaryIO, work: Path) -> Rs274Run:
+    """rs274 -g on an open program file (the child reads it through its inherited descriptor, so what was checked
+    is what is interpreted), with its time and output bounded."""
+    canon, messages = work / "canon.txt", work / "messages.txt"
+    fd = program.fileno()
+    with open(messages, "wb") as output:
+        try:
+            proc = subprocess.run([executable, "-g", f"/dev/fd/{fd}", str(canon)], stdin=subprocess.DEVNULL,
+                                  stdout=output, stderr=output, cwd=work, timeout=TIMEOUT_S, pass_fds=(fd,),
+                                  preexec_fn=_limit_output)
+        except subprocess.TimeoutExpired:
+            return Rs274Run(f"rs274 did not finish within {TIMEOUT_S:.0f} s (an endless loop?)", canon)
+    if proc.returncode == -signal.SIGXFSZ:
+        return Rs274Run(f"rs274's output passed {MAX_OUTPUT_BYTES // 2**20} MiB", canon)
+    if proc.returncode == 0:
+        return Rs274Run(None, canon)
+    with open(messages, "rb") as handle:
+        text = handle.read(16 * 1024).decode("utf-8", "replace")
+    lines = [line.strip() for line in text.splitlines() if line.strip() not in ("", "executing")]
+    return Rs274Run("; ".join(escaped(line)[:200] for line in lines[:2]) or f"exit status {proc.returncode}", canon)
+
+
 def rs274_verdict(program: str | os.PathLike) -> str:
     """'passed', 'failed: <rs274's message>' or 'not available: ...' for a LinuxCNC program file."""
+    from spur_cad.verify.reader import open_program_file
+
     executable = rs274_executable()
     if executable is None:
         return "not available: rs274 not found (install linuxcnc-uspace)"
-    with tempfile.TemporaryDirectory(prefix="spur-cad-rs274-") as work:
-        try:
-            proc = subprocess.run([executable, "-g", str(Path(program).resolve()), str(Path(work) / "canon.txt")],
-                                  stdin=subprocess.DEVNULL, capture_output=True, text=True, cwd=work,
-                                  timeout=TIMEOUT_S)
-        except subprocess.TimeoutExpired:
-            return f"failed: rs274 did not finish within {TIMEOUT_S:.0f} s"
-    if proc.returncode == 0:
-        return "passed"
-    messages = [line.strip() for line in (proc.stderr + proc.stdout).splitlines()
-                if line.strip() and line.strip() != "executing"]
-    return "failed: " + ("; ".join(messages[:2]) if messages else f"exit status {proc.returncode}")
-
-
-def _canonical_text(program: str | os.PathLike, source: str) -> str:
-    """rs274's canonical calls for a program (raises SpurCadError when rs274 is missing or refuses it)."""
-    from spur_cad.errors import SpurCadError
-
-    executable = rs274_executable()
-    if executable is None:
-        raise SpurCadError("--reader rs274: rs274 not found (install linuxcnc-uspace)")
-    with tempfile.TemporaryDirectory(prefix="spur-cad-rs274-") as work:
-        canon = Path(work) / "canon.txt"
-        proc = subprocess.run([executable, "-g", str(Path(program).resolve()), str(canon)], stdin=subprocess.DEVNULL,
-                              capture_output=True, text=True, cwd=work, timeout=TIMEOUT_S)
-        if proc.returncode != 0:
-            messages = [line.strip() for line in proc.stderr.splitlines() if line.strip() not in ("", "executing")]
-            raise SpurCadError(f"{source}: rs274 refuses the program: {'; '.join(messages[:2])}")
-        return canon.read_text()
+    with open_program_file(program) as handle, tempfile.TemporaryDirectory(prefix="spur-cad-rs274-") as work:
+        run = _run(executable, handle, Path(work))
+    return "passed" if run.problem is None else f"failed: {run.problem}"
 
 
 def _refuse_unsimulated(name: str, arguments: str, number: int, source: str) -> None:
     """Calls that change what the moves mean (inch units, non-zero offsets) or moves verify cannot simulate."""
-    import re
-
-    from spur_cad.errors import SpurCadError
-
     where = f"{source}: rs274 canonical call {number}"
     if name in ("ARC_FEED", "STRAIGHT_PROBE", "NURBS_FEED", "RIGID_TAP"):
         raise SpurCadError(f"{where} is {name}, which verify does not simulate")
     if name == "USE_LENGTH_UNITS" and "MM" not in arguments:
-        raise SpurCadError(f"{where} sets {arguments} units; verify reads millimetre programs (G21)")
+        raise SpurCadError(f"{where} sets {shown(arguments)} units; verify reads millimetre programs (G21)")
     offsets = [float(v) for v in re.findall(r"[-+]?\d+\.\d+", arguments)]
     # (tool length offsets do not show in the canonical positions: the programmed point is read, as with
     # spur_cad's reader; test_the_reader_agrees_with_linuxcncs_interpreter compares them under G43)
     if name in ("SET_G92_OFFSET", "SET_G5X_OFFSET", "SET_XY_ROTATION") and \
             any(abs(v) > 1e-9 for v in offsets):
-        raise SpurCadError(f"{where} is {name}({arguments}): non-zero offsets are not applied by verify; "
+        raise SpurCadError(f"{where} is {name}({shown(arguments)}): non-zero offsets are not applied by verify; "
                            "program in the part frame")
 
 
-def read_canonical(program: str | os.PathLike, source: str):
-    """The moves of a LinuxCNC program as LinuxCNC's own interpreter executes them (rs274's canonical calls
-    STRAIGHT_TRAVERSE / STRAIGHT_FEED with SET_FEED_RATE, SET_FEED_MODE, CHANGE_TOOL, SET_SPINDLE_SPEED):
-    the reference reader for LinuxCNC programs. `line` holds the canonical call's number."""
-    import re
+class _CanonState:
+    """The modal state of rs274's canonical calls, appending the moves to `columns`."""
 
-    from spur_cad.errors import SpurCadError
-    from spur_cad.verify.reader import MAX_MOVES, ProgramMoves
+    def __init__(self, columns: list):
+        self.columns = columns
+        self.feed, self.inverse, self.tool, self.spindle = float("nan"), False, 0, 0.0
 
-    text = _canonical_text(program, source)
-    call = re.compile(r"^\s*(\d+)\s+N\S*\s+([A-Z_]+)\((.*)\)\s*$")
-    moves, feed, inverse, tool, spindle = [], float("nan"), False, 0, 0.0
-    for line in text.splitlines():
-        found = call.match(line)
-        if found is None:
-            continue
-        number, name, arguments = int(found.group(1)), found.group(2), found.group(3)
+    def call(self, number: int, name: str, arguments: str, source: str) -> None:
         if name not in NUMERIC_CALLS:
             _refuse_unsimulated(name, arguments, number, source)
-            continue  # comments, coolant, spindle, ...
+            return  # comments, coolant, spindle, ...
         values = [float(v) for v in re.split(r"[,\s]+", arguments.strip()) if v]
         if name in ("STRAIGHT_TRAVERSE", "STRAIGHT_FEED"):
             rapid = name == "STRAIGHT_TRAVERSE"
-            moves.append((rapid, *values[:4], float("nan") if rapid else feed, inverse and not rapid, number,
-                          tool, spindle))
-            if len(moves) > MAX_MOVES:
-                raise SpurCadError(f"{source}: the program has more than {MAX_MOVES:,} moves; split it")
+            for column, value in zip(self.columns, (rapid, *values[:4], float("nan") if rapid else self.feed,
+                                                    self.inverse and not rapid, number, self.tool, self.spindle)):
+                column.append(value)
         elif name == "SET_FEED_RATE":
-            feed = values[0]
+            self.feed = values[0]
         elif name == "SET_FEED_MODE":
-            inverse = values[-1] == 1.0
+            self.inverse = values[-1] == 1.0
         elif name == "CHANGE_TOOL":
-            tool = int(values[0])
+            self.tool = int(values[0])
         elif name == "SET_SPINDLE_SPEED":
-            spindle = values[-1]
-    return ProgramMoves.from_columns(source, list(zip(*moves)) if moves else [[]] * 10)
+            self.spindle = values[-1]
+
+
+def read_canonical(program: BinaryIO, source: str):
+    """The moves of an open LinuxCNC program file as LinuxCNC's own interpreter executes them (rs274's canonical
+    calls STRAIGHT_TRAVERSE / STRAIGHT_FEED with SET_FEED_RATE, SET_FEED_MODE, CHANGE_TOOL, SET_SPINDLE_SPEED):
+    the reference reader for LinuxCNC programs. `line` holds the canonical call's number. rs274's time and output
+    are bounded (TIMEOUT_S, MAX_OUTPUT_BYTES) and its calls are read as a stream (at most MAX_MOVES moves)."""
+    from spur_cad.verify.reader import MAX_MOVES, ProgramMoves, move_columns
+
+    executable = rs274_executable()
+    if executable is None:
+        raise SpurCadError("--reader rs274: rs274 not found (install linuxcnc-uspace)")
+    call = re.compile(r"^\s*(\d+)\s+N\S*\s+([A-Z_]+)\((.*)\)\s*$")
+    columns = move_columns()
+    with tempfile.TemporaryDirectory(prefix="spur-cad-rs274-") as work:
+        run = _run(executable, program, Path(work))
+        if run.problem is not None:
+            raise SpurCadError(f"{source}: rs274 refuses the program: {run.problem}")
+        with open(run.canon, "rb") as canon:
+            state = _CanonState(columns)
+            for raw in canon:
+                found = call.match(raw.decode("utf-8", "replace"))
+                if found is not None:
+                    state.call(int(found.group(1)), found.group(2), found.group(3), source)
+                if len(columns[0]) > MAX_MOVES:
+                    raise SpurCadError(f"{source}: the program has more than {MAX_MOVES:,} moves; verify reads at "
+                                       f"most {MAX_MOVES:,}")
+    return ProgramMoves.from_columns(source, columns)

@@ -17,7 +17,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from spur_cad.cam.ir import Feature, MoveKind, Operation, Toolpath
-from spur_cad.errors import SpurCadError
+from spur_cad.errors import SpurCadError, shown
 from spur_cad.verify.reader import ProgramMoves
 
 POINTS = ("tip", "corner-centre")
@@ -34,7 +34,7 @@ class VerifyOptions:
 
     def validate(self) -> None:
         if self.point not in POINTS:
-            raise SpurCadError(f"--point must be one of {', '.join(POINTS)}, got {self.point!r}")
+            raise SpurCadError(f"--point must be one of {', '.join(POINTS)}, got {shown(self.point)}")
         for name in ("gouge_tolerance_mm", "leftover_tolerance_mm"):
             value = getattr(self, name)
             if value is not None and not (math.isfinite(value) and 0.0 <= value <= 10.0):
@@ -123,8 +123,8 @@ def toolpaths(moves: ProgramMoves, tools: dict, roughing_number: int | None, poi
         count = end - begin
         path = Toolpath(
             kind=np.where(moves.rapid[part], MoveKind.RAPID, MoveKind.LINEAR).astype(np.int8),
-            x=moves.x[part].copy(), y=moves.y[part].copy(), z=z, a=moves.a[part].copy(),
-            feed=moves.feed[part].copy(), inverse_time=moves.inverse_time[part].copy(),
+            x=moves.x[part], y=moves.y[part], z=z, a=moves.a[part],  # views: the moves are not changed
+            feed=moves.feed[part], inverse_time=moves.inverse_time[part],
             space=np.full(count, -1, np.int32), station=np.full(count, -1, np.int32),
             feature=np.full(count, Feature.NONE, np.int8),
             operation=Operation.ROUGHING if number == roughing_number else Operation.FINISHING,

@@ -178,8 +178,7 @@ def verify_programs(job_obj, paths: list[str], dialect: str | None = None, point
     """`spur-cad verify` inside FreeCAD: read the G-code programs (from anywhere; the job's post dialect unless
     given), cut the job's stock with them and show the deviations on the gear in '<job> verification';
     the verdict goes to the report view and a message box. Returns the object."""
-    from spur_cad.errors import SpurCadError
-    from spur_cad.verify.reader import read_program
+    from spur_cad.verify.reader import read_program_file
     from spur_cad.verify.verify import VerifyOptions, verify_moves
     from spur_cad_workbench.features import document_values
     from spur_cad_workbench.simulation import show_result, simulator
@@ -188,12 +187,8 @@ def verify_programs(job_obj, paths: list[str], dialect: str | None = None, point
     simulator()
     job = job_of(job_obj)
     programs = []
-    for path in paths:
-        try:
-            text = Path(path).read_text(encoding="utf-8")
-        except (OSError, UnicodeDecodeError) as exc:
-            raise SpurCadError(f"{path}: cannot read: {getattr(exc, 'strerror', None) or exc}") from None
-        programs.append(read_program(text, dialect or job.post.dialect, path))
+    for path in paths:  # regular files of bounded size, read as a stream (spur-cad verify's reader)
+        programs.append(read_program_file(path, dialect or job.post.dialect))
     result = verify_moves(job, programs, VerifyOptions(point))
     names = ", ".join(Path(path).name for path in paths)
     obj = show_result(job_obj, result.simulation, values_signature(document_values(job_obj)),

@@ -110,7 +110,7 @@ from spur_cad.cam.strategies.generating_helical import (
     helical_passes_estimate,
 )
 from spur_cad.cam.tools import Tool, ToolError
-from spur_cad.errors import WorkLimitError
+from spur_cad.errors import WorkLimitError, shown
 from spur_cad.geometry.frames import turn_points
 from spur_cad.geometry.profile import rack_corner
 from spur_cad.geometry.sampling import full_space_points, sample_profile
@@ -155,10 +155,10 @@ class GeneratingParams:
         if not 0.0 < self.target_scallop_mm <= 0.1:
             raise MachineError(f"[finishing] target_scallop_mm = {self.target_scallop_mm:g} must be in (0, 0.1]")
         if self.cutting_direction not in CUTTING_DIRECTIONS:
-            raise MachineError(f"[finishing] cutting_direction = {self.cutting_direction!r} is unknown "
+            raise MachineError(f"[finishing] cutting_direction = {shown(self.cutting_direction)} is unknown "
                                f"(use one of {', '.join(CUTTING_DIRECTIONS)})")
         if self.flank_tool_end not in FLANK_TOOL_ENDS:
-            raise MachineError(f"[finishing] flank_tool_end = {self.flank_tool_end!r} is unknown "
+            raise MachineError(f"[finishing] flank_tool_end = {shown(self.flank_tool_end)} is unknown "
                                f"(use one of {', '.join(FLANK_TOOL_ENDS)})")
 
 

@@ -1,0 +1,53 @@
+"""Opening the files a user names (job files, programs, measured points): only regular files, read in
+bounded pieces. A FIFO would block the open or the read forever, a device such as /dev/zero never ends,
+a folder cannot be read: each is refused with one line naming the file, before anything is read."""
+
+from __future__ import annotations
+
+import os
+import stat
+from typing import BinaryIO
+
+from spur_cad.errors import SpurCadError, shown_path
+
+_KINDS = ((stat.S_ISDIR, "a folder"), (stat.S_ISFIFO, "a FIFO (named pipe)"), (stat.S_ISCHR, "a device"),
+          (stat.S_ISBLK, "a device"), (stat.S_ISSOCK, "a socket"))
+
+
+def open_regular_file(path: str | os.PathLike, what: str, error: type[SpurCadError] = SpurCadError) -> BinaryIO:
+    """`path` opened for binary reading if it is a regular file (a link to one is fine); else `error` with
+    one line: '<path>: <what> not found' / 'is a FIFO (named pipe), not a regular file' / 'cannot read ...'."""
+    name = shown_path(path)
+    try:
+        # O_NONBLOCK: opening a FIFO does not wait for a writer; the kind is then checked on what was opened
+        fd = os.open(path, os.O_RDONLY | os.O_NONBLOCK | os.O_NOCTTY | os.O_CLOEXEC)
+    except FileNotFoundError:
+        raise error(f"{name}: {what} not found") from None
+    except (OSError, ValueError) as exc:
+        raise error(f"{name}: cannot read the {what}: {getattr(exc, 'strerror', None) or exc}") from None
+    try:
+        mode = os.fstat(fd).st_mode
+        if not stat.S_ISREG(mode):
+            kind = next((label for test, label in _KINDS if test(mode)), "not a regular file")
+            raise error(f"{name}: the {what} is {kind}, not a regular file")
+        os.set_blocking(fd, True)
+        return os.fdopen(fd, "rb")
+    except BaseException:
+        os.close(fd)
+        raise
+
+
+def read_regular_file(path: str | os.PathLike, what: str, max_bytes: int,
+                      error: type[SpurCadError] = SpurCadError) -> bytes:
+    """The bytes of a regular file of at most `max_bytes` (refused with its size beyond, before reading)."""
+    with open_regular_file(path, what, error) as handle:
+        size = os.fstat(handle.fileno()).st_size
+        if size > max_bytes:
+            raise error(f"{shown_path(path)}: the {what} has {size:,} bytes; at most {max_bytes:,} are read")
+        try:
+            data = handle.read(max_bytes + 1)
+        except OSError as exc:
+            raise error(f"{shown_path(path)}: cannot read the {what}: {exc.strerror or exc}") from None
+    if len(data) > max_bytes:  # it grew while being read
+        raise error(f"{shown_path(path)}: the {what} has more than {max_bytes:,} bytes; at most {max_bytes:,} are read")
+    return data
