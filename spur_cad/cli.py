@@ -13,11 +13,13 @@ from __future__ import annotations
 
 import argparse
 import dataclasses
+import os
 import shutil
 import signal
 import sys
 import threading
 import warnings
+from typing import NoReturn
 
 from spur_cad import __version__
 from spur_cad.errors import SpurCadError, one_line
@@ -114,8 +116,6 @@ class ProgressBars:
 
 def _install_freecad(uninstall: bool) -> int:
     """`spur-cad install-freecad [--uninstall]` (see spur_cad.freecad_install)."""
-    import os
-
     from spur_cad.freecad_install import install
     from spur_cad.freecad_install import uninstall as remove
 
@@ -161,9 +161,18 @@ def main(argv: list[str] | None = None, *, exiting: bool = False) -> int:
                 signal.signal(signum, handler)
 
 
-def entry() -> int:
-    """The `spur-cad` program: `main` whose signal handling lasts until the process exits."""
-    return main(exiting=True)
+def entry() -> NoReturn:
+    """The `spur-cad` program: `main` whose signal handling lasts until the process exits. The process ends
+    with os._exit once the output is flushed: the interpreter's own shutdown gives the signals back to their
+    defaults while it tears the modules down (a second or more after a run), and a signal then would end
+    the process silently; the outputs are complete and synced by then, and nothing is left to clean up."""
+    code = main(exiting=True)
+    for stream in (sys.stdout, sys.stderr):
+        try:
+            stream.flush()
+        except (OSError, ValueError):  # a closed pipe: nothing more can be said
+            pass
+    os._exit(code)
 
 
 def _checkpoint(received: list[int]) -> None:
@@ -332,4 +341,4 @@ def _main(argv: list[str] | None, received: list[int]) -> int:
 
 
 if __name__ == "__main__":  # pragma: no cover
-    sys.exit(entry())
+    entry()

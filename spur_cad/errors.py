@@ -66,8 +66,9 @@ class JobFileError(SpurCadError, ValueError):
 MAX_SHOWN_CHARS = 60
 """User text a message echoes (a value, a key, a name) is cut to about this many characters."""
 MAX_SHOWN_PATH_CHARS = 160
-MAX_MESSAGE_CHARS = 600
-"""A whole message line is cut to this many characters (its start, which names the file and key, kept)."""
+MAX_MESSAGE_CHARS = 380
+"""A message is cut to this many characters (its start, which names the file and key, kept): with the
+command line's `spur-cad: error: ` a line stays below 400."""
 _UNPRINTABLE = re.compile(r"[^\S ]|[\x00-\x1f\x7f-\x9f\u2028\u2029\u200b-\u200f\u202a-\u202e\u2066-\u2069"
                           r"\ud800-\udfff]")  # controls, line and paragraph breaks, direction marks, lone surrogates
 
@@ -84,7 +85,8 @@ def _cut(text: str, limit: int, keep_end: bool = False) -> str:
     if keep_end:  # a path: its start and its end (the file's name) both say something
         head = limit // 3
         return f"{text[:head]}...{text[-(limit - head - 3):]}"
-    return f"{text[:limit - 3]}... ({len(text):,} characters)"
+    suffix = f"... ({len(text):,} characters)"
+    return text[:max(0, limit - len(suffix))] + suffix
 
 
 def shown(value: object, limit: int = MAX_SHOWN_CHARS) -> str:

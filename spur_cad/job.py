@@ -14,6 +14,7 @@ the GearSpec. Units are in the key names (mm, deg, percent, m_min, ...).
 from __future__ import annotations
 
 import dataclasses
+import difflib
 import re
 import sys
 import tomllib
@@ -230,8 +231,10 @@ def _load_section(table: object, name: str, source: str, text: str):
     known = {k.name: k for k in keys_of(cls)}
     for key_name in table:
         if key_name not in known:
+            close = difflib.get_close_matches(key_name[:100], known, n=2)
+            hint = (f"did you mean {' or '.join(close)}?" if close else f"known keys: {', '.join(sorted(known))}")
             raise JobFileError(f"{_where(source, text, name, key_name)}: unknown key {shown(key_name)} in [{name}] "
-                               f"(known keys: {', '.join(sorted(known))})", section=name)
+                               f"({hint})", section=name)
     values = {}
     for k in known.values():
         if k.name not in table:

@@ -210,9 +210,10 @@ def _read_bookkeeping(path: Path) -> object | None:
     except OSError as exc:
         raise _foreign(path, "a symbolic link" if exc.errno == errno.ELOOP else
                        f"cannot read it: {exc.strerror or exc}") from None
+    if not stat.S_ISREG(os.fstat(fd).st_mode):
+        os.close(fd)
+        raise _foreign(path, "not a regular file")
     with os.fdopen(fd, "rb") as handle:
-        if not stat.S_ISREG(os.fstat(fd).st_mode):
-            raise _foreign(path, "not a regular file")
         raw = handle.read(MAX_BOOKKEEPING_BYTES + 1)
     if len(raw) > MAX_BOOKKEEPING_BYTES:
         raise _foreign(path, f"larger than {MAX_BOOKKEEPING_BYTES // 1024} KiB")

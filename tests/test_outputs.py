@@ -153,3 +153,25 @@ def test_an_out_that_is_a_file_is_refused(tmp_path):
 def test_single_file_replaced_atomically(tmp_path):
     path = write_file_atomically(tmp_path / "d" / "record.json", b"{}")
     assert path.read_bytes() == b"{}" and os.listdir(tmp_path / "d") == ["record.json"]
+
+
+def test_every_name_a_run_writes_is_in_the_vocabulary():
+    """The vocabulary the folder's manifest is checked against holds every program name the posts can give
+    (each dialect's extension, the lathe's, the restart programs' labels); a name outside it would make
+    write_output_set refuse our own set."""
+    from spur_cad.cam.restart import parse_restart
+    from spur_cad.outputs import is_output_name
+    from spur_cad.post import dialect
+    from spur_cad.post.lathe import LATHE_EXTENSIONS
+    from spur_cad.post.settings import dialect_names
+
+    extensions = {dialect(name).extension for name in dialect_names()} | set(LATHE_EXTENSIONS.values())
+    for extension in extensions:
+        for stem in ("roughing", "roughing_bottom", "finishing", "blank"):
+            assert is_output_name(f"{stem}.{extension}"), (stem, extension)
+        for point in ("roughing:space=5", "roughing:space=5,level=2", "finishing:station=40",
+                      "finishing:space=3,pass=7", "roughing_bottom:space=22,level=9999999"):
+            assert is_output_name(f"{parse_restart(point).label()}.{extension}"), point
+    for name in ("../roughing.ngc", "roughing.txt", "finishing.md", ".spur_cad-set.json", "gear.step/x",
+                 "roughing.ngc\n", "roughing_space5.ngc.bak"):
+        assert not is_output_name(name), name

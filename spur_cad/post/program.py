@@ -84,7 +84,7 @@ def post_program(path: Toolpath, settings: PostSettings, info: ProgramInfo) -> P
     settings.validate()
     d = dialect(settings.dialect)
     if len(path) == 0:
-        raise PostError(f"{info.title}: the toolpath is empty")
+        raise PostError(f"{shown(info.title)}: the toolpath is empty")
     _check_numbers(path, info)
     if settings.rotary_mode == "wrapped" and d.direction_codes is None:
         _check_shortest_path(path)
@@ -135,17 +135,17 @@ def _check_numbers(path: Toolpath, info: ProgramInfo) -> None:
         values = getattr(path, axis)
         limit = MAX_COORDINATE_MM if axis != "a" else 360.0 * 1e6
         if not np.all(np.isfinite(values)) or np.abs(values).max() > limit:
-            raise PostError(f"{info.title}: the toolpath has an {axis.upper()} value that is not a finite number "
-                            f"within +-{limit:g}")
+            raise PostError(f"{shown(info.title)}: the toolpath has an {axis.upper()} value that is not a finite "
+                            f"number within +-{limit:g}")
     feeds = path.feed[path.kind == MoveKind.LINEAR]
     bad = ~(np.isfinite(feeds) & (feeds > 0.0) & (feeds <= MAX_FEED_VALUE))
     if bad.any():
         index = int(np.nonzero(path.kind == MoveKind.LINEAR)[0][np.argmax(bad)])
-        raise PostError(f"{info.title}: move {index} has no usable feed ({float(path.feed[index])!r})")
+        raise PostError(f"{shown(info.title)}: move {index} has no usable feed ({float(path.feed[index])!r})")
     if not 1 <= path.tool_number <= 9999:
-        raise PostError(f"{info.title}: tool number {path.tool_number} must be in 1..9999")
+        raise PostError(f"{shown(info.title)}: tool number {path.tool_number} must be in 1..9999")
     if not (math.isfinite(path.spindle_rpm) and path.spindle_rpm >= 1.0):
-        raise PostError(f"{info.title}: spindle speed {path.spindle_rpm:g} rpm would be written as S0")
+        raise PostError(f"{shown(info.title)}: spindle speed {path.spindle_rpm:g} rpm would be written as S0")
     check_rotary_code(info.rotary_clamp_code, "rotary_clamp_code")
     check_rotary_code(info.rotary_unclamp_code, "rotary_unclamp_code")
 
@@ -358,8 +358,8 @@ class _Writer:
                                    else s.max_line_number)
         too_long = [n for n, line in enumerate(lines, start=1) if len(line) > d.max_line_length]
         if too_long:
-            raise PostError(f"{info.title}: line {too_long[0]} would have {len(lines[too_long[0] - 1])} characters, "
-                            f"more than the {d.name} limit of {d.max_line_length}")
+            raise PostError(f"{shown(info.title)}: line {too_long[0]} would have {len(lines[too_long[0] - 1])} "
+                            f"characters, more than the {d.name} limit of {d.max_line_length}")
         return "\n".join(lines) + "\n"
 
     def _start_blocks(self) -> list[str]:

@@ -60,8 +60,13 @@ def _run(executable: str, program: BinaryIO, work: Path) -> Rs274Run:
                                   preexec_fn=_limit_output)
         except subprocess.TimeoutExpired:
             return Rs274Run(f"rs274 did not finish within {TIMEOUT_S:.0f} s (an endless loop?)", canon)
-    if proc.returncode == -signal.SIGXFSZ:
-        return Rs274Run(f"rs274's output passed {MAX_OUTPUT_BYTES // 2**20} MiB", canon)
+    # rs274 does not check its writes: a file cut at the limit (or the signal the limit sends) is the only sign
+    if proc.returncode == -signal.SIGXFSZ or any(path.exists() and path.stat().st_size >= MAX_OUTPUT_BYTES
+                                                 for path in (canon, messages)):
+        from spur_cad.verify.reader import MAX_MOVES
+
+        return Rs274Run(f"rs274's output passed {MAX_OUTPUT_BYTES // 2**20} MiB (verify reads at most "
+                        f"{MAX_MOVES:,} moves)", canon)
     if proc.returncode == 0:
         return Rs274Run(None, canon)
     with open(messages, "rb") as handle:

@@ -1,0 +1,219 @@
+"""Hostile output folders (issue 33): files planted in the output folder, as anyone who can write one file
+into a shared folder or an unpacked archive could plant them, never make `spur-cad run` touch anything
+outside the folder, delete a user's file, or fail with an internal error.
+
+Every case runs the real CLI in a child process and compares the whole tree around the folder before and
+after: a refused case must leave every byte and name as it was; a case that runs must leave the user's
+files as they were. The reproducer of the issue (a journal naming another directory as its staging
+folder) is the first case.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import resource
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from spur_cad.outputs import JOURNAL, MANIFEST, STAGING_PREFIX
+
+BASE = Path(__file__).resolve().parent / "data" / "hostile" / "clearance_negative.toml"  # the corpus's base job
+TIME_LIMIT_S = 180
+MEMORY_LIMIT_BYTES = 6 * 1024**3
+
+
+def _limits() -> None:
+    resource.setrlimit(resource.RLIMIT_AS, (MEMORY_LIMIT_BYTES, MEMORY_LIMIT_BYTES))
+
+
+def spur_cad(*args: str | Path) -> subprocess.CompletedProcess:
+    return subprocess.run([sys.executable, "-m", "spur_cad.cli", *map(str, args)], capture_output=True, text=True,
+                          timeout=TIME_LIMIT_S, preexec_fn=_limits)
+
+
+@pytest.fixture(scope="module")
+def job(tmp_path_factory) -> Path:
+    """A small job (face width 3 mm, no simulation) that runs in seconds."""
+    text = "\n".join(BASE.read_text().splitlines()[1:]).replace("clearance_mm = -1.0", "clearance_mm = 1.0")
+    path = tmp_path_factory.mktemp("job") / "job.toml"
+    path.write_text(text + "\n")
+    return path
+
+
+def tree(root: Path) -> dict[str, object]:
+    """Every entry under `root` (not following links): file bytes, link targets, folder markers."""
+    entries = {}
+    for folder, names, files in os.walk(root, followlinks=False):
+        for name in names + files:
+            path = Path(folder) / name
+            key = str(path.relative_to(root))
+            if path.is_symlink():
+                entries[key] = ("link", os.readlink(path))
+            elif path.is_dir():
+                entries[key] = ("folder",)
+            elif path.is_fifo():
+                entries[key] = ("fifo",)
+            else:
+                entries[key] = ("file", path.read_bytes())
+    return entries
+
+
+def check_refused_untouched(result: subprocess.CompletedProcess, before: dict, root: Path, blamed: Path) -> None:
+    """Exit 2, exactly one line naming the planted file and saying it is not ours, and nothing changed."""
+    assert result.returncode == 2, result.stderr
+    lines = result.stderr.strip().splitlines()
+    assert len(lines) == 1, result.stderr
+    assert lines[0].startswith(f"spur-cad: error: {blamed} was not written by spur_cad"), lines[0]
+    assert "remove it or choose another folder" in lines[0]
+    assert tree(root) == before
+
+
+@pytest.fixture
+def world(tmp_path) -> tuple[Path, Path]:
+    """An output folder and, beside it, a victim folder and file of the user's."""
+    (tmp_path / "out").mkdir()
+    (tmp_path / "victimdir").mkdir()
+    (tmp_path / "victimdir" / "precious.txt").write_text("precious")
+    (tmp_path / "victim.txt").write_text("victim")
+    return tmp_path, tmp_path / "out"
+
+
+def test_a_journal_naming_another_directory_as_staging_deletes_nothing(job, world):
+    """The issue's reproducer: before the fix this run exited 0 and removed victimdir."""
+    root, out = world
+    (out / JOURNAL).write_text(json.dumps({"staging": str(root / "victimdir"), "new": [], "old": []}))
+    before = tree(root)
+    check_refused_untouched(spur_cad("run", job, "--out", out, "--quiet"), before, root, out / JOURNAL)
+    assert (root / "victimdir" / "precious.txt").read_text() == "precious"
+
+
+@pytest.mark.parametrize("journal", [
+    {"staging": STAGING_PREFIX + "abcd1234", "new": [], "old": ["../victim.txt"]},  # traversal in the old set
+    {"staging": STAGING_PREFIX + "abcd1234", "new": ["../victim.txt"], "old": []},
+    {"staging": "../victimdir", "new": [], "old": []},
+    {"staging": STAGING_PREFIX + "abcd1234", "new": [], "old": ["/tmp/x/victim.txt"]},
+    {"staging": STAGING_PREFIX + "abcd1234", "new": [], "old": ["notes.txt"]},  # a user's name, not ours
+    {"staging": STAGING_PREFIX + "abcd1234", "new": []},  # a key missing
+    {"staging": 5, "new": [], "old": []},
+    {"staging": STAGING_PREFIX + "abcd1234", "new": "ab", "old": []},
+    ["not", "a", "journal"],
+    "ab",
+    7,
+], ids=["old-traversal", "new-traversal", "staging-outside", "old-absolute", "old-user-name", "missing-key",
+        "staging-number", "new-string", "list", "string", "number"])
+def test_a_journal_not_of_our_making_is_refused_with_nothing_touched(job, world, journal):
+    root, out = world
+    (out / "notes.txt").write_text("mine")
+    (out / JOURNAL).write_text(json.dumps(journal))
+    before = tree(root)
+    check_refused_untouched(spur_cad("run", job, "--out", out, "--quiet"), before, root, out / JOURNAL)
+
+
+@pytest.mark.parametrize("manifest", ['"ab"', "5", '["../victim.txt"]', '["a", "b"]', '{"a": 1}', "[1, 2]",
+                                      "not json", '["gear.step", null]', '["roughing.txt"]'],
+                         ids=["string", "number", "traversal", "user-names", "object", "numbers", "not-json", "null",
+                              "user-roughing-notes"])
+def test_a_manifest_not_of_our_making_is_refused_with_nothing_touched(job, world, manifest):
+    """A manifest that is the JSON string "ab" used to delete the user's files a and b."""
+    root, out = world
+    for name in ("a", "b", "roughing.txt"):
+        (out / name).write_text(f"user's {name}")
+    (out / MANIFEST).write_text(manifest)
+    before = tree(root)
+    check_refused_untouched(spur_cad("run", job, "--out", out, "--quiet"), before, root, out / MANIFEST)
+
+
+@pytest.mark.parametrize("kind", ["fifo", "folder", "link-to-file", "dangling-link", "huge"])
+@pytest.mark.parametrize("name", [MANIFEST, JOURNAL])
+def test_bookkeeping_that_is_no_regular_file_of_ours_is_refused_without_hanging(job, world, name, kind):
+    root, out = world
+    target = out / name
+    if kind == "fifo":
+        os.mkfifo(target)
+    elif kind == "folder":
+        target.mkdir()
+    elif kind == "link-to-file":
+        target.symlink_to(root / "victim.txt")
+    elif kind == "dangling-link":
+        target.symlink_to(root / "nowhere")
+    else:
+        target.write_text("[" + '"gear.step", ' * 100_000 + '"gear.step"]')
+    before = tree(root)
+    check_refused_untouched(spur_cad("run", job, "--out", out, "--quiet"), before, root, target)
+
+
+def test_a_staging_folder_that_links_elsewhere_is_refused(job, world):
+    root, out = world
+    staging = out / (STAGING_PREFIX + "abcd1234")
+    staging.symlink_to(root / "victimdir")
+    (out / JOURNAL).write_text(json.dumps({"staging": staging.name, "new": ["gear.step"], "old": []}))
+    before = tree(root)
+    check_refused_untouched(spur_cad("run", job, "--out", out, "--quiet"), before, root, staging)
+
+
+@pytest.mark.parametrize("planted", ["subfolder", "link", "user-file"])
+def test_a_stray_staging_folder_holding_what_we_never_write_is_refused(job, world, planted):
+    root, out = world
+    staging = out / (STAGING_PREFIX + "zz99zz99")
+    staging.mkdir()
+    (staging / "gear.step").write_bytes(b"half-written")  # what a killed run leaves: ours
+    if planted == "subfolder":
+        (staging / "photos").mkdir()
+        (staging / "photos" / "cat.jpg").write_bytes(b"cat")
+        blamed = staging / "photos"
+    elif planted == "link":
+        (staging / "report.html").symlink_to(root / "victim.txt")
+        blamed = staging / "report.html"
+    else:
+        (staging / "thesis.tex").write_text("years of work")
+        blamed = staging / "thesis.tex"
+    before = tree(root)
+    check_refused_untouched(spur_cad("run", job, "--out", out, "--quiet"), before, root, blamed)
+
+
+def test_planted_links_and_user_files_survive_a_run(job, world):
+    """The folder runs, and: links planted where we write temporaries write nowhere outside; files of names a
+    folder without a manifest may hold (roughing.txt, finishing.md: the user's notes) are not taken for a set;
+    a folder of our staging prefix but not our name pattern is the user's. Before the fix roughing.txt and
+    finishing.md were deleted and victim.txt truncated through the planted link."""
+    root, out = world
+    for name in (MANIFEST + ".tmp", JOURNAL + ".tmp"):
+        (out / name).symlink_to(root / "victim.txt")
+    (out / "roughing.txt").write_text("my roughing notes")
+    (out / "finishing.md").write_text("# my finishing notes")
+    (out / (STAGING_PREFIX + "My Photos")).mkdir()
+    (out / (STAGING_PREFIX + "My Photos") / "cat.jpg").write_bytes(b"cat")
+    result = spur_cad("run", job, "--out", out, "--quiet")
+    assert result.returncode == 0 and result.stderr == "", result.stderr
+    assert (root / "victim.txt").read_text() == "victim"
+    assert (root / "victimdir" / "precious.txt").read_text() == "precious"
+    assert (out / "roughing.txt").read_text() == "my roughing notes"
+    assert (out / "finishing.md").read_text() == "# my finishing notes"
+    assert (out / (STAGING_PREFIX + "My Photos") / "cat.jpg").read_bytes() == b"cat"
+    written = json.loads((out / MANIFEST).read_text())
+    assert "summary.json" in written and all((out / name).is_file() for name in written)
+    assert not [p.name for p in out.iterdir() if STAGING_NAME_OF_OURS(p.name)]  # no stray of ours
+    assert sorted(p.name for p in out.iterdir()) == sorted(
+        [*written, MANIFEST, MANIFEST + ".tmp", JOURNAL + ".tmp", "roughing.txt", "finishing.md",
+         STAGING_PREFIX + "My Photos"])
+
+
+def STAGING_NAME_OF_OURS(name: str) -> bool:  # noqa: N802 - reads as the constant it checks against
+    """mkdtemp's names: the prefix and eight characters of [a-z0-9_] (written here independently)."""
+    rest = name.removeprefix(STAGING_PREFIX)
+    return rest != name and len(rest) == 8 and all(c in "abcdefghijklmnopqrstuvwxyz0123456789_" for c in rest)
+
+
+@pytest.mark.parametrize("command", ["verify", "grade"])
+def test_verify_and_grade_outputs_refuse_a_foreign_manifest_too(job, world, tmp_path, command):
+    root, out = world
+    (out / MANIFEST).write_text('"ab"')
+    (out / "a").write_text("mine")
+    other = tmp_path / "input.txt"
+    other.write_text("G0 X0\nM30\n" if command == "verify" else "1,2\n")
+    before = tree(root)
+    check_refused_untouched(spur_cad(command, job, other, "--out", out), before, root, out / MANIFEST)
