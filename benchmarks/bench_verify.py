@@ -2,13 +2,22 @@
 LinuxCNC programs (spur_cad's reader and rs274's canonical output), the verification's simulation
 against the run's own simulation stage, and grading the simulated gear.
 
-    python -m benchmarks.bench_verify [--runs 3]
+    python -m benchmarks.bench_verify [--runs 3] [--large-runs 3]
+
+`large_program_figures` times `spur-cad verify` as a fresh process on a 50 MB program (the reference job's
+finishing program unfolded into plain moves and repeated), with its peak resident memory (issue 33's
+target: within 60 s and 500 MB).
 """
 
 from __future__ import annotations
 
 import argparse
+import os
+import statistics
+import subprocess
+import sys
 import tempfile
+import time
 from pathlib import Path
 
 from benchmarks.run_benchmarks import median_seconds
@@ -56,10 +65,53 @@ def figures(runs: int) -> dict:
     return out
 
 
+def flat_program(path: Path, target_bytes: int) -> int:
+    """The reference job's finishing program unfolded into plain G0/G1 moves, repeated to `target_bytes`;
+    returns the number of moves."""
+    job = load_job(REFERENCE_JOB)
+    _, files = build_programs(job, plan_cam(job))
+    moves = read_program(files["finishing.ngc"].decode(), "linuxcnc", "finishing.ngc")
+    body = "".join(f"G0 X{x:.4f} Y{y:.4f} Z{z:.4f} A{a:.4f}\n" if rapid else
+                   f"G1 X{x:.4f} Y{y:.4f} Z{z:.4f} A{a:.4f} F{f:.1f}\n"
+                   for rapid, x, y, z, a, f in zip(moves.rapid, moves.x, moves.y, moves.z, moves.a, moves.feed))
+    copies = max(1, target_bytes // len(body))
+    with open(path, "w") as handle:
+        handle.write(f"G21 G90 G94 G17\nT{int(moves.tool[0])} M6\nS5000 M3\n")
+        for _ in range(copies):
+            handle.write(body)
+        handle.write("M30\n")
+    return copies * len(moves)
+
+
+def timed_process(args: list[str]) -> tuple[float, int, int]:
+    """Wall seconds, peak resident bytes and exit status of a fresh process."""
+    start = time.perf_counter()
+    child = subprocess.Popen(args, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    _, status, usage = os.wait4(child.pid, 0)
+    return time.perf_counter() - start, usage.ru_maxrss * 1024, os.waitstatus_to_exitcode(status)
+
+
+def large_program_figures(runs: int) -> dict:
+    """`spur-cad verify` (spur_cad's reader, rs274's verdict too where installed) of a 50 MB program."""
+    with tempfile.TemporaryDirectory() as folder:
+        program = Path(folder) / "flat.ngc"
+        moves = flat_program(program, 50 * 1024 * 1024)
+        results = [timed_process([sys.executable, "-m", "spur_cad.cli", "verify", str(REFERENCE_JOB), str(program),
+                                  "--quiet"]) for _ in range(runs)]
+        size = program.stat().st_size
+    assert all(code == 0 for _, _, code in results), results
+    return {"bytes": size, "moves": moves, "wall_s": statistics.median(r[0] for r in results),
+            "peak_mb": statistics.median(r[1] for r in results) / 1e6}
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--runs", type=int, default=3, help="median of N runs for the timings")
+    parser.add_argument("--large-runs", type=int, default=3, help="median of N runs of the 50 MB program")
     args = parser.parse_args()
+    large = large_program_figures(args.large_runs)
+    print(f"50 MB program ({large['bytes']:,} bytes, {large['moves']:,} moves): spur-cad verify "
+          f"{large['wall_s']:.1f} s, peak {large['peak_mb']:.0f} MB (median of {args.large_runs} fresh processes)")
     f = figures(args.runs)
     print(f"reference job, {f['moves']:,} moves: read {f['read_s']:.2f} s (rs274 canonical "
           f"{f.get('read_rs274_s', float('nan')):.2f} s); verify (simulation and verdict) {f['verify_s']:.1f} s "

@@ -152,6 +152,7 @@ def main() -> None:
     from benchmarks.bench_shop_floor import figures as shop_floor_figures
     from benchmarks.bench_sim import bench_sim
     from benchmarks.bench_verify import figures as verify_figures
+    from benchmarks.bench_verify import large_program_figures
     from spur_cad.job import load_job
 
     results = {"machine": machine(), "runs": args.runs, "profile": bench_profile(args.runs),
@@ -159,7 +160,7 @@ def main() -> None:
                "post": bench_post(args.cad_runs), "sim_runs": args.sim_runs, "sim": bench_sim(args.sim_runs),
                "generating": figures(load_job(REFERENCE_JOB)),
                "helical": helical_figures(load_job(HELICAL_JOB), args.run_runs),
-               "verify": verify_figures(args.run_runs),
+               "verify": verify_figures(args.run_runs), "verify_large": large_program_figures(args.run_runs),
                "shop_floor": shop_floor_figures(args.run_runs),
                "run_s": {strategy: end_to_end_seconds(strategy, args.run_runs)
                          for strategy in ("generating", "perimeter")}}
