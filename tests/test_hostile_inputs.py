@@ -36,21 +36,12 @@ def spur_cad(*args: str | Path, timeout: float = QUICK_S) -> subprocess.Complete
 
 
 def measured(*args: str | Path, timeout: float) -> tuple[subprocess.CompletedProcess, int]:
-    """`spur-cad ARGS` and its peak resident memory in bytes (from the kernel's accounting of the child)."""
-    child = subprocess.Popen([sys.executable, "-m", "spur_cad.cli", *map(str, args)], stdout=subprocess.PIPE,
-                             stderr=subprocess.PIPE, text=True, preexec_fn=_limits, stdin=subprocess.DEVNULL)
-    deadline = time.monotonic() + timeout
-    while True:
-        pid, status, usage = os.wait4(child.pid, os.WNOHANG)
-        if pid:
-            break
-        if time.monotonic() > deadline:
-            child.kill()
-            raise AssertionError(f"spur-cad {' '.join(map(str, args))}: no end within {timeout} s")
-        time.sleep(0.05)
-    out, err = child.stdout.read(), child.stderr.read()
-    code = os.waitstatus_to_exitcode(status)
-    return subprocess.CompletedProcess(child.args, code, out, err), usage.ru_maxrss * 1024
+    """`spur-cad ARGS` and its own peak resident memory in bytes (started from a small launcher, so that the
+    pages a fork shares with this large test process are not counted as the command's)."""
+    from benchmarks.peak_memory import run_measured
+
+    result, peak, _ = run_measured([sys.executable, "-m", "spur_cad.cli", *map(str, args)], timeout, _limits)
+    return result, peak
 
 
 def one_error_line(result: subprocess.CompletedProcess, *fragments: str) -> str:
@@ -284,7 +275,7 @@ def test_a_fifty_megabyte_program_is_verified_within_bounds(job, tmp_path):
     program = _flat_program(job, tmp_path, 50 * 1024 * 1024)
     result, peak = measured("verify", job, program, "--reader", "spur_cad", "--quiet", timeout=300)
     assert result.returncode in (0, 1) and re.search(r"(PASS|FAIL): .* moves", result.stdout), result.stderr
-    assert peak < 1024**3, peak
+    assert peak < 768 * 1024**2, peak  # about 470 MB measured (docs/benchmarks.md)
 
 
 @pytest.mark.slow
@@ -304,7 +295,7 @@ def test_fifty_megabytes_of_anything_end_in_one_line_within_bounds(job, tmp_path
     assert result.returncode in (1, 2), result.stderr
     if result.returncode == 2:
         one_error_line(result, f"{path}")
-    assert peak < 1024**3, peak
+    assert peak < 512 * 1024**2, peak
 
 
 @pytest.mark.slow

@@ -1,0 +1,55 @@
+"""Peak resident memory of a command, measured so that the measurement is the command's own.
+
+Linux counts in a child's peak (ru_maxrss) the pages it shared with its parent between fork and exec, so a
+command started from a large process (a test run, a benchmark holding a CAM plan) seems as large as that
+process. `run_measured` starts the command from a fresh, small Python launcher and reports the command's
+own peak (the launcher's few megabytes are the floor).
+"""
+
+from __future__ import annotations
+
+import os
+import signal
+import subprocess
+import sys
+import tempfile
+import time
+
+_LAUNCHER = """
+import os, subprocess, sys
+child = subprocess.Popen(sys.argv[2:])
+_, status, usage = os.wait4(child.pid, 0)
+with open(sys.argv[1], "w") as report:
+    report.write(f"{usage.ru_maxrss * 1024} {os.waitstatus_to_exitcode(status)}")
+sys.exit(0)
+"""
+
+
+def run_measured(args: list[str], timeout_s: float, preexec_fn=None) -> tuple[subprocess.CompletedProcess, int, float]:
+    """(the command's result with its text output, its peak resident bytes, wall seconds); raises
+    subprocess.TimeoutExpired when it runs past `timeout_s`."""
+    with tempfile.NamedTemporaryFile("r", suffix=".peak") as report:
+        start = time.perf_counter()
+        launcher = subprocess.Popen([sys.executable, "-c", _LAUNCHER, report.name, *args], stdout=subprocess.PIPE,
+                                    stderr=subprocess.PIPE, text=True, preexec_fn=preexec_fn,
+                                    stdin=subprocess.DEVNULL, start_new_session=True)
+        try:
+            out, err = launcher.communicate(timeout=timeout_s)
+        except subprocess.TimeoutExpired:
+            os.killpg(launcher.pid, signal.SIGKILL)  # the launcher and the command it started
+            launcher.communicate()
+            raise
+        seconds = time.perf_counter() - start
+        peak, code = (int(value) for value in report.read().split())
+    return subprocess.CompletedProcess(args, code, out, err), peak, seconds
+
+
+def fresh_python_floor_bytes() -> int:
+    """The peak of a bare `python -c pass` started the same way (what run_measured cannot go below)."""
+    return run_measured([sys.executable, "-c", "pass"], 60)[1]
+
+
+if __name__ == "__main__":  # pragma: no cover
+    result, peak_bytes, wall = run_measured(sys.argv[1:], 3600)
+    print(f"exit {result.returncode}, {wall:.2f} s, peak {peak_bytes / 1e6:.0f} MB", file=sys.stderr)
+    sys.exit(result.returncode)
