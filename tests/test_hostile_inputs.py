@@ -335,3 +335,17 @@ def test_a_signal_near_the_end_of_a_run_always_gives_the_interrupted_line(job, t
         else:
             assert err.startswith("spur-cad: interrupted") and len(err.splitlines()) == 1, err
     assert any(code != 0 for code in outcomes), outcomes  # the signals did arrive during runs
+
+
+def test_what_the_reader_keeps_per_definition_or_variable_is_bounded():
+    """Unclosed loops and distinct variables are kept while reading: each is bounded, so a program of a million
+    such lines cannot grow the reader's memory with its length."""
+    from spur_cad.verify.reader import MAX_SUBPROGRAMS, MAX_VARIABLES, ProgramReadError, read_program
+
+    loops = "".join(f"o{n} repeat [1]\n" for n in range(MAX_SUBPROGRAMS + 1)) + "M30\n"
+    with pytest.raises(ProgramReadError, match=f"more than {MAX_SUBPROGRAMS:,} subprograms, loops and labels"):
+        read_program(loops, "linuxcnc", "loops.ngc")
+    variables = "".join(f"#{n} = 1\n" for n in range(1, MAX_VARIABLES + 2)) + "M30\n"
+    with pytest.raises(ProgramReadError, match=f"variables.ngc:{MAX_VARIABLES + 1}: more than {MAX_VARIABLES:,} "
+                                               "variables"):
+        read_program(variables, "linuxcnc", "variables.ngc")

@@ -55,6 +55,7 @@ MAX_MOVES = 2_000_000  # moves recorded (about 60 bytes each)
 MAX_BLOCKS = 8_000_000  # blocks executed (loops and calls counted)
 MAX_CHARACTERS_READ = 100_000_000  # characters read while executing (long blocks of many words cost more)
 MAX_SUBPROGRAMS = 100_000  # subprograms, loops and labels defined
+MAX_VARIABLES = 10_000  # distinct variables set (LinuxCNC has 5,400 numbered parameters)
 MAX_CALL_DEPTH = 8
 MAX_REPEAT = 100_000
 CHECK_EVERY_BLOCKS = 100_000  # how often a long read calls its checkpoint (the CLI stops there on a signal)
@@ -194,11 +195,10 @@ class _Structure:
     repeats: dict = None  # LinuxCNC: offset of an 'o<n> repeat' line -> (offset of its 'endrepeat', Position after)
     labels: dict = None  # Siemens: label -> (Position after its line, offset of its line)
 
+    opened: int = 0  # subprograms, loops and labels met (closed or not): bounds what the index holds
+
     def __post_init__(self):
         self.subs, self.local_subs, self.skips, self.repeats, self.labels = {}, {}, {}, {}, {}
-
-    def count(self) -> int:
-        return len(self.subs) + len(self.local_subs) + len(self.repeats) + len(self.labels)
 
 
 def _index(handle, dialect: str, source: str) -> _Structure:
@@ -229,9 +229,10 @@ def _index(handle, dialect: str, source: str) -> _Structure:
             _index_linuxcnc(found, line, (offset, number), open_subs, open_repeats)
         elif dialect == "siemens" and _LABEL.fullmatch(text):
             found.labels[text[:-1]] = ((offset, number), here)
+            found.opened += 1
         elif fanuc_family and after_end:
             current_sub = _index_subprogram(found, line, (offset, number), current_sub, closing, source)
-        if found.count() > MAX_SUBPROGRAMS:
+        if found.opened > MAX_SUBPROGRAMS:
             raise _error(source, line, f"more than {MAX_SUBPROGRAMS:,} subprograms, loops and labels")
     if found.end < 0:
         raise ProgramReadError(f"{source}: no end of program (M30 or M2)")
@@ -270,6 +271,7 @@ def _index_subprogram(found: _Structure, line: _Line, after: Position, current_s
         head = _SUB_HEAD.fullmatch(line.text)
         if head is None:
             raise _error(source, line, "a block after the end of the program that is not a subprogram")
+        found.opened += 1
         return (head, after, line.number)
     if closing.fullmatch(line.text):
         head, start, _ = current_sub
@@ -286,6 +288,7 @@ def _index_linuxcnc(found: _Structure, line: _Line, after: Position, open_subs: 
         return
     if (head := _LINUXCNC_SUB.fullmatch(text)) is not None:
         open_subs.append((int(head.group(1)), after, line.offset))
+        found.opened += 1
     elif (head := _LINUXCNC_ENDSUB.fullmatch(text)) is not None:
         sub_number = int(head.group(1))
         for i in range(len(open_subs) - 1, -1, -1):
@@ -296,6 +299,7 @@ def _index_linuxcnc(found: _Structure, line: _Line, after: Position, open_subs: 
                 break
     elif (head := _LINUXCNC_REPEAT.fullmatch(text)) is not None:
         open_repeats.setdefault(int(head.group(1)), []).append(line.offset)
+        found.opened += 1
     elif (head := _LINUXCNC_ENDREPEAT.fullmatch(text)) is not None and open_repeats.get(int(head.group(1))):
         found.repeats[open_repeats[int(head.group(1))].pop()] = (line.offset, after)
 
@@ -336,6 +340,12 @@ class _Reader:
         return _error(self.source, line, message)
 
     # --- values -----------------------------------------------------------------------------
+    def _set(self, name: str, value: float, line: _Line) -> None:
+        """A variable set, at most MAX_VARIABLES of them."""
+        if name not in self.variables and len(self.variables) >= MAX_VARIABLES:
+            raise self.error(line, f"more than {MAX_VARIABLES:,} variables set")
+        self.variables[name] = value
+
     def value(self, text: str, line: _Line) -> float:
         """A number, a variable, or a sum of them: '12.5', '#2', '[#2+2.5]', 'R2+2.5', 'ASP-23.9'."""
         if _PLAIN_NUMBER.fullmatch(text):
@@ -461,7 +471,7 @@ class _Reader:
             return after
         if re.fullmatch(r"(R\d+=\S+\s*)+", text):
             for name, value in re.findall(r"(R\d+)=(\S+)", text):
-                self.variables[name] = self.value(value, line)
+                self._set(name, self.value(value, line), line)
             return after
         return None
 
@@ -498,7 +508,7 @@ class _Reader:
         if text[0] == "#":
             found = _ASSIGNMENT.fullmatch(text)
             if found:
-                self.variables[found.group(1)] = self.value(found.group(2), line)
+                self._set(found.group(1), self.value(found.group(2), line), line)
                 return after
             return None
         if _LINUXCNC_SUB.fullmatch(text):
@@ -530,13 +540,13 @@ class _Reader:
             return after  # the program's own number (its title was a comment)
         found = _ASSIGNMENT.fullmatch(text)
         if found:
-            self.variables[found.group(1)] = self.value(found.group(2), line)
+            self._set(found.group(1), self.value(found.group(2), line), line)
             return after
         if self.dialect == "okuma":
             found = re.fullmatch(r"CALL\s*O(\d+)((?:\s+[A-Z][A-Z0-9]*\s*=\s*\S+)*)", text)
             if found:
                 for name, value in re.findall(r"([A-Z][A-Z0-9]*)\s*=\s*(\S+)", found.group(2)):
-                    self.variables[name] = self.value(value, line)
+                    self._set(name, self.value(value, line), line)
                 self._call(found.group(1), line, depth)
                 return after
             return None
