@@ -250,13 +250,14 @@ def _verify(args: argparse.Namespace, received: list[int], loaded: list) -> int:
         source = shown_path(name)
         if args.reader == "rs274":
             with open_program_file(name, source) as handle:  # a regular file of bounded size, checked first
-                programs.append(read_canonical(handle, source))
+                programs.append(read_canonical(handle, source, lambda: _checkpoint(received)))
         else:
             programs.append(read_program_file(name, dialect, source, checkpoint=lambda: _checkpoint(received)))
         _checkpoint(received)
     result = verify_moves(job, programs, options, progress=lambda fraction: _checkpoint(received))
     if dialect == "linuxcnc":
-        result = dataclasses.replace(result, rs274={shown_path(name): rs274_verdict(name) for name in args.programs})
+        result = dataclasses.replace(result, rs274={shown_path(name): rs274_verdict(name, lambda: _checkpoint(received))
+                                                    for name in args.programs})
     lines = result.lines() + [f"rs274 {name}: {verdict}" for name, verdict in result.rs274.items()]
     for line in (lines if not args.quiet else lines[-1 - len(result.rs274):]):
         print(line)

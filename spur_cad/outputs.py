@@ -263,7 +263,11 @@ def _check_staging(out: Path, name: str) -> None:
         return
     if not stat.S_ISDIR(mode):
         raise _foreign(folder, "not a folder")
-    for entry in os.scandir(folder):
+    try:
+        entries = list(os.scandir(folder))
+    except FileNotFoundError:  # a run writing into the folder right now has just finished with it
+        return
+    for entry in entries:
         if not (entry.is_file(follow_symlinks=False) and (is_output_name(entry.name) or
                                                            entry.name in (MANIFEST, JOURNAL))):
             raise _foreign(folder / entry.name, "not a file of an output set")

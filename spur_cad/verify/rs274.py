@@ -14,6 +14,8 @@ import shutil
 import signal
 import subprocess
 import tempfile
+import time
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 from typing import BinaryIO
@@ -48,19 +50,30 @@ def _limit_output() -> None:  # in the child, before rs274 starts: its files sto
     resource.setrlimit(resource.RLIMIT_FSIZE, (MAX_OUTPUT_BYTES, MAX_OUTPUT_BYTES))
 
 
-def _run(executable: str, program: BinaryIO, work: Path) -> Rs274Run:
+def _run(executable: str, program: BinaryIO, work: Path, checkpoint: Callable[[], None] | None = None) -> Rs274Run:
     """rs274 -g on an open program file (the child reads it through its inherited descriptor, so what was checked
-    is what is interpreted), with its time and output bounded."""
+    is what is interpreted), with its time and output bounded; `checkpoint()` is called while it runs (the CLI
+    stops there on a signal, and rs274 is stopped with it)."""
     canon, messages = work / "canon.txt", work / "messages.txt"
     fd = program.fileno()
+    deadline = time.monotonic() + TIMEOUT_S
     with open(messages, "wb") as output:
+        proc = subprocess.Popen([executable, "-g", f"/dev/fd/{fd}", str(canon)], stdin=subprocess.DEVNULL,
+                                stdout=output, stderr=output, cwd=work, pass_fds=(fd,), preexec_fn=_limit_output)
         try:
-            proc = subprocess.run([executable, "-g", f"/dev/fd/{fd}", str(canon)], stdin=subprocess.DEVNULL,
-                                  stdout=output, stderr=output, cwd=work, timeout=TIMEOUT_S, pass_fds=(fd,),
-                                  preexec_fn=_limit_output)
-        except subprocess.TimeoutExpired:
-            return Rs274Run(f"rs274 did not finish within {TIMEOUT_S:.0f} s (an endless loop?)", canon)
-    # rs274 does not check its writes: a file cut at the limit (or the signal the limit sends) is the only sign
+            while True:
+                try:
+                    proc.wait(timeout=0.1)
+                    break
+                except subprocess.TimeoutExpired:
+                    if checkpoint is not None:
+                        checkpoint()
+                    if time.monotonic() > deadline:
+                        return Rs274Run(f"rs274 did not finish within {TIMEOUT_S:.0f} s (an endless loop?)", canon)
+        finally:
+            if proc.returncode is None:
+                proc.kill()
+                proc.wait()
     if proc.returncode == -signal.SIGXFSZ or any(path.exists() and path.stat().st_size >= MAX_OUTPUT_BYTES
                                                  for path in (canon, messages)):
         from spur_cad.verify.reader import MAX_MOVES
@@ -75,7 +88,7 @@ def _run(executable: str, program: BinaryIO, work: Path) -> Rs274Run:
     return Rs274Run("; ".join(escaped(line)[:200] for line in lines[:2]) or f"exit status {proc.returncode}", canon)
 
 
-def rs274_verdict(program: str | os.PathLike) -> str:
+def rs274_verdict(program: str | os.PathLike, checkpoint: Callable[[], None] | None = None) -> str:
     """'passed', 'failed: <rs274's message>' or 'not available: ...' for a LinuxCNC program file."""
     from spur_cad.verify.reader import open_program_file
 
@@ -83,7 +96,7 @@ def rs274_verdict(program: str | os.PathLike) -> str:
     if executable is None:
         return "not available: rs274 not found (install linuxcnc-uspace)"
     with open_program_file(program) as handle, tempfile.TemporaryDirectory(prefix="spur-cad-rs274-") as work:
-        run = _run(executable, handle, Path(work))
+        run = _run(executable, handle, Path(work), checkpoint)
     return "passed" if run.problem is None else f"failed: {run.problem}"
 
 
@@ -130,7 +143,7 @@ class _CanonState:
             self.spindle = values[-1]
 
 
-def read_canonical(program: BinaryIO, source: str):
+def read_canonical(program: BinaryIO, source: str, checkpoint: Callable[[], None] | None = None):
     """The moves of an open LinuxCNC program file as LinuxCNC's own interpreter executes them (rs274's canonical
     calls STRAIGHT_TRAVERSE / STRAIGHT_FEED with SET_FEED_RATE, SET_FEED_MODE, CHANGE_TOOL, SET_SPINDLE_SPEED):
     the reference reader for LinuxCNC programs. `line` holds the canonical call's number. rs274's time and output
@@ -143,7 +156,7 @@ def read_canonical(program: BinaryIO, source: str):
     call = re.compile(r"^\s*(\d+)\s+N\S*\s+([A-Z_]+)\((.*)\)\s*$")
     columns = move_columns()
     with tempfile.TemporaryDirectory(prefix="spur-cad-rs274-") as work:
-        run = _run(executable, program, Path(work))
+        run = _run(executable, program, Path(work), checkpoint)
         if run.problem is not None:
             raise SpurCadError(f"{source}: rs274 refuses the program: {run.problem}")
         with open(run.canon, "rb") as canon:
