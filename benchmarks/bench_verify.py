@@ -63,10 +63,10 @@ def figures(runs: int) -> dict:
     return out
 
 
-def flat_program(path: Path, target_bytes: int) -> int:
-    """The reference job's finishing program unfolded into plain G0/G1 moves, repeated to `target_bytes`;
-    returns the number of moves."""
-    job = load_job(REFERENCE_JOB)
+def flat_program(path: Path, target_bytes: int, job_path: Path = REFERENCE_JOB) -> int:
+    """The job's finishing program unfolded into plain G0/G1 moves, repeated to `target_bytes`; returns the
+    number of moves."""
+    job = load_job(job_path)
     _, files = build_programs(job, plan_cam(job))
     moves = read_program(files["finishing.ngc"].decode(), "linuxcnc", "finishing.ngc")
     body = "".join(f"G0 X{x:.4f} Y{y:.4f} Z{z:.4f} A{a:.4f}\n" if rapid else

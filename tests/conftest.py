@@ -10,6 +10,7 @@ from __future__ import annotations
 import os
 import shutil
 import sysconfig
+from pathlib import Path
 
 import pytest
 
@@ -92,3 +93,13 @@ def rs274() -> str:
 def venv_site_packages() -> str:
     """site-packages (purelib) of the running interpreter, to put on FreeCAD's sys.path."""
     return sysconfig.get_paths()["purelib"]
+
+
+@pytest.fixture(scope="session")
+def small_job(tmp_path_factory):
+    """The hostile corpus's base job made valid (face width 3 mm, no simulation): a run takes seconds."""
+    base = Path(__file__).resolve().parent / "data" / "hostile" / "clearance_negative.toml"
+    text = "\n".join(base.read_text().splitlines()[1:]).replace("clearance_mm = -1.0", "clearance_mm = 1.0")
+    path = tmp_path_factory.mktemp("small_job") / "job.toml"
+    path.write_text(text + "\n")
+    return path

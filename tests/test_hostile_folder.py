@@ -21,7 +21,6 @@ import pytest
 
 from spur_cad.outputs import JOURNAL, MANIFEST, STAGING_PREFIX
 
-BASE = Path(__file__).resolve().parent / "data" / "hostile" / "clearance_negative.toml"  # the corpus's base job
 TIME_LIMIT_S = 180
 MEMORY_LIMIT_BYTES = 6 * 1024**3
 
@@ -35,13 +34,9 @@ def spur_cad(*args: str | Path) -> subprocess.CompletedProcess:
                           timeout=TIME_LIMIT_S, preexec_fn=_limits)
 
 
-@pytest.fixture(scope="module")
-def job(tmp_path_factory) -> Path:
-    """A small job (face width 3 mm, no simulation) that runs in seconds."""
-    text = "\n".join(BASE.read_text().splitlines()[1:]).replace("clearance_mm = -1.0", "clearance_mm = 1.0")
-    path = tmp_path_factory.mktemp("job") / "job.toml"
-    path.write_text(text + "\n")
-    return path
+@pytest.fixture
+def job(small_job: Path) -> Path:
+    return small_job
 
 
 def tree(root: Path) -> dict[str, object]:

@@ -20,7 +20,6 @@ from pathlib import Path
 
 import pytest
 
-BASE = Path(__file__).resolve().parent / "data" / "hostile" / "clearance_negative.toml"  # the corpus's base job
 MEMORY_LIMIT_BYTES = 3 * 1024**3  # address space: numba and OCP reserve much more than they use
 QUICK_S = 60  # a refusal that needs no reading comes in about a second; this only catches a hang
 ONE_LINE = 400
@@ -56,12 +55,9 @@ def one_error_line(result: subprocess.CompletedProcess, *fragments: str) -> str:
     return lines[0]
 
 
-@pytest.fixture(scope="module")
-def job(tmp_path_factory) -> Path:
-    text = "\n".join(BASE.read_text().splitlines()[1:]).replace("clearance_mm = -1.0", "clearance_mm = 1.0")
-    path = tmp_path_factory.mktemp("job") / "job.toml"
-    path.write_text(text + "\n")
-    return path
+@pytest.fixture
+def job(small_job: Path) -> Path:
+    return small_job
 
 
 # --- what is not a regular file ------------------------------------------------------------------------------
@@ -248,31 +244,13 @@ def test_an_out_folder_name_too_long_or_dangling_is_refused_before_the_job_is_re
 
 # --- the slow tier: large inputs, signals -------------------------------------------------------------------------
 
-def _flat_program(job: Path, tmp_path: Path, target_bytes: int) -> Path:
-    """spur_cad's own finishing program of the job, unfolded into plain moves and repeated to `target_bytes`."""
-    from spur_cad.job import load_job
-    from spur_cad.pipeline import build_programs, plan_cam
-    from spur_cad.verify.reader import read_program
-
-    loaded = load_job(job)
-    _, files = build_programs(loaded, plan_cam(loaded))
-    moves = read_program(files["finishing.ngc"].decode(), "linuxcnc", "finishing.ngc")
-    body = "".join(f"G0 X{x:.4f} Y{y:.4f} Z{z:.4f} A{a:.4f}\n" if rapid else
-                   f"G1 X{x:.4f} Y{y:.4f} Z{z:.4f} A{a:.4f} F{f:.1f}\n"
-                   for rapid, x, y, z, a, f in zip(moves.rapid, moves.x, moves.y, moves.z, moves.a, moves.feed))
-    path = tmp_path / "flat.ngc"
-    with open(path, "w") as handle:
-        handle.write(f"G21 G90 G94 G17\nT{int(moves.tool[0])} M6\nS5000 M3\n")
-        for _ in range(max(1, target_bytes // len(body))):
-            handle.write(body)
-        handle.write("M30\n")
-    return path
-
-
 @pytest.mark.slow
 def test_a_fifty_megabyte_program_is_verified_within_bounds(job, tmp_path):
     """Before the fix a 50 MB program took 160-230 s and 4.5 GB."""
-    program = _flat_program(job, tmp_path, 50 * 1024 * 1024)
+    from benchmarks.bench_verify import flat_program
+
+    program = tmp_path / "flat.ngc"
+    flat_program(program, 50 * 1024 * 1024, job)
     result, peak = measured("verify", job, program, "--reader", "spur_cad", "--quiet", timeout=300)
     assert result.returncode in (0, 1) and re.search(r"(PASS|FAIL): .* moves", result.stdout), result.stderr
     assert peak < 768 * 1024**2, peak  # about 470 MB measured (docs/benchmarks.md)
