@@ -33,7 +33,7 @@ import fcntl
 import json
 import os
 import re
-import shutil
+import secrets
 import signal
 import stat
 import tempfile
@@ -53,9 +53,11 @@ OUTPUT_NAME = re.compile(
     rf"|{_OPERATION}\.{_PROGRAM_EXTENSION}|blank\.{_PROGRAM_EXTENSION}"  # programs
     rf"|{_OPERATION}_(space|station)\d{{1,7}}(_(level|pass)\d{{1,7}})?\.{_PROGRAM_EXTENSION}"  # restart programs
     r"|verify\.json|deviation_map\.csv"  # spur-cad verify
-    r"|grade\.json|k_chart\.png")  # spur-cad grade
+    r"|grade\.json|k_chart\.png",  # spur-cad grade
+    re.ASCII)  # digits are 0-9 only
 """The vocabulary of output sets: every name spur_cad writes into an output folder (fullmatch)."""
-STAGING_NAME = re.compile(re.escape(STAGING_PREFIX) + r"[a-z0-9_]{8}")  # tempfile.mkdtemp's 8 random characters
+STAGING_NAME = re.compile(re.escape(STAGING_PREFIX) + r"[a-z0-9_]{8}", re.ASCII)  # 8 random characters (hex
+# since issue 33; tempfile.mkdtemp's alphabet before)
 
 
 class OutputError(SpurCadError, OSError):
@@ -94,7 +96,8 @@ def check_output_folder(out_dir: str | os.PathLike) -> Path:
         if not existing.is_dir() or not os.access(existing, os.W_OK | os.X_OK):
             raise OutputError(f"--out {shown_path(out)}: cannot write into {shown_path(existing)}")
         if out.is_dir():
-            _check_bookkeeping(out)  # a foreign manifest or journal is refused now, not after the computation
+            with _opened(out) as folder:
+                _check_bookkeeping(out, folder)  # a foreign manifest or journal is refused now, not after the run
     except OutputError:
         raise
     except (OSError, ValueError) as exc:  # a path too long for the system, a NUL byte, ...
@@ -109,7 +112,11 @@ def is_output_name(name: str) -> bool:
 
 def write_output_set(out_dir: str | os.PathLike, files: dict[str, bytes]) -> list[Path]:
     """Replace the set in `out_dir` (created if needed) by `files` (name -> content; names of OUTPUT_NAME);
-    returns the paths. Raises OutputError (ForeignFileError for a file not ours) with nothing changed."""
+    returns the paths. Raises OutputError (ForeignFileError for a file not ours) with nothing changed.
+
+    Every operation is relative to descriptors of the output folder and of our staging folder, opened once
+    (without following links): a name in the folder swapped for a link while the set is written cannot
+    redirect a write, a move or a removal to another folder."""
     for name in files:
         if not is_output_name(name):
             raise ValueError(f"output names must be plain file names of the output vocabulary, got {name!r}")
@@ -118,29 +125,31 @@ def write_output_set(out_dir: str | os.PathLike, files: dict[str, bytes]) -> lis
         out.mkdir(parents=True, exist_ok=True)
     except OSError as exc:
         raise OutputError(f"--out {shown_path(out)}: cannot create it: {exc.strerror or exc}") from None
-    with _locked(out):
-        recover(out)
-        old = _read_manifest(out)
+    with _locked(out) as folder:
+        _recover(out, folder)
+        old = _read_manifest(out, folder)
         for name in files:
-            target = out / name
-            if target.is_dir() or (os.path.lexists(target) and not target.is_file()):
+            if _in_the_way(folder, name):
                 raise OutputError(f"--out {shown_path(out)}: {name} is in the way (a folder or special file); "
                                   "nothing was written")
-        staging = Path(tempfile.mkdtemp(prefix=STAGING_PREFIX, dir=out))
-        journal = Journal(staging.name, tuple(sorted(files)), tuple(sorted(old)))
+        staging_name, staging = _new_staging(folder)
+        journal = Journal(staging_name, tuple(sorted(files)), tuple(sorted(old)))
         try:
-            for name, content in files.items():
-                _write_synced(staging / name, content)
-            _write_synced(staging / JOURNAL, journal.to_json())
-            _write_synced(staging / MANIFEST, json.dumps(list(journal.new)).encode())
-            _sync_folder(staging)
-        except BaseException:
-            shutil.rmtree(staging, ignore_errors=True)  # our own fresh folder
-            raise
-        with _signals_held():
-            os.replace(staging / JOURNAL, out / JOURNAL)
-            _sync_folder(out)
-            _switch(out, journal)
+            try:
+                for name, content in files.items():
+                    _write_synced(staging, name, content)
+                _write_synced(staging, JOURNAL, journal.to_json())
+                _write_synced(staging, MANIFEST, json.dumps(list(journal.new)).encode())
+                os.fsync(staging)
+            except BaseException:
+                _remove_staging(folder, staging_name, staging)  # our own fresh folder
+                raise
+            with _signals_held():
+                os.replace(JOURNAL, JOURNAL, src_dir_fd=staging, dst_dir_fd=folder)
+                os.fsync(folder)
+                _switch(folder, journal, staging)
+        finally:
+            os.close(staging)
     return [out / name for name in files]
 
 
@@ -165,31 +174,42 @@ def write_file_atomically(path: str | os.PathLike, content: bytes) -> Path:
 def recover(out: Path) -> None:
     """Complete a switch an earlier run left half-done, then remove our staging folders. Everything is
     validated first (ForeignFileError, nothing touched, when a file is not ours)."""
-    journal, strays = _check_bookkeeping(out)
+    with _locked(out) as folder:
+        _recover(out, folder)
+
+
+def _recover(out: Path, folder: int) -> None:
+    journal, strays = _check_bookkeeping(out, folder)
     if journal is not None:
-        _switch(out, journal)
+        _switch(folder, journal, None)
     for name in strays:
-        _remove_staging(out / name)
+        _remove_staging(folder, name)
 
 
-def _check_bookkeeping(out: Path) -> tuple[Journal | None, list[str]]:
+def _check_bookkeeping(out: Path, folder: int) -> tuple[Journal | None, list[str]]:
     """The journal (None without one) and the names of stray staging folders, every one of them validated with
     the manifest (ForeignFileError when a file is not ours); nothing is changed."""
-    journal = _read_journal(out)
-    strays = [entry for entry in _entries(out) if STAGING_NAME.fullmatch(entry) and
+    journal = _read_journal(out, folder)
+    strays = [entry for entry in sorted(os.listdir(folder)) if STAGING_NAME.fullmatch(entry) and
               (journal is None or entry != journal.staging)]
-    for name in strays:
-        _check_staging(out, name)
-    if journal is not None:
-        _check_staging(out, journal.staging)
-    _read_manifest(out)
+    for name in [*strays, *([journal.staging] if journal is not None else [])]:
+        staging = _open_staging(out, folder, name)
+        if staging is not None:
+            try:
+                _check_staging(out / name, staging)
+            finally:
+                os.close(staging)
+    _read_manifest(out, folder)
     return journal, strays
 
 
 def current_set(out_dir: str | os.PathLike) -> list[str]:
     """Names of the set the folder holds (from its validated manifest; [] when it holds none)."""
     out = Path(out_dir)
-    return sorted(_read_manifest(out)) if out.is_dir() else []
+    if not out.is_dir():
+        return []
+    with _opened(out) as folder:
+        return sorted(_read_manifest(out, folder))
 
 
 def _foreign(path: Path, reason: str) -> ForeignFileError:
@@ -197,14 +217,10 @@ def _foreign(path: Path, reason: str) -> ForeignFileError:
                             "another folder")
 
 
-def _entries(out: Path) -> list[str]:
-    return sorted(os.listdir(out))
-
-
-def _read_bookkeeping(path: Path) -> object | None:
+def _read_bookkeeping(path: Path, folder: int) -> object | None:
     """The JSON of our manifest or journal (None when absent), read only from a regular file of bounded size."""
     try:
-        fd = os.open(path, os.O_RDONLY | os.O_NOFOLLOW | os.O_NONBLOCK | os.O_CLOEXEC)
+        fd = os.open(path.name, os.O_RDONLY | os.O_NOFOLLOW | os.O_NONBLOCK | os.O_CLOEXEC, dir_fd=folder)
     except FileNotFoundError:
         return None
     except OSError as exc:
@@ -233,17 +249,17 @@ def _names(value: object, path: Path, what: str) -> tuple[str, ...]:
     return tuple(value)
 
 
-def _read_manifest(out: Path) -> set[str]:
+def _read_manifest(out: Path, folder: int) -> set[str]:
     """The current set's names from the manifest; the empty set without one (files of older versions that kept
     no manifest are left alone: they are overwritten only where the new set has the same name)."""
     path = out / MANIFEST
-    data = _read_bookkeeping(path)
+    data = _read_bookkeeping(path, folder)
     return set() if data is None else set(_names(data, path, "the manifest"))
 
 
-def _read_journal(out: Path) -> Journal | None:
+def _read_journal(out: Path, folder: int) -> Journal | None:
     path = out / JOURNAL
-    data = _read_bookkeeping(path)
+    data = _read_bookkeeping(path, folder)
     if data is None:
         return None
     if not isinstance(data, dict) or set(data) != {"staging", "new", "old"}:
@@ -254,63 +270,128 @@ def _read_journal(out: Path) -> Journal | None:
     return Journal(staging, _names(data["new"], path, "its new set"), _names(data["old"], path, "its old set"))
 
 
-def _check_staging(out: Path, name: str) -> None:
-    """A staging folder must be a real folder (not a link) holding only regular files of our names."""
-    folder = out / name
+def _open_staging(out: Path, folder: int, name: str) -> int | None:
+    """A staging folder opened without following a link (None when it is gone); ForeignFileError for a link or
+    anything but a folder."""
     try:
-        mode = os.lstat(folder).st_mode
+        return os.open(name, os.O_RDONLY | os.O_DIRECTORY | os.O_NOFOLLOW | os.O_CLOEXEC, dir_fd=folder)
     except FileNotFoundError:
-        return
-    if not stat.S_ISDIR(mode):
-        raise _foreign(folder, "not a folder")
+        return None
+    except OSError as exc:
+        if exc.errno in (errno.ELOOP, errno.ENOTDIR):
+            raise _foreign(out / name, "not a folder") from None
+        raise
+
+
+def _ours(entry: os.DirEntry) -> bool:
+    return entry.is_file(follow_symlinks=False) and (is_output_name(entry.name) or entry.name in (MANIFEST, JOURNAL))
+
+
+def _check_staging(path: Path, staging: int) -> None:
+    """A staging folder must hold only regular files of our names."""
+    for entry in os.scandir(staging):
+        if not _ours(entry):
+            raise _foreign(path / entry.name, "not a file of an output set")
+
+
+def _new_staging(folder: int) -> tuple[str, int]:
+    """A fresh staging folder of ours (mode 0700, the prefix and eight random characters): its name and a
+    descriptor, opened without following a link."""
+    while True:
+        name = STAGING_PREFIX + secrets.token_hex(4)
+        try:
+            os.mkdir(name, 0o700, dir_fd=folder)
+        except FileExistsError:
+            continue
+        return name, os.open(name, os.O_RDONLY | os.O_DIRECTORY | os.O_NOFOLLOW | os.O_CLOEXEC, dir_fd=folder)
+
+
+def _remove_staging(folder: int, name: str, staging: int | None = None) -> None:
+    """Remove a staging folder of ours: the regular files of our names in it, then the folder. Relative to its
+    descriptor: a link put in its place meanwhile is never followed. What cannot be removed is left for the
+    next run (which removes it, or refuses it when it is not ours)."""
+    opened = staging is None
+    if opened:
+        try:
+            staging = os.open(name, os.O_RDONLY | os.O_DIRECTORY | os.O_NOFOLLOW | os.O_CLOEXEC, dir_fd=folder)
+        except OSError:
+            return
     try:
-        entries = list(os.scandir(folder))
-    except FileNotFoundError:  # a run writing into the folder right now has just finished with it
-        return
-    for entry in entries:
-        if not (entry.is_file(follow_symlinks=False) and (is_output_name(entry.name) or
-                                                           entry.name in (MANIFEST, JOURNAL))):
-            raise _foreign(folder / entry.name, "not a file of an output set")
+        for entry in list(os.scandir(staging)):
+            if _ours(entry):
+                with contextlib.suppress(FileNotFoundError):
+                    os.unlink(entry.name, dir_fd=staging)
+    finally:
+        if opened:
+            os.close(staging)
+    with contextlib.suppress(OSError):
+        os.rmdir(name, dir_fd=folder)
 
 
-def _remove_staging(folder: Path) -> None:
-    """Remove a checked staging folder: its regular files, then the folder."""
-    with contextlib.suppress(FileNotFoundError):
-        for entry in os.scandir(folder):
-            if entry.is_file(follow_symlinks=False):
-                os.unlink(folder / entry.name)
-        os.rmdir(folder)
-
-
-def _switch(out: Path, journal: Journal) -> None:
+def _switch(folder: int, journal: Journal, staging: int | None) -> None:
     """Move the staged files into place, remove the old set's extra files, record the new set (the journal
-    and its names were validated)."""
-    staging = out / journal.staging
-    for name in journal.new:
-        if os.path.lexists(staging / name):
-            os.replace(staging / name, out / name)
-    for name in set(journal.old) - set(journal.new):
-        target = out / name
-        with contextlib.suppress(FileNotFoundError):
-            if not stat.S_ISDIR(os.lstat(target).st_mode):
-                target.unlink()
-    manifest = staging / MANIFEST
-    if not os.path.lexists(manifest):  # recovering: write the manifest in a fresh folder of ours
-        fresh = Path(tempfile.mkdtemp(prefix=STAGING_PREFIX, dir=out))
-        manifest = fresh / MANIFEST
-        _write_synced(manifest, json.dumps(list(journal.new)).encode())
-    os.replace(manifest, out / MANIFEST)
-    _sync_folder(out)
+    and its names were validated). `staging`: the journal's staging folder, opened (None: open it here)."""
+    opened = staging is None
+    if opened:
+        try:
+            staging = os.open(journal.staging, os.O_RDONLY | os.O_DIRECTORY | os.O_NOFOLLOW | os.O_CLOEXEC,
+                              dir_fd=folder)
+        except FileNotFoundError:
+            staging = None
+    try:
+        _move_in(folder, journal, staging)
+    finally:
+        if opened and staging is not None:
+            os.close(staging)
+    os.fsync(folder)
     with contextlib.suppress(FileNotFoundError):
-        (out / JOURNAL).unlink()
-    _remove_staging(staging)
-    _remove_staging(manifest.parent)
-    _sync_folder(out)
+        os.unlink(JOURNAL, dir_fd=folder)
+    _remove_staging(folder, journal.staging)
+    os.fsync(folder)
 
 
-def _write_synced(path: Path, content: bytes) -> None:
-    """A new file (never through an existing name or link) written and fsync'ed."""
-    fd = os.open(path, os.O_WRONLY | os.O_CREAT | os.O_EXCL | os.O_NOFOLLOW | os.O_CLOEXEC, 0o644)
+def _move_in(folder: int, journal: Journal, staging: int | None) -> None:
+    """The switch's renames and removals, relative to the folders' descriptors."""
+    for name in journal.new:
+        if staging is not None and _exists(staging, name):
+            os.replace(name, name, src_dir_fd=staging, dst_dir_fd=folder)
+    for name in set(journal.old) - set(journal.new):
+        with contextlib.suppress(FileNotFoundError):
+            if not stat.S_ISDIR(os.stat(name, dir_fd=folder, follow_symlinks=False).st_mode):
+                os.unlink(name, dir_fd=folder)
+    if staging is not None and _exists(staging, MANIFEST):
+        os.replace(MANIFEST, MANIFEST, src_dir_fd=staging, dst_dir_fd=folder)
+        return
+    fresh_name, fresh = _new_staging(folder)
+    try:
+        _write_synced(fresh, MANIFEST, json.dumps(list(journal.new)).encode())
+        os.replace(MANIFEST, MANIFEST, src_dir_fd=fresh, dst_dir_fd=folder)
+    finally:
+        os.close(fresh)
+        _remove_staging(folder, fresh_name)
+
+
+def _exists(folder: int, name: str) -> bool:
+    try:
+        os.stat(name, dir_fd=folder, follow_symlinks=False)
+        return True
+    except FileNotFoundError:
+        return False
+
+
+def _in_the_way(folder: int, name: str) -> bool:
+    """A target name held by a folder, a special file or a link to nothing (a link to a file is replaced)."""
+    if not _exists(folder, name):
+        return False
+    try:
+        return not stat.S_ISREG(os.stat(name, dir_fd=folder).st_mode)
+    except FileNotFoundError:  # a link to nothing
+        return True
+
+
+def _write_synced(folder: int, name: str, content: bytes) -> None:
+    """A new file in `folder` (never through an existing name or link) written and fsync'ed."""
+    fd = os.open(name, os.O_WRONLY | os.O_CREAT | os.O_EXCL | os.O_NOFOLLOW | os.O_CLOEXEC, 0o644, dir_fd=folder)
     with os.fdopen(fd, "wb") as handle:
         os.fchmod(fd, 0o644)  # whatever the umask: the set is readable like any other file
         handle.write(content)
@@ -318,23 +399,22 @@ def _write_synced(path: Path, content: bytes) -> None:
         os.fsync(handle.fileno())
 
 
-def _sync_folder(folder: Path) -> None:
-    fd = os.open(folder, os.O_RDONLY)
+@contextlib.contextmanager
+def _opened(out: Path):
+    """The output folder's descriptor (every operation on its entries is relative to it)."""
+    fd = os.open(out, os.O_RDONLY | os.O_DIRECTORY | os.O_CLOEXEC)
     try:
-        os.fsync(fd)
+        yield fd
     finally:
         os.close(fd)
 
 
 @contextlib.contextmanager
 def _locked(out: Path):
-    """An exclusive flock on the folder itself (no lock file is left behind)."""
-    fd = os.open(out, os.O_RDONLY | os.O_DIRECTORY)
-    try:
+    """The folder's descriptor, with an exclusive flock on the folder itself (no lock file is left behind)."""
+    with _opened(out) as fd:
         fcntl.flock(fd, fcntl.LOCK_EX)
-        yield
-    finally:
-        os.close(fd)  # closing releases the lock
+        yield fd  # closing releases the lock
 
 
 @contextlib.contextmanager

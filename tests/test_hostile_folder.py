@@ -13,8 +13,10 @@ from __future__ import annotations
 import json
 import os
 import resource
+import shutil
 import subprocess
 import sys
+import textwrap
 from pathlib import Path
 
 import pytest
@@ -212,3 +214,69 @@ def test_verify_and_grade_outputs_refuse_a_foreign_manifest_too(job, world, tmp_
     other.write_text("G0 X0\nM30\n" if command == "verify" else "1,2\n")
     before = tree(root)
     check_refused_untouched(spur_cad(command, job, other, "--out", out), before, root, out / MANIFEST)
+
+
+def test_a_manifest_naming_a_digit_of_another_script_is_refused(job, world):
+    """`\\d` in Python's patterns matches any script's digits: `roughing_space٣.ngc` (Arabic-Indic three) passed
+    as one of our names, and the run deleted the user's file of that name."""
+    root, out = world
+    name = "roughing_space\u0663.ngc"
+    (out / name).write_text("user")
+    (out / MANIFEST).write_text(json.dumps([name]))
+    before = tree(root)
+    check_refused_untouched(spur_cad("run", job, "--out", out, "--quiet"), before, root, out / MANIFEST)
+
+
+def test_a_staging_folder_swapped_for_a_link_after_its_check_is_never_followed(tmp_path):
+    """Between the check of a staging folder and its removal (or the switch's moves), whoever can write into the
+    output folder can put a link in its place. Every removal and move is relative to descriptors opened without
+    following links: here the swap is made at the worst moment by hand, with the functions the writer uses."""
+    from spur_cad.outputs import _opened, _remove_staging, _write_synced
+
+    out, victim = tmp_path / "out", tmp_path / "victim"
+    out.mkdir()
+    victim.mkdir()
+    (victim / "gear.step").write_text("the user's own gear")
+    name = STAGING_PREFIX + "abcd1234"
+    with _opened(out) as folder:
+        os.mkdir(name, dir_fd=folder)
+        staging = os.open(name, os.O_RDONLY | os.O_DIRECTORY, dir_fd=folder)
+        _write_synced(staging, "gear.step", b"staged")
+        os.rename(out / name, out / "moved_away")  # the swap: our folder away, a link to the victim in its place
+        (out / name).symlink_to(victim)
+        _remove_staging(folder, name, staging)  # removes what is in *our* folder, through its descriptor
+        os.close(staging)
+        _remove_staging(folder, name)  # by name: the link is not followed
+    assert (victim / "gear.step").read_text() == "the user's own gear"
+    assert list((out / "moved_away").iterdir()) == []  # our staged file went, from our folder
+
+
+@pytest.mark.slow
+def test_a_link_swapped_in_during_a_real_run_deletes_nothing_outside(job, world):
+    """The same swap raced against a real `spur-cad run` by a second process (the hostile review's reproducer:
+    before the fix, 3 runs of 3 deleted the victim folder's files)."""
+    root, out = world
+    swapper = textwrap.dedent(f"""
+        import os, time
+        out = {str(out)!r}
+        deadline = time.time() + 120
+        while time.time() < deadline:
+            if os.path.exists(os.path.join(out, {MANIFEST!r})):
+                names = [n for n in os.listdir(out) if n.startswith({STAGING_PREFIX!r})]
+                if names:
+                    try:
+                        os.rename(os.path.join(out, names[0]), os.path.join(out, "moved_away"))
+                        os.symlink({str(root / "victimdir")!r}, os.path.join(out, names[0]))
+                    except OSError:
+                        continue
+                    break
+    """)
+    for attempt in range(3):
+        for leftover in [p for p in out.iterdir() if p.name != "notes.txt"]:
+            leftover.unlink() if leftover.is_symlink() or leftover.is_file() else shutil.rmtree(leftover)
+        race = subprocess.Popen([sys.executable, "-c", swapper])
+        result = spur_cad("run", job, "--out", out, "--quiet")
+        race.wait(timeout=180)
+        assert result.returncode in (0, 2), result.stderr
+        assert (root / "victimdir" / "precious.txt").read_text() == "precious", attempt
+        assert (root / "victim.txt").read_text() == "victim"

@@ -327,3 +327,26 @@ def test_what_the_reader_keeps_per_definition_or_variable_is_bounded():
     with pytest.raises(ProgramReadError, match=f"variables.ngc:{MAX_VARIABLES + 1}: more than {MAX_VARIABLES:,} "
                                                "variables"):
         read_program(variables, "linuxcnc", "variables.ngc")
+
+
+@pytest.mark.parametrize("dialect, line", [
+    ("siemens", "R1=0" + "R1=" * 60 + "0 X"),  # a nested quantifier backtracked for 20 minutes, deaf to signals
+    ("okuma", "CALL O1" + " A=1" * 900 + " !"),
+    ("fanuc", "G65 P1" + " X1" * 1200 + " !"),
+    ("linuxcnc", "G0 X[" + "#1+" * 1200 + "]"),
+])
+def test_no_block_makes_the_reader_backtrack(job, tmp_path, dialect, line):
+    """A block of at most 4,096 characters is read in linear time (a regular expression runs in C, where no
+    signal can stop it): each of these ends at once, in a verdict or one line."""
+    path = tmp_path / "p.txt"
+    path.write_text(f"T1 M6\nG0 X0 Y0 Z50 A0\n{line}\nM30\n")
+    result = spur_cad("verify", job, path, "--dialect", dialect, "--quiet", timeout=30)
+    assert result.returncode in (1, 2) and "internal error" not in result.stderr, result.stderr
+
+
+def test_a_digit_of_another_script_is_not_a_number_to_the_reader():
+    from spur_cad.verify.reader import ProgramReadError, read_program
+
+    with pytest.raises(ProgramReadError, match=r"p:2: a character outside a comment that is not ASCII"):
+        read_program("T1 M6\nG0 X\u0661 Y0 Z50 A0\nM30\n", "linuxcnc", "p")
+    assert len(read_program("T1 M6\nG0 X1 Y0 Z50 A0 (caf\u00e9)\nM30\n", "linuxcnc", "p")) == 1

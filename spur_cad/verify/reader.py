@@ -147,6 +147,7 @@ _FANUC_CLOSE = re.compile(r"M0*99")
 _PROGRAM_NUMBER = re.compile(r"O\d+")
 _WORDS = re.compile(r"([A-Z])\s*(\[[^\]]*\]|#\d+|[-+]?(?:\d+\.?\d*|\.\d+))")
 _WORDS_ASSIGNED = re.compile(r"([A-Z])\s*(=\s*[^\s]+|\[[^\]]*\]|#\d+|[-+]?(?:\d+\.?\d*|\.\d+))")
+_R_PARAMETER = re.compile(r"R\d+=\S+")
 _ORDER = {"T": 0, "S": 0, "G": 1, "F": 2, "M": 3}  # T and S before M, G before F, then the rest in order
 
 
@@ -405,6 +406,8 @@ class _Reader:
                 continue
             self.blocks += 1
             line = _Line(number, text, here)
+            if not text.isascii():  # e.g. a digit of another script, which Python would read as a number
+                raise self.error(line, "a character outside a comment that is not ASCII (a controller reads none)")
             jump = self.control(line, (offset, number), depth) if _may_be_control(text, dialect) else None
             if jump is not None:
                 offset, number = jump
@@ -469,7 +472,7 @@ class _Reader:
                 raise self.error(line, f"loops and calls nested deeper than {MAX_CALL_DEPTH}")
             self._repeat(self._count(found.group(3), line), lambda: self.execute(first[0], last[1], depth + 1), line)
             return after
-        if re.fullmatch(r"(R\d+=\S+\s*)+", text):
+        if all(_R_PARAMETER.fullmatch(token) for token in text.split()):  # (no nested quantifier: linear time)
             for name, value in re.findall(r"(R\d+)=(\S+)", text):
                 self._set(name, self.value(value, line), line)
             return after
