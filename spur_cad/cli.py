@@ -208,18 +208,18 @@ def _run(args: argparse.Namespace, received: list[int], loaded: list) -> list:
         if bars is not None:
             bars.close()
     checkpoint()
-    paths = _write(out_dir, files)
+    paths = _write(out_dir, files, received)
     checkpoint()  # a signal while the set was switched: it is this run's set, and the message says so
     return paths
 
 
-def _write(out_dir, files: dict[str, bytes]) -> list:
+def _write(out_dir, files: dict[str, bytes], received: list[int]) -> list:
     """The output set written (spur_cad.outputs); a failure is one line naming the folder (exit 2)."""
     from spur_cad.errors import shown_path
     from spur_cad.outputs import OutputError, write_output_set
 
     try:
-        return write_output_set(out_dir, files)
+        return write_output_set(out_dir, files, lambda: _checkpoint(received))
     except OutputError:
         raise
     except OSError as exc:
@@ -263,7 +263,7 @@ def _verify(args: argparse.Namespace, received: list[int], loaded: list) -> int:
         print(line)
     if out_dir is not None:
         _checkpoint(received)
-        _write(out_dir, result_files(result))
+        _write(out_dir, result_files(result), received)
     rs274_failed = any(verdict.startswith("failed") for verdict in result.rs274.values())
     return 0 if result.passed and not rs274_failed else 1
 
@@ -303,7 +303,7 @@ def _grade(args: argparse.Namespace, received: list[int], loaded: list) -> int:
                                 + "\n").encode()}
         if any(trace.kind == "profile" for trace in grading["traces"]):
             files["k_chart.png"] = k_chart_png(spec, grading)
-        _write(out_dir, files)
+        _write(out_dir, files, received)
     if args.required_class is not None and (overall is None or overall > args.required_class):
         return 1
     return 0

@@ -37,6 +37,8 @@ import secrets
 import signal
 import stat
 import tempfile
+import time
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -45,6 +47,8 @@ from spur_cad.errors import SpurCadError, shown_path
 MANIFEST = ".spur_cad-set.json"
 JOURNAL = ".spur_cad-switching.json"
 STAGING_PREFIX = ".spur_cad-staging-"
+STAGING_MARK = ".spur_cad-staging"  # the first file of every staging folder: a folder without it is not ours
+LOCK_WAIT_S = 60.0  # another run holds the folder's lock for the milliseconds of its switch; longer is not a run
 MAX_BOOKKEEPING_BYTES = 64 * 1024  # a manifest or journal lists a few dozen names
 _PROGRAM_EXTENSION = r"(ngc|nc|mpf|min)"  # every milling and lathe dialect's (checked in tests/test_outputs.py)
 _OPERATION = r"(roughing|roughing_bottom|finishing)"
@@ -110,7 +114,8 @@ def is_output_name(name: str) -> bool:
     return isinstance(name, str) and OUTPUT_NAME.fullmatch(name) is not None
 
 
-def write_output_set(out_dir: str | os.PathLike, files: dict[str, bytes]) -> list[Path]:
+def write_output_set(out_dir: str | os.PathLike, files: dict[str, bytes],
+                     checkpoint: Callable[[], None] | None = None) -> list[Path]:
     """Replace the set in `out_dir` (created if needed) by `files` (name -> content; names of OUTPUT_NAME);
     returns the paths. Raises OutputError (ForeignFileError for a file not ours) with nothing changed.
 
@@ -125,7 +130,7 @@ def write_output_set(out_dir: str | os.PathLike, files: dict[str, bytes]) -> lis
         out.mkdir(parents=True, exist_ok=True)
     except OSError as exc:
         raise OutputError(f"--out {shown_path(out)}: cannot create it: {exc.strerror or exc}") from None
-    with _locked(out) as folder:
+    with _locked(out, checkpoint) as folder:
         _recover(out, folder)
         old = _read_manifest(out, folder)
         for name in files:
@@ -192,6 +197,11 @@ def _check_bookkeeping(out: Path, folder: int) -> tuple[Journal | None, list[str
     journal = _read_journal(out, folder)
     strays = [entry for entry in sorted(os.listdir(folder)) if STAGING_NAME.fullmatch(entry) and
               (journal is None or entry != journal.staging)]
+    if journal is not None:
+        blocked = [name for name in journal.new if _in_the_way(folder, name)]
+        if blocked:
+            raise OutputError(f"--out {shown_path(out)}: {blocked[0]} is in the way (a folder or special file) of "
+                              "an interrupted switch that the journal asks to complete; remove it")
     for name in [*strays, *([journal.staging] if journal is not None else [])]:
         staging = _open_staging(out, folder, name)
         if staging is not None:
@@ -284,12 +294,20 @@ def _open_staging(out: Path, folder: int, name: str) -> int | None:
 
 
 def _ours(entry: os.DirEntry) -> bool:
-    return entry.is_file(follow_symlinks=False) and (is_output_name(entry.name) or entry.name in (MANIFEST, JOURNAL))
+    return entry.is_file(follow_symlinks=False) and (is_output_name(entry.name) or
+                                                     entry.name in (MANIFEST, JOURNAL, STAGING_MARK))
 
 
 def _check_staging(path: Path, staging: int) -> None:
-    """A staging folder must hold only regular files of our names."""
-    for entry in os.scandir(staging):
+    """A staging folder must be one we made (ours by owner, mode 0700 and its mark) and hold only regular files
+    of our names: a user's folder renamed to the staging pattern is not emptied."""
+    info = os.fstat(staging)
+    if info.st_uid != os.geteuid() or stat.S_IMODE(info.st_mode) != 0o700:
+        raise _foreign(path, "not a folder spur_cad made: another owner or mode")
+    entries = list(os.scandir(staging))
+    if STAGING_MARK not in {entry.name for entry in entries}:
+        raise _foreign(path, f"no {STAGING_MARK} mark")
+    for entry in entries:
         if not _ours(entry):
             raise _foreign(path / entry.name, "not a file of an output set")
 
@@ -303,18 +321,29 @@ def _new_staging(folder: int) -> tuple[str, int]:
             os.mkdir(name, 0o700, dir_fd=folder)
         except FileExistsError:
             continue
-        return name, os.open(name, os.O_RDONLY | os.O_DIRECTORY | os.O_NOFOLLOW | os.O_CLOEXEC, dir_fd=folder)
+        staging = os.open(name, os.O_RDONLY | os.O_DIRECTORY | os.O_NOFOLLOW | os.O_CLOEXEC, dir_fd=folder)
+        try:
+            os.fchmod(staging, 0o700)  # whatever the umask
+            _write_synced(staging, STAGING_MARK, b"")
+        except BaseException:
+            os.close(staging)
+            raise
+        return name, staging
 
 
 def _remove_staging(folder: int, name: str, staging: int | None = None) -> None:
     """Remove a staging folder of ours: the regular files of our names in it, then the folder. Relative to its
-    descriptor: a link put in its place meanwhile is never followed. What cannot be removed is left for the
-    next run (which removes it, or refuses it when it is not ours)."""
+    descriptor (`staging`, or opened here without following a link and checked again as ours on that very
+    descriptor): a link or a user's folder put in its place meanwhile is never emptied. What cannot be removed
+    is left for the next run (which removes it, or refuses it when it is not ours)."""
     opened = staging is None
     if opened:
         try:
             staging = os.open(name, os.O_RDONLY | os.O_DIRECTORY | os.O_NOFOLLOW | os.O_CLOEXEC, dir_fd=folder)
-        except OSError:
+            _check_staging(Path(name), staging)
+        except (OSError, ForeignFileError):
+            if staging is not None:
+                os.close(staging)
             return
     try:
         for entry in list(os.scandir(staging)):
@@ -339,27 +368,34 @@ def _switch(folder: int, journal: Journal, staging: int | None) -> None:
         except FileNotFoundError:
             staging = None
     try:
-        _move_in(folder, journal, staging)
+        _move_in(folder, journal, staging, staged_manifest=not opened)
+        os.fsync(folder)
+        with contextlib.suppress(FileNotFoundError):
+            os.unlink(JOURNAL, dir_fd=folder)
+        if staging is not None:
+            _remove_staging(folder, journal.staging, staging)
     finally:
         if opened and staging is not None:
             os.close(staging)
     os.fsync(folder)
-    with contextlib.suppress(FileNotFoundError):
-        os.unlink(JOURNAL, dir_fd=folder)
-    _remove_staging(folder, journal.staging)
-    os.fsync(folder)
 
 
-def _move_in(folder: int, journal: Journal, staging: int | None) -> None:
-    """The switch's renames and removals, relative to the folders' descriptors."""
+def _move_in(folder: int, journal: Journal, staging: int | None, staged_manifest: bool) -> None:
+    """The switch's renames and removals, relative to the folders' descriptors. The manifest staged by this run
+    is moved in (`staged_manifest`); when completing an earlier run's switch it is written anew from the
+    journal's validated names."""
     for name in journal.new:
         if staging is not None and _exists(staging, name):
-            os.replace(name, name, src_dir_fd=staging, dst_dir_fd=folder)
+            try:
+                os.replace(name, name, src_dir_fd=staging, dst_dir_fd=folder)
+            except (IsADirectoryError, NotADirectoryError, PermissionError) as exc:  # made in its place meanwhile
+                raise OutputError(f"{name} is in the way of the switch ({exc.strerror}); the journal "
+                                  f"{JOURNAL} lets the next run complete it once {name} is removed") from None
     for name in set(journal.old) - set(journal.new):
         with contextlib.suppress(FileNotFoundError):
             if not stat.S_ISDIR(os.stat(name, dir_fd=folder, follow_symlinks=False).st_mode):
                 os.unlink(name, dir_fd=folder)
-    if staging is not None and _exists(staging, MANIFEST):
+    if staged_manifest and staging is not None and _exists(staging, MANIFEST):
         os.replace(MANIFEST, MANIFEST, src_dir_fd=staging, dst_dir_fd=folder)
         return
     fresh_name, fresh = _new_staging(folder)
@@ -367,8 +403,8 @@ def _move_in(folder: int, journal: Journal, staging: int | None) -> None:
         _write_synced(fresh, MANIFEST, json.dumps(list(journal.new)).encode())
         os.replace(MANIFEST, MANIFEST, src_dir_fd=fresh, dst_dir_fd=folder)
     finally:
+        _remove_staging(folder, fresh_name, fresh)
         os.close(fresh)
-        _remove_staging(folder, fresh_name)
 
 
 def _exists(folder: int, name: str) -> bool:
@@ -410,10 +446,24 @@ def _opened(out: Path):
 
 
 @contextlib.contextmanager
-def _locked(out: Path):
-    """The folder's descriptor, with an exclusive flock on the folder itself (no lock file is left behind)."""
+def _locked(out: Path, checkpoint: Callable[[], None] | None = None):
+    """The folder's descriptor, with an exclusive flock on the folder itself (no lock file is left behind).
+    Waits up to LOCK_WAIT_S for another holder, calling `checkpoint()` meanwhile (the CLI stops there on a
+    signal); a lock held longer is no run of ours (anyone who can read the folder can take it) and is refused."""
     with _opened(out) as fd:
-        fcntl.flock(fd, fcntl.LOCK_EX)
+        deadline = time.monotonic() + LOCK_WAIT_S
+        while True:
+            try:
+                fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+                break
+            except BlockingIOError:
+                if checkpoint is not None:
+                    checkpoint()
+                if time.monotonic() > deadline:
+                    raise OutputError(f"--out {shown_path(out)}: another process has held the folder's lock for "
+                                      f"{LOCK_WAIT_S:.0f} s (a spur_cad run holds it for milliseconds); nothing "
+                                      "was written") from None
+                time.sleep(0.05)
         yield fd  # closing releases the lock
 
 

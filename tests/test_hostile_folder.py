@@ -21,7 +21,7 @@ from pathlib import Path
 
 import pytest
 
-from spur_cad.outputs import JOURNAL, MANIFEST, STAGING_PREFIX
+from spur_cad.outputs import JOURNAL, MANIFEST, STAGING_MARK, STAGING_PREFIX
 
 TIME_LIMIT_S = 180
 MEMORY_LIMIT_BYTES = 6 * 1024**3
@@ -57,6 +57,14 @@ def tree(root: Path) -> dict[str, object]:
             else:
                 entries[key] = ("file", path.read_bytes())
     return entries
+
+
+def ours_staging(path: Path) -> Path:
+    """A staging folder as a killed run leaves it: mode 0700, its mark, owned by this user."""
+    path.mkdir()
+    path.chmod(0o700)
+    (path / STAGING_MARK).write_bytes(b"")
+    return path
 
 
 def check_refused_untouched(result: subprocess.CompletedProcess, before: dict, root: Path, blamed: Path) -> None:
@@ -152,11 +160,25 @@ def test_a_staging_folder_that_links_elsewhere_is_refused(job, world):
     check_refused_untouched(spur_cad("run", job, "--out", out, "--quiet"), before, root, staging)
 
 
+@pytest.mark.parametrize("mode, mark", [(0o755, True), (0o700, False)], ids=["mode-755", "no-mark"])
+def test_a_users_folder_renamed_to_the_staging_pattern_is_not_emptied(job, world, mode, mark):
+    """Renaming a folder needs write access to its parent only: anyone who can write into a shared output folder
+    could rename a user's folder of our names to the staging pattern. A folder we did not make (another mode,
+    no mark) is refused, its files kept."""
+    root, out = world
+    folder = out / (STAGING_PREFIX + "abcd1234")
+    folder.mkdir()
+    folder.chmod(mode)
+    for name in ("gear.step", "summary.json") + ((STAGING_MARK,) if mark else ()):
+        (folder / name).write_text(f"the user's {name}")
+    before = tree(root)
+    check_refused_untouched(spur_cad("run", job, "--out", out, "--quiet"), before, root, folder)
+
+
 @pytest.mark.parametrize("planted", ["subfolder", "link", "user-file"])
 def test_a_stray_staging_folder_holding_what_we_never_write_is_refused(job, world, planted):
     root, out = world
-    staging = out / (STAGING_PREFIX + "zz99zz99")
-    staging.mkdir()
+    staging = ours_staging(out / (STAGING_PREFIX + "zz99zz99"))
     (staging / "gear.step").write_bytes(b"half-written")  # what a killed run leaves: ours
     if planted == "subfolder":
         (staging / "photos").mkdir()
@@ -239,8 +261,10 @@ def test_a_staging_folder_swapped_for_a_link_after_its_check_is_never_followed(t
     (victim / "gear.step").write_text("the user's own gear")
     name = STAGING_PREFIX + "abcd1234"
     with _opened(out) as folder:
-        os.mkdir(name, dir_fd=folder)
+        os.mkdir(name, 0o700, dir_fd=folder)
         staging = os.open(name, os.O_RDONLY | os.O_DIRECTORY, dir_fd=folder)
+        os.fchmod(staging, 0o700)
+        _write_synced(staging, STAGING_MARK, b"")
         _write_synced(staging, "gear.step", b"staged")
         os.rename(out / name, out / "moved_away")  # the swap: our folder away, a link to the victim in its place
         (out / name).symlink_to(victim)
@@ -248,7 +272,7 @@ def test_a_staging_folder_swapped_for_a_link_after_its_check_is_never_followed(t
         os.close(staging)
         _remove_staging(folder, name)  # by name: the link is not followed
     assert (victim / "gear.step").read_text() == "the user's own gear"
-    assert list((out / "moved_away").iterdir()) == []  # our staged file went, from our folder
+    assert not (out / "moved_away" / "gear.step").exists()  # our staged file went, from our folder
 
 
 @pytest.mark.slow
@@ -280,3 +304,54 @@ def test_a_link_swapped_in_during_a_real_run_deletes_nothing_outside(job, world)
         assert result.returncode in (0, 2), result.stderr
         assert (root / "victimdir" / "precious.txt").read_text() == "precious", attempt
         assert (root / "victim.txt").read_text() == "victim"
+
+
+def test_an_interrupted_switch_blocked_by_a_folder_is_refused_before_anything_changes(job, world):
+    """A folder made at a name of the new set while a switch ran: the next run names it at once."""
+    root, out = world
+    staging = ours_staging(out / (STAGING_PREFIX + "abcd1234"))
+    (staging / "gear.step").write_text("staged")
+    (out / "gear.step").mkdir()
+    (out / JOURNAL).write_text(json.dumps({"staging": staging.name, "new": ["gear.step"], "old": []}))
+    before = tree(root)
+    result = spur_cad("run", job, "--out", out, "--quiet")
+    assert result.returncode == 2 and len(result.stderr.splitlines()) == 1, result.stderr
+    assert "gear.step is in the way" in result.stderr and "interrupted switch" in result.stderr
+    assert tree(root) == before
+
+
+def test_a_staged_manifest_is_not_trusted_when_a_switch_is_completed(job, world):
+    """Completing an earlier switch writes the manifest anew from the journal's checked names: a staged manifest
+    that is not ours is never moved in (it used to be, and then every run was refused)."""
+    root, out = world
+    staging = ours_staging(out / (STAGING_PREFIX + "abcd1234"))
+    (staging / "gear.step").write_text("staged")
+    (staging / MANIFEST).write_text('"x"')
+    (out / JOURNAL).write_text(json.dumps({"staging": staging.name, "new": ["gear.step"], "old": []}))
+    result = spur_cad("run", job, "--out", out, "--quiet")
+    assert result.returncode == 0, result.stderr
+    assert "summary.json" in json.loads((out / MANIFEST).read_text())
+
+
+@pytest.mark.slow
+def test_a_lock_held_by_another_process_does_not_make_the_run_deaf(job, world):
+    """Anyone who can read the folder can hold its lock: the run waits (a run of ours holds it for
+    milliseconds), and a signal still stops it with the one line."""
+    import fcntl
+    import signal
+    import time
+
+    root, out = world
+    holder = os.open(out, os.O_RDONLY)
+    fcntl.flock(holder, fcntl.LOCK_EX)
+    try:
+        child = subprocess.Popen([sys.executable, "-m", "spur_cad.cli", "run", str(job), "--out", str(out),
+                                  "--quiet"], stderr=subprocess.PIPE, text=True)
+        time.sleep(20)  # the small job's computation takes about 6 s: the run waits for the lock by then
+        child.send_signal(signal.SIGINT)
+        _, err = child.communicate(timeout=30)
+    finally:
+        os.close(holder)
+    assert child.returncode == 130, err
+    assert err.startswith("spur-cad: interrupted") and len(err.splitlines()) == 1
+    assert not (out / MANIFEST).exists()

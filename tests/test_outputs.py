@@ -16,6 +16,7 @@ import pytest
 from spur_cad.outputs import (
     JOURNAL,
     MANIFEST,
+    STAGING_MARK,
     STAGING_PREFIX,
     OutputError,
     current_set,
@@ -79,7 +80,9 @@ def test_an_interrupted_switch_is_completed_by_the_next_run(tmp_path):
     out = tmp_path / "out"
     write_output_set(out, {"gear.step": b"old a", "finishing.ngc": b"old"})
     staging = out / (STAGING_PREFIX + "abcd1234")
-    staging.mkdir()
+    staging.mkdir(mode=0o700)  # as the writer makes it: mode 0700, its mark first
+    staging.chmod(0o700)
+    (staging / STAGING_MARK).write_bytes(b"")
     (staging / "stock.step").write_bytes(b"new b")
     (staging / MANIFEST).write_text(json.dumps(["gear.step", "stock.step"]))
     (out / "gear.step").write_bytes(b"new a")  # already moved before the kill
