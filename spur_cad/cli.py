@@ -22,7 +22,7 @@ import warnings
 from typing import NoReturn
 
 from spur_cad import __version__
-from spur_cad.errors import SpurCadError, one_line
+from spur_cad.errors import SpurCadError, escaped, one_line
 
 EXIT_INPUT_ERROR = 2
 EXIT_INTERNAL_ERROR = 3
@@ -337,7 +337,7 @@ def _main(argv: list[str] | None, received: list[int]) -> int:
         return EXIT_INTERNAL_ERROR
     if not args.quiet:
         for path in paths:
-            print(f"wrote {path}")
+            print(f"wrote {escaped(str(path))}")  # a folder name's control characters as escapes
     return 0
 
 
