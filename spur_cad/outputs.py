@@ -367,6 +367,12 @@ def _switch(folder: int, journal: Journal, staging: int | None) -> None:
                               dir_fd=folder)
         except FileNotFoundError:
             staging = None
+        if staging is not None:
+            try:  # checked again on this very descriptor: the name may have been given to another folder
+                _check_staging(Path(journal.staging), staging)
+            except BaseException:
+                os.close(staging)
+                raise
     try:
         _move_in(folder, journal, staging, staged_manifest=not opened)
         os.fsync(folder)
