@@ -280,11 +280,16 @@ def _read_journal(out: Path, folder: int) -> Journal | None:
     return Journal(staging, _names(data["new"], path, "its new set"), _names(data["old"], path, "its old set"))
 
 
+def _open_child_folder(folder: int, name: str) -> int:
+    """A descriptor of the folder `name` inside `folder`, opened without following a link (OSError otherwise)."""
+    return os.open(name, os.O_RDONLY | os.O_DIRECTORY | os.O_NOFOLLOW | os.O_CLOEXEC, dir_fd=folder)
+
+
 def _open_staging(out: Path, folder: int, name: str) -> int | None:
     """A staging folder opened without following a link (None when it is gone); ForeignFileError for a link or
     anything but a folder."""
     try:
-        return os.open(name, os.O_RDONLY | os.O_DIRECTORY | os.O_NOFOLLOW | os.O_CLOEXEC, dir_fd=folder)
+        return _open_child_folder(folder, name)
     except FileNotFoundError:
         return None
     except OSError as exc:
@@ -321,7 +326,7 @@ def _new_staging(folder: int) -> tuple[str, int]:
             os.mkdir(name, 0o700, dir_fd=folder)
         except FileExistsError:
             continue
-        staging = os.open(name, os.O_RDONLY | os.O_DIRECTORY | os.O_NOFOLLOW | os.O_CLOEXEC, dir_fd=folder)
+        staging = _open_child_folder(folder, name)
         try:
             os.fchmod(staging, 0o700)  # whatever the umask
             _write_synced(staging, STAGING_MARK, b"")
@@ -339,7 +344,7 @@ def _remove_staging(folder: int, name: str, staging: int | None = None) -> None:
     opened = staging is None
     if opened:
         try:
-            staging = os.open(name, os.O_RDONLY | os.O_DIRECTORY | os.O_NOFOLLOW | os.O_CLOEXEC, dir_fd=folder)
+            staging = _open_child_folder(folder, name)
             _check_staging(Path(name), staging)
         except (OSError, ForeignFileError):
             if staging is not None:
@@ -363,8 +368,7 @@ def _switch(folder: int, journal: Journal, staging: int | None) -> None:
     opened = staging is None
     if opened:
         try:
-            staging = os.open(journal.staging, os.O_RDONLY | os.O_DIRECTORY | os.O_NOFOLLOW | os.O_CLOEXEC,
-                              dir_fd=folder)
+            staging = _open_child_folder(folder, journal.staging)
         except FileNotFoundError:
             staging = None
         if staging is not None:
