@@ -283,25 +283,24 @@ def _grade(args: argparse.Namespace, received: list[int], loaded: list) -> int:
     spec = loaded[0].gear
     grading = grade_measured(spec, read_points_file(args.measured))
     _checkpoint(received)
-    fit = grading["fit"]
-    print(f"fit: rotation {fit['rotation_deg']:.4f} deg, centre ({fit['centre_mm'][0]:.4f}, "
-          f"{fit['centre_mm'][1]:.4f}) mm, rms {fit['rms_deviation_um']:.2f} um over {grading['points']} points")
-    for name, value in grading["deviations_um"].items():
-        grade = grading["classes"][name]
+    fit = grading.fit
+    print(f"fit: rotation {fit.rotation_deg:.4f} deg, centre ({fit.centre_mm[0]:.4f}, "
+          f"{fit.centre_mm[1]:.4f}) mm, rms {fit.rms_deviation_um:.2f} um over {grading.points} points")
+    for name, value in grading.deviations_um.items():
+        grade = grading.classes[name]
         print(f"{name}: {value:.2f} um, class {grade if grade else 'beyond 11'}")
-    for note in grading["notes"]:
+    for note in grading.notes:
         print(f"note: {note}")
-    overall = grading["class"]
-    if not grading["classes"]:
+    overall = grading.overall_class
+    if not grading.classes:
         print("not graded: no flank had three points in its evaluation range")
     else:
         print(f"ISO 1328-1:2013 flank tolerance class: {overall if overall else 'beyond 11'}")
     if out_dir is not None:
         from spur_cad.report.figures import k_chart_png
 
-        files = {"grade.json": (json.dumps({k: v for k, v in grading.items() if k != "traces"}, indent=2)
-                                + "\n").encode()}
-        if any(trace.kind == "profile" for trace in grading["traces"]):
+        files = {"grade.json": (json.dumps(grading.to_json(), indent=2) + "\n").encode()}
+        if grading.has_profile_traces:
             files["k_chart.png"] = k_chart_png(spec, grading)
         _write(out_dir, files, received)
     if args.required_class is not None and (overall is None or overall > args.required_class):

@@ -11,7 +11,8 @@ import math
 from dataclasses import dataclass
 
 from spur_cad.errors import require_instance
-from spur_cad.geometry.spec import GearSpec, inverse_involute_function, involute_function
+from spur_cad.geometry.involute import inverse_involute_function, involute_function
+from spur_cad.geometry.spec import GearSpec
 
 PIN_DIAMETER_STEP_MM = 0.01  # gauge pins are stocked in 0.01 mm steps
 

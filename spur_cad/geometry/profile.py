@@ -23,12 +23,16 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 from scipy.optimize import brentq, minimize_scalar
 
 from spur_cad.errors import GearSpecError
-from spur_cad.geometry.spec import GearSpec, involute_function
+from spur_cad.geometry.involute import involute_function
+
+if TYPE_CHECKING:  # annotations only: spec.py builds profiles with this module (no import loop)
+    from spur_cad.geometry.spec import GearSpec
 
 SEGMENT_LABELS = ("root", "fillet", "involute", "tip")
 

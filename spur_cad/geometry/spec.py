@@ -12,6 +12,7 @@ from dataclasses import dataclass, field, fields
 from typing import TYPE_CHECKING
 
 from spur_cad.errors import GearSpecError
+from spur_cad.geometry.involute import involute_function
 
 if TYPE_CHECKING:  # pragma: no cover
     from spur_cad.geometry.profile import ToothSpaceProfile
@@ -21,27 +22,6 @@ MAX_TEETH = 1000
 MAX_HELIX_ANGLE_DEG = 45.0
 """Largest helix angle accepted (ISO 1328-1's range; beyond it the transverse tooth gets very long)."""
 HANDS = ("right", "left")
-
-
-def involute_function(angle_rad: float) -> float:
-    """inv(a) = tan(a) - a, the polar angle of an involute point with pressure angle a."""
-    return math.tan(angle_rad) - angle_rad
-
-
-def inverse_involute_function(value: float) -> float:
-    """The pressure angle a in [0, pi/2) with inv(a) = value (Newton on a monotone function)."""
-    if value < 0.0:
-        raise ValueError(f"inv(a) is never negative, got {value}")
-    if value == 0.0:
-        return 0.0
-    # Cube-root start (inv(a) ~ a^3/3 for small a), then Newton; converges in a few steps.
-    angle = min((3.0 * value) ** (1.0 / 3.0), 1.5)
-    for _ in range(100):
-        step = (involute_function(angle) - value) / math.tan(angle) ** 2
-        angle = min(max(angle - step, 1e-12), math.pi / 2 - 1e-12)
-        if abs(step) < 1e-16:
-            break
-    return angle
 
 
 def _shown(value: object, limit: int = 40) -> str:

@@ -17,8 +17,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from spur_cad.errors import SpurCadError
-from spur_cad.grade.iso1328 import DEVIATIONS, KINDS, class_of, pitch_deviations, validity_problems
-from spur_cad.grade.simulated import Trace, helix_range_mm, profile_range_mm
+from spur_cad.grade.grading import Grading, MeasuredFit, Trace, add_pitch, classes_of, validity, worst_deviations
+from spur_cad.grade.simulated import helix_range_mm, profile_range_mm
 
 MAX_POINTS = 2_000_000
 MAX_MEASURED_BYTES = 128 * 1024 * 1024  # a scan of MAX_POINTS points (about 70 MB of text) fits
@@ -180,38 +180,28 @@ def _flank_traces(spec, measured: MeasuredPoints, deviation, nearest, design):
     return found, positions
 
 
-def grade_measured(spec, measured: MeasuredPoints) -> dict:
+def grade_measured(spec, measured: MeasuredPoints) -> Grading:
     """ISO 1328-1 deviations and classes of the measured flanks (worst over the flanks measured). Spur gears:
     a helical gear's transverse sections turn with X, which this fit does not follow yet (refused)."""
-    from spur_cad.grade.simulated import worst_deviations
-
     if spec.is_helical:
         raise SpurCadError("grading measured points of a helical gear is not supported yet (spur gears only)")
     design = _design(spec)
     params, deviation, nearest = fit(spec, measured, design)
-    d, b, m = 2.0 * spec.reference_radius_mm, spec.face_width_mm, spec.module_mm
     found_traces, positions = _flank_traces(spec, measured, deviation, nearest, design)
     worst, where = worst_deviations(found_traces)
     complete = [(flank_side, p) for flank_side, p in positions.items() if len(p) == spec.teeth]
     for flank_side, flank_positions in complete:  # pitch needs every flank of one side
-        single, f_pt, f_p = pitch_deviations(np.array([flank_positions[k] for k in range(spec.teeth)]))
-        if f_pt > worst["f_pt"]:
-            worst["f_pt"], where["f_pt"] = f_pt, {"side": flank_side, "space": int(np.argmax(np.abs(single)))}
-        worst["F_p"] = max(worst["F_p"], f_p)
-    measured_kinds = {name for name in worst if name not in ("f_pt", "F_p")} | ({"f_pt", "F_p"} if complete else set())
+        add_pitch(worst, where, flank_side, np.array([flank_positions[k] for k in range(spec.teeth)]))
+    graded = {name for name in worst if name not in ("f_pt", "F_p")} | ({"f_pt", "F_p"} if complete else set())
     outside = sorted({float(x) for x in np.unique(np.round(measured.axial, 3))
                       if not -1e-9 <= x <= spec.face_width_mm + 1e-9})
-    classes = {DEVIATIONS[kind]: class_of(kind, worst[DEVIATIONS[kind]], d, b, m) for kind in KINDS
-               if DEVIATIONS[kind] in measured_kinds}
-    overall = None if not classes or any(c is None for c in classes.values()) else max(classes.values())
+    classes, overall = classes_of(spec, worst, graded)
     pitch = 2.0 * math.pi / spec.teeth
     turn = -((params[0] + 0.5 * pitch) % pitch - 0.5 * pitch)  # the scan's turn from the design, within a pitch
-    return {"standard": "ISO 1328-1:2013", "points": int(len(measured.plane_x)),
-            "notes": [f"planes at X = {', '.join(f'{x:g}' for x in outside)} mm lie outside the face width "
-                      f"[0, {spec.face_width_mm:g}] mm (X is measured from the gear's front face)"] if outside else [],
-            "fit": {"rotation_deg": math.degrees(turn), "centre_mm": [float(params[1]), float(params[2])],
-                    "rms_deviation_um": float(np.sqrt(np.mean(deviation ** 2)) * 1000.0)},
-            "deviations_um": {name: round(value, 3) for name, value in worst.items() if name in measured_kinds},
-            "where": where, "classes": classes, "class": overall,
-            "validity": validity_problems(spec.teeth, d, m, b, math.degrees(spec.helix_angle_rad)),
-            "traces": found_traces}
+    notes = (f"planes at X = {', '.join(f'{x:g}' for x in outside)} mm lie outside the face width "
+             f"[0, {spec.face_width_mm:g}] mm (X is measured from the gear's front face)",) if outside else ()
+    return Grading(deviations_um={name: round(value, 3) for name, value in worst.items() if name in graded},
+                   where=where, classes=classes, overall_class=overall, validity=validity(spec),
+                   traces=tuple(found_traces), points=int(len(measured.plane_x)), notes=notes,
+                   fit=MeasuredFit(math.degrees(turn), (float(params[1]), float(params[2])),
+                                   float(np.sqrt(np.mean(deviation ** 2)) * 1000.0)))

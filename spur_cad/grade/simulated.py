@@ -20,36 +20,21 @@ The gear's grade is the worst class over every deviation of every flank.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
 
 import numpy as np
 
-from spur_cad.grade.iso1328 import (
-    DEVIATIONS,
-    KINDS,
-    class5_um,
-    class_of,
-    evaluate_trace,
-    pitch_deviations,
-    tolerance_um,
-    validity_problems,
+from spur_cad.grade.grading import (
+    Grading,
+    Trace,
+    add_pitch,
+    class5,
+    classes_of,
+    validity,
+    worst_deviations,
 )
 
 SIDES = ("right", "left")
 TIP_EXCLUDED_FRACTION = 0.05
-
-
-@dataclass(frozen=True)
-class Trace:
-    """One measured trace: where (space, side, X for a profile trace), positions (mm) and deviations (um)."""
-
-    kind: str  # "profile" or "helix"
-    space: int
-    side: str
-    x_mm: float | None
-    position_mm: np.ndarray
-    deviation_um: np.ndarray
-    evaluation: tuple[float, float]
 
 
 def helix_range_mm(face_width_mm: float, module_mm: float) -> tuple[float, float]:
@@ -107,54 +92,14 @@ def flank_positions_um(spec, result, side: str) -> np.ndarray:
     return np.array([result.deviation[k][mask][reference, middle] * 1000.0 / cos_alpha for k in range(grid.teeth)])
 
 
-def worst_deviations(measured: list[Trace]) -> tuple[dict[str, float], dict[str, dict]]:
-    """The worst (largest |value|) profile and helix slope, form and total deviation over the traces, and where
-    each is; traces with fewer than three points in their evaluation range are left out, and a deviation no
-    trace gave is missing from both dicts (not 0: it was not measured)."""
-    worst = {name: 0.0 for name in DEVIATIONS.values()}
-    where: dict[str, dict] = {}
-    evaluated: set[str] = set()
-    for trace in measured:
-        try:
-            values = evaluate_trace(trace.position_mm, trace.deviation_um, *trace.evaluation)
-        except ValueError:
-            continue
-        names = ("f_Ha", "f_fa", "F_a") if trace.kind == "profile" else ("f_Hb", "f_fb", "F_b")
-        for name, value in zip(names, (values.slope_um, values.form_um, values.total_um)):
-            evaluated.add(name)
-            if abs(value) >= abs(worst[name]) and (name not in where or abs(value) > abs(worst[name])):
-                worst[name] = value
-                where[name] = {"space": trace.space, "side": trace.side, "x_mm": trace.x_mm}
-    return {name: value for name, value in worst.items() if name in evaluated or name in ("f_pt", "F_p")}, where
-
-
-def grade_simulation(spec, result) -> dict:
-    """The gear's ISO 1328-1 deviations (worst over all flanks), their classes, the gear's class, the class-5
-    tolerances and the validity of the formulas, as JSON-ready data; plus the traces for charts."""
-    d, b, m = 2.0 * spec.reference_radius_mm, spec.face_width_mm, spec.module_mm
+def grade_simulation(spec, result) -> Grading:
+    """The gear's ISO 1328-1 grade from the simulated cut: worst deviations over all flanks, their classes, the
+    gear's class, the class-5 tolerances, every space's pitch, the validity of the formulas and the traces."""
     measured = traces(spec, result)
     worst, where = worst_deviations(measured)
-    pitch = {}
-    for side in SIDES:
-        single, f_pt, f_p = pitch_deviations(flank_positions_um(spec, result, side))
-        pitch[side] = {"single_um": [round(float(v), 3) for v in single], "f_pt_um": f_pt, "F_p_um": f_p}
-        if f_pt > worst["f_pt"]:
-            worst["f_pt"], where["f_pt"] = f_pt, {"side": side, "space": int(np.argmax(np.abs(single)))}
-        if f_p > worst["F_p"]:
-            worst["F_p"], where["F_p"] = f_p, {"side": side}
-    classes = {DEVIATIONS[kind]: class_of(kind, worst[DEVIATIONS[kind]], d, b, m) for kind in KINDS
-               if DEVIATIONS[kind] in worst}
-    grades = [grade for grade in classes.values()]
-    overall = None if any(grade is None for grade in grades) else max(grades)
-    return {
-        "standard": "ISO 1328-1:2013",
-        "deviations_um": {name: round(value, 3) for name, value in worst.items()},
-        "where": where,
-        "classes": classes,
-        "class": overall,
-        "class5_tolerances_um": {kind: tolerance_um(kind, 5, d, b, m) for kind in KINDS},
-        "class5_unrounded_um": {kind: round(value, 3) for kind, value in class5_um(d, b, m).items()},
-        "pitch": pitch,
-        "validity": validity_problems(spec.teeth, d, m, b, math.degrees(spec.helix_angle_rad)),
-        "traces": measured,
-    }
+    pitch = {side: add_pitch(worst, where, side, flank_positions_um(spec, result, side)) for side in SIDES}
+    classes, overall = classes_of(spec, worst, set(worst))
+    tolerances, unrounded = class5(spec)
+    return Grading(deviations_um={name: round(value, 3) for name, value in worst.items()}, where=where,
+                   classes=classes, overall_class=overall, validity=validity(spec), traces=tuple(measured),
+                   class5_tolerances_um=tolerances, class5_unrounded_um=unrounded, pitch=pitch)

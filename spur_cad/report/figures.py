@@ -15,6 +15,7 @@ from spur_cad.report.plots import _png
 
 if TYPE_CHECKING:
     from spur_cad.cam.tools import Tool
+    from spur_cad.grade.grading import Grading
     from spur_cad.sim.simulate import SimResult
 
 
@@ -133,14 +134,14 @@ def deviation_map_png(result: SimResult) -> bytes:
     return _png(fig)
 
 
-def k_chart_png(spec: GearSpec, grading: dict) -> bytes:
+def k_chart_png(spec: GearSpec, grading: Grading) -> bytes:
     """A gear measuring machine's chart for the tooth space with the largest total profile deviation: its
     right and left profile traces (deviation against roll length, the three face positions) and helix traces,
     the evaluation ranges and the tolerance band of the gear's class (the total tolerance F_aT / F_bT, drawn
     around each trace's mean)."""
     from spur_cad.grade.iso1328 import tolerance_um
 
-    traces = grading["traces"]
+    traces = grading.traces
     profile = [t for t in traces if t.kind == "profile"]
 
     def spread_in_range(trace) -> float:
@@ -148,7 +149,7 @@ def k_chart_png(spec: GearSpec, grading: dict) -> bytes:
         return float(np.ptp(trace.deviation_um[inside])) if inside.any() else 0.0
 
     worst = max(profile, key=spread_in_range).space
-    grade = grading["class"] or 11
+    grade = grading.overall_class or 11
     d, b, m = 2.0 * spec.reference_radius_mm, spec.face_width_mm, spec.module_mm
     fig = Figure(figsize=(9.0, 6.5))  # fixed margins: a constrained layout costs a second per report
     fig.subplots_adjust(left=0.08, right=0.98, bottom=0.08, top=0.95, wspace=0.25, hspace=0.4)
