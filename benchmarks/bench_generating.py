@@ -38,9 +38,9 @@ def recommended_tool(job: Job):
     """The generating advice's largest tool with the advised corner radius, rounded down to 0.1 mm, four
     flutes, the job's cutting data (a catalogue-like choice)."""
     advice = plan_cam(job).finishing.result.tool_advice
-    diameter = math.floor(10.0 * advice["recommended_diameter_mm"]) / 10.0
+    diameter = math.floor(10.0 * advice.recommended_diameter_mm) / 10.0
     return dataclasses.replace(job.tools.finishing, diameter_mm=diameter,
-                               corner_radius_mm=advice["advised_corner_radius_mm"], flutes=4)
+                               corner_radius_mm=advice.advised_corner_radius_mm, flutes=4)
 
 
 def figures(job: Job) -> list[dict]:

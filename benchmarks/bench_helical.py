@@ -32,7 +32,7 @@ def figures(job: Job, runs: int) -> dict:
                      "with_acceleration_h": op.estimate.time_with_acceleration_s / 3600.0,
                      "folded_lines": lines[True], "flat_lines": lines[False]}
     out["finishing"]["passes_per_space"] = plan.finishing.result.passes_per_space
-    out["finishing"]["facts"] = plan.finishing.result.facts
+    out["finishing"]["facts"] = dataclasses.asdict(plan.finishing.result.facts)
     result = simulate_stage(job, plan)
     out["sim_s"] = median_seconds(lambda: simulate_stage(job, plan), runs)
     out["sim"] = {"max_gouge_um": 1000 * result.max_gouge_mm, "max_leftover_um": 1000 * result.max_leftover_mm,

@@ -58,8 +58,8 @@ def figures(runs: int) -> dict:
     result = simulate_stage(job, plan)
     out["grade_s"] = median_seconds(lambda: grade_simulation(job.gear, result), runs)
     grading = grade_simulation(job.gear, result)
-    out["grading"] = {"class": grading["class"], "deviations_um": grading["deviations_um"],
-                      "classes": grading["classes"]}
+    out["grading"] = {"class": grading.overall_class, "deviations_um": grading.deviations_um,
+                      "classes": grading.classes}
     return out
 
 

@@ -203,7 +203,7 @@ def _run(args: argparse.Namespace, received: list[int], loaded: list) -> list:
             bars(stage, fraction)
 
     try:
-        files = run_job(loaded[0], progress, checkpoint, restart)
+        files = run_job(loaded[0], progress, checkpoint, restart).files
     finally:
         if bars is not None:
             bars.close()

@@ -8,6 +8,7 @@ the same job. The stages: profile -> CAD -> CAM plan (spur_cad.cam.plan) -> post
 
 from __future__ import annotations
 
+import dataclasses
 import io
 import json
 import time
@@ -20,10 +21,12 @@ from spur_cad.cam.plan import CamInputs, CamPlan
 from spur_cad.cam.plan import plan_cam as plan_cam_inputs
 from spur_cad.geometry.sampling import ProfileSamples, sample_profile
 from spur_cad.job import Job
-from spur_cad.summary import CadResult, build_summary
+from spur_cad.result import CadResult, JobResult
+from spur_cad.summary import build_result, summary_json
 
 if TYPE_CHECKING:
     from spur_cad.cam.restart import RestartPoint
+    from spur_cad.grade.grading import Grading
     from spur_cad.post.program import PostedProgram
     from spur_cad.sim.simulate import SimResult, StockCylinder
 
@@ -37,8 +40,9 @@ def profile_csv(samples: ProfileSamples) -> bytes:
 
 
 def run_job(job: Job, progress: Callable[[str, float], None] | None = None,
-            checkpoint: Callable[[], None] | None = None, restart: RestartPoint | None = None) -> dict[str, bytes]:
-    """Compute every output of the job in memory (no file I/O). `progress(stage, fraction)` is told how
+            checkpoint: Callable[[], None] | None = None, restart: RestartPoint | None = None) -> JobResult:
+    """Compute every output of the job in memory (no file I/O): the typed result with its output set in
+    `files` ({name: bytes}, for spur_cad.outputs.write_output_set). `progress(stage, fraction)` is told how
     far each long stage is (the CLI draws progress bars with it); `checkpoint()` is called before every
     stage (the CLI stops there when a signal has arrived, never inside a library). `restart` adds a program
     restarting an operation there (restart_program)."""
@@ -77,17 +81,29 @@ def run_job(job: Job, progress: Callable[[str, float], None] | None = None,
         program_files[name] = text
     sim_result = timed("simulation", "simulation",
                        lambda: simulate_stage(job, plan, lambda fraction: tell("simulation", fraction)))
-    summary = build_summary(job, samples, cad, plan, job.post, programs, sim_result, seconds)
-    report = timed("report", "report", lambda: report_html(summary, png, job.gear,
+    grading = timed("grading", None, lambda: grade_stage(job, sim_result))
+    result = build_result(job, samples, cad, plan, job.post, programs, sim_result, grading, seconds)
+    report = timed("report", "report", lambda: report_html(result, png, job.gear,
                                                           job.stock.blank_radius_mm(job.gear), plan, sim_result))
-    return {
+    result = dataclasses.replace(result, timings_s=dict(seconds))
+    files = {
         "profile.csv": profile_csv(samples),
         "profile.png": png,
         **step,
         **program_files,
         "report.html": report,
-        "summary.json": (json.dumps(summary, indent=2, sort_keys=False) + "\n").encode(),
+        "summary.json": (json.dumps(summary_json(result), indent=2, sort_keys=False) + "\n").encode(),
     }
+    return dataclasses.replace(result, files=files)
+
+
+def grade_stage(job: Job, sim_result: SimResult | None) -> Grading | None:
+    """The simulated gear's ISO 1328-1 grade (None without a simulation), computed once per run."""
+    if sim_result is None:
+        return None
+    from spur_cad.grade.simulated import grade_simulation
+
+    return grade_simulation(job.gear, sim_result)
 
 
 def build_programs(job: Job, plan: CamPlan) -> tuple[dict[str, PostedProgram], dict[str, bytes]]:

@@ -115,7 +115,7 @@ def test_a_flat_end_mill_finishes_by_generation_within_target_without_gouge(name
         assert values["max_gouge_mm"] <= GOUGE_LIMIT_MM, (feature, values)
         assert values["max_leftover_mm"] <= TARGET + LEFTOVER_SLACK_MM, (feature, values)
     # The plan's own figures promise no more than the target.
-    assert result.flat_height_mm <= TARGET and result.facts["tip_mode_leftover_mm"] <= TARGET
+    assert result.flat_height_mm <= TARGET and result.facts.tip_mode_leftover_mm <= TARGET
 
 
 def test_a_fillet_pass_left_out_is_found_by_the_same_check():
@@ -123,7 +123,7 @@ def test_a_fillet_pass_left_out_is_found_by_the_same_check():
     it misjudges)."""
     _, _, path, result, cut = _planned("reference", 0.999)
     rows = np.nonzero((path.feature == Feature.RIGHT_FLANK) & (path.space == 3) & (path.kind == MoveKind.LINEAR))[0]
-    flank = result.facts["flank_passes_per_flank"]
+    flank = result.facts.flank_passes_per_flank
     keep = np.ones(len(path), bool)
     keep[rows[flank + (len(rows) - flank) // 2]] = False  # a pass in the middle of the right fillet
     dev = cut(subset(path, keep)).deviation

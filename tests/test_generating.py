@@ -462,9 +462,9 @@ def test_generating_takes_a_fraction_of_the_perimeter_time_on_the_reference_job(
     fine = dataclasses.replace(job, finishing=dataclasses.replace(job.finishing, target_scallop_mm=0.001))
     assert plan_cam(fine).finishing.estimate.time_s <= perimeter_s / 2
     advice = plan.finishing.result.tool_advice
-    diameter = math.floor(10 * advice["recommended_diameter_mm"]) / 10
+    diameter = math.floor(10 * advice.recommended_diameter_mm) / 10
     advised = dataclasses.replace(job.tools.finishing, diameter_mm=diameter,
-                                  corner_radius_mm=advice["advised_corner_radius_mm"], flutes=4)
+                                  corner_radius_mm=advice.advised_corner_radius_mm, flutes=4)
     big = dataclasses.replace(job, tools=dataclasses.replace(job.tools, finishing=advised))
     assert plan_cam(big).finishing.estimate.time_s <= perimeter_s / 8
 

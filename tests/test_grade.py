@@ -82,7 +82,7 @@ def _roll(grid, mask):
 
 def test_a_perfect_gear_is_class_1(grid):
     grading = grade_simulation(GEAR, _result(grid, np.zeros((12, len(grid.points), len(grid.rows_x)))))
-    assert grading["class"] == 1 and all(abs(v) < 1e-9 for v in grading["deviations_um"].values())
+    assert grading.overall_class == 1 and all(abs(v) < 1e-9 for v in grading.deviations_um.values())
 
 
 def test_planted_deviations_are_found_with_their_size_and_class(grid):
@@ -103,21 +103,21 @@ def test_planted_deviations_are_found_with_their_size_and_class(grid):
     lo, hi = helix_range_mm(GEAR.face_width_mm, GEAR.module_mm)
     deviation[9][left] += (6.0e-3 * (grid.rows_x - lo) / (hi - lo))[None, :]
     grading = grade_simulation(GEAR, _result(grid, deviation))
-    found = grading["deviations_um"]
-    assert found["f_Ha"] == pytest.approx(8.0, abs=0.5) and grading["where"]["f_Ha"]["space"] == 2
-    assert found["f_fa"] == pytest.approx(3.0, abs=0.5) and grading["where"]["f_fa"]["space"] == 7
+    found = grading.deviations_um
+    assert found["f_Ha"] == pytest.approx(8.0, abs=0.5) and grading.where["f_Ha"].space == 2
+    assert found["f_fa"] == pytest.approx(3.0, abs=0.5) and grading.where["f_fa"].space == 7
     assert found["f_pt"] == pytest.approx(10.0, abs=0.5) and found["F_p"] == pytest.approx(10.0, abs=0.5)
-    assert grading["where"]["f_pt"]["side"] == "left"
-    assert found["f_Hb"] == pytest.approx(6.0, abs=0.5) and grading["where"]["f_Hb"]["space"] == 9
+    assert grading.where["f_pt"].side == "left"
+    assert found["f_Hb"] == pytest.approx(6.0, abs=0.5) and grading.where["f_Hb"].space == 9
     # classes by the hand-worked tolerances of this gear (d = 36, b = 6, m = 3):
     # f_HaT: class 6 = 5.236 x 1.414 = 7.40 -> 7.5 < 8, class 7 = 10.47 -> 10 >= 8: class 7
     # f_faT: class 1 = 6.65 / 4 = 1.66 -> 1.7 < 3, class 2 = 2.35 -> 2.4 < 3, class 3 = 3.33 -> 3.3: class 3
     # f_pT: class 7 = 6.236 x 2 = 12.47 -> 12 >= 10, class 6 = 8.82 -> 9.0 < 10: class 7
     # f_HbT: 0.05 x 6 + 0.35 x 2.449 + 4 = 5.157; class 6 = 7.29 -> 7.5 >= 6, class 5 = 5.157 -> 5.0 < 6: class 6
-    classes = grading["classes"]
+    classes = grading.classes
     assert classes["f_Ha"] == 7 and classes["f_fa"] == 3 and classes["f_pt"] == 7 and classes["f_Hb"] == 6
-    assert grading["class"] == max(c for c in classes.values())
-    assert grading["validity"] == []
+    assert grading.overall_class == max(c for c in classes.values())
+    assert grading.validity == ()
 
 
 def test_formulas_outside_their_range_are_flagged():
@@ -134,7 +134,7 @@ def test_a_run_grades_the_simulated_gear_in_the_summary_and_the_report():
 
     from spur_cad.pipeline import run_job
 
-    files = run_job(parse_job(small_job_text() + "\n[simulation]\nresolution_mm = 0.02\n", "small.toml"))
+    files = run_job(parse_job(small_job_text() + "\n[simulation]\nresolution_mm = 0.02\n", "small.toml")).files
     grading = json.loads(files["summary.json"])["grading"]
     assert grading["standard"] == "ISO 1328-1:2013" and grading["validity"] == []
     assert grading["class"] == max(grading["classes"].values())

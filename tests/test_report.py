@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import base64
+import dataclasses
 import json
 import re
 from pathlib import Path
@@ -12,6 +13,7 @@ import pytest
 from spur_cad.job import load_job
 from spur_cad.pipeline import run_job
 from spur_cad.report.html import render_report
+from spur_cad.result import SimulationFacts
 
 pytestmark = pytest.mark.slow  # make test-all
 
@@ -22,12 +24,12 @@ PNG = b"\x89PNG\r\n\x1a\n"
 
 @pytest.fixture(scope="module")
 def outputs():
-    files = run_job(load_job(REFERENCE_JOB))
-    return files["report.html"].decode("utf-8"), json.loads(files["summary.json"])
+    result = run_job(load_job(REFERENCE_JOB))
+    return result.files["report.html"].decode("utf-8"), json.loads(result.files["summary.json"]), result
 
 
 def test_report_embeds_every_image_and_refers_to_nothing_outside(outputs):
-    html, _ = outputs
+    html, _, _ = outputs
     assert html.startswith("<!DOCTYPE html>")
     sources = re.findall(r'<img[^>]*\ssrc="([^"]*)"', html)
     assert len(sources) == 5  # profile, roughing levels, finishing poses, deviation map, K-chart
@@ -38,7 +40,7 @@ def test_report_embeds_every_image_and_refers_to_nothing_outside(outputs):
 
 
 def test_report_shows_the_inspection_sheet_and_simulation_values_of_the_summary(outputs):
-    html, summary = outputs
+    html, summary, _ = outputs
     ins = summary["inspection"]
     for key in ("span_measurement_mm", "dimension_over_pins_mm", "pin_diameter_mm", "chordal_thickness_mm",
                 "tooth_thickness_mm"):
@@ -56,16 +58,18 @@ def test_report_shows_the_inspection_sheet_and_simulation_values_of_the_summary(
     assert str(summary["post"]["finishing_lines"]) in html
 
 
-def test_report_without_tools_simulation_or_post_still_renders(outputs):
-    _, summary = outputs
-    bare = {key: summary[key] for key in ("spur_cad_version", "job", "gear", "inspection")}
+def test_report_without_toolpaths_simulation_or_grade_still_renders(outputs):
+    _, summary, result = outputs
+    bare = dataclasses.replace(result, roughing=None, finishing=None, grading=None,
+                               simulation=SimulationFacts(enabled=False, resolution_mm=0.005))
     html = render_report(bare, {}).decode("utf-8")
-    assert "Inspection sheet" in html and "Simulated cut" not in html and "<img" not in html
+    assert "Inspection sheet" in html and "Simulation disabled" in html and "<img" not in html
+    assert "Programs and cycle time" not in html and "Grade (ISO" not in html
     assert f"{summary['inspection']['span_measurement_mm']:.4f}" in html
 
 
 def test_report_shows_the_generating_passes_advice_and_all_three_cycle_times(outputs):
-    html, summary = outputs
+    html, summary, _ = outputs
     finishing, advice = summary["finishing"], summary["tools"]["generating_advice"]
     assert finishing["strategy"] == "generating"
     assert f"{finishing['passes_per_space']} straight passes per tooth space" in html

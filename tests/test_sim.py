@@ -195,9 +195,9 @@ def test_root_lowered_by_20um_at_one_station_reports_a_20um_gouge_there(referenc
     result, dev = _window_result(job, plan, subset(fin, mask, z=z), STATION, SPACES)
     assert -dev.min() == pytest.approx(0.020, abs=RES)
     worst = result.worst(gouge=True)
-    assert worst["space"] == SPACE and worst["feature"] in ("root", "right fillet", "left fillet")
+    assert worst.space == SPACE and worst.feature in ("root", "right fillet", "left fillet")
     x_station = finishing_stations(fin)[STATION]
-    assert abs(worst["x_mm"] - x_station) <= job.tools.finishing.diameter_mm / 2
+    assert abs(worst.x_mm - x_station) <= job.tools.finishing.diameter_mm / 2
     # At the station itself the middle of the root arc is 20 um deep (its ends taper where the unshifted
     # flank moves join); no other space is gouged.
     row = int(np.argmin(np.abs(result.grid.rows_x - x_station)))
@@ -230,8 +230,8 @@ def test_right_flank_moved_20um_into_the_part_reports_a_20um_gouge_on_that_flank
     result, dev = _window_result(job, plan, subset(fin, mask, y=dy, z=dz), STATION, SPACES)
     assert -dev.min() == pytest.approx(0.020, abs=RES)
     worst = result.worst(gouge=True)
-    assert worst["space"] == SPACE and worst["feature"].startswith("right ")
-    assert worst["station"] == STATION
+    assert worst.space == SPACE and worst.feature.startswith("right ")
+    assert worst.station == STATION
     assert -result.deviation[[k for k in range(job.gear.teeth) if k != SPACE]].min() <= RES
     left = np.array([n == "left involute" for n in result.grid.feature_names()])  # the root may be touched
     assert -result.deviation[SPACE, left].min() <= RES

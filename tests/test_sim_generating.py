@@ -51,7 +51,7 @@ def test_one_flank_pass_left_out_leaves_material_on_that_flank_only(reference):
     job, plan = reference
     path = plan.finishing.toolpath
     rows = _cut_rows(path, Feature.RIGHT_FLANK, SPACE)  # flank passes (tip -> root), then the fillet's
-    dropped = int(rows[plan.finishing.result.facts["flank_passes_per_flank"] // 2])
+    dropped = int(rows[plan.finishing.result.facts.flank_passes_per_flank // 2])
     keep = np.ones(len(path), bool)
     keep[dropped] = False
     result = _simulate(job, plan, subset(path, keep))
@@ -59,7 +59,7 @@ def test_one_flank_pass_left_out_leaves_material_on_that_flank_only(reference):
     dev = result.deviation[:, :, result.gear_rows]
     assert dev.max() > target + RES
     worst = result.worst(gouge=False)
-    assert worst["space"] == SPACE and worst["feature"].endswith(("involute", "fillet")), worst
+    assert worst.space == SPACE and worst.feature.endswith(("involute", "fillet")), worst
     others = [k for k in range(job.gear.teeth) if k != SPACE]
     assert dev[others].max() <= target + RES
     assert -dev.min() <= RES
@@ -76,7 +76,7 @@ def test_a_root_pass_20um_too_low_is_a_20um_gouge_in_that_root(reference):
     dev = result.deviation[:, :, result.gear_rows]
     assert -dev.min() == pytest.approx(0.020, abs=RES)
     worst = result.worst(gouge=True)
-    assert worst["space"] == SPACE and worst["feature"] in ("root", "right fillet", "left fillet"), worst
+    assert worst.space == SPACE and worst.feature in ("root", "right fillet", "left fillet"), worst
     others = [k for k in range(job.gear.teeth) if k != SPACE]
     assert -dev[others].min() <= RES
 

@@ -1,17 +1,22 @@
 """report.html: one self-contained page (images as base64 data URIs, inline CSS, no scripts, no links out).
 
-Every value shown is read from the job's summary dict (the same content as summary.json); the
-figures come in as PNG bytes. Sections a job does not have (no tools, no simulation, no post)
+Every value shown is read from the job's typed result (spur_cad.result.JobResult, whose serialisation is
+summary.json); the figures come in as PNG bytes. Sections a job does not have (no tools, no simulation, no post)
 are left out or say so.
 """
 
 from __future__ import annotations
 
 import base64
+import dataclasses
 import html
-from typing import Iterable
+from typing import TYPE_CHECKING, Iterable
 
 from spur_cad.cam.plan import REFERENCE_CONTACT_SPACING_MM, REFERENCE_STATION_STEP_MM
+
+if TYPE_CHECKING:
+    from spur_cad.cam.estimate import Estimate
+    from spur_cad.result import FinishingFacts, JobResult, RoughingFacts
 
 _CSS = """
 body { font-family: sans-serif; margin: 2em auto; max-width: 62em; color: #222; }
@@ -59,118 +64,112 @@ def _minutes(seconds: float | None) -> str:
     return f"{seconds / 3600.0:.2f} h ({seconds / 60.0:.0f} min)"
 
 
-def _gear(summary: dict) -> str:
-    gear = summary.get("gear", {})
-    keys = ("teeth", "module_mm", "pressure_angle_deg", "profile_shift_coefficient", "addendum_coefficient",
-            "dedendum_coefficient", "rack_tip_radius_mm", "face_width_mm", "reference_radius_mm", "base_radius_mm",
-            "tip_radius_mm", "root_radius_mm", "form_radius_mm", "tooth_thickness_mm", "space_width_mm",
-            "tip_thickness_mm", "root_arc_length_mm", "undercut")
-    if gear.get("helix_angle_deg"):
-        keys += ("helix_angle_deg", "hand", "transverse_module_mm", "transverse_pressure_angle_deg",
-                 "base_helix_angle_deg", "lead_mm", "overlap_ratio")
-    text = "<h2>Gear</h2>" + _table((k, gear[k]) for k in keys if k in gear)
-    if gear.get("helix_angle_deg"):
+GEAR_ROWS = ("teeth", "module_mm", "pressure_angle_deg", "profile_shift_coefficient", "addendum_coefficient",
+             "dedendum_coefficient", "rack_tip_radius_mm", "face_width_mm", "reference_radius_mm", "base_radius_mm",
+             "tip_radius_mm", "root_radius_mm", "form_radius_mm", "tooth_thickness_mm", "space_width_mm",
+             "tip_thickness_mm", "root_arc_length_mm", "undercut")
+HELICAL_ROWS = ("helix_angle_deg", "hand", "transverse_module_mm", "transverse_pressure_angle_deg",
+                "base_helix_angle_deg", "lead_mm", "overlap_ratio")
+
+
+def _gear(result: JobResult) -> str:
+    gear = result.gear
+    names = GEAR_ROWS + (HELICAL_ROWS if gear.is_helical else ())
+    text = "<h2>Gear</h2>" + _table((name, getattr(gear, name)) for name in names)
+    if gear.is_helical:
         text += ("<p>Helical gear: module, pressure angle, shift, coefficients and rack tip radius are normal-section "
                  "values; radii, thicknesses and the profile are transverse.</p>")
     return text
 
 
-def _inspection(summary: dict) -> str:
-    ins = summary.get("inspection", {})
-    if not ins:
-        return ""
-    sim = summary.get("simulation", {})
-    nominal = ins["tooth_thickness_mm"] + ins["thickness_reduction_mm"]
-    helical = bool(summary.get("gear", {}).get("helix_angle_deg"))
-    span_label = f"span measurement W_k over k = {ins['span_teeth_k']} teeth [mm]"
+def _inspection(result: JobResult) -> str:
+    ins, sim = result.inspection, result.simulation
+    nominal = ins.tooth_thickness_mm + ins.thickness_reduction_mm
+    helical = result.gear.is_helical
+    span_label = f"span measurement W_k over k = {ins.span_teeth_k} teeth [mm]"
     if helical:
-        span_label += (f" (normal section; needs face width > {ins['span_min_face_width_mm']:.2f} mm"
-                       + ("" if ins["span_measurement_mm"] is not None else ": too narrow, measure over balls") + ")")
+        span_label += (f" (normal section; needs face width > {ins.span_min_face_width_mm:.2f} mm"
+                       + ("" if ins.span_measurement_mm is not None else ": too narrow, measure over balls") + ")")
     rows = [
-        (span_label, ins["span_measurement_mm"]),
-        ("  anvils touch the flanks at radius [mm]", ins["span_contact_radius_mm"]),
-        ("pin (ball) diameter [mm]", ins["pin_diameter_mm"]),
-        ("dimension over pins [mm]", ins["dimension_over_pins_mm"]),
-        ("  pins touch the flanks at radius [mm]", ins["pin_contact_radius_mm"]),
+        (span_label, ins.span_measurement_mm),
+        ("  anvils touch the flanks at radius [mm]", ins.span_contact_radius_mm),
+        ("pin (ball) diameter [mm]", ins.pin_diameter_mm),
+        ("dimension over pins [mm]", ins.dimension_over_pins_mm),
+        ("  pins touch the flanks at radius [mm]", ins.pin_contact_radius_mm),
         ("normal chordal tooth thickness [mm]" if helical else "chordal tooth thickness [mm]",
-         ins["chordal_thickness_mm"]),
-        (f"  at chordal height [mm] (measuring radius {ins['chordal_measuring_radius_mm']:g} mm)",
-         ins["chordal_height_mm"]),
-        ("tooth thickness on the reference circle s [mm]", ins["tooth_thickness_mm"]),
+         ins.chordal_thickness_mm),
+        (f"  at chordal height [mm] (measuring radius {ins.chordal_measuring_radius_mm:g} mm)",
+         ins.chordal_height_mm),
+        ("tooth thickness on the reference circle s [mm]", ins.tooth_thickness_mm),
         ("  nominal p/2 + 2 x m tan(alpha) [mm]", nominal),
-        ("  thickness allowance (upper deviation) [mm]", -ins["thickness_reduction_mm"]),
-        ("minimum teeth without undercut", ins["min_teeth_without_undercut"]),
+        ("  thickness allowance (upper deviation) [mm]", -ins.thickness_reduction_mm),
+        ("minimum teeth without undercut", ins.min_teeth_without_undercut),
     ]
     text = "<h2>Inspection sheet</h2>" + _table(rows)
-    flanks = [sim.get("per_feature", {}).get(f"{side} involute") for side in ("right", "left")]
-    if sim.get("enabled") and all(flanks) and ins["span_measurement_mm"] is not None:
-        low = -max(f["max_gouge_mm"] for f in flanks)
-        high = max(f["max_leftover_mm"] for f in flanks)
+    flanks = [sim.feature(f"{side} involute") for side in ("right", "left")]
+    if sim.enabled and all(flanks) and ins.span_measurement_mm is not None:
+        low = -max(f.max_gouge_mm for f in flanks)
+        high = max(f.max_leftover_mm for f in flanks)
         text += ("<p>Tolerance expected from the simulated cut (involute flanks, normal deviation "
                  f"{1000 * low:+.1f} to {1000 * high:+.1f} um on each flank): span measurement "
-                 f"{ins['span_measurement_mm'] + 2 * low:.4f} to {ins['span_measurement_mm'] + 2 * high:.4f} mm; "
-                 f"tooth thickness {ins['tooth_thickness_mm']:.4f} mm "
-                 f"(nominal {nominal:.4f} mm, {-ins['thickness_reduction_mm']:+.4f} mm allowance).</p>")
+                 f"{ins.span_measurement_mm + 2 * low:.4f} to {ins.span_measurement_mm + 2 * high:.4f} mm; "
+                 f"tooth thickness {ins.tooth_thickness_mm:.4f} mm "
+                 f"(nominal {nominal:.4f} mm, {-ins.thickness_reduction_mm:+.4f} mm allowance).</p>")
     return text
 
 
-def _tools(summary: dict) -> str:
-    tools = summary.get("tools")
-    if not tools:
-        return ""
-    rec = [(k, v) for k, v in tools.items() if k not in ("roughing", "finishing") and not isinstance(v, (dict, list))]
+def _tools(result: JobResult) -> str:
+    tools = result.tools
+    rec = dataclasses.asdict(tools.recommendations).items()
     text = "<h2>Tools</h2><h3>Recommendations</h3>" + _table(rec)
-    for key, advice in tools.items():
-        if key.endswith("_advice") and isinstance(advice, dict):
-            strategy = key.removesuffix("_advice")
-            text += f"<h3>For finishing strategy {_e(strategy)}</h3>" + _table(advice.items())
-    chosen = []
-    for role in ("roughing", "finishing"):
-        tool = tools.get(role)
-        if tool:
-            chosen.append((role, tool["kind"], tool["diameter_mm"], tool["corner_radius_mm"], tool["flat_width_mm"],
-                           tool["spindle_rpm"], tool["feed_mm_min"]))
+    if tools.advice is not None:
+        advice = ((name, value) for name, value in dataclasses.asdict(tools.advice).items() if value is not None)
+        text += f"<h3>For finishing strategy {_e(tools.advice_strategy)}</h3>" + _table(advice)
+    chosen = [(role, tool.kind, tool.diameter_mm, tool.corner_radius_mm, tool.flat_width_mm, tool.spindle_rpm,
+               tool.feed_mm_min) for role, tool in (("roughing", tools.roughing), ("finishing", tools.finishing))
+              if tool is not None]
     if chosen:
         text += "<h3>Chosen tools</h3>" + _table(
             chosen, ("", "kind", "D [mm]", "corner r [mm]", "flat width [mm]", "spindle [rpm]", "feed [mm/min]"))
     return text
 
 
-def _program(summary: dict) -> str:
-    rough, finish, post = summary.get("roughing"), summary.get("finishing"), summary.get("post")
-    if not rough and not finish:
+def _program(result: JobResult) -> str:
+    rough, finish, post = result.roughing, result.finishing, result.post
+    if rough is None and finish is None:
         return ""
     rows = []
-    bottom = rough.get("two_stage", {}).get("bottom") if rough else None
-    for name, facts in (("roughing", rough), ("roughing_bottom", bottom), ("finishing", finish)):
-        if facts:
-            lines = post.get(f"{name}_lines") if post else None
-            size = post.get(f"{name}_bytes") if post else None
-            rows.append((name, facts["moves"], "-" if lines is None else str(lines),
-                         "-" if size is None else f"{size / 1000:.1f} kB", f"{facts['cutting_length_mm'] / 1000:.2f} m",
-                         _minutes(facts["estimated_time_s"]),
-                         _minutes(facts.get("estimated_time_with_acceleration_s"))))
+    bottom = rough.two_stage.bottom if rough is not None and rough.two_stage is not None else None
+    operations: tuple[tuple[str, RoughingFacts | FinishingFacts | None], ...] = (
+        ("roughing", rough), ("roughing_bottom", bottom), ("finishing", finish))
+    for name, facts in operations:
+        if facts is not None:
+            program = post.program(name)
+            est: Estimate = facts.estimate
+            rows.append((name, est.moves, "-" if program is None else str(program.lines),
+                         "-" if program is None else f"{program.bytes / 1000:.1f} kB",
+                         f"{est.cutting_length_mm / 1000:.2f} m", _minutes(est.time_s),
+                         _minutes(est.time_with_acceleration_s)))
     text = "<h2>Programs and cycle time</h2>"
-    if post:
-        text += f"<p>Post: {_e(post.get('dialect', '-'))}" + (", folded into subprograms" if post.get("folded") else "")
-        text += "</p>"
+    text += f"<p>Post: {_e(post.dialect)}" + (", folded into subprograms" if post.folded else "")
+    text += "</p>"
     text += _table(rows, ("", "moves (IR)", "G-code lines", "G-code size", "cutting path", "time at feed",
                           "time with acceleration"))
-    if finish:
+    if finish is not None:
         text += _finishing_comparison(finish)
-    if rough:
-        text += (f"<p>Roughing: {rough['levels_per_space']} levels per space, lowest level "
-                 f"{rough['lowest_level_height_mm']:.3f} mm above the root circle.</p>")
-    if bottom:
-        stage = rough["two_stage"]
-        text += (f"<p>Two-stage roughing: the bottom tool (T{stage['bottom_tool']['tool_number']}, D "
-                 f"{stage['bottom_tool']['diameter_mm']:g} mm) roughs {bottom['levels_per_space']} levels per space "
-                 f"below {stage['split_height_above_root_mm']:.3f} mm above the root circle (split chosen by "
-                 f"{_e(stage['split_chosen_by'])}): {_minutes(stage['two_stage_time_s'])} in all, "
-                 f"{_minutes(stage['time_saved_s'])} less than the bottom tool alone "
-                 f"({_minutes(stage['bottom_tool_alone_time_s'])}).</p>")
-    if finish:
-        text += _finishing_words(finish)
+    if rough is not None:
+        text += (f"<p>Roughing: {rough.levels_per_space} levels per space, lowest level "
+                 f"{rough.lowest_level_height_mm:.3f} mm above the root circle.</p>")
+    if bottom is not None:
+        stage = rough.two_stage
+        text += (f"<p>Two-stage roughing: the bottom tool (T{stage.bottom_tool.tool_number}, D "
+                 f"{stage.bottom_tool.diameter_mm:g} mm) roughs {bottom.levels_per_space} levels per space "
+                 f"below {stage.split_height_above_root_mm:.3f} mm above the root circle (split chosen by "
+                 f"{_e(stage.split_chosen_by)}): {_minutes(stage.two_stage_time_s)} in all, "
+                 f"{_minutes(stage.time_saved_s)} less than the bottom tool alone "
+                 f"({_minutes(stage.bottom_tool_alone_time_s)}).</p>")
+    if finish is not None:
+        text += f"<p>{html.escape(finish.report_text, quote=False)}</p>"
     return text
 
 
@@ -178,120 +177,102 @@ NOT_ESTIMATED = ("not estimated (too large to build for comparison, the tool doe
                  "strategy is for spur gears only)")
 
 
-def _finishing_comparison(finish: dict) -> str:
+def _finishing_comparison(finish: FinishingFacts) -> str:
     """This job's finishing beside perimeter finishing and the reference process's strategy (same tool)."""
     reference = (f"reference process's strategy (perimeter, {REFERENCE_CONTACT_SPACING_MM:g} mm contacts, "
                  f"{REFERENCE_STATION_STEP_MM:g} mm X step)")
-    rows = [(f"this job's finishing ({_e(finish['strategy'])})", finish["moves"], _minutes(finish["estimated_time_s"]),
-             _minutes(finish.get("estimated_time_with_acceleration_s")))]
-    others = [("perimeter", "perimeter finishing at this job's target scallop")] if finish["strategy"] != "perimeter" \
-        else []
-    others.append(("reference_strategy", reference))
-    for prefix, label in others:
-        if finish.get(f"{prefix}_time_s") is None:
+    rows = [(f"this job's finishing ({_e(finish.strategy)})", finish.estimate.moves,
+             _minutes(finish.estimate.time_s), _minutes(finish.estimate.time_with_acceleration_s))]
+    others = [(finish.perimeter, "perimeter finishing at this job's target scallop")] \
+        if finish.strategy != "perimeter" else []
+    others.append((finish.reference_strategy, reference))
+    for other, label in others:
+        if other is None:
             rows.append((label, "-", NOT_ESTIMATED, "-"))
         else:
-            rows.append((label, finish[f"{prefix}_moves"], _minutes(finish[f"{prefix}_time_s"]),
-                         _minutes(finish.get(f"{prefix}_time_with_acceleration_s"))))
+            rows.append((label, other.moves, _minutes(other.time_s), _minutes(other.time_with_acceleration_s)))
     return _table(rows, ("finishing (same tool)", "moves", "time at feed", "time with acceleration"))
 
 
-def _finishing_words(finish: dict) -> str:
-    """One paragraph: stations and contacts, or the generating passes and what they leave."""
-    if "passes_per_space" in finish:
-        text = (f"<p>Finishing: {_e(finish['strategy'])}, {finish['passes_per_space']} straight passes per tooth "
-                f"space with A clamped")
-        if "flank_passes_per_flank" in finish:
-            text += (f": {finish['flank_passes_per_flank']} per flank (generating flat height "
-                     f"{1000 * finish['flat_height_mm']:.2f} um), {finish['tip_mode_passes_per_space']} on fillets and "
-                     f"root (largest sampled leftover {1000 * finish['tip_mode_leftover_mm']:.2f} um), "
-                     f"{finish['land_passes_per_space']} on the tip land; {_e(finish['cutting_direction'])} milling, "
-                     f"flank tool end '{_e(finish['flank_tool_end'])}'")
-        return text + ".</p>"
-    return (f"<p>Finishing: {_e(finish['strategy'])}, {finish['stations']} stations "
-            f"({finish['station_step_mm']:.4f} mm apart), {finish['points_per_flank']} contact points per "
-            "flank.</p>")
-
-
-def _simulation(summary: dict) -> str:
-    sim = summary.get("simulation")
-    if not sim:
-        return ""
-    if not sim.get("enabled"):
+def _simulation(result: JobResult) -> str:
+    sim = result.simulation
+    if not sim.enabled:
         return "<h2>Simulated cut</h2><p>Simulation disabled ([simulation] enabled = false) or no toolpaths.</p>"
-    res = sim["resolution_mm"]
-    gouge_ok = sim["max_gouge_mm"] <= res
-    rows = [("resolution [mm]", res), ("max gouge [mm]", sim["max_gouge_mm"]),
-            ("max leftover [mm]", sim["max_leftover_mm"]), ("scallop mean / p95 / p99 [um]",
-                                                           f"{1000 * sim['scallop_mean_mm']:.2f} / "
-                                                           f"{1000 * sim['scallop_p95_mm']:.2f} / "
-                                                           f"{1000 * sim['scallop_p99_mm']:.2f}"),
-            ("removed volume [mm^3]", f"{sim['removed_volume_mm3']:.1f}"),
-            ("design points x rows (all spaces)", sim["design_points"]),
-            ("simulation time [s]", f"{sim['seconds']:.1f}")]
+    res = sim.resolution_mm
+    gouge_ok = sim.max_gouge_mm <= res
+    rows = [("resolution [mm]", res), ("max gouge [mm]", sim.max_gouge_mm),
+            ("max leftover [mm]", sim.max_leftover_mm), ("scallop mean / p95 / p99 [um]",
+                                                        f"{1000 * sim.scallop_mean_mm:.2f} / "
+                                                        f"{1000 * sim.scallop_p95_mm:.2f} / "
+                                                        f"{1000 * sim.scallop_p99_mm:.2f}"),
+            ("removed volume [mm^3]", f"{sim.removed_volume_mm3:.1f}"),
+            ("design points x rows (all spaces)", sim.design_points),
+            ("simulation time [s]", f"{sim.seconds:.1f}")]
     text = "<h2>Simulated cut</h2>" + _table(rows)
     verdict = "ok" if gouge_ok else "warn"
-    text += (f'<p class="{verdict}">Largest gouge {1000 * sim["max_gouge_mm"]:.2f} um '
+    worst = sim.worst_leftover
+    text += (f'<p class="{verdict}">Largest gouge {1000 * sim.max_gouge_mm:.2f} um '
              f'({"within" if gouge_ok else "beyond"} the resolution). Largest leftover '
-             f'{1000 * sim["max_leftover_mm"]:.2f} um at tooth space {sim["worst_leftover"]["space"]}, '
-             f'{_e(sim["worst_leftover"]["feature"])}, X = {sim["worst_leftover"]["x_mm"]:.3f} mm.</p>')
-    per = sim.get("per_feature", {})
-    text += _table(((name, 1000 * f["max_gouge_mm"], 1000 * f["max_leftover_mm"], 1000 * f["mean_mm"])
-                    for name, f in per.items()), ("feature", "max gouge [um]", "max leftover [um]", "mean [um]"))
+             f'{1000 * sim.max_leftover_mm:.2f} um at tooth space {worst.space}, '
+             f'{_e(worst.feature)}, X = {worst.x_mm:.3f} mm.</p>')
+    text += _table(((f.feature, 1000 * f.max_gouge_mm, 1000 * f.max_leftover_mm, 1000 * f.mean_mm)
+                    for f in sim.per_feature), ("feature", "max gouge [um]", "max leftover [um]", "mean [um]"))
     return text
 
 
-def _grading(summary: dict) -> str:
-    grading = summary.get("grading")
-    if not grading:
+DEVIATION_LABELS = {"f_pt": "single pitch f_pt", "F_p": "total cumulative pitch F_p", "f_Ha": "profile slope f_Ha",
+                    "f_fa": "profile form f_fa", "F_a": "total profile F_a", "f_Hb": "helix slope f_Hb",
+                    "f_fb": "helix form f_fb", "F_b": "total helix F_b"}
+
+
+def _grading(result: JobResult) -> str:
+    grading = result.grading
+    if grading is None:
         return ""
-    names = {"f_pt": "single pitch f_pt", "F_p": "total cumulative pitch F_p", "f_Ha": "profile slope f_Ha",
-             "f_fa": "profile form f_fa", "F_a": "total profile F_a", "f_Hb": "helix slope f_Hb",
-             "f_fb": "helix form f_fb", "F_b": "total helix F_b"}
-    rows = ((label, f"{grading['deviations_um'][key]:.2f}", grading["classes"][key] or "beyond 11")
-            for key, label in names.items())
+    rows = ((label, f"{grading.deviations_um[name]:.2f}", grading.classes[name] or "beyond 11")
+            for name, label in DEVIATION_LABELS.items())
     text = ("<h2>Grade (ISO 1328-1:2013, from the simulated cut)</h2>"
             + _table(rows, ("deviation (worst flank)", "[um]", "class")))
-    overall = grading["class"]
+    overall = grading.overall_class
     text += (f'<p>Flank tolerance class of the simulated gear: <b>{overall if overall else "beyond 11"}</b> '
              "(the worst class of the deviations above; profiles from the form circle to 95 % of the roll "
              "length to the tip, helix over the face width less min(5 % b, m) at each end).</p>")
-    if grading.get("validity"):
-        text += f'<p class="warn">Outside the range of the formulas: {_e("; ".join(grading["validity"]))}.</p>'
+    if grading.validity:
+        text += f'<p class="warn">Outside the range of the formulas: {_e("; ".join(grading.validity))}.</p>'
     return text
 
 
-def _warnings(summary: dict) -> str:
-    items = list(summary.get("warnings", []))
-    sim = summary.get("simulation", {})
-    if sim.get("enabled"):
-        if sim["max_gouge_mm"] > sim["resolution_mm"]:
-            w = sim["worst_gouge"]
-            items.append(f"simulation: gouge of {1000 * sim['max_gouge_mm']:.1f} um at tooth space {w['space']}, "
-                         f"{w['feature']}, X = {w['x_mm']:.3f} mm (station {w['station']})")
-        if sim.get("uncut_points"):
-            items.append(f"simulation: {sim['uncut_points']} design points keep more than "
-                         f"{sim['leftover_range_mm']:g} mm of material (never cut)")
+def _warnings(result: JobResult) -> str:
+    items = list(result.warnings)
+    sim = result.simulation
+    if sim.enabled:
+        if sim.max_gouge_mm > sim.resolution_mm:
+            w = sim.worst_gouge
+            items.append(f"simulation: gouge of {1000 * sim.max_gouge_mm:.1f} um at tooth space {w.space}, "
+                         f"{w.feature}, X = {w.x_mm:.3f} mm (station {w.station})")
+        if sim.uncut_points:
+            items.append(f"simulation: {sim.uncut_points} design points keep more than "
+                         f"{sim.leftover_range_mm:g} mm of material (never cut)")
     body = "".join(f"<li>{_e(w)}</li>" for w in items) if items else "<li>none</li>"
     return f"<h2>Warnings</h2><ul class=\"warn\">{body}</ul>"
 
 
-def render_report(summary: dict, images: dict[str, bytes]) -> bytes:
-    """The whole report as UTF-8 HTML bytes. `images`: 'profile', 'roughing', 'finishing', 'deviation' PNGs."""
-    job = summary.get("job", {})
-    title = f"spur_cad report: {job.get('name', 'job')}"
+def render_report(result: JobResult, images: dict[str, bytes]) -> bytes:
+    """The whole report as UTF-8 HTML bytes. `images`: 'profile', 'roughing', 'finishing', 'deviation',
+    'kchart' PNGs."""
+    title = f"spur_cad report: {result.job.name}"
     parts = [
         "<!DOCTYPE html>", '<html lang="en"><head><meta charset="utf-8">', f"<title>{_e(title)}</title>",
         f"<style>{_CSS}</style></head><body>", f"<h1>{_e(title)}</h1>",
-        f"<p>Job file {_e(job.get('file', '-'))}, spur_cad {_e(summary.get('spur_cad_version', ''))}.</p>",
-        _warnings(summary), _gear(summary), _image(images.get("profile"), "tooth space profile"),
-        _inspection(summary), _tools(summary), _program(summary),
+        f"<p>Job file {_e(result.job.file)}, spur_cad {_e(result.version)}.</p>",
+        _warnings(result), _gear(result), _image(images.get("profile"), "tooth space profile"),
+        _inspection(result), _tools(result), _program(result),
         "<h2>Roughing levels</h2>" + _image(images.get("roughing"), "roughing levels")
         if images.get("roughing") else "",
         "<h2>Finishing contacts and cutter locations</h2>" + _image(images.get("finishing"), "finishing poses")
         if images.get("finishing") else "",
-        _simulation(summary), _image(images.get("deviation"), "deviation map"),
-        _grading(summary), _image(images.get("kchart"), "K-chart: profile and helix traces"),
+        _simulation(result), _image(images.get("deviation"), "deviation map"),
+        _grading(result), _image(images.get("kchart"), "K-chart: profile and helix traces"),
         "</body></html>",
     ]
     return ("\n".join(p for p in parts if p) + "\n").encode("utf-8")

@@ -11,12 +11,14 @@ from spur_cad.report.html import render_report
 if TYPE_CHECKING:
     from spur_cad.cam.plan import CamPlan
     from spur_cad.geometry.spec import GearSpec
+    from spur_cad.result import JobResult
     from spur_cad.sim.simulate import SimResult
 
 
-def report_html(summary: dict, profile_png: bytes, spec: GearSpec, blank_radius_mm: float, plan: CamPlan,
+def report_html(result: JobResult, profile_png: bytes, spec: GearSpec, blank_radius_mm: float, plan: CamPlan,
                 sim: SimResult | None) -> bytes:
-    """report.html for a job (pure: bytes out); levels and contact poses come from the plan, not recomputed."""
+    """report.html for a job (pure: bytes out): values from the typed result, levels and contact poses from the
+    plan and the deviation map from the simulation (not recomputed)."""
     from spur_cad.report.figures import deviation_map_png, finishing_png, passes_png, roughing_levels_png
 
     images = {"profile": profile_png}
@@ -34,9 +36,9 @@ def report_html(summary: dict, profile_png: bytes, spec: GearSpec, blank_radius_
         a = np.concatenate([p.a for p in parts])
         images["finishing"] = finishing_png(spec, plan.finishing.tool, y, z, a)
     if sim is not None:
-        from spur_cad.grade.simulated import grade_simulation
+        images["deviation"] = deviation_map_png(sim)
+    if result.grading is not None and result.grading.has_profile_traces:
         from spur_cad.report.figures import k_chart_png
 
-        images["deviation"] = deviation_map_png(sim)
-        images["kchart"] = k_chart_png(spec, grade_simulation(spec, sim))
-    return render_report(summary, images)
+        images["kchart"] = k_chart_png(spec, result.grading)
+    return render_report(result, images)

@@ -36,6 +36,19 @@ class SimulationError(SpurCadError, ValueError):
 
 
 @dataclass(frozen=True)
+class DeviationPlace:
+    """Where a deviation of the simulated gear is: its value (mm, + material), tooth space, feature, design
+    point, X and finishing station (-1: none)."""
+
+    value_mm: float
+    space: int
+    feature: str
+    point: int
+    x_mm: float
+    station: int
+
+
+@dataclass(frozen=True)
 class SimSettings:
     """Resolution and blade lengths. `resolution_mm` bounds the simulation's own error: cusps
     between clipped poses (<= resolution / 2) and the spacing of design points and rows."""
@@ -116,14 +129,14 @@ class SimResult:
         top = self.settings.leftover_range_mm - 1e-9
         return int(np.count_nonzero(self.deviation[:, :, self.gear_rows] >= top))
 
-    def worst(self, gouge: bool) -> dict:
+    def worst(self, gouge: bool) -> DeviationPlace:
         """Where the largest gouge (or leftover) is: space, feature, X, station, value (mm)."""
         dev = self.deviation[:, :, self.gear_rows]
         flat = int(np.argmin(dev) if gouge else np.argmax(dev))
         k, j, r = np.unravel_index(flat, dev.shape)
         row = np.nonzero(self.gear_rows)[0][r]
-        return {"value_mm": float(dev[k, j, r]), "space": int(k), "feature": self.grid.feature_names()[j],
-                "point": int(j), "x_mm": float(self.grid.rows_x[row]), "station": int(self.station_of_row()[row])}
+        return DeviationPlace(float(dev[k, j, r]), int(k), self.grid.feature_names()[j], int(j),
+                              float(self.grid.rows_x[row]), int(self.station_of_row()[row]))
 
 
 def finishing_stations(path: Toolpath | None) -> np.ndarray:

@@ -148,7 +148,7 @@ def export_job(job_obj, out_dir: str) -> list[str]:
     from spur_cad.pipeline import run_job
 
     job = job_of(job_obj)
-    files = run_job(job)
+    files = run_job(job).files
     out = Path(out_dir)
     try:
         paths = write_output_set(out, files)

@@ -10,7 +10,7 @@ there.
 from __future__ import annotations
 
 import dataclasses
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from typing import Any, Protocol
 
 import numpy as np
@@ -20,6 +20,28 @@ from spur_cad.cam.ir import Operation, Toolpath, ToolpathBuilder
 from spur_cad.cam.machine import Machine, MachineError
 from spur_cad.cam.tools import Tool, ToolError
 from spur_cad.geometry.spec import GearSpec
+
+
+class StrategyFacts(Protocol):
+    """A strategy's own typed facts for summary.json's `finishing` section (its fields, in order, after
+    `strategy`) and the report's sentence about them."""
+
+    def report_text(self) -> str:
+        """One or two plain sentences for the report (the report escapes them)."""
+        ...
+
+
+@dataclass(frozen=True)
+class StationFacts:
+    """Facts of strategies that finish by contacts at X stations (perimeter, along_x)."""
+
+    stations: int
+    station_step_mm: float
+    points_per_flank: int
+
+    def report_text(self, strategy: str = "") -> str:
+        return (f"Finishing: {strategy}, {self.stations} stations ({self.station_step_mm:.4f} mm apart), "
+                f"{self.points_per_flank} contact points per flank.")
 
 
 @dataclass(frozen=True)
@@ -35,8 +57,8 @@ class FinishingResult:
     passes_per_space: int = 0  # straight passes per tooth space (strategies with A clamped per pass)
     flat_height_mm: float = 0.0  # largest generating-flat deviation left on the involute (generating)
     passes: tuple = ()  # the strategy's passes of one space, typed by the strategy (generating: GeneratingPass)
-    facts: dict = field(default_factory=dict)  # strategy-specific facts for summary.json's `finishing` section
-    tool_advice: dict = field(default_factory=dict)  # strategy-specific tool advice (summary `tools.<strategy>`)
+    facts: Any = None  # the strategy's own typed facts (StrategyFacts; None: StationFacts of the stations)
+    tool_advice: Any = None  # the strategy's typed tool advice (summary `tools.<strategy>_advice`), or None
 
     @property
     def points_per_flank(self) -> int:
@@ -48,14 +70,16 @@ class FinishingResult:
             return f"{self.passes_per_space} straight passes per space with A clamped"
         return f"{self.stations} stations, {self.points_per_flank} contacts per flank"
 
-    def summary_facts(self) -> dict:
-        """summary.json's strategy-specific finishing facts: stations and contacts, or passes, and `facts`."""
-        if self.passes_per_space:
-            counted = {"passes_per_space": self.passes_per_space, "flat_height_mm": self.flat_height_mm}
-        else:
-            counted = {"stations": self.stations, "station_step_mm": self.station_step_mm,
-                       "points_per_flank": self.points_per_flank}
-        return {**counted, **self.facts}
+    @property
+    def strategy_facts(self) -> Any:
+        """The strategy's own facts: its typed `facts`, or the stations of a contact strategy."""
+        if self.facts is not None:
+            return self.facts
+        return StationFacts(self.stations, self.station_step_mm, self.points_per_flank)
+
+    def report_text(self) -> str:
+        facts = self.strategy_facts
+        return facts.report_text(self.strategy) if isinstance(facts, StationFacts) else facts.report_text()
 
 
 @dataclass(frozen=True)

@@ -672,16 +672,53 @@ def passes_flute_length_mm(passes: tuple[GeneratingPass, ...], tool: Tool, blank
     return float(np.max(np.sqrt(np.maximum(blank_radius_mm**2 - near**2, 0.0)) - z))
 
 
+@dataclass(frozen=True)
+class GeneratingAdvice:
+    """summary.json's `tools.generating_advice`: limits for this tool's corner radius, the largest tool with
+    the advised corner radius (rho), and the flute length this tool's passes need (mm). Helical gears have
+    no flank-mode or recommended figures (None, left out of the summary)."""
+
+    advised_corner_radius_mm: float
+    max_corner_radius_mm: float
+    flank_mode_max_diameter_mm: float | None
+    flank_mode_max_diameter_raised_end_mm: float | None
+    tip_mode_max_diameter_mm: float
+    max_diameter_mm: float
+    recommended_diameter_mm: float | None
+    recommended_flute_length_mm: float | None
+    required_flute_length_mm: float
+
+
+@dataclass(frozen=True)
+class GeneratingFacts:
+    """summary.json's generating facts (after `strategy`) and the report's sentence about them."""
+
+    passes_per_space: int
+    flat_height_mm: float
+    flank_passes_per_flank: int
+    tip_mode_passes_per_space: int
+    land_passes_per_space: int
+    tip_mode_leftover_mm: float
+    cutting_direction: str
+    flank_tool_end: str
+
+    def report_text(self) -> str:
+        return (f"Finishing: generating, {self.passes_per_space} straight passes per tooth space with A clamped: "
+                f"{self.flank_passes_per_flank} per flank (generating flat height "
+                f"{1000 * self.flat_height_mm:.2f} um), {self.tip_mode_passes_per_space} on fillets and root "
+                f"(largest sampled leftover {1000 * self.tip_mode_leftover_mm:.2f} um), "
+                f"{self.land_passes_per_space} on the tip land; {self.cutting_direction} milling, flank tool end "
+                f"'{self.flank_tool_end}'.")
+
+
 def tool_advice(spec: GearSpec, tool: Tool, params: GeneratingParams, plan: GeneratingPlan,
-                blank_radius_mm: float) -> dict[str, float]:
-    """summary.json's `tools.generating_advice`: limits for this tool's corner radius, the largest tool
-    with the advised corner radius (rho), and the flute length this tool's passes need."""
+                blank_radius_mm: float) -> GeneratingAdvice:
+    """Limits for this tool's corner radius, the largest tool with the advised corner radius (rho), and the
+    flute length this tool's passes need."""
     if spec.is_helical:  # the corner must be rho; the tip mode bounds the diameter (generating_helical)
         rho, d_n = spec.rack_tip_radius_mm, rack_corner(spec).normal_corner_offset_mm
-        return {"advised_corner_radius_mm": rho, "max_corner_radius_mm": rho,
-                "tip_mode_max_diameter_mm": 2.0 * d_n + 2.0 * rho, "max_diameter_mm": 2.0 * d_n + 2.0 * rho,
-                "required_flute_length_mm": passes_flute_length_mm(plan.passes, tool, blank_radius_mm,
-                                                                   spec.face_width_mm)}
+        return GeneratingAdvice(rho, rho, None, None, 2.0 * d_n + 2.0 * rho, 2.0 * d_n + 2.0 * rho, None, None,
+                                passes_flute_length_mm(plan.passes, tool, blank_radius_mm, spec.face_width_mm))
     end = params.flank_tool_end
     own = generating_tool_limits(spec, tool.effective_corner_radius_mm, params.target_scallop_mm, blank_radius_mm,
                                  end)
@@ -691,15 +728,11 @@ def tool_advice(spec: GearSpec, tool: Tool, params: GeneratingParams, plan: Gene
         flank = limits.flank_mode_max_diameter_mm if end == "rack" else limits.flank_mode_max_diameter_raised_mm
         return min(flank, limits.tip_mode_max_diameter_mm)
 
-    return {"advised_corner_radius_mm": advised.advised_corner_radius_mm,
-            "max_corner_radius_mm": own.max_corner_radius_mm,
-            "flank_mode_max_diameter_mm": own.flank_mode_max_diameter_mm,
-            "flank_mode_max_diameter_raised_end_mm": own.flank_mode_max_diameter_raised_mm,
-            "tip_mode_max_diameter_mm": own.tip_mode_max_diameter_mm,
-            "max_diameter_mm": largest(own),
-            "recommended_diameter_mm": largest(advised),
-            "recommended_flute_length_mm": advised.required_flute_length_mm,
-            "required_flute_length_mm": passes_flute_length_mm(plan.passes, tool, blank_radius_mm)}
+    return GeneratingAdvice(advised.advised_corner_radius_mm, own.max_corner_radius_mm,
+                            own.flank_mode_max_diameter_mm, own.flank_mode_max_diameter_raised_mm,
+                            own.tip_mode_max_diameter_mm, largest(own), largest(advised),
+                            advised.required_flute_length_mm,
+                            passes_flute_length_mm(plan.passes, tool, blank_radius_mm))
 
 
 # --------------------------------------------------------------------------- the strategy
@@ -749,15 +782,13 @@ class GeneratingStrategy:
         builder = ToolpathBuilder(Operation.FINISHING, tool.tool_number, tool.spindle_rpm(machine))
         _passes(builder, spec, tool, machine, plan, params, safe_height_mm(blank_radius_mm, machine))
         advice = tool_advice(spec, tool, params, plan, blank_radius_mm)
-        if tool.flute_length_mm and tool.flute_length_mm < advice["required_flute_length_mm"]:
+        if tool.flute_length_mm and tool.flute_length_mm < advice.required_flute_length_mm:
             raise ToolError(f"finishing tool flute_length_mm = {tool.flute_length_mm:g} is shorter than the "
-                            f"{advice['required_flute_length_mm']:.3f} mm the generating passes need",
+                            f"{advice.required_flute_length_mm:.3f} mm the generating passes need",
                             field="flute_length_mm", section="tools.finishing")
-        facts = {"flank_passes_per_flank": plan.flank_passes_per_flank,
-                 "tip_mode_passes_per_space": plan.tip_passes_per_space,
-                 "land_passes_per_space": plan.land_passes_per_space,
-                 "tip_mode_leftover_mm": plan.tip_leftover_mm,
-                 "cutting_direction": params.cutting_direction, "flank_tool_end": params.flank_tool_end}
+        facts = GeneratingFacts(plan.passes_per_space, plan.flat_height_mm, plan.flank_passes_per_flank,
+                                plan.tip_passes_per_space, plan.land_passes_per_space, plan.tip_leftover_mm,
+                                params.cutting_direction, params.flank_tool_end)
         result = FinishingResult(self.name, params, _space_poses(plan), 1, 0.0, np.zeros(0),
                                  passes_per_space=plan.passes_per_space, flat_height_mm=plan.flat_height_mm,
                                  passes=plan.passes, facts=facts, tool_advice=advice)

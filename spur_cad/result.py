@@ -1,0 +1,277 @@
+"""What a job's run found, typed end to end: `JobResult` and its small frozen parts.
+
+`spur_cad.pipeline.run_job` returns one; summary.json is its one serialisation (`spur_cad.summary`),
+and the report, the CLI and the workbench read its fields. The parts hold the lower layers' own types
+(the CAM plan's estimates, the tool recommendations, the simulation's places, the `Grading`) rather than
+copies in dictionaries.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, Any
+
+if TYPE_CHECKING:  # annotations only: the CAD kernel and the simulator load when a job uses them
+    from spur_cad.cad.solid import GearSolidReport
+    from spur_cad.cam.estimate import Estimate
+    from spur_cad.cam.recommend import ToolRecommendations
+    from spur_cad.grade.grading import Grading
+    from spur_cad.sim.simulate import DeviationPlace
+
+
+@dataclass(frozen=True)
+class JobFacts:
+    """The job's name and the file it was read from (as shown in messages)."""
+
+    name: str
+    file: str
+
+
+@dataclass(frozen=True)
+class GearFacts:
+    """The gear's derived quantities in mm and degrees (GearSpec.describe)."""
+
+    teeth: int
+    module_mm: float
+    pressure_angle_deg: float
+    profile_shift_coefficient: float
+    addendum_coefficient: float
+    dedendum_coefficient: float
+    rack_tip_radius_mm: float
+    thickness_allowance_fraction: float
+    thickness_allowance_mm: float
+    face_width_mm: float
+    reference_radius_mm: float
+    base_radius_mm: float
+    tip_radius_mm: float
+    root_radius_mm: float
+    form_radius_mm: float
+    pitch_mm: float
+    tooth_thickness_mm: float
+    space_width_mm: float
+    tip_thickness_mm: float
+    root_arc_half_angle_deg: float
+    root_arc_length_mm: float
+    min_fillet_curvature_radius_mm: float
+    undercut: bool
+    undercut_depth_mm: float
+    helix_angle_deg: float
+    hand: str
+    transverse_module_mm: float
+    transverse_pressure_angle_deg: float
+    base_helix_angle_deg: float
+    lead_mm: float | None
+    overlap_ratio: float
+
+    @property
+    def is_helical(self) -> bool:
+        return bool(self.helix_angle_deg)
+
+
+@dataclass(frozen=True)
+class InspectionFacts:
+    """The inspection sheet (spur_cad.geometry.inspection): span, pins, chordal thickness (mm)."""
+
+    span_teeth_k: int
+    span_measurement_mm: float | None  # None: the face is too narrow for a span over k teeth (helical)
+    span_contact_radius_mm: float
+    span_min_face_width_mm: float
+    pin_diameter_mm: float
+    dimension_over_pins_mm: float
+    pin_contact_radius_mm: float
+    chordal_thickness_mm: float
+    chordal_height_mm: float
+    chordal_measuring_radius_mm: float
+    tooth_thickness_mm: float
+    thickness_reduction_mm: float
+    min_teeth_without_undercut: int
+    min_teeth_without_undercut_exact: float
+
+
+@dataclass(frozen=True)
+class SegmentCounts:
+    """Sampled profile points per segment of the half tooth space."""
+
+    root: int
+    fillet: int
+    involute: int
+    tip: int
+
+
+@dataclass(frozen=True)
+class ProfileFacts:
+    """profile.csv: its chordal tolerance, its points and their segments."""
+
+    tolerance_mm: float
+    points: int
+    points_per_segment: SegmentCounts
+
+
+@dataclass(frozen=True)
+class CadResult:
+    """The CAD stage's facts: the solid's spline-fit report, volumes and STEP file sizes."""
+
+    report: GearSolidReport
+    gear_volume_mm3: float
+    stock_volume_mm3: float
+    step_bytes: dict[str, int]
+
+
+@dataclass(frozen=True)
+class ToolFacts:
+    """A chosen tool as the job runs it: shape, spindle speed and feed (tool_number shown for the bottom tool)."""
+
+    kind: str
+    diameter_mm: float
+    corner_radius_mm: float
+    flat_width_mm: float
+    spindle_rpm: float
+    feed_mm_min: float
+    tool_number: int
+
+
+@dataclass(frozen=True)
+class ToolsFacts:
+    """The recommendations for the gear, the chosen tools, and the finishing strategy's own tool advice."""
+
+    recommendations: ToolRecommendations
+    roughing: ToolFacts | None
+    finishing: ToolFacts | None
+    advice_strategy: str | None = None  # the strategy whose advice `advice` is
+    advice: Any = None  # the strategy's typed advice dataclass (e.g. GeneratingAdvice), or None
+
+
+@dataclass(frozen=True)
+class TwoStageFacts:
+    """Two-stage roughing: the bottom tool, the split, its own levels and the time saved."""
+
+    bottom_tool: ToolFacts
+    split_height_above_root_mm: float
+    split_chosen_by: str
+    bottom: RoughingFacts
+    two_stage_time_s: float
+    bottom_tool_alone_time_s: float
+    time_saved_s: float
+
+
+@dataclass(frozen=True)
+class RoughingFacts:
+    """One roughing operation: its levels and its estimate (and two-stage roughing's bottom operation)."""
+
+    levels_per_space: int
+    lowest_level_height_mm: float
+    level_heights_mm: tuple[float, ...]
+    estimate: Estimate
+    two_stage: TwoStageFacts | None = None
+
+
+@dataclass(frozen=True)
+class FinishingFacts:
+    """The finishing operation: its strategy, the strategy's own typed facts (its summary fields and report
+    sentence), its estimate, and the comparison estimates (None when not estimated)."""
+
+    strategy: str
+    strategy_facts: Any
+    report_text: str
+    estimate: Estimate
+    perimeter: Estimate | None
+    reference_strategy: Estimate | None
+
+
+@dataclass(frozen=True)
+class ProgramFacts:
+    """One posted program: its operation, lines, bytes and subprograms."""
+
+    operation: str
+    lines: int
+    bytes: int
+    subprograms: int
+
+
+@dataclass(frozen=True)
+class PostFacts:
+    """The post: dialect, folding and each program's size."""
+
+    dialect: str
+    folded: bool
+    programs: tuple[ProgramFacts, ...]
+
+    def program(self, operation: str) -> ProgramFacts | None:
+        return next((p for p in self.programs if p.operation == operation), None)
+
+
+@dataclass(frozen=True)
+class FeatureDeviation:
+    """The simulated deviations on one feature of the tooth space (mm)."""
+
+    feature: str
+    max_gouge_mm: float
+    max_leftover_mm: float
+    mean_mm: float
+
+
+@dataclass(frozen=True)
+class SimulationFacts:
+    """The simulated cut measured against the design (mm); only `enabled` and the resolution when off."""
+
+    enabled: bool
+    resolution_mm: float
+    max_gouge_mm: float = 0.0
+    max_leftover_mm: float = 0.0
+    removed_volume_mm3: float = 0.0
+    seconds: float = 0.0
+    design_points: int = 0
+    points_per_space: int = 0
+    rows: int = 0
+    point_spacing_mm: float = 0.0
+    uncut_points: int = 0
+    scallop_mean_mm: float = 0.0
+    scallop_p95_mm: float = 0.0
+    scallop_p99_mm: float = 0.0
+    worst_gouge: DeviationPlace | None = None
+    worst_leftover: DeviationPlace | None = None
+    per_feature: tuple[FeatureDeviation, ...] = ()
+    moves: int = 0
+    poses_clipped: int = 0
+    x_sweeps: int = 0
+    gouge_range_mm: float = 0.0
+    leftover_range_mm: float = 0.0
+
+    def feature(self, name: str) -> FeatureDeviation | None:
+        return next((f for f in self.per_feature if f.feature == name), None)
+
+
+@dataclass(frozen=True)
+class LatheFacts:
+    """The blank's lathe program: the control, the bar and the part it turns (mm)."""
+
+    dialect: str
+    bar_diameter_mm: float
+    blank_diameter_mm: float
+    blank_length_mm: float
+    stub_diameter_mm: float
+    stub_length_mm: float
+    part_off: bool
+    work_offset: str
+
+
+@dataclass(frozen=True)
+class JobResult:
+    """Everything a run found, and the output set's files ({name: bytes}, written by spur_cad.outputs)."""
+
+    version: str
+    job: JobFacts
+    gear: GearFacts
+    inspection: InspectionFacts
+    profile: ProfileFacts
+    cad: CadResult
+    tools: ToolsFacts
+    roughing: RoughingFacts | None
+    finishing: FinishingFacts | None
+    warnings: tuple[str, ...]
+    post: PostFacts
+    simulation: SimulationFacts
+    grading: Grading | None
+    lathe: LatheFacts | None
+    timings_s: dict[str, float]
+    files: dict[str, bytes] = field(default_factory=dict)
