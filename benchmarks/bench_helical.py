@@ -11,7 +11,7 @@ import argparse
 import dataclasses
 from pathlib import Path
 
-from benchmarks.run_benchmarks import median_seconds
+from benchmarks.common import median_seconds
 from spur_cad.job import Job, load_job
 from spur_cad.pipeline import build_programs, plan_cam, simulate_stage
 from spur_cad.post import PostSettings

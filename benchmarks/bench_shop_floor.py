@@ -11,7 +11,7 @@ import argparse
 import dataclasses
 from pathlib import Path
 
-from benchmarks.run_benchmarks import median_seconds
+from benchmarks.common import median_seconds
 from spur_cad.cam.recommend import recommend_tools
 from spur_cad.cam.restart import parse_restart
 from spur_cad.cam.turning import LatheSection

@@ -17,8 +17,8 @@ import sys
 import tempfile
 from pathlib import Path
 
+from benchmarks.common import median_seconds
 from benchmarks.peak_memory import fresh_python_floor_bytes, run_measured
-from benchmarks.run_benchmarks import median_seconds
 from spur_cad.job import load_job
 from spur_cad.pipeline import build_programs, plan_cam, simulate_stage
 from spur_cad.verify.reader import read_program

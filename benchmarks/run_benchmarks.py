@@ -10,26 +10,15 @@ import functools
 import json
 import os
 import platform
-import statistics
-import time
 from pathlib import Path
-from typing import Callable
 
+from benchmarks.common import median_seconds
 from spur_cad.geometry import GearSpec, gear_outline, sample_profile
 
 
 def reference_spec() -> GearSpec:
     return GearSpec(teeth=23, module_mm=4.0, rack_tip_radius_mm=0.8, thickness_allowance_fraction=0.05,
                     face_width_mm=20.0)
-
-
-def median_seconds(work: Callable[[], object], runs: int) -> float:
-    times = []
-    for _ in range(runs):
-        start = time.perf_counter()
-        work()
-        times.append(time.perf_counter() - start)
-    return statistics.median(times)
 
 
 def machine() -> str:

@@ -188,7 +188,7 @@ def test_reference_job_file_maps_onto_the_document(freecadcmd, tmp_path):
 
 SAVE_BODY = STATES + """
 import FreeCAD
-from spur_cad_workbench import commands, features, schema
+from spur_cad_workbench import commands, properties, schema
 doc = FreeCAD.newDocument("Saved")
 gear = commands.make_gear(doc, **PROPS["gear"])
 stock = commands.make_stock(gear, **PROPS["stock"])
@@ -209,7 +209,7 @@ job.addProperty("App::PropertyAngle", "AMin", "Machine", "A travel limit, low (d
 job.AMin = -99999.0
 job.FinishingStrategy = ["perimeter"]
 job.SchemaVersion = 1
-RESULT["saved_values"] = features.read_values(job, schema.JOB_FIELDS)
+RESULT["saved_values"] = properties.read_values(job, schema.JOB_FIELDS)
 doc.saveAs(FILE)
 FreeCAD.closeDocument("Saved")
 doc = FreeCAD.openDocument(FILE)
@@ -223,7 +223,7 @@ RESULT["schema_version"] = schema.SCHEMA_VERSION
 RESULT["job_version"] = job.SchemaVersion
 RESULT["migrated_types"] = {p: job.getTypeIdOfProperty(p) for p in ("MaxFeed", "AMin", "FinishingStrategy")}
 RESULT["strategies"] = job.getEnumerationsOfProperty("FinishingStrategy")
-RESULT["restored_values"] = features.read_values(job, schema.JOB_FIELDS)
+RESULT["restored_values"] = properties.read_values(job, schema.JOB_FIELDS)
 for obj in doc.Objects:
     obj.touch()
 doc.recompute()
@@ -234,7 +234,7 @@ doc.save()
 FreeCAD.closeDocument(doc.Name)
 doc = FreeCAD.openDocument(FILE)                 # reopened again: nothing left to migrate
 RESULT["second_restore"] = states(doc)
-RESULT["reopened_values"] = features.read_values(doc.getObject("Job"), schema.JOB_FIELDS)
+RESULT["reopened_values"] = properties.read_values(doc.getObject("Job"), schema.JOB_FIELDS)
 """
 
 PRIMITIVE_PROPERTIES = {"App::PropertyAngle", "App::PropertyBool", "App::PropertyDistance", "App::PropertyEnumeration",

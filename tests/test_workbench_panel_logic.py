@@ -20,10 +20,10 @@ from tests.workbench_helper import ROOT, small_job_text
 @pytest.fixture
 def wb(monkeypatch):
     monkeypatch.syspath_prepend(str(ROOT / "workbench"))
-    from spur_cad_workbench import colourbar, schema, simulation, summary, validation
+    from spur_cad_workbench import colourbar, colours, schema, simulation, summary, validation
 
     return SimpleNamespace(schema=schema, validation=validation, summary=summary, simulation=simulation,
-                           colourbar=colourbar)
+                           colourbar=colourbar, colours=colours)
 
 
 def _values(wb, **job_changes):
@@ -160,5 +160,5 @@ def test_colour_scale_and_colour_bar(wb):
     vertices, fraction = wb.colourbar.bar_geometry(1.6, steps=10)
     assert vertices.shape == (22, 3) and fraction[0] == -1.0 and fraction[-1] == 1.0
     assert np.all(np.diff(vertices[::2, 1]) > 0) and vertices[:, 0].min() > -1.6 and vertices[:, 0].max() < -1.3
-    colours = wb.simulation.deviation_colours(fraction, 1.0)
+    colours = wb.colours.deviation_colours(fraction, 1.0)
     assert np.allclose(colours[0], (0, 0, 1)) and np.allclose(colours[-1], (1, 0, 0))

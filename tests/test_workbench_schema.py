@@ -33,10 +33,10 @@ from tests.workbench_helper import REFERENCE_JOB, ROOT, small_job_text
 def wb(monkeypatch):
     """The workbench package (plain-Python modules only), importable from workbench/."""
     monkeypatch.syspath_prepend(str(ROOT / "workbench"))
-    from spur_cad_workbench import display, environment, schema, simulation, validation
+    from spur_cad_workbench import colours, display, environment, schema, simulation, validation
 
     return SimpleNamespace(schema=schema, validation=validation, display=display, environment=environment,
-                           simulation=simulation)
+                           simulation=simulation, colours=colours)
 
 
 # --- job_from_dict -------------------------------------------------------------------------------
@@ -393,7 +393,7 @@ def test_polylines_split_rapids_from_feeds(wb):
 
 
 def test_deviation_colours(wb):
-    colours = wb.simulation.deviation_colours(np.array([-1.0, -0.05, 0.0, 0.05, 1.0]), 0.1)
+    colours = wb.colours.deviation_colours(np.array([-1.0, -0.05, 0.0, 0.05, 1.0]), 0.1)
     assert np.allclose(colours[0], [0, 0, 1]) and np.allclose(colours[-1], [1, 0, 0])
     assert np.allclose(colours[2], [0, 1, 0])
     assert np.allclose(colours[1], [0, 0.5, 0.5]) and np.allclose(colours[3], [0.5, 0.5, 0])

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from spur_cad_workbench.simulation import deviation_colours
+from spur_cad_workbench.colours import deviation_colours
 
 COLOUR_BAR_NAME = "SpurCadColourBar"
 BAR_STEPS = 40

@@ -33,8 +33,8 @@ from spur_cad_workbench.features import (
     StockFeature,
     ToolpathFeature,
     ViewProvider,
-    job_of,
 )
+from spur_cad_workbench.properties import document_values, job_of
 
 
 def _checked(values: dict, fields, what: str) -> dict:
@@ -103,7 +103,6 @@ def make_job(gear, stock, suggest: bool = True, **values):
     Without tool values the tools are suggested within the gear's recommendations
     (validation.suggest_tools); `suggest=False` keeps the job file's defaults (no tools).
     """
-    from spur_cad_workbench.features import document_values
     from spur_cad_workbench.validation import suggest_tools
 
     job_values = {**schema.default_values()["job"], **_checked(values, schema.JOB_FIELDS, "job")}
@@ -161,7 +160,6 @@ def export_job(job_obj, out_dir: str) -> list[str]:
 def simulate(job_obj, resolution_mm: float | None = None):
     """Simulate the job's toolpaths (spur_cad.sim, at the job's SimulationResolution unless given) and show
     the design points coloured by their deviation. Reuses the job's plan when its values have not changed."""
-    from spur_cad_workbench.features import document_values
     from spur_cad_workbench.simulation import show_result, simulate_job, simulator
     from spur_cad_workbench.summary import values_signature
 
@@ -171,7 +169,8 @@ def simulate(job_obj, resolution_mm: float | None = None):
     reused = cached is not None and cached[0] == signature
     job, plan = job_obj.Proxy.plan_for(job_obj)
     source = "the job's plan (reused)" if reused else "planned for this simulation"
-    return show_result(job_obj, simulate_job(job, plan, resolution_mm), signature, source)
+    return show_result(job_obj, simulate_job(job, plan, resolution_mm), signature, source,
+                       view_provider=ViewProvider)
 
 
 def verify_programs(job_obj, paths: list[str], dialect: str | None = None, point: str = "tip"):
@@ -180,7 +179,6 @@ def verify_programs(job_obj, paths: list[str], dialect: str | None = None, point
     the verdict goes to the report view and a message box. Returns the object."""
     from spur_cad.verify.reader import read_program_file
     from spur_cad.verify.verify import VerifyOptions, verify_moves
-    from spur_cad_workbench.features import document_values
     from spur_cad_workbench.simulation import show_result, simulator
     from spur_cad_workbench.summary import values_signature
 
@@ -192,7 +190,7 @@ def verify_programs(job_obj, paths: list[str], dialect: str | None = None, point
     result = verify_moves(job, programs, VerifyOptions(point))
     names = ", ".join(Path(path).name for path in paths)
     obj = show_result(job_obj, result.simulation, values_signature(document_values(job_obj)),
-                      f"verified programs: {names}", role="verification")
+                      f"verified programs: {names}", role="verification", view_provider=ViewProvider)
     show_message("Verify program", "\n".join(result.lines()), error=not result.passed)
     return obj
 

@@ -15,6 +15,7 @@ from __future__ import annotations
 import numpy as np
 
 from spur_cad.errors import SpurCadError
+from spur_cad_workbench.colours import deviation_colours
 
 MAX_SHOWN_POINTS = 300_000
 
@@ -60,14 +61,6 @@ def colour_scale_mm(deviation: np.ndarray, resolution_mm: float) -> float:
     (differences below it are the simulation's own)."""
     largest = float(np.max(np.abs(deviation))) if len(deviation) else 0.0
     return max(largest, resolution_mm)
-
-
-def deviation_colours(deviation: np.ndarray, scale_mm: float) -> np.ndarray:
-    """(N, 3) RGB in [0, 1]: blue at -scale (gouge), green at 0, red at +scale (leftover) and beyond."""
-    t = np.clip(np.asarray(deviation, float) / scale_mm, -1.0, 1.0)
-    red = np.clip(t, 0.0, 1.0)
-    blue = np.clip(-t, 0.0, 1.0)
-    return np.column_stack([red, 1.0 - np.abs(t), blue])
 
 
 def result_points(result) -> tuple[np.ndarray, np.ndarray]:
@@ -158,9 +151,9 @@ def show_current(obj) -> None:
     recolour(obj)
 
 
-def _simulation_object(job_obj, role: str):
+def _simulation_object(job_obj, role: str, view_provider):
     """The job's simulation object of `role` ("simulation" of its own toolpaths, "verification" of programs;
-    made when missing), linked to the job."""
+    made when missing, its view given a `view_provider` proxy in the GUI), linked to the job."""
     import FreeCAD
 
     doc = job_obj.Document
@@ -177,19 +170,20 @@ def _simulation_object(job_obj, role: str):
         obj.setEditorMode(hidden, 2)
     obj.Job = job_obj
     if FreeCAD.GuiUp and obj.ViewObject is not None:
-        from spur_cad_workbench.features import ViewProvider
-
-        ViewProvider(obj.ViewObject)
+        view_provider(obj.ViewObject)
     return obj
 
 
-def show_result(job_obj, result, planned_values: str = "", plan_source: str = "", role: str = "simulation"):
+def show_result(job_obj, result, planned_values: str = "", plan_source: str = "", role: str = "simulation", *,
+                view_provider):
     """The job's object '<job> <role>' with the coloured design points and the result's facts (role
-    "simulation": the job's own toolpaths; "verification": programs read by `verify_programs`)."""
+    "simulation": the job's own toolpaths; "verification": programs read by `verify_programs`).
+    `view_provider` is the proxy class of a new object's view (features.ViewProvider), passed in by the
+    caller because features imports this module."""
     import FreeCAD
     import Points
 
-    obj = _simulation_object(job_obj, role)
+    obj = _simulation_object(job_obj, role, view_provider)
     obj.Label = f"{job_obj.Label} {role}"
     points, deviation = result_points(result)
     scale = colour_scale_mm(deviation, result.settings.resolution_mm)

@@ -21,7 +21,7 @@ import FreeCADGui
 from PySide import QtCore, QtGui
 
 from spur_cad_workbench import compat, schema
-from spur_cad_workbench.features import document_values, write_values
+from spur_cad_workbench.properties import document_values, write_values
 from spur_cad_workbench.summary import (
     figures_text,
     limits_text,
