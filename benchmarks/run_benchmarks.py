@@ -83,8 +83,8 @@ def bench_cam(runs: int) -> dict:
     beside the reference process's finishing strategy (0.08 mm contact spacing, 0.14 mm X step)."""
     from spur_cad.cam.estimate import estimate
     from spur_cad.cam.finishing import finishing_toolpath
-    from spur_cad.cam.machine import FinishingParams
     from spur_cad.cam.roughing import roughing_toolpath
+    from spur_cad.cam.strategies import FinishingParams
     from spur_cad.job import load_job
 
     job = load_job(Path(__file__).resolve().parents[1] / "resources" / "examples" / "reference_gear.toml")

@@ -11,8 +11,7 @@ package loads nothing heavy: the CAD entry points below import CadQuery on first
 """
 
 from spur_cad.errors import GearSpecError, JobFileError, SpurCadError, StockError
-
-__version__ = "0.1.0"
+from spur_cad.version import __version__
 
 _CAD_ENTRY_POINTS = {"make_gear", "make_stock", "to_build123d", "BlankFeatures", "StockSpec"}
 

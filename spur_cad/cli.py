@@ -21,8 +21,8 @@ import threading
 import warnings
 from typing import NoReturn
 
-from spur_cad import __version__
 from spur_cad.errors import SpurCadError, escaped, one_line
+from spur_cad.version import __version__
 
 EXIT_INPUT_ERROR = 2
 EXIT_INTERNAL_ERROR = 3

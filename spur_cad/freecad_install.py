@@ -30,9 +30,9 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
 
-from spur_cad import __version__
 from spur_cad.errors import SpurCadError
 from spur_cad.outputs import write_file_atomically
+from spur_cad.version import __version__
 
 ADDON_NAME = "spur_cad"
 RECORD_NAME = "spur_cad_environment.json"  # = spur_cad_workbench.environment.RECORD_NAME

@@ -7,8 +7,8 @@ values outside the declared ranges with a JobFileError that names the key and, w
 has it, the key's line; then it runs the sections' cross-field checks (`validate()`) and builds
 the GearSpec. Units are in the key names (mm, deg, percent, m_min, ...).
 
-`job_file_reference_markdown()` writes docs/job-file.md from the same declarations
-(`python -m spur_cad.job --markdown > docs/job-file.md`).
+spur_cad.keydocs writes docs/job-file.md from the same declarations
+(`python -m spur_cad.keydocs > docs/job-file.md`).
 """
 
 from __future__ import annotations
@@ -16,15 +16,15 @@ from __future__ import annotations
 import dataclasses
 import difflib
 import re
-import sys
 import tomllib
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
 
 from spur_cad.cad.specs import BlankFeatures, StockSpec
-from spur_cad.cam.machine import FinishingParams, Machine, RoughingParams
+from spur_cad.cam.machine import Machine, RoughingParams
 from spur_cad.cam.machine_limits import check_machine_limits
+from spur_cad.cam.strategies import REGISTRY, FinishingParams, Strategies, finishing_section_type
 from spur_cad.cam.tools import Tool
 from spur_cad.cam.turning import LatheSection, check_lathe_blank
 from spur_cad.errors import (
@@ -38,7 +38,7 @@ from spur_cad.errors import (
     shown_path,
 )
 from spur_cad.geometry.spec import MAX_TEETH, MIN_TEETH, GearSpec
-from spur_cad.keys import check_section, coerce, key, keys_of, section_problems, toml_literal, type_problem
+from spur_cad.keys import check_section, coerce, key, keys_of, section_problems, type_problem
 from spur_cad.post.settings import PostSettings
 
 
@@ -150,6 +150,7 @@ class Job:
     simulation: SimulationSection = field(default_factory=SimulationSection)
     lathe: LatheSection | None = None  # [lathe] present: the blank's lathe program is written too
     text: str = field(default="", repr=False, compare=False)  # the file's text, to point at lines
+    strategies: Strategies = field(default_factory=lambda: REGISTRY, repr=False, compare=False)  # finishing's
 
     def located(self, error: SpurCadError) -> str:
         """An error raised after loading, prefixed with 'file:line' of the key it blames (its section's
@@ -181,6 +182,15 @@ SECTIONS: dict[str, type] = {
     "post": PostSettings,
     "lathe": LatheSection,
 }
+
+
+def job_sections(strategies: Strategies = REGISTRY) -> dict[str, type]:
+    """SECTIONS with the [finishing] section made from the keys of `strategies`' parameters."""
+    if strategies is REGISTRY:
+        return SECTIONS
+    return {**SECTIONS, "finishing": finishing_section_type(strategies)}
+
+
 _TOOL_ROLES = ("roughing", "finishing", "bottom")
 MAX_JOB_FILE_BYTES = 1024 * 1024
 """Job files larger than this are refused before they are parsed."""
@@ -209,10 +219,10 @@ def _where(source: str, text: str, table: str, key_name: str | None = None) -> s
     return f"{source}:{line}" if line else source
 
 
-def _blamed_key(exc: SpurCadError, name: str, given: dict) -> str | None:
+def _blamed_key(exc: SpurCadError, name: str, given: dict, sections: dict[str, type] = SECTIONS) -> str | None:
     """The key of section `name` a cross-field error is about, for its line: the error's `field` when the
     file sets it, else the first key the message names that the file sets, else the `field` (not set)."""
-    names = [k.name for k in keys_of(SECTIONS[name])]
+    names = [k.name for k in keys_of(sections[name])]
     if exc.field in names and exc.field in given:
         return exc.field
     message = str(exc)
@@ -223,9 +233,9 @@ def _blamed_key(exc: SpurCadError, name: str, given: dict) -> str | None:
     return exc.field if exc.field in names else None
 
 
-def _load_section(table: object, name: str, source: str, text: str):
+def _load_section(table: object, name: str, source: str, text: str, sections: dict[str, type] = SECTIONS):
     """Build section `name`'s dataclass from its TOML table, checking keys, types, ranges and choices."""
-    cls = SECTIONS[name]
+    cls = sections[name]
     if not isinstance(table, dict):
         raise JobFileError(f"{_where(source, text, name)}: [{name}] must be a table")
     known = {k.name: k for k in keys_of(cls)}
@@ -288,8 +298,9 @@ def _longest_number(text: str, source: str) -> str:
     return where
 
 
-def parse_job(text: str, source: str = "<job>") -> Job:
-    """Validate a job file's text; raises JobFileError (or GearSpecError wrapped into it)."""
+def parse_job(text: str, source: str = "<job>", strategies: Strategies = REGISTRY) -> Job:
+    """Validate a job file's text; raises JobFileError (or GearSpecError wrapped into it). `strategies`: the
+    finishing strategies [finishing] strategy names and whose keys it takes."""
     if len(text) > MAX_JOB_FILE_BYTES:
         raise JobFileError(f"{source}: the job file is larger than {MAX_JOB_FILE_BYTES // 1024} KiB; a job file is "
                            "a few kilobytes of TOML")
@@ -303,15 +314,15 @@ def parse_job(text: str, source: str = "<job>") -> Job:
     except RecursionError:
         raise JobFileError(f"{_deepest_value(text, source)}: arrays or tables nested too deeply for a job file") \
             from None
-    return _job_from_data(data, source, text)
+    return _job_from_data(data, source, text, strategies)
 
 
-def job_from_dict(data: dict, source: str) -> Job:
+def job_from_dict(data: dict, source: str, strategies: Strategies = REGISTRY) -> Job:
     """Validate a job given as nested dicts (the TOML structure), e.g. built by the FreeCAD workbench.
 
     Same checks and messages as parse_job, without line numbers (`source` names the origin).
     """
-    return _job_from_data(data, source, "")
+    return _job_from_data(data, source, "", strategies)
 
 
 def _tables(data: dict, source: str, text: str) -> dict[str, object]:
@@ -383,10 +394,11 @@ def _tools_section(sections: dict, tables: dict, where: Callable[[str, str | Non
     return tools
 
 
-def _job_from_data(data: dict, source: str, text: str) -> Job:
+def _job_from_data(data: dict, source: str, text: str, strategies: Strategies = REGISTRY) -> Job:
     """Validate parsed job data; `text` (the file's text, or "") only locates keys for messages."""
     tables = _tables(data, source, text)
-    sections = {name: _load_section(tables[name], name, source, text) for name in SECTIONS if name in tables}
+    types = job_sections(strategies)
+    sections = {name: _load_section(tables[name], name, source, text, types) for name in types if name in tables}
 
     def where(name: str, key_name: str | None) -> str:
         return _where(source, text, name, key_name)
@@ -415,7 +427,7 @@ def _job_from_data(data: dict, source: str, text: str) -> Job:
                 sections[name].validate()
         except SpurCadError as exc:
             prefix = f"[{name}] " if is_tool else ""
-            blamed = _blamed_key(exc, name, tables[name])
+            blamed = _blamed_key(exc, name, tables[name], types)
             raise JobFileError(f"{where(name, blamed)}: {prefix}{exc}", section=name, field=blamed) from None
     tools = _tools_section(sections, tables, where)
     try:
@@ -433,10 +445,10 @@ def _job_from_data(data: dict, source: str, text: str) -> Job:
     optional = {name: sections[name] for name in ("stock", "roughing", "finishing", "machine", "post", "simulation",
                                                   "lathe") if name in sections}
     return Job(source=source, job=sections.get("job", JobSection()), gear_section=gear_section, gear=spec,
-               tools=tools, **optional, text=text)
+               tools=tools, **optional, text=text, strategies=strategies)
 
 
-def load_job(path: str | Path) -> Job:
+def load_job(path: str | Path, strategies: Strategies = REGISTRY) -> Job:
     """Read and validate a job file from disk (a regular file of at most MAX_JOB_FILE_BYTES: a FIFO or a device
     is refused before it is read)."""
     from spur_cad.inputs import read_regular_file
@@ -449,123 +461,4 @@ def load_job(path: str | Path) -> Job:
         raise JobFileError(f"{source}: the job file is not UTF-8 text") from None
     if "\x00" in text:
         raise JobFileError(f"{source}: the job file contains NUL characters (not a text file)")
-    return parse_job(text, source)
-
-
-# --- docs/job-file.md -------------------------------------------------------------------------------------
-
-_DOC_INTRO = """\
-# Job file reference
-
-<!-- Generated from the key declarations (spur_cad.keys.key fields of the section dataclasses) by
-     `python -m spur_cad.job --markdown > docs/job-file.md`; edit those, not this file. -->
-
-A job file is TOML. Units are in key names. Unknown sections or keys, wrong types,
-missing required keys and values outside the accepted range are errors naming the key and the
-line. Without `[tools.*]` the job stops after the CAD stage (tool recommendations are still
-reported, no G-code is written).
-
-Every number must be finite (`nan` and `inf` are rejected) and inside its range: `[a, b]`
-includes both ends, `(a, b]` excludes a; `a..b` is a range of whole numbers. An integer is
-accepted where a number is expected; `true`/`false` only where a flag is. The last column names
-the FreeCAD workbench's property holding the key (see [workbench.md](workbench.md)).
-"""
-
-_DOC_NOTES = """\
-Notes:
-
-- `[gear] thickness_allowance_percent` thins the nominal tooth thickness on the reference
-  circle by that percentage (the reference process's "profile clearance", 0-5 %);
-  `thickness_allowance_mm` subtracts a further absolute amount (see [geometry.md](geometry.md)).
-  The gear itself must be cuttable by rack generation: `rack_tip_radius_mm` at most 0.6 x module,
-  `thickness_allowance_mm` at most 0.5 x module, a positive root radius, no pointed tooth.
-- `[gear] bore_diameter_mm`, `keyway_width_mm`, `keyway_depth_mm` (0 = none): a through bore and
-  a hub keyway on the bore's +Z side (under tooth space 0); depth is measured from the bore
-  surface. At least one module of wall must remain under the root circle; a keyway needs a bore
-  and both its width (below the bore diameter) and depth.
-- `[stock]`: the blank is a cylinder of tip radius + `radial_allowance_mm` from
-  X = -`front_margin_mm` to face width + `back_margin_mm`; a holding stub (`stub_diameter_mm`,
-  `stub_length_mm`, both or neither, not wider than the blank) continues it toward the chuck (+X).
-- `[tools.*]`: `flute_length_mm` / `stick_out_mm` of 0 mean "not given"; when given they are
-  checked against what the job needs (summary `tools.required_flute_length_mm`,
-  `tools.required_stick_out_mm`). See [cam.md](cam.md) for every limit.
-- `[roughing] finish_stock_mm` must be below `flank_allowance_mm`.
-- `[machine]` travel limits: each low limit must be below its high limit.
-  `rotary_clamp_code` / `rotary_unclamp_code` are needed when `[roughing] clamp_rotary`
-  is true; `rotary_continuous = false` makes finishing unwind A after every station.
-- `[post] folded = true` needs `rotary_mode = "unwound"`.
-- `[stock] blank_diameter_mm` (the blank as turned) replaces tip diameter + 2 x
-  `radial_allowance_mm`; it may not be below the tip diameter, and the blank may stand at most
-  0.5 x the finishing tool's diameter (a slot's depth) above the tip circle.
-- `[machine]` physical limits (`max_part_diameter_mm`, `max_part_weight_kg`, `max_overhang_mm`,
-  `spindle_nose_top_mm`; 0 = not checked) are errors naming the limit; tools below
-  `smallest_end_mill_mm` are warnings (see [shop-floor.md](shop-floor.md)).
-- `[tools.bottom]`: two-stage roughing, a flat end mill smaller than `[tools.roughing]` for the
-  bottom of the spaces (T3 when it gives no number); the split is chosen for the shortest time
-  unless `[roughing] bottom_tool_above_root_mm` sets it.
-- `[lathe]`: with the section the blank's lathe program `blank.<ext>` is written too (see
-  [lathe.md](lathe.md)).
-"""
-
-_TYPE_WORDS = {float: "number", int: "integer", bool: "boolean", str: "string"}
-
-
-def _doc_text(text: str) -> str:
-    """Docstring or meaning text for markdown: docs/<name>.md becomes a link."""
-    return re.sub(r"docs/([\w-]+\.md)", r"[\1](\1)", text)
-
-
-def _section_summary(cls: type) -> str:
-    """The first paragraph of a section dataclass's docstring, without its '[section]: ' prefix."""
-    first = " ".join(line.strip() for line in (cls.__doc__ or "").strip().split("\n\n")[0].splitlines())
-    first = re.sub(r"^\[[^\]]+\](\s*/\s*\[[^\]]+\])*:\s*", "", first)
-    return _doc_text(first[:1].upper() + first[1:])
-
-
-def _accepted(k) -> str:
-    if k.type is bool:
-        return "`true`, `false`"
-    if k.names:
-        return ", ".join(f"`{n}`" for n in k.names)
-    if k.low is not None:
-        text = k.interval()
-        return text.removesuffix(f" {k.unit}") if k.unit else text
-    return "any"
-
-
-def job_file_reference_markdown() -> str:
-    """docs/job-file.md: the introduction, one table per section from its key declarations, the notes."""
-    parts = [_DOC_INTRO]
-    done: set[type] = set()
-    for cls in SECTIONS.values():
-        if cls in done:
-            continue
-        done.add(cls)
-        names = [n for n, c in SECTIONS.items() if c is cls]
-        parts.append(f"## {' / '.join(f'[{n}]' for n in names)}\n\n{_section_summary(cls)}\n")
-        if len(names) > 1:
-            roles = " or ".join(n.split(".")[-1].capitalize() for n in names)
-            parts.append(f"In the workbench property names, `{{Role}}` is {roles}.\n")
-        rows = ["| key | type | unit | default | accepted | meaning | workbench property |",
-                "| --- | --- | --- | --- | --- | --- | --- |"]
-        for k in keys_of(cls):
-            default = "**required**" if k.required else f"`{toml_literal(k.default)}`"
-            rows.append(f"| `{k.name}` | {_TYPE_WORDS[k.type]} | {k.unit or '-'} | {default} | {_accepted(k)} | "
-                        f"{_doc_text(k.meaning)} | `{k.label}` |")
-        parts.append("\n".join(rows) + "\n")
-    parts.append(_DOC_NOTES)
-    return "\n".join(parts)
-
-
-def main(argv: list[str] | None = None) -> int:
-    """`python -m spur_cad.job --markdown`: print docs/job-file.md."""
-    argv = sys.argv[1:] if argv is None else argv
-    if argv != ["--markdown"]:
-        print("usage: python -m spur_cad.job --markdown > docs/job-file.md", file=sys.stderr)
-        return 2
-    sys.stdout.write(job_file_reference_markdown())
-    return 0
-
-
-if __name__ == "__main__":
-    raise SystemExit(main())
+    return parse_job(text, source, strategies)

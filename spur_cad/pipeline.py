@@ -16,13 +16,13 @@ from typing import TYPE_CHECKING, Callable
 
 import numpy as np
 
-from spur_cad import __version__
 from spur_cad.cam.plan import CamInputs, CamPlan
 from spur_cad.cam.plan import plan_cam as plan_cam_inputs
 from spur_cad.geometry.sampling import ProfileSamples, sample_profile
 from spur_cad.job import Job
 from spur_cad.result import CadResult, JobResult
 from spur_cad.summary import build_result, summary_json
+from spur_cad.version import __version__
 
 if TYPE_CHECKING:
     from spur_cad.cam.restart import RestartPoint
@@ -229,7 +229,7 @@ def build_cad(job: Job, checkpoint: Callable[[], None] | None = None) -> tuple[C
 def cam_inputs(job: Job) -> CamInputs:
     """The part of a job the CAM stage reads."""
     return CamInputs(job.gear, job.stock, job.tools.roughing, job.tools.finishing, job.roughing, job.finishing,
-                     job.machine, job.tools.bottom)
+                     job.machine, job.tools.bottom, job.strategies)
 
 
 def plan_cam(job: Job, checkpoint: Callable[[], None] | None = None) -> CamPlan:

@@ -10,7 +10,6 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from spur_cad import __version__
 from spur_cad.cam.estimate import Estimate
 from spur_cad.cam.machine import Machine
 from spur_cad.cam.plan import CamPlan, FinishingPlan, RoughingPlan
@@ -39,6 +38,7 @@ from spur_cad.result import (
     ToolsFacts,
     TwoStageFacts,
 )
+from spur_cad.version import __version__
 
 if TYPE_CHECKING:  # the simulator loads only when a job uses it
     from spur_cad.grade.grading import Grading

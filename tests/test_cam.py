@@ -14,10 +14,10 @@ from spur_cad.cam.contacts import station_positions, station_step_mm
 from spur_cad.cam.estimate import estimate
 from spur_cad.cam.finishing import finishing_toolpath
 from spur_cad.cam.ir import Feature, MoveKind, Operation, ToolpathBuilder
-from spur_cad.cam.machine import FinishingParams, Machine, RoughingParams
+from spur_cad.cam.machine import Machine, RoughingParams
 from spur_cad.cam.recommend import check_tools, recommend_tools
 from spur_cad.cam.roughing import roughing_levels, roughing_toolpath
-from spur_cad.cam.strategies import get_strategy
+from spur_cad.cam.strategies import FinishingParams, get_strategy
 from spur_cad.cam.tools import Tool, ToolError
 from spur_cad.geometry import gear_outline, sample_profile
 from tests.gears import CAM_GEARS, spec_of, textbook_of, tools_for

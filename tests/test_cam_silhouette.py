@@ -10,8 +10,9 @@ from shapely.geometry import Polygon
 
 from spur_cad.cam.finishing import finishing_toolpath
 from spur_cad.cam.ir import Feature, MoveKind
-from spur_cad.cam.machine import FinishingParams, Machine, RoughingParams
+from spur_cad.cam.machine import Machine, RoughingParams
 from spur_cad.cam.roughing import roughing_toolpath
+from spur_cad.cam.strategies import FinishingParams
 from spur_cad.geometry import gear_outline
 from tests import silhouette
 from tests.gears import CAM_GEARS, spec_of, tools_for

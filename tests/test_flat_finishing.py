@@ -21,10 +21,10 @@ import pytest
 from spur_cad.cad.specs import StockSpec
 from spur_cad.cam.finishing import plan_finishing
 from spur_cad.cam.ir import Feature, MoveKind
-from spur_cad.cam.machine import FinishingParams, Machine, RoughingParams
+from spur_cad.cam.machine import Machine, RoughingParams
 from spur_cad.cam.plan import CamInputs, check_cam_inputs, plan_cam
 from spur_cad.cam.recommend import check_tools, recommend_tools
-from spur_cad.cam.strategies import get_strategy
+from spur_cad.cam.strategies import FinishingParams, get_strategy
 from spur_cad.cam.tools import Tool, ToolError
 from spur_cad.geometry import GearSpec
 from spur_cad.job import load_job

@@ -15,8 +15,8 @@ from shapely.geometry import Polygon
 
 from spur_cad.cam.finishing import plan_finishing
 from spur_cad.cam.ir import Feature, MoveKind
-from spur_cad.cam.machine import FinishingParams, Machine
-from spur_cad.cam.strategies import get_strategy, strategy_names
+from spur_cad.cam.machine import Machine
+from spur_cad.cam.strategies import FinishingParams, get_strategy, strategy_names
 from spur_cad.cam.strategies.generating import MOVES_PER_PASS, GeneratingParams, generating_tool_limits
 from spur_cad.cam.tools import Tool, ToolError
 from spur_cad.geometry import GearSpec, gear_outline
@@ -136,12 +136,18 @@ def test_raised_end_fits_a_tool_the_rack_end_cannot_take():
     with pytest.raises(ToolError, match="largest diameter for tip mode"):
         get_strategy("generating").generate(spec, big, MACHINE, GeneratingParams(), spec.tip_radius_mm + 0.5)
     # ... but its flank passes with the raised end pass the exact gouge check (the rack end's do not).
-    from spur_cad.cam.strategies.generating import GOUGE_TOLERANCE_MM, _design_points, _gouges, flank_poses, flank_rolls
+    from spur_cad.cam.strategies.generating_geometry import (
+        GOUGE_TOLERANCE_MM,
+        design_points,
+        flank_poses,
+        flank_rolls,
+        gouges,
+    )
 
     rolls, _ = flank_rolls(spec, 0.005)
-    assert _gouges(_design_points(spec), *flank_poses(spec, big, rolls, "rack"), big).max() > GOUGE_TOLERANCE_MM
+    assert gouges(design_points(spec), *flank_poses(spec, big, rolls, "rack"), big).max() > GOUGE_TOLERANCE_MM
     a, y, z = flank_poses(spec, big, rolls, "raised")
-    assert _gouges(_design_points(spec), a, y, z, big).max() <= GOUGE_TOLERANCE_MM
+    assert gouges(design_points(spec), a, y, z, big).max() <= GOUGE_TOLERANCE_MM
     # ... and so does the independent checker.
     a_deg = np.degrees(np.concatenate([a, -a]))
     sils = silhouette.place_silhouettes(np.concatenate([y, -y]), np.concatenate([z, z]), a_deg, big.diameter_mm,
@@ -412,8 +418,10 @@ def test_tiny_target_is_refused_before_planning():
     from spur_cad.errors import WorkLimitError
 
     spec = _gear("reference_z23_m4")
+    # the smallest target the key takes, with a flat end mill (its wedges between contacts bound the passes)
     with pytest.raises(WorkLimitError, match="passes per tooth space") as caught:
-        get_strategy("generating").estimate_moves(spec, _tool(2.0, 0.5), GeneratingParams(target_scallop_mm=1e-9))
+        get_strategy("generating").estimate_moves(spec, Tool(diameter_mm=1.5, kind="flat"),
+                                                  GeneratingParams(target_scallop_mm=1e-4))
     assert caught.value.key == "finishing.target_scallop_mm"
 
 

@@ -10,7 +10,8 @@ from pathlib import Path
 import pytest
 
 from spur_cad.errors import JobFileError
-from spur_cad.job import SECTIONS, job_file_reference_markdown, load_job, parse_job
+from spur_cad.job import SECTIONS, load_job, parse_job
+from spur_cad.keydocs import job_file_reference_markdown
 from spur_cad.keys import keys_of
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -238,7 +239,7 @@ def test_the_simulators_accepted_resolutions_are_the_declared_range():
 def test_docs_job_file_md_is_generated_from_the_declarations():
     committed = (ROOT / "docs" / "job-file.md").read_text()
     assert committed == job_file_reference_markdown(), (
-        "docs/job-file.md is out of date: run `python -m spur_cad.job --markdown > docs/job-file.md`")
+        "docs/job-file.md is out of date: run `python -m spur_cad.keydocs > docs/job-file.md`")
 
 
 TWO_TOOLS = """[gear]

@@ -12,8 +12,9 @@ import pytest
 
 from spur_cad.cam.finishing import finishing_toolpath
 from spur_cad.cam.ir import MoveKind
-from spur_cad.cam.machine import FinishingParams, Machine, RoughingParams
+from spur_cad.cam.machine import Machine, RoughingParams
 from spur_cad.cam.roughing import roughing_toolpath
+from spur_cad.cam.strategies import FinishingParams
 from spur_cad.post import DIALECT_NAMES, PostError, PostSettings, ProgramInfo, post_program
 from tests.gcode_reader import inlined_lines, read_program
 from tests.gears import CAM_GEARS, spec_of, tools_for

@@ -91,7 +91,8 @@ def test_finishing_by_generation_alone_cuts_other_gears_from_the_blank_within_ta
     """No roughing: the blank (tip radius + 0.5 mm) cut by the generating passes alone must come out as the
     design, every feature within the target + resolution, no gouge beyond the resolution."""
     from spur_cad.cam.finishing import plan_finishing
-    from spur_cad.cam.machine import FinishingParams, Machine
+    from spur_cad.cam.machine import Machine
+    from spur_cad.cam.strategies import FinishingParams
     from spur_cad.cam.tools import Tool
     from spur_cad.sim import StockCylinder
     from tests.test_generating import _gear

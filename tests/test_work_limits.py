@@ -106,8 +106,8 @@ def test_comparisons_too_large_to_build_are_left_out_not_refused(small_job):
     it is not built for comparison; the job's own finishing by generation is planned as usual."""
     from spur_cad.cam.plan import MAX_COMPARISON_MOVES
     from spur_cad.cam.strategies import get_strategy, params_from_section
-    from spur_cad.report.html import render_report
-    from spur_cad.summary import finishing_section
+    from spur_cad.report.html import finishing_comparison_html
+    from spur_cad.summary import finishing_facts, finishing_json
 
     job = dataclasses.replace(small_job, gear=dataclasses.replace(small_job.gear, face_width_mm=60.0))
     perimeter = get_strategy("perimeter")
@@ -117,7 +117,7 @@ def test_comparisons_too_large_to_build_are_left_out_not_refused(small_job):
     plan = plan_cam(job)
     assert plan.finishing.perimeter_estimate is None and plan.finishing.reference_estimate is None
     assert plan.finishing.estimate.moves == len(plan.finishing.toolpath)
-    facts = finishing_section(plan.finishing)
+    facts = finishing_json(finishing_facts(plan.finishing))
     assert facts["perimeter_time_s"] is None and facts["reference_strategy_moves"] is None
-    html = render_report({"finishing": facts}, {}).decode()
+    html = finishing_comparison_html(finishing_facts(plan.finishing))
     assert html.count("not estimated (too large to build for comparison") == 2

@@ -17,9 +17,10 @@ import pytest
 from spur_cad.cad.specs import StockSpec
 from spur_cad.cam.finishing import plan_finishing
 from spur_cad.cam.ir import MoveKind, Operation, ToolpathBuilder
-from spur_cad.cam.machine import FinishingParams, Machine, RoughingParams
+from spur_cad.cam.machine import Machine, RoughingParams
 from spur_cad.cam.recommend import check_roughing_reach, check_tools, recommend_tools
 from spur_cad.cam.roughing import roughing_levels
+from spur_cad.cam.strategies import FinishingParams
 from spur_cad.cam.tools import Tool
 from spur_cad.errors import JobFileError, SpurCadError
 from spur_cad.job import GearSection, Job, JobSection, SimulationSection, job_from_dict, load_job, parse_job
@@ -137,7 +138,7 @@ def _section_classes() -> dict[str, type]:
     """Job-file sections and their dataclasses, read from spur_cad.job.Job's fields (so new sections count)."""
     hints = typing.get_type_hints(Job)
     sections = {("gear" if f.name == "gear_section" else f.name): hints[f.name] for f in dataclasses.fields(Job)
-                if f.name not in ("source", "gear", "tools", "text")}
+                if f.name not in ("source", "gear", "tools", "text", "strategies")}
     sections["tools.roughing"] = sections["tools.finishing"] = sections["tools.bottom"] = Tool
     # an optional section (`lathe: LatheSection | None`) is its dataclass
     return {name: next((a for a in typing.get_args(cls) if a is not type(None)), cls) for name, cls in sections.items()}

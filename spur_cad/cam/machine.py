@@ -164,33 +164,3 @@ class RoughingParams:
         if not self.finish_stock_mm < self.flank_allowance_mm:
             raise MachineError(f"[roughing] finish_stock_mm = {self.finish_stock_mm:g} must be below "
                                f"flank_allowance_mm = {self.flank_allowance_mm:g}", field="finish_stock_mm")
-
-
-def _strategy_names() -> tuple[str, ...]:
-    """The finishing strategies' names, from the registry (which imports this module, hence the late import)."""
-    from spur_cad.cam.strategies import strategy_names
-
-    return strategy_names()
-
-
-@dataclass(frozen=True)
-class FinishingParams:
-    """[finishing]: the finishing strategy and its parameters (docs/cam.md)."""
-
-    strategy: str = key("generating", label="FinishingStrategy", group="Finishing strategy",
-                        meaning="a finishing strategy name (see docs/cam.md)", names_from=_strategy_names)
-    target_scallop_mm: float = key(0.005, unit="mm", low=0.0001, high=0.1, label="TargetScallop",
-                                   group="Finishing strategy", meaning="target scallop height")
-    step_over_mm: float = key(0.0, unit="mm", low=0.0, high=2000.0, label="FinishingStepOver",
-                              group="Finishing strategy", meaning="X step between stations, 0: from the target scallop")
-    cutting_direction: str = key("climb", label="CuttingDirection", group="Finishing strategy",
-                                 choices=("climb", "conventional"),
-                                 meaning="generating: climb or conventional milling (spindle clockwise, M3)")
-    flank_tool_end: str = key("rack", label="FlankToolEnd", group="Finishing strategy", choices=("rack", "raised"),
-                              meaning="generating: tool end on the rack's tip round (rack) or raised per pass (raised)")
-
-    def validate(self) -> None:
-        check_section(self, "finishing", MachineError)
-        from spur_cad.cam.strategies import get_strategy  # the registry imports this module
-
-        get_strategy(self.strategy)

@@ -7,7 +7,7 @@ from __future__ import annotations
 
 import dataclasses
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -16,7 +16,7 @@ from spur_cad.cam.contacts import ContactCounts, contact_counts
 from spur_cad.cam.estimate import Estimate, estimate, move_seconds
 from spur_cad.cam.finishing import plan_finishing
 from spur_cad.cam.ir import Toolpath
-from spur_cad.cam.machine import FinishingParams, Machine, MachineError, RoughingParams, check_travel
+from spur_cad.cam.machine import Machine, MachineError, RoughingParams, check_travel
 from spur_cad.cam.machine_limits import check_machine_limits
 from spur_cad.cam.recommend import (
     ToolRecommendations,
@@ -32,7 +32,14 @@ from spur_cad.cam.roughing import (
     roughing_levels,
     roughing_toolpath,
 )
-from spur_cad.cam.strategies import FinishingResult, get_strategy, params_from_section
+from spur_cad.cam.strategies import (
+    REGISTRY,
+    FinishingParams,
+    FinishingResult,
+    Strategies,
+    get_strategy,
+    params_from_section,
+)
 from spur_cad.cam.tools import Tool, ToolError
 from spur_cad.errors import StockError, WorkLimitError, shown
 from spur_cad.geometry.spec import GearSpec
@@ -119,6 +126,7 @@ class CamInputs:
     finishing: FinishingParams
     machine: Machine
     bottom_tool: Tool | None = None  # two-stage roughing: the smaller tool for the bottom of the spaces
+    strategies: Strategies = field(default_factory=lambda: REGISTRY)  # where [finishing] strategy is found
 
 
 def check_cam_inputs(inputs: CamInputs) -> tuple[ToolRecommendations, RoughingLevels | None]:
@@ -127,7 +135,8 @@ def check_cam_inputs(inputs: CamInputs) -> tuple[ToolRecommendations, RoughingLe
     roughing work bound and the roughing reach. Returns the
     recommendations and the roughing levels (None without a roughing tool)."""
     spec, machine, stock = inputs.spec, inputs.machine, inputs.stock
-    if spec.is_helical and inputs.finishing_tool is not None and inputs.finishing.strategy != "generating":
+    if spec.is_helical and inputs.finishing_tool is not None and \
+            not get_strategy(inputs.finishing.strategy, inputs.strategies).helical:
         raise MachineError(f"[finishing] strategy = {shown(inputs.finishing.strategy)} is for spur gears; a "
                            f"helical gear (helix_angle_deg = {spec.helix_angle_deg:g}) is finished by "
                            "strategy = \"generating\"",
@@ -141,7 +150,7 @@ def check_cam_inputs(inputs: CamInputs) -> tuple[ToolRecommendations, RoughingLe
     else:
         check_tools(spec, rec, inputs.roughing_tool, inputs.finishing_tool)
     if inputs.finishing_tool is not None:
-        check_finishing_work(spec, inputs.finishing_tool, machine, inputs.finishing)
+        check_finishing_work(spec, inputs.finishing_tool, machine, inputs.finishing, inputs.strategies)
     if inputs.roughing_tool is None:
         return rec, None
     tool = inputs.roughing_tool
@@ -218,7 +227,9 @@ def plan_cam(inputs: CamInputs, checkpoint: Callable[[], None] | None = None) ->
     tools = {role: tool for role, tool in (("roughing", inputs.roughing_tool), ("finishing", inputs.finishing_tool))
              if tool is not None}
     warnings: list[str] = list(check_machine_limits(inputs.spec, inputs.stock, inputs.machine, tools))
-    warnings.extend(small_tool_warnings(rec, inputs.machine.smallest_end_mill_mm, inputs.finishing.strategy))
+    strategy = get_strategy(inputs.finishing.strategy, inputs.strategies)
+    warnings.extend(small_tool_warnings(rec, inputs.machine.smallest_end_mill_mm, strategy.name,
+                                        strategy.largest_tool(rec)))
     bottom = two_stage = None
     if levels is not None and inputs.bottom_tool is not None:
         check()
@@ -304,9 +315,9 @@ def _plan_roughing(inputs: CamInputs, levels: RoughingLevels, blank: float, tool
 
 
 def check_finishing_work(spec: GearSpec, tool: Tool, machine: Machine, section: FinishingParams,
-                         **overrides) -> None:
+                         strategies: Strategies = REGISTRY, **overrides) -> None:
     """Refuse finishing whose contacts per flank or moves exceed the limits, before generating it."""
-    strategy = get_strategy(section.strategy)
+    strategy = get_strategy(section.strategy, strategies)
     params = params_from_section(strategy, section, **overrides)
     strategy.check_tool(spec, tool)
     if strategy.simultaneous_rotary and not machine.rotary_simultaneous:
@@ -328,7 +339,7 @@ def check_finishing_work(spec: GearSpec, tool: Tool, machine: Machine, section: 
 
 def _plan_finishing(inputs: CamInputs, blank: float, check: Callable[[], None]) -> FinishingPlan:
     spec, tool, machine = inputs.spec, inputs.finishing_tool, inputs.machine
-    path, result = plan_finishing(spec, tool, machine, inputs.finishing, blank)
+    path, result = plan_finishing(spec, tool, machine, inputs.finishing, blank, inputs.strategies)
     check_travel(machine, path.x, path.y, path.z, path.a, "finishing")
     own = estimate(path, machine)
     check()
@@ -348,10 +359,10 @@ def _comparison_estimate(spec: GearSpec, tool: Tool, machine: Machine, blank: fl
     """The estimate of another finishing with the same tool, for comparison; None when it would exceed
     MAX_COMPARISON_MOVES (or cannot be planned with this tool). A table that only indexes is taken as
     simultaneous here: the figure says what that strategy would take."""
-    if spec.is_helical and section.strategy != "generating":  # perimeter is for spur gears only
+    strategy = get_strategy(section.strategy)
+    if spec.is_helical and not strategy.helical:  # perimeter is for spur gears only
         return None
     simultaneous = dataclasses.replace(machine, rotary_simultaneous=True)
-    strategy = get_strategy(section.strategy)
     try:
         check_finishing_work(spec, tool, simultaneous, section, **overrides)
         if strategy.estimate_moves(spec, tool, params_from_section(strategy, section, **overrides)) \

@@ -64,7 +64,7 @@ def generating_max_diameter_mm(spec: GearSpec, corner_radius_mm: float, target_s
     end): the smaller of the tip-mode limit (flat within the rack's tip flat) and the flank-mode limit (no flank
     pass reaches into the design); 0.0 when none fits. Helical gears: the corner must be rho, the diameter
     within the normal tip flat 2 d_n + 2 rho."""
-    from spur_cad.cam.strategies.generating import generating_tool_limits
+    from spur_cad.cam.strategies.generating_geometry import generating_tool_limits
     from spur_cad.geometry.profile import rack_corner
 
     rho = spec.rack_tip_radius_mm
@@ -93,7 +93,11 @@ def recommend_tools(spec: GearSpec, blank_radius_mm: float, clearance_mm: float,
     plunge = PLUNGE_CAPACITY_FRACTION * flat
     roughing_max = 2.0 * space_half_width_mm(flank_polyline(spec), spec.root_radius_mm + plunge)
     flute = blank_radius_mm - spec.root_radius_mm
-    target = min(max(target_scallop_mm, 1e-4), 0.1)  # within the [finishing] key's range (advice, not a check)
+    from spur_cad.cam.strategies.base import TargetScallopParams
+    from spur_cad.keys import key_of
+
+    scallop = key_of(TargetScallopParams, "target_scallop_mm")  # advice within the key's range (not a check)
+    target = min(max(target_scallop_mm, scallop.low), scallop.high)
     generating = generating_max_diameter_mm(spec, spec.rack_tip_radius_mm, target, blank_radius_mm)
     flat_end_mill = generating_max_diameter_mm(spec, 0.0, target, blank_radius_mm)
     return ToolRecommendations(max_flat, max_corner, plunge, roughing_max, flute, flute + clearance_mm,
@@ -148,16 +152,12 @@ def _check_flat_finishing(spec: GearSpec, tool: Tool, rec: ToolRecommendations) 
                         "radius (bull_nose or ball)", field="diameter_mm", section="tools.finishing")
 
 
-def small_tool_warnings(rec: ToolRecommendations, smallest_end_mill_mm: float, strategy: str) -> tuple[str, ...]:
+def small_tool_warnings(rec: ToolRecommendations, smallest_end_mill_mm: float, strategy: str,
+                        finishing: tuple[str, float]) -> tuple[str, ...]:
     """Warnings for recommended largest tools below [machine] smallest_end_mill_mm (no catalogue tool of that
-    kind fits this gear): roughing, finishing for `strategy` (generating: the largest tool with corner radius
-    rho; perimeter, along_x: root arc flat + 2 x the fillet's smallest curvature radius) and the flat end mill.
-    Limits at 0 (no such tool at all) are errors elsewhere, not warnings."""
-    if strategy == "generating":
-        finishing = ("finishing_generating_max_diameter_mm", rec.finishing_generating_max_diameter_mm)
-    else:
-        finishing = ("finishing_max_flat_width_mm + 2 finishing_max_corner_radius_mm",
-                     rec.finishing_max_flat_width_mm + 2.0 * rec.finishing_max_corner_radius_mm)
+    kind fits this gear): roughing, finishing for `strategy` (`finishing`: the strategy's own largest tool, its
+    name and diameter, FinishingStrategy.largest_tool) and the flat end mill. Limits at 0 (no such tool at all)
+    are errors elsewhere, not warnings."""
     limits = (("roughing tool", "roughing_max_diameter_mm", rec.roughing_max_diameter_mm),
               (f"finishing tool for strategy {strategy}", *finishing),
               ("flat end mill for finishing by generation", "finishing_flat_end_mill_max_diameter_mm",

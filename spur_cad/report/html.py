@@ -156,7 +156,7 @@ def _program(result: JobResult) -> str:
     text += _table(rows, ("", "moves (IR)", "G-code lines", "G-code size", "cutting path", "time at feed",
                           "time with acceleration"))
     if finish is not None:
-        text += _finishing_comparison(finish)
+        text += finishing_comparison_html(finish)
     if rough is not None:
         text += (f"<p>Roughing: {rough.levels_per_space} levels per space, lowest level "
                  f"{rough.lowest_level_height_mm:.3f} mm above the root circle.</p>")
@@ -177,7 +177,7 @@ NOT_ESTIMATED = ("not estimated (too large to build for comparison, the tool doe
                  "strategy is for spur gears only)")
 
 
-def _finishing_comparison(finish: FinishingFacts) -> str:
+def finishing_comparison_html(finish: FinishingFacts) -> str:
     """This job's finishing beside perimeter finishing and the reference process's strategy (same tool)."""
     reference = (f"reference process's strategy (perimeter, {REFERENCE_CONTACT_SPACING_MM:g} mm contacts, "
                  f"{REFERENCE_STATION_STEP_MM:g} mm X step)")

@@ -10,6 +10,7 @@ resolution, its own error) and none is left more than the leftover tolerance abo
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import math
 from dataclasses import dataclass, field
@@ -42,14 +43,24 @@ class VerifyOptions:
 
 
 @dataclass(frozen=True)
+class SpacePlace:
+    """Where in a tooth space a deviation is: the design feature and point, X and the finishing station."""
+
+    feature: str
+    point: int
+    x_mm: float
+    station: int  # -1: none
+
+
+@dataclass(frozen=True)
 class SpaceVerdict:
     """One tooth space: its largest gouge and leftover (mm, >= 0) and where they are."""
 
     space: int
     max_gouge_mm: float
     max_leftover_mm: float
-    worst_gouge: dict
-    worst_leftover: dict
+    worst_gouge: SpacePlace
+    worst_leftover: SpacePlace
 
 
 @dataclass(frozen=True)
@@ -76,7 +87,7 @@ class VerifyResult:
         return {"passed": self.passed, "max_gouge_mm": self.max_gouge_mm, "max_leftover_mm": self.max_leftover_mm,
                 "gouge_tolerance_mm": self.gouge_tolerance_mm, "leftover_tolerance_mm": self.leftover_tolerance_mm,
                 "moves": self.moves, "seconds": round(self.seconds, 3), "rs274": self.rs274,
-                "spaces": [vars(space) for space in self.spaces]}
+                "spaces": [dataclasses.asdict(space) for space in self.spaces]}
 
     def lines(self) -> list[str]:
         """The verdict for people: one line per space beyond tolerance, then the overall line."""
@@ -87,9 +98,9 @@ class VerifyResult:
                                                   ("leftover", space.max_leftover_mm, self.leftover_tolerance_mm,
                                                    space.worst_leftover)):
                 if value > tolerance:
-                    station = f", station {worst['station']}" if worst["station"] >= 0 else ""
-                    out.append(f"space {space.space}: {kind} {value * 1000:.1f} um at X {worst['x_mm']:.3f} mm, "
-                               f"{worst['feature']}{station} (tolerance {tolerance * 1000:.1f} um)")
+                    station = f", station {worst.station}" if worst.station >= 0 else ""
+                    out.append(f"space {space.space}: {kind} {value * 1000:.1f} um at X {worst.x_mm:.3f} mm, "
+                               f"{worst.feature}{station} (tolerance {tolerance * 1000:.1f} um)")
         verdict = "PASS" if self.passed else "FAIL"
         out.append(f"{verdict}: max gouge {self.max_gouge_mm * 1000:.1f} um (tolerance "
                    f"{self.gouge_tolerance_mm * 1000:.1f}), max leftover {self.max_leftover_mm * 1000:.1f} um "
@@ -141,11 +152,10 @@ def station_positions(path: Toolpath) -> np.ndarray:
     return np.unique(np.round(path.x[feed & transverse], 6))
 
 
-def _where(result, k: int, flat_index: int, rows: np.ndarray, names: list[str]) -> dict:
+def _where(result, k: int, flat_index: int, rows: np.ndarray, names: list[str]) -> SpacePlace:
     j, r = np.unravel_index(flat_index, result.deviation[k][:, rows].shape)
     row = np.nonzero(rows)[0][r]
-    return {"feature": names[j], "point": int(j), "x_mm": float(result.grid.rows_x[row]),
-            "station": int(result.station_of_row()[row])}
+    return SpacePlace(names[j], int(j), float(result.grid.rows_x[row]), int(result.station_of_row()[row]))
 
 
 def space_verdicts(result) -> tuple[SpaceVerdict, ...]:

@@ -1,38 +1,86 @@
-"""Finishing strategies as plug-ins: one protocol (`base.FinishingStrategy`) and this registry.
+"""Finishing strategies as plug-ins: one protocol (`base.FinishingStrategy`), the default registry
+`REGISTRY`, and the [finishing] section made from a registry.
 
-Adding a strategy is one new module here plus one entry in REGISTRY; the job file's
-[finishing] strategy key, the CLI, the workbench's strategy list, the simulation and the report
-find it through `strategy_names()` and `get_strategy()`.
+A strategy's module declares everything about it: its [finishing] keys (the `key(...)` fields of its
+parameters dataclass, with their checks), its tool check, its typed facts for summary.json and the report
+(`FinishingResult.facts`, with `report_text()`) and its typed tool advice. The job loader, the workbench
+panel, docs/job-file.md, the summary and the report learn them from a registry; adding a strategy is one
+module and one entry in REGISTRY (docs/architecture.md). Functions take `strategies=` to use another
+registry (a mapping name -> strategy), e.g. a strategy defined in a test.
 """
 
 from __future__ import annotations
+
+import dataclasses
+import functools
+from collections.abc import Mapping
+from types import MappingProxyType
 
 from spur_cad.cam.machine import MachineError
 from spur_cad.cam.strategies.along_x import AlongXStrategy
 from spur_cad.cam.strategies.base import FinishingResult, FinishingStrategy, params_from_section
 from spur_cad.cam.strategies.generating import GeneratingStrategy
 from spur_cad.cam.strategies.perimeter import PerimeterStrategy
+from spur_cad.errors import shown
+from spur_cad.keys import METADATA_KEY, check_section, key
 
-REGISTRY: dict[str, FinishingStrategy] = {
+Strategies = Mapping[str, FinishingStrategy]
+
+REGISTRY: Strategies = MappingProxyType({
     PerimeterStrategy.name: PerimeterStrategy(),
     AlongXStrategy.name: AlongXStrategy(),
     GeneratingStrategy.name: GeneratingStrategy(),
-}
+})
+"""The default registry (read-only: another registry is a new mapping passed as `strategies=`)."""
+DEFAULT_STRATEGY = GeneratingStrategy.name
 
 
-def strategy_names() -> tuple[str, ...]:
+def strategy_names(strategies: Strategies = REGISTRY) -> tuple[str, ...]:
     """Names of the registered finishing strategies, in registry order."""
-    return tuple(REGISTRY)
+    return tuple(strategies)
 
 
-def get_strategy(name: str) -> FinishingStrategy:
+def get_strategy(name: str, strategies: Strategies = REGISTRY) -> FinishingStrategy:
     """The registered strategy called `name`; MachineError naming the known ones otherwise."""
     try:
-        return REGISTRY[name]
+        return strategies[name]
     except KeyError:
-        raise MachineError(f"[finishing] strategy '{name}' is unknown (use one of {', '.join(REGISTRY)})",
+        raise MachineError(f"[finishing] strategy {shown(name)} is unknown (use one of {', '.join(strategies)})",
                            field="strategy", section="finishing") from None
 
 
-__all__ = ["REGISTRY", "FinishingResult", "FinishingStrategy", "get_strategy", "params_from_section",
-           "strategy_names"]
+def finishing_section_type(strategies: Strategies = REGISTRY) -> type:
+    """The [finishing] section's dataclass for a registry: `strategy` and, in registry order, every
+    strategy's keys (a key several strategies share is declared once, in a common base such as
+    `base.TargetScallopParams`)."""
+    return _section_type(tuple(strategies.items()))
+
+
+@functools.cache
+def _section_type(entries: tuple[tuple[str, FinishingStrategy], ...]) -> type:
+    strategies = dict(entries)
+    names = tuple(strategies)
+    default = DEFAULT_STRATEGY if DEFAULT_STRATEGY in strategies else names[0]
+    fields: dict[str, tuple] = {"strategy": (str, key(default, label="FinishingStrategy", group="Finishing strategy",
+                                                      meaning="a finishing strategy name (see docs/cam.md)",
+                                                      names_from=lambda: names))}
+    for strategy in strategies.values():
+        for f in dataclasses.fields(strategy.params_type):
+            if METADATA_KEY in f.metadata and f.name not in fields:
+                fields[f.name] = (f.type, dataclasses.field(default=f.default, metadata=f.metadata))
+
+    def validate(self) -> None:
+        check_section(self, "finishing", MachineError)
+        get_strategy(self.strategy, strategies)
+
+    doc = "[finishing]: the finishing strategy and its parameters (docs/cam.md); made from the strategies' keys."
+    namespace = {"validate": validate, "__module__": __name__, "__doc__": doc}
+    return dataclasses.make_dataclass("FinishingParams", [(name, kind, spec) for name, (kind, spec) in fields.items()],
+                                      frozen=True, namespace=namespace)
+
+
+FinishingParams = finishing_section_type(REGISTRY)
+"""The [finishing] section of the default registry."""
+
+__all__ = ["DEFAULT_STRATEGY", "REGISTRY", "FinishingParams", "FinishingResult", "FinishingStrategy", "Strategies",
+           "finishing_section_type", "get_strategy", "params_from_section", "strategy_names"]

@@ -9,7 +9,13 @@ from spur_cad.cam.common import PLUNGE_FEED_FRACTION, apply_inverse_time, safe_h
 from spur_cad.cam.contacts import SpacePoses, contact_counts, space_poses, station_positions, station_step_mm
 from spur_cad.cam.ir import Feature, MoveKind, Toolpath, ToolpathBuilder
 from spur_cad.cam.machine import Machine
-from spur_cad.cam.strategies.base import FinishingResult, ScallopParams, check_flat_fits_root_arc, finishing_builder
+from spur_cad.cam.strategies.base import (
+    FinishingResult,
+    ScallopParams,
+    check_flat_fits_root_arc,
+    contact_largest_tool,
+    finishing_builder,
+)
 from spur_cad.cam.tools import Tool
 from spur_cad.geometry.spec import GearSpec
 
@@ -28,6 +34,10 @@ class AlongXStrategy:
     name = "along_x"
     description = "one pass along X per contact pose, A fixed during each pass"
     params_type = AlongXParams
+    helical = False  # transverse contacts of a spur gear
+
+    def largest_tool(self, recommendations) -> tuple[str, float]:
+        return contact_largest_tool(recommendations)
     simultaneous_rotary = True  # the steps between poses beside the part turn A at feed
 
     def check_tool(self, spec: GearSpec, tool: Tool) -> None:

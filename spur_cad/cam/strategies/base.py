@@ -20,6 +20,7 @@ from spur_cad.cam.ir import Operation, Toolpath, ToolpathBuilder
 from spur_cad.cam.machine import Machine, MachineError
 from spur_cad.cam.tools import Tool, ToolError
 from spur_cad.geometry.spec import GearSpec
+from spur_cad.keys import check_section, key
 
 
 class StrategyFacts(Protocol):
@@ -83,17 +84,22 @@ class FinishingResult:
 
 
 @dataclass(frozen=True)
-class ScallopParams:
-    """The [finishing] keys most strategies share: the target scallop and the X step (0: derived)."""
+class TargetScallopParams:
+    """The [finishing] key every strategy reads: the target scallop (its range is checked here, once)."""
 
-    target_scallop_mm: float = 0.005
-    step_over_mm: float = 0.0
+    target_scallop_mm: float = key(0.005, unit="mm", low=0.0001, high=0.1, label="TargetScallop",
+                                   group="Finishing strategy", meaning="target scallop height")
 
     def validate(self) -> None:
-        if not 0.0 < self.target_scallop_mm <= 0.1:
-            raise MachineError(f"[finishing] target_scallop_mm = {self.target_scallop_mm:g} must be in (0, 0.1]")
-        if self.step_over_mm < 0.0:
-            raise MachineError(f"[finishing] step_over_mm = {self.step_over_mm:g} must not be negative")
+        check_section(self, "finishing", MachineError)
+
+
+@dataclass(frozen=True)
+class ScallopParams(TargetScallopParams):
+    """The [finishing] keys of strategies with X stations: the target scallop and the X step (0: derived)."""
+
+    step_over_mm: float = key(0.0, unit="mm", low=0.0, high=2000.0, label="FinishingStepOver",
+                              group="Finishing strategy", meaning="X step between stations, 0: from the target scallop")
 
 
 class FinishingStrategy(Protocol):
@@ -101,12 +107,18 @@ class FinishingStrategy(Protocol):
 
     name: str
     description: str
-    params_type: type
+    params_type: type  # frozen dataclass; its `key(...)` fields are [finishing] keys (job file, workbench, docs)
     simultaneous_rotary: bool  # feed moves turn A (needs [machine] rotary_simultaneous = true)
+    helical: bool  # finishes helical gears too (else spur gears only)
 
     def estimate_moves(self, spec: GearSpec, tool: Tool, params: Any) -> int:
         """How many IR moves `generate` would make, counted cheaply beforehand (the plan refuses
         work beyond its limits before generating)."""
+        ...
+
+    def largest_tool(self, recommendations: Any) -> tuple[str, float]:
+        """The largest finishing tool this strategy takes on the gear, from its ToolRecommendations: the
+        figure's name there (or how it is made of them) and its diameter (mm); 0 when none fits."""
         ...
 
     def check_tool(self, spec: GearSpec, tool: Tool) -> None:
@@ -118,6 +130,14 @@ class FinishingStrategy(Protocol):
                  blank_radius_mm: float) -> tuple[Toolpath, FinishingResult]:
         """The finishing operation as IR plus its facts (pure function)."""
         ...
+
+
+def contact_largest_tool(recommendations: Any) -> tuple[str, float]:
+    """The largest tool of the strategies that place the corner on flank contacts (perimeter, along_x): the
+    root arc's flat plus twice the fillet's smallest curvature radius."""
+    rec = recommendations
+    return ("finishing_max_flat_width_mm + 2 finishing_max_corner_radius_mm",
+            rec.finishing_max_flat_width_mm + 2.0 * rec.finishing_max_corner_radius_mm)
 
 
 def check_corner_contacts_tool(tool: Tool, strategy: str) -> None:

@@ -138,7 +138,7 @@ def _even(lo: float, hi: float, step: float) -> np.ndarray:
 
 def flank_roll_step(spec: GearSpec, target_mm: float) -> float:
     """Even roll spacing whose generating flats leave at most `target` at the largest roll any section sees."""
-    from spur_cad.cam.strategies.generating import _flat_leftover
+    from spur_cad.cam.strategies.generating_flat import flat_leftover_mm as _flat_leftover
 
     involute = spec.tooth_space_profile().segment("involute")
     lo, hi = face_turn_range(spec)

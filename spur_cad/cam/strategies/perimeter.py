@@ -20,7 +20,13 @@ from spur_cad.cam.contacts import (
 )
 from spur_cad.cam.ir import Feature, MoveKind, Toolpath, ToolpathBuilder
 from spur_cad.cam.machine import Machine
-from spur_cad.cam.strategies.base import FinishingResult, ScallopParams, check_flat_fits_root_arc, finishing_builder
+from spur_cad.cam.strategies.base import (
+    FinishingResult,
+    ScallopParams,
+    check_flat_fits_root_arc,
+    contact_largest_tool,
+    finishing_builder,
+)
 from spur_cad.cam.tools import Tool
 from spur_cad.geometry.spec import GearSpec
 
@@ -38,6 +44,10 @@ class PerimeterStrategy:
     name = "perimeter"
     description = "transverse stations along X, once around the gear at each (simultaneous Y/Z/A)"
     params_type = PerimeterParams
+    helical = False  # transverse contacts of a spur gear
+
+    def largest_tool(self, recommendations) -> tuple[str, float]:
+        return contact_largest_tool(recommendations)
     simultaneous_rotary = True
 
     def check_tool(self, spec: GearSpec, tool: Tool) -> None:

@@ -1,0 +1,196 @@
+"""Finishing by generation, its plan: the parameters ([finishing] keys) and the passes of one tooth space in
+cutting order, spur (spur_cad.cam.strategies.generating_geometry) or helical
+(spur_cad.cam.strategies.generating_helical), with what they leave."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from spur_cad.cam.ir import Feature
+from spur_cad.cam.strategies.base import TargetScallopParams
+from spur_cad.cam.strategies.generating_flat import flat_leftover_mm
+from spur_cad.cam.strategies.generating_geometry import (
+    CUTTING_DIRECTIONS,
+    FLANK_TOOL_ENDS,
+    GOUGE_TOLERANCE_MM,
+    MAX_PASSES_PER_SPACE,
+    TIP_MODE_SAFETY,
+    TIP_SAFETY_HELICAL,
+    GeneratingPass,
+    check_generating_tool,
+    design_points,
+    fillet_pose,
+    flank_poses,
+    flank_rolls,
+    generating_tool_limits,
+    gouges,
+    land_angles,
+    land_pose,
+    root_pose,
+    rough_passes_per_space,
+    tip_rolls,
+)
+from spur_cad.cam.strategies.generating_helical import (
+    face_turn_range,
+    flank_roll_step,
+    helical_passes,
+    helical_passes_estimate,
+)
+from spur_cad.cam.tools import Tool, ToolError
+from spur_cad.errors import WorkLimitError
+from spur_cad.geometry.spec import GearSpec
+from spur_cad.keys import key
+
+
+@dataclass(frozen=True)
+class GeneratingParams(TargetScallopParams):
+    """[finishing] keys the generating strategy uses.
+
+    cutting_direction: "climb" (default: the finished side is left by the thinnest chip, the
+    usual choice for finishing on a rigid machine) or "conventional", for a spindle turning
+    clockwise (M3), see the module docstring. flank_tool_end: "rack" (default: the corner
+    tangent to the flank at the rack's point T, the same place relative to the rack for every
+    pass) or "raised" (per pass, just low enough for the straight side to cut the whole flat).
+    """
+
+    cutting_direction: str = key("climb", label="CuttingDirection", group="Finishing strategy",
+                                 choices=CUTTING_DIRECTIONS,
+                                 meaning="generating: climb or conventional milling (spindle clockwise, M3)")
+    flank_tool_end: str = key("rack", label="FlankToolEnd", group="Finishing strategy", choices=FLANK_TOOL_ENDS,
+                              meaning="generating: tool end on the rack's tip round (rack) or raised per pass (raised)")
+
+
+@dataclass(frozen=True)
+class GeneratingPlan:
+    """The passes of one tooth space in cutting order, and what they leave."""
+
+    passes: tuple[GeneratingPass, ...]
+    flank_rolls_rad: np.ndarray  # involute rolls t, form circle -> tip (each flank)
+    fillet_betas_rad: np.ndarray  # contact angles on the rack round, junction -> 0 (each fillet)
+    root_rolls_rad: np.ndarray  # rack rolls phi of the root passes, v -> -v
+    land_angles_rad: np.ndarray  # part directions psi of the land passes (empty: blank at the tip diameter)
+    flat_height_mm: float  # largest generating-flat deviation left on the involute (closed form)
+    tip_leftover_mm: float  # largest sampled leftover on fillet, root and lands (helical: the bound the rolls keep)
+
+    @property
+    def passes_per_space(self) -> int:
+        return len(self.passes)
+
+    @property
+    def flank_passes_per_flank(self) -> int:
+        return len(self.flank_rolls_rad)
+
+    @property
+    def tip_passes_per_space(self) -> int:
+        return sum(1 for p in self.passes if p.mode == "tip")
+
+    @property
+    def land_passes_per_space(self) -> int:
+        return sum(1 for p in self.passes if p.mode == "land")
+
+
+def _refuse_gouging_passes(spec: GearSpec, tool: Tool, params: GeneratingParams, poses: dict) -> None:
+    """ToolError naming the largest tools that fit when a pass of `poses` (name -> (A rad, Y, Z)) reaches
+    into the dense exact design points beyond GOUGE_TOLERANCE_MM."""
+    design = design_points(spec)
+    for name, (a, y, z) in poses.items():
+        if len(a) == 0:
+            continue
+        depth = gouges(design, a, y, z, tool)
+        if depth.max() > GOUGE_TOLERANCE_MM:
+            limits = generating_tool_limits(spec, tool.effective_corner_radius_mm, params.target_scallop_mm,
+                                            spec.tip_radius_mm)
+            best = (limits.flank_mode_max_diameter_mm if params.flank_tool_end == "rack"
+                    else limits.flank_mode_max_diameter_raised_mm)
+            raise ToolError(f"finishing strategy generating: a {name} pass of the {tool.diameter_mm:g} mm tool "
+                            f"reaches {1000 * depth.max():.2f} um into the gear; largest diameter for flank mode "
+                            f"with r_t = {tool.effective_corner_radius_mm:g} mm and flank_tool_end = "
+                            f"'{params.flank_tool_end}': {best:.3f} mm, for tip mode: "
+                            f"{limits.tip_mode_max_diameter_mm:.3f} mm")
+
+
+def plan_generating(spec: GearSpec, tool: Tool, params: GeneratingParams, *, lands: bool = True,
+                    check: bool = True) -> GeneratingPlan:
+    """The passes of tooth space 0 (the land beside it when `lands`, both flanks, fillets and root), in
+    cutting order."""
+    params.validate()
+    check_generating_tool(spec, tool)
+    if spec.is_helical:
+        return _plan_helical(spec, tool, params, lands)
+    profile = spec.tooth_space_profile()
+    target = params.target_scallop_mm
+    rough = rough_passes_per_space(spec, tool, target)
+    if rough > MAX_PASSES_PER_SPACE:
+        raise WorkLimitError(f"generating finishing would need about {rough:.3g} passes per tooth space (limit "
+                             f"{MAX_PASSES_PER_SPACE:,}) for target_scallop_mm = {target:.3g}; raise [finishing] "
+                             "target_scallop_mm", field="target_scallop_mm", section="finishing")
+    t_rolls, flat_height = flank_rolls(spec, target)
+    betas, roots, tip_leftover = tip_rolls(spec, tool, TIP_MODE_SAFETY * target)
+    fa, fy, fz = flank_poses(spec, tool, t_rolls, params.flank_tool_end)
+    ba, by, bz = fillet_pose(spec, tool, betas)
+    ra, ry, rz = root_pose(spec, tool, roots)
+    psis, land_leftover = land_angles(spec, tool, TIP_MODE_SAFETY * target) if lands else (np.zeros(0), 0.0)
+    la, ly, lz = land_pose(spec, psis)
+    if check:
+        _refuse_gouging_passes(spec, tool, params, {"flank": (fa, fy, fz), "fillet": (ba, by, bz),
+                                                    "root": (ra, ry, rz), "land": (la, ly, lz)})
+    rb = spec.base_radius_mm
+    fillet = profile.segment("fillet")
+    passes: list[GeneratingPass] = []
+
+    def add(mode, feature, roll, beta, a, y, z, side, radius):
+        passes.append(GeneratingPass(mode, feature, float(roll), float(beta), math.degrees(float(a)), float(y),
+                                     float(z), side, float(radius)))
+
+    flank_radius = rb * np.sqrt(1.0 + t_rolls**2)
+    fillet_radius = (np.hypot(*fillet.points(betas).T) if fillet is not None and len(betas) > 1
+                     else np.full(len(betas), spec.root_radius_mm))
+    # land of the tooth on the +Y side, then right flank, tip -> root
+    for i in range(len(psis)):
+        add("land", Feature.TIP, psis[i], math.nan, la[i], ly[i], lz[i], 1, spec.tip_radius_mm)
+    for i in range(len(t_rolls) - 1, -1, -1):
+        add("flank", Feature.RIGHT_FLANK, t_rolls[i], math.nan, fa[i], fy[i], fz[i], 1, flank_radius[i])
+    # right fillet, junction -> root (its last pose, beta = 0, is the root's first)
+    for i in range(len(betas) - 1):
+        add("tip", Feature.RIGHT_FLANK, ba[i], betas[i], ba[i], by[i], bz[i], 1, fillet_radius[i])
+    # root, v -> -v
+    for i in range(len(roots)):
+        add("tip", Feature.ROOT, ra[i], math.nan, ra[i], ry[i], rz[i], 1, spec.root_radius_mm)
+    for i in range(len(roots) - 2, -1, -1):
+        add("tip", Feature.ROOT, -ra[i], math.nan, -ra[i], -ry[i], rz[i], -1, spec.root_radius_mm)
+    # left fillet, root -> junction
+    for i in range(len(betas) - 2, -1, -1):
+        add("tip", Feature.LEFT_FLANK, -ba[i], betas[i], -ba[i], -by[i], bz[i], -1, fillet_radius[i])
+    # left flank, root -> tip
+    for i in range(len(t_rolls)):
+        add("flank", Feature.LEFT_FLANK, t_rolls[i], math.nan, -fa[i], -fy[i], fz[i], -1, flank_radius[i])
+    return GeneratingPlan(tuple(passes), t_rolls, betas, np.concatenate([roots, -roots[-2::-1]]), psis,
+                          flat_height, max(tip_leftover, land_leftover))
+
+
+def _plan_helical(spec: GearSpec, tool: Tool, params: GeneratingParams, lands: bool) -> GeneratingPlan:
+    """The helical gear's passes (spur_cad.cam.strategies.generating_helical) as a plan."""
+    target = params.target_scallop_mm
+    rough = helical_passes_estimate(spec, target)
+    if rough > MAX_PASSES_PER_SPACE:
+        raise WorkLimitError(f"generating finishing would need about {rough:.3g} passes per tooth space (limit "
+                             f"{MAX_PASSES_PER_SPACE:,}) for target_scallop_mm = {target:.3g}; raise [finishing] "
+                             "target_scallop_mm", field="target_scallop_mm", section="finishing")
+    lo, hi = face_turn_range(spec)
+    rows = helical_passes(spec, tool, target, spec.tip_radius_mm + tool.diameter_mm, lands)
+    rb = spec.base_radius_mm
+    passes = []
+    for mode, feature, roll, a, y0, z0, sy, sz, side in rows:
+        radius = {"flank": rb * math.sqrt(1.0 + roll * roll), "land": spec.tip_radius_mm}.get(mode,
+                                                                                                spec.root_radius_mm)
+        passes.append(GeneratingPass(mode, feature, roll, math.nan, math.degrees(a), y0, z0, side, radius, sy, sz))
+    flank = np.array(sorted(p.roll_rad for p in passes if p.feature == Feature.RIGHT_FLANK and p.mode == "flank"))
+    tips = np.array(sorted({p.roll_rad for p in passes if p.mode == "tip"}, reverse=True))
+    land = np.array([p.roll_rad for p in passes if p.mode == "land"])
+    step = flank_roll_step(spec, target)
+    t_worst = spec.tooth_space_profile().segment("involute").end + hi - lo
+    return GeneratingPlan(tuple(passes), flank, np.zeros(0), tips, land,
+                          flat_leftover_mm(rb, t_worst - step, t_worst), TIP_SAFETY_HELICAL * target)

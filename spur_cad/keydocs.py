@@ -1,0 +1,130 @@
+"""docs/job-file.md, generated from the job-file keys' declarations (spur_cad.keys.key fields of the section
+dataclasses of spur_cad.job, and of the finishing strategies' parameters): `python -m spur_cad.keydocs >
+docs/job-file.md`. A test fails when the committed file differs from what the declarations generate."""
+
+from __future__ import annotations
+
+import re
+import sys
+
+from spur_cad.cam.strategies import REGISTRY, Strategies
+from spur_cad.job import job_sections
+from spur_cad.keys import keys_of, toml_literal
+
+_DOC_INTRO = """\
+# Job file reference
+
+<!-- Generated from the key declarations (spur_cad.keys.key fields of the section dataclasses) by
+     `python -m spur_cad.keydocs > docs/job-file.md`; edit those, not this file. -->
+
+A job file is TOML. Units are in key names. Unknown sections or keys, wrong types,
+missing required keys and values outside the accepted range are errors naming the key and the
+line. Without `[tools.*]` the job stops after the CAD stage (tool recommendations are still
+reported, no G-code is written).
+
+Every number must be finite (`nan` and `inf` are rejected) and inside its range: `[a, b]`
+includes both ends, `(a, b]` excludes a; `a..b` is a range of whole numbers. An integer is
+accepted where a number is expected; `true`/`false` only where a flag is. The last column names
+the FreeCAD workbench's property holding the key (see [workbench.md](workbench.md)).
+"""
+
+_DOC_NOTES = """\
+Notes:
+
+- `[gear] thickness_allowance_percent` thins the nominal tooth thickness on the reference
+  circle by that percentage (the reference process's "profile clearance", 0-5 %);
+  `thickness_allowance_mm` subtracts a further absolute amount (see [geometry.md](geometry.md)).
+  The gear itself must be cuttable by rack generation: `rack_tip_radius_mm` at most 0.6 x module,
+  `thickness_allowance_mm` at most 0.5 x module, a positive root radius, no pointed tooth.
+- `[gear] bore_diameter_mm`, `keyway_width_mm`, `keyway_depth_mm` (0 = none): a through bore and
+  a hub keyway on the bore's +Z side (under tooth space 0); depth is measured from the bore
+  surface. At least one module of wall must remain under the root circle; a keyway needs a bore
+  and both its width (below the bore diameter) and depth.
+- `[stock]`: the blank is a cylinder of tip radius + `radial_allowance_mm` from
+  X = -`front_margin_mm` to face width + `back_margin_mm`; a holding stub (`stub_diameter_mm`,
+  `stub_length_mm`, both or neither, not wider than the blank) continues it toward the chuck (+X).
+- `[tools.*]`: `flute_length_mm` / `stick_out_mm` of 0 mean "not given"; when given they are
+  checked against what the job needs (summary `tools.required_flute_length_mm`,
+  `tools.required_stick_out_mm`). See [cam.md](cam.md) for every limit.
+- `[roughing] finish_stock_mm` must be below `flank_allowance_mm`.
+- `[machine]` travel limits: each low limit must be below its high limit.
+  `rotary_clamp_code` / `rotary_unclamp_code` are needed when `[roughing] clamp_rotary`
+  is true; `rotary_continuous = false` makes finishing unwind A after every station.
+- `[post] folded = true` needs `rotary_mode = "unwound"`.
+- `[stock] blank_diameter_mm` (the blank as turned) replaces tip diameter + 2 x
+  `radial_allowance_mm`; it may not be below the tip diameter, and the blank may stand at most
+  0.5 x the finishing tool's diameter (a slot's depth) above the tip circle.
+- `[machine]` physical limits (`max_part_diameter_mm`, `max_part_weight_kg`, `max_overhang_mm`,
+  `spindle_nose_top_mm`; 0 = not checked) are errors naming the limit; tools below
+  `smallest_end_mill_mm` are warnings (see [shop-floor.md](shop-floor.md)).
+- `[tools.bottom]`: two-stage roughing, a flat end mill smaller than `[tools.roughing]` for the
+  bottom of the spaces (T3 when it gives no number); the split is chosen for the shortest time
+  unless `[roughing] bottom_tool_above_root_mm` sets it.
+- `[lathe]`: with the section the blank's lathe program `blank.<ext>` is written too (see
+  [lathe.md](lathe.md)).
+"""
+
+_TYPE_WORDS = {float: "number", int: "integer", bool: "boolean", str: "string"}
+
+
+def _doc_text(text: str) -> str:
+    """Docstring or meaning text for markdown: docs/<name>.md becomes a link."""
+    return re.sub(r"docs/([\w-]+\.md)", r"[\1](\1)", text)
+
+
+def _section_summary(cls: type) -> str:
+    """The first paragraph of a section dataclass's docstring, without its '[section]: ' prefix."""
+    first = " ".join(line.strip() for line in (cls.__doc__ or "").strip().split("\n\n")[0].splitlines())
+    first = re.sub(r"^\[[^\]]+\](\s*/\s*\[[^\]]+\])*:\s*", "", first)
+    return _doc_text(first[:1].upper() + first[1:])
+
+
+def _accepted(k) -> str:
+    if k.type is bool:
+        return "`true`, `false`"
+    if k.names:
+        return ", ".join(f"`{n}`" for n in k.names)
+    if k.low is not None:
+        text = k.interval()
+        return text.removesuffix(f" {k.unit}") if k.unit else text
+    return "any"
+
+
+def job_file_reference_markdown(strategies: Strategies = REGISTRY) -> str:
+    """docs/job-file.md: the introduction, one table per section from its key declarations (the [finishing]
+    keys from the strategies of `strategies`), the notes."""
+    sections = job_sections(strategies)
+    parts = [_DOC_INTRO]
+    done: set[type] = set()
+    for cls in sections.values():
+        if cls in done:
+            continue
+        done.add(cls)
+        names = [n for n, c in sections.items() if c is cls]
+        parts.append(f"## {' / '.join(f'[{n}]' for n in names)}\n\n{_section_summary(cls)}\n")
+        if len(names) > 1:
+            roles = " or ".join(n.split(".")[-1].capitalize() for n in names)
+            parts.append(f"In the workbench property names, `{{Role}}` is {roles}.\n")
+        rows = ["| key | type | unit | default | accepted | meaning | workbench property |",
+                "| --- | --- | --- | --- | --- | --- | --- |"]
+        for k in keys_of(cls):
+            default = "**required**" if k.required else f"`{toml_literal(k.default)}`"
+            rows.append(f"| `{k.name}` | {_TYPE_WORDS[k.type]} | {k.unit or '-'} | {default} | {_accepted(k)} | "
+                        f"{_doc_text(k.meaning)} | `{k.label}` |")
+        parts.append("\n".join(rows) + "\n")
+    parts.append(_DOC_NOTES)
+    return "\n".join(parts)
+
+
+def main(argv: list[str] | None = None) -> int:
+    """`python -m spur_cad.keydocs`: print docs/job-file.md."""
+    argv = sys.argv[1:] if argv is None else argv
+    if argv:
+        print("usage: python -m spur_cad.keydocs > docs/job-file.md", file=sys.stderr)
+        return 2
+    sys.stdout.write(job_file_reference_markdown())
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
