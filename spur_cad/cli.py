@@ -232,6 +232,7 @@ def _verify(args: argparse.Namespace, received: list[int], loaded: list) -> int:
     from spur_cad.errors import shown, shown_path
     from spur_cad.job import load_job
     from spur_cad.outputs import check_output_folder
+    from spur_cad.post.dialects import DIALECTS
     from spur_cad.verify.reader import open_program_file, read_program_file
     from spur_cad.verify.rs274 import read_canonical, rs274_verdict
     from spur_cad.verify.verify import VerifyOptions, result_files, verify_moves
@@ -243,7 +244,9 @@ def _verify(args: argparse.Namespace, received: list[int], loaded: list) -> int:
     options = VerifyOptions(args.point, args.gouge_tolerance_mm, args.leftover_tolerance_mm, tuple(args.point_tools))
     options.validate()
     dialect = args.dialect or job.post.dialect
-    if args.reader == "rs274" and dialect != "linuxcnc":
+    known = DIALECTS.get(dialect)  # None for a name the table does not hold (the reader says so)
+    rs274_checkable = known is not None and known.rs274_checkable  # LinuxCNC's interpreter reads these programs
+    if args.reader == "rs274" and not rs274_checkable:
         raise SpurCadError(f"--reader rs274 reads LinuxCNC programs only (the dialect is {shown(dialect)})")
     programs = []
     for name in args.programs:
@@ -255,7 +258,7 @@ def _verify(args: argparse.Namespace, received: list[int], loaded: list) -> int:
             programs.append(read_program_file(name, dialect, source, checkpoint=lambda: _checkpoint(received)))
         _checkpoint(received)
     result = verify_moves(job, programs, options, progress=lambda fraction: _checkpoint(received))
-    if dialect == "linuxcnc":
+    if rs274_checkable:
         result = dataclasses.replace(result, rs274={shown_path(name): rs274_verdict(name, lambda: _checkpoint(received))
                                                     for name in args.programs})
     lines = result.lines() + [f"rs274 {name}: {verdict}" for name, verdict in result.rs274.items()]

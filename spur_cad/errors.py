@@ -63,6 +63,13 @@ class JobFileError(SpurCadError, ValueError):
     """A job file that cannot be read: bad TOML, unknown key, wrong type, missing value."""
 
 
+class PostError(SpurCadError, ValueError):
+    """A post setting or a toolpath the chosen controller cannot take; the message names it.
+
+    Here (not in spur_cad.post.settings) so that the dialect table and the settings both import it
+    and neither imports the other."""
+
+
 MAX_SHOWN_CHARS = 60
 """User text a message echoes (a value, a key, a name) is cut to about this many characters."""
 MAX_SHOWN_PATH_CHARS = 160

@@ -12,24 +12,31 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 
-from spur_cad.cam.turning import LatheError, LathePlan, LatheSection
+from spur_cad.cam.turning import LATHE_DIALECTS, LatheError, LathePlan, LatheSection
 from spur_cad.errors import require_instance, shown
-from spur_cad.post.program import MAX_COORDINATE_MM, inert_comment_text
+from spur_cad.post.dialects import DIALECTS, Dialect
+from spur_cad.post.program import MAX_COORDINATE_MM, comment_line, program_title
 
-LATHE_EXTENSIONS = {"siemens": "mpf", "fanuc": "nc", "linuxcnc": "ngc"}
-MAX_LINE_LENGTH = {"siemens": 200, "fanuc": 128, "linuxcnc": 250}
+LATHE_EXTENSIONS = {name: DIALECTS[name].extension for name in LATHE_DIALECTS}
+"""The lathe program's extension per [lathe] dialect, from the dialect table (siemens mpf, fanuc nc, linuxcnc ngc)."""
 COORDINATE_DECIMALS = 3  # X (diameter) and Z: 1 um
 FEED_DECIMALS = 3  # mm/rev
-WORKPIECE_BITS = 192
-"""840D WORKPIECE(...) blank of SINUMERIK Operate: the bit value 192 marks ZI and ZB as absolute (see docs/lathe.md)."""
 
 
-def lathe_extension(dialect: str) -> str:
-    """The program file's extension for a lathe dialect: siemens mpf, fanuc nc, linuxcnc ngc."""
-    if dialect not in LATHE_EXTENSIONS:
-        raise LatheError(f"[lathe] dialect = {shown(dialect)} is not known (known: {', '.join(LATHE_EXTENSIONS)})",
+def lathe_dialect(dialect: str | Dialect) -> Dialect:
+    """The table's dialect called `dialect` when it has lathe words, or a LatheError listing [lathe]'s dialects;
+    a `Dialect` with lathe words is returned as it is (a controller not in the table, e.g. one being added)."""
+    found = dialect if isinstance(dialect, Dialect) else DIALECTS.get(dialect) if isinstance(dialect, str) else None
+    if found is None or found.lathe is None:
+        name = dialect.name if isinstance(dialect, Dialect) else dialect
+        raise LatheError(f"[lathe] dialect = {shown(name)} is not known (known: {', '.join(LATHE_DIALECTS)})",
                          field="dialect")
-    return LATHE_EXTENSIONS[dialect]
+    return found
+
+
+def lathe_extension(dialect: str | Dialect) -> str:
+    """The program file's extension for a lathe dialect: siemens mpf, fanuc nc, linuxcnc ngc."""
+    return lathe_dialect(dialect).extension
 
 
 def _number(value: float, decimals: int) -> str:
@@ -41,41 +48,38 @@ def _number(value: float, decimals: int) -> str:
 
 
 class _Program:
-    """The blocks of one lathe program in one dialect."""
+    """The blocks of one lathe program in one dialect (its file frame and its lathe words)."""
 
-    def __init__(self, lathe: LatheSection):
-        self.lathe, self.d = lathe, lathe.dialect
+    def __init__(self, lathe: LatheSection, d: Dialect):
+        self.lathe, self.d, self.words = lathe, d, d.lathe
         self.lines: list[str] = []
 
     def comment(self, text: str) -> str:
-        width = MAX_LINE_LENGTH[self.d] - 4
-        text = inert_comment_text(text, width)
-        if self.d == "fanuc":
-            text = text.upper()
-        return f"; {text}" if self.d == "siemens" else f"({text})"
+        return comment_line(self.d, text)
 
     def spindle_code(self) -> str:
-        return self.lathe.spindle_direction.replace("M", "M0") if self.d == "fanuc" else self.lathe.spindle_direction
+        direction = self.lathe.spindle_direction
+        return direction.replace("M", "M0") if self.words.padded_m_codes else direction
 
     def header(self, plan: LathePlan, title: str, comments: Sequence[str]) -> None:
-        lathe, g = self.lathe, plan.geometry
+        lathe, g, d, words = self.lathe, plan.geometry, self.d, self.words
         rpm = str(int(round(lathe.max_spindle_rpm)))
-        if self.d == "fanuc":
-            title_text = inert_comment_text(title, MAX_LINE_LENGTH["fanuc"] - 16).upper()
-            self.lines += ["%", f"O{lathe.program_number:04d} ({title_text})"]
-        else:
+        if d.percent_delimited:
+            self.lines.append("%")
+        if d.program_start:
+            self.lines.append(d.program_start.format(number=lathe.program_number, title=program_title(d, title)))
+        if "{title}" not in d.program_start:
             self.lines.append(self.comment(title))
         self.lines += [self.comment(text) for text in (*comments, *_setup_comments(plan, lathe))]
-        if self.d == "siemens":
-            top, far = _number(plan.face_stock_mm, COORDINATE_DECIMALS), _number(
-                g.end_z - lathe.parting_blade_width_mm, COORDINATE_DECIMALS)
-            self.lines += [f'WORKPIECE(,,,"CYLINDER",{WORKPIECE_BITS},{top},{far},'
-                           f'{_number(g.end_z, COORDINATE_DECIMALS)},{_number(g.bar_diameter, COORDINATE_DECIMALS)})',
-                           "G18 G90 G71 G95 G40 DIAMON", lathe.work_offset, f"LIMS={rpm}"]
-        elif self.d == "fanuc":
-            self.lines += ["G21 G18 G40 G99", lathe.work_offset, f"G50 S{rpm}"]
-        else:
-            self.lines += ["G7", "G18 G21 G90 G40 G95", lathe.work_offset]
+        if words.workpiece:
+            self.lines.append(words.workpiece.format(
+                top=_number(plan.face_stock_mm, COORDINATE_DECIMALS),
+                far=_number(g.end_z - lathe.parting_blade_width_mm, COORDINATE_DECIMALS),
+                end=_number(g.end_z, COORDINATE_DECIMALS), diameter=_number(g.bar_diameter, COORDINATE_DECIMALS)))
+        self.lines += [*words.setup, d.work_offsets.word.format(code=lathe.work_offset,
+                                                                 number=int(lathe.work_offset[1:]) - 53)]
+        if words.spindle_limit:
+            self.lines.append(words.spindle_limit.format(rpm=rpm))
 
     def tool_call(self, tool: int) -> None:
         lathe = self.lathe
@@ -88,19 +92,15 @@ class _Program:
         vc = str(max(1, int(round(speeds[tool]))))
         rpm = str(int(round(lathe.max_spindle_rpm)))
         what = "turning insert" if tool == lathe.turning_tool_number else "parting blade"
-        self.lines.append(self.comment(f"T{tool}: {what}"))
-        if self.d == "siemens":
-            self.lines += [f"T{tool} D1", f"G96 S{vc} {self.spindle_code()}", "M8"]
-        elif self.d == "fanuc":
-            self.lines += [f"T{tool:02d}{tool:02d}", f"G96 S{vc} {self.spindle_code()}", "M08"]
-        else:
-            self.lines += [f"T{tool} M6 G43", f"G96 D{rpm} S{vc} {self.spindle_code()}", "M8"]
+        self.lines += [self.comment(f"T{tool}: {what}"), self.words.tool_change.format(tool=tool),
+                       self.words.constant_speed.format(vc=vc, rpm=rpm, direction=self.spindle_code()),
+                       self.d.coolant_on]
 
     def end(self) -> None:
-        if self.d == "fanuc":
-            self.lines += ["M09", "M05", "G97", "M30", "%"]
-        else:
-            self.lines += ["M9", "M5", "M30"]
+        d = self.d
+        self.lines += [d.coolant_off, d.spindle_off, *self.words.end, d.program_end]
+        if d.percent_delimited:
+            self.lines.append("%")
 
 
 def _setup_comments(plan: LathePlan, lathe: LatheSection) -> list[str]:
@@ -127,19 +127,24 @@ def _check_plan(plan: LathePlan) -> None:
             raise LatheError(f"lathe move {index} uses tool {move.tool}, outside 1..99")
 
 
-def post_lathe(plan: LathePlan, lathe: LatheSection, title: str, comments: Sequence[str] = ()) -> str:
-    """The text of the lathe program for `plan` (spur_cad.cam.turning.plan_lathe) in [lathe] dialect.
+def post_lathe(plan: LathePlan, lathe: LatheSection, title: str, comments: Sequence[str] = (),
+               dialect: Dialect | None = None) -> str:
+    """The text of the lathe program for `plan` (spur_cad.cam.turning.plan_lathe) in [lathe] dialect, or in
+    `dialect` when given (a controller with lathe words that is not in the table; lathe.dialect is then not used).
 
     `title` (e.g. the job's name) and `comments` are user text: each becomes one inert comment line.
     """
     require_instance(plan, LathePlan, "plan")
     require_instance(lathe, LatheSection, "lathe")
     require_instance(title, str, "title")
+    if dialect is not None:
+        require_instance(dialect, Dialect, "dialect")
     lathe.validate()
+    d = lathe_dialect(lathe.dialect if dialect is None else dialect)
     _check_plan(plan)
     if not plan.moves:
         raise LatheError("the lathe plan has no moves")
-    program = _Program(lathe)
+    program = _Program(lathe, d)
     program.header(plan, title, [str(c) for c in comments])
     tool, motion, position, feed = 0, "", (None, None), None
     for move in plan.moves:
@@ -167,8 +172,8 @@ def post_lathe(plan: LathePlan, lathe: LatheSection, title: str, comments: Seque
                 feed = f
         program.lines.append(" ".join(words))
     program.end()
-    limit = MAX_LINE_LENGTH[lathe.dialect]
+    limit = d.max_line_length
     too_long = [n for n, line in enumerate(program.lines, start=1) if len(line) > limit]
     if too_long:
-        raise LatheError(f"lathe program line {too_long[0]} is longer than the {lathe.dialect} limit of {limit}")
+        raise LatheError(f"lathe program line {too_long[0]} is longer than the {d.name} limit of {limit}")
     return "\n".join(program.lines) + "\n"

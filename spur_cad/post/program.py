@@ -21,9 +21,10 @@ import numpy as np
 
 from spur_cad.cam.ir import MoveKind, Toolpath
 from spur_cad.cam.machine import check_rotary_code
-from spur_cad.errors import shown
-from spur_cad.post.dialects import Dialect, dialect
-from spur_cad.post.settings import PostError, PostSettings
+from spur_cad.errors import PostError, require_instance, shown
+from spur_cad.post.dialects import Dialect
+from spur_cad.post.dialects import dialect as dialect_named
+from spur_cad.post.settings import PostSettings
 
 MAX_COORDINATE_MM = 100_000.0
 """Largest |X|, |Y|, |Z| a program may command (100 m: beyond any machining centre, far inside every
@@ -45,6 +46,20 @@ def inert_comment_text(text: str, max_length: int) -> str:
     if _ACTIVE_COMMENT.match(text):  # LinuxCNC acts on (MSG,...), (LOGOPEN,...), (ABORT,...), (PY,...), ...
         text = "_" + text
     return text if len(text) <= max_length else text[:max_length - 3] + "..."
+
+
+def comment_line(d: Dialect, text: str) -> str:
+    """User text as one inert comment line of dialect `d` (its syntax and case, cut to its line limit)."""
+    text = inert_comment_text(text, d.max_line_length - 4)
+    if d.comments.uppercase:
+        text = text.upper()
+    return f"({text})" if d.comments.style == "paren" else f"; {text}"
+
+
+def program_title(d: Dialect, title: str) -> str:
+    """The title inside dialect `d`'s program-start block (room left for the O number and the parentheses)."""
+    text = inert_comment_text(title, d.max_line_length - 16)
+    return text.upper() if d.comments.uppercase else text
 
 
 @dataclass(frozen=True)
@@ -79,16 +94,20 @@ class _Run:
     a_reference: float  # the exact A (degrees, sign applied) the run's A words are written relative to
 
 
-def post_program(path: Toolpath, settings: PostSettings, info: ProgramInfo) -> PostedProgram:
-    """Write `path` as one program in the settings' dialect."""
+def post_program(path: Toolpath, settings: PostSettings, info: ProgramInfo,
+                 dialect: Dialect | None = None) -> PostedProgram:
+    """Write `path` as one program in the settings' dialect, or in `dialect` when given (a controller that is
+    not in the table, e.g. one being added: docs/post.md; settings.dialect is then not used)."""
     settings.validate()
-    d = dialect(settings.dialect)
+    if dialect is not None:
+        require_instance(dialect, Dialect, "dialect")
+    d = dialect_named(settings.dialect if dialect is None else dialect)
     if len(path) == 0:
         raise PostError(f"{shown(info.title)}: the toolpath is empty")
     _check_numbers(path, info)
-    if settings.rotary_mode == "wrapped" and d.direction_codes is None:
+    if settings.rotary_mode == "wrapped" and d.rotary.direction_codes is None:
         _check_shortest_path(path)
-    lin, rot = 10 ** d.linear_decimals, 10 ** d.rotary_decimals
+    lin, rot = 10 ** d.linear_decimals, 10 ** d.rotary.decimals
     x = np.rint(path.x * lin).astype(np.int64)
     y = np.rint(path.y * lin).astype(np.int64)
     z = np.rint(path.z * lin).astype(np.int64)
@@ -231,10 +250,7 @@ class _Writer:
 
     def comment(self, text: str) -> str:
         """One inert comment line (see inert_comment_text)."""
-        text = inert_comment_text(text, self.d.max_line_length - 4)
-        if self.d.uppercase_comments:
-            text = text.upper()
-        return f"({text})" if self.d.comment_style == "paren" else f"; {text}"
+        return comment_line(self.d, text)
 
     def run_key(self, run: _Run) -> bytes:
         """Everything a run's folded text depends on, as bytes: equal keys give equal subprogram text."""
@@ -277,13 +293,13 @@ class _Writer:
     def _position_words(self, run: _Run, folded: bool, modal: "_Modal", position: tuple[int, int, int, int],
                         a_exact: float) -> tuple[list[str], str | None]:
         """The X/Y/Z/A words of a move (only the axes that change) and the rotary direction code, if any."""
-        d = self.d
-        lin_dec, rot_dec = d.linear_decimals, d.rotary_decimals
+        d, subs = self.d, self.d.subprograms
+        lin_dec, rot_dec = d.linear_decimals, d.rotary.decimals
         x, y, z, a_rel = position
         last_x, last_y, last_z, last_a = modal.position
         words: list[str] = []
         if x != last_x:
-            words.append(d.param_word.format(address="X", param=d.x_param)
+            words.append(subs.param_word.format(address="X", param=subs.x_param)
                          if folded and run.x_base is not None else "X" + _number(x, lin_dec))
         if y != last_y:
             words.append("Y" + _number(y, lin_dec))
@@ -293,14 +309,15 @@ class _Writer:
         if a_rel != last_a:
             if folded:
                 offset = ("+" if a_rel > 0 else "") + _number(a_rel, rot_dec)
-                words.append(d.param_word.format(address="A", param=d.a_param) if a_rel == 0 else
-                             d.param_offset_word.format(address="A", param=d.a_param, offset=offset))
+                words.append(subs.param_word.format(address="A", param=subs.a_param) if a_rel == 0 else
+                             subs.param_offset_word.format(address="A", param=subs.a_param, offset=offset))
             else:
                 wrapped = self.settings.rotary_mode == "wrapped"
                 total = run.a_base + a_rel
                 words.append("A" + _number(total % (360 * self.c.rot) if wrapped else total, rot_dec))
-                if wrapped and d.direction_codes and modal.a_exact is not None:
-                    direction = d.direction_codes[0] if a_exact > modal.a_exact else d.direction_codes[1]
+                codes = d.rotary.direction_codes
+                if wrapped and codes and modal.a_exact is not None:
+                    direction = codes[0] if a_exact > modal.a_exact else codes[1]
         return words, direction
 
     def _motion_words(self, kind: int, inverse_move: bool, feed: float, index: int, modal: "_Modal",
@@ -337,24 +354,25 @@ class _Writer:
         """The whole program: header, subprogram definitions (before or after the main body, per dialect),
         the main body with its calls, the end; block numbers and the line-length check last."""
         d, s, info = self.d, self.settings, self.info
+        subs = d.subprograms
         sub_ids = self._sub_ids(len(sub_bodies))
         head: list[str] = ["%"] if d.percent_delimited else []
         if d.program_start:
             head.append(d.program_start.format(number=s.program_number, title=self._title()))
         titled = (info.comments if d.program_start and "{title}" in d.program_start else (info.title, *info.comments))
         head += [self.comment(line) for line in titled]
-        definitions = [] if d.subprograms_after_end or d.fold_style == "repeat" else \
+        definitions = [] if subs.after_end or subs.fold_style == "repeat" else \
             self._definitions(sub_bodies, sub_ids)
         main = self._start_blocks() + self._main_body(body, sub_bodies, sub_ids)
         if s.coolant:
             main.append(d.coolant_off)
         main += [d.spindle_off, d.program_end]
-        tail = self._definitions(sub_bodies, sub_ids) if d.subprograms_after_end else []
+        tail = self._definitions(sub_bodies, sub_ids) if subs.after_end else []
         if d.percent_delimited:
             tail.append("%")
         lines = head + definitions + main + tail
         if s.line_numbers:
-            lines = self._numbered(lines, min(sub_ids) - 1 if d.fold_style == "local_sub" and sub_ids
+            lines = self._numbered(lines, min(sub_ids) - 1 if subs.fold_style == "local_sub" and sub_ids
                                    else s.max_line_number)
         too_long = [n for n, line in enumerate(lines, start=1) if len(line) > d.max_line_length]
         if too_long:
@@ -366,7 +384,7 @@ class _Writer:
         """Blank description, setup, work offset, tool, spindle, coolant, and a restart's move to the clearance
         height (up or down, Z alone, before moving across)."""
         d, s, info = self.d, self.settings, self.info
-        offset = d.work_offset.format(code=s.work_offset, number=int(s.work_offset[1:]) - 53)
+        offset = d.work_offsets.word.format(code=s.work_offset, number=int(s.work_offset[1:]) - 53)
         lines = [*self._workpiece(), d.setup, offset, *[t.format(tool=self.tool) for t in d.tool_change],
                  d.spindle_on.format(rpm=self.rpm)]
         if s.coolant:
@@ -387,16 +405,16 @@ class _Writer:
 
     def _definitions(self, sub_bodies: list[list[str]], sub_ids: list[int]) -> list[str]:
         """Every subprogram, framed by the dialect's start and end blocks."""
-        d = self.d
+        subs = self.d.subprograms
         lines: list[str] = []
         for index, body in enumerate(sub_bodies):
-            lines += [d.sub_start.format(sub=sub_ids[index]), *body, d.sub_end.format(sub=sub_ids[index])]
+            lines += [subs.start.format(sub=sub_ids[index]), *body, subs.end.format(sub=sub_ids[index])]
         return lines
 
     def _main_body(self, body: list[tuple[str, object]], sub_bodies: list[list[str]], sub_ids: list[int]) -> list[str]:
         """Inline runs and subprogram calls in order; a repeat-style dialect writes each section at its first use."""
-        d = self.d
-        lin_dec, rot_dec = d.linear_decimals, d.rotary_decimals
+        d, subs = self.d, self.d.subprograms
+        lin_dec, rot_dec = d.linear_decimals, d.rotary.decimals
         main: list[str] = []
         written: set[int] = set()
         for kind, item in body:
@@ -404,24 +422,23 @@ class _Writer:
                 main += item
                 continue
             index, run = item
-            if d.fold_style == "repeat" and index not in written:  # first use: the section itself, labelled
+            if subs.fold_style == "repeat" and index not in written:  # first use: the section itself, labelled
                 written.add(index)
-                main += [d.call[0].format(x=_number(run.x_base or 0, lin_dec), a=_number(run.a_base, rot_dec)),
-                         d.sub_start.format(sub=sub_ids[index]), *sub_bodies[index],
-                         d.sub_end.format(sub=sub_ids[index])]
+                main += [subs.call[0].format(x=_number(run.x_base or 0, lin_dec), a=_number(run.a_base, rot_dec)),
+                         subs.start.format(sub=sub_ids[index]), *sub_bodies[index],
+                         subs.end.format(sub=sub_ids[index])]
             else:
                 x = _number(run.x_base if run.x_base is not None else 0, lin_dec)
-                main += [line.format(sub=sub_ids[index], x=x, a=_number(run.a_base, rot_dec)) for line in d.call]
+                main += [line.format(sub=sub_ids[index], x=x, a=_number(run.a_base, rot_dec)) for line in subs.call]
         return main
 
     def _title(self) -> str:
         """The title inside the program-start block (room left for the O number and the parentheses)."""
-        text = inert_comment_text(self.info.title, self.d.max_line_length - 16)
-        return text.upper() if self.d.uppercase_comments else text
+        return program_title(self.d, self.info.title)
 
     def _sub_ids(self, count: int) -> list[int]:
         """Subprogram numbers: after the program number; Haas labels (N numbers) at the top of the range."""
-        if self.d.fold_style == "local_sub":
+        if self.d.subprograms.fold_style == "local_sub":
             top = self.settings.max_line_number
             return [top - count + 1 + i for i in range(count)]
         first = self.settings.program_number + 1

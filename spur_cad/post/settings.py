@@ -4,25 +4,20 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from spur_cad.errors import SpurCadError, shown
+from spur_cad.errors import PostError, shown
 from spur_cad.keys import check_section, key
+from spur_cad.post.dialects import DIALECTS
+
+__all__ = ["WORK_OFFSETS", "PostError", "PostSettings", "dialect_names"]
 
 
 def dialect_names() -> tuple[str, ...]:
-    """The dialects' names, from the table in spur_cad.post.dialects (which imports this module, hence the
-    late import): adding a dialect there is all it takes."""
-    from spur_cad.post.dialects import DIALECTS
-
+    """The dialects' names, from the table in spur_cad.post.dialects: adding a dialect there is all it takes."""
     return tuple(DIALECTS)
-
 
 
 WORK_OFFSETS = ("G54", "G55", "G56", "G57", "G58", "G59")
 """The work offsets a program may select."""
-
-
-class PostError(SpurCadError, ValueError):
-    """A post setting or a toolpath the chosen controller cannot take; the message names it."""
 
 
 @dataclass(frozen=True)

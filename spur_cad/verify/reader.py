@@ -42,9 +42,13 @@ from dataclasses import dataclass
 import numpy as np
 
 from spur_cad.errors import SpurCadError, shown, shown_path
+from spur_cad.post.dialects import DIALECTS as DIALECT_TABLE
+from spur_cad.post.dialects import Dialect, lathe_names
 
-DIALECTS = ("linuxcnc", "fanuc", "haas", "siemens", "okuma")
-LATHE_DIALECTS = ("linuxcnc", "fanuc", "siemens")
+DIALECTS = tuple(DIALECT_TABLE)
+"""The names the reader takes (the dialect table's; a `Dialect` not in it may be given too)."""
+LATHE_DIALECTS = lathe_names()
+"""The names the reader takes in lathe mode: the table's dialects with lathe words."""
 # The largest program read, and what reading it may do. Together they bound a verification to about a minute
 # and half a gigabyte whatever the program holds (docs/verification.md, "Limits").
 MAX_PROGRAM_BYTES = 64 * 1024 * 1024  # refused at once beyond this, naming the size
@@ -143,7 +147,6 @@ _LINUXCNC_CALL = re.compile(r"O(\d+)\s*CALL((?:\s*\[[^\]]*\])*)")
 _ASSIGNMENT = re.compile(r"(#\d+)\s*=\s*(.+)")
 _LABEL = re.compile(r"[A-Z_][A-Z0-9_]*:")
 _SUB_HEAD = re.compile(r"O(\d+)|N(\d+)")
-_FANUC_CLOSE = re.compile(r"M0*99")
 _PROGRAM_NUMBER = re.compile(r"O\d+")
 _WORDS = re.compile(r"([A-Z])\s*(\[[^\]]*\]|#\d+|[-+]?(?:\d+\.?\d*|\.\d+))")
 _WORDS_ASSIGNED = re.compile(r"([A-Z])\s*(=\s*[^\s]+|\[[^\]]*\]|#\d+|[-+]?(?:\d+\.?\d*|\.\d+))")
@@ -151,19 +154,33 @@ _R_PARAMETER = re.compile(r"R\d+=\S+")
 _ORDER = {"T": 0, "S": 0, "G": 1, "F": 2, "M": 3}  # T and S before M, G before F, then the rest in order
 
 
-def _clean(raw: bytes, dialect: str) -> str:
+@dataclass(frozen=True, slots=True)
+class _Syntax:
+    """What reading every line needs from the dialect table (spur_cad.post.dialects), in flat fields."""
+
+    paren: bool  # ( ... ) is a comment
+    semicolon: bool  # ; starts a comment to the end of the line
+    local_labels: bool  # a line N<n> heads a local subprogram (Haas), not a block number
+    structure: str  # "o_words", "labels" or "numbered" (Subprograms.structure)
+    closing: re.Pattern  # "numbered": the block closing a subprogram
+
+    @classmethod
+    def of(cls, d: Dialect) -> "_Syntax":
+        subs = d.subprograms
+        return cls("paren" in d.comments.reads, "semicolon" in d.comments.reads, subs.local_labels,
+                   subs.structure, re.compile(subs.closing))
+
+
+def _clean(raw: bytes, syntax: _Syntax) -> str:
     """A line without comments, block number and surrounding blanks; upper case (LinuxCNC's o-words too);
     '' for a line with nothing to execute ('%' delimits Fanuc and Haas programs)."""
     line = raw.decode("utf-8")  # checked while indexing
-    if dialect == "siemens":
+    if syntax.paren and "(" in line:
+        line = _COMMENT.sub("", line)
+    if syntax.semicolon:
         line = line.split(";", 1)[0]
-    else:
-        if "(" in line:
-            line = _COMMENT.sub("", line)
-        if dialect == "linuxcnc":
-            line = line.split(";", 1)[0]
     line = line.strip().upper()
-    if line[:1] == "N" and (dialect != "haas" or not _HAAS_LOCAL.fullmatch(line)):  # Haas's N<n> heads a local sub
+    if line[:1] == "N" and (not syntax.local_labels or not _HAAS_LOCAL.fullmatch(line)):  # N<n> heads a local sub
         line = _BLOCK_NUMBER.sub("", line, count=1)
     return "" if line == "%" else line
 
@@ -202,14 +219,15 @@ class _Structure:
         self.subs, self.local_subs, self.skips, self.repeats, self.labels = {}, {}, {}, {}, {}
 
 
-def _index(handle, dialect: str, source: str) -> _Structure:
+def _index(handle, syntax: _Syntax, source: str) -> _Structure:
     """One pass over the file: check every line (UTF-8, no NUL, length, count) and find the structure; linear in
     the file's length (a line that cannot end or open a structure is not even decoded)."""
     found = _Structure()
     open_subs: list[tuple[int, Position, int]] = []  # LinuxCNC: (number, body start, line offset)
     open_repeats: dict[int, list[int]] = {}  # LinuxCNC: number -> offsets of its open repeats
-    fanuc_family = dialect in ("fanuc", "haas", "okuma")
-    closing = re.compile("RTS") if dialect == "okuma" else _FANUC_CLOSE
+    fanuc_family = syntax.structure == "numbered"
+    o_words, labels = syntax.structure == "o_words", syntax.structure == "labels"
+    closing = syntax.closing
     current_sub: tuple[re.Match, Position, int] | None = None  # Fanuc family after the end: the open subprogram
     offset, number = 0, 0
     for raw in iter(lambda: handle.readline(MAX_LINE_CHARS + 3), b""):  # a line read is bounded too
@@ -219,16 +237,16 @@ def _index(handle, dialect: str, source: str) -> _Structure:
         after_end = found.end >= 0
         if not (after_end and fanuc_family) and not _CANDIDATE.search(raw):
             continue
-        text = _clean(raw, dialect)
+        text = _clean(raw, syntax)
         if not text:
             continue
         line = _Line(number, text, here)
         if not after_end and _ENDS.search(text):
             found.end = offset
             continue
-        if dialect == "linuxcnc":
-            _index_linuxcnc(found, line, (offset, number), open_subs, open_repeats)
-        elif dialect == "siemens" and _LABEL.fullmatch(text):
+        if o_words:
+            _index_o_words(found, line, (offset, number), open_subs, open_repeats)
+        elif labels and _LABEL.fullmatch(text):
             found.labels[text[:-1]] = ((offset, number), here)
             found.opened += 1
         elif fanuc_family and after_end:
@@ -282,7 +300,7 @@ def _index_subprogram(found: _Structure, line: _Line, after: Position, current_s
     return current_sub
 
 
-def _index_linuxcnc(found: _Structure, line: _Line, after: Position, open_subs: list, open_repeats: dict) -> None:
+def _index_o_words(found: _Structure, line: _Line, after: Position, open_subs: list, open_repeats: dict) -> None:
     """LinuxCNC o-word structure, paired with stacks (each opening is closed by the nearest closing of its number)."""
     text = line.text
     if text[:1] != "O":
@@ -312,10 +330,19 @@ def _error(source: str, line: _Line, message: str) -> ProgramReadError:
 class _Reader:
     """Executes one program: machine state, variables, subprogram calls, recorded moves."""
 
-    def __init__(self, handle, dialect: str, source: str, checkpoint=None, lathe: bool = False):
-        self.dialect, self.source, self.checkpoint, self.lathe = dialect, source, checkpoint, lathe
+    def __init__(self, handle, d: Dialect, source: str, checkpoint=None, lathe: bool = False):
+        self.d, self.source, self.checkpoint, self.lathe = d, source, checkpoint, lathe
+        self.syntax, self.subprograms = _Syntax.of(d), d.subprograms
+        self.lathe_words = d.lathe if lathe else None  # checked to be there (_dialect)
+        self.lathe_keywords = self.lathe_words is not None and self.lathe_words.keywords
+        self.spindle_limit_code = self.lathe_words.spindle_limit_code if self.lathe_words is not None else None
+        self.offset_code = None if lathe else d.work_offsets.numbered_code  # G15 (H<n>) on Okuma
+        # The rotary direction codes without M and leading zeros -> True for the positive one (Okuma M15, M16).
+        self.directions = {code[1:].lstrip("0") or "0": index == 0
+                           for index, code in enumerate(d.rotary.direction_codes or ())}
         self.axes = "XZ" if lathe else "XYZA"
-        self.diameter = dialect == "fanuc"  # lathe X as a diameter: G7 (LinuxCNC), DIAMON (Siemens)
+        # lathe X as a diameter: from the start where no word sets it (Fanuc), else G7 (LinuxCNC), DIAMON (Siemens)
+        self.diameter = self.lathe_words is not None and self.lathe_words.diameter_word is None
         self.per_rev = False  # lathe feed per revolution: G95 (G99 on Fanuc)
         self.block_codes: set[str] = set()  # G codes of the block whose words are checked together
         self.blocks = 0
@@ -335,7 +362,7 @@ class _Reader:
         self.feed_in_block = False
         self.columns = move_columns()
         self.ended = False
-        self.words_pattern = _WORDS_ASSIGNED if dialect in ("siemens", "okuma") else _WORDS
+        self.words_pattern = _WORDS_ASSIGNED if d.assigned_words else _WORDS
 
     def error(self, line: _Line, message: str) -> ProgramReadError:
         return _error(self.source, line, message)
@@ -380,7 +407,7 @@ class _Reader:
 
     # --- execution ------------------------------------------------------------------------------
     def run(self) -> ProgramMoves:
-        self.structure = _index(self.handle, self.dialect, self.source)
+        self.structure = _index(self.handle, self.syntax, self.source)
         self.handle.seek(0)
         self.execute((0, 0), self.structure.end, 0)
         if not self.ended:
@@ -391,7 +418,7 @@ class _Reader:
     def execute(self, start: Position, stop: int, depth: int) -> None:
         """Run the lines from `start` up to (not including) the line at offset `stop`."""
         offset, number = start
-        lines, dialect = self.lines, self.dialect
+        lines, syntax = self.lines, self.syntax
         while offset < stop and not self.ended:
             raw, after = lines.line(offset)
             if not raw:
@@ -401,14 +428,14 @@ class _Reader:
             self.characters_read += len(raw)
             if self.lines_read % CHECK_EVERY_BLOCKS == 0:
                 self._limits(number)
-            text = _clean(raw, dialect)
+            text = _clean(raw, syntax)
             if not text:
                 continue
             self.blocks += 1
             line = _Line(number, text, here)
             if not text.isascii():  # e.g. a digit of another script, which Python would read as a number
                 raise self.error(line, "a character outside a comment that is not ASCII (a controller reads none)")
-            jump = self.control(line, (offset, number), depth) if _may_be_control(text, dialect) else None
+            jump = self.control(line, (offset, number), depth) if _may_be_control(text, syntax.structure) else None
             if jump is not None:
                 offset, number = jump
                 continue
@@ -453,13 +480,14 @@ class _Reader:
 
     def control(self, line: _Line, after: Position, depth: int) -> Position | None:
         """Subprogram definitions, calls, repeats and labels; the position to go on at, or None for a block."""
-        if self.dialect == "linuxcnc":
-            return self._linuxcnc_control(line, after, depth)
-        if self.dialect == "siemens":
-            return self._siemens_control(line, after, depth)
-        return self._fanuc_family_control(line, after, depth)
+        structure = self.syntax.structure
+        if structure == "o_words":
+            return self._o_word_control(line, after, depth)
+        if structure == "labels":
+            return self._label_control(line, after, depth)
+        return self._numbered_control(line, after, depth)
 
-    def _siemens_control(self, line: _Line, after: Position, depth: int) -> Position | None:
+    def _label_control(self, line: _Line, after: Position, depth: int) -> Position | None:
         text = line.text
         if _LABEL.fullmatch(text) or re.fullmatch(r'WORKPIECE\([^()]*\)', text):
             return after  # a label, or the blank for the control's simulation (ignored)
@@ -506,7 +534,7 @@ class _Reader:
                 else:
                     self.variables[name] = value
 
-    def _linuxcnc_control(self, line: _Line, after: Position, depth: int) -> Position | None:
+    def _o_word_control(self, line: _Line, after: Position, depth: int) -> Position | None:
         text = line.text
         if text[0] == "#":
             found = _ASSIGNMENT.fullmatch(text)
@@ -537,7 +565,7 @@ class _Reader:
             return closing[1]
         return None
 
-    def _fanuc_family_control(self, line: _Line, after: Position, depth: int) -> Position | None:
+    def _numbered_control(self, line: _Line, after: Position, depth: int) -> Position | None:
         text = line.text
         if _PROGRAM_NUMBER.fullmatch(text):
             return after  # the program's own number (its title was a comment)
@@ -545,7 +573,7 @@ class _Reader:
         if found:
             self._set(found.group(1), self.value(found.group(2), line), line)
             return after
-        if self.dialect == "okuma":
+        if self.subprograms.named_calls:
             found = re.fullmatch(r"CALL\s*O(\d+)((?:\s+[A-Z][A-Z0-9]*\s*=\s*\S+)*)", text)
             if found:
                 for name, value in re.findall(r"([A-Z][A-Z0-9]*)\s*=\s*(\S+)", found.group(2)):
@@ -567,7 +595,7 @@ class _Reader:
             return after
         found = re.fullmatch(r"M0*9([78])\s*P\s*(\d+)(?:\s*L\s*(\d+))?", text)
         if found:
-            if found.group(1) == "7" and self.dialect != "haas":
+            if found.group(1) == "7" and not self.subprograms.local_labels:
                 raise self.error(line, "M97 (local subprogram) is a Haas code")
             self._call(found.group(2), line, depth, self._count(found.group(3), line), local=found.group(1) == "7")
             return after
@@ -576,8 +604,8 @@ class _Reader:
 
     # --- one block --------------------------------------------------------------------------------
     def block(self, line: _Line) -> None:
-        if self.lathe and self.dialect == "siemens":
-            line = self._siemens_lathe_words(line)
+        if self.lathe_keywords:
+            line = self._lathe_keywords(line)
         words = self.words(line)
         if len(words) > 1:
             words.sort(key=_word_order)  # T and S before M (M6 loads the tool the block names), G before F
@@ -613,27 +641,29 @@ class _Reader:
             self._t_word(value, line)
         elif letter == "S":
             self.spindle = self.value(value, line)
-        elif letter in "HDP" or (letter == "N" and self.dialect == "siemens"):
-            return  # tool offset numbers, G64 P tolerance, G96 D spindle limit, G15 H work offset
+        elif letter in self.d.ignored_words:
+            return  # tool offset numbers, G64 P tolerance, G96 D spindle limit, G15 H work offset (Siemens: N)
         elif self.lathe and letter in "YAUW":
             raise self.error(line, f"word {letter}{value}: a lathe program moves X and Z only (absolute, no U/W)")
         else:
             raise self.error(line, f"word {letter}{value} is not supported by this reader")
 
     def _t_word(self, value: str, line: _Line) -> None:
-        """T: the tool M6 loads; on a Siemens or Fanuc lathe the turret indexes at once (Fanuc T0101: tool 1,
+        """T: the tool M6 loads; on a lathe with a turret (Siemens, Fanuc) it indexes at once (Fanuc T0101: tool 1,
         offset 1)."""
-        if not (self.lathe and self.dialect in ("siemens", "fanuc")):
+        words = self.lathe_words
+        if words is None or not words.turret:
             self.pending_tool = int(self.value(value, line))
             return
-        if self.dialect == "fanuc":
+        if words.tool_offset_t:
             if not re.fullmatch(r"\d{3,4}", value):
-                raise self.error(line, f"T{value}: a Fanuc lathe T word gives the tool and its offset (T0101)")
+                raise self.error(line, f"T{value}: a {self.d.title} lathe T word gives the tool and its offset "
+                                       "(T0101)")
             self.tool = self.pending_tool = int(value) // 100
         else:
             self.tool = self.pending_tool = int(self.value(value, line))
 
-    def _siemens_lathe_words(self, line: _Line) -> _Line:
+    def _lathe_keywords(self, line: _Line) -> _Line:
         """Siemens lathe words that are not address + number: LIMS=<rpm> (spindle limit under G96), DIAMON /
         DIAM90 (X as diameter) and DIAMOF (X as radius); the rest of the block is returned."""
         text = line.text
@@ -649,15 +679,15 @@ class _Reader:
         would set a coordinate system or a working area), Okuma G15 H<n> (work offset n >= 1)."""
         letters = {letter for letter, _ in words}
         for code in self.block_codes:
-            if code in ("50", "26") and (letters & set("XZUWY") or "S" not in letters):
+            if code == self.spindle_limit_code and (letters & set("XZUWY") or "S" not in letters):
                 raise self.error(line, f"G{code} is read only as the spindle speed limit G{code} S<rpm> "
                                        "(with axes it sets a coordinate system or a working area)")
-            if code == "15":
+            if code == self.offset_code:
                 numbers = [value for letter, value in words if letter == "H"]
                 if len(numbers) != 1 or not re.fullmatch(r"\d+", numbers[0]) or int(numbers[0]) < 1 \
                         or letters & set("XYZA"):
-                    raise self.error(line, "G15 is read only as Okuma's work offset selection G15 H<n> "
-                                           "(n = 1, 2, ...) in a block of its own")
+                    raise self.error(line, f"G{code} is read only as {self.d.title}'s work offset selection "
+                                           f"G{code} H<n> (n = 1, 2, ...) in a block of its own")
 
     def words(self, line: _Line) -> list[tuple[str, str]]:
         text = line.text
@@ -674,29 +704,30 @@ class _Reader:
             self.motion = code
         elif self.lathe and self._lathe_g_code(code, line):
             return
-        elif code == "15" and self.dialect == "okuma" and not self.lathe:
+        elif code == self.offset_code:
             self.block_codes.add(code)  # G15 H<n>: Okuma's work offset n
         elif code in ("93", "94"):
             if self.inverse != (code == "93"):
                 self.feed = math.nan  # a feed mode change leaves no F in effect (LinuxCNC, Fanuc)
             self.inverse = code == "93"
-        elif code not in SETUP_G and not (code == "71" and self.dialect == "siemens"):  # G71: metric on 840D
+        elif code not in SETUP_G and code not in self.d.extra_setup_g:  # e.g. G71: metric on the 840D
             raise self.error(line, f"G{value} is not supported by this reader (it reads G0/G1 moves, G90, G93/G94)")
 
     def _lathe_g_code(self, code: str, line: _Line) -> bool:
         """Lathe G codes; False for the codes milling and turning share (G21, G40, G54...)."""
-        per_rev, per_minute = ("99", "98") if self.dialect == "fanuc" else ("95", "94")
+        words = self.lathe_words
+        per_rev, per_minute = words.feed_codes
         if code in (per_rev, per_minute):
             if self.per_rev != (code == per_rev):
                 self.feed = math.nan  # a new feed mode needs a new F
             self.per_rev = code == per_rev
         elif code in ("96", "97", "18"):
             pass  # constant cutting speed (S in m/min) or rpm, the ZX plane
-        elif code in ("7", "8") and self.dialect == "linuxcnc":
-            self.diameter = code == "7"
-        elif (code, self.dialect) in (("50", "fanuc"), ("26", "siemens")):
+        elif words.diameter_codes is not None and code in words.diameter_codes:
+            self.diameter = code == words.diameter_codes[0]
+        elif code == self.spindle_limit_code:
             self.block_codes.add(code)
-        elif code == "93" or (code in ("90", "94") and self.dialect == "fanuc"):
+        elif code == "93" or code in words.cycle_codes:
             raise self.error(line, f"G{code} is not read in a lathe program (Fanuc's G90 and G94 are turning "
                                    "cycles in system A, G93 is inverse time)")
         else:
@@ -709,7 +740,7 @@ class _Reader:
             self.ended = True
         elif code == "6":
             self.tool = self.pending_tool
-        elif code in ("15", "16") and self.dialect == "okuma":
+        elif code in self.directions:
             return code  # Okuma's rotary direction (other controls use M15/M16 for other things)
         elif code not in QUIET_M:
             raise self.error(line, f"M{value} is not supported by this reader")
@@ -750,22 +781,22 @@ class _Reader:
     def _check_lathe_move(self, line: _Line) -> None:
         if not self.diameter:
             raise self.error(line, "X is a radius here; this reader reads lathe programs in diameter mode "
-                                   + ("(G7)" if self.dialect == "linuxcnc" else "(DIAMON)"))
+                                   + f"({self.lathe_words.diameter_word})")
         if self.motion == "1" and not self.per_rev:
             raise self.error(line, "a lathe feed move without feed per revolution ("
-                                   + ("G99" if self.dialect == "fanuc" else "G95") + ")")
+                                   + f"G{self.lathe_words.feed_codes[0]})")
 
 
 
 def _directed(current: float, target: float, direction: str, reader: _Reader, line: _Line) -> float:
     """The unwound A reached from `current` turning positively (M15) or negatively (M16) to the angle `target`
-    in [0, 360)."""
+    in [0, 360); `direction` is the code without M (a key of reader.directions)."""
     if not 0.0 <= target < 360.0:
         raise reader.error(line, f"with M{direction}, A must be an angle in [0, 360), got {target:g}")
     if math.isnan(current):
         return target
     step = (target - current) % 360.0
-    return current + step if direction == "15" else current - ((360.0 - step) % 360.0)
+    return current + step if reader.directions[direction] else current - ((360.0 - step) % 360.0)
 
 
 
@@ -779,34 +810,42 @@ def _word_order(word: tuple[str, str]) -> int:
     return _ORDER.get(word[0], 4)
 
 
-def _may_be_control(text: str, dialect: str) -> bool:
-    """False for a block that no control statement of the dialect can be (most blocks: moves)."""
-    if dialect == "siemens":
+def _may_be_control(text: str, structure: str) -> bool:
+    """False for a block that no control statement of the structure can be (most blocks: moves)."""
+    if structure == "labels":  # labels, R<n>= parameters, REPEAT, WORKPIECE
         return ":" in text or "=" in text or text[0] in "RW"
-    if dialect == "linuxcnc":
+    if structure == "o_words":
         return text[0] in "O#"
-    return text[0] in "O#C" or "P" in text  # Fanuc family: O, #n =, CALL (Okuma), G65 P, M98 P, M97 P
+    return text[0] in "O#C" or "P" in text  # numbered: O, #n =, CALL (Okuma), G65 P, M98 P, M97 P
 
 
-def _check_dialect(dialect: str, lathe: bool) -> None:
-    if dialect not in DIALECTS:
+def _dialect(dialect: str | Dialect, lathe: bool) -> Dialect:
+    """The table's dialect called `dialect` (a Dialect is taken as it is: a controller not in the table); in
+    lathe mode one with lathe words."""
+    if isinstance(dialect, Dialect):
+        found = dialect
+    elif dialect not in DIALECTS:
         raise ProgramReadError(f"unknown dialect {shown(dialect)} (known: {', '.join(DIALECTS)})")
-    if lathe and dialect not in LATHE_DIALECTS:
-        raise ProgramReadError(f"no lathe dialect {shown(dialect)} (known: {', '.join(LATHE_DIALECTS)})")
+    else:
+        found = DIALECT_TABLE[dialect]
+    if lathe and found.lathe is None:
+        raise ProgramReadError(f"no lathe dialect {shown(found.name)} (known: {', '.join(LATHE_DIALECTS)})")
+    return found
 
 
-def read_program(text: str, dialect: str, source: str = "program", checkpoint=None,
+def read_program(text: str, dialect: str | Dialect, source: str = "program", checkpoint=None,
                  lathe: bool = False) -> ProgramMoves:
-    """The moves of a program's text in `dialect` (one of DIALECTS); raises ProgramReadError naming `source`'s
-    line. `checkpoint()` is called every CHECK_EVERY_BLOCKS lines read (the CLI stops there when a signal
-    arrived). `lathe`: a lathe program (LATHE_DIALECTS; the module docstring says what is read): x is the
-    diameter as written, y = a = 0, feed in mm/rev as written. Lines end with LF (or CR LF)."""
-    _check_dialect(dialect, lathe)
+    """The moves of a program's text in `dialect` (one of DIALECTS, or a Dialect of spur_cad.post.dialects: a
+    controller not in the table); raises ProgramReadError naming `source`'s line. `checkpoint()` is called every
+    CHECK_EVERY_BLOCKS lines read (the CLI stops there when a signal arrived). `lathe`: a lathe program
+    (LATHE_DIALECTS, or a Dialect with lathe words; the module docstring says what is read): x is the diameter
+    as written, y = a = 0, feed in mm/rev as written. Lines end with LF (or CR LF)."""
+    d = _dialect(dialect, lathe)
     data = text.encode("utf-8", "surrogatepass")
     if len(data) > MAX_PROGRAM_BYTES:
         raise ProgramReadError(f"{source}: the program has {len(data):,} bytes; verify reads at most "
                                f"{MAX_PROGRAM_BYTES:,} ({MAX_PROGRAM_BYTES // 2**20} MiB)")
-    return _Reader(io.BytesIO(data), dialect, source, checkpoint, lathe).run()
+    return _Reader(io.BytesIO(data), d, source, checkpoint, lathe).run()
 
 
 def open_program_file(path: str | os.PathLike, source: str | None = None):
@@ -824,11 +863,11 @@ def open_program_file(path: str | os.PathLike, source: str | None = None):
     return handle
 
 
-def read_program_file(path: str | os.PathLike, dialect: str, source: str | None = None, checkpoint=None,
+def read_program_file(path: str | os.PathLike, dialect: str | Dialect, source: str | None = None, checkpoint=None,
                       lathe: bool = False) -> ProgramMoves:
     """`read_program` of a file, read as a stream: a regular file of at most MAX_PROGRAM_BYTES (a FIFO, a device
     or a larger file is refused before reading); memory holds a line at a time besides the moves."""
-    _check_dialect(dialect, lathe)
+    d = _dialect(dialect, lathe)
     source = source if source is not None else shown_path(path)
     with open_program_file(path, source) as handle:
-        return _Reader(handle, dialect, source, checkpoint, lathe).run()
+        return _Reader(handle, d, source, checkpoint, lathe).run()
