@@ -14,7 +14,8 @@ import numpy as np
 import pytest
 
 from spur_cad.cam.finishing import finishing_toolpath
-from spur_cad.cam.machine import FinishingParams, Machine
+from spur_cad.cam.machine import Machine
+from spur_cad.cam.strategies import FinishingParams
 from spur_cad.cam.turning import LATHE_DIALECTS, LatheError, LatheSection, plan_lathe
 from spur_cad.job import load_job
 from spur_cad.post import PostError, PostSettings, ProgramInfo, post_program
