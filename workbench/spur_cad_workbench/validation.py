@@ -7,7 +7,6 @@ message under the panel group it is about, so the panel shows it beside the fiel
 
 from __future__ import annotations
 
-import math
 import re
 from dataclasses import dataclass
 
@@ -201,38 +200,11 @@ def unusual_value_notes(job_values: dict[str, object]) -> dict[str, str]:
     return notes
 
 
-def _floor_to(value: float, step: float) -> float:
-    return math.floor(value / step + 1e-9) * step
-
-
-def _generating_finishing_tool(job) -> tuple[float, float]:
-    """(corner radius, flat width) for finishing by generation: the advised corner radius (the rack tip
-    radius: tip mode exact) and a diameter at 95 % of the largest that fits both modes with the rack end,
-    in 0.05 mm steps."""
-    from spur_cad.cam.strategies.generating import generating_tool_limits
-
-    spec = job.gear
-    corner = spec.rack_tip_radius_mm
-    if corner <= 0.0:  # a sharp rack: no tool with a corner can play it
-        return 0.0, 0.0
-    if spec.is_helical:  # the corner must be rho; 95 % of the rack's normal tip flat for the tool's flat
-        from spur_cad.geometry.profile import rack_corner
-
-        return corner, _floor_to(0.95 * 2.0 * rack_corner(spec).normal_corner_offset_mm, 0.05)
-    else:
-        limits = generating_tool_limits(spec, corner, job.finishing.target_scallop_mm,
-                                        job.stock.blank_radius_mm(spec))
-        largest = min(limits.tip_mode_max_diameter_mm, limits.flank_mode_max_diameter_mm)
-    diameter = _floor_to(0.95 * largest, 0.05)
-    return corner, diameter - 2.0 * corner
-
-
 def suggest_tools(values: dict[str, dict[str, object]]) -> dict[str, object]:
     """Job property values choosing tools within the recommendations (for a new job); {} if none fits.
 
-    Finishing by generation (the default): r_t = rho and 95 % of the largest diameter that fits;
-    other strategies: bull-nose with r_t at 90 % of the smallest fillet radius (0.05 mm steps, at
-    most 1 mm) and flat width at 90 % of the root arc. Roughing: the largest 0.1 mm diameter that
+    Finishing: the tool the job's strategy suggests (FinishingStrategy.suggested_tool: by generation, the
+    default, r_t = rho and 95 % of the largest diameter that fits). Roughing: the largest 0.1 mm diameter that
     passes the tool limits and the roughing-reach rule.
     """
     from spur_cad.cam.recommend import recommend_tools
@@ -243,13 +215,15 @@ def suggest_tools(values: dict[str, dict[str, object]]) -> dict[str, object]:
         return {}
     spec = check.job.gear
     rec = check.recommendations
-    if check.job.finishing.strategy == "generating":
-        corner, flat = _generating_finishing_tool(check.job)
-    else:
-        corner = min(_floor_to(0.9 * rec.finishing_max_corner_radius_mm, 0.05), 1.0)
-        flat = _floor_to(0.9 * rec.finishing_max_flat_width_mm, 0.05)
-    if corner <= 0.0 or flat < 0.0 or (flat == 0.0 and check.job.finishing.strategy != "generating"):
+    from spur_cad.cam.strategies import get_strategy
+    from spur_cad.cam.strategies.base import floor_to_step
+
+    strategy = get_strategy(check.job.finishing.strategy, check.job.strategies)
+    suggested = strategy.suggested_tool(spec, rec, check.job.finishing.target_scallop_mm,
+                                        check.job.stock.blank_radius_mm(spec))
+    if suggested is None:
         return {}
+    corner, flat = suggested
     kind = "bull_nose" if flat > 0.0 else "ball"  # generating with a flat of 0: a ball end mill of radius rho
     chosen = {"UseFinishingTool": True, "FinishingToolKind": kind,
               "FinishingToolDiameter": round(flat + 2 * corner, 6),
@@ -259,7 +233,7 @@ def suggest_tools(values: dict[str, dict[str, object]]) -> dict[str, object]:
     finishing = Tool(diameter_mm=chosen["FinishingToolDiameter"], kind=kind, corner_radius_mm=corner)
     blank = check.job.stock.blank_radius_mm(spec)
     limit = recommend_tools(spec, blank, check.job.machine.clearance_mm, finishing).roughing_max_diameter_mm
-    diameter = _floor_to(limit, 0.1)
+    diameter = floor_to_step(limit, 0.1)
     while diameter >= 0.2:
         candidate = {**chosen, "UseRoughingTool": True, "RoughingToolKind": "flat",
                      "RoughingToolDiameter": round(diameter, 6),

@@ -14,6 +14,7 @@ from spur_cad.cam.strategies.base import (
     ScallopParams,
     check_flat_fits_root_arc,
     contact_largest_tool,
+    contact_suggested_tool,
     finishing_builder,
 )
 from spur_cad.cam.tools import Tool
@@ -38,6 +39,10 @@ class AlongXStrategy:
 
     def largest_tool(self, recommendations) -> tuple[str, float]:
         return contact_largest_tool(recommendations)
+
+    def suggested_tool(self, spec: GearSpec, recommendations, target_scallop_mm: float,
+                       blank_radius_mm: float) -> tuple[float, float] | None:
+        return contact_suggested_tool(recommendations)
     simultaneous_rotary = True  # the steps between poses beside the part turn A at feed
 
     def check_tool(self, spec: GearSpec, tool: Tool) -> None:

@@ -10,6 +10,7 @@ there.
 from __future__ import annotations
 
 import dataclasses
+import math
 from dataclasses import dataclass
 from typing import Any, Protocol
 
@@ -121,6 +122,12 @@ class FinishingStrategy(Protocol):
         figure's name there (or how it is made of them) and its diameter (mm); 0 when none fits."""
         ...
 
+    def suggested_tool(self, spec: GearSpec, recommendations: Any, target_scallop_mm: float,
+                       blank_radius_mm: float) -> tuple[float, float] | None:
+        """(corner radius, flat width D - 2 r) in mm of a finishing tool a new job starts with (the workbench
+        suggests it), within this strategy's limits; None when no tool fits."""
+        ...
+
     def check_tool(self, spec: GearSpec, tool: Tool) -> None:
         """ToolError (naming the tool key) when the tool's shape cannot do this strategy on this gear;
         cheap (the plan's and the workbench's checks run it before generating)."""
@@ -138,6 +145,20 @@ def contact_largest_tool(recommendations: Any) -> tuple[str, float]:
     rec = recommendations
     return ("finishing_max_flat_width_mm + 2 finishing_max_corner_radius_mm",
             rec.finishing_max_flat_width_mm + 2.0 * rec.finishing_max_corner_radius_mm)
+
+
+def floor_to_step(value: float, step: float) -> float:
+    """`value` rounded down to a multiple of `step` (a catalogue-like size)."""
+    return math.floor(value / step + 1e-9) * step
+
+
+def contact_suggested_tool(recommendations: Any) -> tuple[float, float] | None:
+    """A bull-nose tool for the contact strategies: corner radius at 90 % of the fillet's smallest curvature
+    radius (0.05 mm steps, at most 1 mm), flat width at 90 % of the root arc; None when either is 0."""
+    rec = recommendations
+    corner = min(floor_to_step(0.9 * rec.finishing_max_corner_radius_mm, 0.05), 1.0)
+    flat = floor_to_step(0.9 * rec.finishing_max_flat_width_mm, 0.05)
+    return (corner, flat) if corner > 0.0 and flat > 0.0 else None
 
 
 def check_corner_contacts_tool(tool: Tool, strategy: str) -> None:

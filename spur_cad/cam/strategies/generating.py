@@ -16,7 +16,7 @@ from spur_cad.cam.common import PLUNGE_FEED_FRACTION, safe_height_mm
 from spur_cad.cam.contacts import SpacePoses, TransversePoses
 from spur_cad.cam.ir import Feature, MoveKind, Operation, Toolpath, ToolpathBuilder
 from spur_cad.cam.machine import Machine
-from spur_cad.cam.strategies.base import FinishingResult
+from spur_cad.cam.strategies.base import FinishingResult, floor_to_step
 from spur_cad.cam.strategies.generating_advice import passes_flute_length_mm, tool_advice
 from spur_cad.cam.strategies.generating_flat import flat_deviation_mm
 from spur_cad.cam.strategies.generating_geometry import (
@@ -33,6 +33,7 @@ from spur_cad.cam.strategies.generating_geometry import (
 )
 from spur_cad.cam.strategies.generating_plan import GeneratingParams, GeneratingPlan, plan_generating
 from spur_cad.cam.tools import Tool, ToolError
+from spur_cad.geometry.profile import rack_corner
 from spur_cad.geometry.spec import GearSpec
 
 
@@ -86,11 +87,27 @@ class GeneratingStrategy:
     description = "the tool as the generating rack: A clamped, one straight pass along X per roll"
     params_type = GeneratingParams
     helical = True  # through the normal rack (generating_helical)
+    simultaneous_rotary = False  # A is clamped for every pass; it indexes only at the safe height
 
     def largest_tool(self, recommendations) -> tuple[str, float]:
         """The largest tool with the advised corner radius rho."""
         return "finishing_generating_max_diameter_mm", recommendations.finishing_generating_max_diameter_mm
-    simultaneous_rotary = False  # A is clamped for every pass; it indexes only at the safe height
+
+    def suggested_tool(self, spec: GearSpec, recommendations, target_scallop_mm: float,
+                       blank_radius_mm: float) -> tuple[float, float] | None:
+        """The advised corner radius (the rack tip radius: tip mode exact) and a diameter at 95 % of the
+        largest that fits both modes with the rack end, in 0.05 mm steps (helical: 95 % of the rack's normal
+        tip flat); a flat of 0 is a ball end mill of radius rho."""
+        corner = spec.rack_tip_radius_mm
+        if corner <= 0.0:  # a sharp rack: no tool with a corner can play it
+            return None
+        if spec.is_helical:
+            flat = floor_to_step(0.95 * 2.0 * rack_corner(spec).normal_corner_offset_mm, 0.05)
+        else:
+            limits = generating_tool_limits(spec, corner, target_scallop_mm, blank_radius_mm)
+            largest = min(limits.tip_mode_max_diameter_mm, limits.flank_mode_max_diameter_mm)
+            flat = floor_to_step(0.95 * largest, 0.05) - 2.0 * corner
+        return (corner, flat) if flat >= 0.0 else None
 
     def check_tool(self, spec: GearSpec, tool: Tool) -> None:
         check_generating_tool(spec, tool)
