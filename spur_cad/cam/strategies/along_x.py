@@ -10,11 +10,10 @@ from spur_cad.cam.contacts import SpacePoses, contact_counts, space_poses, stati
 from spur_cad.cam.ir import Feature, MoveKind, Toolpath, ToolpathBuilder
 from spur_cad.cam.machine import Machine
 from spur_cad.cam.strategies.base import (
+    ContactStrategy,
     FinishingResult,
     ScallopParams,
     check_flat_fits_root_arc,
-    contact_largest_tool,
-    contact_suggested_tool,
     finishing_builder,
 )
 from spur_cad.cam.tools import Tool
@@ -29,20 +28,12 @@ class AlongXParams(ScallopParams):
     """[finishing] keys the along-X strategy uses (step_over_mm only for the reported station step)."""
 
 
-class AlongXStrategy:
+class AlongXStrategy(ContactStrategy):
     """See the module docstring."""
 
     name = "along_x"
     description = "one pass along X per contact pose, A fixed during each pass"
     params_type = AlongXParams
-    helical = False  # transverse contacts of a spur gear
-
-    def largest_tool(self, recommendations) -> tuple[str, float]:
-        return contact_largest_tool(recommendations)
-
-    def suggested_tool(self, spec: GearSpec, recommendations, target_scallop_mm: float,
-                       blank_radius_mm: float) -> tuple[float, float] | None:
-        return contact_suggested_tool(recommendations)
     simultaneous_rotary = True  # the steps between poses beside the part turn A at feed
 
     def check_tool(self, spec: GearSpec, tool: Tool) -> None:

@@ -161,6 +161,20 @@ def contact_suggested_tool(recommendations: Any) -> tuple[float, float] | None:
     return (corner, flat) if corner > 0.0 and flat > 0.0 else None
 
 
+class ContactStrategy:
+    """What the strategies placing the tool's corner on transverse flank contacts share (perimeter, along_x):
+    spur gears only, and their largest and suggested tools."""
+
+    helical = False  # transverse contacts of a spur gear
+
+    def largest_tool(self, recommendations: Any) -> tuple[str, float]:
+        return contact_largest_tool(recommendations)
+
+    def suggested_tool(self, spec: GearSpec, recommendations: Any, target_scallop_mm: float,
+                       blank_radius_mm: float) -> tuple[float, float] | None:
+        return contact_suggested_tool(recommendations)
+
+
 def check_corner_contacts_tool(tool: Tool, strategy: str) -> None:
     """Strategies that place the tool's corner on spaced flank contacts (perimeter, along_x) need a round
     corner: their contact spacing and X stations bound the cusps by the corner radius, and a sharp corner

@@ -21,11 +21,10 @@ from spur_cad.cam.contacts import (
 from spur_cad.cam.ir import Feature, MoveKind, Toolpath, ToolpathBuilder
 from spur_cad.cam.machine import Machine
 from spur_cad.cam.strategies.base import (
+    ContactStrategy,
     FinishingResult,
     ScallopParams,
     check_flat_fits_root_arc,
-    contact_largest_tool,
-    contact_suggested_tool,
     finishing_builder,
 )
 from spur_cad.cam.tools import Tool
@@ -39,20 +38,12 @@ class PerimeterParams(ScallopParams):
     contact_spacing_mm: float | None = None  # fixed arc-length contact spacing (the reference process's)
 
 
-class PerimeterStrategy:
+class PerimeterStrategy(ContactStrategy):
     """See the module docstring."""
 
     name = "perimeter"
     description = "transverse stations along X, once around the gear at each (simultaneous Y/Z/A)"
     params_type = PerimeterParams
-    helical = False  # transverse contacts of a spur gear
-
-    def largest_tool(self, recommendations) -> tuple[str, float]:
-        return contact_largest_tool(recommendations)
-
-    def suggested_tool(self, spec: GearSpec, recommendations, target_scallop_mm: float,
-                       blank_radius_mm: float) -> tuple[float, float] | None:
-        return contact_suggested_tool(recommendations)
     simultaneous_rotary = True
 
     def check_tool(self, spec: GearSpec, tool: Tool) -> None:
