@@ -212,7 +212,7 @@ def build_cad(job: Job, checkpoint: Callable[[], None] | None = None) -> tuple[C
     """Gear solid, stock and STEP files; returns (CAD facts, files). `checkpoint()` between the steps."""
     import cadquery as cq
 
-    from spur_cad.cad.solid import build_gear_shape, make_stock, solid_volume_mm3
+    from spur_cad.cad.solid import build_gear_shape, front_face_area_mm2, make_stock, solid_volume_mm3
     from spur_cad.cad.step import step_files
 
     shape, report = build_gear_shape(job.gear, job.gear_section.blank_features())
@@ -221,7 +221,8 @@ def build_cad(job: Job, checkpoint: Callable[[], None] | None = None) -> tuple[C
     gear = cq.Workplane("YZ").add(cq.Solid(shape))
     stock = make_stock(job.gear, job.stock)
     files = step_files(gear, stock)
-    facts = CadResult(report, solid_volume_mm3(shape), solid_volume_mm3(stock.val().wrapped),
+    gear_volume = front_face_area_mm2(shape) * job.gear.face_width_mm  # exact: a section moved along X
+    facts = CadResult(report, gear_volume, solid_volume_mm3(stock.val().wrapped),
                       {name: len(content) for name, content in files.items()})
     return facts, files
 

