@@ -150,7 +150,7 @@ class Job:
     simulation: SimulationSection = field(default_factory=SimulationSection)
     lathe: LatheSection | None = None  # [lathe] present: the blank's lathe program is written too
     text: str = field(default="", repr=False, compare=False)  # the file's text, to point at lines
-    strategies: Strategies = field(default_factory=lambda: REGISTRY, repr=False, compare=False)  # finishing's
+    strategies: Strategies = field(default_factory=lambda: dict(REGISTRY), repr=False, compare=False)  # [finishing]'s
 
     def located(self, error: SpurCadError) -> str:
         """An error raised after loading, prefixed with 'file:line' of the key it blames (its section's
@@ -185,9 +185,8 @@ SECTIONS: dict[str, type] = {
 
 
 def job_sections(strategies: Strategies = REGISTRY) -> dict[str, type]:
-    """SECTIONS with the [finishing] section made from the keys of `strategies`' parameters."""
-    if strategies is REGISTRY:
-        return SECTIONS
+    """SECTIONS with the [finishing] section made from the keys of `strategies`' parameters (the same class
+    as FinishingParams for the default registry's strategies)."""
     return {**SECTIONS, "finishing": finishing_section_type(strategies)}
 
 
@@ -442,10 +441,11 @@ def _job_from_data(data: dict, source: str, text: str, strategies: Strategies = 
             name = exc.section if exc.section in ("stock", "lathe") else "lathe"
             blamed = _blamed_key(exc, name, tables.get(name, {}))
             raise JobFileError(f"{where(name, blamed)}: {exc}", section=name, field=blamed) from None
-    optional = {name: sections[name] for name in ("stock", "roughing", "finishing", "machine", "post", "simulation",
-                                                  "lathe") if name in sections}
+    optional = {name: sections[name] for name in ("stock", "roughing", "machine", "post", "simulation", "lathe")
+                if name in sections}
+    finishing = sections["finishing"] if "finishing" in sections else types["finishing"]()  # the registry's default
     return Job(source=source, job=sections.get("job", JobSection()), gear_section=gear_section, gear=spec,
-               tools=tools, **optional, text=text, strategies=strategies)
+               tools=tools, finishing=finishing, **optional, text=text, strategies=dict(strategies))
 
 
 def load_job(path: str | Path, strategies: Strategies = REGISTRY) -> Job:

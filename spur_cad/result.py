@@ -15,6 +15,8 @@ if TYPE_CHECKING:  # annotations only: the CAD kernel and the simulator load whe
     from spur_cad.cad.solid import GearSolidReport
     from spur_cad.cam.estimate import Estimate
     from spur_cad.cam.recommend import ToolRecommendations
+    from spur_cad.geometry.inspection import InspectionSheet
+    from spur_cad.geometry.spec import GearFacts
     from spur_cad.grade.grading import Grading
     from spur_cad.sim.simulate import DeviationPlace
 
@@ -25,67 +27,6 @@ class JobFacts:
 
     name: str
     file: str
-
-
-@dataclass(frozen=True)
-class GearFacts:
-    """The gear's derived quantities in mm and degrees (GearSpec.describe)."""
-
-    teeth: int
-    module_mm: float
-    pressure_angle_deg: float
-    profile_shift_coefficient: float
-    addendum_coefficient: float
-    dedendum_coefficient: float
-    rack_tip_radius_mm: float
-    thickness_allowance_fraction: float
-    thickness_allowance_mm: float
-    face_width_mm: float
-    reference_radius_mm: float
-    base_radius_mm: float
-    tip_radius_mm: float
-    root_radius_mm: float
-    form_radius_mm: float
-    pitch_mm: float
-    tooth_thickness_mm: float
-    space_width_mm: float
-    tip_thickness_mm: float
-    root_arc_half_angle_deg: float
-    root_arc_length_mm: float
-    min_fillet_curvature_radius_mm: float
-    undercut: bool
-    undercut_depth_mm: float
-    helix_angle_deg: float
-    hand: str
-    transverse_module_mm: float
-    transverse_pressure_angle_deg: float
-    base_helix_angle_deg: float
-    lead_mm: float | None
-    overlap_ratio: float
-
-    @property
-    def is_helical(self) -> bool:
-        return bool(self.helix_angle_deg)
-
-
-@dataclass(frozen=True)
-class InspectionFacts:
-    """The inspection sheet (spur_cad.geometry.inspection): span, pins, chordal thickness (mm)."""
-
-    span_teeth_k: int
-    span_measurement_mm: float | None  # None: the face is too narrow for a span over k teeth (helical)
-    span_contact_radius_mm: float
-    span_min_face_width_mm: float
-    pin_diameter_mm: float
-    dimension_over_pins_mm: float
-    pin_contact_radius_mm: float
-    chordal_thickness_mm: float
-    chordal_height_mm: float
-    chordal_measuring_radius_mm: float
-    tooth_thickness_mm: float
-    thickness_reduction_mm: float
-    min_teeth_without_undercut: int
-    min_teeth_without_undercut_exact: float
 
 
 @dataclass(frozen=True)
@@ -262,7 +203,7 @@ class JobResult:
     version: str
     job: JobFacts
     gear: GearFacts
-    inspection: InspectionFacts
+    inspection: InspectionSheet
     profile: ProfileFacts
     cad: CadResult
     tools: ToolsFacts

@@ -15,7 +15,7 @@ from spur_cad.cam.machine import Machine
 from spur_cad.cam.plan import CamPlan, FinishingPlan, RoughingPlan
 from spur_cad.cam.recommend import ToolRecommendations
 from spur_cad.cam.tools import Tool
-from spur_cad.geometry.inspection import inspection_sheet
+from spur_cad.geometry.inspection import inspection_facts
 from spur_cad.geometry.sampling import ProfileSamples
 from spur_cad.post.program import PostedProgram
 from spur_cad.post.settings import PostSettings
@@ -23,8 +23,6 @@ from spur_cad.result import (
     CadResult,
     FeatureDeviation,
     FinishingFacts,
-    GearFacts,
-    InspectionFacts,
     JobFacts,
     JobResult,
     LatheFacts,
@@ -60,8 +58,8 @@ def build_result(job, samples: ProfileSamples, cad: CadResult, plan: CamPlan, po
     labels = np.array(samples.label_names())
     counts = SegmentCounts(*(int(np.count_nonzero(labels == name)) for name in SEGMENT_NAMES))
     return JobResult(
-        version=__version__, job=JobFacts(job.job.name, job.source), gear=GearFacts(**job.gear.describe()),
-        inspection=InspectionFacts(**inspection_sheet(job.gear)),
+        version=__version__, job=JobFacts(job.job.name, job.source), gear=job.gear.facts(),
+        inspection=inspection_facts(job.gear),
         profile=ProfileFacts(job.job.profile_tolerance_mm, len(samples), counts), cad=cad,
         tools=tools_facts(plan, job.machine, job.tools.roughing, job.tools.finishing),
         roughing=roughing_facts(plan, job.machine), finishing=finishing_facts(plan.finishing),

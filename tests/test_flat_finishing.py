@@ -115,7 +115,7 @@ def test_a_flat_end_mill_finishes_by_generation_within_target_without_gouge(name
         assert values["max_gouge_mm"] <= GOUGE_LIMIT_MM, (feature, values)
         assert values["max_leftover_mm"] <= TARGET + LEFTOVER_SLACK_MM, (feature, values)
     # The plan's own figures promise no more than the target.
-    assert result.flat_height_mm <= TARGET and result.facts.tip_mode_leftover_mm <= TARGET
+    assert result.facts.flat_height_mm <= TARGET and result.facts.tip_mode_leftover_mm <= TARGET
 
 
 def test_a_fillet_pass_left_out_is_found_by_the_same_check():

@@ -365,7 +365,7 @@ def test_pass_counts_match_method_figures():
             land = sum(1 for p in result.passes if p.mode == "land")
             counts[corner, scallop] = (flank, tip)
             assert result.passes_per_space == 2 * flank + tip + land
-            assert 0.9 * scallop <= result.flat_height_mm <= scallop
+            assert 0.9 * scallop <= result.facts.flat_height_mm <= scallop
     assert abs(counts[0.5, 0.001][0] - 22) <= 2 and abs(counts[0.5, 0.005][0] - 10) <= 2
     assert abs(counts[0.8, 0.001][1] - 62) <= 5 and abs(counts[0.8, 0.005][1] - 30) <= 3
 

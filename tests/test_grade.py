@@ -207,6 +207,7 @@ def test_measured_points_give_the_planted_deviations_and_their_classes(tmp_path)
     assert found["f_pt"] == pytest.approx(10.0, abs=0.5) and found["F_p"] == pytest.approx(10.0, abs=0.5)
     # a scan has no space 0: the fit may number the spaces from another one, but keeps their order
     assert where["f_Ha"]["side"] == "right" and where["f_Hb"]["side"] == "left"
+    assert where["F_p"]["side"] in ("right", "left")  # the side of the largest F_p (one Grading type, issue 26)
     assert (where["f_Hb"]["space"] - where["f_Ha"]["space"]) % 12 == 7
     assert grading["classes"]["f_Ha"] == 7 and grading["classes"]["f_pt"] == 7 and grading["classes"]["f_Hb"] == 6
     assert code == 1 and grading["class"] == 7  # worse than the required class 6

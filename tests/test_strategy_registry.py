@@ -40,6 +40,13 @@ class RowsFacts:
         return f"Finishing: rows, {self.rows_per_flank} rows per flank over {self.stations} stations."
 
 
+@dataclass(frozen=True)
+class RowsAdvice:
+    """The test strategy's own tool advice."""
+
+    rows_tool_max_diameter_mm: float
+
+
 class RowsStrategy:
     """The along-X passes under another name, with their own parameter and facts."""
 
@@ -64,7 +71,8 @@ class RowsStrategy:
     def generate(self, spec, tool, machine, params: RowsParams, blank_radius_mm: float):
         path, result = AlongXStrategy().generate(spec, tool, machine, self._along_x(params), blank_radius_mm)
         return path, dataclasses.replace(result, strategy=self.name,
-                                         facts=RowsFacts(params.rows_per_flank, result.stations))
+                                         facts=RowsFacts(params.rows_per_flank, result.stations),
+                                         tool_advice=RowsAdvice(2.0 * tool.diameter_mm))
 
     @staticmethod
     def _along_x(params: RowsParams) -> AlongXParams:
@@ -95,8 +103,7 @@ def test_the_key_documentation_lists_the_strategy_and_its_key():
     assert "rows_per_flank" not in job_file_reference_markdown()
 
 
-@pytest.mark.slow  # a whole run (CAD, CAM, posts, report) of a small gear: make test-all
-def test_the_summary_and_the_report_show_the_strategy_s_own_facts():
+def test_the_summary_and_the_report_show_the_strategy_s_own_facts_and_advice():
     from spur_cad.pipeline import run_job
 
     result = run_job(parse_job(JOB, "rows.toml", strategies=STRATEGIES))
@@ -106,6 +113,32 @@ def test_the_summary_and_the_report_show_the_strategy_s_own_facts():
     assert list(finishing)[:3] == ["strategy", "rows_per_flank", "stations"]  # its fields, in its order
     assert f"Finishing: rows, 5 rows per flank over {stations} stations." in result.files["report.html"].decode()
     assert "(strategy: rows, " in result.files["finishing.ngc"].decode()  # the program header names it
+    advice = json.loads(result.files["summary.json"])["tools"]["rows_advice"]
+    assert advice == {"rows_tool_max_diameter_mm": 2.0 * result.tools.finishing.diameter_mm}
+    report = result.files["report.html"].decode()
+    assert "For finishing strategy rows" in report and "rows_tool_max_diameter_mm" in report
+
+
+def test_a_registry_s_default_strategy_applies_without_a_finishing_section():
+    job = parse_job(small_job_text().replace("[finishing]\n", "[unused]\n").split("[unused]")[0],
+                    "rows.toml", strategies={RowsStrategy.name: RowsStrategy()})
+    assert job.finishing.strategy == "rows" and job.finishing.rows_per_flank == 7
+
+
+def test_two_strategies_declaring_one_key_differently_are_refused():
+    from spur_cad.cam.strategies import finishing_section_type
+
+    @dataclass(frozen=True)
+    class OtherRowsParams(ScallopParams):
+        rows_per_flank: int = key(9, low=1, high=50, label="RowsPerFlank", group="Finishing strategy",
+                                  meaning="another meaning")
+
+    class OtherRows(RowsStrategy):
+        name = "other_rows"
+        params_type = OtherRowsParams
+
+    with pytest.raises(TypeError, match="declare the key rows_per_flank differently"):
+        finishing_section_type({"rows": RowsStrategy(), "other_rows": OtherRows()})
 
 
 def test_the_default_registry_is_unchanged_and_read_only():

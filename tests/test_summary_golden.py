@@ -25,8 +25,12 @@ pytestmark = pytest.mark.slow  # two full runs: make test-all
 
 ROOT = Path(__file__).resolve().parents[1]
 GOLDEN = ROOT / "tests" / "data" / "golden"
-TIMED = {("timings_s",), ("simulation", "seconds")}  # wall-clock figures of the run itself
+TIMED = {("timings_s",), ("simulation", "seconds")}  # wall-clock figures of the run itself: values not compared
 NUMBER_REL_TOL = 1e-9  # floating-point noise across machines (the same machine reproduces every bit)
+KEY_REL_TOL = {("cad", "gear_volume_mm3"): 1e-6}
+"""The gear's volume is the front face's area times the face width since issue 27 (exact for the section
+moved along X), where the recorded run integrated the solid: the helical solid's pipe shell approximates
+its screw surfaces, and its integral was 4.5e-7 smaller (docs/cad.md)."""
 
 FILE_SHA256 = {
     "reference_gear": {
@@ -48,9 +52,10 @@ FILE_SHA256 = {
 
 def differences(expected: object, actual: object, path: tuple = ()) -> list[str]:
     """Where two JSON values differ: keys (in order), types, and values (numbers within NUMBER_REL_TOL)."""
-    if path in TIMED:
-        return []
     where = "/".join(map(str, path)) or "<top>"
+    if path in TIMED:  # the run's own timings: their keys stay (new stages may add keys), their values vary
+        missing = [k for k in expected if k not in actual] if isinstance(expected, dict) else []
+        return [f"{where}: keys {missing} are gone"] if missing else []
     if isinstance(expected, dict) and isinstance(actual, dict):
         if list(expected) != list(actual):
             return [f"{where}: keys {list(expected)} became {list(actual)}"]
@@ -62,18 +67,20 @@ def differences(expected: object, actual: object, path: tuple = ()) -> list[str]
     if type(expected) is not type(actual):
         return [f"{where}: {expected!r} became {actual!r}"]
     if isinstance(expected, float):
-        same = math.isclose(expected, actual, rel_tol=NUMBER_REL_TOL, abs_tol=1e-12)
+        same = math.isclose(expected, actual, rel_tol=KEY_REL_TOL.get(path, NUMBER_REL_TOL), abs_tol=1e-12)
         return [] if same else [f"{where}: {expected!r} became {actual!r}"]
     return [] if expected == actual else [f"{where}: {expected!r} became {actual!r}"]
 
 
 def test_the_comparison_sees_a_changed_key_order_value_and_type():
     golden = {"a": 1.0, "b": {"c": [1, 2]}, "timings_s": {"cam": 1.0}}
-    assert differences(golden, {"a": 1.0, "b": {"c": [1, 2]}, "timings_s": {"cam": 9.0}}) == []
-    assert differences(golden, {"b": {"c": [1, 2]}, "a": 1.0, "timings_s": {}})  # order
-    assert differences(golden, {"a": 1.001, "b": {"c": [1, 2]}, "timings_s": {}})  # value
-    assert differences(golden, {"a": 1, "b": {"c": [1, 2]}, "timings_s": {}})  # type
-    assert differences(golden, {"a": 1.0, "b": {"c": [1]}, "timings_s": {}})  # length
+    timings = {"cam": 9.0, "grading": 0.1}
+    assert differences(golden, {"a": 1.0, "b": {"c": [1, 2]}, "timings_s": timings}) == []
+    assert differences(golden, {"a": 1.0, "b": {"c": [1, 2]}, "timings_s": {"grading": 0.1}})  # a timing gone
+    assert differences(golden, {"b": {"c": [1, 2]}, "a": 1.0, "timings_s": timings})  # order
+    assert differences(golden, {"a": 1.001, "b": {"c": [1, 2]}, "timings_s": timings})  # value
+    assert differences(golden, {"a": 1, "b": {"c": [1, 2]}, "timings_s": timings})  # type
+    assert differences(golden, {"a": 1.0, "b": {"c": [1]}, "timings_s": timings})  # length
 
 
 @pytest.mark.parametrize("example", ["reference_gear", "helical_gear"])

@@ -126,7 +126,7 @@ class CamInputs:
     finishing: FinishingParams
     machine: Machine
     bottom_tool: Tool | None = None  # two-stage roughing: the smaller tool for the bottom of the spaces
-    strategies: Strategies = field(default_factory=lambda: REGISTRY)  # where [finishing] strategy is found
+    strategies: Strategies = field(default_factory=lambda: dict(REGISTRY))  # where [finishing] strategy is found
 
 
 def check_cam_inputs(inputs: CamInputs) -> tuple[ToolRecommendations, RoughingLevels | None]:

@@ -7,6 +7,7 @@ inspector should measure on the finished part.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from dataclasses import dataclass
 
@@ -167,7 +168,27 @@ def minimum_teeth_without_undercut(spec: GearSpec) -> float:
     return 2.0 * height / (spec.module_mm * math.sin(alpha) ** 2)
 
 
-def inspection_sheet(spec: GearSpec) -> dict[str, float | int | None]:
+@dataclass(frozen=True)
+class InspectionSheet:
+    """The inspection values a report or summary shows (mm; see `inspection_facts`)."""
+
+    span_teeth_k: int
+    span_measurement_mm: float | None  # None: the face is too narrow for a span over k teeth (helical)
+    span_contact_radius_mm: float
+    span_min_face_width_mm: float
+    pin_diameter_mm: float
+    dimension_over_pins_mm: float
+    pin_contact_radius_mm: float
+    chordal_thickness_mm: float
+    chordal_height_mm: float
+    chordal_measuring_radius_mm: float
+    tooth_thickness_mm: float
+    thickness_reduction_mm: float
+    min_teeth_without_undercut: int
+    min_teeth_without_undercut_exact: float
+
+
+def inspection_facts(spec: GearSpec) -> InspectionSheet:
     """The inspection values a report or summary shows. Helical gears: span and chordal thickness in the
     normal section, over balls; the span's k is lowered until the anvils fit the face width (b > W sin(beta_b)),
     and the span is None when not even k = 1 fits (measure over balls)."""
@@ -182,19 +203,16 @@ def inspection_sheet(spec: GearSpec) -> dict[str, float | int | None]:
     pins = over_pins(spec, pin)
     chord = chordal_thickness(spec)
     z_min = minimum_teeth_without_undercut(spec)
-    return {
-        "span_teeth_k": k,
-        "span_measurement_mm": span.length_mm if span_fits else None,
-        "span_contact_radius_mm": span.contact_radius_mm,
-        "span_min_face_width_mm": span_min_face_width_mm(spec, span),
-        "pin_diameter_mm": pins.pin_diameter_mm,
-        "dimension_over_pins_mm": pins.dimension_mm,
-        "pin_contact_radius_mm": pins.contact_radius_mm,
-        "chordal_thickness_mm": chord.chordal_thickness_mm,
-        "chordal_height_mm": chord.chordal_height_mm,
-        "chordal_measuring_radius_mm": chord.measuring_radius_mm,
-        "tooth_thickness_mm": spec.tooth_thickness_mm,
-        "thickness_reduction_mm": spec.thickness_reduction_mm,
-        "min_teeth_without_undercut": math.ceil(z_min - 1e-9),
-        "min_teeth_without_undercut_exact": z_min,
-    }
+    return InspectionSheet(
+        span_teeth_k=k, span_measurement_mm=span.length_mm if span_fits else None,
+        span_contact_radius_mm=span.contact_radius_mm, span_min_face_width_mm=span_min_face_width_mm(spec, span),
+        pin_diameter_mm=pins.pin_diameter_mm, dimension_over_pins_mm=pins.dimension_mm,
+        pin_contact_radius_mm=pins.contact_radius_mm, chordal_thickness_mm=chord.chordal_thickness_mm,
+        chordal_height_mm=chord.chordal_height_mm, chordal_measuring_radius_mm=chord.measuring_radius_mm,
+        tooth_thickness_mm=spec.tooth_thickness_mm, thickness_reduction_mm=spec.thickness_reduction_mm,
+        min_teeth_without_undercut=math.ceil(z_min - 1e-9), min_teeth_without_undercut_exact=z_min)
+
+
+def inspection_sheet(spec: GearSpec) -> dict[str, float | int | None]:
+    """`inspection_facts` as a dict (for scripts: summary.json's `inspection`)."""
+    return dataclasses.asdict(inspection_facts(spec))

@@ -7,6 +7,7 @@ tooth-space profile and raises GearSpecError with a specific message when it is 
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from dataclasses import dataclass, field, fields
 from typing import TYPE_CHECKING
@@ -45,6 +46,47 @@ def _range_check(name: str, value: float, low: float, high: float, *, low_open: 
             f"{name} = {value:g}{unit} is outside the accepted range {lo}{low:g}, {high:g}{hi}{unit}{extra}",
             field=name,
         )
+
+
+@dataclass(frozen=True)
+class GearFacts:
+    """The gear's derived quantities in mm and degrees (GearSpec.facts)."""
+
+    teeth: int
+    module_mm: float
+    pressure_angle_deg: float
+    profile_shift_coefficient: float
+    addendum_coefficient: float
+    dedendum_coefficient: float
+    rack_tip_radius_mm: float
+    thickness_allowance_fraction: float
+    thickness_allowance_mm: float
+    face_width_mm: float
+    reference_radius_mm: float
+    base_radius_mm: float
+    tip_radius_mm: float
+    root_radius_mm: float
+    form_radius_mm: float
+    pitch_mm: float
+    tooth_thickness_mm: float
+    space_width_mm: float
+    tip_thickness_mm: float
+    root_arc_half_angle_deg: float
+    root_arc_length_mm: float
+    min_fillet_curvature_radius_mm: float
+    undercut: bool
+    undercut_depth_mm: float
+    helix_angle_deg: float
+    hand: str
+    transverse_module_mm: float
+    transverse_pressure_angle_deg: float
+    base_helix_angle_deg: float
+    lead_mm: float | None
+    overlap_ratio: float
+
+    @property
+    def is_helical(self) -> bool:
+        return bool(self.helix_angle_deg)
 
 
 @dataclass(frozen=True)
@@ -275,10 +317,10 @@ class GearSpec:
     def undercut_depth_mm(self) -> float:
         return self.tooth_space_profile().undercut_depth_mm
 
-    def describe(self) -> dict[str, float | int | bool | str | None]:
+    def facts(self) -> GearFacts:
         """The derived quantities a report or summary shows, in mm and degrees."""
         profile = self.tooth_space_profile()
-        return {
+        return GearFacts(**{
             "teeth": self.teeth,
             "module_mm": self.module_mm,
             "pressure_angle_deg": self.pressure_angle_deg,
@@ -310,4 +352,8 @@ class GearSpec:
             "base_helix_angle_deg": math.degrees(self.base_helix_angle_rad),
             "lead_mm": self.lead_mm if self.is_helical else None,
             "overlap_ratio": self.face_width_mm * math.sin(self.helix_angle_rad) / self.normal_pitch_mm,
-        }
+        })
+
+    def describe(self) -> dict[str, float | int | bool | str | None]:
+        """`facts()` as a dict (for scripts: summary.json's `gear`)."""
+        return dataclasses.asdict(self.facts())

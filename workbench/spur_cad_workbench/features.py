@@ -208,7 +208,7 @@ class GearFeature(_Proxy):
     def execute(self, obj):
         from spur_cad.cad.solid import build_gear_shape
         from spur_cad.errors import SpurCadError
-        from spur_cad.geometry.inspection import inspection_sheet
+        from spur_cad.geometry.inspection import inspection_facts
 
         try:
             job = job_of(obj)
@@ -216,15 +216,15 @@ class GearFeature(_Proxy):
         except SpurCadError as exc:
             fail(obj, str(exc))
             return
-        spec, sheet = job.gear, inspection_sheet(job.gear)
+        spec, sheet = job.gear, inspection_facts(job.gear)
         write_outputs(obj, {
             "ReferenceRadius": spec.reference_radius_mm, "BaseRadius": spec.base_radius_mm,
             "TipRadius": spec.tip_radius_mm, "RootRadius": spec.root_radius_mm, "FormRadius": spec.form_radius_mm,
-            "ToothThickness": spec.tooth_thickness_mm, "SpanTeeth": int(sheet["span_teeth_k"]),
-            "SpanMeasurement": sheet["span_measurement_mm"], "PinDiameter": sheet["pin_diameter_mm"],
-            "DimensionOverPins": sheet["dimension_over_pins_mm"], "Undercut": bool(spec.undercut),
+            "ToothThickness": spec.tooth_thickness_mm, "SpanTeeth": sheet.span_teeth_k,
+            "SpanMeasurement": sheet.span_measurement_mm, "PinDiameter": sheet.pin_diameter_mm,
+            "DimensionOverPins": sheet.dimension_over_pins_mm, "Undercut": bool(spec.undercut),
             "UndercutDepth": spec.undercut_depth_mm,
-            "MinTeethWithoutUndercut": int(sheet["min_teeth_without_undercut"])})
+            "MinTeethWithoutUndercut": sheet.min_teeth_without_undercut})
         set_shape(obj, part_shape(shape))
         report(obj, None)
 

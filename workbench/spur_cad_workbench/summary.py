@@ -110,9 +110,11 @@ def long_job_advice(figures: PlanFigures, strategy: str) -> str:
         return ""
     name, op = max(figures.operations(), key=lambda item: item[1].seconds_with_acceleration)
     if name == "finishing":
+        from spur_cad.cam.strategies import DEFAULT_STRATEGY, get_strategy
+
         ways = "a larger target scallop, a larger finishing tool (within its limits)"
-        if strategy != "generating":
-            ways += ", or the generating strategy (fewer, straight passes)"
+        if strategy != DEFAULT_STRATEGY:  # the default is the fastest strategy the registry has
+            ways += f", or the {DEFAULT_STRATEGY} strategy ({get_strategy(DEFAULT_STRATEGY).description})"
     else:
         ways = "a larger roughing tool (within its limit), a larger level depth or step-over, a higher feed per tooth"
     return (f"Long job: {duration_text(total)}, of which {name} {duration_text(op.seconds_with_acceleration)}. "

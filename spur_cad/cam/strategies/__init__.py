@@ -18,7 +18,12 @@ from types import MappingProxyType
 
 from spur_cad.cam.machine import MachineError
 from spur_cad.cam.strategies.along_x import AlongXStrategy
-from spur_cad.cam.strategies.base import FinishingResult, FinishingStrategy, params_from_section
+from spur_cad.cam.strategies.base import (
+    FinishingResult,
+    FinishingStrategy,
+    TargetScallopParams,
+    params_from_section,
+)
 from spur_cad.cam.strategies.generating import GeneratingStrategy
 from spur_cad.cam.strategies.perimeter import PerimeterStrategy
 from spur_cad.errors import shown
@@ -64,10 +69,21 @@ def _section_type(entries: tuple[tuple[str, FinishingStrategy], ...]) -> type:
     fields: dict[str, tuple] = {"strategy": (str, key(default, label="FinishingStrategy", group="Finishing strategy",
                                                       meaning="a finishing strategy name (see docs/cam.md)",
                                                       names_from=lambda: names))}
+    declared: dict[str, str] = {}
     for strategy in strategies.values():
+        if not issubclass(strategy.params_type, TargetScallopParams):  # the plan and the advice read the target
+            raise TypeError(f"finishing strategy {strategy.name}: its parameters must derive from "
+                            "TargetScallopParams")
         for f in dataclasses.fields(strategy.params_type):
-            if METADATA_KEY in f.metadata and f.name not in fields:
+            if METADATA_KEY not in f.metadata:
+                continue
+            if f.name in fields and (fields[f.name][0], fields[f.name][1].default, fields[f.name][1].metadata) \
+                    != (f.type, f.default, f.metadata):
+                raise TypeError(f"finishing strategies {declared[f.name]} and {strategy.name} declare the key "
+                                f"{f.name} differently: declare a shared key once, in a common base")
+            if f.name not in fields:
                 fields[f.name] = (f.type, dataclasses.field(default=f.default, metadata=f.metadata))
+                declared[f.name] = strategy.name
 
     def validate(self) -> None:
         check_section(self, "finishing", MachineError)

@@ -57,7 +57,6 @@ class FinishingResult:
     station_step_mm: float
     station_x_mm: np.ndarray  # X of the stations, where the simulation puts extra rows (empty: none)
     passes_per_space: int = 0  # straight passes per tooth space (strategies with A clamped per pass)
-    flat_height_mm: float = 0.0  # largest generating-flat deviation left on the involute (generating)
     passes: tuple = ()  # the strategy's passes of one space, typed by the strategy (generating: GeneratingPass)
     facts: Any = None  # the strategy's own typed facts (StrategyFacts; None: StationFacts of the stations)
     tool_advice: Any = None  # the strategy's typed tool advice (summary `tools.<strategy>_advice`), or None

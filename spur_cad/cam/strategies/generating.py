@@ -134,7 +134,7 @@ class GeneratingStrategy:
                                 plan.tip_passes_per_space, plan.land_passes_per_space, plan.tip_leftover_mm,
                                 params.cutting_direction, params.flank_tool_end)
         result = FinishingResult(self.name, params, _space_poses(plan), 1, 0.0, np.zeros(0),
-                                 passes_per_space=plan.passes_per_space, flat_height_mm=plan.flat_height_mm,
+                                 passes_per_space=plan.passes_per_space,
                                  passes=plan.passes, facts=facts, tool_advice=advice)
         return builder.build(), result
 
