@@ -9,15 +9,20 @@ the same job. The stages: profile -> CAD -> CAM plan (spur_cad.cam.plan) -> post
 from __future__ import annotations
 
 import dataclasses
+import datetime
 import io
 import json
+import os
+import re
 import time
+from collections.abc import Mapping
 from typing import TYPE_CHECKING, Callable
 
 import numpy as np
 
 from spur_cad.cam.plan import CamInputs, CamPlan
 from spur_cad.cam.plan import plan_cam as plan_cam_inputs
+from spur_cad.errors import SpurCadError, shown
 from spur_cad.geometry.sampling import ProfileSamples, sample_profile
 from spur_cad.job import Job
 from spur_cad.result import CadResult, JobResult
@@ -53,6 +58,7 @@ def run_job(job: Job, progress: Callable[[str, float], None] | None = None,
         if progress is not None:
             progress(stage, fraction)
 
+    timestamp = step_timestamp(os.environ)  # checked before any work
     seconds: dict[str, float] = {}
 
     def timed(name: str, stage: str | None, compute: Callable):
@@ -70,7 +76,7 @@ def run_job(job: Job, progress: Callable[[str, float], None] | None = None,
     samples = timed("profile", None, lambda: sample_profile(job.gear.tooth_space_profile(),
                                                             job.job.profile_tolerance_mm))
     png = timed("plot", None, lambda: tooth_space_png(job.gear, samples))
-    cad, step = timed("cad_and_step", "CAD and STEP", lambda: build_cad(job, checkpoint))
+    cad, step = timed("cad_and_step", "CAD and STEP", lambda: build_cad(job, checkpoint, timestamp))
     plan = timed("cam", "toolpaths", lambda: plan_cam(job, checkpoint))
     programs, program_files = timed("post", None, lambda: build_programs(job, plan))
     if restart is not None:
@@ -208,8 +214,22 @@ def program_comments(job: Job, plan: CamPlan, operation: str) -> tuple[str, ...]
     )
 
 
-def build_cad(job: Job, checkpoint: Callable[[], None] | None = None) -> tuple[CadResult, dict[str, bytes]]:
-    """Gear solid, stock and STEP files; returns (CAD facts, files). `checkpoint()` between the steps."""
+def step_timestamp(environment: Mapping[str, str]) -> str | None:
+    """The STEP headers' time from SOURCE_DATE_EPOCH (seconds since 1970, the reproducible-builds
+    convention), as 'YYYY-MM-DDTHH:MM:SS' UTC; None when it is not set (OCCT then writes its clock)."""
+    text = environment.get("SOURCE_DATE_EPOCH")
+    if text is None:
+        return None
+    if not re.fullmatch(r"[0-9]{1,11}", text.strip()):
+        raise SpurCadError(f"SOURCE_DATE_EPOCH must be a whole number of seconds since 1970, got {shown(text)}")
+    moment = datetime.datetime.fromtimestamp(int(text.strip()), tz=datetime.timezone.utc)
+    return moment.strftime("%Y-%m-%dT%H:%M:%S")
+
+
+def build_cad(job: Job, checkpoint: Callable[[], None] | None = None,
+              timestamp: str | None = None) -> tuple[CadResult, dict[str, bytes]]:
+    """Gear solid, stock and STEP files; returns (CAD facts, files). `checkpoint()` between the steps;
+    `timestamp` is the STEP headers' time (step_timestamp)."""
     import cadquery as cq
 
     from spur_cad.cad.solid import build_gear_shape, front_face_area_mm2, make_stock, solid_volume_mm3
@@ -220,7 +240,7 @@ def build_cad(job: Job, checkpoint: Callable[[], None] | None = None) -> tuple[C
         checkpoint()
     gear = cq.Workplane("YZ").add(cq.Solid(shape))
     stock = make_stock(job.gear, job.stock)
-    files = step_files(gear, stock)
+    files = step_files(gear, stock, timestamp)
     gear_volume = front_face_area_mm2(shape) * job.gear.face_width_mm  # exact: a section moved along X
     facts = CadResult(report, gear_volume, solid_volume_mm3(stock.val().wrapped),
                       {name: len(content) for name, content in files.items()})
