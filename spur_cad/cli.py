@@ -22,6 +22,7 @@ import warnings
 from typing import NoReturn
 
 from spur_cad.errors import SpurCadError, escaped, one_line
+from spur_cad.inputs import step_timestamp
 from spur_cad.version import __version__
 
 EXIT_INPUT_ERROR = 2
@@ -321,6 +322,7 @@ def _main(argv: list[str] | None, received: list[int]) -> int:
         return _install_freecad(args.uninstall)
     loaded: list = []
     try:
+        step_timestamp(os.environ)  # before numpy's f2py (imported by scipy) reads it and fails with a traceback
         if args.command == "verify":
             return _verify(args, received, loaded)
         if args.command == "grade":

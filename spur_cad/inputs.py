@@ -4,11 +4,14 @@ a folder cannot be read: each is refused with one line naming the file, before a
 
 from __future__ import annotations
 
+import datetime
 import os
+import re
 import stat
+from collections.abc import Mapping
 from typing import BinaryIO
 
-from spur_cad.errors import SpurCadError, shown_path
+from spur_cad.errors import SpurCadError, shown, shown_path
 
 _KINDS = ((stat.S_ISDIR, "a folder"), (stat.S_ISFIFO, "a FIFO (named pipe)"), (stat.S_ISCHR, "a device"),
           (stat.S_ISBLK, "a device"), (stat.S_ISSOCK, "a socket"))
@@ -51,3 +54,17 @@ def read_regular_file(path: str | os.PathLike, what: str, max_bytes: int,
     if len(data) > max_bytes:  # it grew while being read
         raise error(f"{shown_path(path)}: the {what} has more than {max_bytes:,} bytes; at most {max_bytes:,} are read")
     return data
+
+
+def step_timestamp(environment: Mapping[str, str]) -> str | None:
+    """The STEP headers' time from SOURCE_DATE_EPOCH (seconds since 1970, the reproducible-builds
+    convention), as 'YYYY-MM-DDTHH:MM:SS' UTC; None when it is not set (OCCT then writes its clock). A value
+    that is no such number is refused with one line: numpy's f2py, which scipy imports, would otherwise fail
+    on it at import with a traceback, so the CLI checks it before anything heavy is imported."""
+    text = environment.get("SOURCE_DATE_EPOCH")
+    if text is None:
+        return None
+    if not re.fullmatch(r"[0-9]{1,11}", text.strip()):
+        raise SpurCadError(f"SOURCE_DATE_EPOCH must be a whole number of seconds since 1970, got {shown(text)}")
+    moment = datetime.datetime.fromtimestamp(int(text.strip()), tz=datetime.timezone.utc)
+    return moment.strftime("%Y-%m-%dT%H:%M:%S")

@@ -9,21 +9,18 @@ the same job. The stages: profile -> CAD -> CAM plan (spur_cad.cam.plan) -> post
 from __future__ import annotations
 
 import dataclasses
-import datetime
 import io
 import json
 import os
-import re
 import time
-from collections.abc import Mapping
 from typing import TYPE_CHECKING, Callable
 
 import numpy as np
 
 from spur_cad.cam.plan import CamInputs, CamPlan
 from spur_cad.cam.plan import plan_cam as plan_cam_inputs
-from spur_cad.errors import SpurCadError, shown
 from spur_cad.geometry.sampling import ProfileSamples, sample_profile
+from spur_cad.inputs import step_timestamp
 from spur_cad.job import Job
 from spur_cad.result import CadResult, JobResult
 from spur_cad.summary import build_result, summary_json
@@ -58,7 +55,7 @@ def run_job(job: Job, progress: Callable[[str, float], None] | None = None,
         if progress is not None:
             progress(stage, fraction)
 
-    timestamp = step_timestamp(os.environ)  # checked before any work
+    timestamp = step_timestamp(os.environ)  # checked before any work (the CLI checks it before any import)
     seconds: dict[str, float] = {}
 
     def timed(name: str, stage: str | None, compute: Callable):
@@ -212,18 +209,6 @@ def program_comments(job: Job, plan: CamPlan, operation: str) -> tuple[str, ...]
         f"estimated time: {minutes:.1f} min ({planned.estimate.moves} moves)",
         "frame: X = gear axis (front face X0), Y0 Z0 on the A axis, tool tip centre programmed",
     )
-
-
-def step_timestamp(environment: Mapping[str, str]) -> str | None:
-    """The STEP headers' time from SOURCE_DATE_EPOCH (seconds since 1970, the reproducible-builds
-    convention), as 'YYYY-MM-DDTHH:MM:SS' UTC; None when it is not set (OCCT then writes its clock)."""
-    text = environment.get("SOURCE_DATE_EPOCH")
-    if text is None:
-        return None
-    if not re.fullmatch(r"[0-9]{1,11}", text.strip()):
-        raise SpurCadError(f"SOURCE_DATE_EPOCH must be a whole number of seconds since 1970, got {shown(text)}")
-    moment = datetime.datetime.fromtimestamp(int(text.strip()), tz=datetime.timezone.utc)
-    return moment.strftime("%Y-%m-%dT%H:%M:%S")
 
 
 def build_cad(job: Job, checkpoint: Callable[[], None] | None = None,

@@ -161,6 +161,20 @@ def test_bad_job_gives_one_clear_line_and_writes_nothing(tmp_path, case):
     assert not out.exists()
 
 
+@pytest.mark.parametrize("epoch", ["yesterday", "-5", "1e9", "99999999999999"])
+def test_a_bad_source_date_epoch_gives_one_line_and_writes_nothing(tmp_path, epoch):
+    out = tmp_path / "out"
+    exe = Path(sys.executable).with_name("spur-cad")
+    command = [str(exe)] if exe.exists() else [sys.executable, "-m", "spur_cad.cli"]
+    result = subprocess.run(command + ["run", str(REFERENCE_JOB), "--out", str(out)], capture_output=True,
+                            text=True, cwd=ROOT, timeout=300, check=False,
+                            env={**os.environ, "SOURCE_DATE_EPOCH": epoch})
+    assert result.returncode == 2, result.stderr
+    assert result.stderr.strip().splitlines() == [
+        f"spur-cad: error: SOURCE_DATE_EPOCH must be a whole number of seconds since 1970, got '{epoch}'"]
+    assert not out.exists()
+
+
 def test_missing_job_file(tmp_path):
     result = run_cli("run", str(tmp_path / "nope.toml"), "--out", str(tmp_path / "o"))
     assert result.returncode == 2 and "job file not found" in result.stderr

@@ -1,12 +1,14 @@
 """summary.json keeps its keys and values: the reference and helical examples' summaries equal the ones
 recorded before the typed result (tests/data/golden/, made by `spur-cad run` of commit 8accc5c), key for key
-and in the same order; only the run's own timings may differ. Their STEP files and programs are
-byte-identical to that run's (SHA-256 below), but for what OCCT's STEP writer writes from the clock and
-from counters it keeps for the whole process: the time stamp in FILE_NAME, the number it appends to the
-name of a lone shape's PRODUCT and the ids of NEXT_ASSEMBLY_USAGE_OCCURRENCE (these count the STEP files
-the process wrote before, docs/cad.md); they are set to fixed values before hashing. The assembly job.step
-also numbers its colour styles in an order that changes from run to run: its entities are compared as a
-set, each with its references' numbers left out."""
+and in the same order; only the run's own timings may differ, and two figures changed on purpose since
+(KEY_REL_TOL, and gear.step / stock.step's sizes: their PRODUCT is named after the part since issue 27,
+where OCCT named it 'Open CASCADE STEP translator 7.9 <n>', n counting the shapes the process wrote before,
+so that a long test run or a second Export wrote other sizes).
+
+Their STEP files and programs are byte-identical to that run's (SHA-256 below), but for the header's time
+(set to a fixed value before hashing; SOURCE_DATE_EPOCH sets it, tested below) and, in job.step, the order
+in which OCCT writes the two parts' colour styles, which changes from run to run: its entities are compared
+as a set, each with its references' numbers left out (docs/cad.md)."""
 
 from __future__ import annotations
 
@@ -34,16 +36,16 @@ its screw surfaces, and its integral was 4.5e-7 smaller (docs/cad.md)."""
 
 FILE_SHA256 = {
     "reference_gear": {
-        "gear.step": "4992a57fe54e48d904f1cd00e25668b37a2ce5e2671fa218d1824938bafb4bbc",
+        "gear.step": "d63e1fbe9f6b1a9dbb03295d016cc495645ac63bd01ead54b0ef15ba5f43b726",
         "job.step": "64724ed5fc3cb76ccdec76bd6326985294039c3aa149ffb77eed498aafde1e47",
-        "stock.step": "63e7228399fa7ca6e203068de9cb24c937e4917c53ba3fec10e8989f6cdf3781",
+        "stock.step": "f29f32d10d575d3b033b99c2db42bd461c52ee614dec62272ebd18331587afa7",
         "finishing.ngc": "a412b900207c83c6e9216c7c7a664fad482160b5308cab6ab3d60fdf66c260df",
         "roughing.ngc": "79d62a50184a1a1549274e6aeedd197fc4fdc22ecfb598cef592c47784e62bf0",
     },
     "helical_gear": {
-        "gear.step": "9c08468cb21b99c05f3a7dce9d57934b1c6467b9ca847384dd9c0eecb827d79f",
+        "gear.step": "55151216afe658ced2126a3425feae957ce86633099a47124e9eabc72b2905ee",
         "job.step": "7e19aab6bbd41f68a02af8fb4b706e9f5326b57ddb045532a8e3c6b36c9c7ebc",
-        "stock.step": "f8f313147e88cb33d94d8e3687ea4a4a12795731b7dea5d541b4e525cb57110f",
+        "stock.step": "36aa673a6487d20e588c6234896e20f6242d28191541c96d2476681b318784a0",
         "finishing.ngc": "8b25588cef4d2c29ac1a8bfaeadbf5e899d7510c72619d3f0e06036ee1cbcb4e",
         "roughing.ngc": "fb327f77c54e481ea34e95c05220de66074d188506956f5893a00fa85219e889",
     },
@@ -110,3 +112,24 @@ def _entities_without_numbers(content: bytes) -> bytes:
     data = content.decode().split("DATA;", 1)[1]
     entities = (re.sub(r"#\d+", "#", " ".join(text.split())) for text in data.split(";") if text.strip())
     return "\n".join(sorted(entities)).encode()
+
+
+def test_two_runs_with_source_date_epoch_write_the_same_files(monkeypatch):
+    """SOURCE_DATE_EPOCH (the reproducible-builds convention) sets the STEP headers' time: two runs of one job
+    give identical files, but for the wall-clock timings in summary.json and report.html and job.step's
+    colour styles' order (compared as entities)."""
+    monkeypatch.chdir(ROOT)
+    monkeypatch.setenv("SOURCE_DATE_EPOCH", "1700000000")
+    job = load_job(Path("resources") / "examples" / "reference_gear.toml")
+    first, second = run_job(job).files, run_job(job).files
+    assert sorted(first) == sorted(second)
+    assert b"'2023-11-14T22:13:20'" in first["gear.step"] and b"PRODUCT('gear','gear'" in first["gear.step"]
+    for name in first:
+        if name == "job.step":
+            assert _entities_without_numbers(first[name]) == _entities_without_numbers(second[name])
+        elif name in ("summary.json", "report.html"):
+            assert len(first[name]) > 0
+        else:
+            assert first[name] == second[name], name
+    timed = json.loads(first["summary.json"]), json.loads(second["summary.json"])
+    assert differences(*timed) == []
