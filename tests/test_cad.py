@@ -225,7 +225,7 @@ def test_stock_errors(stock, words):
 def test_step_round_trip_and_assembly_names(tmp_path):
     spec = spec_of("reference_z23_m4")
     gear, stock = spur_cad.make_gear(spec), spur_cad.make_stock(spec)
-    files = step_files(gear, stock)
+    files = step_files(gear.val().wrapped, stock.val().wrapped)
     for name, content in files.items():
         (tmp_path / name).write_bytes(content)
         assert b"SI_UNIT(.MILLI.,.METRE.)" in content, name

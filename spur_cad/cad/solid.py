@@ -19,7 +19,6 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-import cadquery as cq
 import numpy as np
 from OCP.BRepAdaptor import BRepAdaptor_Surface
 from OCP.BRepAlgoAPI import BRepAlgoAPI_Cut, BRepAlgoAPI_Fuse
@@ -32,19 +31,23 @@ from OCP.BRepBuilderAPI import (
 )
 from OCP.BRepCheck import BRepCheck_Analyzer
 from OCP.BRepGProp import BRepGProp
+from OCP.BRepLib import BRepLib
 from OCP.BRepOffsetAPI import BRepOffsetAPI_MakePipeShell
 from OCP.BRepPrimAPI import BRepPrimAPI_MakeBox, BRepPrimAPI_MakeCylinder, BRepPrimAPI_MakePrism
 from OCP.GC import GC_MakeArcOfCircle
-from OCP.Geom import Geom_BSplineCurve, Geom_Curve
+from OCP.GCE2d import GCE2d_MakeSegment
+from OCP.Geom import Geom_BSplineCurve, Geom_Curve, Geom_CylindricalSurface
+from OCP.Geom2d import Geom2d_Line
 from OCP.GeomAbs import GeomAbs_Plane
 from OCP.GeomAPI import GeomAPI_Interpolate, GeomAPI_ProjectPointOnCurve
-from OCP.gp import gp_Ax1, gp_Ax2, gp_Dir, gp_Pnt, gp_Trsf, gp_Vec
+from OCP.gp import gp_Ax1, gp_Ax2, gp_Ax3, gp_Dir, gp_Dir2d, gp_Pnt, gp_Pnt2d, gp_Trsf, gp_Vec
 from OCP.GProp import GProp_GProps
+from OCP.ShapeUpgrade import ShapeUpgrade_UnifySameDomain
 from OCP.TColgp import TColgp_Array1OfVec, TColgp_HArray1OfPnt
 from OCP.TColStd import TColStd_HArray1OfBoolean
 from OCP.TopAbs import TopAbs_FACE
 from OCP.TopExp import TopExp_Explorer
-from OCP.TopoDS import TopoDS, TopoDS_Edge, TopoDS_Shape
+from OCP.TopoDS import TopoDS, TopoDS_Edge, TopoDS_Shape, TopoDS_Wire
 
 from spur_cad.cad.specs import BlankFeatures, StockSpec
 from spur_cad.errors import ArgumentError, require_instance
@@ -220,9 +223,8 @@ def _sweep_helical(edges: list[TopoDS_Edge], spec: GearSpec) -> TopoDS_Shape:
     if not wire_maker.IsDone():
         raise RuntimeError("the transverse outline did not close into a wire")
     b = spec.face_width_mm
-    spine = cq.Wire.assembleEdges([cq.Edge.makeLine(cq.Vector(0.0, 0.0, 0.0), cq.Vector(b, 0.0, 0.0))]).wrapped
-    helix = cq.Wire.makeHelix(spec.lead_mm, b, spec.reference_radius_mm, center=cq.Vector(0.0, 0.0, 0.0),
-                              dir=cq.Vector(1.0, 0.0, 0.0), lefthand=spec.hand == "left").wrapped
+    spine = BRepBuilderAPI_MakeWire(BRepBuilderAPI_MakeEdge(gp_Pnt(0.0, 0.0, 0.0), gp_Pnt(b, 0.0, 0.0)).Edge()).Wire()
+    helix = _helix_along_x(spec.lead_mm, b, spec.reference_radius_mm, spec.hand == "left")
     pipe = BRepOffsetAPI_MakePipeShell(spine)
     pipe.SetMode(helix, False)
     pipe.Add(wire_maker.Wire())
@@ -230,6 +232,19 @@ def _sweep_helical(edges: list[TopoDS_Edge], spec: GearSpec) -> TopoDS_Shape:
     if not pipe.IsDone() or not pipe.MakeSolid():
         raise RuntimeError("the helical sweep of the transverse outline failed")
     return pipe.Shape()
+
+
+def _helix_along_x(lead_mm: float, length_mm: float, radius_mm: float, left_hand: bool) -> TopoDS_Wire:
+    """A helix about +X from the origin over `length_mm` (as CadQuery's Wire.makeHelix makes it: a line in the
+    (u, v) domain of a cylinder, its 3-D curve built from it)."""
+    surface = Geom_CylindricalSurface(gp_Ax3(gp_Pnt(0.0, 0.0, 0.0), gp_Dir(1.0, 0.0, 0.0)), radius_mm)
+    line = Geom2d_Line(gp_Pnt2d(0.0, 0.0), gp_Dir2d(-2.0 * math.pi if left_hand else 2.0 * math.pi, lead_mm))
+    turns = length_mm / lead_mm
+    segment = GCE2d_MakeSegment(line.Value(0.0),
+                                line.Value(turns * math.sqrt((2.0 * math.pi) ** 2 + lead_mm ** 2))).Value()
+    wire = BRepBuilderAPI_MakeWire(BRepBuilderAPI_MakeEdge(segment, surface).Edge()).Wire()
+    BRepLib.BuildCurves3d_s(wire, 1e-6, MaxSegment=2000)
+    return wire
 
 
 def _cut(shape: TopoDS_Shape, tool: TopoDS_Shape) -> TopoDS_Shape:
@@ -279,25 +294,34 @@ def build_stock_shape(spec: GearSpec, stock: StockSpec = StockSpec()) -> TopoDS_
         fuse = BRepAlgoAPI_Fuse(shape, _x_cylinder(stock.stub_diameter_mm / 2.0, x_end,
                                                    x_end + stock.stub_length_mm))
         fuse.Build()
-        shape = cq.Shape.cast(fuse.Shape()).clean().wrapped
+        unify = ShapeUpgrade_UnifySameDomain(fuse.Shape(), True, True, True)  # the seam between blank and stub
+        unify.AllowInternalEdges(False)
+        unify.Build()
+        shape = unify.Shape()
     return shape
 
 
 def make_gear(spec: GearSpec, features: BlankFeatures = BlankFeatures(),
-              fit_tolerance_mm: float | None = None) -> cq.Workplane:
-    """The gear solid as a CadQuery Workplane (machine frame: axis X, front face at X = 0)."""
+              fit_tolerance_mm: float | None = None):
+    """The gear solid as a CadQuery Workplane (machine frame: axis X, front face at X = 0). CadQuery is
+    imported here, for the scripts that want it: the pipeline works on OCP shapes (its import is costly)."""
+    import cadquery as cq
+
     shape, _ = build_gear_shape(spec, features, fit_tolerance_mm)
     return cq.Workplane("YZ").add(cq.Solid(shape))
 
 
-def make_stock(spec: GearSpec, stock: StockSpec = StockSpec()) -> cq.Workplane:
+def make_stock(spec: GearSpec, stock: StockSpec = StockSpec()):
     """The stock (blank cylinder, optional holding stub) as a CadQuery Workplane."""
+    import cadquery as cq
+
     return cq.Workplane("YZ").add(cq.Solid(build_stock_shape(spec, stock)))
 
 
 def to_build123d(workplane_or_shape):
     """Wrap the same OCP shape as a build123d Solid (no copy, no re-modelling)."""
     import build123d
+    import cadquery as cq
 
     require_instance(workplane_or_shape, (cq.Workplane, cq.Shape, TopoDS_Shape), "workplane_or_shape")
     shape = workplane_or_shape

@@ -1,8 +1,9 @@
 """STEP export of the gear, the stock and the job assembly (named, coloured parts), in millimetres.
 
 Written with OCP's STEP writers as CadQuery's exporters write them (the same settings: pcurves, precision
-mode 0, millimetres), into a private temporary folder that is removed afterwards; the caller decides
-where the files go. What OCCT would take from outside the part is set here, so that the same job gives the
+mode 0, millimetres; the assembly as CadQuery's Assembly makes it), without importing CadQuery (its import
+costs more than the export), into a private temporary folder that is removed afterwards; the caller
+decides where the files go. What OCCT would take from outside the part is set here, so that the same job gives the
 same bytes (docs/cad.md): a lone shape's PRODUCT is named after the part (OCCT would name it
 'Open CASCADE STEP translator 7.9 <n>', n counting the shapes the process wrote before), the assembly's
 NEXT_ASSEMBLY_USAGE_OCCURRENCE ids count from 1 in the file (OCCT counts them per process), and the
@@ -13,16 +14,24 @@ from __future__ import annotations
 
 import tempfile
 from pathlib import Path
+from typing import TYPE_CHECKING
 
-import cadquery as cq
+if TYPE_CHECKING:  # annotations only
+    from OCP.TopoDS import TopoDS_Shape
 
 GEAR_COLOUR = (0.55, 0.62, 0.72, 1.0)  # steel blue-grey
 STOCK_COLOUR = (0.85, 0.75, 0.45, 0.35)  # translucent brass
 
 
 def _settings() -> None:
-    """The writer settings CadQuery's STEP exporters use (OCCT keeps them process-wide)."""
+    """The writer settings CadQuery's STEP exporters use (OCCT keeps them process-wide), and OCCT's messages
+    kept to failures, as CadQuery keeps them on import: else the writer prints its transfer statistics on
+    standard output (the CLI's, the workbench's console)."""
     from OCP.Interface import Interface_Static
+    from OCP.Message import Message, Message_Gravity
+
+    for printer in Message.DefaultMessenger_s().Printers():
+        printer.SetTraceLevel(Message_Gravity.Message_Fail)
 
     Interface_Static.SetIVal_s("write.surfacecurve.mode", 1)
     Interface_Static.SetIVal_s("write.precision.mode", 0)
@@ -51,7 +60,7 @@ def _own_model(model, product_name: str | None, timestamp: str | None) -> None:
         APIHeaderSection_MakeHeader(model).SetTimeStamp(TCollection_HAsciiString(timestamp))
 
 
-def _export_shape(workplane: cq.Workplane, name: str, folder: Path, timestamp: str | None) -> bytes:
+def _export_shape(shape: TopoDS_Shape, name: str, folder: Path, timestamp: str | None) -> bytes:
     """One solid as a STEP file whose PRODUCT is called `name`."""
     from OCP.IFSelect import IFSelect_RetDone
     from OCP.STEPControl import STEPControl_AsIs, STEPControl_Writer
@@ -59,31 +68,69 @@ def _export_shape(workplane: cq.Workplane, name: str, folder: Path, timestamp: s
     path = folder / f"{name}.step"
     writer = STEPControl_Writer()
     _settings()
-    writer.Transfer(workplane.val().wrapped, STEPControl_AsIs)
+    writer.Transfer(shape, STEPControl_AsIs)
     _own_model(writer.Model(), name, timestamp)
     if writer.Write(str(path)) != IFSelect_RetDone:
         raise RuntimeError(f"OCP could not write {name}.step")
     return path.read_bytes()
 
 
-def job_assembly(gear: cq.Workplane, stock: cq.Workplane, name: str = "job") -> cq.Assembly:
-    """Assembly with parts named `gear` and `stock`, both already in the machine frame."""
-    assembly = cq.Assembly(name=name)
-    assembly.add(gear, name="gear", color=cq.Color(*GEAR_COLOUR))
-    assembly.add(stock, name="stock", color=cq.Color(*STOCK_COLOUR))
-    return assembly
+def job_document(gear: TopoDS_Shape, stock: TopoDS_Shape, name: str = "job"):
+    """An XCAF document holding the assembly `name` with the parts `gear` and `stock`, coloured, both already
+    in the machine frame: as CadQuery's Assembly makes it for a coloured STEP export (each part a compound
+    of its solid, named, with a surface colour, placed once in the assembly at the identity)."""
+    from OCP.Quantity import Quantity_Color, Quantity_ColorRGBA, Quantity_TOC_sRGB
+    from OCP.TCollection import TCollection_ExtendedString
+    from OCP.TDataStd import TDataStd_Name
+    from OCP.TDF import TDF_Label
+    from OCP.TDocStd import TDocStd_Document
+    from OCP.TopLoc import TopLoc_Location
+    from OCP.TopoDS import TopoDS_Builder, TopoDS_Compound
+    from OCP.XCAFApp import XCAFApp_Application
+    from OCP.XCAFDoc import XCAFDoc_ColorType, XCAFDoc_DocumentTool
+
+    def named(label, text: str):
+        TDataStd_Name.Set_s(label, TCollection_ExtendedString(text))
+        return label
+
+    application = XCAFApp_Application.GetApplication_s()
+    from OCP.BinXCAFDrivers import BinXCAFDrivers
+
+    BinXCAFDrivers.DefineFormat_s(application)
+    document = TDocStd_Document(TCollection_ExtendedString("BinXCAF"))
+    application.InitDocument(document)
+    shapes = XCAFDoc_DocumentTool.ShapeTool_s(document.Main())
+    shapes.SetAutoNaming_s(False)
+    colours = XCAFDoc_DocumentTool.ColorTool_s(document.Main())
+    XCAFDoc_DocumentTool.LayerTool_s(document.Main())
+    XCAFDoc_DocumentTool.MaterialTool_s(document.Main())
+    assembly = named(shapes.NewShape(), name)
+    for part_name, shape, (r, g, b, a) in (("gear", gear, GEAR_COLOUR), ("stock", stock, STOCK_COLOUR)):
+        compound = TopoDS_Compound()
+        builder = TopoDS_Builder()
+        builder.MakeCompound(compound)
+        builder.Add(compound, shape)
+        part = named(shapes.NewShape(), part_name)
+        shapes.SetShape(part, compound)
+        colours.SetColor(part, Quantity_ColorRGBA(Quantity_Color(r, g, b, Quantity_TOC_sRGB), a),
+                         XCAFDoc_ColorType.XCAFDoc_ColorSurf)
+        named(shapes.AddComponent(assembly, part, TopLoc_Location()), part_name)
+    top = TDF_Label()
+    shapes.SetLocation(assembly, TopLoc_Location(), top)
+    named(top, name)
+    shapes.UpdateAssemblies()
+    return document
 
 
-def _export_assembly(assembly: cq.Assembly, folder: Path, timestamp: str | None) -> bytes:
+def _export_assembly(gear: TopoDS_Shape, stock: TopoDS_Shape, folder: Path, timestamp: str | None) -> bytes:
     """The assembly as CadQuery's default STEP export writes it (colours, layers, names)."""
-    from cadquery.occ_impl.assembly import toCAF
     from OCP.IFSelect import IFSelect_RetDone
     from OCP.Interface import Interface_Static
     from OCP.STEPCAFControl import STEPCAFControl_Writer
     from OCP.STEPControl import STEPControl_StepModelType
     from OCP.XSControl import XSControl_WorkSession
 
-    _, document = toCAF(assembly, True)
+    document = job_document(gear, stock)
     writer = STEPCAFControl_Writer(XSControl_WorkSession(), False)
     writer.SetColorMode(True)
     writer.SetLayerMode(True)
@@ -98,11 +145,11 @@ def _export_assembly(assembly: cq.Assembly, folder: Path, timestamp: str | None)
     return path.read_bytes()
 
 
-def step_files(gear: cq.Workplane, stock: cq.Workplane, timestamp: str | None = None) -> dict[str, bytes]:
-    """{'gear.step', 'stock.step', 'job.step'} as bytes; `timestamp` ('YYYY-MM-DDTHH:MM:SS', UTC) is the
-    headers' time, OCCT's clock when None."""
+def step_files(gear: TopoDS_Shape, stock: TopoDS_Shape, timestamp: str | None = None) -> dict[str, bytes]:
+    """{'gear.step', 'stock.step', 'job.step'} as bytes from the two solids (machine frame); `timestamp`
+    ('YYYY-MM-DDTHH:MM:SS', UTC) is the headers' time, OCCT's clock when None."""
     with tempfile.TemporaryDirectory(prefix="spur_cad_step_") as tmp:
         folder = Path(tmp)
         return {"gear.step": _export_shape(gear, "gear", folder, timestamp),
                 "stock.step": _export_shape(stock, "stock", folder, timestamp),
-                "job.step": _export_assembly(job_assembly(gear, stock), folder, timestamp)}
+                "job.step": _export_assembly(gear, stock, folder, timestamp)}
