@@ -43,15 +43,43 @@ def _without_simulation(text: str) -> str:
     return text + "\n[simulation]\nenabled = false\n"
 
 
+def big_gear_job(teeth: int, module_mm: float, face_width_mm: float, rack_tip_radius_mm: float,
+                 radial_allowance_mm: float) -> str:
+    """A job file for a big gear with tools the recommendations choose (95 % of the largest roughing tool in
+    0.1 mm, the generating tool with corner radius rho in 0.05 mm)."""
+    import math
+
+    from spur_cad.cam.recommend import recommend_tools
+    from spur_cad.geometry import GearSpec
+
+    spec = GearSpec(teeth=teeth, module_mm=module_mm, rack_tip_radius_mm=rack_tip_radius_mm,
+                    face_width_mm=face_width_mm, thickness_allowance_fraction=0.05)
+    rec = recommend_tools(spec, spec.tip_radius_mm + radial_allowance_mm, 1.0)
+    roughing = math.floor(rec.roughing_max_diameter_mm * 0.95 * 10) / 10
+    finishing = math.floor(rec.finishing_generating_max_diameter_mm * 0.95 * 20) / 20
+    return (f'[job]\nname = "big z{teeth} m{module_mm:g}"\n[gear]\nteeth = {teeth}\nmodule_mm = {module_mm}\n'
+            f"rack_tip_radius_mm = {rack_tip_radius_mm}\nthickness_allowance_percent = 5.0\n"
+            f"face_width_mm = {face_width_mm}\n[stock]\nradial_allowance_mm = {radial_allowance_mm}\n"
+            f'[tools.roughing]\nkind = "flat"\ndiameter_mm = {roughing}\nflutes = 3\n'
+            f'[tools.finishing]\nkind = "bull_nose"\ndiameter_mm = {finishing}\n'
+            f"corner_radius_mm = {rack_tip_radius_mm}\nflutes = 2\n")
+
+
+BIG_GEARS = {"z120_m1_b10": (120, 1.0, 10.0, 0.25, 0.3), "z200_m3_b30": (200, 3.0, 30.0, 0.6, 0.5)}
+
+
 def figures(runs: int) -> dict:
-    """Medians of `runs` fresh runs: the bare import floor, the reference job (simulation on and off) and the
-    helical example."""
+    """Medians of `runs` fresh runs: the bare import floor, the reference job (simulation on and off), the
+    helical example and the two big gears of issue 27."""
     with tempfile.TemporaryDirectory(prefix="spur_cad_bench_run_") as tmp:
         folder = Path(tmp)
         no_simulation = folder / "reference_no_simulation.toml"
         no_simulation.write_text(_without_simulation((EXAMPLES / "reference_gear.toml").read_text()))
         jobs = {"reference": EXAMPLES / "reference_gear.toml", "reference_no_simulation": no_simulation,
                 "helical": EXAMPLES / "helical_gear.toml"}
+        for name, values in BIG_GEARS.items():
+            jobs[name] = folder / f"{name}.toml"
+            jobs[name].write_text(big_gear_job(*values))
         out = {"import_ocp_numpy": _median_run([sys.executable, "-c", "import OCP, numpy"], runs)}
         for name, job in jobs.items():
             target = folder / f"out_{name}"

@@ -127,9 +127,10 @@ def simulation_facts(result: SimResult | None, resolution_mm: float) -> Simulati
     """The simulated cut's facts (only `enabled` and the resolution when nothing was simulated)."""
     if result is None:
         return SimulationFacts(enabled=False, resolution_mm=resolution_mm)
-    dev = result.deviation[:, :, result.gear_rows]
-    finished = dev[dev < result.settings.leftover_range_mm - 1e-9]
-    positive = np.maximum(finished, 0.0)
+    dev = result.gear_deviation  # a view: a big gear has millions of design points x rows
+    positive = dev[dev < result.settings.leftover_range_mm - 1e-9]  # the finished points (a copy)
+    np.maximum(positive, 0.0, out=positive)  # leftover only, in place
+    p95, p99 = (float(v) for v in np.percentile(positive, [95, 99])) if positive.size else (0.0, 0.0)
     names = np.array(result.grid.feature_names())
     per_feature = []
     for name in FEATURES:
@@ -145,8 +146,7 @@ def simulation_facts(result: SimResult | None, resolution_mm: float) -> Simulati
         rows=int(result.gear_rows.sum()), point_spacing_mm=result.grid.spacing_mm,
         uncut_points=result.uncut_points,
         scallop_mean_mm=float(positive.mean()) if positive.size else 0.0,
-        scallop_p95_mm=float(np.percentile(positive, 95)) if positive.size else 0.0,
-        scallop_p99_mm=float(np.percentile(positive, 99)) if positive.size else 0.0,
+        scallop_p95_mm=p95, scallop_p99_mm=p99,
         worst_gouge=result.worst(True), worst_leftover=result.worst(False), per_feature=tuple(per_feature),
         moves=result.moves, poses_clipped=result.poses_clipped, x_sweeps=result.x_sweeps,
         gouge_range_mm=result.settings.gouge_range_mm, leftover_range_mm=result.settings.leftover_range_mm)

@@ -105,14 +105,16 @@ def deviation_map_png(result: SimResult) -> bytes:
     """Deviation over the space outline (arc length) x face width for the tooth space with the largest
     deviation, and per tooth space the largest gouge and leftover."""
     rows = result.gear_rows
-    dev = result.deviation[:, :, rows] * 1000.0  # um
+    deviation = result.gear_deviation  # mm, a view (no copy of a big gear's millions of values)
+    most, least = deviation.max(axis=(1, 2)) * 1000.0, deviation.min(axis=(1, 2)) * 1000.0  # um, per space
     x = result.grid.rows_x[rows]
     arc = result.grid.arc_mm
-    worst = int(np.abs(dev).reshape(dev.shape[0], -1).max(axis=1).argmax())
-    limit = max(float(np.abs(dev[worst]).max()), 1000.0 * result.settings.resolution_mm)
+    worst = int(np.maximum(most, -least).argmax())
+    worst_space = deviation[worst] * 1000.0  # um
+    limit = max(float(np.abs(worst_space).max()), 1000.0 * result.settings.resolution_mm)
     fig = Figure(figsize=(9.0, 7.0), layout="constrained")
     ax, bars = fig.subplots(2, 1, height_ratios=[3, 1.4])
-    image = ax.pcolormesh(arc, x, dev[worst].T, cmap="RdBu_r", vmin=-limit, vmax=limit, shading="nearest")
+    image = ax.pcolormesh(arc, x, worst_space.T, cmap="RdBu_r", vmin=-limit, vmax=limit, shading="nearest")
     fig.colorbar(image, ax=ax, label="deviation [um] (red: leftover, blue: gouge)")
     names = result.grid.feature_names()
     starts = [0] + [j for j in range(1, len(names)) if names[j] != names[j - 1]]
@@ -123,10 +125,9 @@ def deviation_map_png(result: SimResult) -> bytes:
     ax.set_ylabel("X (face width) [mm]")
     ax.set_title(f"simulated deviation of tooth space {worst} (largest |deviation|); resolution "
                  f"{1000 * result.settings.resolution_mm:g} um", fontsize=9)
-    per_space = dev.reshape(dev.shape[0], -1)
-    spaces = np.arange(dev.shape[0])
-    bars.bar(spaces - 0.2, np.maximum(per_space.max(axis=1), 0.0), width=0.4, color="tab:red", label="max leftover")
-    bars.bar(spaces + 0.2, np.maximum(-per_space.min(axis=1), 0.0), width=0.4, color="tab:blue", label="max gouge")
+    spaces = np.arange(deviation.shape[0])
+    bars.bar(spaces - 0.2, np.maximum(most, 0.0), width=0.4, color="tab:red", label="max leftover")
+    bars.bar(spaces + 0.2, np.maximum(-least, 0.0), width=0.4, color="tab:blue", label="max gouge")
     bars.set_xlabel("tooth space")
     bars.set_ylabel("[um]")
     bars.legend(fontsize=8)

@@ -107,14 +107,23 @@ class SimResult:
         return (x >= -1e-9) & (x <= self.face_width_mm + 1e-9)
 
     @property
+    def gear_deviation(self) -> np.ndarray:
+        """The deviation inside the face width (space, point, row): a view, not a copy, when those rows are one
+        run (the rows are in X order), for the statistics of a big gear's millions of points."""
+        rows = np.nonzero(self.gear_rows)[0]
+        if len(rows) and rows[-1] - rows[0] + 1 == len(rows):
+            return self.deviation[:, :, rows[0]:rows[-1] + 1]
+        return self.deviation[:, :, self.gear_rows]
+
+    @property
     def max_gouge_mm(self) -> float:
         """Largest gouge inside the face width (0 when none)."""
-        return float(max(0.0, -self.deviation[:, :, self.gear_rows].min()))
+        return float(max(0.0, -self.gear_deviation.min()))
 
     @property
     def max_leftover_mm(self) -> float:
         """Largest leftover inside the face width (0 when none)."""
-        return float(max(0.0, self.deviation[:, :, self.gear_rows].max()))
+        return float(max(0.0, self.gear_deviation.max()))
 
     def station_of_row(self) -> np.ndarray:
         """Nearest finishing station index per row (-1 without finishing stations)."""
@@ -127,11 +136,11 @@ class SimResult:
         """Design points of the face width never cut below the blade's outer end (their leftover is
         at least leftover_range_mm, and the removed volume overestimates there)."""
         top = self.settings.leftover_range_mm - 1e-9
-        return int(np.count_nonzero(self.deviation[:, :, self.gear_rows] >= top))
+        return int(np.count_nonzero(self.gear_deviation >= top))
 
     def worst(self, gouge: bool) -> DeviationPlace:
         """Where the largest gouge (or leftover) is: space, feature, X, station, value (mm)."""
-        dev = self.deviation[:, :, self.gear_rows]
+        dev = self.gear_deviation
         flat = int(np.argmin(dev) if gouge else np.argmax(dev))
         k, j, r = np.unravel_index(flat, dev.shape)
         row = np.nonzero(self.gear_rows)[0][r]
