@@ -85,7 +85,37 @@ def figures(runs: int) -> dict:
             target = folder / f"out_{name}"
             out[name] = _median_run([*_cli(), "run", str(job), "--out", str(target), "--quiet"], runs)
             shutil.rmtree(target, ignore_errors=True)
+    out["reference_in_one_process"] = second_run_figures(runs)
     return out
+
+
+SECOND_RUN = """
+import json, sys, time
+from spur_cad.job import load_job
+from spur_cad.pipeline import run_job
+job = load_job(sys.argv[1])
+seconds = []
+for _ in range(2):
+    started = time.perf_counter()
+    run_job(job)
+    seconds.append(time.perf_counter() - started)
+print(json.dumps(seconds))
+"""
+
+
+def second_run_figures(runs: int) -> dict:
+    """The reference job run twice by `run_job` in one process (as the workbench or a script does): the first
+    run pays for the imports it defers and numba's loading of its cache, the second for nothing but the work."""
+    firsts, seconds = [], []
+    for _ in range(runs):
+        result, _peak, _wall = run_measured([sys.executable, "-c", SECOND_RUN,
+                                             str(EXAMPLES / "reference_gear.toml")], 600)
+        if result.returncode != 0:
+            raise RuntimeError(f"second run failed: {result.stderr[-500:]}")
+        first, second = json.loads(result.stdout)
+        firsts.append(first)
+        seconds.append(second)
+    return {"first_run_s": statistics.median(firsts), "second_run_s": statistics.median(seconds)}
 
 
 def main() -> None:

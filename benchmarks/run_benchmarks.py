@@ -143,6 +143,7 @@ def main() -> None:
     from benchmarks.bench_sim import bench_sim
     from benchmarks.bench_verify import figures as verify_figures
     from benchmarks.bench_verify import large_program_figures
+    from benchmarks.bench_workbench import figures as workbench_figures
     from spur_cad.job import load_job
 
     results = {"machine": machine(), "runs": args.runs, "profile": bench_profile(args.runs),
@@ -152,7 +153,7 @@ def main() -> None:
                "helical": helical_figures(load_job(HELICAL_JOB), args.run_runs),
                "verify": verify_figures(args.run_runs), "verify_large": large_program_figures(args.run_runs),
                "shop_floor": shop_floor_figures(args.run_runs),
-               "fresh_runs": run_figures(args.cad_runs),
+               "fresh_runs": run_figures(args.cad_runs), "workbench_generate": workbench_figures(),
                "run_s": {strategy: end_to_end_seconds(strategy, args.run_runs)
                          for strategy in ("generating", "perimeter")}}
     print(json.dumps(results, indent=2))

@@ -417,3 +417,19 @@ def test_a_small_helix_angle_is_swept_as_finely_as_a_large_one():
     flanks = np.isin(result.grid.feature_names(), ["right involute", "left involute"])
     assert dev.min() >= job.roughing.finish_stock_mm - RES / 2
     assert dev[flanks].max() <= 1.25 * job.roughing.flank_allowance_mm
+
+
+def test_the_helical_simulation_gives_the_same_bits_on_any_number_of_threads(finished):
+    """The helical kernel clips disjoint blocks of rows on threads: one thread and three (blocks that split the
+    tool's width and the passes) must leave every blade at exactly the same place."""
+    job, plan = finished
+
+    def of(path):
+        return subset(path, np.isin(path.space, [0]))
+
+    cuts = [Cut(of(plan.roughing.toolpath), job.tools.roughing), Cut(of(plan.finishing.toolpath), job.tools.finishing)]
+    one, three = (simulate(job.gear, job_stock(job), cuts, SimSettings(resolution_mm=0.01), threads=threads)
+                  for threads in (1, 3))
+    assert one.poses_clipped == three.poses_clipped > 10_000
+    assert np.array_equal(one.deviation, three.deviation)
+    assert np.ptp(one.deviation[0]) > 0.1  # the space was cut: the blades hold different lengths

@@ -7,11 +7,10 @@ import math
 from typing import TYPE_CHECKING
 
 import numpy as np
-from matplotlib.figure import Figure
 
 from spur_cad.geometry.sampling import full_space_points, sample_profile
 from spur_cad.geometry.spec import GearSpec
-from spur_cad.report.plots import _png
+from spur_cad.report.plots import _png, figure
 
 if TYPE_CHECKING:
     from spur_cad.cam.tools import Tool
@@ -28,7 +27,7 @@ def roughing_levels_png(spec: GearSpec, heights_mm: np.ndarray, half_widths_mm: 
                         blank_radius_mm: float) -> bytes:
     """The tooth space with each roughing level: the tool bottom's reach at that height, the tool drawn at
     both ends of the lowest level."""
-    fig = Figure(figsize=(7.5, 6.0), layout="constrained")
+    fig = figure(7.5, 6.0)
     ax = fig.add_subplot(1, 1, 1)
     outline = _space_outline(spec)
     ax.plot(outline[:, 0], outline[:, 1], "-", color="k", lw=1.5, label="design")
@@ -63,7 +62,7 @@ def finishing_png(spec: GearSpec, tool: Tool, y: np.ndarray, z: np.ndarray, a_de
     to each corner-circle centre."""
     from spur_cad.geometry.frames import machine_to_part
 
-    fig = Figure(figsize=(7.5, 6.0), layout="constrained")
+    fig = figure(7.5, 6.0)
     ax = fig.add_subplot(1, 1, 1)
     outline = _space_outline(spec)
     ax.plot(outline[:, 0], outline[:, 1], "-", color="k", lw=1.2, label="design")
@@ -112,7 +111,8 @@ def deviation_map_png(result: SimResult) -> bytes:
     worst = int(np.maximum(most, -least).argmax())
     worst_space = deviation[worst] * 1000.0  # um
     limit = max(float(np.abs(worst_space).max()), 1000.0 * result.settings.resolution_mm)
-    fig = Figure(figsize=(9.0, 7.0), layout="constrained")
+    fig = figure(9.0, 7.0, left=0.08, right=1.0, bottom=0.07, top=0.95)
+    fig.subplots_adjust(hspace=0.3)
     ax, bars = fig.subplots(2, 1, height_ratios=[3, 1.4])
     image = ax.pcolormesh(arc, x, worst_space.T, cmap="RdBu_r", vmin=-limit, vmax=limit, shading="nearest")
     fig.colorbar(image, ax=ax, label="deviation [um] (red: leftover, blue: gouge)")
@@ -152,8 +152,8 @@ def k_chart_png(spec: GearSpec, grading: Grading) -> bytes:
     worst = max(profile, key=spread_in_range).space
     grade = grading.overall_class or 11
     d, b, m = 2.0 * spec.reference_radius_mm, spec.face_width_mm, spec.module_mm
-    fig = Figure(figsize=(9.0, 6.5))  # fixed margins: a constrained layout costs a second per report
-    fig.subplots_adjust(left=0.08, right=0.98, bottom=0.08, top=0.95, wspace=0.25, hspace=0.4)
+    fig = figure(9.0, 6.5, left=0.08, right=0.98, bottom=0.08, top=0.95)
+    fig.subplots_adjust(wspace=0.25, hspace=0.4)
     axes = fig.subplots(2, 2)
     for column, side in enumerate(("right", "left")):
         for row, kind in enumerate(("profile", "helix")):
@@ -189,7 +189,7 @@ def passes_png(spec: GearSpec, tool: Tool, passes: tuple, blank_radius_mm: float
     from spur_cad.cam.contacts import tool_signed_distance
     from spur_cad.geometry.frames import machine_to_part, turn_points
 
-    fig = Figure(figsize=(7.5, 6.5), layout="constrained")
+    fig = figure(7.5, 6.5, left=0.09, right=0.98)
     ax = fig.add_subplot(1, 1, 1)
     outline = _space_outline(spec)
     neighbour = turn_points(outline, -2.0 * math.pi / spec.teeth)

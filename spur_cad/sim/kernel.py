@@ -252,23 +252,25 @@ def _blade_entry(dx, theta, px, pz_, nx, nz_, y, z, lo, hi, radius, half_flat, r
 
 @njit(cache=True)
 def _clip_twisted_pose(x, y, z, a, x_end, h, h_top, points, normals, chunk_start, chunk_centre, chunk_radius,
-                       rows, t_min, radius, half_flat, rt, reach, blade_len, pitch, teeth, twist, dx_step):
+                       rows, t_min, radius, half_flat, rt, reach, blade_len, pitch, teeth, twist, dx_step, row_first,
+                       row_stop, samples, row_cos, row_sin):
     """Clip the blades of a helical design by the tool at (x, y, z, a) or, with x_end > x, by the tool
-    following the lead from x to x_end (entries sampled every dx_step over the tool's width)."""
+    following the lead from x to x_end (entries sampled every dx_step over the tool's width); only the rows
+    row_first <= r < row_stop. `samples`, `row_cos` and `row_sin` are work space (as long as clip_poses_twisted
+    makes them)."""
     if z > reach:
         return 0
     spread = abs(twist) * radius
     c0 = a + twist * x
     first, last = _sector_range(y, z, c0, spread, radius, blade_len, pitch, teeth)
-    r_lo = np.searchsorted(rows, x - radius, side="right")
-    r_hi = np.searchsorted(rows, x_end + radius, side="left")
+    r_lo = max(np.searchsorted(rows, x - radius, side="right"), row_first)
+    r_hi = min(np.searchsorted(rows, x_end + radius, side="left"), row_stop)
     if r_lo >= r_hi:
         return 0
     sweep = x_end > x
     n_samples = 0
     if sweep:
         n_samples = 2 * int(math.ceil(radius / dx_step)) + 1  # odd: dx = 0 is a sample
-    samples = np.empty(max(n_samples, 1))
     cuts = 0
     n_chunks = len(chunk_radius)
     for k in range(first, last + 1):
@@ -276,10 +278,40 @@ def _clip_twisted_pose(x, y, z, a, x_end, h, h_top, points, normals, chunk_start
         theta0 = c0 + k * pitch
         c = math.cos(theta0)
         s = math.sin(theta0)
+        if not sweep:  # the rows' turns for this sector, computed once, not once per blade
+            for r in range(r_lo, r_hi):
+                theta = theta0 + twist * (rows[r] - x)
+                row_cos[r - r_lo] = math.cos(theta)
+                row_sin[r - r_lo] = math.sin(theta)
         for ci in range(n_chunks):
             py = chunk_centre[ci, 0]
             pz = chunk_centre[ci, 1]
             if _chunk_gap(c, s, py, pz, y, z, half_flat, rt) > chunk_radius[ci] + spread * math.hypot(py, pz):
+                continue
+            if not sweep:
+                for r in range(r_lo, r_hi):
+                    dx = rows[r] - x
+                    rc = row_cos[r - r_lo]  # as _blade_entry turns the blade, with the row's cos and sin
+                    rs = row_sin[r - r_lo]
+                    # The tool's slice at dx lies in the box |u - y| <= sqrt(R^2 - dx^2), w >= z + its lowest point
+                    # (the corner's bottom there): a chunk whose circle misses the box has no blade to clip here.
+                    corner_dx = max(abs(dx) - half_flat, 0.0)
+                    bottom = rt - math.sqrt(max(rt * rt - corner_dx * corner_dx, 0.0))
+                    box_half_width = math.sqrt(max(radius * radius - dx * dx, 0.0))
+                    if _chunk_gap(rc, rs, py, pz, y, z + bottom, box_half_width, 0.0) > chunk_radius[ci]:
+                        continue
+                    for j in range(chunk_start[ci], chunk_start[ci + 1]):
+                        px = points[j, 0]
+                        pz_ = points[j, 1]
+                        nx = normals[j, 0]
+                        nz_ = normals[j, 1]
+                        current = h[sector, j, r]
+                        entry = first_entry(dx, rc * px - rs * pz_ - y, rs * px + rc * pz_ - z, rc * nx - rs * nz_,
+                                            rs * nx + rc * nz_, t_min, min(h_top[sector, j], current), radius,
+                                            half_flat, rt)
+                        if entry < current:
+                            h[sector, j, r] = entry
+                            cuts += 1
                 continue
             for j in range(chunk_start[ci], chunk_start[ci + 1]):
                 px = points[j, 0]
@@ -288,15 +320,6 @@ def _clip_twisted_pose(x, y, z, a, x_end, h, h_top, points, normals, chunk_start
                 nz_ = normals[j, 1]
                 top = h_top[sector, j]
                 hrow = h[sector, j]
-                if not sweep:
-                    for r in range(r_lo, r_hi):
-                        dx = rows[r] - x
-                        entry = _blade_entry(dx, theta0 + twist * dx, px, pz_, nx, nz_, y, z, t_min, min(top, hrow[r]),
-                                             radius, half_flat, rt)
-                        if entry < hrow[r]:
-                            hrow[r] = entry
-                            cuts += 1
-                    continue
                 deepest = INF
                 for i in range(n_samples):
                     dx = -radius + 2.0 * radius * i / (n_samples - 1)
@@ -329,14 +352,20 @@ def _clip_twisted_pose(x, y, z, a, x_end, h, h_top, points, normals, chunk_start
     return cuts
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def clip_poses_twisted(poses, x_end, h, h_top, points, normals, chunk_start, chunk_centre, chunk_radius, rows, t_min,
-                       radius, half_flat, rt, reach, blade_len, pitch, teeth, twist, dx_step):
+                       radius, half_flat, rt, reach, blade_len, pitch, teeth, twist, dx_step, row_first, row_stop):
     """`clip_poses` for a helical design (row r turned by twist * rows[r], rad/mm); x_end[i] > x[i] is a move
-    following the lead from x to x_end (A falling by twist * dX)."""
+    following the lead from x to x_end (A falling by twist * dX). Only rows row_first <= r < row_stop are
+    clipped: every row is independent of the others, so threads given disjoint rows (the GIL released) give
+    the same result as one thread given all."""
     cuts = 0
+    samples = np.empty(2 * int(math.ceil(radius / dx_step)) + 1 if dx_step > 0.0 else 1)
+    row_cos = np.empty(len(rows))
+    row_sin = np.empty(len(rows))
     for i in range(poses.shape[0]):
         cuts += _clip_twisted_pose(poses[i, 0], poses[i, 1], poses[i, 2], poses[i, 3], x_end[i], h, h_top, points,
                                    normals, chunk_start, chunk_centre, chunk_radius, rows, t_min, radius, half_flat, rt,
-                                   reach, blade_len, pitch, teeth, twist, dx_step)
+                                   reach, blade_len, pitch, teeth, twist, dx_step, row_first, row_stop, samples,
+                                   row_cos, row_sin)
     return cuts

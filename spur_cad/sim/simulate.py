@@ -14,8 +14,11 @@ See docs/simulation.md for the choice of representation. Each move is linear in 
 
 from __future__ import annotations
 
+import functools
 import math
+import os
 import time
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
 from typing import Callable, Sequence
 
@@ -27,8 +30,9 @@ from spur_cad.errors import SpurCadError
 from spur_cad.geometry.spec import GearSpec
 from spur_cad.sim.design import DesignGrid, design_grid
 
-CHUNK_POINTS = 8
+CHUNK_POINTS = 4
 POSE_BATCH = 20000
+MAX_THREADS = 4
 
 
 class SimulationError(SpurCadError, ValueError):
@@ -230,14 +234,15 @@ def decompose(path: Toolpath, tool: Tool, resolution_mm: float, reach_mm: float,
     return poses, x_end, int(along_x.sum())
 
 
-def _chunks(grid: DesignGrid, t_min: float, t_max: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Groups of consecutive design points with a circle holding all their blades."""
+def _chunks(grid: DesignGrid, t_min: float, t_max: float | np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Groups of consecutive design points with a circle holding all their blades, from t_min to t_max (per
+    point, or one for all: the circles shrink as the material left along the blades does)."""
     m = len(grid.points)
     start = np.arange(0, m + CHUNK_POINTS - 1, CHUNK_POINTS)
     start[-1] = m
     start = np.unique(np.minimum(start, m))
     inner = grid.points + t_min * grid.normals
-    outer = grid.points + t_max * grid.normals
+    outer = grid.points + np.reshape(t_max, (-1, 1)) * grid.normals
     centres, radii = [], []
     for lo, hi in zip(start[:-1], start[1:]):
         ends = np.concatenate([inner[lo:hi], outer[lo:hi]])
@@ -276,11 +281,12 @@ def section_areas(grid: DesignGrid, h: np.ndarray) -> np.ndarray:
 def simulate(spec: GearSpec, stock: StockCylinder, operations: Sequence[Cut],
              settings: SimSettings = SimSettings(), *, station_x: np.ndarray | None = None,
              rows_x_range: tuple[float, float] | None = None,
-             progress: Callable[[float], None] | None = None) -> SimResult:
+             progress: Callable[[float], None] | None = None, threads: int | None = None) -> SimResult:
     """Cut the stock with every operation in order and measure the result against the design.
 
     `station_x`: finishing station positions (rows are added there and halfway between them, where
-    the scallop ridges stand). `rows_x_range` limits the rows (default: the stock's X extent).
+    the scallop ridges stand). `rows_x_range` limits the rows (default: the stock's X extent). `threads`: see
+    simulate_grid.
     """
     settings.validate()
     started = time.perf_counter()
@@ -293,7 +299,7 @@ def simulate(spec: GearSpec, stock: StockCylinder, operations: Sequence[Cut],
     check_design_size(spec, spacing, x_hi - x_lo, len(extra), settings.resolution_mm)
     grid = design_grid(spec, spacing, x_lo, x_hi, extra)
     return simulate_grid(grid, stock, operations, settings, face_width_mm=spec.face_width_mm, station_x=stations,
-                         progress=progress, started=started)
+                         progress=progress, started=started, threads=threads)
 
 
 MAX_DESIGN_VALUES = 60_000_000
@@ -325,8 +331,10 @@ def point_spacing_mm(corner_radius_mm: float, resolution_mm: float) -> float:
 
 def simulate_grid(grid: DesignGrid, stock: StockCylinder, operations: Sequence[Cut],
                   settings: SimSettings = SimSettings(), *, face_width_mm: float, station_x: np.ndarray | None = None,
-                  progress: Callable[[float], None] | None = None, started: float | None = None) -> SimResult:
-    """`simulate` on a given design grid (any outline with normals, e.g. a plain cylinder in tests)."""
+                  progress: Callable[[float], None] | None = None, started: float | None = None,
+                  threads: int | None = None) -> SimResult:
+    """`simulate` on a given design grid (any outline with normals, e.g. a plain cylinder in tests). A helical
+    design is clipped on `threads` threads (default: simulation_threads()), with the same result for any number."""
     from spur_cad.sim.kernel import clip_poses, clip_poses_twisted
 
     settings.validate()
@@ -336,7 +344,6 @@ def simulate_grid(grid: DesignGrid, stock: StockCylinder, operations: Sequence[C
     t_min, t_max = -settings.gouge_range_mm, settings.leftover_range_mm
     h = initial_blades(grid, stock, t_max)
     initial = h.copy()
-    chunk_start, chunk_centre, chunk_radius = _chunks(grid, t_min, t_max)
     blade_ends = np.concatenate([grid.points + t_min * grid.normals, grid.points + t_max * grid.normals])
     reach = float(np.hypot(*blade_ends.T).max()) + 1e-9
     blade_len = max(settings.gouge_range_mm, settings.leftover_range_mm)
@@ -360,10 +367,14 @@ def simulate_grid(grid: DesignGrid, stock: StockCylinder, operations: Sequence[C
     done = 0
     for poses, x_end, radius, half_flat, rt, dx_step in batches:
         h_top = np.ascontiguousarray(h.max(axis=2))
+        # Blades only shorten, so each batch's chunk circles need hold them from t_min to their longest h only.
+        chunk_start, chunk_centre, chunk_radius = _chunks(grid, t_min, np.maximum(h_top.max(axis=0), t_min))
         if twist:
-            clip_poses_twisted(np.ascontiguousarray(poses), np.ascontiguousarray(x_end), h, h_top, grid.points,
-                               grid.normals, chunk_start, chunk_centre, chunk_radius, grid.rows_x, t_min, radius,
-                               half_flat, rt, reach, blade_len, grid.pitch_rad, grid.teeth, twist, dx_step)
+            clip = functools.partial(clip_poses_twisted, np.ascontiguousarray(poses), np.ascontiguousarray(x_end), h,
+                                     h_top, grid.points, grid.normals, chunk_start, chunk_centre, chunk_radius,
+                                     grid.rows_x, t_min, radius, half_flat, rt, reach, blade_len, grid.pitch_rad,
+                                     grid.teeth, twist, dx_step)
+            _on_row_blocks(clip, len(grid.rows_x), threads or simulation_threads())
         else:
             clip_poses(np.ascontiguousarray(poses), np.ascontiguousarray(x_end), h, h_top, grid.points, grid.normals,
                        chunk_start, chunk_centre, chunk_radius, grid.rows_x, t_min, t_max, radius, half_flat, rt, reach,
@@ -376,6 +387,25 @@ def simulate_grid(grid: DesignGrid, stock: StockCylinder, operations: Sequence[C
     removed = float(((stock_area - section_areas(grid, h)) * grid.row_width).sum())
     return SimResult(grid, h, initial, stock, face_width_mm, settings, removed, time.perf_counter() - started,
                      total, sweeps, moves, np.asarray(station_x if station_x is not None else (), float))
+
+
+def simulation_threads() -> int:
+    """Threads the kernels run on: the processors this process may use, at most MAX_THREADS."""
+    return max(1, min(len(os.sched_getaffinity(0)), MAX_THREADS))
+
+
+def _on_row_blocks(clip: Callable[[int, int], object], rows: int, threads: int) -> None:
+    """Run clip(first_row, stop_row) on disjoint blocks of rows, one per thread (the kernel releases the GIL).
+    Rows are independent (each blade's h is clipped by a minimum, searched from the same bounds whatever the
+    other rows hold), so the result is bit for bit that of one call on all rows."""
+    threads = min(threads, rows)
+    if threads <= 1:
+        clip(0, rows)
+        return
+    edges = np.linspace(0, rows, threads + 1).round().astype(int)
+    with ThreadPoolExecutor(max_workers=threads) as pool:
+        for future in [pool.submit(clip, int(lo), int(hi)) for lo, hi in zip(edges[:-1], edges[1:])]:
+            future.result()
 
 
 def shifted(path: Toolpath, mask: np.ndarray, dy: np.ndarray | float = 0.0, dz: np.ndarray | float = 0.0) -> Toolpath:
