@@ -127,26 +127,24 @@ def simulation_facts(result: SimResult | None, resolution_mm: float) -> Simulati
     """The simulated cut's facts (only `enabled` and the resolution when nothing was simulated)."""
     if result is None:
         return SimulationFacts(enabled=False, resolution_mm=resolution_mm)
+    from spur_cad.sim.statistics import feature_statistics, scallop_statistics
+
     dev = result.gear_deviation  # a view: a big gear has millions of design points x rows
-    positive = dev[dev < result.settings.leftover_range_mm - 1e-9]  # the finished points (a copy)
-    np.maximum(positive, 0.0, out=positive)  # leftover only, in place
-    p95, p99 = (float(v) for v in np.percentile(positive, [95, 99])) if positive.size else (0.0, 0.0)
+    scallop = scallop_statistics(dev, result.settings.leftover_range_mm - 1e-9)  # the finished points
     names = np.array(result.grid.feature_names())
     per_feature = []
     for name in FEATURES:
         mask = np.array([n.endswith(name) if name in ("root", "tip") else n == name for n in names])
         if mask.any():
-            values = dev[:, mask, :]
-            per_feature.append(FeatureDeviation(name, float(max(0.0, -values.min())), float(max(0.0, values.max())),
-                                                float(values.mean())))
+            feature = feature_statistics(dev, mask)
+            per_feature.append(FeatureDeviation(name, feature.max_gouge_mm, feature.max_leftover_mm, feature.mean_mm))
     return SimulationFacts(
         enabled=True, resolution_mm=result.settings.resolution_mm, max_gouge_mm=result.max_gouge_mm,
         max_leftover_mm=result.max_leftover_mm, removed_volume_mm3=result.removed_volume_mm3,
         seconds=result.seconds, design_points=int(dev.size), points_per_space=int(result.grid.points.shape[0]),
         rows=int(result.gear_rows.sum()), point_spacing_mm=result.grid.spacing_mm,
         uncut_points=result.uncut_points,
-        scallop_mean_mm=float(positive.mean()) if positive.size else 0.0,
-        scallop_p95_mm=p95, scallop_p99_mm=p99,
+        scallop_mean_mm=scallop.mean_mm, scallop_p95_mm=scallop.p95_mm, scallop_p99_mm=scallop.p99_mm,
         worst_gouge=result.worst(True), worst_leftover=result.worst(False), per_feature=tuple(per_feature),
         moves=result.moves, poses_clipped=result.poses_clipped, x_sweeps=result.x_sweeps,
         gouge_range_mm=result.settings.gouge_range_mm, leftover_range_mm=result.settings.leftover_range_mm)

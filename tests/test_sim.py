@@ -253,3 +253,23 @@ def test_a_station_left_out_reports_leftover_there(reference):
     assert np.all(np.abs(result.grid.rows_x[rows_high] - x_station) < step)
     assert high[0].any() and high[1].any()  # in both measured spaces
     assert -dev.min() <= RES
+
+
+@pytest.mark.parametrize("spaces_per_block", [1, 4, 1000])
+def test_worst_places_found_block_by_block_are_numpys_first_extremes(reference, monkeypatch, spaces_per_block):
+    """SimResult.worst reads the gear in blocks of tooth spaces (argmin of the whole strided view would copy it):
+    the place it names is the first extreme in C order, as np.argmin / np.argmax over all of it give."""
+    from spur_cad.sim import statistics
+
+    job, plan = reference
+    fin = plan.finishing.toolpath
+    mask = _finishing_window(plan, WINDOW, SPACES)
+    fault = (fin.feature == Feature.ROOT) & (fin.station == STATION) & (fin.space == SPACE)
+    result, _ = _window_result(job, plan, subset(fin, mask, z=fin.z - np.where(fault, 0.020, 0.0)), STATION, SPACES)
+    monkeypatch.setattr(statistics, "BLOCK_VALUES", spaces_per_block * result.deviation[0].size)
+    dev = result.gear_deviation
+    for gouge, index in ((True, np.argmin(dev)), (False, np.argmax(dev))):
+        k, j, r = np.unravel_index(index, dev.shape)
+        place = result.worst(gouge)
+        assert (place.space, place.point, place.value_mm) == (k, j, dev[k, j, r])
+        assert place.x_mm == result.grid.rows_x[np.nonzero(result.gear_rows)[0][r]]

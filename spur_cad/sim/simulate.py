@@ -144,9 +144,19 @@ class SimResult:
 
     def worst(self, gouge: bool) -> DeviationPlace:
         """Where the largest gouge (or leftover) is: space, feature, X, station, value (mm)."""
+        from spur_cad.sim.statistics import space_blocks
+
         dev = self.gear_deviation
-        flat = int(np.argmin(dev) if gouge else np.argmax(dev))
-        k, j, r = np.unravel_index(flat, dev.shape)
+        best, k, j, r = np.inf, 0, 0, 0
+        first_space = 0
+        for block in space_blocks(dev):  # argmin of a strided view would copy all of it: block by block
+            flat = int(np.argmin(block) if gouge else np.argmax(block))
+            value = float(block.flat[flat]) * (1.0 if gouge else -1.0)
+            if value < best:  # the first place of the extreme, as numpy's argmin over the whole gives
+                best = value
+                k, j, r = np.unravel_index(flat, block.shape)
+                k += first_space
+            first_space += block.shape[0]
         row = np.nonzero(self.gear_rows)[0][r]
         return DeviationPlace(float(dev[k, j, r]), int(k), self.grid.feature_names()[j], int(j),
                               float(self.grid.rows_x[row]), int(self.station_of_row()[row]))
@@ -253,13 +263,15 @@ def _chunks(grid: DesignGrid, t_min: float, t_max: float | np.ndarray) -> tuple[
 
 
 def initial_blades(grid: DesignGrid, stock: StockCylinder, t_max: float) -> np.ndarray:
-    """Blade outer ends before cutting: where the normal leaves the stock cylinder (at most t_max)."""
+    """Blade outer ends before cutting: where the normal leaves the stock cylinder (at most t_max). The same in
+    every tooth space and row, so a read-only view of one value per design point, not a copy per space and row
+    (a big gear's array of the whole gear is hundreds of megabytes)."""
     p, n = grid.points, grid.normals
     pn = np.einsum("ij,ij->i", p, n)
     inside = stock.radius_mm**2 - np.einsum("ij,ij->i", p, p)
     exit_t = -pn + np.sqrt(np.maximum(pn * pn + inside, 0.0))
     h0 = np.minimum(exit_t, t_max)
-    return np.broadcast_to(h0[None, :, None], (grid.teeth, len(p), len(grid.rows_x))).copy()
+    return np.broadcast_to(h0[None, :, None], (grid.teeth, len(p), len(grid.rows_x)))
 
 
 def section_areas(grid: DesignGrid, h: np.ndarray) -> np.ndarray:
@@ -342,8 +354,8 @@ def simulate_grid(grid: DesignGrid, stock: StockCylinder, operations: Sequence[C
     res = settings.resolution_mm
     x_lo, x_hi = float(grid.rows_x[0]), float(grid.rows_x[-1])
     t_min, t_max = -settings.gouge_range_mm, settings.leftover_range_mm
-    h = initial_blades(grid, stock, t_max)
-    initial = h.copy()
+    initial = initial_blades(grid, stock, t_max)
+    h = initial.copy()
     blade_ends = np.concatenate([grid.points + t_min * grid.normals, grid.points + t_max * grid.normals])
     reach = float(np.hypot(*blade_ends.T).max()) + 1e-9
     blade_len = max(settings.gouge_range_mm, settings.leftover_range_mm)
