@@ -182,8 +182,9 @@ def _checkpoint(received: list[int]) -> None:
         raise Terminated() if signal.SIGTERM in received else KeyboardInterrupt()
 
 
-def _run(args: argparse.Namespace, received: list[int], loaded: list) -> list:
-    """Load, compute and write the job's output set; the job goes into `loaded` (for locating errors)."""
+def _run(args: argparse.Namespace, received: list[int], loaded: list) -> tuple[list, tuple[str, ...]]:
+    """Load, compute and write the job's output set; the job goes into `loaded` (for locating errors). Returns
+    the paths written and the run's warnings (summary.json's)."""
     from spur_cad.cam.restart import parse_restart
     from spur_cad.job import load_job  # heavy imports after the signal handling is in place
     from spur_cad.outputs import check_output_folder
@@ -204,14 +205,14 @@ def _run(args: argparse.Namespace, received: list[int], loaded: list) -> list:
             bars(stage, fraction)
 
     try:
-        files = run_job(loaded[0], progress, checkpoint, restart).files
+        result = run_job(loaded[0], progress, checkpoint, restart)
     finally:
         if bars is not None:
             bars.close()
     checkpoint()
-    paths = _write(out_dir, files, received)
+    paths = _write(out_dir, result.files, received)
     checkpoint()  # a signal while the set was switched: it is this run's set, and the message says so
-    return paths
+    return paths, result.warnings
 
 
 def _write(out_dir, files: dict[str, bytes], received: list[int]) -> list:
@@ -327,7 +328,7 @@ def _main(argv: list[str] | None, received: list[int]) -> int:
             return _verify(args, received, loaded)
         if args.command == "grade":
             return _grade(args, received, loaded)
-        paths = _run(args, received, loaded)
+        paths, run_warnings = _run(args, received, loaded)
     except SpurCadError as exc:
         message = loaded[0].located(exc) if loaded and exc.section else str(exc)
         print(f"spur-cad: error: {one_line(message)}", file=sys.stderr)
@@ -342,6 +343,8 @@ def _main(argv: list[str] | None, received: list[int]) -> int:
     if not args.quiet:
         for path in paths:
             print(f"wrote {escaped(str(path))}")  # a folder name's control characters as escapes
+        for warning in run_warnings:  # the report and summary.json hold them too
+            print(f"spur-cad: warning: {one_line(warning)}", file=sys.stderr)
     return 0
 
 

@@ -176,8 +176,42 @@ def site_packages() -> list[str]:
     return list(dict.fromkeys([paths["purelib"], paths["platlib"]]))
 
 
+MAX_RECORD_BYTES = 64 * 1024
+
+
+def _own_folders(where: InstallPaths) -> set[Path]:
+    """The folders an install may create and an uninstall may remove again when empty: `Mod`, the user data
+    folder and, for a versioned one (FreeCAD 1.1's `v1-1`), the folder above it; never a folder above those
+    (`~/.local/share` stays even when installing created it)."""
+    folders = {where.link.parent, where.user_data_dir}
+    if _VERSIONED_NAME.fullmatch(where.user_data_dir.name):
+        folders.add(where.user_data_dir.parent)
+    return folders
+
+
+def _missing_folders(where: InstallPaths) -> list[Path]:
+    """The folders of _own_folders that do not exist yet (installing creates them)."""
+    return [folder for folder in _own_folders(where) if not folder.exists() and not folder.is_symlink()]
+
+
+def _recorded_folders(where: InstallPaths) -> list[Path]:
+    """The folders an earlier install recorded as its own creation, as far as they are folders on the way to the
+    link (the record is a file on disk: anything else in it is ignored, never acted on)."""
+    from spur_cad.inputs import read_regular_file
+
+    try:
+        record = json.loads(read_regular_file(where.record, "install record", MAX_RECORD_BYTES))
+    except (SpurCadError, OSError, ValueError):
+        return []
+    listed = record.get("created_folders") if isinstance(record, dict) else None
+    ours = _own_folders(where)
+    return [Path(p) for p in listed if isinstance(p, str) and Path(p) in ours] if isinstance(listed, list) else []
+
+
 def _install_one(where: InstallPaths, root: Path, users: str) -> str:
-    """Link the addon (or keep the Addon Manager's copy) and write the record in one user data folder."""
+    """Link the addon (or keep the Addon Manager's copy) and write the record in one user data folder (with the
+    folders this created, so that uninstalling leaves none of them empty behind)."""
+    created = _recorded_folders(where)
     if _is_addon_manager_copy(where.link):
         addon = where.link
         _, version = package_name_and_version(addon) or ("", "")
@@ -186,13 +220,15 @@ def _install_one(where: InstallPaths, root: Path, users: str) -> str:
     else:
         if where.link.is_symlink():
             where.link.unlink()
+        created += _missing_folders(where)
         where.link.parent.mkdir(parents=True, exist_ok=True)
         where.link.symlink_to(root, target_is_directory=True)
         addon = root
         done = f"linked {where.link} -> {root} for {users}"
     record = {"spur_cad_version": __version__, "addon": str(addon), "python": sys.executable,
               "python_version": f"{sys.version_info[0]}.{sys.version_info[1]}",
-              "site_packages": site_packages()}
+              "site_packages": site_packages(),
+              "created_folders": sorted({str(folder) for folder in created}, key=len, reverse=True)}
     write_file_atomically(where.record, (json.dumps(record, indent=2) + "\n").encode())
     return done
 
@@ -216,7 +252,10 @@ def install(env: Mapping[str, str]) -> list[str]:
 
 
 def _uninstall_one(where: InstallPaths) -> list[str]:
+    """Remove the link and the record, then the folders installing created, where they are empty now (deepest
+    first; a folder holding anything, or that is a link, stays)."""
     done = []
+    created = _recorded_folders(where)
     if where.link.is_symlink():
         where.link.unlink()
         done.append(f"removed {where.link}")
@@ -225,6 +264,13 @@ def _uninstall_one(where: InstallPaths) -> list[str]:
     if where.record.exists():
         where.record.unlink()
         done.append(f"removed {where.record}")
+    for folder in sorted(created, key=lambda path: len(path.parts), reverse=True):
+        try:
+            if folder.is_dir() and not folder.is_symlink() and not any(folder.iterdir()):
+                folder.rmdir()
+                done.append(f"removed the empty folder {folder} (made by the install)")
+        except OSError:  # something arrived in it meanwhile, or it cannot be read: it stays
+            continue
     return done
 
 

@@ -393,9 +393,92 @@ def _tools_section(sections: dict, tables: dict, where: Callable[[str, str | Non
     return tools
 
 
+AUTO = "auto"
+AUTO_KEYS = ("diameter_mm", "corner_radius_mm")
+"""Tool keys a job may give as "auto": the suggestion for the gear (spur_cad.cam.suggest) takes their place."""
+_AUTO_ROLES = ("roughing", "finishing")
+_PROVISIONAL = {"diameter_mm": 1.0, "corner_radius_mm": 0.0}  # stand-ins until the suggestion is known
+
+
+def _without_auto(tables: dict, where: Callable[[str, str | None], str]) -> tuple[dict, dict[str, set[str]]]:
+    """The tables with every "auto" tool key replaced by a stand-in, and {role: its "auto" keys}; "auto"
+    anywhere else is refused with one line."""
+    autos: dict[str, set[str]] = {}
+    tables = dict(tables)
+    for name, table in list(tables.items()):
+        if not isinstance(table, dict):
+            continue
+        for key_name, value in table.items():
+            if value != AUTO:
+                continue
+            role = name.removeprefix("tools.")
+            if not name.startswith("tools.") or role not in _AUTO_ROLES or key_name not in AUTO_KEYS:
+                allowed = " and ".join(f"[tools.{r}]" for r in _AUTO_ROLES)
+                raise JobFileError(f"{where(name, key_name)}: [{name}] {key_name} = \"auto\": only "
+                                   f"{' and '.join(AUTO_KEYS)} of {allowed} may be \"auto\"",
+                                   section=name, field=key_name)
+            autos.setdefault(role, set()).add(key_name)
+            tables[name] = {**tables[name], key_name: _PROVISIONAL[key_name]}
+    return tables, autos
+
+
+def _resolve_auto(sections: dict, tables: dict, autos: dict[str, set[str]], spec: GearSpec, strategies: Strategies,
+                  where: Callable[[str, str | None], str]) -> None:
+    """Put the suggested tools' sizes (and kinds, where the table gives none) in place of the "auto" keys: the
+    finishing tool first (the roughing limit depends on its flat width), then the roughing tool."""
+    from spur_cad.cam.strategies import get_strategy
+    from spur_cad.cam.suggest import suggested_finishing, suggested_roughing
+
+    stock, machine = sections.get("stock", StockSpec()), sections.get("machine", Machine())
+    blank = stock.blank_radius_mm(spec)
+    finishing_section = sections.get("finishing") or finishing_section_type(strategies)()
+    for role in ("finishing", "roughing"):
+        if role not in autos:
+            continue
+        name = f"tools.{role}"
+        if role == "finishing":
+            strategy = get_strategy(finishing_section.strategy, strategies)
+            shape = suggested_finishing(spec, strategy, finishing_section.target_scallop_mm, blank,
+                                        machine.clearance_mm)
+        else:
+            shape = suggested_roughing(spec, sections.get("tools.finishing"),
+                                       sections.get("roughing", RoughingParams()), blank, machine.clearance_mm)
+        first = sorted(autos[role])[0]
+        if shape is None:
+            raise JobFileError(f"{where(name, first)}: [{name}] {first} = \"auto\": no {role} tool fits this gear "
+                               "within its limits; give the tool's size", section=name, field=first)
+        chosen = {key_name: getattr(shape, key_name) for key_name in autos[role]}
+        if "kind" not in tables[name]:
+            chosen["kind"] = shape.kind
+        sections[name] = dataclasses.replace(sections[name], **chosen)
+
+
+def _validate_sections(sections: dict, tables: dict, types: dict, autos: dict[str, set[str]], spec: GearSpec,
+                       strategies: Strategies, where: Callable[[str, str | None], str]) -> None:
+    """Every section's own checks, the tools last: their "auto" keys are resolved once the sections the
+    suggestion depends on (machine, roughing, finishing) have passed theirs."""
+    for name in ("machine", "roughing", "finishing", "post", "lathe", *(f"tools.{role}" for role in _TOOL_ROLES)):
+        if name not in sections:
+            continue
+        is_tool = name.startswith("tools.")
+        if is_tool and autos:
+            _resolve_auto(sections, tables, autos, spec, strategies, where)
+            autos = {}
+        try:
+            if is_tool:
+                sections[name].validate(name.removeprefix("tools."))
+            else:
+                sections[name].validate()
+        except SpurCadError as exc:
+            prefix = f"[{name}] " if is_tool else ""
+            blamed = _blamed_key(exc, name, tables[name], types)
+            raise JobFileError(f"{where(name, blamed)}: {prefix}{exc}", section=name, field=blamed) from None
+
+
 def _job_from_data(data: dict, source: str, text: str, strategies: Strategies = REGISTRY) -> Job:
     """Validate parsed job data; `text` (the file's text, or "") only locates keys for messages."""
-    tables = _tables(data, source, text)
+    tables, autos = _without_auto(_tables(data, source, text), lambda name, key_name: _where(source, text, name,
+                                                                                              key_name))
     types = job_sections(strategies)
     sections = {name: _load_section(tables[name], name, source, text, types) for name in types if name in tables}
 
@@ -415,19 +498,7 @@ def _job_from_data(data: dict, source: str, text: str, strategies: Strategies = 
         except (GearSpecError, StockError) as exc:
             blamed = _blamed_key(exc, name, tables.get(name, {}))
             raise JobFileError(f"{where(name, blamed)}: invalid [{name}]: {exc}", section=name, field=blamed) from None
-    for name in ("machine", "roughing", "finishing", "post", "lathe", *(f"tools.{role}" for role in _TOOL_ROLES)):
-        if name not in sections:
-            continue
-        is_tool = name.startswith("tools.")
-        try:
-            if is_tool:
-                sections[name].validate(name.removeprefix("tools."))
-            else:
-                sections[name].validate()
-        except SpurCadError as exc:
-            prefix = f"[{name}] " if is_tool else ""
-            blamed = _blamed_key(exc, name, tables[name], types)
-            raise JobFileError(f"{where(name, blamed)}: {prefix}{exc}", section=name, field=blamed) from None
+    _validate_sections(sections, tables, types, autos, spec, strategies, where)
     tools = _tools_section(sections, tables, where)
     try:
         check_machine_limits(spec, sections.get("stock", StockSpec()), sections.get("machine", Machine()),

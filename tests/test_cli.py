@@ -110,6 +110,8 @@ def test_quiet_prints_nothing(tmp_path):
 BAD_JOBS = {
     "unknown key": ("[gear]\nteeth = 23\nmodule_mm = 4.0\nface_width_mm = 20\ncolour = 'red'\n",
                     "bad.toml:5: unknown key 'colour' in [gear]"),
+    "misspelt key": ("[gear]\nteeth = 23\nmodule = 4.0\nface_width_mm = 20\n",
+                     "bad.toml:3: unknown key 'module' in [gear] (did you mean module_mm"),
     "wrong type": ("[gear]\nteeth = 23\nmodule_mm = 'four'\nface_width_mm = 20\n",
                    "bad.toml:3: [gear] module_mm must be a number"),
     "invalid gear": ("[gear]\nteeth = 23\nmodule_mm = 4.0\nface_width_mm = 20\nrack_tip_radius_mm = 2.3\n",

@@ -239,3 +239,39 @@ def test_freecad_loads_the_installed_workbench_and_forgets_it_after_uninstall(fr
     result, proc = run_freecad_code(IMPORT_BODY, tmp_path, freecadcmd=freecadcmd)
     assert result is not None and result.get("ok"), describe(proc, result)
     assert result["imported"] is False
+
+
+def _tree(folder: Path) -> set[str]:
+    return {str(path.relative_to(folder)) for path in folder.rglob("*")}
+
+
+def test_uninstall_leaves_no_empty_folder_it_made_and_keeps_those_it_found(home, capsys):
+    """Installing on a machine where FreeCAD never ran creates its user data folder and `Mod`: uninstalling
+    removes them again. Folders that were there before, `~/.local/share` above FreeCAD's, or that hold
+    anything else after all, stay."""
+    (home / ".local" / "share").mkdir(parents=True)
+    before = _tree(home)
+    assert main(["install-freecad"]) == 0 and main(["install-freecad"]) == 0  # a second install keeps the record
+    assert main(["install-freecad", "--uninstall"]) == 0
+    assert _tree(home) == before
+    # FreeCAD's folder existed already (FreeCAD ran once): it stays, the Mod folder made by the install goes.
+    _data(home).mkdir()
+    (_data(home) / "user.cfg").write_text("<FCParameters/>")
+    before = _tree(home)
+    assert main(["install-freecad"]) == 0
+    (_data(home) / "Mod" / "another_workbench").mkdir()  # the user installs another workbench meanwhile
+    assert main(["install-freecad", "--uninstall"]) == 0
+    assert _tree(home) == before | {".local/share/FreeCAD/Mod", ".local/share/FreeCAD/Mod/another_workbench"}
+
+
+def test_a_record_naming_other_folders_removes_none_of_them(home, tmp_path):
+    """The record is a file on disk: folders it names outside the install's own are never touched."""
+    assert main(["install-freecad"]) == 0
+    record = _data(home) / "spur_cad_environment.json"
+    victims = [tmp_path / "empty_victim", home / ".local" / "share", home / ".local"]
+    victims[0].mkdir()
+    data = json.loads(record.read_text())
+    data["created_folders"] = [str(v) for v in victims] + [123, None]
+    record.write_text(json.dumps(data))
+    assert main(["install-freecad", "--uninstall"]) == 0
+    assert all(v.is_dir() for v in victims)

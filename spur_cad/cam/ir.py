@@ -20,6 +20,10 @@ import numpy as np
 
 from spur_cad.geometry.frames import machine_to_part
 
+MAX_TOOLPATH_MOVES = 10_000_000
+"""Largest toolpath a plan builds (about 13 x the reference job's perimeter finishing: some 0.6 GB of
+IR and 0.4 GB of flat G-code); larger work is refused before it is generated (cam/plan.py)."""
+
 
 class MoveKind(IntEnum):
     RAPID = 0

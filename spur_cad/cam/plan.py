@@ -6,6 +6,7 @@ job; summary, posts, simulation, report and the workbench read it (docs/architec
 from __future__ import annotations
 
 import dataclasses
+import re
 from collections.abc import Callable
 from dataclasses import dataclass, field
 
@@ -15,7 +16,7 @@ from spur_cad.cad.specs import StockSpec
 from spur_cad.cam.contacts import ContactCounts, contact_counts
 from spur_cad.cam.estimate import Estimate, estimate, move_seconds
 from spur_cad.cam.finishing import plan_finishing
-from spur_cad.cam.ir import Toolpath
+from spur_cad.cam.ir import MAX_TOOLPATH_MOVES, Toolpath
 from spur_cad.cam.machine import Machine, MachineError, RoughingParams, check_travel
 from spur_cad.cam.machine_limits import check_machine_limits
 from spur_cad.cam.recommend import (
@@ -43,10 +44,6 @@ from spur_cad.cam.strategies import (
 from spur_cad.cam.tools import Tool, ToolError
 from spur_cad.errors import StockError, WorkLimitError, shown
 from spur_cad.geometry.spec import GearSpec
-
-MAX_TOOLPATH_MOVES = 10_000_000
-"""Largest toolpath a plan builds (about 13 x the reference job's perimeter finishing: some 0.6 GB of
-IR and 0.4 GB of flat G-code); larger work is refused before it is generated."""
 
 MAX_CONTACTS_PER_FLANK = 20_000
 """Largest number of finishing contact poses per flank (each is placed and gouge-checked)."""
@@ -148,7 +145,9 @@ def check_cam_inputs(inputs: CamInputs) -> tuple[ToolRecommendations, RoughingLe
     if inputs.bottom_tool is not None:
         check_two_stage_tools(spec, rec, inputs.roughing_tool, inputs.bottom_tool, inputs.finishing_tool)
     else:
-        check_tools(spec, rec, inputs.roughing_tool, inputs.finishing_tool)
+        conflicts = tool_conflicts(inputs, rec)
+        if conflicts:
+            raise conflicts_error(inputs, conflicts)
     if inputs.finishing_tool is not None:
         check_finishing_work(spec, inputs.finishing_tool, machine, inputs.finishing, inputs.strategies)
     if inputs.roughing_tool is None:
@@ -172,6 +171,59 @@ def check_cam_inputs(inputs: CamInputs) -> tuple[ToolRecommendations, RoughingLe
             raise ToolError(str(exc), field=exc.field,
                             section="tools.bottom" if deepest is not tool else exc.section) from None
     return rec, levels
+
+
+def tool_conflicts(inputs: CamInputs, rec: ToolRecommendations) -> list[ToolError]:
+    """Every way the job's roughing and finishing tools do not fit the gear, each tool checked on its own (its
+    limits; the finishing strategy's rule for its shape; the roughing tool's reach to the bottom of the
+    spaces), so that one message can name them all."""
+    spec, blank = inputs.spec, inputs.stock.blank_radius_mm(inputs.spec)
+    conflicts: list[ToolError] = []
+
+    def collect(check: Callable[[], None]) -> bool:
+        try:
+            check()
+        except ToolError as exc:
+            conflicts.append(exc)
+            return False
+        return True
+
+    finishing, roughing = inputs.finishing_tool, inputs.roughing_tool
+    if finishing is not None and collect(lambda: check_tools(spec, rec, None, finishing)):
+        strategy = get_strategy(inputs.finishing.strategy, inputs.strategies)
+        collect(lambda: strategy.check_tool(spec, finishing))
+    if roughing is not None and collect(lambda: check_tools(spec, rec, roughing, None)) and finishing is not None:
+        inputs.roughing.validate()
+        moves, driver = estimated_roughing_moves(spec, roughing, inputs.roughing, blank)
+        check_moves("roughing", moves, "roughing", driver)  # the levels' work bounded before they are made
+        collect(lambda: check_roughing_reach(roughing, roughing_levels(spec, roughing, inputs.roughing, blank)
+                                             .lowest_height_mm - spec.root_radius_mm, rec))
+    return conflicts
+
+
+def conflicts_error(inputs: CamInputs, conflicts: list[ToolError]) -> ToolError:
+    """One ToolError for every conflict, blaming the first one's key, with a set of tools that fits the gear (the
+    suggestion comes first: a long message is cut at its end)."""
+    from spur_cad.cam.suggest import suggested_tools
+
+    strategy = get_strategy(inputs.finishing.strategy, inputs.strategies)
+    suggestion = suggested_tools(inputs.spec, strategy, inputs.finishing.target_scallop_mm, inputs.roughing,
+                                 inputs.stock.blank_radius_mm(inputs.spec), inputs.machine.clearance_mm)
+    fits = (f"tools that fit: {suggestion.text()} (or \"auto\" sizes)" if suggestion.finishing or suggestion.roughing
+            else "no tool fits this gear")
+    first = conflicts[0]
+    if len(conflicts) == 1:
+        return ToolError(f"{first}; {fits}", field=first.field, section=first.section)
+    listed = "; ".join(f"{i}) {_short(exc)}" for i, exc in enumerate(conflicts, 1))
+    return ToolError(f"{len(conflicts)} tool conflicts; {fits}: {listed}", field=first.field, section=first.section)
+
+
+def _short(conflict: ToolError) -> str:
+    """A conflict's first clause without its parenthesised explanations (the list of several must fit a line)."""
+    text = str(conflict).split("; ")[0]
+    while (shorter := re.sub(r"\s*\([^()]*\)", "", text)) != text:
+        text = shorter
+    return text
 
 
 def check_two_stage_tools(spec: GearSpec, rec: ToolRecommendations, roughing_tool: Tool | None, bottom: Tool,
@@ -229,7 +281,8 @@ def plan_cam(inputs: CamInputs, checkpoint: Callable[[], None] | None = None) ->
     warnings: list[str] = list(check_machine_limits(inputs.spec, inputs.stock, inputs.machine, tools))
     strategy = get_strategy(inputs.finishing.strategy, inputs.strategies)
     warnings.extend(small_tool_warnings(rec, inputs.machine.smallest_end_mill_mm, strategy.name,
-                                        strategy.largest_tool(rec)))
+                                        strategy.largest_tool(rec),
+                                        inputs.finishing_tool.kind if inputs.finishing_tool is not None else None))
     bottom = two_stage = None
     if levels is not None and inputs.bottom_tool is not None:
         check()

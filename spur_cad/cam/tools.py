@@ -19,14 +19,21 @@ class ToolError(SpurCadError, ValueError):
 @dataclass(frozen=True)
 class Tool:
     """[tools.roughing] / [tools.finishing]: an end mill. `corner_radius_mm` is r_t of a bull-nose
-    (0 for flat, D/2 for ball); flat width d = D - 2 r_t."""
+    (0 for flat, D/2 for ball); flat width d = D - 2 r_t.
+
+    A job file may give the roughing and finishing tools' `diameter_mm` and `corner_radius_mm` as "auto": the
+    tools spur_cad suggests for the gear take their place (and the kind, where the table gives none): the
+    finishing tool the strategy suggests (by generation r_t = rho and 95 % of the largest diameter, in 0.05 mm
+    steps), then the largest flat roughing tool in 0.1 mm steps that fits the spaces and reaches their bottom."""
 
     diameter_mm: float = key(unit="mm", low=0.1, high=100.0, label="{Role}ToolDiameter", group="{Role} tool",
-                             meaning="tool diameter D")
+                             meaning='tool diameter D (a job file may say "auto" for the roughing and finishing '
+                                     'tools: the size spur_cad suggests for the gear)')
     kind: str = key("flat", label="{Role}ToolKind", group="{Role} tool", names_from=lambda: TOOL_KINDS,
                     meaning="end mill shape: flat, bull_nose or ball")
     corner_radius_mm: float = key(0.0, unit="mm", low=0.0, high=50.0, label="{Role}CornerRadius", group="{Role} tool",
-                                  meaning="corner radius r_t: 0 flat, in (0, D/2) bull-nose, D/2 (or 0) ball")
+                                  meaning='corner radius r_t: 0 flat, in (0, D/2) bull-nose, D/2 (or 0) ball (a job '
+                                          'file may say "auto", as for the diameter)')
     flutes: int = key(2, low=1, high=20, label="{Role}Flutes", group="{Role} tool", meaning="number of flutes")
     flute_length_mm: float = key(0.0, unit="mm", low=0.0, high=500.0, label="{Role}FluteLength", group="{Role} tool",
                                  meaning="flute length, 0: not given (not checked)")

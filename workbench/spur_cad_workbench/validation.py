@@ -203,42 +203,32 @@ def unusual_value_notes(job_values: dict[str, object]) -> dict[str, str]:
 def suggest_tools(values: dict[str, dict[str, object]]) -> dict[str, object]:
     """Job property values choosing tools within the recommendations (for a new job); {} if none fits.
 
-    Finishing: the tool the job's strategy suggests (FinishingStrategy.suggested_tool: by generation, the
-    default, r_t = rho and 95 % of the largest diameter that fits). Roughing: the largest 0.1 mm diameter that
-    passes the tool limits and the roughing-reach rule.
+    The tools are spur_cad's suggestion for the gear (spur_cad.cam.suggest, as a job file's "auto" sizes):
+    finishing, the tool the job's strategy suggests (by generation, the default: r_t = rho and 95 % of the
+    largest diameter that fits); roughing, the largest 0.1 mm diameter that passes the tool limits and the
+    roughing-reach rule, and below it the largest with which the whole job passes this panel's checks.
     """
-    from spur_cad.cam.recommend import recommend_tools
+    from spur_cad.cam.strategies import get_strategy
+    from spur_cad.cam.suggest import ROUGHING_STEP_MM, SMALLEST_SUGGESTED_MM, suggested_tools
 
     check = validate({**values, "job": {**values["job"], TOOL_SWITCHES["roughing"].prop: False,
                                         TOOL_SWITCHES["finishing"].prop: False}})
     if check.job is None:
         return {}
-    spec = check.job.gear
-    rec = check.recommendations
-    from spur_cad.cam.strategies import get_strategy
-    from spur_cad.cam.strategies.base import floor_to_step
-
-    strategy = get_strategy(check.job.finishing.strategy, check.job.strategies)
-    suggested = strategy.suggested_tool(spec, rec, check.job.finishing.target_scallop_mm,
-                                        check.job.stock.blank_radius_mm(spec))
-    if suggested is None:
+    job = check.job
+    strategy = get_strategy(job.finishing.strategy, job.strategies)
+    suggested = suggested_tools(job.gear, strategy, job.finishing.target_scallop_mm, job.roughing,
+                                job.stock.blank_radius_mm(job.gear), job.machine.clearance_mm)
+    if suggested.finishing is None:
         return {}
-    corner, flat = suggested
-    kind = "bull_nose" if flat > 0.0 else "ball"  # generating with a flat of 0: a ball end mill of radius rho
-    chosen = {"UseFinishingTool": True, "FinishingToolKind": kind,
-              "FinishingToolDiameter": round(flat + 2 * corner, 6),
-              "FinishingCornerRadius": round(corner, 6)}
-    from spur_cad.cam.tools import Tool
-
-    finishing = Tool(diameter_mm=chosen["FinishingToolDiameter"], kind=kind, corner_radius_mm=corner)
-    blank = check.job.stock.blank_radius_mm(spec)
-    limit = recommend_tools(spec, blank, check.job.machine.clearance_mm, finishing).roughing_max_diameter_mm
-    diameter = floor_to_step(limit, 0.1)
-    while diameter >= 0.2:
+    finishing = suggested.finishing
+    chosen = {"UseFinishingTool": True, "FinishingToolKind": finishing.kind,
+              "FinishingToolDiameter": finishing.diameter_mm, "FinishingCornerRadius": finishing.corner_radius_mm}
+    diameter = suggested.roughing.diameter_mm if suggested.roughing is not None else 0.0
+    while diameter >= SMALLEST_SUGGESTED_MM - 1e-9:
         candidate = {**chosen, "UseRoughingTool": True, "RoughingToolKind": "flat",
-                     "RoughingToolDiameter": round(diameter, 6),
-                     "RoughingCornerRadius": 0.0}
+                     "RoughingToolDiameter": round(diameter, 6), "RoughingCornerRadius": 0.0}
         if validate({**values, "job": {**values["job"], **candidate}}).ok:
             return candidate
-        diameter -= 0.1
+        diameter -= ROUGHING_STEP_MM
     return chosen
