@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import json
 import os
+import re
 import shutil
 import subprocess
 import sys
@@ -28,13 +29,14 @@ import pytest
 from tests.freecad_helper import describe, run_freecad_code
 from tests.workbench_helper import REFERENCE_JOB, ROOT
 
-ADDON_PARTS = ("package.xml", "LICENSE", "workbench", "resources/icons")  # the addon folder, in the checkout
+ADDON_PARTS = ("package.xml", "LICENSE", "workbench", "resources/icons", "resources/examples")  # the addon folder
 STEP_TIMEOUT_S = 180
 
 
 @dataclass(frozen=True)
 class WheelInstall:
     wheel: Path
+    build_output: str  # what building the wheel printed (standard output and error)
     source: Path  # the copy of the working tree the wheel was built from
     venv: Path
     site_packages: Path  # the fresh venv's
@@ -81,8 +83,8 @@ def wheel_install(tmp_path_factory) -> WheelInstall:
     source = _copy_working_tree(work / "source")
     dist = work / "dist"
     env = _environment()
-    _run([sys.executable, "-m", "pip", "wheel", "--no-deps", "--no-build-isolation", "--no-index", "-w", dist, source],
-         cwd=outside, env=env)
+    built = _run([sys.executable, "-m", "pip", "wheel", "-v", "--no-deps", "--no-build-isolation", "--no-index", "-w",
+                  dist, source], cwd=outside, env=env)
     (wheel,) = dist.glob("spur_cad-*.whl")
     venv = work / "venv"
     _run([sys.executable, "-m", "venv", "--without-pip", venv], cwd=outside, env=env)
@@ -92,7 +94,7 @@ def wheel_install(tmp_path_factory) -> WheelInstall:
     site = Path(_run([python, "-c", "import sysconfig; print(sysconfig.get_paths()['purelib'])"],
                      cwd=outside, env=env).stdout.strip())
     (site / "spur_cad_test_dependencies.pth").write_text(sysconfig.get_paths()["purelib"] + "\n")
-    return WheelInstall(wheel, source, venv, site, outside)
+    return WheelInstall(wheel, built.stdout + built.stderr, source, venv, site, outside)
 
 
 PROBE = """
@@ -107,6 +109,30 @@ spec.loader.exec_module(resources)
 print(json.dumps({"spur_cad": spur_cad.__file__, "version": spur_cad.__version__, "addon": str(root),
                   "icon": resources.icon_path("spur_cad"), "numpy": numpy.__file__}))
 """
+
+
+def test_the_wheel_builds_without_a_warning(wheel_install):
+    """setuptools warned of the addon's folders missing from `packages` (they may be left out of a wheel) and of
+    `project.license` as a table; the build (verbose: every setuptools message shown) now warns of nothing."""
+    warnings = [line for line in wheel_install.build_output.splitlines()
+                if re.search(r"warn|deprecat|would be ignored", line, re.IGNORECASE)]
+    assert warnings == [], "\n".join(warnings)
+    assert "spur_cad-" in wheel_install.build_output  # the output was really captured
+
+
+@pytest.mark.slow
+def test_the_installed_wheel_runs_the_example_it_carries(wheel_install):
+    """`spur-cad run` from the wheel's venv on the reference job the wheel carries writes the whole set."""
+    site = wheel_install.site_packages
+    job = site / "spur_cad" / "freecad_addon" / "resources" / "examples" / "reference_gear.toml"
+    assert job.is_file() and not job.is_symlink()
+    out = wheel_install.outside / "reference_out"
+    _run([wheel_install.venv / "bin" / "spur-cad", "run", job, "--out", out], cwd=wheel_install.outside,
+         env=_environment())
+    assert {"gear.step", "roughing.ngc", "finishing.ngc", "report.html", "summary.json"} <= {
+        path.name for path in out.iterdir()}
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["gear"]["tip_radius_mm"] == 50.0 and summary["simulation"]["enabled"]
 
 
 def test_the_wheel_carries_the_addon_and_installs_apart_from_the_checkout(wheel_install):

@@ -119,7 +119,9 @@ def manager_supports(freecad: tuple[str, str, str, str], low: str, high: str) ->
 
 def test_required_fields_are_present(package):
     """Format 1 in the Package_Metadata namespace (the only format FreeCAD reads); name, description, date,
-    maintainer with e-mail and a repository url (with its branch: the Addon Manager assumes "master")."""
+    maintainer with e-mail; urls of known types, a repository url with its branch (the Addon Manager assumes
+    "master"), and none a placeholder (spur_cad has no public address: it names none rather than a made-up one;
+    the Addon Manager takes the repository a user adds as a custom one, docs/install.md)."""
     assert package.tag == "{" + NAMESPACE + "}package" and package.get("format") == "1"
     name = _text(package, "p:name")
     assert name == "spur_cad" and not NAME_FORBIDDEN & set(name)
@@ -130,7 +132,10 @@ def test_required_fields_are_present(package):
     urls = package.findall("p:url", NS)
     assert {url.get("type") for url in urls} <= URL_TYPES
     repositories = [url for url in urls if url.get("type") == "repository"]
-    assert len(repositories) == 1 and repositories[0].get("branch") and repositories[0].text.strip()
+    assert len(repositories) <= 1 and all(url.get("branch") and url.text.strip() for url in repositories)
+    for url in urls:
+        host = re.sub(r"^[a-z]+://", "", (url.text or "").strip()).split("/")[0]
+        assert host and not re.search(r"(^|\.)(example\.(com|org|net)|example|invalid|test|localhost)$", host), url.text
 
 
 def test_every_element_is_in_the_package_namespace(package):
@@ -144,7 +149,8 @@ def test_version_and_licence_match_pyproject(package, pyproject):
     assert _text(package, "p:version") == pyproject["version"] == spur_cad.__version__
     assert manager_version(_text(package, "p:version"))[:3] == [int(p) for p in pyproject["version"].split(".")]
     licence = package.find("p:license", NS)
-    assert licence.text.strip() == pyproject["license"]["text"]
+    assert licence.text.strip() == pyproject["license"]  # pyproject's SPDX string (PEP 639)
+    assert pyproject["license-files"] == [licence.get("file")]
     assert re.fullmatch(r"[A-Za-z0-9.+-]+", licence.text.strip())  # an SPDX identifier, as the Addon Manager wants
     assert (ROOT / licence.get("file")).is_file()
     assert "Apache License" in (ROOT / licence.get("file")).read_text()[:200]
@@ -270,7 +276,9 @@ FAULTS = [  # (what is planted in a copy of package.xml, old text, new text, the
     ("unknown dependency type", 'type="python">tqdm', 'type="pip">tqdm', "depends"),
     ("missing dependency", '<depend type="python">tqdm</depend>', "", "depends"),
     ("import name for a pip name", ">build123d<", ">OCP<", "depends"),
-    ("url without branch", ' branch="main"', "", "fields"),
+    ("url without branch", "<icon>", '<url type="repository">https://git.host.org/spur_cad</url><icon>', "fields"),
+    ("placeholder url", "<icon>", '<url type="repository" branch="main">https://example.invalid/spur_cad</url><icon>',
+     "fields"),
     ("no maintainer e-mail", ' email="maintainers@spur-cad.invalid"', "", "fields"),
     ("format 2", 'format="1"', 'format="2"', "fields"),
     ("name with a slash", "<name>spur_cad</name>", "<name>spur/cad</name>", "fields"),
