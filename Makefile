@@ -6,7 +6,7 @@ PYTHON      := $(VENV)/bin/python
 STAMP       := $(VENV)/.installed
 PYTEST_ARGS ?=
 
-FAST_TIER   := not slow and not freecad and not linuxcnc
+FAST_TIER   := not slow and not freecad and not linuxcnc and not browser
 
 .PHONY: venv demo test test-all lint bench clean
 

@@ -49,6 +49,9 @@ class JobSection:
     name: str = key("gear job", label="JobName", group="Job", meaning="job name (summary, program headers)")
     profile_tolerance_mm: float = key(0.001, unit="mm", low=0.0001, high=0.1, label="ProfileTolerance", group="Job",
                                       meaning="chordal tolerance of sampled profiles (profile.csv)")
+    report_template: str = key("", label="ReportTemplate", group="Job",
+                               meaning="report.html's Jinja2 template, a file relative to the job file (empty: "
+                                       "spur_cad's own, spur_cad/report/templates/report.html.j2: copy it to start)")
 
 
 @dataclass(frozen=True)
@@ -150,6 +153,7 @@ class Job:
     simulation: SimulationSection = field(default_factory=SimulationSection)
     lathe: LatheSection | None = None  # [lathe] present: the blank's lathe program is written too
     text: str = field(default="", repr=False, compare=False)  # the file's text, to point at lines
+    report_template_text: str | None = field(default=None, repr=False, compare=False)  # [job] report_template's
     strategies: Strategies = field(default_factory=lambda: dict(REGISTRY), repr=False, compare=False)  # [finishing]'s
 
     def located(self, error: SpurCadError) -> str:
@@ -519,9 +523,36 @@ def _job_from_data(data: dict, source: str, text: str, strategies: Strategies = 
                tools=tools, finishing=finishing, **optional, text=text, strategies=dict(strategies))
 
 
+MAX_TEMPLATE_BYTES = 256 * 1024
+"""Largest report template read (spur_cad's own is about 7 kB)."""
+
+
+def with_report_template(job: Job, folder: Path) -> Job:
+    """The job with its [job] report_template read (relative to `folder`, the job file's) and compiled: a missing
+    or unreadable file, one that is not a regular file or larger than MAX_TEMPLATE_BYTES, or a template syntax
+    error is one JobFileError at the key's line."""
+    name = job.job.report_template
+    if not name:
+        return job
+    from spur_cad.inputs import read_regular_file
+    from spur_cad.report.html import ReportTemplateError, compile_template
+
+    path = folder / name
+    where = _where(job.source, job.text, "job", "report_template")
+    try:
+        text = read_regular_file(path, "report template", MAX_TEMPLATE_BYTES, JobFileError).decode("utf-8")
+        compile_template(text, shown_path(path))
+    except UnicodeDecodeError:
+        raise JobFileError(f"{where}: [job] report_template: {shown_path(path)} is not UTF-8 text",
+                           section="job", field="report_template") from None
+    except (JobFileError, ReportTemplateError) as exc:
+        raise JobFileError(f"{where}: [job] report_template: {exc}", section="job", field="report_template") from None
+    return dataclasses.replace(job, report_template_text=text)
+
+
 def load_job(path: str | Path, strategies: Strategies = REGISTRY) -> Job:
     """Read and validate a job file from disk (a regular file of at most MAX_JOB_FILE_BYTES: a FIFO or a device
-    is refused before it is read)."""
+    is refused before it is read); [job] report_template is read from the job file's folder."""
     from spur_cad.inputs import read_regular_file
 
     source = shown_path(path)  # messages name the file with its control characters escaped
@@ -532,4 +563,4 @@ def load_job(path: str | Path, strategies: Strategies = REGISTRY) -> Job:
         raise JobFileError(f"{source}: the job file is not UTF-8 text") from None
     if "\x00" in text:
         raise JobFileError(f"{source}: the job file contains NUL characters (not a text file)")
-    return parse_job(text, source, strategies)
+    return with_report_template(parse_job(text, source, strategies), Path(path).parent)

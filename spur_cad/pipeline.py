@@ -19,6 +19,7 @@ import numpy as np
 
 from spur_cad.cam.plan import CamInputs, CamPlan
 from spur_cad.cam.plan import plan_cam as plan_cam_inputs
+from spur_cad.errors import shown_path
 from spur_cad.geometry.sampling import ProfileSamples, sample_profile
 from spur_cad.inputs import step_timestamp
 from spur_cad.job import Job
@@ -86,8 +87,10 @@ def run_job(job: Job, progress: Callable[[str, float], None] | None = None,
                        lambda: simulate_stage(job, plan, lambda fraction: tell("simulation", fraction)))
     grading = timed("grading", None, lambda: grade_stage(job, sim_result))
     result = build_result(job, samples, cad, plan, job.post, programs, sim_result, grading, seconds)
+    template_source = shown_path(job.job.report_template) if job.job.report_template else "report.html.j2"
     report = timed("report", "report", lambda: report_html(result, png, job.gear,
-                                                          job.stock.blank_radius_mm(job.gear), plan, sim_result))
+                                                          job.stock.blank_radius_mm(job.gear), plan, sim_result,
+                                                          job.report_template_text, template_source))
     result = dataclasses.replace(result, timings_s=dict(seconds))
     files = {
         "profile.csv": profile_csv(samples),

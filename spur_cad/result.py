@@ -69,6 +69,33 @@ class ToolFacts:
     spindle_rpm: float
     feed_mm_min: float
     tool_number: int
+    flutes: int = 0
+    flute_length_mm: float = 0.0  # 0: not given
+    stick_out_mm: float = 0.0  # 0: not given
+
+
+@dataclass(frozen=True)
+class SetupFacts:
+    """How the part sits on the machine and what the programs reach (the report's set-up sheet): the blank
+    (X from the front face), the holding stub, the work offset, A's sense, coolant, the programmed tool-tip Z
+    range over every operation, and the roughing's stock, step-down and step-over."""
+
+    machine_name: str
+    blank_diameter_mm: float
+    blank_x_min_mm: float
+    blank_x_max_mm: float
+    stub_diameter_mm: float
+    stub_length_mm: float
+    work_offset: str
+    rotary_sign: int
+    coolant: bool
+    clearance_mm: float
+    z_min_mm: float | None
+    z_max_mm: float | None
+    finish_stock_mm: float
+    flank_allowance_mm: float
+    roughing_step_down_mm: float | None
+    roughing_step_over_mm: float | None
 
 
 @dataclass(frozen=True)
@@ -216,3 +243,4 @@ class JobResult:
     lathe: LatheFacts | None
     timings_s: dict[str, float]
     files: dict[str, bytes] = field(default_factory=dict)
+    setup: SetupFacts | None = None  # the report's set-up sheet (not in summary.json)

@@ -31,6 +31,7 @@ from spur_cad.result import (
     ProgramFacts,
     RoughingFacts,
     SegmentCounts,
+    SetupFacts,
     SimulationFacts,
     ToolFacts,
     ToolsFacts,
@@ -67,7 +68,7 @@ def build_result(job, samples: ProfileSamples, cad: CadResult, plan: CamPlan, po
         post=PostFacts(post.dialect, post.folded, tuple(ProgramFacts(name, p.lines, p.bytes, p.subprograms)
                                                         for name, p in programs.items())),
         simulation=simulation_facts(simulation, job.simulation.resolution_mm), grading=grading,
-        lathe=lathe_facts(job), timings_s=seconds)
+        lathe=lathe_facts(job), timings_s=seconds, setup=setup_facts(job, plan, post))
 
 
 def lathe_facts(job) -> LatheFacts | None:
@@ -85,7 +86,23 @@ def tool_facts(tool: Tool | None, machine: Machine) -> ToolFacts | None:
     if tool is None:
         return None
     return ToolFacts(tool.kind, tool.diameter_mm, tool.effective_corner_radius_mm, tool.flat_width_mm,
-                     tool.spindle_rpm(machine), tool.feed_mm_min(machine), tool.tool_number)
+                     tool.spindle_rpm(machine), tool.feed_mm_min(machine), tool.tool_number, tool.flutes,
+                     tool.flute_length_mm, tool.stick_out_mm)
+
+
+def setup_facts(job, plan: CamPlan, post: PostSettings) -> SetupFacts:
+    """The set-up sheet's facts of a job (`job` is a spur_cad.job.Job) and its plan."""
+    spec, stock, rough = job.gear, job.stock, job.roughing
+    paths = [p.toolpath for p in (plan.roughing, plan.roughing_bottom, plan.finishing) if p is not None]
+    z = np.concatenate([path.z[path.motion_mask] for path in paths]) if paths else np.zeros(0)
+    x_min, x_max = stock.blank_x_range_mm(spec)
+    tool = job.tools.roughing
+    return SetupFacts(
+        job.machine.name, 2.0 * stock.blank_radius_mm(spec), x_min, x_max, stock.stub_diameter_mm,
+        stock.stub_length_mm, post.work_offset, post.rotary_sign, post.coolant, job.machine.clearance_mm,
+        float(z.min()) if z.size else None, float(z.max()) if z.size else None, rough.finish_stock_mm,
+        rough.flank_allowance_mm, rough.max_level_depth_fraction * tool.diameter_mm if tool is not None else None,
+        rough.step_over_fraction * tool.diameter_mm if tool is not None else None)
 
 
 def tools_facts(plan: CamPlan, machine: Machine, roughing_tool: Tool | None,

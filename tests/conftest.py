@@ -1,5 +1,5 @@
 """pytest plumbing for the external tools: FreeCAD (`freecad` marker), LinuxCNC `rs274`
-(`linuxcnc` marker).
+(`linuxcnc` marker), headless Chromium and poppler's pdfinfo / pdftotext (`browser` marker).
 
 A marked test whose tool is missing is skipped locally, but fails when the environment
 variable CI is "true": CI installs the tools (.ci/run), so a missing tool there is a bug.
@@ -21,7 +21,7 @@ FREECADCMD_CANDIDATES = ("/usr/lib/freecad/bin/freecadcmd-python3", "/usr/lib/fr
                          "/usr/lib/freecad-python3/bin/FreeCADCmd")
 FREECAD_GUI_NAMES = ("freecad", "FreeCAD", "freecad-python3")
 
-__all__ = ["freecad_gui_paths", "freecadcmd_path", "rs274_path"]
+__all__ = ["browser_paths", "freecad_gui_paths", "freecadcmd_path", "rs274_path"]
 
 
 def _find(names: tuple[str, ...], candidates: tuple[str, ...] = (), env_var: str | None = None) -> str | None:
@@ -48,6 +48,14 @@ def freecad_gui_paths() -> tuple[str, str] | None:
     return (xvfb_run, freecad) if xvfb_run and freecad else None
 
 
+def browser_paths() -> tuple[str, str, str] | None:
+    """(chromium, pdfinfo, pdftotext): Debian's Chromium to render and print report.html, poppler to read the
+    PDF it prints; None if any is missing."""
+    chromium = _find(("chromium", "chromium-browser"), (), "CHROMIUM")
+    pdfinfo, pdftotext = shutil.which("pdfinfo"), shutil.which("pdftotext")
+    return (chromium, pdfinfo, pdftotext) if chromium and pdfinfo and pdftotext else None
+
+
 def running_in_ci() -> bool:
     """True when the environment variable CI says so (GitHub/GitLab set CI=true)."""
     return os.environ.get("CI", "").strip().lower() in ("true", "1", "yes")
@@ -69,6 +77,8 @@ def pytest_runtest_setup(item: pytest.Item) -> None:
         require_tool(freecadcmd_path(), "FreeCAD", "freecadcmd")
     if item.get_closest_marker("linuxcnc"):
         require_tool(rs274_path(), "LinuxCNC", "rs274")
+    if item.get_closest_marker("browser"):
+        require_tool(browser_paths(), "Chromium and poppler", "chromium, pdfinfo or pdftotext")
 
 
 @pytest.fixture(scope="session")
@@ -81,6 +91,12 @@ def freecadcmd() -> str:
 def freecad_gui() -> tuple[str, str]:
     """(xvfb-run, freecad) for GUI tests (skip locally / fail in CI when missing)."""
     return require_tool(freecad_gui_paths(), "FreeCAD GUI", "xvfb-run or freecad")
+
+
+@pytest.fixture(scope="session")
+def browser() -> tuple[str, str, str]:
+    """(chromium, pdfinfo, pdftotext) (skip locally / fail in CI when missing)."""
+    return require_tool(browser_paths(), "Chromium and poppler", "chromium, pdfinfo or pdftotext")
 
 
 @pytest.fixture(scope="session")

@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import dataclasses
 import json
+import re
 from dataclasses import dataclass
 
 import pytest
@@ -116,7 +117,9 @@ def test_the_summary_and_the_report_show_the_strategy_s_own_facts_and_advice():
     advice = json.loads(result.files["summary.json"])["tools"]["rows_advice"]
     assert advice == {"rows_tool_max_diameter_mm": 2.0 * result.tools.finishing.diameter_mm}
     report = result.files["report.html"].decode()
-    assert "For finishing strategy rows" in report and "rows_tool_max_diameter_mm" in report
+    assert "Advice for finishing strategy rows" in report  # its advice, labelled from its field names
+    assert re.search(rf"rows tool max diameter</th><td class=\"num\">{advice['rows_tool_max_diameter_mm']:.3f}</td>"
+                     r"<td class=\"unit\">mm</td>", report)
 
 
 def test_a_registry_s_default_strategy_applies_without_a_finishing_section():

@@ -7,6 +7,8 @@ cycle time of the bottom tool alone (a plan without the large tool), LinuxCNC's 
 
 from __future__ import annotations
 
+import re
+
 import numpy as np
 import pytest
 from shapely.geometry import Polygon
@@ -184,4 +186,5 @@ def test_the_report_and_summary_show_both_programs_and_the_time_saved(two_stage,
     assert stage["bottom"]["moves"] == len(plan.roughing_bottom.toolpath)
     assert summary["post"]["roughing_bottom_lines"] > 0
     report = (tmp_path / "out" / "report.html").read_text()
-    assert "Two-stage roughing: the bottom tool (T3, D 1.5 mm)" in report and "roughing_bottom" in report
+    assert "Two-stage roughing: the bottom tool (T3, D 1.500 mm)" in report and "roughing_bottom.ngc" in report
+    assert re.search(r"<th>T3</th><td class=\"text\">roughing, bottom of the spaces</td>", report)  # its tool row

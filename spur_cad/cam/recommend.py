@@ -156,12 +156,12 @@ def small_tool_warnings(rec: ToolRecommendations, smallest_end_mill_mm: float, s
                         finishing: tuple[str, float], finishing_kind: str | None = None) -> tuple[str, ...]:
     """Warnings for recommended largest tools below [machine] smallest_end_mill_mm (no catalogue tool of that
     kind fits this gear): roughing, finishing for `strategy` (`finishing`: the strategy's own largest tool, its
-    name and diameter, FinishingStrategy.largest_tool) and, when the job finishes with a flat end mill
-    (`finishing_kind`), the flat end mill's. Limits at 0 (no such tool at all) are errors elsewhere, not
-    warnings."""
+    name and diameter, FinishingStrategy.largest_tool) and the flat end mill's, unless the job finishes with a
+    tool that has a corner (`finishing_kind` bull_nose or ball: the flat end mill's limit is not its concern).
+    Limits at 0 (no such tool at all) are errors elsewhere, not warnings."""
     limits = (("roughing tool", "roughing_max_diameter_mm", rec.roughing_max_diameter_mm),
               (f"finishing tool for strategy {strategy}", *finishing))
-    if finishing_kind == "flat":
+    if finishing_kind in (None, "flat"):
         limits += (("flat end mill for finishing by generation", "finishing_flat_end_mill_max_diameter_mm",
                     rec.finishing_flat_end_mill_max_diameter_mm),)
     return tuple(f"this gear's largest {what} ({name} = {value:.3f} mm) is below the smallest end mill "

@@ -1,1 +1,2 @@
-"""Plots and (later) the HTML report; matplotlib is used through its object API only (no pyplot state)."""
+"""Figures and the report: matplotlib through its object API only (no pyplot state), report.html from a Jinja2
+template (templates/report.html.j2)."""

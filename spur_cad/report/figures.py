@@ -111,25 +111,26 @@ def deviation_map_png(result: SimResult) -> bytes:
     worst = int(np.maximum(most, -least).argmax())
     worst_space = deviation[worst] * 1000.0  # um
     limit = max(float(np.abs(worst_space).max()), 1000.0 * result.settings.resolution_mm)
-    fig = figure(9.0, 7.0, left=0.08, right=1.0, bottom=0.07, top=0.95)
+    fig = figure(9.0, 7.0, left=0.08, right=0.97, bottom=0.07, top=0.95)
     fig.subplots_adjust(hspace=0.3)
     ax, bars = fig.subplots(2, 1, height_ratios=[3, 1.4])
     image = ax.pcolormesh(arc, x, worst_space.T, cmap="RdBu_r", vmin=-limit, vmax=limit, shading="nearest")
-    fig.colorbar(image, ax=ax, label="deviation [um] (red: leftover, blue: gouge)")
+    fig.colorbar(image, ax=ax, label="deviation [\u00b5m] (red: leftover, blue: gouge)", fraction=0.05, pad=0.02)
     names = result.grid.feature_names()
     starts = [0] + [j for j in range(1, len(names)) if names[j] != names[j - 1]]
     for j in starts:
         ax.axvline(arc[j], color="k", lw=0.4)
-        ax.annotate(names[j], (arc[j], x[-1]), fontsize=6, rotation=90, va="top", ha="right")
+        ax.annotate(names[j], (arc[j], x[-1]), fontsize=7, rotation=90, va="top", ha="right",
+                    xytext=(-1, -2), textcoords="offset points")
     ax.set_xlabel("position along the tooth space, right tooth centre -> root -> left tooth centre [mm]")
     ax.set_ylabel("X (face width) [mm]")
     ax.set_title(f"simulated deviation of tooth space {worst} (largest |deviation|); resolution "
-                 f"{1000 * result.settings.resolution_mm:g} um", fontsize=9)
+                 f"{1000 * result.settings.resolution_mm:g} \u00b5m", fontsize=9)
     spaces = np.arange(deviation.shape[0])
     bars.bar(spaces - 0.2, np.maximum(most, 0.0), width=0.4, color="tab:red", label="max leftover")
     bars.bar(spaces + 0.2, np.maximum(-least, 0.0), width=0.4, color="tab:blue", label="max gouge")
     bars.set_xlabel("tooth space")
-    bars.set_ylabel("[um]")
+    bars.set_ylabel("[\u00b5m]")
     bars.legend(fontsize=8)
     bars.grid(True, lw=0.3, axis="y")
     return _png(fig)
@@ -159,18 +160,19 @@ def k_chart_png(spec: GearSpec, grading: Grading) -> bytes:
         for row, kind in enumerate(("profile", "helix")):
             ax = axes[row][column]
             band = tolerance_um("F_aT" if kind == "profile" else "F_bT", grade, d, b, m)  # the gear's class
-            for trace in (t for t in traces if t.kind == kind and t.side == side and t.space == worst):
+            chosen = [t for t in traces if t.kind == kind and t.side == side and t.space == worst]
+            for trace, style in zip(chosen, ("-", "--", ":", "-.") * len(chosen)):  # coinciding traces stay visible
                 label = f"X = {trace.x_mm:.2f} mm" if trace.x_mm is not None else "reference circle"
-                ax.plot(trace.position_mm, trace.deviation_um, lw=0.9, label=label)
+                ax.plot(trace.position_mm, trace.deviation_um, style, lw=1.1, label=label)
                 mean = float(np.mean(trace.deviation_um))
                 for edge in (-0.5 * band, 0.5 * band):
                     ax.axhline(mean + edge, color="tab:red", lw=0.6, ls="--")
                 for edge in trace.evaluation:
                     ax.axvline(edge, color="k", lw=0.5, ls=":")
             ax.set_title(f"space {worst}, {side} flank: {kind} (band: class {grade} "
-                         f"{'F_aT' if kind == 'profile' else 'F_bT'} = {band:g} um)", fontsize=8)
+                         f"{'F_aT' if kind == 'profile' else 'F_bT'} = {band:g} \u00b5m)", fontsize=8)
             ax.set_xlabel("roll length [mm]" if kind == "profile" else "X (face width) [mm]", fontsize=8)
-            ax.set_ylabel("deviation [um] (+ material)", fontsize=8)
+            ax.set_ylabel("deviation [\u00b5m] (+ material)", fontsize=8)
             ax.grid(True, lw=0.3)
             if ax.get_legend_handles_labels()[0]:
                 ax.legend(fontsize=6)

@@ -51,12 +51,17 @@ def tooth_space_png(spec: GearSpec, samples: ProfileSamples) -> bytes:
     half_angle = np.pi / spec.teeth
     span = np.linspace(-1.3 * half_angle, 1.3 * half_angle, 200)
     profile = spec.tooth_space_profile()
-    for name, radius in (("tip", spec.tip_radius_mm), ("reference", spec.reference_radius_mm),
-                         ("base", spec.base_radius_mm), ("form", profile.form_radius_mm),
-                         ("root", spec.root_radius_mm)):
+    circles = sorted((("tip", spec.tip_radius_mm), ("reference", spec.reference_radius_mm),
+                      ("base", spec.base_radius_mm), ("form", profile.form_radius_mm),
+                      ("root", spec.root_radius_mm)), key=lambda item: -item[1])
+    label_gap = 0.045 * (spec.tip_radius_mm - spec.root_radius_mm + 1.0)  # labels of close circles kept apart
+    label_y = np.inf
+    for name, radius in circles:  # top down, each label at least label_gap below the one above it
         ax.plot(radius * np.sin(span), radius * np.cos(span), ":", color="0.6", lw=0.8)
-        ax.annotate(f"{name} r={radius:.3f}", (radius * np.sin(span[-1]), radius * np.cos(span[-1])),
-                    fontsize=7, color="0.4")
+        end_y = radius * np.cos(span[-1])
+        label_y = min(end_y, label_y - label_gap)
+        ax.annotate(f"{name} r = {radius:.3f} mm", (radius * np.sin(span[-1]), end_y), xytext=(
+            radius * np.sin(span[-1]), label_y), fontsize=7, color="0.4", va="center")
     ax.set_aspect("equal")
     ax.set_xlabel("x [mm]")
     ax.set_ylabel("y [mm] (space axis)")
@@ -64,6 +69,6 @@ def tooth_space_png(spec: GearSpec, samples: ProfileSamples) -> bytes:
              f"x={spec.profile_shift_coefficient:g}"
              f"  rho={spec.rack_tip_radius_mm:g} mm" + ("  UNDERCUT" if profile.undercut else ""))
     ax.set_title(title, fontsize=9)
-    ax.legend(loc="upper center", fontsize=8, ncols=4)
+    ax.legend(loc="lower center", fontsize=8, ncols=4)  # below the root: the tip circle stays visible
     ax.grid(True, lw=0.3)
     return _png(fig)

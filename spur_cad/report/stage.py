@@ -6,7 +6,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from spur_cad.report.html import render_report
+from spur_cad.report.html import TEMPLATE_NAME, render_report
 
 if TYPE_CHECKING:
     from spur_cad.cam.plan import CamPlan
@@ -16,9 +16,10 @@ if TYPE_CHECKING:
 
 
 def report_html(result: JobResult, profile_png: bytes, spec: GearSpec, blank_radius_mm: float, plan: CamPlan,
-                sim: SimResult | None) -> bytes:
+                sim: SimResult | None, template_text: str | None = None, template_source: str = TEMPLATE_NAME) -> bytes:
     """report.html for a job (pure: bytes out): values from the typed result, levels and contact poses from the
-    plan and the deviation map from the simulation (not recomputed)."""
+    plan and the deviation map from the simulation (not recomputed); `template_text`: a shop's own template
+    (default spur_cad's), `template_source` names it in messages."""
     from spur_cad.report.figures import deviation_map_png, finishing_png, passes_png, roughing_levels_png
 
     images = {"profile": profile_png}
@@ -41,4 +42,4 @@ def report_html(result: JobResult, profile_png: bytes, spec: GearSpec, blank_rad
         from spur_cad.report.figures import k_chart_png
 
         images["kchart"] = k_chart_png(spec, result.grading)
-    return render_report(result, images)
+    return render_report(result, images, template_text, template_source)

@@ -53,8 +53,8 @@ class GeneratingFacts:
     def report_text(self) -> str:
         return (f"Finishing: generating, {self.passes_per_space} straight passes per tooth space with A clamped: "
                 f"{self.flank_passes_per_flank} per flank (generating flat height "
-                f"{1000 * self.flat_height_mm:.2f} um), {self.tip_mode_passes_per_space} on fillets and root "
-                f"(largest sampled leftover {1000 * self.tip_mode_leftover_mm:.2f} um), "
+                f"{1000 * self.flat_height_mm:.2f} \u00b5m), {self.tip_mode_passes_per_space} on fillets and root "
+                f"(largest sampled leftover {1000 * self.tip_mode_leftover_mm:.2f} \u00b5m), "
                 f"{self.land_passes_per_space} on the tip land; {self.cutting_direction} milling, flank tool end "
                 f"'{self.flank_tool_end}'.")
 

@@ -1,0 +1,367 @@
+"""The report's values as a gear maker reads them: labelled rows with units and a sensible precision, built from
+the job's typed result for the report template (report/templates/report.html.j2, or a shop's own copy).
+
+Precision: gear and tool sizes in mm to 3 decimals, inspection dimensions to 4 (micrometres matter there),
+deviations in µm to 1 decimal, angles to 3 decimals, speeds and feeds whole, times in h and min. A negative
+zero is shown as 0.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from dataclasses import dataclass
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from spur_cad.result import JobResult, ToolFacts
+
+MICRO = "\u00b5m"
+
+
+@dataclass(frozen=True)
+class Row:
+    """One labelled value: the label a gear maker reads, the value as text, its unit ('' for none)."""
+
+    label: str
+    value: str
+    unit: str = ""
+
+
+@dataclass(frozen=True)
+class Table:
+    """A table with a head row and rows of text cells (the first cell a label)."""
+
+    head: tuple[str, ...]
+    rows: tuple[tuple[str, ...], ...]
+
+
+def number(value: float | int | None, digits: int = 3) -> str:
+    """`value` with `digits` decimals; '-' for None; never '-0.000'."""
+    if value is None:
+        return "-"
+    if isinstance(value, bool):
+        return "yes" if value else "no"
+    if isinstance(value, int):
+        return f"{value:,}"
+    text = f"{value:.{digits}f}"
+    return text[1:] if text.startswith("-") and float(text) == 0.0 else text
+
+
+def signed(value: float, digits: int = 1) -> str:
+    """A signed value ('+4.9', '-0.3'; 0 as '0.0')."""
+    text = number(value, digits)
+    return text if text.startswith("-") or float(text) == 0.0 else f"+{text}"
+
+
+def duration(seconds: float | None) -> str:
+    """'2 h 31 min' ('-' for None; under an hour '41 min', under a minute '12 s')."""
+    if seconds is None:
+        return "-"
+    if seconds < 60.0:
+        return f"{seconds:.0f} s"
+    minutes = round(seconds / 60.0)
+    return f"{minutes // 60} h {minutes % 60:02d} min" if minutes >= 60 else f"{minutes} min"
+
+
+GEAR_LABELS = (  # (GearFacts field, label, unit, digits); helical rows only for a helical gear
+    ("teeth", "number of teeth z", "", 0),
+    ("module_mm", "module m (normal module m_n for a helical gear)", "mm", 3),
+    ("pressure_angle_deg", "pressure angle", "°", 3),
+    ("profile_shift_coefficient", "profile shift coefficient x", "", 3),
+    ("addendum_coefficient", "addendum coefficient", "", 3),
+    ("dedendum_coefficient", "dedendum coefficient", "", 3),
+    ("rack_tip_radius_mm", "rack tip radius rho", "mm", 3),
+    ("face_width_mm", "face width b", "mm", 3),
+    ("reference_radius_mm", "reference radius", "mm", 4),
+    ("base_radius_mm", "base radius", "mm", 4),
+    ("tip_radius_mm", "tip radius", "mm", 4),
+    ("root_radius_mm", "root radius", "mm", 4),
+    ("form_radius_mm", "form radius (involute starts)", "mm", 4),
+    ("tooth_thickness_mm", "tooth thickness on the reference circle", "mm", 4),
+    ("space_width_mm", "space width on the reference circle", "mm", 4),
+    ("tip_thickness_mm", "tooth thickness at the tip", "mm", 4),
+    ("root_arc_length_mm", "root arc length", "mm", 3),
+    ("undercut", "undercut", "", 0),
+)
+HELICAL_LABELS = (
+    ("helix_angle_deg", "helix angle on the reference cylinder", "°", 3),
+    ("hand", "hand of helix", "", 0),
+    ("transverse_module_mm", "transverse module", "mm", 4),
+    ("transverse_pressure_angle_deg", "transverse pressure angle", "°", 3),
+    ("base_helix_angle_deg", "base helix angle", "°", 3),
+    ("lead_mm", "lead", "mm", 3),
+    ("overlap_ratio", "overlap ratio", "", 3),
+)
+LIMIT_LABELS = (  # (ToolRecommendations field, label)
+    ("roughing_max_diameter_mm", "largest roughing end mill (flat)"),
+    ("finishing_generating_max_diameter_mm", "largest finishing tool by generation (corner = rack tip radius)"),
+    ("finishing_flat_end_mill_max_diameter_mm", "largest flat end mill that finishes by generation"),
+    ("finishing_max_corner_radius_mm", "largest finishing corner radius (the fillet's tightest curve)"),
+    ("finishing_max_flat_width_mm", "largest finishing flat width (the root arc)"),
+    ("plunge_allowance_mm", "material roughing may leave above the root"),
+    ("required_flute_length_mm", "flute length the tools need (blank to root)"),
+    ("required_stick_out_mm", "stick-out the tools need"),
+)
+TOOL_KINDS = {"flat": "flat end mill", "bull_nose": "bull-nose end mill", "ball": "ball end mill"}
+OPERATION_NAMES = {"roughing": "roughing", "roughing_bottom": "roughing, bottom of the spaces",
+                   "finishing": "finishing"}
+
+
+def _value(value: object, digits: int) -> str:
+    if isinstance(value, str):
+        return value
+    if isinstance(value, float) and digits == 0:
+        return number(value, 0)
+    return number(value, digits)  # type: ignore[arg-type]
+
+
+def gear_rows(result: JobResult) -> tuple[Row, ...]:
+    """The gear's data, labelled (helical rows for a helical gear)."""
+    labels = GEAR_LABELS + (HELICAL_LABELS if result.gear.is_helical else ())
+    return tuple(Row(label, _value(getattr(result.gear, name), digits), unit) for name, label, unit, digits in labels)
+
+
+def limit_rows(result: JobResult) -> tuple[Row, ...]:
+    """The gear's tool limits, labelled (0 shown as 'none fits')."""
+    rec = result.tools.recommendations
+    return tuple(Row(label, number(getattr(rec, name), 3) if getattr(rec, name) > 0.0 else "none fits",
+                     "mm" if getattr(rec, name) > 0.0 else "") for name, label in LIMIT_LABELS)
+
+
+def advice_rows(result: JobResult) -> tuple[Row, ...]:
+    """The finishing strategy's own tool advice (its fields as sentences: '_mm' names become 'mm' units)."""
+    advice = result.tools.advice
+    if advice is None:
+        return ()
+    rows = []
+    for name, value in dataclasses.asdict(advice).items():
+        if value is None:
+            continue
+        unit = "mm" if name.endswith("_mm") else ""
+        label = name.removesuffix("_mm").replace("_", " ")
+        rows.append(Row(label, _value(value, 3), unit))
+    return tuple(rows)
+
+
+def tool_cells(role: str, tool: ToolFacts) -> tuple[str, ...]:
+    """A tool's row of the tool table: T number, role, type, D, corner, flat, flute length, stick-out, flutes,
+    speed, feed (lengths not given shown as '-')."""
+    def length(value: float) -> str:
+        return number(value, 1) if value > 0.0 else "-"
+
+    return (f"T{tool.tool_number}", role, TOOL_KINDS.get(tool.kind, tool.kind), number(tool.diameter_mm, 3),
+            number(tool.corner_radius_mm, 3), number(tool.flat_width_mm, 3), length(tool.flute_length_mm),
+            length(tool.stick_out_mm), str(tool.flutes), number(tool.spindle_rpm, 0), number(tool.feed_mm_min, 0))
+
+
+TOOL_HEAD = ("tool", "used for", "type", "D [mm]", "corner r [mm]", "flat [mm]", "flute length [mm]",
+             "stick-out [mm]", "flutes", "spindle [rpm]", "feed [mm/min]")
+
+
+def program_file(result: JobResult, operation: str) -> str:
+    """The operation's program file as the output set names it ('-' when no program was written)."""
+    from spur_cad.post.dialects import dialect
+
+    if result.post.program(operation) is None:
+        return "-"
+    return f"{operation}.{dialect(result.post.dialect).extension}"
+
+
+def tool_table(result: JobResult) -> Table:
+    """Every tool the programs load, in the order they are used."""
+    tools = result.tools
+    used = [("roughing", tools.roughing)]
+    rough = result.roughing
+    if rough is not None and rough.two_stage is not None:
+        used.append(("roughing, bottom of the spaces", rough.two_stage.bottom_tool))
+    used.append(("finishing", tools.finishing))
+    return Table(TOOL_HEAD, tuple(tool_cells(role, tool) for role, tool in used if tool is not None))
+
+
+def _operations(result: JobResult) -> list[tuple[str, object, object]]:
+    """(operation, facts, its tool) of the operations the job has."""
+    rough, finish, tools = result.roughing, result.finishing, result.tools
+    out = []
+    if rough is not None:
+        out.append(("roughing", rough, tools.roughing))
+        if rough.two_stage is not None:
+            out.append(("roughing_bottom", rough.two_stage.bottom, rough.two_stage.bottom_tool))
+    if finish is not None:
+        out.append(("finishing", finish, tools.finishing))
+    return out
+
+
+def operation_table(result: JobResult) -> Table:
+    """Per operation: program, strategy, tool, stock to leave, step-down / step-over, coolant, time and its share."""
+    setup = result.setup
+    operations = _operations(result)
+    total = sum(facts.estimate.time_with_acceleration_s for _, facts, _ in operations) or 1.0
+    rows = []
+    for name, facts, tool in operations:
+        program = program_file(result, name)
+        if name.startswith("roughing"):
+            strategy = f"z-level roughing, {facts.levels_per_space} levels per space"
+            stock = (f"{number(setup.finish_stock_mm, 2)} to {number(setup.flank_allowance_mm, 2)} mm"
+                     if setup is not None else "-")
+            steps = (f"down {number(setup.roughing_step_down_mm, 2)} mm, "
+                     f"over {number(setup.roughing_step_over_mm, 2)} mm"
+                     if setup is not None and setup.roughing_step_down_mm is not None and name == "roughing" else "-")
+        else:
+            strategy = f"finishing, strategy {facts.strategy}"
+            stock, steps = "0 (to size)", "-"
+        seconds = facts.estimate.time_with_acceleration_s
+        rows.append((OPERATION_NAMES.get(name, name), program, strategy,
+                     f"T{tool.tool_number}" if tool is not None else "-", stock, steps,
+                     ("on" if setup.coolant else "off") if setup is not None else "-", duration(seconds),
+                     f"{100.0 * seconds / total:.0f} %"))
+    head = ("operation", "program", "strategy", "tool", "stock to leave", "step-down / step-over", "coolant",
+            "estimated time", "share")
+    return Table(head, tuple(rows))
+
+
+def totals_rows(result: JobResult) -> tuple[Row, ...]:
+    """The job's totals: operations, tools, Z range, largest speed and feed, path lengths, estimated time."""
+    operations = _operations(result)
+    setup = result.setup
+    tools = [tool for _, _, tool in operations if tool is not None]
+    cutting = sum(facts.estimate.cutting_length_mm for _, facts, _ in operations)
+    rapid = sum(facts.estimate.rapid_length_mm for _, facts, _ in operations)
+    seconds = sum(facts.estimate.time_with_acceleration_s for _, facts, _ in operations)
+    rows = [Row("operations", str(len(operations))),
+            Row("tools", str(len({tool.tool_number for tool in tools})))]
+    if setup is not None and setup.z_min_mm is not None:
+        rows.append(Row("programmed tool-tip Z (from the rotary axis)",
+                        f"{number(setup.z_min_mm, 3)} to {number(setup.z_max_mm, 3)}", "mm"))
+    if tools:
+        rows += [Row("largest spindle speed", number(max(t.spindle_rpm for t in tools), 0), "rpm"),
+                 Row("largest feed", number(max(t.feed_mm_min for t in tools), 0), "mm/min")]
+    rows += [Row("cutting path", number(cutting / 1000.0, 2), "m"), Row("rapid path", number(rapid / 1000.0, 2), "m"),
+             Row("estimated machine time (with acceleration)", duration(seconds))]
+    return tuple(rows)
+
+
+def setup_rows(result: JobResult) -> tuple[Row, ...]:
+    """Stock, work offset and A's zero, as a machinist sets the part up."""
+    setup, gear = result.setup, result.gear
+    if setup is None:
+        return ()
+    rows = [Row("machine", setup.machine_name),
+            Row("blank diameter", number(setup.blank_diameter_mm, 3), "mm"),
+            Row("blank along X (front face of the gear at X = 0)",
+                f"{number(setup.blank_x_min_mm, 3)} to {number(setup.blank_x_max_mm, 3)}", "mm")]
+    if setup.stub_diameter_mm > 0.0:
+        rows.append(Row("holding stub toward the chuck (+X)",
+                        f"D {number(setup.stub_diameter_mm, 3)} x {number(setup.stub_length_mm, 3)}", "mm"))
+    rows += [
+        Row("work offset", f"{setup.work_offset}: X = 0 on the gear's front face, Y = 0 and Z = 0 on the rotary axis"),
+        Row("A zero", f"tooth space 0's axis points to +Z; space k is brought under the tool at "
+                      f"A = -k x {number(360.0 / gear.teeth, 4)}°"
+                      + ("" if setup.rotary_sign == 1 else " (the post writes A with the opposite sign)")),
+        Row("gear axis", "machine X = rotary axis A; the tool along Z, above the part"),
+        Row("clearance above the blank for moves that turn A", number(setup.clearance_mm, 3), "mm"),
+    ]
+    return tuple(rows)
+
+
+def program_table(result: JobResult) -> Table:
+    """The programs: file, moves, lines, size, cutting path, both estimated times."""
+    rows = []
+    for name, facts, _ in _operations(result):
+        program = result.post.program(name)
+        est = facts.estimate
+        rows.append((OPERATION_NAMES.get(name, name), program_file(result, name),
+                     f"{est.moves:,}", f"{program.lines:,}" if program is not None else "-",
+                     f"{program.bytes / 1000:.1f} kB" if program is not None else "-",
+                     f"{number(est.cutting_length_mm / 1000.0, 2)} m", duration(est.time_s),
+                     duration(est.time_with_acceleration_s)))
+    head = ("operation", "program", "moves", "lines", "size", "cutting path", "time at feed", "with acceleration")
+    return Table(head, tuple(rows))
+
+
+def inspection_rows(result: JobResult) -> tuple[Row, ...]:
+    """The inspection sheet: span, pins, chordal thickness, each to 4 decimals, with the allowance."""
+    ins, helical = result.inspection, result.gear.is_helical
+    nominal = ins.tooth_thickness_mm + ins.thickness_reduction_mm
+    span = f"span measurement W_k over k = {ins.span_teeth_k} teeth" + (" (normal section)" if helical else "")
+    rows = [
+        Row(span, number(ins.span_measurement_mm, 4) if ins.span_measurement_mm is not None
+            else f"face too narrow (needs more than {number(ins.span_min_face_width_mm, 2)} mm): measure over balls",
+            "mm" if ins.span_measurement_mm is not None else ""),
+        Row("anvils touch the flanks at radius", number(ins.span_contact_radius_mm, 3), "mm"),
+        Row("pin (ball) diameter", number(ins.pin_diameter_mm, 4), "mm"),
+        Row("dimension over pins (balls)", number(ins.dimension_over_pins_mm, 4), "mm"),
+        Row("pins touch the flanks at radius", number(ins.pin_contact_radius_mm, 3), "mm"),
+        Row(("normal " if helical else "") + "chordal tooth thickness", number(ins.chordal_thickness_mm, 4), "mm"),
+        Row(f"at chordal height (measuring radius {number(ins.chordal_measuring_radius_mm, 3)} mm)",
+            number(ins.chordal_height_mm, 4), "mm"),
+        Row("tooth thickness on the reference circle", number(ins.tooth_thickness_mm, 4), "mm"),
+        Row("nominal thickness (no allowance)", number(nominal, 4), "mm"),
+        Row("thickness allowance (upper deviation)", signed(-ins.thickness_reduction_mm, 4), "mm"),
+        Row("fewest teeth without undercut", str(ins.min_teeth_without_undercut)),
+    ]
+    return tuple(rows)
+
+
+def expected_tolerance(result: JobResult) -> str | None:
+    """The span and thickness the simulated cut leaves (from the involute flanks' deviations), or None."""
+    ins, sim = result.inspection, result.simulation
+    flanks = [sim.feature(f"{side} involute") for side in ("right", "left")]
+    if not (sim.enabled and all(flanks) and ins.span_measurement_mm is not None):
+        return None
+    low = -max(f.max_gouge_mm for f in flanks)
+    high = max(f.max_leftover_mm for f in flanks)
+    return (f"The simulated cut leaves each involute flank {signed(1000 * low)} to {signed(1000 * high)} {MICRO} "
+            f"from the design: span measurement {number(ins.span_measurement_mm + 2 * low, 4)} to "
+            f"{number(ins.span_measurement_mm + 2 * high, 4)} mm.")
+
+
+def simulation_rows(result: JobResult) -> tuple[Row, ...]:
+    """The simulated cut's figures in µm."""
+    sim = result.simulation
+    if not sim.enabled:
+        return ()
+    return (Row("resolution", number(1000 * sim.resolution_mm, 1), MICRO),
+            Row("largest gouge (material cut below the design)", number(1000 * sim.max_gouge_mm, 1), MICRO),
+            Row("largest leftover (material left above the design)", number(1000 * sim.max_leftover_mm, 1), MICRO),
+            Row("leftover: mean / 95 % / 99 % of the finished points",
+                f"{number(1000 * sim.scallop_mean_mm, 1)} / {number(1000 * sim.scallop_p95_mm, 1)} / "
+                f"{number(1000 * sim.scallop_p99_mm, 1)}", MICRO),
+            Row("removed volume", number(sim.removed_volume_mm3, 0), "mm³"),
+            Row("design points measured (all spaces and rows)", f"{sim.design_points:,}"))
+
+
+def feature_table(result: JobResult) -> Table:
+    """Per feature of the tooth space: largest gouge and leftover, mean deviation (µm)."""
+    sim = result.simulation
+    rows = tuple((f.feature, number(1000 * f.max_gouge_mm, 1), number(1000 * f.max_leftover_mm, 1),
+                  signed(1000 * f.mean_mm, 1)) for f in sim.per_feature) if sim.enabled else ()
+    return Table(("feature", f"largest gouge [{MICRO}]", f"largest leftover [{MICRO}]", f"mean [{MICRO}]"), rows)
+
+
+DEVIATION_LABELS = {"f_pt": "single pitch f_pt", "F_p": "total cumulative pitch F_p", "f_Ha": "profile slope f_Ha",
+                    "f_fa": "profile form f_fa", "F_a": "total profile F_a", "f_Hb": "helix slope f_Hb",
+                    "f_fb": "helix form f_fb", "F_b": "total helix F_b"}
+
+
+def grading_table(result: JobResult) -> Table:
+    """ISO 1328-1 deviations of the worst flank (µm) and their classes."""
+    grading = result.grading
+    rows = () if grading is None else tuple(
+        (label, number(grading.deviations_um[name], 1), str(grading.classes[name] or "beyond 11"))
+        for name, label in DEVIATION_LABELS.items())
+    return Table(("deviation (worst flank)", f"[{MICRO}]", "class"), rows)
+
+
+def warning_lines(result: JobResult) -> tuple[str, ...]:
+    """The run's warnings and the simulation's own (a gouge beyond the resolution, points never cut)."""
+    items = list(result.warnings)
+    sim = result.simulation
+    if sim.enabled:
+        if sim.max_gouge_mm > sim.resolution_mm:
+            w = sim.worst_gouge
+            items.append(f"simulation: gouge of {number(1000 * sim.max_gouge_mm, 1)} {MICRO} at tooth space "
+                         f"{w.space}, {w.feature}, X = {number(w.x_mm, 3)} mm")
+        if sim.uncut_points:
+            items.append(f"simulation: {sim.uncut_points:,} design points keep more than "
+                         f"{number(sim.leftover_range_mm, 1)} mm of material (never cut)")
+    return tuple(items)
