@@ -42,6 +42,15 @@ def _write(tmp_path: Path, text: str) -> Path:
     return job
 
 
+def _job_without_simulation(folder: Path, text: str) -> tuple[Path, Path]:
+    """The job text written to folder/job.toml with [simulation] enabled = false (these tests check tools)."""
+    folder.mkdir()
+    job = folder / "job.toml"
+    job.write_text(text.replace("[simulation]", "[simulation]\nenabled = false") if "[simulation]" in text
+                   else text + "\n[simulation]\nenabled = false\n")
+    return folder, job
+
+
 def test_every_tool_conflict_in_one_line_with_a_set_that_fits(tmp_path):
     job = _write(tmp_path, own_gear_text())
     out = tmp_path / "out"
@@ -74,11 +83,7 @@ def test_the_suggested_set_runs_and_equals_what_auto_takes(tmp_path):
                          finishing_corner_radius_mm='"auto"')
     summaries = {}
     for name, text in (("typed", typed), ("auto", auto)):
-        folder = tmp_path / name
-        folder.mkdir()
-        job = folder / "job.toml"
-        job.write_text(text.replace("[simulation]", "[simulation]\nenabled = false") if "[simulation]" in text
-                       else text + "\n[simulation]\nenabled = false\n")
+        folder, job = _job_without_simulation(tmp_path / name, text)
         result = run_cli("run", str(job), "--out", str(folder / "out"), "--quiet")
         assert result.returncode == 0, result.stderr
         summaries[name] = json.loads((folder / "out" / "summary.json").read_text())
@@ -121,11 +126,7 @@ def test_warnings_reach_the_terminal_and_no_flat_end_mill_warning_for_a_bull_nos
                          finishing_corner_radius_mm="0.0")
     flat = re.sub(r"(?m)^radial_allowance_mm = .*$", "radial_allowance_mm = 0.3", flat)  # a 0.7 mm tool's land pass
     for name, text in (("bull", bull), ("flat", flat)):
-        folder = tmp_path / name
-        folder.mkdir()
-        job = folder / "job.toml"
-        job.write_text(text.replace("[simulation]", "[simulation]\nenabled = false") if "[simulation]" in text
-                       else text + "\n[simulation]\nenabled = false\n")
+        folder, job = _job_without_simulation(tmp_path / name, text)
         result = run_cli("run", str(job), "--out", str(folder / "out"))
         assert result.returncode == 0, result.stderr
         warnings = json.loads((folder / "out" / "summary.json").read_text())["warnings"]
