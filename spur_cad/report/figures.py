@@ -118,10 +118,13 @@ def deviation_map_png(result: SimResult) -> bytes:
     fig.colorbar(image, ax=ax, label="deviation [\u00b5m] (red: leftover, blue: gouge)", fraction=0.05, pad=0.02)
     names = result.grid.feature_names()
     starts = [0] + [j for j in range(1, len(names)) if names[j] != names[j - 1]]
-    for j in starts:
+    ends = starts[1:] + [len(names) - 1]
+    room = 0.025 * (arc[-1] - arc[0])  # a name needs about this much of the axis beside the next one
+    for j, end in zip(starts, ends):
         ax.axvline(arc[j], color="k", lw=0.4)
-        ax.annotate(names[j], (arc[j], x[-1]), fontsize=7, rotation=90, va="top", ha="right",
-                    xytext=(-1, -2), textcoords="offset points")
+        if arc[end] - arc[j] >= room:  # features too short to carry their name (a tip land's corner) go unnamed
+            ax.annotate(names[j], (arc[end], x[-1]), fontsize=7, rotation=90, va="top", ha="right",
+                        xytext=(-2, -2), textcoords="offset points")
     ax.set_xlabel("position along the tooth space, right tooth centre -> root -> left tooth centre [mm]")
     ax.set_ylabel("X (face width) [mm]")
     ax.set_title(f"simulated deviation of tooth space {worst} (largest |deviation|); resolution "
@@ -131,7 +134,7 @@ def deviation_map_png(result: SimResult) -> bytes:
     bars.bar(spaces + 0.2, np.maximum(-least, 0.0), width=0.4, color="tab:blue", label="max gouge")
     bars.set_xlabel("tooth space")
     bars.set_ylabel("[\u00b5m]")
-    bars.legend(fontsize=8)
+    bars.legend(fontsize=8, loc="lower right", bbox_to_anchor=(1.0, 1.0), ncols=2, frameon=False)  # above the bars
     bars.grid(True, lw=0.3, axis="y")
     return _png(fig)
 
