@@ -299,7 +299,8 @@ def test_spur_cad_run_writes_the_helical_job_and_refuses_a_wrong_corner_naming_t
     assert summary["cad"]["gear_volume_mm3"] == pytest.approx(area * 20.0, rel=1e-6)
     assert (tmp_path / "out" / "gear.step").stat().st_size > 100_000
     report = (tmp_path / "out" / "report.html").read_text()
-    assert "normal section; needs face width" in report and "lead_mm" in report
+    assert f"normal section; needs face width &gt; {summary['inspection']['span_min_face_width_mm']:.2f} mm" in report
+    assert f'<th>lead</th><td class="num">{summary["gear"]["lead_mm"]:.3f}</td><td class="unit">mm</td>' in report
     job = tmp_path / "helical.toml"
     with_tools = HELICAL_JOB + "[tools.finishing]\nkind = 'bull_nose'\ndiameter_mm = 2.0\ncorner_radius_mm = 0.5\n"
     job.write_text(with_tools)

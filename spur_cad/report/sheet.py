@@ -282,7 +282,8 @@ def inspection_rows(result: JobResult) -> tuple[Row, ...]:
     """The inspection sheet: span, pins, chordal thickness, each to 4 decimals, with the allowance."""
     ins, helical = result.inspection, result.gear.is_helical
     nominal = ins.tooth_thickness_mm + ins.thickness_reduction_mm
-    span = f"span measurement W_k over k = {ins.span_teeth_k} teeth" + (" (normal section)" if helical else "")
+    span = f"span measurement W_k over k = {ins.span_teeth_k} teeth" + (
+        f" (normal section; needs face width > {number(ins.span_min_face_width_mm, 2)} mm)" if helical else "")
     rows = [
         Row(span, number(ins.span_measurement_mm, 4) if ins.span_measurement_mm is not None
             else f"face too narrow (needs more than {number(ins.span_min_face_width_mm, 2)} mm): measure over balls",
