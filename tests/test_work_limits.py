@@ -106,7 +106,7 @@ def test_comparisons_too_large_to_build_are_left_out_not_refused(small_job):
     it is not built for comparison; the job's own finishing by generation is planned as usual."""
     from spur_cad.cam.plan import MAX_COMPARISON_MOVES
     from spur_cad.cam.strategies import get_strategy, params_from_section
-    from spur_cad.report.html import finishing_comparison_html
+    from spur_cad.report.html import finishing_comparison
     from spur_cad.summary import finishing_facts, finishing_json
 
     job = dataclasses.replace(small_job, gear=dataclasses.replace(small_job.gear, face_width_mm=60.0))
@@ -119,8 +119,9 @@ def test_comparisons_too_large_to_build_are_left_out_not_refused(small_job):
     assert plan.finishing.estimate.moves == len(plan.finishing.toolpath)
     facts = finishing_json(finishing_facts(plan.finishing))
     assert facts["perimeter_time_s"] is None and facts["reference_strategy_moves"] is None
-    html = finishing_comparison_html(finishing_facts(plan.finishing))
-    assert html.count("not estimated (too large to build for comparison") == 2
+    table = finishing_comparison(finishing_facts(plan.finishing))
+    assert sum(cell.startswith("not estimated (too large to build for comparison") for row in table.rows
+               for cell in row) == 2
 
 
 COMPARISON_GEARS = ["reference_z23_m4", "undercut_z8", "shifted_z12", "pa14_5_z40", "undercut_negative_shift_z14"]
