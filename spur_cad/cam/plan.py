@@ -42,7 +42,7 @@ from spur_cad.cam.strategies import (
     params_from_section,
 )
 from spur_cad.cam.tools import Tool, ToolError
-from spur_cad.errors import StockError, WorkLimitError, shown
+from spur_cad.errors import SpurCadError, StockError, WorkLimitError, shown
 from spur_cad.geometry.spec import GearSpec
 
 MAX_CONTACTS_PER_FLANK = 20_000
@@ -207,10 +207,17 @@ def conflicts_error(inputs: CamInputs, conflicts: list[ToolError]) -> ToolError:
     from spur_cad.cam.suggest import suggested_tools
 
     strategy = get_strategy(inputs.finishing.strategy, inputs.strategies)
-    suggestion = suggested_tools(inputs.spec, strategy, inputs.finishing.target_scallop_mm, inputs.roughing,
-                                 inputs.stock.blank_radius_mm(inputs.spec), inputs.machine.clearance_mm)
-    fits = (f"tools that fit: {suggestion.text()} (or \"auto\" sizes)" if suggestion.finishing or suggestion.roughing
-            else "no tool fits this gear")
+    try:
+        suggestion = suggested_tools(inputs.spec, strategy, inputs.finishing.target_scallop_mm, inputs.roughing,
+                                     inputs.stock.blank_radius_mm(inputs.spec), inputs.machine.clearance_mm)
+    except SpurCadError:  # the suggestion's own limits (a work bound, say): the conflicts still come first
+        suggestion = None
+    if suggestion is None:
+        fits = "no set of tools to suggest"
+    elif suggestion.finishing or suggestion.roughing:
+        fits = f"tools that fit: {suggestion.text()} (or \"auto\" sizes)"
+    else:
+        fits = "no tool fits this gear"
     first = conflicts[0]
     if len(conflicts) == 1:
         return ToolError(f"{first}; {fits}", field=first.field, section=first.section)
