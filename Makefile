@@ -1,5 +1,5 @@
 # spur_cad developer tasks. `make test`: the fast tier, before every commit (ruff + the tests not marked
-# slow/freecad/linuxcnc, a few minutes). `make test-all`: everything (what CI runs through .ci/run).
+# slow/freecad/linuxcnc/browser, a few minutes). `make test-all`: everything (what CI runs through .ci/run).
 
 VENV        := .venv
 PYTHON      := $(VENV)/bin/python
