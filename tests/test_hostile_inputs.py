@@ -292,11 +292,14 @@ def test_a_signal_near_the_end_of_a_run_always_gives_the_interrupted_line(job, t
     """8 of 21 signals near the end of a run killed it silently (the handlers were given back before the exit).
     Signals are sent across the last second of a run: every run exits 0 with its set, or 130 / 143 with the
     one line; none dies by the signal."""
-    start = time.monotonic()
-    first = subprocess.run([sys.executable, "-m", "spur_cad.cli", "run", str(job), "--out", str(tmp_path / "t"),
-                            "--quiet"], capture_output=True, text=True, timeout=300)
-    assert first.returncode == 0, first.stderr
-    duration = time.monotonic() - start
+    durations = []
+    for warm in range(2):  # the first run may load or compile what the later ones find ready: time the second
+        start = time.monotonic()
+        first = subprocess.run([sys.executable, "-m", "spur_cad.cli", "run", str(job), "--out",
+                                str(tmp_path / f"t{warm}"), "--quiet"], capture_output=True, text=True, timeout=300)
+        assert first.returncode == 0, first.stderr
+        durations.append(time.monotonic() - start)
+    duration = min(durations)
     outcomes = []
     for trial in range(12):
         signum = (signal.SIGINT, signal.SIGTERM)[trial % 2]
