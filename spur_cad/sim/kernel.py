@@ -106,6 +106,13 @@ def first_entry(dx, ay, az, ny, nz, lo, hi, radius, half_flat, rt):
 
 
 @njit(cache=True, inline="always")
+def _turned_blade(c, s, px, pz_, nx, nz_, y, z):
+    """A blade (design point p, normal n) turned by (cos, sin) = (c, s), relative to the tool tip at (y, z):
+    (ay, az, ny, nz) as first_entry takes them."""
+    return c * px - s * pz_ - y, s * px + c * pz_ - z, c * nx - s * nz_, s * nx + c * nz_
+
+
+@njit(cache=True, inline="always")
 def _chunk_gap(c, s, py, pz, y, z, half_flat, rt):
     """Distance from a chunk's centre (py, pz), turned by (cos, sin) = (c, s), to the tool's section at (y, z)
     (negative inside): a chunk whose circle radius is below it cannot meet the tool."""
@@ -157,14 +164,7 @@ def _clip_at_pose(x, y, z, a, x_end, h, h_top, points, normals, chunk_start, chu
             if _chunk_gap(c, s, chunk_centre[ci, 0], chunk_centre[ci, 1], y, z, half_flat, rt) > chunk_radius[ci]:
                 continue
             for j in range(chunk_start[ci], chunk_start[ci + 1]):
-                px = points[j, 0]
-                pz_ = points[j, 1]
-                nx = normals[j, 0]
-                nz_ = normals[j, 1]
-                ay = c * px - s * pz_ - y
-                az = s * px + c * pz_ - z
-                ny = c * nx - s * nz_
-                nz = s * nx + c * nz_
+                ay, az, ny, nz = _turned_blade(c, s, points[j, 0], points[j, 1], normals[j, 0], normals[j, 1], y, z)
                 top = h_top[sector, j]
                 deepest = first_entry(0.0, ay, az, ny, nz, t_min, top, radius, half_flat, rt)
                 if deepest == INF:
@@ -241,12 +241,7 @@ def clip_poses(poses, x_end, h, h_top, points, normals, chunk_start, chunk_centr
 @njit(cache=True)
 def _blade_entry(dx, theta, px, pz_, nx, nz_, y, z, lo, hi, radius, half_flat, rt):
     """First entry of one blade (design point p, normal n, turned by theta) into the tool slice at dx."""
-    c = math.cos(theta)
-    s = math.sin(theta)
-    ay = c * px - s * pz_ - y
-    az = s * px + c * pz_ - z
-    ny = c * nx - s * nz_
-    nz = s * nx + c * nz_
+    ay, az, ny, nz = _turned_blade(math.cos(theta), math.sin(theta), px, pz_, nx, nz_, y, z)
     return first_entry(dx, ay, az, ny, nz, lo, hi, radius, half_flat, rt)
 
 
@@ -301,13 +296,10 @@ def _clip_twisted_pose(x, y, z, a, x_end, h, h_top, points, normals, chunk_start
                     if _chunk_gap(rc, rs, py, pz, y, z + bottom, box_half_width, 0.0) > chunk_radius[ci]:
                         continue
                     for j in range(chunk_start[ci], chunk_start[ci + 1]):
-                        px = points[j, 0]
-                        pz_ = points[j, 1]
-                        nx = normals[j, 0]
-                        nz_ = normals[j, 1]
                         current = h[sector, j, r]
-                        entry = first_entry(dx, rc * px - rs * pz_ - y, rs * px + rc * pz_ - z, rc * nx - rs * nz_,
-                                            rs * nx + rc * nz_, t_min, min(h_top[sector, j], current), radius,
+                        ay, az, ny, nz = _turned_blade(rc, rs, points[j, 0], points[j, 1], normals[j, 0],
+                                                       normals[j, 1], y, z)
+                        entry = first_entry(dx, ay, az, ny, nz, t_min, min(h_top[sector, j], current), radius,
                                             half_flat, rt)
                         if entry < current:
                             h[sector, j, r] = entry
