@@ -155,6 +155,11 @@ def test_a_copied_and_edited_template_named_in_the_job_is_used(tmp_path):
         assert refused.returncode == 2 and not (tmp_path / "out2").exists()
         assert len(refused.stderr.strip().splitlines()) == 1
         assert refused.stderr.startswith(f"spur-cad: error: {job}:{line}:") and says in refused.stderr, refused.stderr
+    (tmp_path / "templates" / "shop.html.j2").write_text("x" * (300 * 1024))  # larger than a template is read
+    refused = run_cli("run", str(job), "--out", str(tmp_path / "out4"))
+    assert refused.returncode == 2 and not (tmp_path / "out4").exists()
+    assert refused.stderr.startswith(f"spur-cad: error: {job}:{line}: [job] report_template: ")
+    assert "at most 262,144 are read" in refused.stderr
     (tmp_path / "templates" / "shop.html.j2").unlink()
     (tmp_path / "templates" / "shop.html.j2").mkdir()  # not a regular file
     refused = run_cli("run", str(job), "--out", str(tmp_path / "out3"))
