@@ -208,6 +208,7 @@ job.removeProperty("AMin")
 job.addProperty("App::PropertyAngle", "AMin", "Machine", "A travel limit, low (deg)")
 job.AMin = -99999.0
 job.FinishingStrategy = ["perimeter"]
+job.removeProperty("BottomRoughingMoves")  # schema 4's bottom-tool results: not in an older document
 job.SchemaVersion = 1
 RESULT["saved_values"] = properties.read_values(job, schema.JOB_FIELDS)
 doc.saveAs(FILE)
@@ -222,6 +223,7 @@ job = doc.getObject("Job")
 RESULT["schema_version"] = schema.SCHEMA_VERSION
 RESULT["job_version"] = job.SchemaVersion
 RESULT["migrated_types"] = {p: job.getTypeIdOfProperty(p) for p in ("MaxFeed", "AMin", "FinishingStrategy")}
+RESULT["bottom_results"] = ["BottomRoughingMoves" in job.PropertiesList, job.BottomRoughingMoves]
 RESULT["strategies"] = job.getEnumerationsOfProperty("FinishingStrategy")
 RESULT["restored_values"] = properties.read_values(job, schema.JOB_FIELDS)
 for obj in doc.Objects:
@@ -255,15 +257,16 @@ def test_documents_save_and_reopen_without_pickles(freecadcmd, tmp_path):
     restored = result["restored"]  # the migrated gear is touched (a property was added), nothing is invalid
     assert all("Invalid" not in state and status == "ok" for state, status in restored.values()), restored
     assert _all_up_to_date(result["recomputed"]), result
-    assert result["schema_version"] == 3
-    assert result["migrated"] == {"version": 3, "has": True, "value": 0.0}
+    assert result["schema_version"] == 4
+    assert result["migrated"] == {"version": 4, "has": True, "value": 0.0}
     # unit-carrying types: a feed is a speed shown in FreeCAD's units (mm/s) and read back in mm/min
     types = {"MaxFeed": "App::PropertySpeed", "AMin": "App::PropertyFloat",
              "FinishingStrategy": "App::PropertyEnumeration"}
     assert result["new_types"] == types
     assert result["new_max_feed"][0] == pytest.approx(5000.0 / 60.0) and "mm/s" in result["new_max_feed"][1]
     # schema-1 types re-created with the values they held, the drop-down list brought up to date
-    assert result["job_version"] == 3 and result["migrated_types"] == types
+    assert result["job_version"] == 4 and result["migrated_types"] == types
+    assert result["bottom_results"] == [True, 0]  # schema 4's results of the bottom tool, added on reopening
     assert result["migrated_groups"] == ["Values: computed", "Values: status"]
     assert result["strategies"] == list(strategy_names())  # the registry's list, brought up to date
     before = result["saved_values"]
@@ -432,3 +435,39 @@ def test_a_helical_gear_in_the_document_is_the_swept_solid_and_exports_like_the_
     # FreeCAD integrates the swept faces more coarsely than spur_cad (1.2e-5 here); the turn is checked above
     assert result["volume"] == pytest.approx(summary["cad"]["gear_volume_mm3"], rel=1e-4)
     assert output_differences(cli, out, (str(example), "Helical")) == []
+
+
+DEFAULT_JOB_BODY = """
+import FreeCAD
+from spur_cad_workbench import commands, schema
+from spur_cad_workbench.properties import document_values
+doc = FreeCAD.newDocument("Default")
+gear = commands.make_gear(doc)                     # what the toolbar's three buttons make, no value given
+stock = commands.make_stock(gear)
+job = commands.make_job(gear, stock)
+doc.recompute()
+RESULT["states"] = {o.Name: [list(o.State), getattr(o, "Status", "")] for o in doc.Objects}
+RESULT["minutes"] = {title: getattr(job, title + "TimeWithAcceleration")
+                     for title in ("Roughing", "BottomRoughing", "Finishing")}
+RESULT["data"] = schema.job_data(document_values(job))
+"""
+
+
+def test_the_default_job_starts_from_advised_tools_and_a_time_a_shop_accepts(freecadcmd, tmp_path):
+    """Issue 28 point 1: gear, stock and job made with no values recompute without error, rough in two stages
+    (the tool that reaches the root of this gear is under 2 mm), and the job's cycle time, all three programs
+    counted, is within one shift (8 h; 18 h 36 min before); each program's time is the engine's own estimate
+    for the job the document holds."""
+    from spur_cad.job import job_from_dict
+
+    result, proc = run_workbench_code(DEFAULT_JOB_BODY, tmp_path / "fc", freecadcmd=freecadcmd)
+    assert result is not None and result.get("ok"), describe(proc, result)
+    assert _all_up_to_date(result["states"]), result["states"]
+    job = job_from_dict(result["data"], "default")
+    assert job.tools.bottom is not None and job.tools.roughing.diameter_mm > job.tools.bottom.diameter_mm
+    plan = plan_cam(job)
+    minutes = result["minutes"]
+    for title, planned in (("Roughing", plan.roughing), ("BottomRoughing", plan.roughing_bottom),
+                           ("Finishing", plan.finishing)):
+        assert minutes[title] == pytest.approx(planned.estimate.time_with_acceleration_s / 60.0, rel=1e-9)
+    assert 60.0 < sum(minutes.values()) < 8 * 60.0

@@ -162,3 +162,65 @@ def test_colour_scale_and_colour_bar(wb):
     assert np.all(np.diff(vertices[::2, 1]) > 0) and vertices[:, 0].min() > -1.6 and vertices[:, 0].max() < -1.3
     colours = wb.colours.deviation_colours(fraction, 1.0)
     assert np.allclose(colours[0], (0, 0, 1)) and np.allclose(colours[-1], (1, 0, 0))
+
+
+def _new_job(wb, **gear):
+    """A new job as the workbench starts it: the default gear (changed by `gear`), a new stock, new job values."""
+    values = wb.schema.default_values()
+    values["gear"].update(gear)
+    values["stock"] = wb.schema.new_stock_values(values["gear"])
+    values["job"].update(wb.validation.new_job_values(values))
+    return values
+
+
+def test_the_default_new_job_is_valid_two_stage_and_within_a_shift(wb):
+    """Issue 28: a new job for the default gear (z23 m4, rho 0.38 m: the roughing tool that reaches the root is
+    under 2 mm) starts from tools that take a gear maker's time: two-stage roughing, within one shift, and a
+    tenth or more faster than the bottom tool alone; the panel's cycle time counts all three programs."""
+    values = _new_job(wb)
+    result = wb.validation.validate(values)
+    assert result.ok, result.messages
+    job = result.job
+    assert job.tools.bottom is not None and job.tools.roughing.diameter_mm > job.tools.bottom.diameter_mm
+    assert job.roughing.flank_allowance_mm == pytest.approx(0.3)
+    plan = plan_cam(job)
+    stage = plan.two_stage
+    assert stage is not None and stage.two_stage_time_s <= 0.9 * stage.bottom_tool_alone_time_s
+    figures = wb.summary.plan_figures(job, plan)
+    programs = (plan.roughing, plan.roughing_bottom, plan.finishing)
+    total_s = sum(p.estimate.time_with_acceleration_s for p in programs)
+    assert figures.seconds_with_acceleration == pytest.approx(total_s)
+    assert total_s < wb.summary.LONG_JOB_S  # today about 4 h 46 min (18 h 36 min before issue 28)
+    text = wb.summary.figures_text(figures)
+    assert "Roughing the bottom (bottom tool):" in text and text.startswith(
+        f"Cycle time {wb.summary.duration_text(total_s)}")
+    # the same gear with the one roughing tool that reaches the root takes far longer: two-stage paid
+    single = {**values, "job": {**values["job"], "UseBottomTool": False,
+                                "RoughingToolDiameter": values["job"]["BottomToolDiameter"]}}
+    alone = plan_cam(wb.validation.validate(single).job)
+    assert alone.roughing.estimate.time_s == pytest.approx(plan.two_stage.bottom_tool_alone_time_s)
+
+
+@pytest.mark.parametrize("gear", [dict(Teeth=17, Module=2.0, RackTipRadius=0.5, FaceWidth=10.0, ProfileShift=0.3),
+                                  dict(Teeth=40, Module=1.0, RackTipRadius=0.38, FaceWidth=8.0),
+                                  dict(Teeth=31, Module=2.5, RackTipRadius=0.95, FaceWidth=15.0)])
+def test_new_jobs_for_other_gears_are_valid_and_two_stage_only_when_it_pays(wb, gear):
+    result = wb.validation.validate(_new_job(wb, **gear))
+    assert result.ok, result.messages
+    plan = plan_cam(result.job)
+    if plan.two_stage is not None:
+        assert plan.two_stage.two_stage_time_s <= 0.9 * plan.two_stage.bottom_tool_alone_time_s
+    finishing_d = result.job.tools.finishing.diameter_mm
+    assert result.job.roughing.flank_allowance_mm <= 0.15 * finishing_d + 1e-9
+
+
+def test_long_roughing_advice_offers_two_stage_and_no_larger_tool_at_its_limit(wb):
+    s = wb.summary
+    long_rough = s.PlanFigures(s.OperationFigures(10, 9 * 3600.0, 9 * 3600.0, 5), None)
+    at_limit = s.long_job_advice(long_rough, "generating", roughing_room_mm=0.05)
+    assert "larger roughing tool" not in at_limit and "two-stage roughing" in at_limit
+    two_stage = s.PlanFigures(s.OperationFigures(10, 9 * 3600.0, 9 * 3600.0, 5), None, (),
+                              s.OperationFigures(10, 600.0, 600.0, 5))
+    advice = s.long_job_advice(two_stage, "generating", roughing_room_mm=2.0)
+    assert "two-stage" not in advice and "larger roughing tool" in advice
+    assert advice.startswith("Long job: 9 h 10 min, of which roughing 9 h 00 min")

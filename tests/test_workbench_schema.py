@@ -321,13 +321,17 @@ def test_suggested_tools_pass_the_tool_limits(wb, name, strategy):
     assert job.tools.finishing is not None and job.tools.finishing.kind == "bull_nose"
     blank = job.stock.blank_radius_mm(job.gear)
     rec = recommend_tools(job.gear, blank, job.machine.clearance_mm, job.tools.finishing)
-    check_tools(job.gear, rec, job.tools.roughing, job.tools.finishing)
+    # the tool that reaches the bottom of the spaces: the bottom tool of two-stage roughing, else the roughing tool
+    deepest = job.tools.bottom if job.tools.bottom is not None else job.tools.roughing
+    check_tools(job.gear, rec, deepest, job.tools.finishing)
+    if job.tools.bottom is not None:  # the upper levels' tool: a larger flat end mill
+        assert job.tools.roughing.kind == "flat" and job.tools.roughing.diameter_mm > deepest.diameter_mm
     assert job.finishing.strategy == strategy  # the suggested tool must fit the strategy, flanks included
     plan_finishing(job.gear, job.tools.finishing, job.machine, dataclasses.replace(job.finishing, step_over_mm=10.0),
                    blank)
-    if job.tools.roughing is not None:
-        levels = roughing_levels(job.gear, job.tools.roughing, job.roughing, blank)
-        check_roughing_reach(job.tools.roughing, levels.lowest_height_mm - job.gear.root_radius_mm, rec)
+    if deepest is not None:
+        levels = roughing_levels(job.gear, deepest, job.roughing, blank)
+        check_roughing_reach(deepest, levels.lowest_height_mm - job.gear.root_radius_mm, rec)
 
 
 # --- toolpath display in the part frame ---------------------------------------------------------------

@@ -23,8 +23,10 @@ from spur_cad.cam.recommend import (
     ToolRecommendations,
     check_roughing_reach,
     check_tools,
+    flank_polyline,
     recommend_tools,
     small_tool_warnings,
+    space_half_width_mm,
 )
 from spur_cad.cam.roughing import (
     RoughingLevels,
@@ -355,6 +357,50 @@ def _plan_two_stage(inputs: CamInputs, levels: RoughingLevels,
     chosen = "set" if set_height > 0.0 else "shortest time"
     return upper, lower, TwoStage(float(levels.heights_mm[j] - root), chosen,
                                   upper.estimate.time_s + lower.estimate.time_s, alone.estimate.time_s)
+
+
+TWO_STAGE_PAYS_FRACTION = 0.9
+"""Two-stage roughing is suggested when it takes at most this fraction of the bottom tool's time alone: below a
+tenth saved, a second tool change, tool and set-up are not worth it."""
+TOP_TOOL_STEP_MM = 1.0  # suggested upper-level roughing tools: whole millimetres (the common catalogue sizes)
+TOP_TOOL_CANDIDATES = 6  # at most this many sizes are planned (each plans the roughing of all spaces)
+
+
+@dataclass(frozen=True)
+class TwoStageSuggestion:
+    """A larger roughing tool for the upper levels above `inputs.roughing_tool` (then the bottom tool)."""
+
+    top_diameter_mm: float
+    two_stage_time_s: float
+    bottom_tool_alone_time_s: float
+
+
+def suggested_two_stage(inputs: CamInputs) -> TwoStageSuggestion | None:
+    """Two-stage roughing when it pays: with the job's roughing tool as the bottom tool, the larger flat end mill
+    (whole millimetres, up to the space width at the reference circle) whose upper levels make the shortest
+    roughing; None when none saves at least 1 - TWO_STAGE_PAYS_FRACTION of the bottom tool's time alone."""
+    spec, bottom = inputs.spec, inputs.roughing_tool
+    if bottom is None or spec.is_helical:  # helical roughing follows the lead: one tool (check_two_stage_tools)
+        return None
+    blank = inputs.stock.blank_radius_mm(spec)
+    widest_mm = 2.0 * space_half_width_mm(flank_polyline(spec), spec.reference_radius_mm)
+    first_mm = (np.floor(bottom.diameter_mm / TOP_TOOL_STEP_MM) + 1.0) * TOP_TOOL_STEP_MM
+    sizes = np.arange(first_mm, widest_mm + 1e-9, TOP_TOOL_STEP_MM)
+    if len(sizes) > TOP_TOOL_CANDIDATES:  # the largest sizes: a small step above the bottom tool gains little
+        sizes = sizes[-TOP_TOOL_CANDIDATES:]
+    best = None
+    for diameter in sizes:
+        top = dataclasses.replace(bottom, diameter_mm=float(diameter), kind="flat", corner_radius_mm=0.0)
+        trial = dataclasses.replace(inputs, roughing_tool=top, bottom_tool=bottom, finishing_tool=None)
+        try:
+            _, _, stage = _plan_two_stage(trial, roughing_levels(spec, top, inputs.roughing, blank), blank)
+        except SpurCadError:  # the larger tool reaches no higher than the bottom tool, or no level fits
+            continue
+        if best is None or stage.two_stage_time_s < best.two_stage_time_s:
+            best = TwoStageSuggestion(float(diameter), stage.two_stage_time_s, stage.bottom_tool_alone_time_s)
+    if best is None or best.two_stage_time_s > TWO_STAGE_PAYS_FRACTION * best.bottom_tool_alone_time_s:
+        return None
+    return best
 
 
 def _level_seconds(path: Toolpath, machine: Machine, levels: int) -> np.ndarray:

@@ -80,8 +80,9 @@ def make_gear(doc=None, **values):
 
 
 def make_stock(gear, **values):
-    """The stock (blank) for `gear`, linked to it."""
-    stock_values = {**schema.default_values()["stock"], **_checked(values, schema.STOCK_FIELDS, "stock")}
+    """The stock (blank) for `gear`, linked to it (a new stock's radial allowance: schema.new_stock_values)."""
+    gear_values = {"Module": schema.plain_value(schema.field_by_prop("Module"), gear.Module)}
+    stock_values = {**schema.new_stock_values(gear_values), **_checked(values, schema.STOCK_FIELDS, "stock")}
     obj = gear.Document.addObject("Part::FeaturePython", "Stock")
     StockFeature(obj, gear, stock_values)
     _view(obj, STOCK_COLOUR, transparency=75)
@@ -100,16 +101,17 @@ def _toolpath_object(doc, operation: str):
 def make_job(gear, stock, suggest: bool = True, **values):
     """A 4-axis job for `gear` and `stock` with its roughing and finishing toolpath objects.
 
-    Without tool values the tools are suggested within the gear's recommendations
-    (validation.suggest_tools); `suggest=False` keeps the job file's defaults (no tools).
+    Without tool values the job starts from what a gear maker would start from (validation.new_job_values: the
+    suggested tools, two-stage roughing when it pays, the flank allowance unless given); `suggest=False` keeps
+    the job file's defaults (no tools).
     """
-    from spur_cad_workbench.validation import suggest_tools
+    from spur_cad_workbench.validation import new_job_values, suggest_tools
 
     job_values = {**schema.default_values()["job"], **_checked(values, schema.JOB_FIELDS, "job")}
     tool_props = {field.prop for field in schema.JOB_FIELDS if field.section.startswith("tools.")}
     if suggest and not tool_props & set(values):
         current = {**document_values(stock), "job": job_values}
-        job_values.update(suggest_tools(current))
+        job_values.update(suggest_tools(current) if "FlankAllowance" in values else new_job_values(current))
     doc = gear.Document
     obj = doc.addObject("App::FeaturePython", "Job")
     JobFeature(obj, gear, stock, job_values)

@@ -309,16 +309,16 @@ class JobFeature(_Proxy):
                    "RequiredFluteLength": rec.required_flute_length_mm,
                    "RequiredStickOut": rec.required_stick_out_mm, "Warnings": list(plan.warnings),
                    "PlannedValues": values_signature(document_values(obj))}
-        for name in schema.TOOL_ROLES:
-            title = name.capitalize()
-            planned, op = getattr(plan, name), getattr(figures, name)
+        for name, title in schema.OPERATION_TITLES.items():
+            op = getattr(figures, name)
             outputs[f"{title}Moves"] = op.moves if op is not None else 0
             outputs[f"{title}Time"] = op.seconds / 60.0 if op is not None else 0.0
             outputs[f"{title}TimeWithAcceleration"] = op.seconds_with_acceleration / 60.0 if op is not None else 0.0
             outputs[f"{title}ProgramLines"] = op.program_lines if op is not None else 0
-            target = getattr(obj, f"{title}Toolpath")
+        for name in schema.TOOL_ROLES:  # the bottom tool's program has no toolpath object (see workbench/README.md)
+            target = getattr(obj, f"{name.capitalize()}Toolpath")
             if target is not None:
-                update_toolpath(target, planned)
+                update_toolpath(target, getattr(plan, name))
         write_outputs(obj, outputs)
         for dependant in dependants(obj):
             if getattr(dependant.Proxy, "KIND", "") != "simulation":

@@ -36,7 +36,8 @@ drop-down lists, so a new key needs no migration code. Version 2: MaxFeed and Ra
 PropertySpeed (were PropertyFloat), AMin and AMax PropertyFloat (were PropertyAngle, which
 clamped the default +-99999 deg to +-360). Version 3: the job's results gained the times with
 accelerations, the program lines and PlannedValues; computed groups renamed "Values: ..." (sorted after
-the inputs; reopening moves them).
+the inputs; reopening moves them). Version 4: the bottom tool's roughing program (two-stage roughing) has its
+own results (BottomRoughingMoves, ...Time, ...TimeWithAcceleration, ...ProgramLines).
 """
 
 from __future__ import annotations
@@ -47,8 +48,10 @@ from dataclasses import dataclass
 from spur_cad.job import SECTIONS
 from spur_cad.keys import keys_of
 
-SCHEMA_VERSION = 3
+SCHEMA_VERSION = 4
 TOOL_ROLES = ("roughing", "finishing")
+OPERATION_TITLES = {"roughing": "Roughing", "roughing_bottom": "BottomRoughing", "finishing": "Finishing"}
+"""The programs a job writes, in cutting order, and the prefix of their result properties on the job."""
 
 # FreeCAD property type for each kind of value (the mapping above; outputs use the same kinds).
 PROPERTY_TYPES = {
@@ -190,16 +193,13 @@ JOB_OUTPUTS = (
     _f("RoughingMaxDiameter", "length", TOOL_LIMITS, "", "", "largest roughing diameter"),
     _f("RequiredFluteLength", "length", TOOL_LIMITS, "", "", "flute length the job needs"),
     _f("RequiredStickOut", "length", TOOL_LIMITS, "", "", "stick-out the job needs"),
-    _f("RoughingMoves", "int", RESULTS, "", "", "moves of the roughing program"),
-    _f("RoughingTime", "float", RESULTS, "", "", "estimated roughing time (min)"),
-    _f("FinishingMoves", "int", RESULTS, "", "", "moves of the finishing program"),
-    _f("FinishingTime", "float", RESULTS, "", "", "estimated finishing time (min)"),
-    _f("RoughingTimeWithAcceleration", "float", RESULTS, "", "", "estimated roughing time with the machine's "
-       "accelerations (min)"),
-    _f("FinishingTimeWithAcceleration", "float", RESULTS, "", "", "estimated finishing time with the machine's "
-       "accelerations (min)"),
-    _f("RoughingProgramLines", "int", RESULTS, "", "", "lines of the roughing program as posted"),
-    _f("FinishingProgramLines", "int", RESULTS, "", "", "lines of the finishing program as posted"),
+    *(field for name, title in OPERATION_TITLES.items() for field in (
+        _f(f"{title}Moves", "int", RESULTS, "", "", f"moves of the {name.replace('_', ' ')} program"),
+        _f(f"{title}Time", "float", RESULTS, "", "", f"estimated {name.replace('_', ' ')} time (min)"),
+        _f(f"{title}TimeWithAcceleration", "float", RESULTS, "", "",
+           f"estimated {name.replace('_', ' ')} time with the machine's accelerations (min)"),
+        _f(f"{title}ProgramLines", "int", RESULTS, "", "", f"lines of the {name.replace('_', ' ')} program as posted"),
+    )),
     _f("PlannedValues", "string", RESULTS, "", "", "fingerprint of the values the results were planned for"),
     _f("Warnings", "strings", RESULTS, "", "", "warnings of the CAM stage"),
 )
@@ -242,6 +242,20 @@ def _section_defaults() -> dict[str, dict[str, object]]:
 
 # A new gear (no job file): ISO 53 basic rack profile A (tip radius 0.38 m) on the reference gear's size.
 NEW_GEAR = {"teeth": 23, "module_mm": 4.0, "face_width_mm": 20.0, "rack_tip_radius_mm": 0.38 * 4.0}
+
+
+NEW_STOCK_ALLOWANCE_MODULES = 0.125
+"""A new stock's radial allowance is at most this many modules (the job file's 0.5 mm default is more than a
+small gear's finishing tool takes off the tips in one pass: about 0.4 module)."""
+
+
+def new_stock_values(gear_values: dict[str, object]) -> dict[str, object]:
+    """The stock property values a new stock starts from for a gear with these property values."""
+    stock = dict(default_values()["stock"])
+    module_mm = float(gear_values.get("Module", 0.0))
+    if module_mm > 0.0:
+        stock["RadialAllowance"] = min(float(stock["RadialAllowance"]), NEW_STOCK_ALLOWANCE_MODULES * module_mm)
+    return stock
 
 
 def default_values() -> dict[str, dict[str, object]]:

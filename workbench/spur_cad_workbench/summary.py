@@ -12,9 +12,12 @@ import hashlib
 import json
 from dataclasses import dataclass
 
-from spur_cad_workbench.schema import TOOL_ROLES, job_data
+from spur_cad_workbench.schema import OPERATION_TITLES, job_data
 
+OPERATION_NAMES = {"roughing": "Roughing", "roughing_bottom": "Roughing the bottom (bottom tool)",
+                   "finishing": "Finishing"}
 LONG_JOB_S = 8 * 3600.0  # a shift: longer jobs get advice on what would shorten them
+ROUGHING_ROOM_MM = 0.1  # a roughing tool within this of its limit is at its limit (tools come in 0.1 mm steps)
 
 
 @dataclass(frozen=True)
@@ -30,14 +33,17 @@ class OperationFigures:
 
 @dataclass(frozen=True)
 class PlanFigures:
-    """The figures of a planned job, by operation (None: the job has no such operation), and its warnings."""
+    """The figures of a planned job, by program (None: the job has no such program; `roughing_bottom`: the
+    bottom tool's program of two-stage roughing), and its warnings."""
 
     roughing: OperationFigures | None
     finishing: OperationFigures | None
     warnings: tuple[str, ...] = ()
+    roughing_bottom: OperationFigures | None = None
 
     def operations(self) -> list[tuple[str, OperationFigures]]:
-        return [(name, figures) for name in TOOL_ROLES if (figures := getattr(self, name)) is not None]
+        """(program name, figures) in cutting order, the programs the job has."""
+        return [(name, figures) for name in OPERATION_TITLES if (figures := getattr(self, name)) is not None]
 
     @property
     def seconds(self) -> float:
@@ -60,13 +66,14 @@ def plan_figures(job, plan) -> PlanFigures:
 
     programs, _ = build_programs(job, plan)
     found = {}
-    for name in TOOL_ROLES:
+    for name in OPERATION_TITLES:
         planned = getattr(plan, name)
         if planned is not None:
             found[name] = OperationFigures(int(planned.estimate.moves), float(planned.estimate.time_s),
                                            float(planned.estimate.time_with_acceleration_s),
                                            int(programs[name].lines))
-    return PlanFigures(found.get("roughing"), found.get("finishing"), tuple(plan.warnings))
+    return PlanFigures(found.get("roughing"), found.get("finishing"), tuple(plan.warnings),
+                       found.get("roughing_bottom"))
 
 
 def duration_text(seconds: float) -> str:
@@ -85,7 +92,7 @@ def figures_text(figures: PlanFigures) -> str:
     lines = [f"Cycle time {duration_text(figures.seconds_with_acceleration)} with the machine's accelerations "
              f"({duration_text(figures.seconds)} at the programmed feeds)"]
     for name, op in figures.operations():
-        lines.append(f"{name.capitalize()}: {duration_text(op.seconds_with_acceleration)}, {op.moves:,} moves, "
+        lines.append(f"{OPERATION_NAMES[name]}: {duration_text(op.seconds_with_acceleration)}, {op.moves:,} moves, "
                      f"{op.program_lines:,} program lines")
     return "\n".join(lines)
 
@@ -103,8 +110,10 @@ def limits_text(rec, with_roughing_limit: bool = True) -> str:
             f"{rec.required_stick_out_mm:.2f} mm")
 
 
-def long_job_advice(figures: PlanFigures, strategy: str) -> str:
-    """Empty for a job within LONG_JOB_S; else which operation takes the time and what would shorten it."""
+def long_job_advice(figures: PlanFigures, strategy: str, roughing_room_mm: float | None = None) -> str:
+    """Empty for a job within LONG_JOB_S; else which operation takes the time and what would shorten it.
+    `roughing_room_mm`: how much larger the roughing tool may be (its limit minus its diameter; None unknown):
+    a tool at its limit is not advised to grow."""
     total = figures.seconds_with_acceleration
     if total <= LONG_JOB_S or not figures.operations():
         return ""
@@ -116,6 +125,11 @@ def long_job_advice(figures: PlanFigures, strategy: str) -> str:
         if strategy != DEFAULT_STRATEGY:  # the default is the fastest strategy the registry has
             ways += f", or the {DEFAULT_STRATEGY} strategy ({get_strategy(DEFAULT_STRATEGY).description})"
     else:
-        ways = "a larger roughing tool (within its limit), a larger level depth or step-over, a higher feed per tooth"
-    return (f"Long job: {duration_text(total)}, of which {name} {duration_text(op.seconds_with_acceleration)}. "
-            f"Shorter with {ways}.")
+        options = []
+        if roughing_room_mm is None or roughing_room_mm >= ROUGHING_ROOM_MM:
+            options.append("a larger roughing tool (within its limit)")
+        if figures.roughing_bottom is None:
+            options.append("two-stage roughing (a larger tool for the upper levels, this one as the bottom tool)")
+        ways = ", ".join(options + ["a larger level depth or step-over, a higher feed per tooth"])
+    return (f"Long job: {duration_text(total)}, of which {OPERATION_NAMES[name].lower()} "
+            f"{duration_text(op.seconds_with_acceleration)}. Shorter with {ways}.")

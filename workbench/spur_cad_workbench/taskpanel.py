@@ -379,7 +379,10 @@ class JobTaskPanel:
         if figures is not None:
             self.summary_figures.setText(f"{figures_text(figures)}\n({source})")
             strategy = str(values["job"].get("FinishingStrategy", ""))
-            self.summary_advice.setText(long_job_advice(figures, strategy))
+            rec, job = result.recommendations, values["job"]
+            room = (rec.roughing_max_diameter_mm - float(job["RoughingToolDiameter"])
+                    if rec is not None and job.get("UseRoughingTool") else None)
+            self.summary_advice.setText(long_job_advice(figures, strategy, room))
         else:
             self.summary_figures.setText("Cycle time: press Plan (or OK) for the times, moves and program lines of "
                                          "these values." if result.ok else "")
@@ -477,14 +480,14 @@ def _job_figures(job_obj):
     from spur_cad_workbench.summary import OperationFigures, PlanFigures
 
     found = {}
-    for name in schema.TOOL_ROLES:
-        title = name.capitalize()
+    for name, title in schema.OPERATION_TITLES.items():
         moves = int(getattr(job_obj, f"{title}Moves"))
         if moves:
             found[name] = OperationFigures(moves, float(getattr(job_obj, f"{title}Time")) * 60.0,
                                            float(getattr(job_obj, f"{title}TimeWithAcceleration")) * 60.0,
                                            int(getattr(job_obj, f"{title}ProgramLines")))
-    return PlanFigures(found.get("roughing"), found.get("finishing"), tuple(job_obj.Warnings))
+    return PlanFigures(found.get("roughing"), found.get("finishing"), tuple(job_obj.Warnings),
+                       found.get("roughing_bottom"))
 
 
 def show_job_panel(job_obj) -> JobTaskPanel:

@@ -200,19 +200,58 @@ def unusual_value_notes(job_values: dict[str, object]) -> dict[str, str]:
     return notes
 
 
+NEW_JOB_FLANK_ALLOWANCE_MM = 0.3
+"""A new job's roughing flank allowance: the reference shop's proven 0.3 mm (the job file's default, 0.1 mm, is a
+fine staircase that takes three times the roughing levels)..."""
+NEW_JOB_FLANK_ALLOWANCE_FRACTION = 0.15
+"""... at most this fraction of the finishing tool's diameter, so that a small finishing tool's radial engagement
+on the staircase stays light."""
+
+
+def new_job_values(values: dict[str, dict[str, object]]) -> dict[str, object]:
+    """A new job's starting values for the gear and stock in `values`: the suggested tools (suggest_tools) and
+    the flank allowance a gear maker starts from (NEW_JOB_FLANK_ALLOWANCE_MM, within the finishing tool's
+    share); {} if no tool fits."""
+    from spur_cad.cam.strategies import get_strategy
+    from spur_cad.cam.suggest import suggested_finishing
+
+    check = _without_tools(values)
+    if check.job is None:
+        return {}
+    job = check.job
+    finishing = suggested_finishing(job.gear, get_strategy(job.finishing.strategy, job.strategies),
+                                    job.finishing.target_scallop_mm, job.stock.blank_radius_mm(job.gear),
+                                    job.machine.clearance_mm)
+    if finishing is None:
+        return {}
+    allowance = round(min(NEW_JOB_FLANK_ALLOWANCE_MM, NEW_JOB_FLANK_ALLOWANCE_FRACTION * finishing.diameter_mm), 3)
+    # the roughing reach and the two-stage split depend on the allowance: suggest the tools with it
+    tools = suggest_tools({**values, "job": {**values["job"], "FlankAllowance": allowance}})
+    return {**tools, "FlankAllowance": allowance}
+
+
+def _without_tools(values: dict[str, dict[str, object]]) -> Validation:
+    """The values checked with every tool switched off (what the gear, stock and job sections alone allow)."""
+    return validate({**values, "job": {**values["job"], TOOL_SWITCHES["roughing"].prop: False,
+                                       TOOL_SWITCHES["finishing"].prop: False, "UseBottomTool": False}})
+
+
 def suggest_tools(values: dict[str, dict[str, object]]) -> dict[str, object]:
     """Job property values choosing tools within the recommendations (for a new job); {} if none fits.
 
     The tools are spur_cad's suggestion for the gear (spur_cad.cam.suggest, as a job file's "auto" sizes):
     finishing, the tool the job's strategy suggests (by generation, the default: r_t = rho and 95 % of the
     largest diameter that fits); roughing, the largest 0.1 mm diameter that passes the tool limits and the
-    roughing-reach rule, and below it the largest with which the whole job passes this panel's checks.
+    roughing-reach rule, and below it the largest with which the whole job passes this panel's checks. When
+    a larger tool for the upper levels saves at least a tenth of the roughing time (spur_cad.cam.plan
+    suggested_two_stage), that tool roughs and the suggested one becomes the bottom tool (two-stage roughing).
     """
+    from spur_cad.cam.plan import suggested_two_stage
     from spur_cad.cam.strategies import get_strategy
     from spur_cad.cam.suggest import ROUGHING_STEP_MM, SMALLEST_SUGGESTED_MM, suggested_tools
+    from spur_cad.pipeline import cam_inputs
 
-    check = validate({**values, "job": {**values["job"], TOOL_SWITCHES["roughing"].prop: False,
-                                        TOOL_SWITCHES["finishing"].prop: False}})
+    check = _without_tools(values)
     if check.job is None:
         return {}
     job = check.job
@@ -223,12 +262,27 @@ def suggest_tools(values: dict[str, dict[str, object]]) -> dict[str, object]:
         return {}
     finishing = suggested.finishing
     chosen = {"UseFinishingTool": True, "FinishingToolKind": finishing.kind,
-              "FinishingToolDiameter": finishing.diameter_mm, "FinishingCornerRadius": finishing.corner_radius_mm}
+              "FinishingToolDiameter": finishing.diameter_mm, "FinishingCornerRadius": finishing.corner_radius_mm,
+              "UseBottomTool": False}
     diameter = suggested.roughing.diameter_mm if suggested.roughing is not None else 0.0
     while diameter >= SMALLEST_SUGGESTED_MM - 1e-9:
         candidate = {**chosen, "UseRoughingTool": True, "RoughingToolKind": "flat",
                      "RoughingToolDiameter": round(diameter, 6), "RoughingCornerRadius": 0.0}
-        if validate({**values, "job": {**values["job"], **candidate}}).ok:
-            return candidate
+        single = validate({**values, "job": {**values["job"], **candidate}})
+        if single.ok:
+            return _with_two_stage(values, candidate, suggested_two_stage(cam_inputs(single.job)))
         diameter -= ROUGHING_STEP_MM
     return chosen
+
+
+def _with_two_stage(values: dict[str, dict[str, object]], single: dict[str, object], stage) -> dict[str, object]:
+    """The single roughing tool of `single` as the bottom tool below the suggested larger one (`stage`, a
+    TwoStageSuggestion or None), when the whole job then passes the checks; else `single`."""
+    if stage is None:
+        return single
+    two_stage = {**single, "RoughingToolDiameter": stage.top_diameter_mm, "UseBottomTool": True,
+                 "BottomToolKind": "flat", "BottomToolDiameter": single["RoughingToolDiameter"],
+                 "BottomCornerRadius": 0.0}
+    for role in ("CuttingSpeed", "FeedPerTooth", "Flutes"):  # the bottom tool cuts with the roughing tool's data
+        two_stage[f"Bottom{role}"] = values["job"][f"Roughing{role}"]
+    return two_stage if validate({**values, "job": {**values["job"], **two_stage}}).ok else single
