@@ -97,12 +97,14 @@ def figures_text(figures: PlanFigures) -> str:
     return "\n".join(lines)
 
 
-def limits_text(rec, with_roughing_limit: bool = True) -> str:
+def limits_text(rec, with_roughing_limit: bool = True, two_stage: bool = False) -> str:
     """The tool limits of the gear (spur_cad.cam.recommend.ToolRecommendations), one line each; without the
-    roughing diameter when it would derive from an invalid finishing tool (its plunge allowance)."""
+    roughing diameter when it would derive from an invalid finishing tool (its plunge allowance); with
+    `two_stage` that limit is the bottom tool's."""
     if rec is None:
         return ""
-    roughing = f"Roughing tool: D at most {rec.roughing_max_diameter_mm:.3f} mm\n" if with_roughing_limit else ""
+    deepest = "Bottom tool" if two_stage else "Roughing tool"
+    roughing = f"{deepest}: D at most {rec.roughing_max_diameter_mm:.3f} mm\n" if with_roughing_limit else ""
     return (f"{roughing}"
             f"Finishing tool: corner radius at most {rec.finishing_max_corner_radius_mm:.3f} mm, flat D - 2 r at most "
             f"{rec.finishing_max_flat_width_mm:.3f} mm (perimeter, along X)\n"
@@ -133,3 +135,41 @@ def long_job_advice(figures: PlanFigures, strategy: str, roughing_room_mm: float
         ways = ", ".join(options + ["a larger level depth or step-over, a higher feed per tooth"])
     return (f"Long job: {duration_text(total)}, of which {OPERATION_NAMES[name].lower()} "
             f"{duration_text(op.seconds_with_acceleration)}. Shorter with {ways}.")
+
+
+GROUP_SUMMARY_CHARS = 60
+"""A folded group's header shows its state in at most this many characters (it fits the default task dock)."""
+
+
+def _tool_summary(job: dict, role: str) -> str:
+    """'T1 flat D 4 mm', 'T2 bull-nose D 3.35 mm' or 'not used'."""
+    if not job.get(f"Use{role}Tool"):
+        return "not used"
+    diameter = float(job.get(f"{role}ToolDiameter", 0.0))
+    kind = str(job.get(f"{role}ToolKind", "")).replace("_", "-")
+    return f"T{job.get(f'{role}ToolNumber', '')} {kind} D {diameter:g} mm"
+
+
+def group_summary(group: str, job: dict[str, object]) -> str:
+    """What a folded group of the job panel holds, in a few words ('T1 flat D 4 mm', 'generating, scallop
+    0.005 mm'); '' for groups without one. Cut at GROUP_SUMMARY_CHARS with an ellipsis."""
+    tools = {"Roughing tool": "Roughing", "Finishing tool": "Finishing", "Bottom tool": "Bottom"}
+    if group in tools:
+        text = _tool_summary(job, tools[group])
+    elif group == "Finishing strategy":
+        text = f"{job.get('FinishingStrategy', '')}, scallop {float(job.get('TargetScallop', 0.0)):g} mm"
+    elif group == "Roughing strategy":
+        text = f"flank allowance {float(job.get('FlankAllowance', 0.0)):g} mm"
+    elif group == "Machine":
+        text = str(job.get("MachineName", ""))
+    elif group == "Post":
+        text = str(job.get("PostDialect", ""))
+    elif group == "Simulation":
+        text = "on" if job.get("SimulationEnabled") else "off"
+    elif group == "Lathe":
+        text = "program written" if job.get("WriteLatheProgram") else "no program"
+    elif group == "Job":
+        text = str(job.get("JobName", ""))
+    else:
+        return ""
+    return text if len(text) <= GROUP_SUMMARY_CHARS else text[:GROUP_SUMMARY_CHARS - 1].rstrip() + "\u2026"

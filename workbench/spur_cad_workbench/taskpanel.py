@@ -24,6 +24,7 @@ from spur_cad_workbench import compat, schema
 from spur_cad_workbench.properties import document_values, write_values
 from spur_cad_workbench.summary import (
     figures_text,
+    group_summary,
     limits_text,
     long_job_advice,
     plan_figures,
@@ -37,10 +38,11 @@ HIGHLIGHT_STYLE = f"border: 2px solid {ERROR_COLOUR};"
 NOTE_STYLE = "color: #555555;"
 ADVICE_STYLE = "color: #8a5a00;"
 BIG = 1e9
-COLLAPSED_GROUPS = ("Machine", "Machine limits", "Simulation", "Post", "Bottom tool", "Lathe", "Lathe tools")
-"""Rarely changed or optional groups: closed until asked for."""
+TITLE_WIDTH_PX = 120
+"""The task box's title (the job's label) is elided to this width: FreeCAD's task box never wraps its title,
+so a long job name would widen the panel beyond the dock."""
 FIELD_MIN_WIDTH_PX = 112
-PANEL_MIN_WIDTH_PX = 200  # fits FreeCAD's default task dock (about 264 px with its margins and scroll bar)
+PANEL_MIN_WIDTH_PX = 170  # fits a 240 px task dock: its scroll area's 220 px less the task box's margins
 QUANTITY_UNITS = {"length": "mm", "distance": "mm", "angle": "deg"}
 NUMBER_DECIMALS = 6
 REVALIDATE_DELAY_MS = 250  # typing: check once the keys pause (a check plans roughing levels: up to 0.5 s)
@@ -75,7 +77,7 @@ class NumberBox(QtGui.QDoubleSpinBox):
 class Section:
     """A titled, collapsible part of the panel: a header button and a body with a form layout."""
 
-    def __init__(self, title: str, collapsed: bool):
+    def __init__(self, title: str, collapsed: bool, on_open=None):
         self.widget = QtGui.QWidget()
         layout = QtGui.QVBoxLayout(self.widget)
         layout.setContentsMargins(0, 0, 0, 0)
@@ -85,28 +87,49 @@ class Section:
         self.header.setText(title)
         self.header.setCheckable(True)
         self.header.setToolButtonStyle(compat.qt_enum(QtCore.Qt, "ToolButtonStyle", "ToolButtonTextBesideIcon"))
-        self.header.setSizePolicy(_policy("Expanding"), _policy("Fixed"))
+        self.header.setSizePolicy(_policy("Ignored"), _policy("Fixed"))  # a long summary never widens the panel
         self.header.setStyleSheet("QToolButton { border: none; font-weight: bold; text-align: left; }")
         self.body = QtGui.QWidget()
         self.form = QtGui.QFormLayout(self.body)
         self.form.setRowWrapPolicy(compat.qt_enum(QtGui.QFormLayout, "RowWrapPolicy", "WrapLongRows"))
         self.form.setFieldGrowthPolicy(compat.qt_enum(QtGui.QFormLayout, "FieldGrowthPolicy", "AllNonFixedFieldsGrow"))
         self.form.setContentsMargins(8, 0, 0, 4)
+        self.summary = _wrapped_label(NOTE_STYLE, f"section-summary:{title}")
+        self.summary.setContentsMargins(22, 0, 0, 0)
+        self.summary.setVisible(False)
         layout.addWidget(self.header)
+        layout.addWidget(self.summary)
         layout.addWidget(self.body)
+        self.on_open = on_open  # called after the body is shown (the panel scrolls its fields to their start)
         self.header.toggled.connect(self.set_open)
         self.header.setChecked(not collapsed)
         self.set_open(not collapsed)
+
+    def set_summary(self, summary: str) -> None:
+        """Show what the group holds under its title while it is folded ('T1 flat D 4 mm')."""
+        self.summary.setText(summary)
+        self.summary.setVisible(bool(summary) and not self.is_open)
 
     def set_open(self, is_open: bool) -> None:
         self.header.setChecked(is_open)
         arrow = "DownArrow" if is_open else "RightArrow"
         self.header.setArrowType(compat.qt_enum(QtCore.Qt, "ArrowType", arrow))
         self.body.setVisible(is_open)
+        self.summary.setVisible(bool(self.summary.text()) and not is_open)
+        if is_open and self.on_open is not None:
+            self.on_open()
 
     @property
     def is_open(self) -> bool:
         return self.header.isChecked()
+
+
+def show_start(widget: QtGui.QWidget) -> None:
+    """Scroll a field's text to its start unless the user is typing in it: a narrow field shows "-1000.00 mm"
+    cut as "-1000.0" rather than "000.00 mm" (a lost minus sign), and "generic 4-axis VM" not "eneric 4-axis VMC"."""
+    edit = widget if isinstance(widget, QtGui.QLineEdit) else getattr(widget, "lineEdit", lambda: None)()
+    if edit is not None and not edit.hasFocus():
+        edit.setCursorPosition(0)
 
 
 def _wrapped_label(style: str = "", name: str = "") -> QtGui.QLabel:
@@ -154,7 +177,12 @@ class JobTaskPanel:
         self.job = job_obj
         self.form = QtGui.QWidget()
         self.form.setObjectName("SpurCadJobPanel")
-        self.form.setWindowTitle(f"4-axis job: {job_obj.Label}")
+        title = f"4-axis job: {job_obj.Label}"
+        bold = QtGui.QFont(self.form.font())
+        bold.setBold(True)
+        elide = compat.qt_enum(QtCore.Qt, "TextElideMode", "ElideRight")
+        self.form.setWindowTitle(QtGui.QFontMetrics(bold).elidedText(title, elide, TITLE_WIDTH_PX))
+        self.form.setToolTip(title)
         self.form.setMinimumWidth(PANEL_MIN_WIDTH_PX)
         self.widgets = FieldWidgets(self.form)
         self.labels: dict[str, QtGui.QLabel] = {}
@@ -175,7 +203,8 @@ class JobTaskPanel:
         self._timer.setSingleShot(True)
         self._timer.timeout.connect(self.revalidate)
         for group in _group_names():
-            section = Section(group, group in COLLAPSED_GROUPS)
+            section = Section(group, collapsed=True,  # the summary on top and each header say what they hold
+                              on_open=lambda group=group: self._show_starts(group))
             self.sections[group] = section
             if group not in self.messages:
                 section.form.addRow(self._message_label(group))
@@ -227,6 +256,10 @@ class JobTaskPanel:
         self.labels[field.prop], self.notes[field.prop] = label, note
         section.form.addRow(label, widget)
         self.widgets.add(field.prop)
+        show_start(widget)
+        finished = getattr(widget, "editingFinished", None)
+        if finished is not None:  # looked up afresh: see FieldWidgets
+            finished.connect(lambda prop=field.prop: show_start(self.widgets[prop]))
         section.form.addRow(note)
 
     def _widget(self, field, value) -> QtGui.QWidget:
@@ -270,6 +303,14 @@ class JobTaskPanel:
         widget.lineEdit().textChanged.connect(self._schedule)
         return widget
 
+    def _show_starts(self, group: str) -> None:
+        """The fields of a group just opened show their text from its start (FreeCAD's quantity boxes set their
+        text again when first shown)."""
+        QtCore.QCoreApplication.processEvents()
+        for field in schema.JOB_FIELDS:
+            if field.group == group and field.prop in self.widgets:
+                show_start(self.widgets[field.prop])
+
     # --- values and checks -----------------------------------------------------------------
     def _value(self, field):
         widget = self.widgets[field.prop]
@@ -310,6 +351,7 @@ class JobTaskPanel:
             unit = QUANTITY_UNITS[schema.field_by_prop(prop).kind]
             compat.set_spin_box_value(widget, FreeCAD.Units, float(value), unit)
             self._shown[prop] = (widget.text(), float(value))
+        show_start(self.widgets[prop])
         self.revalidate()  # at once (a user's typing waits for a pause: _schedule)
 
     def current_messages(self) -> dict[str, str]:
@@ -336,13 +378,16 @@ class JobTaskPanel:
             label.setText(advice.get(group, ""))
             label.setVisible(group in advice)
         self._highlight(next((p.prop for p in result.problems if p.prop in self.widgets), None))
-        notes = {**recommendation_notes(result.recommendations), **unusual_value_notes(values["job"])}
+        two_stage = bool(values["job"].get("UseBottomTool"))
+        notes = {**recommendation_notes(result.recommendations, two_stage), **unusual_value_notes(values["job"])}
         finishing_invalid = any(problem.group == "Finishing tool" for problem in result.problems)
-        if finishing_invalid:
-            notes.pop("RoughingToolDiameter", None)  # its limit depends on the finishing tool (A_p)
+        if finishing_invalid:  # the roughing limit depends on the finishing tool (A_p)
+            notes.pop("BottomToolDiameter" if two_stage else "RoughingToolDiameter", None)
         for prop, label in self.notes.items():
             label.setText(notes.get(prop, ""))
             label.setVisible(prop in notes)
+        for group, section in self.sections.items():
+            section.set_summary(group_summary(group, values["job"]))
         for section, switch in schema.SECTION_SWITCHES.items():
             enabled = self.widgets[switch.prop].isChecked()
             for field in schema.JOB_FIELDS:
@@ -374,7 +419,8 @@ class JobTaskPanel:
             first = result.problems[0]
             self.summary.setText(f"{len(result.problems)} problem: {first.advice}")
             self.summary.setStyleSheet(ERROR_STYLE)
-        self.summary_limits.setText(limits_text(result.recommendations, with_roughing_limit))
+        self.summary_limits.setText(limits_text(result.recommendations, with_roughing_limit,
+                                                bool(values["job"].get("UseBottomTool"))))
         figures, source = self._figures(values_signature(values)) if result.ok else (None, "")
         if figures is not None:
             self.summary_figures.setText(f"{figures_text(figures)}\n({source})")

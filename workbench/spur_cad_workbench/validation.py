@@ -163,8 +163,9 @@ def validate(values: dict[str, dict[str, object]], source: str = "job") -> Valid
     return Validation(job, (), rec)
 
 
-def recommendation_notes(rec) -> dict[str, str]:
-    """Text shown beside the tool fields (property name -> note) for ToolRecommendations `rec`."""
+def recommendation_notes(rec, two_stage: bool = False) -> dict[str, str]:
+    """Text shown beside the tool fields (property name -> note) for ToolRecommendations `rec`; with `two_stage`
+    (a bottom tool in use) the roughing tool's limit is the bottom tool's and the roughing tool only fits the space."""
     if rec is None:
         return {}
     notes = {
@@ -174,7 +175,10 @@ def recommendation_notes(rec) -> dict[str, str]:
                                  "the rack's tip flat and the flank limit",
         "FinishingCornerRadius": f"at most {rec.finishing_max_corner_radius_mm:.3f} mm (smallest fillet radius)",
     }
-    for role in ("Roughing", "Finishing"):
+    if two_stage:
+        notes["BottomToolDiameter"] = notes.pop("RoughingToolDiameter")
+        notes["RoughingToolDiameter"] = "two-stage roughing: larger than the bottom tool (it roughs the upper levels)"
+    for role in ("Roughing", "Finishing", "Bottom"):
         notes[f"{role}FluteLength"] = f"at least {rec.required_flute_length_mm:.3f} mm (or 0: not checked)"
         notes[f"{role}StickOut"] = f"at least {rec.required_stick_out_mm:.3f} mm (or 0: not checked)"
     return notes
