@@ -84,19 +84,12 @@ def find_colour_bar(scene):
     return None
 
 
-def _view_of(document):
-    """The 3D view of a FreeCAD document (None without the GUI or a 3D view)."""
-    import FreeCADGui
-
-    gui_document = FreeCADGui.getDocument(document.Name)
-    view = gui_document.ActiveView if gui_document is not None else None
-    return view if view is not None and hasattr(view, "getSceneGraph") else None
-
-
 def show_colour_bar(scale_mm: float, document) -> None:
     """Put the colour bar (replacing an older one) into the 3D view of `document`. Its width-to-height ratio
     is the view's when shown: after resizing the view, showing it again puts it back at the left edge."""
-    view = _view_of(document)
+    from spur_cad_workbench.views import view_3d
+
+    view = view_3d(document)
     if view is None:
         return
     remove_colour_bar(document)
@@ -106,7 +99,9 @@ def show_colour_bar(scale_mm: float, document) -> None:
 
 def remove_colour_bar(document) -> None:
     """Take the colour bar out of the 3D view of `document` (a stale simulation has no scale to show)."""
-    view = _view_of(document)
+    from spur_cad_workbench.views import view_3d
+
+    view = view_3d(document)
     scene = view.getSceneGraph() if view is not None else None
     old = find_colour_bar(scene) if scene is not None else None
     if old is not None:

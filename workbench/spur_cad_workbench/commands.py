@@ -12,7 +12,8 @@ Entry points take and return document objects:
 
 The GUI commands run the entry points through FreeCADGui.doCommandGui, so they are recorded
 in macros; a SpurCadError is shown as its message (report view and a message box), never as a
-traceback.
+traceback. Spur gear and Import job file also turn the 3D view isometric and fit it, Stock and 4-axis job
+fit it (recorded lines calling views.orient_and_fit); the entry points leave the camera alone.
 """
 
 from __future__ import annotations
@@ -285,6 +286,12 @@ NEW_DOCUMENT = "if App.ActiveDocument is None: App.newDocument('Gear')"
 RECOMPUTE = "App.ActiveDocument.recompute()"
 
 
+def _fit_view(obj: str, isometric: bool) -> list[str]:
+    """Macro lines turning the 3D view of `obj`'s document to the isometric view (if asked) and fitting all."""
+    return ["import spur_cad_workbench.views",
+            f"spur_cad_workbench.views.orient_and_fit({obj}.Document, isometric={isometric})"]
+
+
 def _call(result: str, function: str, *arguments: str) -> str:
     """A macro line calling an entry point of this module."""
     return f"{result} = spur_cad_workbench.commands.{function}({', '.join(arguments)})"
@@ -315,11 +322,8 @@ class GearCommand(_Command):
         return True
 
     def Activated(self):
-        if run_recorded([NEW_DOCUMENT, _call("spur_cad_gear", "make_gear", "App.ActiveDocument"), RECOMPUTE],
-                        "Spur gear"):
-            import FreeCADGui
-
-            FreeCADGui.SendMsgToActiveView("ViewFit")
+        run_recorded([NEW_DOCUMENT, _call("spur_cad_gear", "make_gear", "App.ActiveDocument"), RECOMPUTE,
+                      *_fit_view("spur_cad_gear", isometric=True)], "Spur gear")
 
 
 class StockCommand(_Command):
@@ -331,7 +335,8 @@ class StockCommand(_Command):
 
     def Activated(self):
         gear = _selected("gear")
-        run_recorded([_call("spur_cad_stock", "make_stock", _object(gear)), RECOMPUTE], "Stock")
+        run_recorded([_call("spur_cad_stock", "make_stock", _object(gear)), RECOMPUTE,
+                      *_fit_view("spur_cad_stock", isometric=False)], "Stock")
 
 
 class JobCommand(_Command):
@@ -344,7 +349,8 @@ class JobCommand(_Command):
     def Activated(self):
         stock = _selected("stock")
         run_recorded([_call("spur_cad_job", "make_job", _object(stock.Gear), _object(stock)), RECOMPUTE,
-                      "Gui.ActiveDocument.setEdit(spur_cad_job.Name)"], "4-axis job")
+                      *_fit_view("spur_cad_job", isometric=False), "Gui.ActiveDocument.setEdit(spur_cad_job.Name)"],
+                     "4-axis job")
 
 
 class ImportJobCommand(_Command):
@@ -361,7 +367,8 @@ class ImportJobCommand(_Command):
         path, _ = QtGui.QFileDialog.getOpenFileName(FreeCADGui.getMainWindow(), "Import spur_cad job file", "",
                                                     "spur_cad job (*.toml)")
         if path:  # a new document named after the job file
-            run_recorded([_call("spur_cad_objects", "import_job_file", "None", repr(path))], "Import job file")
+            run_recorded([_call("spur_cad_objects", "import_job_file", "None", repr(path)),
+                          *_fit_view("spur_cad_objects[0]", isometric=True)], "Import job file")
 
 
 class SimulateCommand(_Command):

@@ -14,7 +14,8 @@ What differs (more in docs/freecad-compat.md):
   the wrapper has `PySide.QtWidgets` only in 1.x (both re-export the widgets from `PySide.QtGui`);
 - Gui::QuantitySpinBox has a per-widget `decimals` property in 1.x only;
 - ViewProviderGeometryObject's `ShapeColor` property became `ShapeAppearance` (a material list) in 1.0;
-- Control.showDialog returns None in 0.20 and a TaskDialog wrapper in 1.x.
+- Control.showDialog returns None in 0.20 and a TaskDialog wrapper in 1.x;
+- a proxy's state is restored through `__setstate__` in 0.20 and `loads` in 1.x (StatelessProxy).
 FreeCAD 1.1's versioned user data folder (`v1-1`) concerns the installer: spur_cad/freecad_install.py.
 """
 
@@ -35,6 +36,28 @@ PATH_MODULE_NAMES = ("Path", "PathApp")
 PATH_FEATURE_TYPE = "Path::FeaturePython"
 
 QUANTITY_SPIN_BOX = "Gui::QuantitySpinBox"
+
+
+class StatelessProxy:
+    """Base of every proxy (document and view objects): saved as null, restored to nothing, in 0.20 and 1.x.
+
+    All state lives in properties. FreeCAD saves a proxy's state from `dumps` (1.x) or `__getstate__` (0.20;
+    Python 3.11's object has one) and restores it through `loads` (1.x: src/App/PropertyPythonObject.cpp,
+    fromString) or `__setstate__` (0.20). A proxy without `__setstate__` breaks reopening in 0.20: it then
+    assigns the saved null to the instance's `__dict__` and prints "AttributeError: setAttr failed"
+    (observed with the simulation's proxy, issue 28). 1.x sets `__dict__` only for a state that is not None."""
+
+    def dumps(self):
+        return None
+
+    def loads(self, state):
+        return None
+
+    def __getstate__(self):
+        return None
+
+    def __setstate__(self, state):
+        return None
 
 
 def freecad_version(freecad) -> tuple[int, int, int]:

@@ -149,23 +149,7 @@ def set_shape(obj, shape) -> None:
     obj.Placement = placement
 
 
-class _Stateless:
-    """Saved documents hold no pickled Python: proxies save as null (all state lives in properties)."""
-
-    def dumps(self):
-        return None
-
-    def loads(self, state):
-        return None
-
-    def __getstate__(self):
-        return None
-
-    def __setstate__(self, state):
-        return None
-
-
-class _Proxy(_Stateless):
+class _Proxy(compat.StatelessProxy):
     """Common proxy behaviour: no state of its own, migration on restore."""
 
     KIND = ""
@@ -393,7 +377,7 @@ def update_toolpath(obj, planned) -> None:
     obj.purgeTouched()  # set by the job's recompute: nothing left for the toolpath itself to do
 
 
-class ViewProvider(_Stateless):
+class ViewProvider(compat.StatelessProxy):
     """Icon, tree children and editing of the workbench's objects; no state."""
 
     def __init__(self, vobj):
@@ -406,6 +390,13 @@ class ViewProvider(_Stateless):
         kind = getattr(getattr(getattr(self, "Object", None), "Proxy", None), "KIND", "")
         return icon_path({"gear": "gear", "stock": "stock", "job": "job", "toolpath": "toolpath",
                           "simulation": "simulate"}.get(kind, "spur_cad"))
+
+    def onChanged(self, vobj, prop):
+        """A simulation shown or hidden (Space): its job's toolpaths hidden or shown again (views.py)."""
+        if prop == "Visibility" and getattr(getattr(vobj.Object, "Proxy", None), "KIND", "") == "simulation":
+            from spur_cad_workbench.views import simulation_visibility_changed
+
+            simulation_visibility_changed(vobj.Object)
 
     def claimChildren(self):
         obj = getattr(self, "Object", None)

@@ -3,11 +3,12 @@
 `simulate_job` cuts the stock with the job's toolpaths through spur_cad.sim's pipeline stage
 (`spur_cad.pipeline.simulate_stage`, as `spur-cad run` does); `show_result` draws every design
 point of the face width, in the part frame, coloured by its deviation (blue gouge, green on
-the design, red leftover) in a simulation object linked to its job. The colour scale
-(`ColourScale`, editable) starts at the largest deviation shown, so the worst point is fully
-coloured; a colour bar in the 3D view gives the scale. The object remembers the values it was
-simulated for (`PlannedValues`): when the job changes, the job marks it stale (grey). Without
-spur_cad.sim, `simulator()` raises SimulationUnavailable with the message the command shows.
+the design, red leftover) in a simulation object linked to its job; while it is visible, the
+job's toolpath objects are hidden (views.py). The colour scale (`ColourScale`, editable) starts
+at the largest deviation shown, so the worst point is fully coloured; a colour bar in the 3D
+view gives the scale. The object remembers the values it was simulated for (`PlannedValues`):
+when the job changes, the job marks it stale (grey). Without spur_cad.sim, `simulator()` raises
+SimulationUnavailable with the message the command shows.
 """
 
 from __future__ import annotations
@@ -16,6 +17,8 @@ import numpy as np
 
 from spur_cad.errors import SpurCadError
 from spur_cad_workbench.colours import deviation_colours
+from spur_cad_workbench.compat import StatelessProxy
+from spur_cad_workbench.views import show_toolpaths_unless_simulated
 
 MAX_SHOWN_POINTS = 300_000
 
@@ -105,9 +108,9 @@ def legend_text(scale_mm: float, shown: int, total: int) -> str:
             f"{scale_mm * 1000:.3g} um or more ({shown:,} of {total:,} design points shown)")
 
 
-class SimulationFeature:
+class SimulationFeature(StatelessProxy):
     """Proxy of a simulation object (Points::FeaturePython): recolours the points when ColourScale changes.
-    Stateless (saved as null); the deviations live in the Deviations property."""
+    Saved as null (compat.StatelessProxy); the deviations live in the Deviations property."""
 
     KIND = "simulation"
 
@@ -120,12 +123,6 @@ class SimulationFeature:
     def onChanged(self, obj, prop):
         if prop == "ColourScale" and "Deviations" in obj.PropertiesList and len(obj.Deviations):
             recolour(obj)
-
-    def dumps(self):
-        return None
-
-    def loads(self, state):
-        return None
 
 
 def recolour(obj) -> None:
@@ -206,6 +203,8 @@ def show_result(job_obj, result, planned_values: str = "", plan_source: str = ""
     if FreeCAD.GuiUp and obj.ViewObject is not None:
         obj.ViewObject.DisplayMode = "Color"
         obj.ViewObject.PointSize = 3
+        obj.ViewObject.Visibility = True
+        show_toolpaths_unless_simulated(job_obj)  # the points lie under the toolpaths: hide those
     FreeCAD.Console.PrintMessage(f"{obj.Label}: max gouge {result.max_gouge_mm * 1000:.2f} um, max leftover "
                                  f"{result.max_leftover_mm * 1000:.2f} um\n")
     return obj
