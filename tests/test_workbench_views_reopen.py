@@ -99,6 +99,7 @@ job = doc.getObject("Job")
 job.ViewObject.Proxy.panel.reject()
 settle()
 RESULT["job"] = camera(doc, [gear, stock])
+job.UseBottomTool = False  # the small job's one roughing tool (a new job may rough in two stages)
 for name, value in PROPS["job"].items():
     setattr(job, name, value)
 doc.recompute()
