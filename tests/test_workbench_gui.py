@@ -19,6 +19,7 @@ from tests.workbench_helper import (
     ARTIFACTS,
     SMALL_GEAR_PROPERTIES,
     SMALL_JOB_PROPERTIES,
+    SMALL_STOCK_PROPERTIES,
     run_workbench_code,
     small_job_text,
 )
@@ -87,6 +88,8 @@ doc.recompute()
 select(gear)
 FreeCADGui.runCommand("SpurCad_Stock")
 stock = doc.getObject("Stock")
+for name, value in PROPS["stock"].items():
+    setattr(stock, name, value)
 select(stock)
 FreeCADGui.runCommand("SpurCad_Job")
 settle()
@@ -214,7 +217,7 @@ def test_workbench_commands_panel_and_screenshot_in_the_gui(freecad_gui, tmp_pat
     SCREENSHOT.unlink(missing_ok=True)
     job_file = tmp_path / "small.toml"
     job_file.write_text(small_job_text())
-    props = {"gear": SMALL_GEAR_PROPERTIES, "job": SMALL_JOB_PROPERTIES}
+    props = {"gear": SMALL_GEAR_PROPERTIES, "stock": SMALL_STOCK_PROPERTIES, "job": SMALL_JOB_PROPERTIES}
     body = (f"PROPS = {props!r}\nOUT = {str(tmp_path / 'exported')!r}\nJOB_FILE = {str(job_file)!r}\n"
             f"SCREENSHOT = {str(SCREENSHOT)!r}\n" + GUI_BODY)
     result, proc = run_workbench_code(body, tmp_path / "fc", gui=freecad_gui, timeout_s=300)

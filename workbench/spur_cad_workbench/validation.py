@@ -14,11 +14,11 @@ from spur_cad.errors import SpurCadError
 from spur_cad_workbench.schema import TOOL_SWITCHES, job_data
 
 # Panel groups (the property groups of schema.JOB_FIELDS, plus the gear and stock objects).
-SECTION_GROUPS = {"tools.roughing": "Roughing tool", "tools.finishing": "Finishing tool",
+SECTION_GROUPS = {"tools.roughing": "Roughing tool", "tools.finishing": "Finishing tool", "tools.bottom": "Bottom tool",
                   "roughing": "Roughing strategy", "finishing": "Finishing strategy", "machine": "Machine",
                   "post": "Post", "job": "Job", "gear": "Gear", "stock": "Stock", "simulation": "Simulation"}
 _SECTION_RE = re.compile(
-    r"\[(tools\.roughing|tools\.finishing|roughing|finishing|machine|post|job|gear|stock|simulation)\]")
+    r"\[(tools\.roughing|tools\.finishing|tools\.bottom|roughing|finishing|machine|post|job|gear|stock|simulation)\]")
 
 
 @dataclass(frozen=True)
