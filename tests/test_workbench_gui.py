@@ -54,15 +54,16 @@ def answer_file_dialog(path):
         dialog.accept()
     QtCore.QTimer.singleShot(100, fill)
 
-def answer_input_dialog(text, then_path):
-    # type the restart point into the next input dialog, then the path into the file dialog after it
+def answer_restart_dialog(space, then_path):
+    # pick the tooth space in the next Restart program dialog, then type the path into the file dialog after it
     def fill(left=50):
         dialog = QtGui.QApplication.activeModalWidget()
-        if not isinstance(dialog, QtGui.QInputDialog):
+        if dialog is None or dialog.objectName() != "SpurCadRestartDialog":
             if left:
                 QtCore.QTimer.singleShot(100, lambda: fill(left - 1))
             return
-        dialog.setTextValue(text)
+        combo = dialog.findChild(QtGui.QComboBox, "space")
+        combo.setCurrentIndex(combo.findData(space))
         answer_file_dialog(then_path)
         dialog.accept()
     QtCore.QTimer.singleShot(100, fill)
@@ -171,7 +172,7 @@ for box in boxes:
 # Restart program: roughing from tooth space 3, written where the user says
 RESTART = os.path.join(OUT + "_restart", "roughing_space3.ngc")
 os.makedirs(OUT + "_restart")
-answer_input_dialog("roughing:space=3", RESTART)
+answer_restart_dialog(3, RESTART)
 select(job)
 FreeCADGui.runCommand("SpurCad_Restart")
 settle()

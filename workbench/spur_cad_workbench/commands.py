@@ -7,13 +7,16 @@ Entry points take and return document objects:
     job = make_job(gear, stock)                       # tools suggested within the recommendations
     doc.recompute()
     export_job(job, "/tmp/out")                       # the same files as `spur-cad run`
+    write_restart_program(job, RestartPoint("roughing", (("space", 5),)), "/tmp/roughing_space5.ngc")
     gear, stock, job = import_job_file(doc, "job.toml")
     result = simulate(job)                            # needs spur_cad.sim
 
 The GUI commands run the entry points through FreeCADGui.doCommandGui, so they are recorded
 in macros; a SpurCadError is shown as its message (report view and a message box), never as a
 traceback. Spur gear and Import job file also turn the 3D view isometric and fit it, Stock and 4-axis job
-fit it (recorded lines calling views.orient_and_fit); the entry points leave the camera alone.
+fit it (recorded lines calling views.orient_and_fit); the entry points leave the camera alone. Long work
+(export, simulate, verify, restart planning) shows FreeCAD's progress indicator and a wait cursor and keeps
+the window repainting (progress.WorkProgress).
 """
 
 from __future__ import annotations
@@ -35,7 +38,11 @@ from spur_cad_workbench.features import (
     ToolpathFeature,
     ViewProvider,
 )
+from spur_cad_workbench.progress import WorkProgress
 from spur_cad_workbench.properties import document_values, job_of
+
+EXPORT_STAGES = ("CAD and STEP", "toolpaths", "simulation", "report")
+"""The stages spur_cad.pipeline.run_job reports to its progress callback, in order."""
 
 
 def _checked(values: dict, fields, what: str) -> dict:
@@ -154,7 +161,8 @@ def export_job(job_obj, out_dir: str) -> list[str]:
     # beside the job file.
     document = job_obj.Document.FileName
     job = with_report_template(job_of(job_obj), Path(document).parent if document else Path.cwd())
-    files = run_job(job).files
+    with WorkProgress("Export", EXPORT_STAGES) as work:
+        files = run_job(job, progress=work.advance, checkpoint=work.events).files
     out = Path(out_dir)
     try:
         paths = write_output_set(out, files)
@@ -174,10 +182,12 @@ def simulate(job_obj, resolution_mm: float | None = None):
     signature = values_signature(document_values(job_obj))
     cached = getattr(job_obj.Proxy, "cached_plan", None)
     reused = cached is not None and cached[0] == signature
-    job, plan = job_obj.Proxy.plan_for(job_obj)
+    with WorkProgress("Simulate", ("toolpaths", "simulation")) as work:
+        job, plan = job_obj.Proxy.plan_for(job_obj, checkpoint=work.events)
+        work.stage_done("toolpaths")
+        result = simulate_job(job, plan, resolution_mm, progress=lambda done: work.advance("simulation", done))
     source = "the job's plan (reused)" if reused else "planned for this simulation"
-    return show_result(job_obj, simulate_job(job, plan, resolution_mm), signature, source,
-                       view_provider=ViewProvider)
+    return show_result(job_obj, result, signature, source, view_provider=ViewProvider)
 
 
 def verify_programs(job_obj, paths: list[str], dialect: str | None = None, point: str = "tip"):
@@ -192,27 +202,39 @@ def verify_programs(job_obj, paths: list[str], dialect: str | None = None, point
     simulator()
     job = job_of(job_obj)
     programs = []
-    for path in paths:  # regular files of bounded size, read as a stream (spur-cad verify's reader)
-        programs.append(read_program_file(path, dialect or job.post.dialect))
-    result = verify_moves(job, programs, VerifyOptions(point))
+    with WorkProgress("Verify program", ("reading", "simulation")) as work:
+        for path in paths:  # regular files of bounded size, read as a stream (spur-cad verify's reader)
+            programs.append(read_program_file(path, dialect or job.post.dialect))
+            work.events()
+        work.stage_done("reading")
+        result = verify_moves(job, programs, VerifyOptions(point), progress=lambda done: work.advance("simulation",
+                                                                                                     done))
     names = ", ".join(Path(path).name for path in paths)
     obj = show_result(job_obj, result.simulation, values_signature(document_values(job_obj)),
                       f"verified programs: {names}", role="verification", view_provider=ViewProvider)
-    show_message("Verify program", "\n".join(result.lines()), error=not result.passed)
+    show_message("Verify program", "\n".join(result.lines()), level="message" if result.passed else "error")
     return obj
 
 
-def write_restart_program(job_obj, point: str, path: str) -> str:
+def write_restart_program(job_obj, point, path: str) -> str:
     """`spur-cad run --restart POINT` inside FreeCAD: the program restarting the job's roughing or finishing at
-    `point` (e.g. "roughing:space=5", "finishing:station=40"; docs/shop-floor.md) written to `path`."""
-    from spur_cad.cam.restart import parse_restart
+    `point` written to `path`. `point` is a spur_cad.cam.restart.RestartPoint (what the Restart program dialog
+    records: RestartPoint("roughing", (("space", 5), ("level", 2)))) or its text ("roughing:space=5,level=2",
+    "finishing:station=40"; docs/shop-floor.md). Errors name the point as the dialog does."""
+    from spur_cad.cam.restart import RestartError, parse_restart
     from spur_cad.errors import SpurCadError
     from spur_cad.outputs import write_file_atomically
     from spur_cad.pipeline import restart_program
+    from spur_cad_workbench.restart_dialog import reworded
 
-    restart = parse_restart(point)
-    job, plan = job_obj.Proxy.plan_for(job_obj)
-    _, text = restart_program(job, plan, restart)
+    restart = parse_restart(point) if isinstance(point, str) else point
+    with WorkProgress("Restart program", ("toolpaths", "restart program")) as work:
+        job, plan = job_obj.Proxy.plan_for(job_obj, checkpoint=work.events)
+        work.stage_done("toolpaths")
+        try:
+            _, text = restart_program(job, plan, restart)
+        except RestartError as exc:
+            raise SpurCadError(reworded(str(exc), restart)) from None
     try:
         written = write_file_atomically(path, text)
     except OSError as exc:
@@ -251,14 +273,21 @@ def _selected(kind: str):
     return found[-1] if found else None
 
 
-def show_message(title: str, message: str, error: bool = True) -> None:
-    """A message for the user: one line in the report view and a (non-blocking) message box."""
-    (FreeCAD.Console.PrintError if error else FreeCAD.Console.PrintWarning)(f"{title}: {message}\n")
+MESSAGE_LEVELS = {"message": ("PrintMessage", "Information"), "warning": ("PrintWarning", "Warning"),
+                  "error": ("PrintError", "Critical")}
+"""A message's level -> (FreeCAD.Console method, QMessageBox icon)."""
+
+
+def show_message(title: str, message: str, level: str = "error") -> None:
+    """A message for the user at `level` ("message": a result such as PASS, "warning", "error"): in the report
+    view at that level (black, orange, red) and in a (non-blocking) message box with the level's icon."""
+    print_name, icon_name = MESSAGE_LEVELS[level]
+    getattr(FreeCAD.Console, print_name)(f"{title}: {message}\n")
     if FreeCAD.GuiUp:
         import FreeCADGui
         from PySide import QtGui
 
-        icon = compat.qt_enum(QtGui.QMessageBox, "Icon", "Warning" if error else "Information")
+        icon = compat.qt_enum(QtGui.QMessageBox, "Icon", icon_name)
         ok = compat.qt_enum(QtGui.QMessageBox, "StandardButton", "Ok")
         box = QtGui.QMessageBox(icon, title, message, ok, FreeCADGui.getMainWindow())
         box.setObjectName("SpurCadMessage")
@@ -384,7 +413,7 @@ class SimulateCommand(_Command):
         try:
             simulator()
         except SimulationUnavailable as exc:
-            show_message("Simulate", str(exc), error=False)
+            show_message("Simulate", str(exc), level="warning")
             return
         job = _selected("job")
         run_recorded([_call("spur_cad_simulation", "simulate", _object(job))], "Simulate")
@@ -422,18 +451,36 @@ class RestartCommand(_Command):
         import FreeCADGui
         from PySide import QtGui
 
-        job = _selected("job")
+        from spur_cad.errors import SpurCadError
+
+        job_obj = _selected("job")
         window = FreeCADGui.getMainWindow()
-        point, ok = QtGui.QInputDialog.getText(
-            window, "Restart program", "Restart at (numbered from 0): roughing:space=K[,level=N], "
-            "finishing:station=N or finishing:space=K[,pass=N]", QtGui.QLineEdit.Normal, "roughing:space=0")
-        if not ok or not point.strip():
+        try:
+            dialog = restart_dialog(job_obj, window)
+        except SpurCadError as exc:
+            show_message("Restart program", str(exc))
             return
-        path, _ = QtGui.QFileDialog.getSaveFileName(window, "Write the restart program", "",
-                                                    "G-code (*.ngc *.nc *.mpf *.min);;All files (*)")
+        if not compat.exec_dialog(dialog.dialog):
+            return
+        point, name = dialog.point(), dialog.file_name()
+        document = job_obj.Document.FileName
+        folder = Path(document).parent if document else Path.cwd()
+        path, _ = QtGui.QFileDialog.getSaveFileName(window, "Save the restart program", str(folder / name),
+                                                    f"G-code (*{Path(name).suffix});;All files (*)")
         if path:
-            run_recorded([_call("spur_cad_restart", "write_restart_program", _object(job), repr(point.strip()),
+            run_recorded(["from spur_cad.cam.restart import RestartPoint",
+                          _call("spur_cad_restart", "write_restart_program", _object(job_obj), repr(point),
                                 repr(path))], "Restart program")
+
+
+def restart_dialog(job_obj, parent=None):
+    """The Restart program dialog (restart_dialog.RestartDialog, not shown yet) for the job's current plan,
+    planned first (with the progress indicator) when the job's values changed since the last plan."""
+    from spur_cad_workbench.restart_dialog import RestartDialog
+
+    with WorkProgress("Restart program", ("toolpaths",)) as work:
+        job, plan = job_obj.Proxy.plan_for(job_obj, checkpoint=work.events)
+    return RestartDialog(job, plan, parent)
 
 
 class ExportCommand(_Command):

@@ -251,3 +251,13 @@ def show_task_dialog(control, panel, document_name: str | None = None):
             dialog.setAutoCloseOnDeletedDocument(True)
     return dialog
 
+
+
+def progress_indicator(freecad):
+    """FreeCAD's progress indicator (start(text, steps), next(), stop()), or None where FreeCAD has none.
+
+    `FreeCAD.Base.ProgressIndicator` has these three methods in 0.20 (checked in the GUI: in the GUI it drives
+    the status bar's Gui::ProgressBar and sets a wait cursor) and 1.x (src/Base/ProgressIndicatorPy.cpp,
+    unchanged since its split out of Sequencer.cpp in 2022)."""
+    factory = getattr(getattr(freecad, "Base", None), "ProgressIndicator", None)
+    return factory() if factory is not None else None

@@ -261,8 +261,9 @@ class JobFeature(_Proxy):
         add_fields(obj, self.OUTPUTS, outputs=True)
         add_bookkeeping(obj)
 
-    def plan_for(self, obj):
-        """(job, plan) of the job's current values: the last plan when the values have not changed since."""
+    def plan_for(self, obj, checkpoint=None):
+        """(job, plan) of the job's current values: the last plan when the values have not changed since.
+        `checkpoint()` is called between planning steps (the GUI processes events there)."""
         from spur_cad.pipeline import plan_cam
         from spur_cad_workbench.summary import values_signature
 
@@ -271,7 +272,7 @@ class JobFeature(_Proxy):
         if cached is not None and cached[0] == signature:
             return cached[1], cached[2]
         job = job_of(obj)
-        plan = plan_cam(job)
+        plan = plan_cam(job, checkpoint)
         self.cached_plan = (signature, job, plan)
         return job, plan
 

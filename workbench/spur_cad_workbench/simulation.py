@@ -41,9 +41,10 @@ def simulator():
         raise
 
 
-def simulate_job(job, plan, resolution_mm: float | None = None):
+def simulate_job(job, plan, resolution_mm: float | None = None, progress=None):
     """spur_cad.sim's result for the job's roughing then finishing IR, at the job's [simulation] resolution
-    unless `resolution_mm` is given (simulated even when [simulation] enabled is false: the user asked)."""
+    unless `resolution_mm` is given (simulated even when [simulation] enabled is false: the user asked).
+    `progress(fraction)` is told how far the simulation is."""
     import dataclasses
 
     simulator()
@@ -53,7 +54,7 @@ def simulate_job(job, plan, resolution_mm: float | None = None):
                                    resolution_mm=resolution_mm or job.simulation.resolution_mm)
     settings.validate()
     wanted = dataclasses.replace(job, simulation=settings)
-    result = simulate_stage(wanted, plan)
+    result = simulate_stage(wanted, plan, progress)
     if result is None:
         raise SpurCadError("the job has no toolpaths to simulate (choose a roughing or finishing tool)")
     return result
