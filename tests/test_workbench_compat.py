@@ -422,6 +422,18 @@ def test_show_task_dialog_on_020_and_1x():
     assert compat.show_task_dialog(FakeControl(untied), panel) is untied and untied.calls == []
 
 
+def test_progress_indicator_where_freecad_has_one():
+    # 0.20 and 1.x: FreeCAD.Base.ProgressIndicator() with start(text, steps), next(), stop()
+    # (src/Base/ProgressIndicatorPy.cpp); the 0.20 object is checked in the GUI test (tests/test_workbench_dialogs_gui.py)
+    class Indicator:
+        pass
+
+    with_one = types.SimpleNamespace(Base=types.SimpleNamespace(ProgressIndicator=Indicator))
+    assert isinstance(compat.progress_indicator(with_one), Indicator)
+    assert compat.progress_indicator(types.SimpleNamespace(Base=types.SimpleNamespace())) is None
+    assert compat.progress_indicator(types.SimpleNamespace()) is None
+
+
 # --- the real FreeCAD 0.20 ------------------------------------------------------------------------------
 
 CONSOLE_BODY = r"""
