@@ -424,7 +424,7 @@ def test_show_task_dialog_on_020_and_1x():
 
 def test_progress_indicator_where_freecad_has_one():
     # 0.20 and 1.x: FreeCAD.Base.ProgressIndicator() with start(text, steps), next(), stop()
-    # (src/Base/ProgressIndicatorPy.cpp); the 0.20 object is checked in the GUI test (tests/test_workbench_dialogs_gui.py)
+    # (src/Base/ProgressIndicatorPy.cpp); the 0.20 object is checked in tests/test_workbench_dialogs_gui.py
     class Indicator:
         pass
 

@@ -5,7 +5,9 @@ One FreeCAD session: the restart dialog offers the gear's tooth spaces and the s
 same point, the command runs the dialog and then the file dialog with the CLI's file name, and a point that
 does not exist is refused in the dialog's words. Export shows FreeCAD's progress bar, status text and wait
 cursor while Qt timers keep firing; Verify's PASS is a message in the report view (not a warning), FAIL an
-error, both compared with colours the report view gives lines printed at each level."""
+error, both compared with colours the report view gives lines printed at each level (Export's and the restart
+program's "wrote ..." are messages too).
+A screenshot of the dialog goes to test-artifacts/."""
 
 from __future__ import annotations
 
@@ -183,7 +185,7 @@ settle()
 RESULT["fail_box"] = message_boxes("Verify program")
 RESULT["colours"] = {name: report_colour(needle) for name, needle in (
     ("message", "reference message line"), ("warning", "reference warning line"), ("error", "reference error line"),
-    ("pass", "PASS: "), ("fail", "FAIL: "))}
+    ("pass", "PASS: "), ("fail", "FAIL: "), ("export", "files to "), ("restart", "wrote the restart program"))}
 RESULT["hooked"] = hooked
 """
 
@@ -262,6 +264,7 @@ def test_restart_dialog_and_long_work_in_the_gui(freecad_gui, tmp_path):
     colours = result["colours"]
     assert len({colours["message"], colours["warning"], colours["error"]}) == 3, colours
     assert colours["pass"] == colours["message"] and colours["fail"] == colours["error"], colours
+    assert colours["export"] == colours["restart"] == colours["message"], colours  # success: a message
     assert result["pass_box"] and result["pass_box"][0][0] is True
     assert result["pass_box"][0][1].splitlines()[-1].startswith("PASS: ")
     assert result["fail_box"] and result["fail_box"][0][0] is False

@@ -168,7 +168,7 @@ def export_job(job_obj, out_dir: str) -> list[str]:
         paths = write_output_set(out, files)
     except OSError as exc:
         raise SpurCadError(f"cannot write to {out}: {exc.strerror or exc}") from None
-    FreeCAD.Console.PrintMessage(f"{job_obj.Label}: wrote {len(paths)} files to {out}\n")
+    show_message("Export", f"{job_obj.Label}: wrote {len(paths)} files to {out}", level="message")
     return [str(path) for path in paths]
 
 
@@ -239,7 +239,7 @@ def write_restart_program(job_obj, point, path: str) -> str:
         written = write_file_atomically(path, text)
     except OSError as exc:
         raise SpurCadError(f"cannot write {path}: {exc.strerror or exc}") from None
-    FreeCAD.Console.PrintMessage(f"{job_obj.Label}: wrote the restart program {written}\n")
+    show_message("Restart program", f"{job_obj.Label}: wrote the restart program {written}", level="message")
     return str(written)
 
 

@@ -97,10 +97,13 @@ class RestartDialog:
         form.addRow("Operation", self.operation)
         self.space = widgets.QComboBox()
         self.space.setObjectName("space")
-        form.addRow("Tooth space", self.space)
         self.station = widgets.QSpinBox()
         self.station.setObjectName("station")
-        form.addRow("Station", self.station)
+        point_row = widgets.QHBoxLayout()  # one row: the space or the station, whichever the operation uses
+        point_row.addWidget(self.space, 1)
+        point_row.addWidget(self.station, 1)
+        self.point_label = widgets.QLabel()
+        form.addRow(self.point_label, point_row)
         self.use_second = widgets.QCheckBox()
         self.use_second.setObjectName("use_second")
         self.second = widgets.QSpinBox()
@@ -121,7 +124,6 @@ class RestartDialog:
         layout.addLayout(form)
         layout.addWidget(self.note)
         layout.addWidget(buttons)
-        self._form = form
         self.operation.currentIndexChanged.connect(self._operation_changed)
         self.space.currentIndexChanged.connect(self._space_changed)
         self.use_second.toggled.connect(self.second.setEnabled)
@@ -171,9 +173,11 @@ class RestartDialog:
     def _operation_changed(self, *_) -> None:
         """Show the chosen operation's kind of point, with its ranges."""
         choice = self.current()
-        self._set_row_visible(self.space, not choice.by_station)
-        self._set_row_visible(self.station, choice.by_station)
-        self._set_row_visible(self.second, not choice.by_station)
+        self.point_label.setText("Station" if choice.by_station else "Tooth space")
+        self.space.setVisible(not choice.by_station)
+        self.station.setVisible(choice.by_station)
+        for widget in (self.second_label, self.use_second, self.second):
+            widget.setVisible(not choice.by_station)
         if choice.by_station:
             stations = choice.stations()
             self.station.setRange(stations[0], stations[-1])
@@ -193,7 +197,7 @@ class RestartDialog:
         self.use_second.setChecked(False)
         self.second.setEnabled(False)
         self.note.setText(f"{self.teeth} tooth spaces, numbered from 0 as in the verify report and the restart "
-                          f"programs' comments: space k is at A = -k x {360.0 / self.teeth:g}°.")
+                          f"programs' comments: space k is at A = -k x {360.0 / self.teeth:.3f}°.")
         self._space_changed()
 
     def _space_changed(self, *_) -> None:
@@ -205,14 +209,3 @@ class RestartDialog:
         low, high = (values[0], values[-1]) if values else (0, 0)
         self.second.setRange(low, high)
         self.second.setSuffix(f"   (of {low} to {high})")
-
-    def _set_row_visible(self, widget, visible: bool) -> None:
-        """Show or hide a form row: the field (or its row layout's widgets) and its label."""
-        widget.setVisible(visible)
-        if widget is self.second:
-            self.use_second.setVisible(visible)
-            self.second_label.setVisible(visible)
-            return
-        label = self._form.labelForField(widget)
-        if label is not None:
-            label.setVisible(visible)
