@@ -6,6 +6,7 @@ from __future__ import annotations
 import dataclasses
 import json
 import math
+import re
 import sys
 import tomllib
 import typing
@@ -165,9 +166,11 @@ def test_properties_carry_the_keys_meaning_group_and_unit(wb):
         assert f.unit == k.unit
 
 
-# The documented mapping (schema.py's docstring), checked on properties of every row.
+# The documented mapping (schema.py's docstring), checked on properties of every row. Every mm input is a
+# PropertyDistance (schema 4): a PropertyLength would store a typed -3 as 0 without a word.
 EXPECTED_TYPES = {
-    "Module": "App::PropertyLength", "FaceWidth": "App::PropertyLength", "RoughingFeedPerTooth": "App::PropertyLength",
+    "Module": "App::PropertyDistance", "FaceWidth": "App::PropertyDistance",
+    "RoughingFeedPerTooth": "App::PropertyDistance",
     "XMin": "App::PropertyDistance", "ZMax": "App::PropertyDistance",
     "PressureAngle": "App::PropertyAngle", "AMin": "App::PropertyFloat", "AMax": "App::PropertyFloat",
     "MaxFeed": "App::PropertySpeed", "RapidFeed": "App::PropertySpeed",
@@ -192,7 +195,8 @@ def test_property_types_follow_the_documented_unit_mapping(wb):
         annotation = typing.get_type_hints(_section_classes()[f.section])[f.key]
         allowed = {int: {"int"}, bool: {"bool"}, str: {"string", "choice"}, float: numeric}[annotation]
         assert f.kind in allowed, f
-        if f.kind == "length":
+        assert f.kind != "length", f  # clamps to >= 0: outputs only
+        if f.kind == "distance":
             assert f.unit == "mm"
         if f.kind == "angle":
             assert f.unit == "deg"
@@ -261,9 +265,11 @@ def test_valid_job_has_no_messages_and_the_recommendations(wb):
     assert rec.finishing_max_flat_width_mm == pytest.approx(2 * book.corner_offset / book.r * book.rf, abs=1e-9)
     assert rec.required_flute_length_mm == pytest.approx(book.ra + job.stock.radial_allowance_mm - book.rf)
     assert rec.plunge_allowance_mm == pytest.approx(0.5 * job.tools.finishing.flat_width_mm)
-    notes = wb.validation.recommendation_notes(rec)
-    assert f"{rec.roughing_max_diameter_mm:.3f} mm" in notes["RoughingToolDiameter"]
-    assert f"{rec.finishing_max_flat_width_mm:.3f} mm" in notes["FinishingToolDiameter"]
+    notes = wb.validation.recommendation_notes(rec)  # without FreeCAD's unit schema: mm to 0.1 um
+    for prop, limit in (("RoughingToolDiameter", rec.roughing_max_diameter_mm),
+                        ("FinishingToolDiameter", rec.finishing_max_flat_width_mm)):
+        shown = re.search(r"at most (\d+\.\d{1,4}) mm", notes[prop])
+        assert shown is not None and abs(float(shown.group(1)) - limit) <= 0.00005, notes[prop]
 
 
 def _cli_message(text: str) -> str:

@@ -12,7 +12,8 @@ What differs (more in docs/freecad-compat.md):
 - Qt 5 / Qt 6 through FreeCAD's `PySide` wrapper: PySide6's enums are Python enums, so
   `int(QDialogButtonBox.Ok | QDialogButtonBox.Cancel)` raises TypeError; `exec_` is deprecated;
   the wrapper has `PySide.QtWidgets` only in 1.x (both re-export the widgets from `PySide.QtGui`);
-- Gui::QuantitySpinBox has a per-widget `decimals` property in 1.x only;
+- Gui::QuantitySpinBox has a per-widget `decimals` property in 1.x only (0.20 shows a Quantity with the
+  precision of its own `Format`);
 - ViewProviderGeometryObject's `ShapeColor` property became `ShapeAppearance` (a material list) in 1.0;
 - Control.showDialog returns None in 0.20 and a TaskDialog wrapper in 1.x;
 - a proxy's state is restored through `__setstate__` in 0.20 and `loads` in 1.x (StatelessProxy).
@@ -194,6 +195,15 @@ def set_spin_box_value(widget, units, value: float, unit: str) -> None:
     widget.setProperty("value", units.Quantity(f"{float(value)!r} {unit}"))
 
 
+def set_spin_box_quantity(widget, quantity) -> None:
+    """Show a Base.Quantity in a Gui::QuantitySpinBox with the precision of its `Format`: 0.20's spin box
+    formats the Quantity it is given with that format (Quantity::getUserString); 1.x's also has a per-widget
+    `decimals` property, which is set to the same."""
+    widget.setProperty("value", quantity)
+    if has_qt_property(widget, "decimals"):
+        widget.setProperty("decimals", int(quantity.Format["Precision"]))
+
+
 def spin_box_value(widget, units, unit: str) -> float:
     """A Gui::QuantitySpinBox's value as a float in `unit`.
 
@@ -261,3 +271,13 @@ def progress_indicator(freecad):
     unchanged since its split out of Sequencer.cpp in 2022)."""
     factory = getattr(getattr(freecad, "Base", None), "ProgressIndicator", None)
     return factory() if factory is not None else None
+
+
+def refresh_icon(view_object) -> bool:
+    """Make the tree ask a Python view provider for its icon again (`signalChangeIcon`, 0.19 to 1.1,
+    src/Gui/ViewProviderPy.xml); False where there is no such call (console mode: no view object)."""
+    signal = getattr(view_object, "signalChangeIcon", None)
+    if signal is None:
+        return False
+    signal()
+    return True

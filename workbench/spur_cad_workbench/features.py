@@ -9,12 +9,13 @@ It is never saved (a reopened document plans again) and is planned again when an
 newer schema introduced, with their defaults).
 
 Shapes come from spur_cad's CadQuery/OCP solids, transferred as BREP text. Input errors
-(SpurCadError): the object's `Status` property says what is wrong, the report view gets the
-one-line message, computed values are cleared and what depends on the object (toolpaths,
-simulations) is marked stale and drawn grey. In the GUI `execute` then raises InputError, so that
-FreeCAD puts the object in its error state (the tree's error mark); FreeCAD reports that
-exception on its developer channel, not in the report view. Without the GUI it does not raise
-(FreeCAD would print the exception's traceback on the console); scripts read `Status`.
+(SpurCadError): the object's `Status` property says what is wrong in one sentence that names the field
+by its title, with lengths in the user's unit schema (validation.sentence), the report view gets the same
+line, computed values are cleared, the tree icon gets a red error badge, and what depends on the object
+(stock, job, toolpaths, simulations) is marked stale and drawn grey. `execute` never raises: FreeCAD 0.20
+prints a Python exception from `execute` with its traceback in the report view (Base::PyException::
+throwException reports it), and a user's typing error is no program error. So FreeCAD's own error state
+("Invalid" in `State`) is not set; scripts read `Status`.
 """
 
 from __future__ import annotations
@@ -23,7 +24,7 @@ import io
 
 import FreeCAD
 
-from spur_cad_workbench import compat, schema
+from spur_cad_workbench import compat, schema, units
 from spur_cad_workbench.properties import add_bookkeeping, add_fields, document_values, job_of, source_of, write_outputs
 from spur_cad_workbench.resources import icon_path
 
@@ -39,31 +40,37 @@ GEAR_DEVIATION_PERCENT = 0.02
 GEAR_ANGULAR_DEFLECTION_DEG = 5.0
 
 
-class InputError(Exception):
-    """Raised from `execute` in the GUI so that FreeCAD marks the object as in error (message: the Status)."""
+ERROR_PREFIX = "error: "
 
 
 def report(obj, message: str | None) -> None:
     """Record the recompute's outcome; an error also goes to the report view as one line."""
-    prefix = f"{source_of(obj)}: "
-    if message is not None and message.startswith(prefix):
-        message = message[len(prefix):]
-    status = "ok" if message is None else f"error: {message}"
+    status = "ok" if message is None else f"{ERROR_PREFIX}{message}"
     if obj.Status != status:
+        was_error = obj.Status.startswith(ERROR_PREFIX)
         obj.Status = status
+        if FreeCAD.GuiUp and was_error != (message is not None):
+            compat.refresh_icon(obj.ViewObject)  # the error badge comes or goes
     if message is not None:
         FreeCAD.Console.PrintError(f"{obj.Label}: {message}\n")
 
 
-def fail(obj, message: str) -> None:
-    """An input error on `obj`: Status and report line, computed values cleared, dependants marked stale; in
-    the GUI raise InputError so that FreeCAD shows the object's error state."""
-    report(obj, message)
+def fail(obj, exc) -> None:
+    """An input error (a SpurCadError) on `obj`: one sentence in its Status and the report view, computed values
+    cleared, dependants marked stale. Never raises (see the module docstring)."""
+    from spur_cad_workbench.validation import sentence
+
+    report(obj, sentence(exc, source_of(obj), FreeCAD.Units))
     clear_outputs(obj)
     for dependant in dependants(obj):
         mark_stale(dependant, f"{obj.Label} has an error")
-    if FreeCAD.GuiUp:
-        raise InputError(obj.Status.removeprefix("error: "))
+
+
+def failed_input(obj):
+    """The spur_cad object `obj` depends on whose last recompute failed (its error is reported there), or None."""
+    return next((other for other in obj.OutListRecursive
+                 if getattr(getattr(other, "Proxy", None), "KIND", "") and
+                 str(getattr(other, "Status", "")).startswith(ERROR_PREFIX)), None)
 
 
 def clear_outputs(obj) -> None:
@@ -198,7 +205,7 @@ class GearFeature(_Proxy):
             job = job_of(obj)
             shape, _ = build_gear_shape(job.gear, job.gear_section.blank_features())
         except SpurCadError as exc:
-            fail(obj, str(exc))
+            fail(obj, exc)
             return
         spec, sheet = job.gear, inspection_facts(job.gear)
         write_outputs(obj, {
@@ -209,8 +216,24 @@ class GearFeature(_Proxy):
             "DimensionOverPins": sheet.dimension_over_pins_mm, "Undercut": bool(spec.undercut),
             "UndercutDepth": spec.undercut_depth_mm,
             "MinTeethWithoutUndercut": sheet.min_teeth_without_undercut})
+        write_outputs(obj, precise_outputs(obj))
         set_shape(obj, part_shape(shape))
         report(obj, None)
+
+
+def precise_outputs(obj) -> dict[str, str]:
+    """The gear's length outputs as text to 0.1 um in the user's unit schema (schema.PRECISE)."""
+    return {f"{field.prop}{schema.PRECISE_SUFFIX}": units.inspection_text(getattr(obj, field.prop).Value, FreeCAD.Units)
+            for field in schema.GEAR_OUTPUTS if field.kind == "length"}
+
+
+def skipped_for_failed_input(obj) -> bool:
+    """Whether `obj` (a stock or job) depends on an object in error: then it is marked stale, not failed (the
+    error is reported once, on the object that has it)."""
+    broken = failed_input(obj)
+    if broken is not None:
+        mark_stale(obj, f"{broken.Label} has an error")
+    return broken is not None
 
 
 class StockFeature(_Proxy):
@@ -232,11 +255,13 @@ class StockFeature(_Proxy):
         from spur_cad.cad.solid import build_stock_shape
         from spur_cad.errors import SpurCadError
 
+        if skipped_for_failed_input(obj):
+            return
         try:
             job = job_of(obj)
             shape = build_stock_shape(job.gear, job.stock)
         except SpurCadError as exc:
-            fail(obj, str(exc))
+            fail(obj, exc)
             return
         write_outputs(obj, {"BlankRadius": job.stock.blank_radius_mm(job.gear)})
         set_shape(obj, part_shape(shape))
@@ -280,12 +305,15 @@ class JobFeature(_Proxy):
         from spur_cad.errors import SpurCadError
         from spur_cad_workbench.summary import plan_figures, values_signature
 
+        if skipped_for_failed_input(obj):
+            self.cached_plan = None
+            return
         try:
             job, plan = self.plan_for(obj)  # the panel's Plan may have planned these values already
             figures = plan_figures(job, plan)
         except SpurCadError as exc:
             self.cached_plan = None
-            fail(obj, str(exc))
+            fail(obj, exc)
             return
         rec = plan.recommendations
         outputs = {"FinishingMaxFlatWidth": rec.finishing_max_flat_width_mm,
@@ -388,9 +416,15 @@ class ViewProvider(compat.StatelessProxy):
         self.Object = vobj.Object
 
     def getIcon(self):
-        kind = getattr(getattr(getattr(self, "Object", None), "Proxy", None), "KIND", "")
-        return icon_path({"gear": "gear", "stock": "stock", "job": "job", "toolpath": "toolpath",
+        obj = getattr(self, "Object", None)
+        kind = getattr(getattr(obj, "Proxy", None), "KIND", "")
+        path = icon_path({"gear": "gear", "stock": "stock", "job": "job", "toolpath": "toolpath",
                           "simulation": "simulate"}.get(kind, "spur_cad"))
+        if str(getattr(obj, "Status", "")).startswith(ERROR_PREFIX):
+            from spur_cad_workbench.resources import error_icon
+
+            return error_icon(path)
+        return path
 
     def onChanged(self, vobj, prop):
         """A simulation shown or hidden (Space): its job's toolpaths hidden or shown again (views.py)."""

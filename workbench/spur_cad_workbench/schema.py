@@ -11,8 +11,10 @@ group, tooltip = its meaning, and the property type from the key's type, unit an
 
 | key                                   | FreeCAD property            | value as the property holds it   |
 | ------------------------------------- | --------------------------- | -------------------------------- |
-| float, mm, range >= 0                 | App::PropertyLength         | Quantity, .Value in mm           |
-| float, mm, range below 0              | App::PropertyDistance       | Quantity, .Value in mm           |
+| float, mm                             | App::PropertyDistance       | Quantity, .Value in mm (a        |
+|                                       |                             | negative value reaches spur_cad's|
+|                                       |                             | check; PropertyLength clamps to 0|
+|                                       |                             | silently); outputs: PropertyLength|
 | float, deg, range within [-360, 360]  | App::PropertyAngle          | Quantity, .Value in deg          |
 | float, deg, range beyond +-360        | App::PropertyFloat          | number in deg (PropertyAngle     |
 |                                       |                             | clamps to [-360, 360])           |
@@ -36,8 +38,11 @@ drop-down lists, so a new key needs no migration code. Version 2: MaxFeed and Ra
 PropertySpeed (were PropertyFloat), AMin and AMax PropertyFloat (were PropertyAngle, which
 clamped the default +-99999 deg to +-360). Version 3: the job's results gained the times with
 accelerations, the program lines and PlannedValues; computed groups renamed "Values: ..." (sorted after
-the inputs; reopening moves them). Version 4: the bottom tool's roughing program (two-stage roughing) has its
-own results (BottomRoughingMoves, ...Time, ...TimeWithAcceleration, ...ProgramLines).
+the inputs; reopening moves them). Version 4: every mm input became PropertyDistance (was PropertyLength
+for keys that are never negative, which stored a typed -3 as 0 without a word); the gear gained its
+length outputs as text to 0.1 um in the user's unit schema ("Values: precise"); the bottom tool's roughing
+program (two-stage roughing) has its own results (BottomRoughingMoves, ...Time, ...TimeWithAcceleration,
+...ProgramLines).
 """
 
 from __future__ import annotations
@@ -106,7 +111,7 @@ def property_kind(k) -> str:
     numeric_low = k.low if not isinstance(k.low, str) else None
     numeric_high = k.high if not isinstance(k.high, str) else None
     if k.unit == "mm":
-        return "length" if numeric_low is not None and numeric_low >= 0.0 else "distance"
+        return "distance"
     if k.unit == "deg" and numeric_low is not None and numeric_high is not None and \
             -ANGLE_PROPERTY_LIMIT_DEG <= numeric_low and numeric_high <= ANGLE_PROPERTY_LIMIT_DEG:
         return "angle"
@@ -164,6 +169,7 @@ GEAR_FIELDS, STOCK_FIELDS, JOB_FIELDS = FIELDS["gear"], FIELDS["stock"], FIELDS[
 # "Values", after every input group, so the inputs come first.
 COMPUTED, INSPECTION, TOOL_LIMITS, RESULTS = "Values: computed", "Values: inspection", "Values: tool limits", \
     "Values: results"
+PRECISE = "Values: precise"
 STATUS_GROUP = "Values: status"
 GEAR_OUTPUTS = (
     _f("ReferenceRadius", "length", COMPUTED, "", "", "reference radius r = m z / 2"),
@@ -180,6 +186,13 @@ GEAR_OUTPUTS = (
     _f("UndercutDepth", "length", INSPECTION, "", "", "depth of the undercut (0 without undercut)"),
     _f("MinTeethWithoutUndercut", "int", INSPECTION, "", "", "fewest teeth generated without undercut"),
 )
+# The gear's lengths again as text to 0.1 um (the property editor shows a length with the user's global number
+# of decimals, 2 by default, and FreeCAD 0.20 has no per-property precision), in the unit schema of the last
+# recompute (units.py).
+PRECISE_SUFFIX = "Precise"
+GEAR_OUTPUTS += tuple(_f(f"{field.prop}{PRECISE_SUFFIX}", "string", PRECISE, "", "",
+                         f"{field.doc}, to 0.1 um in the unit schema of the last recompute")
+                      for field in GEAR_OUTPUTS if field.kind == "length")
 
 STOCK_OUTPUTS = (
     _f("BlankRadius", "length", COMPUTED, "", "", "radius of the blank cylinder"),

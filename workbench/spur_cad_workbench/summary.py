@@ -97,19 +97,25 @@ def figures_text(figures: PlanFigures) -> str:
     return "\n".join(lines)
 
 
-def limits_text(rec, with_roughing_limit: bool = True, two_stage: bool = False) -> str:
-    """The tool limits of the gear (spur_cad.cam.recommend.ToolRecommendations), one line each; without the
-    roughing diameter when it would derive from an invalid finishing tool (its plunge allowance); with
-    `two_stage` that limit is the bottom tool's."""
+def limits_text(rec, with_roughing_limit: bool = True, two_stage: bool = False, units=None) -> str:
+    """The tool limits of the gear (spur_cad.cam.recommend.ToolRecommendations), one line each, lengths in the
+    user's unit schema (units.py); without the roughing diameter when it would derive from an invalid finishing
+    tool (its plunge allowance); with `two_stage` that limit is the bottom tool's."""
+    from spur_cad_workbench.units import text
+
     if rec is None:
         return ""
+
+    def length(value_mm: float) -> str:
+        return text(value_mm, "mm", units)
+
     deepest = "Bottom tool" if two_stage else "Roughing tool"
-    roughing = f"{deepest}: D at most {rec.roughing_max_diameter_mm:.3f} mm\n" if with_roughing_limit else ""
+    roughing = f"{deepest}: D at most {length(rec.roughing_max_diameter_mm)}\n" if with_roughing_limit else ""
     return (f"{roughing}"
-            f"Finishing tool: corner radius at most {rec.finishing_max_corner_radius_mm:.3f} mm, flat D - 2 r at most "
-            f"{rec.finishing_max_flat_width_mm:.3f} mm (perimeter, along X)\n"
-            f"Both: flute length at least {rec.required_flute_length_mm:.2f} mm, stick-out at least "
-            f"{rec.required_stick_out_mm:.2f} mm")
+            f"Finishing tool: corner radius at most {length(rec.finishing_max_corner_radius_mm)}, flat D - 2 r at "
+            f"most {length(rec.finishing_max_flat_width_mm)} (perimeter, along X)\n"
+            f"Both: flute length at least {length(rec.required_flute_length_mm)}, stick-out at least "
+            f"{length(rec.required_stick_out_mm)}")
 
 
 def long_job_advice(figures: PlanFigures, strategy: str, roughing_room_mm: float | None = None) -> str:

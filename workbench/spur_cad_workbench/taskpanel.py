@@ -1,9 +1,12 @@
 """The 4-axis job's task panel: a summary on top, then tools, cutting data, strategies, machine and post in
 collapsible sections, checked as you type.
 
-- Fields: titles for people (schema.title), FreeCAD's unit-aware Gui::QuantitySpinBox for lengths
-  and angles, spin boxes with the unit as suffix for the other units; each row fits FreeCAD's
-  default task dock width (labels wrap above their field when the dock is narrow).
+- Fields: titles for people (schema.title), FreeCAD's unit-aware Gui::QuantitySpinBox for lengths,
+  angles and feeds (in the user's unit schema, with enough decimals for a micrometre: units.py), spin
+  boxes with the unit as suffix for the other units (mm/rev and mm/s^2 in the schema's length unit);
+  each row fits FreeCAD's default task dock width (labels wrap above their field when the dock is narrow).
+- Texts: notes, limits and messages name fields by their titles and give lengths and feeds in the
+  user's unit schema (validation.py, summary.py and units.py with `FreeCAD.Units`).
 - Summary: validity, the tool limits (cheap, as you type), and the cycle time by both estimators,
   moves and program lines. Those need a plan: they are shown from the job's last recompute while
   the values are the job's, from the panel's own plan after "Plan", and marked outdated otherwise.
@@ -20,7 +23,7 @@ import FreeCAD
 import FreeCADGui
 from PySide import QtCore, QtGui
 
-from spur_cad_workbench import compat, schema
+from spur_cad_workbench import compat, schema, units
 from spur_cad_workbench.properties import document_values, write_values
 from spur_cad_workbench.summary import (
     figures_text,
@@ -30,7 +33,7 @@ from spur_cad_workbench.summary import (
     plan_figures,
     values_signature,
 )
-from spur_cad_workbench.validation import recommendation_notes, unusual_value_notes, validate
+from spur_cad_workbench.validation import recommendation_notes, sentence, unusual_value_notes, validate
 
 ERROR_COLOUR = "#b00020"
 ERROR_STYLE = f"color: {ERROR_COLOUR};"
@@ -43,7 +46,7 @@ TITLE_WIDTH_PX = 120
 so a long job name would widen the panel beyond the dock."""
 FIELD_MIN_WIDTH_PX = 112
 PANEL_MIN_WIDTH_PX = 170  # fits a 240 px task dock: its scroll area's 220 px less the task box's margins
-QUANTITY_UNITS = {"length": "mm", "distance": "mm", "angle": "deg"}
+QUANTITY_UNITS = {"length": "mm", "distance": "mm", "angle": "deg", "speed": "mm/min"}
 NUMBER_DECIMALS = 6
 REVALIDATE_DELAY_MS = 250  # typing: check once the keys pause (a check plans roughing levels: up to 0.5 s)
 
@@ -192,6 +195,7 @@ class JobTaskPanel:
         self.highlighted: str | None = None
         self.result = None
         self._shown: dict[str, tuple[str, float]] = {}  # quantity fields: (text shown, exact value) when set
+        self._per_unit: dict[str, float] = {}  # number fields shown in another unit: job-file units per shown one
         self._planned: tuple[str, object] | None = None  # (values signature, PlanFigures) planned by the panel
         layout = QtGui.QVBoxLayout(self.form)
         layout.setContentsMargins(0, 0, 0, 0)
@@ -282,14 +286,27 @@ class JobTaskPanel:
             widget.valueChanged.connect(self._schedule)
         elif field.kind in QUANTITY_UNITS and (widget := self._quantity_box(field, value)) is not None:
             pass
-        else:  # other units (m/min, 1/min, mm/min, %, s, ...) and plain numbers: the unit as a suffix
-            widget = NumberBox()
-            if field.unit:
-                widget.setSuffix(f" {field.unit}")
-            widget.setValue(float(value))
-            self._shown[field.prop] = (widget.text(), float(value))  # beyond 6 decimals: kept until edited
-            widget.valueChanged.connect(self._schedule)
+        else:  # other units (m/min, 1/min, mm/rev, %, s, ...) and plain numbers: the unit as a suffix
+            widget = self._number_box(field, value)
         return widget
+
+    def _number_box(self, field, value) -> NumberBox:
+        """A number field with its unit as suffix; a mm-based unit (mm/rev, mm/s^2) in the user's schema."""
+        widget = NumberBox()
+        suffix, per_unit = units.display_unit(field.unit, FreeCAD.Units) if field.unit else ("", 1.0)
+        if suffix:
+            widget.setSuffix(f" {suffix}")
+        if per_unit != 1.0:
+            self._per_unit[field.prop] = per_unit
+        widget.setValue(float(value) / per_unit)
+        self._shown[field.prop] = (widget.text(), float(value))  # beyond 6 decimals: kept until edited
+        widget.valueChanged.connect(self._schedule)
+        return widget
+
+    @staticmethod
+    def _show_quantity(widget, value: float, unit: str) -> None:
+        """Show `value` (in `unit`) in a quantity field, in the user's schema to the unit's resolution."""
+        compat.set_spin_box_quantity(widget, units.field_quantity(value, unit, FreeCAD.Units))
 
     def _quantity_box(self, field, value):
         """FreeCAD's unit-aware spin box (any number: spur_cad's own messages judge it), or None without one."""
@@ -297,7 +314,7 @@ class JobTaskPanel:
         widget = compat.quantity_spin_box(FreeCADGui.UiLoader(), unit, -BIG, BIG)
         if widget is None:
             return None
-        compat.set_spin_box_value(widget, FreeCAD.Units, float(value), unit)
+        self._show_quantity(widget, float(value), unit)
         # 0.20 rounds to the shown decimals: an untouched field keeps its exact value
         self._shown[field.prop] = (widget.text(), float(value))
         widget.lineEdit().textChanged.connect(self._schedule)
@@ -326,7 +343,7 @@ class JobTaskPanel:
         if widget.text() == shown_text:  # untouched since set: the exact value, not the rounded one shown
             return exact
         if isinstance(widget, QtGui.QDoubleSpinBox):
-            return float(widget.value())
+            return float(widget.value()) * self._per_unit.get(field.prop, 1.0)
         return compat.spin_box_value(widget, FreeCAD.Units, QUANTITY_UNITS[field.kind])
 
     def job_values(self) -> dict:
@@ -345,11 +362,11 @@ class JobTaskPanel:
         elif isinstance(widget, QtGui.QSpinBox):
             widget.setValue(value)
         elif isinstance(widget, QtGui.QDoubleSpinBox):
-            widget.setValue(float(value))
+            widget.setValue(float(value) / self._per_unit.get(prop, 1.0))
             self._shown[prop] = (widget.text(), float(value))
         else:
             unit = QUANTITY_UNITS[schema.field_by_prop(prop).kind]
-            compat.set_spin_box_value(widget, FreeCAD.Units, float(value), unit)
+            self._show_quantity(widget, float(value), unit)
             self._shown[prop] = (widget.text(), float(value))
         show_start(self.widgets[prop])
         self.revalidate()  # at once (a user's typing waits for a pause: _schedule)
@@ -372,14 +389,15 @@ class JobTaskPanel:
         """Check the values; show the problem in its section and highlight its field; notes, limits, summary."""
         self._timer.stop()
         values = self._values()
-        result = self.result = validate(values, self.job.Label)
+        result = self.result = validate(values, self.job.Label, FreeCAD.Units)
         advice = {problem.group: problem.advice for problem in result.problems}
         for group, label in self.messages.items():
             label.setText(advice.get(group, ""))
             label.setVisible(group in advice)
         self._highlight(next((p.prop for p in result.problems if p.prop in self.widgets), None))
         two_stage = bool(values["job"].get("UseBottomTool"))
-        notes = {**recommendation_notes(result.recommendations, two_stage), **unusual_value_notes(values["job"])}
+        notes = {**recommendation_notes(result.recommendations, two_stage, FreeCAD.Units),
+                 **unusual_value_notes(values["job"], FreeCAD.Units)}
         finishing_invalid = any(problem.group == "Finishing tool" for problem in result.problems)
         if finishing_invalid:  # the roughing limit depends on the finishing tool (A_p)
             notes.pop("BottomToolDiameter" if two_stage else "RoughingToolDiameter", None)
@@ -420,7 +438,7 @@ class JobTaskPanel:
             self.summary.setText(f"{len(result.problems)} problem: {first.advice}")
             self.summary.setStyleSheet(ERROR_STYLE)
         self.summary_limits.setText(limits_text(result.recommendations, with_roughing_limit,
-                                                bool(values["job"].get("UseBottomTool"))))
+                                                bool(values["job"].get("UseBottomTool")), FreeCAD.Units))
         figures, source = self._figures(values_signature(values)) if result.ok else (None, "")
         if figures is not None:
             self.summary_figures.setText(f"{figures_text(figures)}\n({source})")
@@ -451,7 +469,7 @@ class JobTaskPanel:
             plan = plan_cam(result.job)
             figures = plan_figures(result.job, plan)
         except SpurCadError as exc:
-            self.summary.setText(str(exc))
+            self.summary.setText(sentence(exc, self.job.Label, FreeCAD.Units))
             self.summary.setStyleSheet(ERROR_STYLE)
             return False
         finally:

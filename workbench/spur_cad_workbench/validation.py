@@ -2,7 +2,9 @@
 
 `validate` runs the same checks as the command line (spur_cad.job.job_from_dict, then the
 tool limits and the roughing reach of spur_cad.cam.recommend) and files each SpurCadError
-message under the panel group it is about, so the panel shows it beside the fields.
+message under the panel group it is about, so the panel shows it beside the fields. What people read
+(`sentence`, `advice`, the notes) names fields by their titles, never by job-file keys, and gives lengths and
+feeds in the user's unit schema (units.py; `units` is FreeCAD.Units, None: the job file's mm).
 """
 
 from __future__ import annotations
@@ -11,6 +13,7 @@ import re
 from dataclasses import dataclass
 
 from spur_cad.errors import SpurCadError
+from spur_cad_workbench import units as unit_text
 from spur_cad_workbench.schema import TOOL_SWITCHES, job_data
 
 # Panel groups (the property groups of schema.JOB_FIELDS, plus the gear and stock objects).
@@ -95,14 +98,30 @@ _CORNER_LIMIT = re.compile(r"corner_radius_mm = ([\d.]+) must be in \(0, ([\d.]+
 _TIP_MODE_LIMIT = re.compile(r"largest diameter for tip mode with this corner radius: ([\d.]+) mm")
 
 
-def advice(message: str, section: str | None, key: str | None, values: dict | None = None) -> str:
+_GOT_NUMBER = re.compile(r"got (-?\d+(?:\.\d+)?(?:[eE][-+]?\d+)?)$")
+_UNITS_IN_MESSAGES = ("mm", "mm/min")
+
+
+def _with_unit(body: str, field) -> str:
+    """'... got -3' -> '... got -3 mm' when the field's unit is a length or feed (converted with the others)."""
+    if field is None or field.unit not in _UNITS_IN_MESSAGES:
+        return body
+    return _GOT_NUMBER.sub(lambda found: f"got {found.group(1)} {field.unit}", body)
+
+
+def advice(message: str, section: str | None, key: str | None, values: dict | None = None, units=None) -> str:
     """The message as the panel says it: the group, then what to change ("Finishing tool: diameter at most
-    3.55 mm for a corner radius of 1.52 mm ..."), with key names replaced by the field titles."""
+    3.55 mm for a corner radius of 1.52 mm ..."), with key names replaced by the field titles and lengths in
+    the user's unit schema."""
+    return unit_text.message(_advice(message, section, key, values), units)
+
+
+def _advice(message: str, section: str | None, key: str | None, values: dict | None) -> str:
     from spur_cad_workbench.schema import title
 
     group = SECTION_GROUPS.get(section or "", group_of(message))
     field = field_of(section, key)
-    body = re.sub(r"^\[[a-z.]+\] ", "", message)
+    body = _with_unit(re.sub(r"^\[[a-z.]+\] ", "", message), field)
     found = _ROUGHING_LIMIT.search(message)
     if found:
         return (f"{group}: diameter at most {float(found.group(2)):.3g} mm for this gear (the tooth space's width "
@@ -124,15 +143,37 @@ def advice(message: str, section: str | None, key: str | None, values: dict | No
     return f"{group}: {_with_titles(body, section or '')}"
 
 
-def _problem(exc: SpurCadError, source: str, values: dict) -> Problem:
+_INVALID_PREFIX = re.compile(r"^(?:\[[a-z.]+\] |invalid (?:gear|\[[a-z.]+\]): )")
+
+
+def sentence(exc: SpurCadError, source: str, units=None) -> str:
+    """One sentence about a SpurCadError as a gear, stock or job object states it: the field's title first
+    ("Module must be in [0.05 mm, 100 mm], got -3 mm."), titles for key names, lengths in the user's schema."""
+    from spur_cad_workbench.schema import title
+
+    body = _INVALID_PREFIX.sub("", _strip_source(str(exc), source).strip())
+    field = field_of(exc.section, exc.field)
+    if field is not None:
+        body = _with_unit(body, field)
+        rest = body[len(exc.field) + 1:] if body.startswith(f"{exc.field} ") else None
+        body = title(field) + (f" {_with_titles(rest, exc.section)}" if rest is not None
+                               else f": {_with_titles(body, exc.section)}")
+    else:
+        body = _with_titles(body, exc.section or "")
+        body = body[:1].upper() + body[1:]
+    body = unit_text.message(body, units)
+    return body if body.endswith(".") else f"{body}."
+
+
+def _problem(exc: SpurCadError, source: str, values: dict, units=None) -> Problem:
     message = _strip_source(str(exc), source)
     field = field_of(exc.section, exc.field)
     group = SECTION_GROUPS.get(exc.section or "", group_of(message))
     return Problem(group, field.prop if field is not None else None, message,
-                   advice(message, exc.section, exc.field, values))
+                   advice(message, exc.section, exc.field, values, units))
 
 
-def validate(values: dict[str, dict[str, object]], source: str = "job") -> Validation:
+def validate(values: dict[str, dict[str, object]], source: str = "job", units=None) -> Validation:
     """Check gear, stock and job values as the command line would; never raises for a SpurCadError.
 
     Recommendations never use an invalid tool: with the finishing tool in error they are the gear's alone.
@@ -147,40 +188,45 @@ def validate(values: dict[str, dict[str, object]], source: str = "job") -> Valid
     try:
         without_tools = job_from_dict(base, source)
     except SpurCadError as exc:
-        return Validation(None, (_problem(exc, source, values),), None)
+        return Validation(None, (_problem(exc, source, values, units),), None)
     spec, blank = without_tools.gear, without_tools.stock.blank_radius_mm(without_tools.gear)
     clearance = without_tools.machine.clearance_mm
     try:
         job = job_from_dict(data, source)
     except SpurCadError as exc:
-        return Validation(None, (_problem(exc, source, values),), recommend_tools(spec, blank, clearance))
+        return Validation(None, (_problem(exc, source, values, units),), recommend_tools(spec, blank, clearance))
     try:
         rec, _ = check_cam_inputs(cam_inputs(job))
     except SpurCadError as exc:
-        problem = _problem(exc, source, values)
+        problem = _problem(exc, source, values, units)
         finishing = None if problem.group == SECTION_GROUPS["tools.finishing"] else job.tools.finishing
         return Validation(None, (problem,), recommend_tools(spec, blank, clearance, finishing))
     return Validation(job, (), rec)
 
 
-def recommendation_notes(rec, two_stage: bool = False) -> dict[str, str]:
-    """Text shown beside the tool fields (property name -> note) for ToolRecommendations `rec`; with `two_stage`
-    (a bottom tool in use) the roughing tool's limit is the bottom tool's and the roughing tool only fits the space."""
+def recommendation_notes(rec, two_stage: bool = False, units=None) -> dict[str, str]:
+    """Text shown beside the tool fields (property name -> note) for ToolRecommendations `rec`, lengths in the
+    user's unit schema; with `two_stage` (a bottom tool in use) the roughing tool's limit is the bottom tool's
+    and the roughing tool only fits the space."""
     if rec is None:
         return {}
+
+    def length(value_mm: float) -> str:
+        return unit_text.text(value_mm, "mm", units)
+
     notes = {
-        "RoughingToolDiameter": f"at most {rec.roughing_max_diameter_mm:.3f} mm (space width at root + A_p)",
+        "RoughingToolDiameter": f"at most {length(rec.roughing_max_diameter_mm)} (space width at root + A_p)",
         "FinishingToolDiameter": f"perimeter, along_x: flat width D - 2 r_t at most "
-                                 f"{rec.finishing_max_flat_width_mm:.3f} mm (root arc length); generating: within "
+                                 f"{length(rec.finishing_max_flat_width_mm)} (root arc length); generating: within "
                                  "the rack's tip flat and the flank limit",
-        "FinishingCornerRadius": f"at most {rec.finishing_max_corner_radius_mm:.3f} mm (smallest fillet radius)",
+        "FinishingCornerRadius": f"at most {length(rec.finishing_max_corner_radius_mm)} (smallest fillet radius)",
     }
     if two_stage:
         notes["BottomToolDiameter"] = notes.pop("RoughingToolDiameter")
         notes["RoughingToolDiameter"] = "two-stage roughing: larger than the bottom tool (it roughs the upper levels)"
     for role in ("Roughing", "Finishing", "Bottom"):
-        notes[f"{role}FluteLength"] = f"at least {rec.required_flute_length_mm:.3f} mm (or 0: not checked)"
-        notes[f"{role}StickOut"] = f"at least {rec.required_stick_out_mm:.3f} mm (or 0: not checked)"
+        notes[f"{role}FluteLength"] = f"at least {length(rec.required_flute_length_mm)} (or 0: not checked)"
+        notes[f"{role}StickOut"] = f"at least {length(rec.required_stick_out_mm)} (or 0: not checked)"
     return notes
 
 
@@ -188,15 +234,15 @@ def recommendation_notes(rec, two_stage: bool = False) -> dict[str, str]:
 _UNUSUAL = (
     ("MaxSpindleRpm", lambda v: v < 2000.0, "unusually low for a machining centre (usual: 6,000 to 40,000 1/min); "
                                             "small end mills will run far below their cutting speed"),
-    ("MaxFeed", lambda v: v < 500.0, "unusually low (usual: 2,000 to 30,000 mm/min); every feed is capped by it"),
+    ("MaxFeed", lambda v: v < 500.0, "unusually low (usual: 2000 to 30000 mm/min); every feed is capped by it"),
     ("MaxRotarySpeed", lambda v: v < 360.0, "unusually low for a rotary table (usual: 1,800 to 30,000 deg/min)"),
     ("BlockTime", lambda v: v > 0.05, "unusually long (usual: 0.5 to 8 ms); short moves will be slow"),
 )
 
 
-def unusual_value_notes(job_values: dict[str, object]) -> dict[str, str]:
+def unusual_value_notes(job_values: dict[str, object], units=None) -> dict[str, str]:
     """Notes for machine values that are valid but unlike any machining centre (property name -> note)."""
-    notes = {prop: note for prop, unusual, note in _UNUSUAL
+    notes = {prop: unit_text.message(note, units) for prop, unusual, note in _UNUSUAL
              if isinstance(job_values.get(prop), float) and unusual(job_values[prop])}
     rapid, feed = job_values.get("RapidFeed"), job_values.get("MaxFeed")
     if isinstance(rapid, float) and isinstance(feed, float) and rapid < feed:
