@@ -334,12 +334,15 @@ def test_bad_input_is_a_message_on_the_object_not_a_traceback(freecadcmd, tmp_pa
     output = proc.stdout + proc.stderr
     assert "Traceback" not in output, describe(proc, result)
     # The command line points at the key's line ("bad.toml:24: ..."); the document has no file lines.
-    tool_message = _cli_error(small_job_text(finishing_diameter=9.0), tmp_path, capsys).split(": ", 1)[1]
-    assert result["job_status"] == f"error: {tool_message}"
+    # The objects say it in one sentence with the field's title (the command line names the key).
+    assert result["job_status"].startswith("error: Finishing tool: diameter at most ")
+    assert "_mm" not in result["job_status"] and result["job_status"].endswith(".")
     gear_message = _cli_error(small_job_text(teeth=3), tmp_path, capsys).split(": ", 1)[1]  # drop "bad.toml:8"
     after = result["after"]
-    assert after["Gear"][1] == f"error: {gear_message}" and after["Stock"][1] == after["Gear"][1]
-    assert f"Gear: {gear_message}" in output  # one line in the report (here: the console)
+    assert after["Gear"][1] == "error: Teeth must be in 5..1000, got 3."
+    assert after["Stock"][1] == "stale: Gear has an error"  # reported once, on the gear
+    assert "Gear: Teeth must be in 5..1000, got 3." in output  # one line in the report (here: the console)
+    assert output.count("must be in 5..1000") == 1
     assert result["export_error"].endswith(gear_message)
     assert not (tmp_path / "never").exists()
     assert result["unknown_property"].startswith("unknown gear properties: Teth")

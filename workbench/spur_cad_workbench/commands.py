@@ -306,7 +306,11 @@ def run_recorded(lines: list[str], title: str) -> bool:
         for line in lines:
             FreeCADGui.doCommandGui(line)
     except SpurCadError as exc:
-        show_message(title, str(exc))
+        from spur_cad_workbench.validation import sentence
+
+        doc = FreeCAD.ActiveDocument
+        source = (doc.FileName or doc.Name) if doc is not None else ""
+        show_message(title, sentence(exc, source, FreeCAD.Units))  # field titles, the user's units
         return False
     return True
 

@@ -21,8 +21,9 @@ RESOLUTIONS = {"mm": MESSAGE_RESOLUTION_MM, "deg": 0.0001, "mm/min": 0.1, "mm/s^
 FIELD_MIN_DECIMALS = 2  # FreeCAD's default number of decimals: fields look like FreeCAD's own
 _NUMBER = r"-?\d+(?:\.\d+)?(?:[eE][-+]?\d+)?"
 _UNIT = r"(mm/min|mm)(?![\w/^])"
-_INTERVAL = re.compile(rf"([\[(])({_NUMBER}), ({_NUMBER})([\])]) {_UNIT}")
-_SINGLE = re.compile(rf"(?<![\w.])({_NUMBER}) {_UNIT}")
+_LENGTH_OR_FEED = re.compile(  # '[0.05, 100] mm' (a range: both ends in one unit) or '3.55 mm'
+    rf"(?P<open>[\[(])(?P<low>{_NUMBER}), (?P<high>{_NUMBER})(?P<close>[\])]) (?P<range_unit>mm/min|mm)(?![\w/^])"
+    rf"|(?<![\w.])(?P<value>{_NUMBER}) {_UNIT}")
 
 
 def preferred(value: float, unit: str, units) -> tuple[float, str, float]:
@@ -49,11 +50,14 @@ def decimals(shown: float, per_unit: float, resolution: float, min_decimals: int
     return most
 
 
-def text(value: float, unit: str = "mm", units=None, resolution: float | None = None, fixed: bool = False) -> str:
+def text(value: float, unit: str = "mm", units=None, resolution: float | None = None, fixed: bool = False,
+         like: float | None = None) -> str:
     """`value` (in `unit`) as the user's schema writes it: '3.55 mm', '0.1398 in', '83.333 mm/s'. `fixed`:
-    always the resolution's decimals ('21.4500 mm' for inspection values), else only the digits it has."""
+    always the resolution's decimals ('21.4500 mm' for inspection values), else only the digits it has; `like`:
+    in the unit the schema gives that value (both ends of a range in one unit)."""
     step = resolution if resolution is not None else RESOLUTIONS.get(unit, MESSAGE_RESOLUTION_MM)
-    shown, name, per_unit = preferred(value, unit, units)
+    _, name, per_unit = preferred(value if like is None else like, unit, units)
+    shown = float(value) / per_unit
     count = decimals(shown, per_unit, step, 99 if fixed else 0)
     separator = "" if name == '"' else " "
     return f"{shown:.{count}f}{separator}{name}"
@@ -90,9 +94,11 @@ def display_unit(unit: str, units) -> tuple[str, float]:
 
 def message(sentence: str, units=None) -> str:
     """A message with its lengths and feeds ('[0.05, 100] mm', '3.55 mm', '1 mm/min') in the user's schema."""
-    def interval(found: re.Match) -> str:
-        low, high = (text(float(found.group(i)), found.group(5), units) for i in (2, 3))
-        return f"{found.group(1)}{low}, {high}{found.group(4)}"
+    def converted(found: re.Match) -> str:
+        if found.group("value") is not None:
+            return text(float(found.group("value")), found.group(found.lastindex), units)
+        high, unit = float(found.group("high")), found.group("range_unit")
+        low_text, high_text = (text(float(found.group(end)), unit, units, like=high) for end in ("low", "high"))
+        return f"{found.group('open')}{low_text}, {high_text}{found.group('close')}"
 
-    sentence = _INTERVAL.sub(interval, sentence)
-    return _SINGLE.sub(lambda found: text(float(found.group(1)), found.group(2), units), sentence)
+    return _LENGTH_OR_FEED.sub(converted, sentence)

@@ -147,12 +147,17 @@ _INVALID_PREFIX = re.compile(r"^(?:\[[a-z.]+\] |invalid (?:gear|\[[a-z.]+\]): )"
 
 
 def sentence(exc: SpurCadError, source: str, units=None) -> str:
-    """One sentence about a SpurCadError as a gear, stock or job object states it: the field's title first
-    ("Module must be in [0.05 mm, 100 mm], got -3 mm."), titles for key names, lengths in the user's schema."""
-    from spur_cad_workbench.schema import title
+    """One sentence about a SpurCadError as an object's Status and the report view state it: a gear or stock
+    field's title first ("Module must be in [0.05 mm, 100 mm], got -3 mm."), a job's as the panel says it
+    (its group first: "Finishing tool: diameter at most ..."); titles for key names, lengths in the user's schema."""
+    from spur_cad_workbench.schema import SECTION_OBJECTS, title
 
-    body = _INVALID_PREFIX.sub("", _strip_source(str(exc), source).strip())
+    message = _strip_source(str(exc), source).strip()
     field = field_of(exc.section, exc.field)
+    if exc.section not in SECTION_OBJECTS and (field is not None or exc.section in SECTION_GROUPS):
+        body = advice(message, exc.section, exc.field, None, units)
+        return body if body.endswith(".") else f"{body}."
+    body = _INVALID_PREFIX.sub("", message)
     if field is not None:
         body = _with_unit(body, field)
         rest = body[len(exc.field) + 1:] if body.startswith(f"{exc.field} ") else None
