@@ -259,9 +259,12 @@ def test_workbench_commands_panel_and_screenshot_in_the_gui(freecad_gui, tmp_pat
     assert result["verify_command"] and result["verify_command"][0].splitlines()[-1].startswith("FAIL: ")
     assert any(name.startswith("roughing.") for name in result["exported"])
     assert result["imported"] == ["small", ["small quick gear"]]
-    expected = _expected(small_job_text(finishing_diameter=9.0))
-    assert ["Export", expected] in result["export_error"] and result["exported_bad"] == []
-    assert f"Export: {expected}" in result["report"]
+    # the message box: one sentence naming the field as the panel does (the command line names the key)
+    [[title, text]] = result["export_error"]
+    assert title == "Export" and text.startswith("Finishing tool: diameter at most ") and text.endswith(".")
+    assert "_mm" not in text and "[tools." not in text and "Traceback" not in text, text  # r_t, d_1: symbols
+    assert result["exported_bad"] == []
+    assert f"Export: {text}" in result["report"]  # the same line in the report view
 
     # the restart program the command wrote is the one `spur-cad run --restart roughing:space=3` writes
     job = parse_job(small_job_text(), "small.toml")

@@ -200,6 +200,10 @@ gear.removeProperty("KeywayDepth")      # as if saved by an older schema without
 gear.SchemaVersion = 0
 gear.setGroupOfProperty("TipRadius", "Computed")  # the groups of schemas 1 and 2
 gear.setGroupOfProperty("Status", "Base")
+gear.removeProperty("Module")           # schema 3: an input in mm that is never negative was a PropertyLength
+gear.addProperty("App::PropertyLength", "Module", "Gear", "module m")
+gear.Module = PROPS["gear"]["Module"]
+gear.removeProperty("SpanMeasurementPrecise")  # schema 4 added the precise outputs
 # as saved by schema 1: MaxFeed a plain float, AMin an angle (which clamped -99999 to -360), and a shorter list
 job.removeProperty("MaxFeed")
 job.addProperty("App::PropertyFloat", "MaxFeed", "Machine", "linear feed limit (mm/min)")
@@ -218,6 +222,8 @@ RESULT["restored"] = states(doc)
 gear = doc.getObject("Gear")
 RESULT["migrated"] = dict(version=gear.SchemaVersion, has=("KeywayDepth" in gear.PropertiesList),
                           value=gear.KeywayDepth.Value)
+RESULT["migrated_module"] = [gear.getTypeIdOfProperty("Module"), gear.Module.Value,
+                             "SpanMeasurementPrecise" in gear.PropertiesList]
 RESULT["migrated_groups"] = [gear.getGroupOfProperty("TipRadius"), gear.getGroupOfProperty("Status")]
 job = doc.getObject("Job")
 RESULT["schema_version"] = schema.SCHEMA_VERSION
@@ -231,6 +237,7 @@ for obj in doc.Objects:
 doc.recompute()
 RESULT["recomputed"] = states(doc)
 RESULT["moves"] = [job.RoughingMoves, job.FinishingMoves, job.FinishingToolpath.Moves]
+RESULT["precise"] = [gear.SpanMeasurementPrecise, gear.SpanMeasurement.Value]
 RESULT["links"] = [job.Gear.Name, job.Stock.Name, doc.getObject("Stock").Gear.Name]
 doc.save()
 FreeCAD.closeDocument(doc.Name)
@@ -259,6 +266,10 @@ def test_documents_save_and_reopen_without_pickles(freecadcmd, tmp_path):
     assert _all_up_to_date(result["recomputed"]), result
     assert result["schema_version"] == 4
     assert result["migrated"] == {"version": 4, "has": True, "value": 0.0}
+    # schema 3's PropertyLength inputs re-created as PropertyDistance with their value; precise outputs added
+    assert result["migrated_module"] == ["App::PropertyDistance", SMALL_GEAR_PROPERTIES["Module"], True]
+    precise, span = result["precise"]
+    assert precise == f"{span:.4f} mm"
     # unit-carrying types: a feed is a speed shown in FreeCAD's units (mm/s) and read back in mm/min
     types = {"MaxFeed": "App::PropertySpeed", "AMin": "App::PropertyFloat",
              "FinishingStrategy": "App::PropertyEnumeration"}
