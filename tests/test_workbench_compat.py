@@ -504,6 +504,10 @@ RESULT["field_dynamic"] = [bytes(name).decode() for name in field.dynamicPropert
 speed = compat.quantity_spin_box(FreeCADGui.UiLoader(), "mm/min")
 compat.set_spin_box_value(speed, FreeCAD.Units, 100.0, "mm/min")
 RESULT["speed"] = [compat.spin_box_value(speed, FreeCAD.Units, "mm/min"), speed.text()]
+precise = FreeCAD.Units.Quantity("100 mm/min")
+precise.Format = dict(precise.Format, Precision=4)   # a per-widget precision through the Quantity's format
+compat.set_spin_box_quantity(speed, precise)
+RESULT["precise_speed"] = [compat.spin_box_value(speed, FreeCAD.Units, "mm/min"), speed.text()]
 RESULT["no_widget"] = compat.quantity_spin_box(FreeCADGui.UiLoader(), "mm") is None
 
 class Panel:
@@ -547,6 +551,9 @@ def test_the_020_branches_in_the_gui(freecad_gui, tmp_path):
     # 0.20: the speed shows in mm/s with the global 2 decimals, and the stored value is the rounded one
     speed, speed_text = result["speed"]
     assert speed_text == "1.67 mm/s" and speed == pytest.approx(100.2)
+    # ... unless the Quantity it is given carries its own precision (what the task panel does)
+    speed, speed_text = result["precise_speed"]
+    assert speed_text == "1.6667 mm/s" and speed == pytest.approx(100.002)
     assert result["no_widget"] is False
     assert result["dialog"] == "None"  # 0.20's showDialog returns nothing
     assert "OK" in result["task_buttons"] and "Cancel" in result["task_buttons"]

@@ -224,3 +224,25 @@ def test_long_roughing_advice_offers_two_stage_and_no_larger_tool_at_its_limit(w
     advice = s.long_job_advice(two_stage, "generating", roughing_room_mm=2.0)
     assert "two-stage" not in advice and "larger roughing tool" in advice
     assert advice.startswith("Long job: 9 h 10 min, of which roughing 9 h 00 min")
+
+
+@pytest.mark.parametrize(("section", "key", "value", "title"), [
+    ("gear", "module_mm", -3.0, "Module"), ("gear", "teeth", 2, "Teeth"),
+    ("gear", "profile_shift_coefficient", 2.0, "Profile shift coefficient x"),
+    ("gear", "rack_tip_radius_mm", 5.0, "Rack tip radius"), ("gear", "bore_diameter_mm", 200.0, "Bore diameter"),
+    ("gear", "face_width_mm", float("nan"), "Face width"), ("stock", "radial_allowance_mm", -1.0, "Radial allowance"),
+])
+def test_an_object_s_error_is_one_sentence_with_the_field_s_title_and_unit(wb, section, key, value, title):
+    from spur_cad.errors import SpurCadError
+    from spur_cad.job import job_from_dict
+
+    data = {"gear": {"teeth": 23, "module_mm": 4.0, "face_width_mm": 20.0, "rack_tip_radius_mm": 1.52}}
+    data.setdefault(section, {})[key] = value
+    with pytest.raises(SpurCadError) as caught:
+        job_from_dict(data, "doc.FCStd")
+    text = wb.validation.sentence(caught.value, "doc.FCStd")
+    assert text.startswith(f"{title} ") or text.startswith(f"{title}:"), text
+    assert text.endswith(".") and ". " not in text[:-1] and "\n" not in text, text
+    assert not KEY_NAME.search(text) and "[" + section + "]" not in text and "doc.FCStd" not in text, text
+    if key.endswith("_mm") and value == value:  # a length: its unit is said (NaN has none)
+        assert " mm" in text, text

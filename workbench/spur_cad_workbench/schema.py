@@ -11,10 +11,7 @@ group, tooltip = its meaning, and the property type from the key's type, unit an
 
 | key                                   | FreeCAD property            | value as the property holds it   |
 | ------------------------------------- | --------------------------- | -------------------------------- |
-| float, mm                             | App::PropertyDistance       | Quantity, .Value in mm (a        |
-|                                       |                             | negative value reaches spur_cad's|
-|                                       |                             | check; PropertyLength clamps to 0|
-|                                       |                             | silently); outputs: PropertyLength|
+| float, mm                             | App::PropertyDistance       | Quantity, .Value in mm (1)       |
 | float, deg, range within [-360, 360]  | App::PropertyAngle          | Quantity, .Value in deg          |
 | float, deg, range beyond +-360        | App::PropertyFloat          | number in deg (PropertyAngle     |
 |                                       |                             | clamps to [-360, 360])           |
@@ -26,6 +23,10 @@ group, tooltip = its meaning, and the property type from the key's type, unit an
 | bool                                  | App::PropertyBool           | bool                             |
 | str with choices or registry names    | App::PropertyEnumeration    | str                              |
 | other str                             | App::PropertyString         | str                              |
+
+(1) Also for keys that are never negative: PropertyLength clamps to >= 0, so a typed -3 mm would be
+stored as 0 without a word; a PropertyDistance keeps it for spur_cad's check to refuse. Computed
+lengths are PropertyLength.
 
 Cutting speeds (m/min), spindle speeds (1/min) and rotary speeds (deg/min) stay PropertyFloat:
 catalogues quote them in those units, and FreeCAD would show them as mm/s, Hz or deg/s.
