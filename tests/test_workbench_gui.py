@@ -190,6 +190,9 @@ imported_job.FinishingToolDiameter = 9.0
 os.makedirs(OUT + "_bad")
 answer_file_dialog(OUT + "_bad")
 select(imported_job)
+for box in QtGui.QApplication.topLevelWidgets():   # the earlier commands' boxes (results, PASS) closed
+    if box.objectName() == "SpurCadMessage":
+        box.close()
 FreeCADGui.runCommand("SpurCad_Export")
 settle()
 boxes = [w for w in QtGui.QApplication.topLevelWidgets() if w.objectName() == "SpurCadMessage" and w.isVisible()]
