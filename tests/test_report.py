@@ -58,6 +58,31 @@ def test_report_embeds_every_image_and_refers_to_nothing_outside(outputs):
     assert not re.search(r"https?://|<script|<link|<iframe|url\(", html, re.IGNORECASE)
 
 
+def test_the_finishing_figure_has_no_empty_band_and_draws_every_tool_inside_it(outputs):
+    """Issue 28: the passes figure's height follows its data (it had about 200 px of empty space) and the land
+    passes' tool outlines stay inside the plot (they ran off its top): no all-white row band above the title or
+    below the axis labels, and no coloured pass pixel in the top row of the plot frame's inside."""
+    import io
+
+    import matplotlib.image
+    import numpy as np
+
+    html, _, _ = outputs
+    sources = re.findall(r'<img[^>]*\ssrc="data:image/png;base64,([^"]*)"', html)
+    image = matplotlib.image.imread(io.BytesIO(base64.b64decode(sources[2])), format="png")[..., :3]
+    white_rows = np.all(image > 0.98, axis=(1, 2))
+    leading = int(np.argmax(~white_rows))
+    trailing = int(np.argmax(~white_rows[::-1]))
+    assert (leading + trailing) / len(image) < 0.15, (leading, trailing, len(image))  # 9 %; was 40 %
+    # the plot frame: the longest dark horizontal line is its top or bottom edge; inside its top edge no
+    # land-pass colour (matplotlib's tab:purple) meets the frame
+    dark = np.all(image < 0.25, axis=2)
+    frame_rows = np.flatnonzero(dark.sum(axis=1) > 0.6 * image.shape[1])
+    top_edge = int(frame_rows.min())
+    purple = np.all(np.abs(image - np.array([0x94, 0x67, 0xBD]) / 255.0) < 0.12, axis=2)
+    assert purple.any() and not purple[top_edge + 1: top_edge + 3].any()
+
+
 def test_report_shows_the_summarys_values_labelled_with_units(outputs):
     html, summary, _ = outputs
     text = visible_text(html)

@@ -10,7 +10,7 @@ import numpy as np
 
 from spur_cad.geometry.sampling import full_space_points, sample_profile
 from spur_cad.geometry.spec import GearSpec
-from spur_cad.report.plots import _png, figure
+from spur_cad.report.plots import _png, figure, figure_for_extent
 
 if TYPE_CHECKING:
     from spur_cad.cam.tools import Tool
@@ -194,38 +194,41 @@ def passes_png(spec: GearSpec, tool: Tool, passes: tuple, blank_radius_mm: float
     from spur_cad.cam.contacts import tool_signed_distance
     from spur_cad.geometry.frames import machine_to_part, turn_points
 
-    fig = figure(7.5, 6.5, left=0.09, right=0.98)
-    ax = fig.add_subplot(1, 1, 1)
     outline = _space_outline(spec)
     neighbour = turn_points(outline, -2.0 * math.pi / spec.teeth)
-    ax.plot(outline[:, 0], outline[:, 1], "-", color="k", lw=1.2, label="design")
-    ax.plot(neighbour[:, 0], neighbour[:, 1], "-", color="0.4", lw=0.8)
     span = np.linspace(-math.pi / spec.teeth, 3.0 * math.pi / spec.teeth, 300)
-    ax.plot(blank_radius_mm * np.sin(span), blank_radius_mm * np.cos(span), ":", color="0.5", lw=1, label="blank")
     design = np.concatenate([outline, neighbour])
     r_t, half_flat = tool.effective_corner_radius_mm, tool.flat_width_mm / 2.0
     phi = np.linspace(0.0, math.pi / 2, 12)
-    top = 2.5 * tool.diameter_mm
+    top = tool.diameter_mm  # the tool drawn one diameter up from its tip: enough to see its shape and side
     profile_y = np.concatenate([[-half_flat - r_t], -half_flat - r_t * np.sin(phi[::-1]),
                                 half_flat + r_t * np.sin(phi), [half_flat + r_t]])
     profile_z = np.concatenate([[top], r_t - r_t * np.cos(phi[::-1]), r_t - r_t * np.cos(phi), [top]])
-    labelled = set()
-    contacts = []
+    shapes, contacts = [], []
     for p in passes:
-        a_deg = p.a_deg
-        shape = machine_to_part(p.y_mm + profile_y, p.z_mm + profile_z, np.full(len(profile_y), a_deg))
+        shapes.append(machine_to_part(p.y_mm + profile_y, p.z_mm + profile_z, np.full(len(profile_y), p.a_deg)))
+        distance = tool_signed_distance(turn_points(design, math.radians(p.a_deg)), p.y_mm, p.z_mm, tool)
+        contacts.append(design[int(np.argmin(distance))])
+    contacts = np.array(contacts)
+    x_low, x_high = -0.75 * spec.pitch_mm, 1.25 * spec.pitch_mm
+    highest = max([blank_radius_mm] + [float(shape[:, 1].max()) for shape in shapes])
+    y_low, y_high = spec.root_radius_mm - 1.0, highest + 0.5  # every tool outline inside the plot
+    fig = figure_for_extent(7.5, x_high - x_low, y_high - y_low)
+    ax = fig.add_subplot(1, 1, 1)
+    ax.plot(outline[:, 0], outline[:, 1], "-", color="k", lw=1.2, label="design")
+    ax.plot(neighbour[:, 0], neighbour[:, 1], "-", color="0.4", lw=0.8)
+    ax.plot(blank_radius_mm * np.sin(span), blank_radius_mm * np.cos(span), ":", color="0.5", lw=1, label="blank")
+    labelled = set()
+    for p, shape in zip(passes, shapes):
         label = None if p.mode in labelled else f"{p.mode} passes"
         labelled.add(p.mode)
         ax.plot(shape[:, 0], shape[:, 1], "-", color=_PASS_COLOURS.get(p.mode, "0.6"), lw=0.4, label=label)
-        distance = tool_signed_distance(turn_points(design, math.radians(a_deg)), p.y_mm, p.z_mm, tool)
-        contacts.append(design[int(np.argmin(distance))])
-    contacts = np.array(contacts)
     ax.plot(contacts[:, 0], contacts[:, 1], ".", ms=4, color="tab:red", label="contacts")
     ax.set_aspect("equal")
     ax.set_xlabel("part Y [mm] (space 0, A = 0)")
     ax.set_ylabel("part Z [mm]")
-    ax.set_xlim(-0.75 * spec.pitch_mm, 1.25 * spec.pitch_mm)
-    ax.set_ylim(spec.root_radius_mm - 1.0, blank_radius_mm + 1.5)
+    ax.set_xlim(x_low, x_high)
+    ax.set_ylim(y_low, y_high)
     counts = {mode: sum(1 for p in passes if p.mode == mode) for mode in _PASS_COLOURS}
     ax.set_title(f"finishing passes of one tooth space: {len(passes)} ({counts['flank']} flank, {counts['tip']} fillet "
                  f"and root, {counts['land']} land), {tool.kind} D {tool.diameter_mm:g} mm r {r_t:g} mm", fontsize=9)

@@ -24,6 +24,17 @@ def figure(width_in: float, height_in: float, left: float = 0.1, right: float = 
     return fig
 
 
+def figure_for_extent(width_in: float, x_range: float, y_range: float, margins_in=(0.75, 0.15, 0.6, 0.4),
+                      largest_height_in: float = 9.0) -> Figure:
+    """A figure for one equal-aspect plot of data `x_range` wide and `y_range` tall: the height follows the
+    data (no band of empty space above and below), margins (left, right, bottom, top) fixed in inches."""
+    left, right, bottom, top = margins_in
+    axes_height_in = (width_in - left - right) * y_range / max(x_range, 1e-9)
+    height_in = min(axes_height_in + bottom + top, largest_height_in)
+    return figure(width_in, height_in, left=left / width_in, right=1.0 - right / width_in, bottom=bottom / height_in,
+                  top=1.0 - top / height_in)
+
+
 def _png(fig: Figure) -> bytes:
     """The figure as PNG bytes at 120 dpi (zlib level 1: the plots' flat colours compress nearly as well, in a
     fraction of the default level's time)."""
