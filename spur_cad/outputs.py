@@ -99,9 +99,10 @@ def check_output_folder(out_dir: str | os.PathLike) -> Path:
         existing = next((p for p in (out, *out.parents) if p.exists()), Path("."))
         if not existing.is_dir() or not os.access(existing, os.W_OK | os.X_OK):
             raise OutputError(f"--out {shown_path(out)}: cannot write into {shown_path(existing)}")
-        if out.is_dir():
+        if out.is_dir():  # a foreign manifest or journal is refused now, not after the run
             with _opened(out) as folder:
-                _check_bookkeeping(out, folder)  # a foreign manifest or journal is refused now, not after the run
+                if _try_lock(folder):  # busy: another run's staging folder may be half made; checked when writing
+                    _check_bookkeeping(out, folder)
     except OutputError:
         raise
     except (OSError, ValueError) as exc:  # a path too long for the system, a NUL byte, ...
@@ -453,6 +454,15 @@ def _opened(out: Path):
         yield fd
     finally:
         os.close(fd)
+
+
+def _try_lock(folder: int) -> bool:
+    """Take the folder's exclusive lock if nobody holds it (released when `folder` is closed); False if held."""
+    try:
+        fcntl.flock(folder, fcntl.LOCK_EX | fcntl.LOCK_NB)
+    except BlockingIOError:
+        return False
+    return True
 
 
 @contextlib.contextmanager

@@ -178,3 +178,25 @@ def test_every_name_a_run_writes_is_in_the_vocabulary():
     for name in ("../roughing.ngc", "roughing.txt", "finishing.md", ".spur_cad-set.json", "gear.step/x",
                  "roughing.ngc\n", "roughing_space5.ngc.bak"):
         assert not is_output_name(name), name
+
+
+def test_a_staging_folder_being_made_by_a_run_holding_the_lock_is_not_refused_as_foreign(tmp_path):
+    """Found under load: the early check of --out (before a run computes) read another run's staging folder
+    between its mkdir and its mark and refused the folder as not ours. While the folder's lock is held the
+    early check leaves the bookkeeping alone (the write checks it under the lock); an idle folder holding the
+    same markless staging folder is still refused."""
+    import fcntl
+
+    from spur_cad.outputs import STAGING_PREFIX, ForeignFileError, check_output_folder
+
+    out = tmp_path / "out"
+    out.mkdir()
+    os.mkdir(out / f"{STAGING_PREFIX}0123abcd", 0o700)  # as _new_staging leaves it before writing the mark
+    holder = os.open(out, os.O_RDONLY)
+    try:
+        fcntl.flock(holder, fcntl.LOCK_EX)  # another run, mid-write
+        assert check_output_folder(out) == out
+    finally:
+        os.close(holder)
+    with pytest.raises(ForeignFileError, match="mark"):
+        check_output_folder(out)
