@@ -203,6 +203,7 @@ gear.setGroupOfProperty("Status", "Base")
 gear.removeProperty("Module")           # schema 3: an input in mm that is never negative was a PropertyLength
 gear.addProperty("App::PropertyLength", "Module", "Gear", "module m")
 gear.Module = PROPS["gear"]["Module"]
+gear.setExpression("Module", "FaceWidth / 2")  # a binding (as a spreadsheet's): kept when Module is re-created
 gear.removeProperty("SpanMeasurementPrecise")  # schema 4 added the precise outputs
 # as saved by schema 1: MaxFeed a plain float, AMin an angle (which clamped -99999 to -360), and a shorter list
 job.removeProperty("MaxFeed")
@@ -224,6 +225,7 @@ RESULT["migrated"] = dict(version=gear.SchemaVersion, has=("KeywayDepth" in gear
                           value=gear.KeywayDepth.Value)
 RESULT["migrated_module"] = [gear.getTypeIdOfProperty("Module"), gear.Module.Value,
                              "SpanMeasurementPrecise" in gear.PropertiesList]
+RESULT["migrated_expressions"] = [list(item) for item in gear.ExpressionEngine]
 RESULT["migrated_groups"] = [gear.getGroupOfProperty("TipRadius"), gear.getGroupOfProperty("Status")]
 job = doc.getObject("Job")
 RESULT["schema_version"] = schema.SCHEMA_VERSION
@@ -268,6 +270,7 @@ def test_documents_save_and_reopen_without_pickles(freecadcmd, tmp_path):
     assert result["migrated"] == {"version": 4, "has": True, "value": 0.0}
     # schema 3's PropertyLength inputs re-created as PropertyDistance with their value; precise outputs added
     assert result["migrated_module"] == ["App::PropertyDistance", SMALL_GEAR_PROPERTIES["Module"], True]
+    assert result["migrated_expressions"] == [["Module", "FaceWidth / 2"]]
     precise, span = result["precise"]
     assert precise == f"{span:.4f} mm"
     # unit-carrying types: a feed is a speed shown in FreeCAD's units (mm/s) and read back in mm/min

@@ -328,6 +328,19 @@ def _plan_two_stage(inputs: CamInputs, levels: RoughingLevels,
     spec, bottom = inputs.spec, inputs.bottom_tool
     bottom_levels = roughing_levels(spec, bottom, inputs.roughing, blank)
     alone = _plan_roughing(inputs, bottom_levels, blank, bottom)
+    _, j, below = _two_stage_split(inputs, levels, blank, bottom_levels, alone)
+    upper = _plan_roughing(inputs, _levels_where(levels, np.arange(len(levels.heights_mm)) <= j), blank)
+    lower = _plan_roughing(inputs, _levels_where(bottom_levels, below), blank, bottom)
+    chosen = "set" if inputs.roughing.bottom_tool_above_root_mm > 0.0 else "shortest time"
+    return upper, lower, TwoStage(float(levels.heights_mm[j] - spec.root_radius_mm), chosen,
+                                  upper.estimate.time_s + lower.estimate.time_s, alone.estimate.time_s)
+
+
+def _two_stage_split(inputs: CamInputs, levels: RoughingLevels, blank: float, bottom_levels: RoughingLevels,
+                     alone: RoughingPlan) -> tuple[float, int, np.ndarray]:
+    """(feed-bound seconds of both tools' levels, index of the roughing tool's lowest level, the bottom tool's
+    levels below it) of the split `_plan_two_stage` describes; `alone`: the bottom tool's plan of all its levels."""
+    spec, bottom = inputs.spec, inputs.bottom_tool
     root, set_height = spec.root_radius_mm, inputs.roughing.bottom_tool_above_root_mm
     splits = range(len(levels.heights_mm))
     if set_height > 0.0:
@@ -351,12 +364,7 @@ def _plan_two_stage(inputs: CamInputs, levels: RoughingLevels,
         raise MachineError(f"two-stage roughing: the roughing tool (D {inputs.roughing_tool.diameter_mm:g} mm) reaches "
                            f"as deep as the bottom tool (D {bottom.diameter_mm:g} mm); leave out [tools.bottom]",
                            field="diameter_mm", section="tools.bottom")
-    _, j, below = best
-    upper = _plan_roughing(inputs, _levels_where(levels, np.arange(len(levels.heights_mm)) <= j), blank)
-    lower = _plan_roughing(inputs, _levels_where(bottom_levels, below), blank, bottom)
-    chosen = "set" if set_height > 0.0 else "shortest time"
-    return upper, lower, TwoStage(float(levels.heights_mm[j] - root), chosen,
-                                  upper.estimate.time_s + lower.estimate.time_s, alone.estimate.time_s)
+    return best
 
 
 TWO_STAGE_PAYS_FRACTION = 0.9
@@ -380,9 +388,11 @@ def suggested_two_stage(inputs: CamInputs) -> TwoStageSuggestion | None:
     (whole millimetres, up to the space width at the reference circle) whose upper levels make the shortest
     roughing; None when none saves at least 1 - TWO_STAGE_PAYS_FRACTION of the bottom tool's time alone."""
     spec, bottom = inputs.spec, inputs.roughing_tool
-    if bottom is None or spec.is_helical:  # helical roughing follows the lead: one tool (check_two_stage_tools)
-        return None
+    if bottom is None or spec.is_helical:  # not suggested for helical gears (each of their roughing plans takes
+        return None                        # seconds); a job file may still name a [tools.bottom] for one
     blank = inputs.stock.blank_radius_mm(spec)
+    bottom_levels = roughing_levels(spec, bottom, inputs.roughing, blank)
+    alone = _plan_roughing(dataclasses.replace(inputs, bottom_tool=bottom), bottom_levels, blank, bottom)
     widest_mm = 2.0 * space_half_width_mm(flank_polyline(spec), spec.reference_radius_mm)
     first_mm = (np.floor(bottom.diameter_mm / TOP_TOOL_STEP_MM) + 1.0) * TOP_TOOL_STEP_MM
     sizes = np.arange(first_mm, widest_mm + 1e-9, TOP_TOOL_STEP_MM)
@@ -392,12 +402,13 @@ def suggested_two_stage(inputs: CamInputs) -> TwoStageSuggestion | None:
     for diameter in sizes:
         top = dataclasses.replace(bottom, diameter_mm=float(diameter), kind="flat", corner_radius_mm=0.0)
         trial = dataclasses.replace(inputs, roughing_tool=top, bottom_tool=bottom, finishing_tool=None)
-        try:
-            _, _, stage = _plan_two_stage(trial, roughing_levels(spec, top, inputs.roughing, blank), blank)
+        try:  # the split's feed-bound time: the two programs less their linking moves
+            seconds, _, _ = _two_stage_split(trial, roughing_levels(spec, top, inputs.roughing, blank), blank,
+                                             bottom_levels, alone)
         except SpurCadError:  # the larger tool reaches no higher than the bottom tool, or no level fits
             continue
-        if best is None or stage.two_stage_time_s < best.two_stage_time_s:
-            best = TwoStageSuggestion(float(diameter), stage.two_stage_time_s, stage.bottom_tool_alone_time_s)
+        if best is None or seconds < best.two_stage_time_s:
+            best = TwoStageSuggestion(float(diameter), seconds, alone.estimate.time_s)
     if best is None or best.two_stage_time_s > TWO_STAGE_PAYS_FRACTION * best.bottom_tool_alone_time_s:
         return None
     return best

@@ -118,8 +118,12 @@ def make_job(gear, stock, suggest: bool = True, **values):
     job_values = {**schema.default_values()["job"], **_checked(values, schema.JOB_FIELDS, "job")}
     tool_props = {field.prop for field in schema.JOB_FIELDS if field.section.startswith("tools.")}
     if suggest and not tool_props & set(values):
+        from spur_cad_workbench.progress import WorkProgress
+
         current = {**document_values(stock), "job": job_values}
-        job_values.update(suggest_tools(current) if "FlankAllowance" in values else new_job_values(current))
+        with WorkProgress("4-axis job", ("choosing tools",)) as progress:  # a second or more: a wait cursor
+            job_values.update(suggest_tools(current) if "FlankAllowance" in values else new_job_values(current))
+            progress.stage_done("choosing tools")
     doc = gear.Document
     obj = doc.addObject("App::FeaturePython", "Job")
     JobFeature(obj, gear, stock, job_values)
@@ -461,8 +465,10 @@ class RestartCommand(_Command):
         window = FreeCADGui.getMainWindow()
         try:
             dialog = restart_dialog(job_obj, window)
-        except SpurCadError as exc:
-            show_message("Restart program", str(exc))
+        except SpurCadError as exc:  # the job cannot be planned: said as the panel says it, not in key names
+            from spur_cad_workbench.validation import sentence
+
+            show_message("Restart program", sentence(exc, job_obj.Label, FreeCAD.Units))
             return
         if not compat.exec_dialog(dialog.dialog):
             return

@@ -39,6 +39,7 @@ def add_fields(obj, fields, values: dict | None = None, outputs: bool = False) -
     changed = []
     for field in fields:
         value = values.get(field.prop) if values is not None else None
+        expressions: list[tuple[str, str]] = []
         if field.prop in obj.PropertiesList:
             if obj.getGroupOfProperty(field.prop) != field.group:  # a group of an older schema
                 obj.setGroupOfProperty(field.prop, field.group)
@@ -48,6 +49,8 @@ def add_fields(obj, fields, values: dict | None = None, outputs: bool = False) -
                     changed.append(field.prop)
                 continue
             value = schema.plain_value(field, getattr(obj, field.prop))  # a type of an older schema
+            # removing a property drops the expressions bound to it (a spreadsheet driving the gear): kept
+            expressions = [(path, text) for path, text in obj.ExpressionEngine if path == field.prop]
             obj.removeProperty(field.prop)
         obj.addProperty(field.property_type, field.prop, field.group, field.doc, attr)
         changed.append(field.prop)
@@ -55,6 +58,8 @@ def add_fields(obj, fields, values: dict | None = None, outputs: bool = False) -
             setattr(obj, field.prop, list(field.choices))
         if value is not None and not outputs:
             setattr(obj, field.prop, property_value(field, value))
+        for path, text in expressions:
+            obj.setExpression(path, text)
     return changed
 
 

@@ -188,7 +188,7 @@ class RestartDialog:
         self.space.blockSignals(True)
         self.space.clear()
         for space in choice.spaces():
-            self.space.addItem(f"space {space} of 0 to {self.teeth - 1}   (A {-space * 360.0 / self.teeth:.3f}°)",
+            self.space.addItem(f"space {space} of 0 to {self.teeth - 1}   (A {-space * 360.0 / self.teeth + 0.0:.3f}°)",
                                space)
         self.space.blockSignals(False)
         unit = SECOND_UNIT[choice.operation]

@@ -147,25 +147,31 @@ GROUP_SUMMARY_CHARS = 60
 """A folded group's header shows its state in at most this many characters (it fits the default task dock)."""
 
 
-def _tool_summary(job: dict, role: str) -> str:
-    """'T1 flat D 4 mm', 'T2 bull-nose D 3.35 mm' or 'not used'."""
+def _tool_summary(job: dict, role: str, units) -> str:
+    """'T1 flat D 4 mm', 'T2 bull-nose D 3.35 mm' (lengths in the user's unit schema) or 'not used'."""
+    from spur_cad_workbench.units import text
+
     if not job.get(f"Use{role}Tool"):
         return "not used"
-    diameter = float(job.get(f"{role}ToolDiameter", 0.0))
+    diameter = text(float(job.get(f"{role}ToolDiameter", 0.0)), "mm", units)
     kind = str(job.get(f"{role}ToolKind", "")).replace("_", "-")
-    return f"T{job.get(f'{role}ToolNumber', '')} {kind} D {diameter:g} mm"
+    return f"T{job.get(f'{role}ToolNumber', '')} {kind} D {diameter}"
 
 
-def group_summary(group: str, job: dict[str, object]) -> str:
+def group_summary(group: str, job: dict[str, object], units=None) -> str:
     """What a folded group of the job panel holds, in a few words ('T1 flat D 4 mm', 'generating, scallop
-    0.005 mm'); '' for groups without one. Cut at GROUP_SUMMARY_CHARS with an ellipsis."""
+    5 um'; lengths in the user's unit schema, `units` = FreeCAD.Units, None for mm); '' for groups without one.
+    Cut at GROUP_SUMMARY_CHARS with an ellipsis."""
+    from spur_cad_workbench.units import text as length_text
+
     tools = {"Roughing tool": "Roughing", "Finishing tool": "Finishing", "Bottom tool": "Bottom"}
     if group in tools:
-        text = _tool_summary(job, tools[group])
+        text = _tool_summary(job, tools[group], units)
     elif group == "Finishing strategy":
-        text = f"{job.get('FinishingStrategy', '')}, scallop {float(job.get('TargetScallop', 0.0)):g} mm"
+        scallop = length_text(float(job.get("TargetScallop", 0.0)), "mm", units)
+        text = f"{job.get('FinishingStrategy', '')}, scallop {scallop}"
     elif group == "Roughing strategy":
-        text = f"flank allowance {float(job.get('FlankAllowance', 0.0)):g} mm"
+        text = f"flank allowance {length_text(float(job.get('FlankAllowance', 0.0)), 'mm', units)}"
     elif group == "Machine":
         text = str(job.get("MachineName", ""))
     elif group == "Post":

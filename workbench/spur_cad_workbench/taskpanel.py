@@ -405,7 +405,7 @@ class JobTaskPanel:
             label.setText(notes.get(prop, ""))
             label.setVisible(prop in notes)
         for group, section in self.sections.items():
-            section.set_summary(group_summary(group, values["job"]))
+            section.set_summary(group_summary(group, values["job"], FreeCAD.Units))
         for section, switch in schema.SECTION_SWITCHES.items():
             enabled = self.widgets[switch.prop].isChecked()
             for field in schema.JOB_FIELDS:

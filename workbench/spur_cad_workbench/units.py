@@ -41,7 +41,7 @@ def preferred(value: float, unit: str, units) -> tuple[float, str, float]:
 def decimals(shown: float, per_unit: float, resolution: float, min_decimals: int = 0) -> int:
     """Fewest decimals (at least `min_decimals`) that show `shown` to `resolution` (in the job-file unit; a
     displayed unit is `per_unit` of them): 3 in mm for a micrometre, 4 in inches, 1 in um."""
-    most = max(0, round(math.log10(per_unit / resolution)))
+    most = max(0, math.ceil(math.log10(per_unit / resolution) - 1e-9))  # 6 in inches: 0.0254 um, not 0.254
     if not math.isfinite(shown):
         return 0
     for count in range(min(min_decimals, most), most + 1):

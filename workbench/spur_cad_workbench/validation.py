@@ -239,7 +239,7 @@ def recommendation_notes(rec, two_stage: bool = False, units=None) -> dict[str, 
 _UNUSUAL = (
     ("MaxSpindleRpm", lambda v: v < 2000.0, "unusually low for a machining centre (usual: 6,000 to 40,000 1/min); "
                                             "small end mills will run far below their cutting speed"),
-    ("MaxFeed", lambda v: v < 500.0, "unusually low (usual: 2000 to 30000 mm/min); every feed is capped by it"),
+    ("MaxFeed", lambda v: v < 500.0, "unusually low (usual: 2000 mm/min to 30000 mm/min); every feed is capped by it"),
     ("MaxRotarySpeed", lambda v: v < 360.0, "unusually low for a rotary table (usual: 1,800 to 30,000 deg/min)"),
     ("BlockTime", lambda v: v > 0.05, "unusually long (usual: 0.5 to 8 ms); short moves will be slow"),
 )
