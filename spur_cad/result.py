@@ -131,6 +131,7 @@ class RoughingFacts:
     level_heights_mm: tuple[float, ...]
     estimate: Estimate
     two_stage: TwoStageFacts | None = None
+    tip_heights_mm: tuple[float, ...] = ()  # passes over each tip land (tooth axis up), top to bottom
 
 
 @dataclass(frozen=True)

@@ -115,7 +115,8 @@ def tools_facts(plan: CamPlan, machine: Machine, roughing_tool: Tool | None,
 
 def _roughing(roughing: RoughingPlan) -> RoughingFacts:
     return RoughingFacts(len(roughing.levels.heights_mm), roughing.lowest_level_above_root_mm,
-                         tuple(float(h) for h in roughing.levels.heights_mm), roughing.estimate)
+                         tuple(float(h) for h in roughing.levels.heights_mm), roughing.estimate,
+                         tip_heights_mm=tuple(float(h) for h in roughing.tip_heights_mm))
 
 
 def roughing_facts(plan: CamPlan, machine: Machine) -> RoughingFacts | None:
@@ -239,7 +240,8 @@ def estimate_json(est: Estimate) -> dict:
 def roughing_json(roughing: RoughingFacts) -> dict:
     facts = {"levels_per_space": roughing.levels_per_space,
              "lowest_level_height_mm": roughing.lowest_level_height_mm,
-             "level_heights_mm": list(roughing.level_heights_mm), **estimate_json(roughing.estimate)}
+             "level_heights_mm": list(roughing.level_heights_mm),
+             "tip_pass_heights_mm": list(roughing.tip_heights_mm), **estimate_json(roughing.estimate)}
     stage = roughing.two_stage
     if stage is not None:
         facts["two_stage"] = {

@@ -84,13 +84,22 @@ def test_a_blank_smaller_than_the_tip_circle_is_refused_and_a_larger_one_cut():
     assert job.stock.blank_radius_mm(job.gear) == pytest.approx(tip_diameter / 2 + 0.3)
 
 
-def test_a_blank_standing_above_the_tips_more_than_the_finishing_tool_takes_is_refused_naming_its_line(tmp_path,
-                                                                                                       capsys):
+ROUGHING_TOOL = '[tools.roughing]\nkind = "flat"\ndiameter_mm = 2.0\nflutes = 3\n\n'
+
+
+def _allowance(allowance_mm: float, roughing: bool = True) -> str:
+    """The small job with its blank `allowance_mm` above the tip circle (and without its roughing tool)."""
+    text = _with(small_job_text(), "stock", f"radial_allowance_mm = {allowance_mm}").replace(
+        "radial_allowance_mm = 0.5\n", "")
+    assert ROUGHING_TOOL in text
+    return text if roughing else text.replace(ROUGHING_TOOL, "")
+
+
+def test_without_roughing_a_blank_standing_above_the_tips_more_than_the_finishing_tool_takes_is_refused(tmp_path,
+                                                                                                        capsys):
     # the finishing tool (D 1.5 mm) takes at most 0.5 x D = 0.75 mm off the tips in one pass
-    ok = parse_job(_with(small_job_text(), "stock", "radial_allowance_mm = 0.74").replace(
-        "radial_allowance_mm = 0.5\n", ""), "ok.toml")
-    plan_cam(ok)
-    text = _with(small_job_text(), "stock", "radial_allowance_mm = 0.8").replace("radial_allowance_mm = 0.5\n", "")
+    plan_cam(parse_job(_allowance(0.74, roughing=False), "ok.toml"))
+    text = _allowance(0.8, roughing=False)
     job = tmp_path / "big.toml"
     job.write_text(text)
     line = next(n for n, row in enumerate(text.splitlines(), 1) if row.startswith("radial_allowance_mm"))
@@ -99,6 +108,21 @@ def test_a_blank_standing_above_the_tips_more_than_the_finishing_tool_takes_is_r
     assert len(err) == 1 and err[0].startswith(f"spur-cad: error: {job}:{line}: radial_allowance_mm: the blank "
                                                "stands 0.800 mm above the tip circle")
     assert not (tmp_path / "out").exists()
+
+
+def test_with_roughing_the_tips_are_roughed_to_the_finish_stock_and_a_larger_stock_is_refused():
+    """Roughing takes the blank down to the tip circle + finish_stock_mm: any allowance runs; a finish stock
+    more than the finishing tool takes off the tips in one pass (0.75 mm) is refused, naming its key."""
+    job = parse_job(_allowance(1.8), "big.toml")
+    plan = plan_cam(job)
+    tips = plan.roughing.tip_heights_mm
+    # 1.8 mm in cuts of at most 0.5 x D 2 mm: two, the last at the tip circle + the finish stock
+    assert len(tips) == 2 and tips[-1] == pytest.approx(job.gear.tip_radius_mm + job.roughing.finish_stock_mm)
+    assert tips[0] - tips[-1] <= 1.0 + 1e-9 and job.stock.blank_radius_mm(job.gear) - tips[0] <= 1.0 + 1e-9
+    with pytest.raises(SpurCadError, match=r"finish_stock_mm = 0.8: roughing leaves that much on the tip lands") as err:
+        plan_cam(parse_job(_with(_allowance(1.8), "roughing", "finish_stock_mm = 0.8\nflank_allowance_mm = 1.0"),
+                           "stock.toml"))
+    assert (err.value.section, err.value.field) == ("roughing", "finish_stock_mm")
 
 
 @pytest.mark.parametrize("offset", ["G54", "G57", "G59"])

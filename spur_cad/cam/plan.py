@@ -34,6 +34,7 @@ from spur_cad.cam.roughing import (
     estimated_roughing_moves,
     roughing_levels,
     roughing_toolpath,
+    tip_heights_mm,
 )
 from spur_cad.cam.strategies import (
     REGISTRY,
@@ -64,13 +65,15 @@ two stations' worth, PerimeterStrategy.estimate); beyond it the comparison is le
 
 @dataclass(frozen=True)
 class RoughingPlan:
-    """Roughing: the levels (computed once), the toolpath and its estimate."""
+    """Roughing: the levels (computed once), the toolpath and its estimate, and the heights of the passes over
+    each tip land (tooth axis up; none in two-stage roughing's bottom program)."""
 
     tool: Tool
     levels: RoughingLevels
     lowest_level_above_root_mm: float
     toolpath: Toolpath
     estimate: Estimate
+    tip_heights_mm: np.ndarray = field(default_factory=lambda: np.zeros(0))  # passes over each tip land
 
 
 @dataclass(frozen=True)
@@ -141,7 +144,8 @@ def check_cam_inputs(inputs: CamInputs) -> tuple[ToolRecommendations, RoughingLe
                            "strategy = \"generating\"",
                            field="strategy", section="finishing")
     blank = stock.blank_radius_mm(spec)
-    check_blank_allowance(spec, stock, inputs.finishing_tool)
+    check_blank_allowance(spec, stock, inputs.finishing_tool,
+                          inputs.roughing if inputs.roughing_tool is not None else None)
     rec = recommend_tools(spec, blank, machine.clearance_mm, inputs.finishing_tool,
                           inputs.finishing.target_scallop_mm)
     if inputs.bottom_tool is not None:
@@ -262,14 +266,23 @@ LAND_PASS_DEPTH_FRACTION = 0.5
 full-width slot, and 0.5 D is the catalogue's slotting depth (the default roughing level depth too)."""
 
 
-def check_blank_allowance(spec: GearSpec, stock: StockSpec, finishing_tool: Tool | None) -> None:
-    """The blank above the tip circle is left by roughing (it cuts the spaces only) and taken off the tips by
-    the finishing tool in one pass (land passes, the perimeter's tip sweep): refuse more than that tool's
-    slotting depth (LAND_PASS_DEPTH_FRACTION x its diameter)."""
+def check_blank_allowance(spec: GearSpec, stock: StockSpec, finishing_tool: Tool | None,
+                          roughing: RoughingParams | None = None) -> None:
+    """What stands above the tip circle when finishing starts is taken off the tips by the finishing tool in one
+    pass (land passes, the perimeter's tip sweep): refuse more than that tool's slotting depth
+    (LAND_PASS_DEPTH_FRACTION x its diameter). Without a roughing tool that is the blank's allowance; with one
+    (`roughing`, its [roughing] section), roughing's tip passes leave at most [roughing] finish_stock_mm."""
     if finishing_tool is None:
         return
     allowance = stock.blank_radius_mm(spec) - spec.tip_radius_mm
     limit = LAND_PASS_DEPTH_FRACTION * finishing_tool.diameter_mm
+    if roughing is not None:
+        if min(allowance, roughing.finish_stock_mm) > limit + 1e-9:
+            raise MachineError(f"[roughing] finish_stock_mm = {roughing.finish_stock_mm:g}: roughing leaves that much "
+                               f"on the tip lands, more than the finishing tool takes off them in one pass "
+                               f"({limit:.3f} mm: {LAND_PASS_DEPTH_FRACTION:g} x D {finishing_tool.diameter_mm:g} "
+                               "mm, a slot's depth)", field="finish_stock_mm", section="roughing")
+        return
     if allowance > limit + 1e-9:
         name = "blank_diameter_mm" if stock.blank_diameter_mm > 0.0 else "radial_allowance_mm"
         raise StockError(f"{name}: the blank stands {allowance:.3f} mm above the tip circle, more than the finishing "
@@ -330,7 +343,7 @@ def _plan_two_stage(inputs: CamInputs, levels: RoughingLevels,
     alone = _plan_roughing(inputs, bottom_levels, blank, bottom)
     _, j, below = _two_stage_split(inputs, levels, blank, bottom_levels, alone)
     upper = _plan_roughing(inputs, _levels_where(levels, np.arange(len(levels.heights_mm)) <= j), blank)
-    lower = _plan_roughing(inputs, _levels_where(bottom_levels, below), blank, bottom)
+    lower = _plan_roughing(inputs, _levels_where(bottom_levels, below), blank, bottom, tips=False)
     chosen = "set" if inputs.roughing.bottom_tool_above_root_mm > 0.0 else "shortest time"
     return upper, lower, TwoStage(float(levels.heights_mm[j] - spec.root_radius_mm), chosen,
                                   upper.estimate.time_s + lower.estimate.time_s, alone.estimate.time_s)
@@ -421,14 +434,17 @@ def _level_seconds(path: Toolpath, machine: Machine, levels: int) -> np.ndarray:
     return np.bincount(path.station[on_level], weights=seconds[on_level], minlength=levels)
 
 
-def _plan_roughing(inputs: CamInputs, levels: RoughingLevels, blank: float, tool: Tool | None = None) -> RoughingPlan:
+def _plan_roughing(inputs: CamInputs, levels: RoughingLevels, blank: float, tool: Tool | None = None,
+                   tips: bool = True) -> RoughingPlan:
+    """One roughing program: the spaces' levels, and the tip lands' passes when `tips`."""
     spec, stock = inputs.spec, inputs.stock
     tool = tool or inputs.roughing_tool
     lowest_above_root = levels.lowest_height_mm - spec.root_radius_mm
     path = roughing_toolpath(spec, tool, inputs.machine, inputs.roughing, blank, stock.back_margin_mm,
-                             stock.stub_diameter_mm / 2.0, stock.front_margin_mm, levels=levels)
+                             stock.stub_diameter_mm / 2.0, stock.front_margin_mm, levels=levels, tips=tips)
     check_travel(inputs.machine, path.x, path.y, path.z, path.a, "roughing")
-    return RoughingPlan(tool, levels, lowest_above_root, path, estimate(path, inputs.machine))
+    heights = tip_heights_mm(spec, tool, inputs.roughing, blank) if tips else np.zeros(0)
+    return RoughingPlan(tool, levels, lowest_above_root, path, estimate(path, inputs.machine), heights)
 
 
 def check_finishing_work(spec: GearSpec, tool: Tool, machine: Machine, section: FinishingParams,

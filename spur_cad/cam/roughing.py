@@ -68,13 +68,17 @@ def estimated_roughing_moves(spec: GearSpec, tool: Tool, params: RoughingParams,
 
     Levels: the depth limit alone needs (blank - root) / max depth of them; the flank staircase
     budget adds at most (half a pitch, more than the flank's horizontal extent) / budget. Passes per
-    level: the widest level is narrower than a pitch."""
+    level: the widest level is narrower than a pitch. The tip lands: at most as many cuts as the depth limit
+    needs, each at most 2 r_blank tan(pi / z) wide (tip_half_width_mm)."""
     max_depth = params.max_level_depth_fraction * tool.diameter_mm
     budget = params.flank_allowance_mm - params.finish_stock_mm
     depth_levels = math.ceil((blank_radius_mm - spec.root_radius_mm) / max_depth)
     flank_levels = math.ceil(spec.pitch_mm / 2.0 / budget)
     passes = math.ceil(spec.pitch_mm / (params.step_over_fraction * tool.diameter_mm)) + 1
-    moves = spec.teeth * ((depth_levels + flank_levels + 2) * (2 * passes + 4) + 4)
+    tip_passes = math.ceil(2.0 * blank_radius_mm * math.tan(math.pi / spec.teeth)
+                           / (params.step_over_fraction * tool.diameter_mm)) + 1
+    moves = spec.teeth * ((depth_levels + flank_levels + 2) * (2 * passes + 4) + 4
+                          + depth_levels * (2 * tip_passes + 4) + 6)
     driver = max((depth_levels, "max_level_depth_fraction"), (flank_levels, "flank_allowance_mm"),
                  (passes, "step_over_fraction"))[1]
     return moves, driver
@@ -203,8 +207,11 @@ def check_helical_roughing_machine(spec: GearSpec, machine: Machine) -> None:
 
 def roughing_toolpath(spec: GearSpec, tool: Tool, machine: Machine, params: RoughingParams,
                       blank_radius_mm: float, back_margin_mm: float = 0.0, stub_radius_mm: float = 0.0,
-                      front_margin_mm: float = 0.0, levels: RoughingLevels | None = None) -> Toolpath:
-    """The roughing operation as IR (pure function); `levels` when the caller has computed them already."""
+                      front_margin_mm: float = 0.0, levels: RoughingLevels | None = None,
+                      tips: bool = True) -> Toolpath:
+    """The roughing operation as IR (pure function); `levels` when the caller has computed them already. `tips`:
+    after each space, the passes over the tip land beside it (tip_heights_mm; two-stage roughing's bottom tool
+    leaves them to the larger tool)."""
     params.validate()
     machine.validate()
     tool.validate("roughing")
@@ -224,7 +231,11 @@ def roughing_toolpath(spec: GearSpec, tool: Tool, machine: Machine, params: Roug
     feed = tool.feed_mm_min(machine)
     step = params.step_over_fraction * tool.diameter_mm
     pitch_deg = 360.0 / spec.teeth
+    space_offsets = [_pass_offsets(max(half_width - sweep_radius, 0.0), step) for half_width in levels.half_widths_mm]
+    tip_heights = tip_heights_mm(spec, tool, params, blank_radius_mm) if tips else np.zeros(0)
+    tip_offsets = _pass_offsets(tip_half_width_mm(spec, tool, params, levels, blank_radius_mm) - radius, step)
     builder = ToolpathBuilder(Operation.ROUGHING, tool.tool_number, tool.spindle_rpm(machine))
+    passes = _Passes(builder, x_front, x_back, safe_z, feed)
     for k in range(spec.teeth):
         a = -k * pitch_deg
         if params.clamp_rotary and k > 0:
@@ -232,29 +243,89 @@ def roughing_toolpath(spec: GearSpec, tool: Tool, machine: Machine, params: Roug
         builder.move(MoveKind.RAPID, x_front, 0.0, safe_z, a, space=k)
         if params.clamp_rotary:
             builder.move(MoveKind.CLAMP_ROTARY, x_front, 0.0, safe_z, a, space=k)
-        x_here = x_front
-        for index, (height, half_width) in enumerate(zip(levels.heights_mm, levels.half_widths_mm)):
-            reach = max(half_width - sweep_radius, 0.0)
-            n = max(1, math.ceil(2.0 * reach / step - 1e-9)) if reach > 0.0 else 0
-            offsets = np.linspace(-reach, reach, n + 1) if n else np.array([0.0])
-            if x_here != x_front:  # come back to the front, above the cleared level, before going down
-                builder.move(MoveKind.LINEAR, x_here, builder.last_pose()[1], safe_z, a, feed, space=k, station=index)
-                builder.move(MoveKind.RAPID, x_front, offsets[0], safe_z, a, space=k, station=index)
-                x_here = x_front
-            builder.move(MoveKind.LINEAR, x_front, offsets[0], height, a, PLUNGE_FEED_FRACTION * feed, space=k,
-                         station=index)
-            for j, y in enumerate(offsets):
-                if j > 0:
-                    builder.move(MoveKind.LINEAR, x_here, y, height, a, feed, space=k, station=index,
-                                 feature=Feature.LEVEL)
-                x_here = x_back if x_here == x_front else x_front
-                builder.move(MoveKind.LINEAR, x_here, y, height, a, feed, space=k, station=index,
-                             feature=Feature.LEVEL)
-        builder.move(MoveKind.LINEAR, x_here, builder.last_pose()[1], safe_z, a, feed, space=k)
+        passes.levels(a, k, levels.heights_mm, space_offsets, range(len(space_offsets)), Feature.LEVEL)
+        if len(tip_heights):  # the tip land of the tooth between spaces k and k + 1, its axis up
+            a_tip = a - pitch_deg / 2.0
+            if params.clamp_rotary:
+                builder.move(MoveKind.UNCLAMP_ROTARY, *builder.last_pose(), space=k)
+            builder.move(MoveKind.RAPID, x_front, tip_offsets[0], safe_z, a_tip, space=k)
+            if params.clamp_rotary:
+                builder.move(MoveKind.CLAMP_ROTARY, x_front, tip_offsets[0], safe_z, a_tip, space=k)
+            passes.levels(a_tip, k, tip_heights, [tip_offsets] * len(tip_heights), [-1] * len(tip_heights),
+                          Feature.TIP)
     path = builder.build()
     if spec.is_helical:
         path = follow_lead(path, spec, machine)
     return path
+
+
+@dataclass
+class _Passes:
+    """Writes zig-zag passes along X at given heights for one A (a space's levels, a tip land's passes)."""
+
+    builder: ToolpathBuilder
+    x_front: float
+    x_back: float
+    safe_z: float
+    feed: float
+
+    def levels(self, a: float, space: int, heights, offsets, stations, feature: Feature) -> None:
+        """From the front at each height (back to the front above the cleared level before going down), Y steps
+        beside the part; then up to the safe height."""
+        builder, x_front, safe_z, feed = self.builder, self.x_front, self.safe_z, self.feed
+        x_here = x_front
+        for height, ys, station in zip(heights, offsets, stations):
+            if x_here != x_front:  # come back to the front, above the cleared level, before going down
+                builder.move(MoveKind.LINEAR, x_here, builder.last_pose()[1], safe_z, a, feed, space=space,
+                             station=station)
+                builder.move(MoveKind.RAPID, x_front, ys[0], safe_z, a, space=space, station=station)
+                x_here = x_front
+            builder.move(MoveKind.LINEAR, x_front, ys[0], height, a, PLUNGE_FEED_FRACTION * feed, space=space,
+                         station=station)
+            for j, y in enumerate(ys):
+                if j > 0:
+                    builder.move(MoveKind.LINEAR, x_here, y, height, a, feed, space=space, station=station,
+                                 feature=feature)
+                x_here = self.x_back if x_here == x_front else x_front
+                builder.move(MoveKind.LINEAR, x_here, y, height, a, feed, space=space, station=station,
+                             feature=feature)
+        builder.move(MoveKind.LINEAR, x_here, builder.last_pose()[1], safe_z, a, feed, space=space)
+
+
+def _pass_offsets(reach_mm: float, step_mm: float) -> np.ndarray:
+    """Y of the passes of one level: -reach..reach at most `step_mm` apart (one pass at 0 without reach)."""
+    if reach_mm <= 0.0:
+        return np.array([0.0])
+    n = max(1, math.ceil(2.0 * reach_mm / step_mm - 1e-9))
+    return np.linspace(-reach_mm, reach_mm, n + 1)
+
+
+def tip_heights_mm(spec: GearSpec, tool: Tool, params: RoughingParams, blank_radius_mm: float) -> np.ndarray:
+    """Heights of the passes over a tip land (tool tip Z with the tooth's axis up), top to bottom: the blank
+    taken down to the tip radius + finish stock in equal cuts of at most the level depth limit; none when the
+    blank stands no higher. A flat tool bottom at Z >= r_a + stock is farther than that from the axis at every
+    Y (and in every section a helical pass turns through): it cannot come nearer the design."""
+    floor = spec.tip_radius_mm + params.finish_stock_mm
+    depth = blank_radius_mm - floor
+    if depth <= 1e-9:
+        return np.zeros(0)
+    cuts = math.ceil(depth / (params.max_level_depth_fraction * tool.diameter_mm) - 1e-9)
+    return blank_radius_mm - depth * np.arange(1, cuts + 1) / cuts
+
+
+def tip_half_width_mm(spec: GearSpec, tool: Tool, params: RoughingParams, levels: RoughingLevels,
+                      blank_radius_mm: float) -> float:
+    """Half-width the tip passes clear (the tooth's axis up): out to the side of the column the space's highest
+    level at or below the offset flank's tip edge cleared (its passes' reach + D / 2, the space's axis up; above
+    it, the staircase of the levels higher up may stand above the tip circle beside the tooth's corner). That
+    side, turned by half a pitch, is farthest from the tooth's axis at the blank's radius."""
+    tip_edge = offset_flank(spec, params.finish_stock_mm)[0][-1, 1]
+    below = np.flatnonzero(levels.heights_mm <= tip_edge + 1e-9)
+    level = int(below[0]) if len(below) else len(levels.heights_mm) - 1
+    reach = max(float(levels.half_widths_mm[level]) - transverse_radius_mm(spec, tool, blank_radius_mm), 0.0)
+    cleared = reach + tool.diameter_mm / 2.0
+    half_pitch = math.pi / spec.teeth
+    return max((blank_radius_mm * math.sin(half_pitch) - cleared) / math.cos(half_pitch), 0.0)
 
 
 def follow_lead(path: Toolpath, spec: GearSpec, machine: Machine) -> Toolpath:

@@ -73,8 +73,10 @@ def program_notes(result: JobResult) -> tuple[str, ...]:
     rough, finish = result.roughing, result.finishing
     notes = []
     if rough is not None:
+        tips = (f"; {len(rough.tip_heights_mm)} over each tip land, down to "
+                f"{number(rough.tip_heights_mm[-1], 3)} mm from the axis" if rough.tip_heights_mm else "")
         notes.append(f"Roughing: {rough.levels_per_space} levels per space, the lowest "
-                     f"{number(rough.lowest_level_height_mm, 3)} mm above the root circle.")
+                     f"{number(rough.lowest_level_height_mm, 3)} mm above the root circle{tips}.")
         stage = rough.two_stage
         if stage is not None:
             notes.append(f"Two-stage roughing: the bottom tool (T{stage.bottom_tool.tool_number}, D "
