@@ -4,8 +4,11 @@ designed gear. Nothing here uses the generators' geometry."""
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 import pytest
+import shapely
 from shapely.geometry import Polygon
 
 from spur_cad.cam.finishing import finishing_toolpath
@@ -82,6 +85,48 @@ def test_roughing_respects_finish_stock_and_flank_allowance(name, design_polygon
     # What stays below the lowest pass is within what the finishing tool's bottom can take when it
     # plunges: A_p = half its flat width (the method's catalogue rule).
     assert lowest - spec.root_radius_mm <= 0.5 * finishing.flat_width_mm + 1e-9
+
+
+def _left_above_tip_mm(spec, path, tool, blank: float) -> float:
+    """How far the blank roughing leaves over the tooth between spaces 0 and 1 stands above the tip circle:
+    a polar grid (0.005 mm radially) from the tip circle to the blank over that tooth's whole pitch, against
+    the tool silhouettes of spaces 0 and 1 (space 0's moves include that tooth's tip passes)."""
+    rows = path.motion_mask & np.isin(path.space, [0, 1])
+    union = shapely.union_all(silhouette.silhouettes_in_part_frame(path, tool.diameter_mm, 0.0, TOOL_LENGTH,
+                                                                   mask=rows))
+    half_pitch = math.pi / spec.teeth
+    axis = silhouette.to_part_frame(0.0, 1.0, -math.degrees(half_pitch))  # the tooth is up at A = -half a pitch
+    centre = math.atan2(axis[0], axis[1])
+    radius, angle = np.meshgrid(np.linspace(spec.tip_radius_mm, blank, 101),
+                                centre + np.linspace(-half_pitch, half_pitch, 801))
+    left = ~shapely.contains_xy(union, (radius * np.sin(angle)).ravel(), (radius * np.cos(angle)).ravel())
+    return float((radius.ravel()[left] - spec.tip_radius_mm).max(initial=0.0))
+
+
+@pytest.mark.parametrize("name", CAM_GEARS)
+def test_roughing_takes_the_blank_down_to_the_tip_circle_plus_the_finish_stock(name, design_polygons):
+    """The tip passes never come nearer the design than the finish stock, and leave over the tooth at most the
+    finish stock plus the height of the flat tool bottom over the circle at its passes' edge, within what the
+    finishing tool takes off the tips in one pass (a slot: half its diameter)."""
+    spec = spec_of(name)
+    tool, finishing = tools_for(name)
+    params = RoughingParams(flank_allowance_mm=0.1 * spec.module_mm, finish_stock_mm=0.005 * spec.module_mm)
+    blank = spec.tip_radius_mm + 0.5
+    path = roughing_toolpath(spec, tool, Machine(), params, blank)
+    tips = path.motion_mask & (path.feature == Feature.TIP)
+    assert np.count_nonzero(tips & (path.space == 0)) >= 1  # at least one pass along X over the land
+    floor = spec.tip_radius_mm + params.finish_stock_mm
+    assert path.z[tips].min() == pytest.approx(floor)
+    sils = silhouette.silhouettes_in_part_frame(path, tool.diameter_mm, 0.0, TOOL_LENGTH, mask=tips)
+    grown = design_polygons[name].buffer(params.finish_stock_mm - 1e-6, quad_segs=256)
+    assert silhouette.max_penetration_mm(grown, sils) <= HALF_MICRON
+    edge = np.abs(path.y[tips]).max() + tool.diameter_mm / 2.0
+    left = _left_above_tip_mm(spec, path, tool, blank)
+    assert left <= math.hypot(edge, floor) - spec.tip_radius_mm + 0.005
+    assert left <= 0.5 * finishing.diameter_mm
+    # without the tip passes the whole allowance stands there
+    without = roughing_toolpath(spec, tool, Machine(), params, blank, tips=False)
+    assert _left_above_tip_mm(spec, without, tool, blank) == pytest.approx(0.5)
 
 
 @pytest.mark.parametrize("name", CAM_GEARS)
