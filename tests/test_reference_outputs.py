@@ -1,6 +1,11 @@
 """The reference job's G-code (every dialect, folded and flat) and profile.csv are byte-identical
 to the files generated before the architecture rework (tests/data/make_reference_outputs.py says
-how they were made). A refactoring that changes one byte of a program fails here."""
+how they were made). A refactoring that changes one byte of a program fails here.
+
+The roughing programs were stored again for issue 29 (roughing's passes over the tip lands): each differs from
+the earlier one only by the inserted tip-pass blocks (four per tooth: index A half a pitch on, down to the tip
+circle + finish stock, one pass along X, up) and the header's estimated time, checked line by line before
+they were written."""
 
 from __future__ import annotations
 

@@ -3,7 +3,11 @@ recorded before the typed result (tests/data/golden/, made by `spur-cad run` of 
 and in the same order; only the run's own timings may differ, and two figures changed on purpose since
 (KEY_REL_TOL, and gear.step / stock.step's sizes: their PRODUCT is named after the part since issue 27,
 where OCCT named it 'Open CASCADE STEP translator 7.9 <n>', n counting the shapes the process wrote before,
-so that a long test run or a second Export wrote other sizes).
+so that a long test run or a second Export wrote other sizes), and roughing since issue 29: its passes over the
+tip lands (roughing.tip_pass_heights_mm, one cut to the tip circle + finish stock per tooth in both examples)
+add 4 moves per tooth to the reference gear's roughing, 6 (two passes) to the helical one's, with their
+lengths and times, the roughing programs' lines and the simulation's move counts; the finishing programs and
+the simulated deviations are unchanged (the helical removed volume grew by 0.003 mm^3, in the margins).
 
 Their STEP files and programs are byte-identical to that run's (SHA-256 below), but for the header's time
 (set to a fixed value before hashing; SOURCE_DATE_EPOCH sets it, tested below) and, in job.step, the order
@@ -40,14 +44,14 @@ FILE_SHA256 = {
         "job.step": "64724ed5fc3cb76ccdec76bd6326985294039c3aa149ffb77eed498aafde1e47",
         "stock.step": "f29f32d10d575d3b033b99c2db42bd461c52ee614dec62272ebd18331587afa7",
         "finishing.ngc": "a412b900207c83c6e9216c7c7a664fad482160b5308cab6ab3d60fdf66c260df",
-        "roughing.ngc": "79d62a50184a1a1549274e6aeedd197fc4fdc22ecfb598cef592c47784e62bf0",
+        "roughing.ngc": "625d276286fc273e08a83d1c59e3593706393e6d5534705d9f4861a010dec965",
     },
     "helical_gear": {
         "gear.step": "55151216afe658ced2126a3425feae957ce86633099a47124e9eabc72b2905ee",
         "job.step": "7e19aab6bbd41f68a02af8fb4b706e9f5326b57ddb045532a8e3c6b36c9c7ebc",
         "stock.step": "36aa673a6487d20e588c6234896e20f6242d28191541c96d2476681b318784a0",
         "finishing.ngc": "8b25588cef4d2c29ac1a8bfaeadbf5e899d7510c72619d3f0e06036ee1cbcb4e",
-        "roughing.ngc": "fb327f77c54e481ea34e95c05220de66074d188506956f5893a00fa85219e889",
+        "roughing.ngc": "a27f50864f54af602813579914266c40e79c38978d37a3aa45b4d6929c62ea4a",
     },
 }
 
