@@ -245,10 +245,15 @@ def test_a_legacy_program_verifies_as_the_original_and_the_wrong_rotary_directio
     assert abs(result["max_gouge_mm"] - original["max_gouge_mm"]) <= 0.001
     assert abs(result["max_leftover_mm"] - original["max_leftover_mm"]) <= 0.001
     assert [s["max_gouge_mm"] <= RESOLUTION for s in result["spaces"]] == [True] * 12
-    _, at_tip = _verify(tmp_path / "tip", _job_text("perimeter"),
-                        {"roughing.min": roughing, "finishing.min": legacy.encode()}, "--dialect", "okuma")
-    flank = [s["max_leftover_mm"] for s in at_tip["spaces"]]
-    assert min(flank) >= corner - RESOLUTION  # read at the tip, the tool is r_t too high everywhere
+    code, at_tip = _verify(tmp_path / "tip", _job_text("perimeter"),
+                           {"roughing.min": roughing, "finishing.min": legacy.encode()}, "--dialect", "okuma")
+    _, roughed = _verify(tmp_path / "roughed", _job_text("perimeter"), {"roughing.min": roughing}, "--dialect",
+                         "okuma")
+    # read at the tip, the tool is r_t too high everywhere: every space keeps the worst of what roughing left
+    # (its lowest level's leftover above the root, far beyond the tolerance)
+    assert code == 1 and min(s["max_leftover_mm"] for s in roughed["spaces"]) > 2 * at_tip["leftover_tolerance_mm"]
+    assert [s["max_leftover_mm"] for s in at_tip["spaces"]] == pytest.approx(
+        [s["max_leftover_mm"] for s in roughed["spaces"]], abs=RESOLUTION)
     swapped = _legacy_program(path, corner, swap_direction=True)
     code, result = _verify(tmp_path / "swap", _job_text("perimeter"),
                            {"roughing.min": roughing, "finishing.min": swapped.encode()},
