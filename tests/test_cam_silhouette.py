@@ -14,7 +14,7 @@ from shapely.geometry import Polygon
 from spur_cad.cam.finishing import finishing_toolpath
 from spur_cad.cam.ir import Feature, MoveKind
 from spur_cad.cam.machine import Machine, RoughingParams
-from spur_cad.cam.roughing import roughing_toolpath
+from spur_cad.cam.roughing import estimated_roughing_moves, roughing_toolpath
 from spur_cad.cam.strategies import FinishingParams
 from spur_cad.geometry import gear_outline
 from tests import silhouette
@@ -127,6 +127,10 @@ def test_roughing_takes_the_blank_down_to_the_tip_circle_plus_the_finish_stock(n
     # without the tip passes the whole allowance stands there
     without = roughing_toolpath(spec, tool, Machine(), params, blank, tips=False)
     assert _left_above_tip_mm(spec, without, tool, blank) == pytest.approx(0.5)
+    # the work limit's estimate still bounds the moves, with several cuts over the tips on a large blank
+    for radius in (blank, blank + 3.0):
+        moves = len(roughing_toolpath(spec, tool, Machine(), params, radius))
+        assert estimated_roughing_moves(spec, tool, params, radius)[0] >= moves
 
 
 @pytest.mark.parametrize("name", CAM_GEARS)
