@@ -31,6 +31,7 @@ if TYPE_CHECKING:
     from spur_cad.cam.restart import RestartPoint
     from spur_cad.grade.grading import Grading
     from spur_cad.post.program import PostedProgram
+    from spur_cad.sim.engagement import Engagement
     from spur_cad.sim.simulate import SimResult, StockCylinder
 
 
@@ -260,5 +261,19 @@ def simulate_stage(job: Job, plan: CamPlan, progress: Callable[[float], None] | 
     if not job.simulation.enabled or not operations:
         return None
     stations = plan.finishing.result.station_x_mm if plan.finishing is not None else np.zeros(0)
-    return simulate(job.gear, job_stock(job), operations, SimSettings(resolution_mm=job.simulation.resolution_mm),
-                    station_x=stations, progress=progress)
+    result = simulate(job.gear, job_stock(job), operations, SimSettings(resolution_mm=job.simulation.resolution_mm),
+                      station_x=stations, progress=progress)
+    return dataclasses.replace(result, engagement=roughing_engagement(job, plan))
+
+
+def roughing_engagement(job: Job, plan: CamPlan) -> Engagement | None:
+    """a_e, a_p and removal rate of every roughing move, on the material it meets (spur_cad.sim.engagement)."""
+    from spur_cad.sim.engagement import MeasuredCut, measure_engagement
+
+    cuts = [MeasuredCut(name, planned.toolpath, planned.tool) for name, planned in
+            (("roughing", plan.roughing), ("roughing_bottom", plan.roughing_bottom)) if planned is not None]
+    if not cuts:
+        return None
+    stock = job_stock(job)
+    return measure_engagement(job.gear.teeth, stock.radius_mm, (stock.x_min, stock.x_max), cuts,
+                              job.gear.section_turn_rad(1.0))

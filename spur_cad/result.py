@@ -132,6 +132,11 @@ class RoughingFacts:
     estimate: Estimate
     two_stage: TwoStageFacts | None = None
     tip_heights_mm: tuple[float, ...] = ()  # passes over each tip land (tooth axis up), top to bottom
+    # Measured on the simulated stock over every roughing move (both operations of two-stage roughing); None
+    # without a simulation (spur_cad.sim.engagement).
+    max_radial_engagement_fraction: float | None = None  # a_e / D
+    max_axial_depth_mm: float | None = None  # a_p
+    mean_removal_rate_mm3_min: float | None = None  # removed volume / time of the moves removing it
 
 
 @dataclass(frozen=True)

@@ -11,7 +11,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from spur_cad.cam.estimate import Estimate
-from spur_cad.cam.machine import Machine
+from spur_cad.cam.machine import Machine, RoughingParams
 from spur_cad.cam.plan import CamPlan, FinishingPlan, RoughingPlan
 from spur_cad.cam.recommend import ToolRecommendations
 from spur_cad.cam.tools import Tool
@@ -63,8 +63,8 @@ def build_result(job, samples: ProfileSamples, cad: CadResult, plan: CamPlan, po
         inspection=inspection_facts(job.gear),
         profile=ProfileFacts(job.job.profile_tolerance_mm, len(samples), counts), cad=cad,
         tools=tools_facts(plan, job.machine, job.tools.roughing, job.tools.finishing),
-        roughing=roughing_facts(plan, job.machine), finishing=finishing_facts(plan.finishing),
-        warnings=tuple(plan.warnings),
+        roughing=roughing_facts(plan, job.machine, simulation), finishing=finishing_facts(plan.finishing),
+        warnings=tuple(plan.warnings) + engagement_warnings(simulation, job.roughing),
         post=PostFacts(post.dialect, post.folded, tuple(ProgramFacts(name, p.lines, p.bytes, p.subprograms)
                                                         for name, p in programs.items())),
         simulation=simulation_facts(simulation, job.simulation.resolution_mm), grading=grading,
@@ -119,11 +119,28 @@ def _roughing(roughing: RoughingPlan) -> RoughingFacts:
                          tip_heights_mm=tuple(float(h) for h in roughing.tip_heights_mm))
 
 
-def roughing_facts(plan: CamPlan, machine: Machine) -> RoughingFacts | None:
-    """The roughing operation, with two-stage roughing's bottom operation."""
+def engagement_warnings(simulation: SimResult | None, params: RoughingParams) -> tuple[str, ...]:
+    """Roughing moves the simulated stock shows beyond the job's depth or step-over limits."""
+    if simulation is None or simulation.engagement is None:
+        return ()
+    from spur_cad.sim.engagement import EngagementLimits
+    from spur_cad.sim.engagement import engagement_warnings as warnings
+
+    limits = EngagementLimits(params.max_level_depth_fraction, params.step_over_fraction)
+    return tuple(warnings(simulation.engagement, limits))
+
+
+def roughing_facts(plan: CamPlan, machine: Machine, simulation: SimResult | None = None) -> RoughingFacts | None:
+    """The roughing operation, with two-stage roughing's bottom operation and the engagement measured on the
+    simulated stock."""
     if plan.roughing is None:
         return None
     facts = _roughing(plan.roughing)
+    engagement = simulation.engagement if simulation is not None else None
+    if engagement is not None:
+        facts = dataclasses.replace(facts, max_radial_engagement_fraction=engagement.max_radial_fraction,
+                                    max_axial_depth_mm=engagement.max_axial_depth_mm,
+                                    mean_removal_rate_mm3_min=engagement.mean_removal_rate_mm3_min)
     if plan.roughing_bottom is None:
         return facts
     stage, bottom = plan.two_stage, plan.roughing_bottom
@@ -237,17 +254,22 @@ def estimate_json(est: Estimate) -> dict:
             "estimated_time_s": est.time_s, "estimated_time_with_acceleration_s": est.time_with_acceleration_s}
 
 
-def roughing_json(roughing: RoughingFacts) -> dict:
+def roughing_json(roughing: RoughingFacts, measured: bool = True) -> dict:
+    """The operation's facts; `measured`: with the engagement keys (of both operations, on the first only)."""
     facts = {"levels_per_space": roughing.levels_per_space,
              "lowest_level_height_mm": roughing.lowest_level_height_mm,
              "level_heights_mm": list(roughing.level_heights_mm),
              "tip_pass_heights_mm": list(roughing.tip_heights_mm), **estimate_json(roughing.estimate)}
+    if measured:
+        facts.update(max_radial_engagement_fraction=roughing.max_radial_engagement_fraction,
+                     max_axial_depth_mm=roughing.max_axial_depth_mm,
+                     mean_removal_rate_mm3_min=roughing.mean_removal_rate_mm3_min)
     stage = roughing.two_stage
     if stage is not None:
         facts["two_stage"] = {
             "bottom_tool": tool_json(stage.bottom_tool, with_number=True),
             "split_height_above_root_mm": stage.split_height_above_root_mm, "split_chosen_by": stage.split_chosen_by,
-            "bottom": roughing_json(stage.bottom), "two_stage_time_s": stage.two_stage_time_s,
+            "bottom": roughing_json(stage.bottom, measured=False), "two_stage_time_s": stage.two_stage_time_s,
             "bottom_tool_alone_time_s": stage.bottom_tool_alone_time_s, "time_saved_s": stage.time_saved_s}
     return facts
 

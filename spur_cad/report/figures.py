@@ -1,5 +1,5 @@
 """The job report's figures (PNG bytes, matplotlib object API): roughing levels, finishing contacts and
-cutter locations, the simulated deviation map."""
+cutter locations, the simulated deviation map, the roughing engagement."""
 
 from __future__ import annotations
 
@@ -15,6 +15,7 @@ from spur_cad.report.plots import _png, figure, figure_for_extent
 if TYPE_CHECKING:
     from spur_cad.cam.tools import Tool
     from spur_cad.grade.grading import Grading
+    from spur_cad.sim.engagement import Engagement
     from spur_cad.sim.simulate import SimResult
 
 
@@ -234,4 +235,31 @@ def passes_png(spec: GearSpec, tool: Tool, passes: tuple, blank_radius_mm: float
                  f"and root, {counts['land']} land), {tool.kind} D {tool.diameter_mm:g} mm r {r_t:g} mm", fontsize=9)
     ax.legend(fontsize=8, loc="best")
     ax.grid(True, lw=0.3)
+    return _png(fig)
+
+
+def engagement_png(engagement: Engagement, step_over_fraction: float, max_depth_fraction: float) -> bytes:
+    """Histograms of the roughing moves that removed material: radial engagement a_e / D and axial depth
+    a_p / D, per operation, with the job's step-over and slotting depth limits."""
+    fig = figure(7.5, 2.6, left=0.08, right=0.98, bottom=0.19, top=0.86)
+    cutting = engagement.cutting
+    names = list(dict.fromkeys(np.array(engagement.operation)[cutting]))
+    operation = np.array(engagement.operation)
+    values = (engagement.radial_fraction, engagement.axial_depth_mm / engagement.diameter_mm)
+    for col, (value, limit, label) in enumerate(zip(values, (step_over_fraction, max_depth_fraction),
+                                                    ("radial engagement a_e / D", "axial depth a_p / D"))):
+        ax = fig.add_subplot(1, 2, col + 1)
+        top = max(1.0, float(value[cutting].max(initial=0.0)), limit) * 1.05
+        bins = np.linspace(0.0, top, 43)
+        ax.hist([value[cutting & (operation == name)] for name in names], bins=bins, stacked=True,
+                label=names, color=["tab:blue", "tab:orange"][:len(names)])
+        ax.axvline(limit, color="tab:red", lw=1.0, ls="--", label="limit")
+        ax.set_xlabel(label, fontsize=8)
+        ax.set_ylabel("moves", fontsize=8)
+        ax.tick_params(labelsize=7)
+        ax.grid(True, lw=0.3)
+        if col == 0:
+            ax.legend(fontsize=7, loc="upper center")
+    n = int(cutting.sum())
+    fig.suptitle(f"roughing engagement measured on the simulated stock ({n} moves removing material)", fontsize=9)
     return _png(fig)

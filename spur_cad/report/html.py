@@ -125,7 +125,7 @@ def report_context(result: JobResult, images: dict[str, bytes]) -> dict:
         "overall_class": (grading.overall_class or "beyond 11") if grading is not None else "",
         "grading_validity": "; ".join(grading.validity) if grading is not None and grading.validity else "",
         "images": {name: _image_uri(images.get(name)) for name in ("profile", "roughing", "finishing", "deviation",
-                                                                  "kchart")},
+                                                                  "engagement", "kchart")},
     }
 
 

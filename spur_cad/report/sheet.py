@@ -328,7 +328,19 @@ def simulation_rows(result: JobResult) -> tuple[Row, ...]:
                 f"{number(1000 * sim.scallop_mean_mm, 1)} / {number(1000 * sim.scallop_p95_mm, 1)} / "
                 f"{number(1000 * sim.scallop_p99_mm, 1)}", MICRO),
             Row("removed volume", number(sim.removed_volume_mm3, 0), "mm³"),
-            Row("design points measured (all spaces and rows)", f"{sim.design_points:,}"))
+            Row("design points measured (all spaces and rows)", f"{sim.design_points:,}")) + engagement_rows(result)
+
+
+def engagement_rows(result: JobResult) -> tuple[Row, ...]:
+    """The roughing engagement measured on the simulated stock (none without roughing or simulation)."""
+    rough = result.roughing
+    if rough is None or rough.max_radial_engagement_fraction is None:
+        return ()
+    return (Row("roughing: largest radial engagement (width met / tool diameter)",
+                number(rough.max_radial_engagement_fraction, 2), "x D"),
+            Row("roughing: largest axial depth met", number(rough.max_axial_depth_mm, 3), "mm"),
+            Row("roughing: mean material removal rate (while removing)", number(rough.mean_removal_rate_mm3_min, 0),
+                "mm³/min"))
 
 
 def feature_table(result: JobResult) -> Table:

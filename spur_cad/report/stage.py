@@ -38,6 +38,14 @@ def report_html(result: JobResult, profile_png: bytes, spec: GearSpec, blank_rad
         images["finishing"] = finishing_png(spec, plan.finishing.tool, y, z, a)
     if sim is not None:
         images["deviation"] = deviation_map_png(sim)
+    rough = result.setup
+    if sim is not None and sim.engagement is not None and result.tools.roughing is not None \
+            and rough.roughing_step_down_mm is not None:
+        from spur_cad.report.figures import engagement_png
+
+        diameter = result.tools.roughing.diameter_mm
+        images["engagement"] = engagement_png(sim.engagement, rough.roughing_step_over_mm / diameter,
+                                              rough.roughing_step_down_mm / diameter)
     if result.grading is not None and result.grading.has_profile_traces:
         from spur_cad.report.figures import k_chart_png
 

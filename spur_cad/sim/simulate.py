@@ -20,7 +20,7 @@ import os
 import time
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
-from typing import Callable, Sequence
+from typing import TYPE_CHECKING, Callable, Sequence
 
 import numpy as np
 
@@ -29,6 +29,9 @@ from spur_cad.cam.tools import Tool
 from spur_cad.errors import SpurCadError
 from spur_cad.geometry.spec import GearSpec
 from spur_cad.sim.design import DesignGrid, design_grid
+
+if TYPE_CHECKING:  # numba loads with the kernels, when a simulation runs
+    from spur_cad.sim.engagement import Engagement
 
 CHUNK_POINTS = 4
 POSE_BATCH = 20000
@@ -103,6 +106,7 @@ class SimResult:
     x_sweeps: int
     moves: int
     station_x: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    engagement: Engagement | None = None  # roughing engagement, measured by the caller (spur_cad.sim.engagement)
 
     @property
     def gear_rows(self) -> np.ndarray:
