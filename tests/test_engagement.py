@@ -167,3 +167,19 @@ def test_the_reference_job_s_roughing_is_within_its_limits_and_a_deepened_pass_i
                               f"axial depth {expected:.3f} mm beyond the slotting depth limit 1.750 mm")
     named_spaces = {int(s) for s in re.findall(r"tooth space (\d+)", warning)}
     assert named_spaces == {5}
+
+
+def test_the_helical_example_s_roughing_slots_once_per_level_and_steps_over_within_its_limit():
+    """Passes following the lead: each level's first pass a slot (a_e = 1 D measured across the lead), the others
+    within the step-over; no warning."""
+    job = load_job(REFERENCE_JOB.with_name("helical_gear.toml"))
+    plan = plan_cam(job)
+    e = roughing_engagement(job, plan)
+    params = job.roughing
+    assert engagement_warnings(e, EngagementLimits(params.max_level_depth_fraction, params.step_over_fraction)) == []
+    slots = e.cutting & (e.radial_fraction > 0.99)
+    assert slots.sum() == job.gear.teeth * len(plan.roughing.levels.heights_mm)
+    assert e.max_radial_fraction <= 1.0
+    assert e.max_axial_depth_mm <= params.max_level_depth_fraction * plan.roughing.tool.diameter_mm
+    others = e.cutting & ~slots
+    assert np.all(e.radial_fraction[others] <= params.step_over_fraction + 1.5 * e.radial_step[others])

@@ -51,11 +51,41 @@ def test_report_embeds_every_image_and_refers_to_nothing_outside(outputs):
     html, _, _ = outputs
     assert html.startswith("<!DOCTYPE html>")
     sources = re.findall(r'<img[^>]*\ssrc="([^"]*)"', html)
-    assert len(sources) == 5  # profile, roughing levels, finishing passes, deviation map, K-chart
+    assert len(sources) == 6  # profile, roughing levels, finishing passes, deviation map, engagement, K-chart
     for src in sources:
         assert src.startswith("data:image/png;base64,")
         assert base64.b64decode(src.split(",", 1)[1], validate=True)[:8] == PNG
     assert not re.search(r"https?://|<script|<link|<iframe|url\(", html, re.IGNORECASE)
+
+
+def test_the_report_shows_the_measured_roughing_engagement_with_its_histogram(outputs):
+    """The summary's engagement figures on the sheet, and the histogram: bars (the roughing's colour) and a red
+    limit line in both panels (a_e / D, a_p / D). The figure goes to test-artifacts/ to be looked at."""
+    import io
+
+    import matplotlib.image
+    import numpy as np
+
+    html, summary, _ = outputs
+    text = " ".join(visible_text(html).split())
+    rough = summary["roughing"]
+    ae = rough["max_radial_engagement_fraction"]
+    assert f"largest radial engagement (width met / tool diameter) {ae:.2f} x D" in text
+    assert f"largest axial depth met {rough['max_axial_depth_mm']:.3f} mm" in text
+    assert f"mean material removal rate (while removing) {rough['mean_removal_rate_mm3_min']:.0f} mm³/min" in text
+    src = re.search(r'<img alt="Roughing moves by the radial engagement[^"]*" src="data:image/png;base64,([^"]*)"',
+                    html)
+    png = base64.b64decode(src.group(1))
+    artifacts = ROOT / "test-artifacts"
+    artifacts.mkdir(exist_ok=True)
+    (artifacts / "report_engagement.png").write_bytes(png)
+    rgb = (matplotlib.image.imread(io.BytesIO(png))[:, :, :3] * 255).round().astype(int)
+    half = rgb.shape[1] // 2
+    bars = np.all(rgb == np.array((0x1F, 0x77, 0xB4)), axis=-1)  # tab:blue
+    limit = (rgb[:, :, 0] > 150) & (rgb[:, :, 0] - rgb[:, :, 2] > 80)  # the dashed red line, antialiased
+    assert bars[:, :half].sum() > 20 and bars[:, half:].sum() > 20
+    for panel in (limit[:, :half], limit[:, half:]):  # a vertical dashed line: one column red over half its height
+        assert panel.sum(axis=0).max() > 0.3 * rgb.shape[0]
 
 
 def test_the_finishing_figure_has_no_empty_band_and_draws_every_tool_inside_it(outputs):

@@ -30,6 +30,7 @@ from spur_cad.cam.tools import Tool
 COLUMNS_PER_DIAMETER = 100
 ROWS_PER_DIAMETER = 5
 LEAD_SAMPLES = 9  # slices sampled across a helical sweep's tool width
+SKIM_FRACTION = 0.005  # a layer thinner than this x D is counted in the volume only, not in a_e or a_p
 _EPS_MM = 1e-9
 
 
@@ -101,14 +102,17 @@ def _bottom(d, half_flat, rt):
 
 
 @njit(cache=True, inline="always")
-def _lower(top, low, k, i, j, b, across, along, acc):
-    """Lower cell (k, i, j) to the tool's bottom b; record what it met in acc (see _stamp_all)."""
+def _lower(top, low, k, i, j, b, across, along, skim, acc):
+    """Lower cell (k, i, j) to the tool's bottom b; record what it met in acc (see _stamp_all): its volume,
+    and where it stood unless it was a skim (a layer thinner than `skim`)."""
     cut = max(b, low[j])
     t = top[k, i, j]
     if t <= cut + _EPS_MM:
         return
     top[k, i, j] = cut
     acc[0] += t - cut
+    if t - cut <= skim:
+        return
     acc[1] = min(acc[1], across)
     acc[2] = max(acc[2], across)
     acc[3] = min(acc[3], along)
@@ -119,7 +123,7 @@ def _lower(top, low, k, i, j, b, across, along, acc):
 
 @njit(cache=True)
 def _stamp_segment(top, low, k, row0, row_w, col0, col_w, c0, xa, xb, ya, yb, z, ux, uy, radius, half_flat, rt,
-                   acc):
+                   skim, acc):
     """The tool moved horizontally from (xa, ya) to (xb, yb) at height z in the design frame turned by c0 (a
     single pose when both ends are one; (ux, uy) its move's horizontal direction, (0, 0) for none): a cell's
     bottom is the tool's bottom at its distance from the segment (exact); `across` is the cell's signed offset
@@ -148,16 +152,18 @@ def _stamp_segment(top, low, k, row0, row_w, col0, col_w, c0, xa, xb, ya, yb, z,
             if d > radius:
                 continue
             _lower(top, low, k, i, j, za + t / max(length, 1e-300) * (zb - za) + _bottom(d, half_flat, rt), across,
-                   along, acc)
+                   along, skim, acc)
 
 
 @njit(cache=True)
 def _lead_envelope(d_lo, d_hi, c0, y, z, radius, half_flat, rt, twist, col0, col_w, env, across, along, used):
     """Lowest tool bottom per column over the slices dx in [d_lo, d_hi] of a tool following a helical lead (each
-    slice turned by twist * dx), with the cutting slice's offsets; clears the columns `used` (first, last) by
-    the previous envelope and returns the columns this one reaches."""
+    slice turned by twist * dx), with the column's offset across from the tool's axis slice and the cutting
+    slice's dx; clears the columns `used` (first, last) by the previous envelope and sets the columns this one
+    reaches."""
     for j in range(used[0], used[1] + 1):
         env[j] = np.inf
+    y_axis = math.cos(c0) * y + math.sin(c0) * z
     n_cols = len(env)
     n_samples = 1 if d_hi - d_lo < 1e-9 else LEAD_SAMPLES
     j_min, j_max = n_cols, -1
@@ -166,24 +172,26 @@ def _lead_envelope(d_lo, d_hi, c0, y, z, radius, half_flat, rt, twist, col0, col
         phi = c0 + twist * dx
         c, s = math.cos(phi), math.sin(phi)
         yt = c * y + s * z
-        zt = -s * y + c * z
         w = math.sqrt(max(radius * radius - dx * dx, 0.0))
         j0 = max(int(math.ceil((yt - w - col0) / col_w - 0.5)), 0)
         j1 = min(int(math.floor((yt + w - col0) / col_w - 0.5)), n_cols - 1)
         for j in range(j0, j1 + 1):
-            lateral = col0 + (j + 0.5) * col_w - yt
-            b = zt + _bottom(math.sqrt(dx * dx + lateral * lateral), half_flat, rt)
+            # the slice's bottom turned into the design frame: the machine point (c Y - s Z, s Y + c Z) of column
+            # Y at height Z lies on the bottom, at the lateral offset taken at the tip's height (to first order)
+            col_y = col0 + (j + 0.5) * col_w
+            lateral = c * col_y - s * z - y
+            b = (z + _bottom(math.sqrt(dx * dx + lateral * lateral), half_flat, rt) - s * col_y) / c
             if b < env[j]:
                 env[j] = b
-                across[j] = lateral
+                across[j] = col0 + (j + 0.5) * col_w - y_axis
                 along[j] = dx
         j_min, j_max = min(j_min, j0), max(j_max, j1)
     used[0], used[1] = j_min, j_max
 
 
 @njit(cache=True)
-def _stamp_lead(top, low, k, row0, row_w, col0, col_w, c0, x_lo, x_hi, y, z, radius, half_flat, rt, twist, acc, env,
-                across, along, used):
+def _stamp_lead(top, low, k, row0, row_w, col0, col_w, c0, x_lo, x_hi, y, z, radius, half_flat, rt, twist, skim, acc,
+                env, across, along, used):
     """The tool following a helical lead from x_lo to x_hi (Y and Z fixed; c0: the design's turn at x_lo): a row
     sees the slices dx in [row - x_hi, row - x_lo], sampled; rows seeing the same slices share one envelope."""
     n_rows = top.shape[1]
@@ -201,11 +209,11 @@ def _stamp_lead(top, low, k, row0, row_w, col0, col_w, c0, x_lo, x_hi, y, z, rad
             key_lo, key_hi = d_lo, d_hi
         for j in range(used[0], used[1] + 1):
             if env[j] != np.inf:
-                _lower(top, low, k, i, j, env[j], across[j], along[j], acc)
+                _lower(top, low, k, i, j, env[j], across[j], along[j], skim, acc)
 
 
 @njit(cache=True)
-def _stamp_all(top, low, row0, row_w, col0, col_w, stamps, move_of, n_moves, radius, half_flat, rt, twist):
+def _stamp_all(top, low, row0, row_w, col0, col_w, stamps, move_of, n_moves, radius, half_flat, rt, twist, skim):
     """Apply stamps (k, c0, x_a, x_b, y_a, y_b, z, lead, u_x, u_y) in order; per move: removed (mm^2 x rows),
     across-offset min/max, along-offset min/max, highest material met, lowest cut."""
     acc = np.zeros((n_moves, 7))
@@ -224,10 +232,10 @@ def _stamp_all(top, low, row0, row_w, col0, col_w, stamps, move_of, n_moves, rad
         st = stamps[n]
         if st[7] > 0.0:
             _stamp_lead(top, low, int(st[0]), row0, row_w, col0, col_w, st[1], st[2], st[3], st[4], st[6], radius,
-                        half_flat, rt, twist, acc[move_of[n]], env, across, along, used)
+                        half_flat, rt, twist, skim, acc[move_of[n]], env, across, along, used)
         else:
             _stamp_segment(top, low, int(st[0]), row0, row_w, col0, col_w, st[1], st[2], st[3], st[4], st[5], st[6],
-                           st[8], st[9], radius, half_flat, rt, acc[move_of[n]])
+                           st[8], st[9], radius, half_flat, rt, skim, acc[move_of[n]])
     return acc
 
 
@@ -268,7 +276,14 @@ class StockHeightField:
         rt = tool.effective_corner_radius_mm
         stamps, move_of = self._stamps(path, radius, column_mm)
         return _stamp_all(self.top, self.low, self.row0, self.row_w, self.col0, self.col_w, stamps, move_of,
-                          len(path), radius, radius - rt, rt, self.twist)
+                          len(path), radius, radius - rt, rt, self.twist, self.skim_mm(tool))
+
+    def skim_mm(self, tool: Tool) -> float:
+        """Layers thinner than this count in the volume only: SKIM_FRACTION x D, and on a helical design the
+        spread of its slices' bottoms at one column (turned by up to +-twist R, at most y_max from the axis), so
+        that a pass beside the last one does not count the floor the last one's other slices left as width."""
+        radius = tool.diameter_mm / 2.0
+        return max(SKIM_FRACTION * tool.diameter_mm, 2.0 * abs(self.twist) * radius * abs(self.col0))
 
     def _stamps(self, path: Toolpath, radius: float, step_mm: float) -> tuple[np.ndarray, np.ndarray]:
         """(k, c0, x_a, x_b, y_a, y_b, z, lead, u_x, u_y) per stamp and its move, in the moves' order: one per
@@ -343,18 +358,26 @@ def measure_engagement(teeth: int, blank_radius_mm: float, x_range_mm: tuple[flo
         acc = field.cut(cut.path, cut.tool, column_mm)
         fed = np.nonzero(cut.path.kind == MoveKind.LINEAR)[0]
         acc, d = acc[fed], cut.tool.diameter_mm
-        met = acc[:, 0] > 0.0
+        engaged = np.isfinite(acc[:, 5])  # met more than skims
+        first, second = (np.where(engaged, acc[:, hi] - acc[:, lo], 0.0) for lo, hi in ((1, 2), (3, 4)))
         start = cut.path.start_poses()[fed]
-        still = (cut.path.x[fed] == start[:, 0]) & (cut.path.y[fed] == start[:, 1])  # Z (or A) only: no direction
-        across = np.where(met, acc[:, 2] - acc[:, 1] + field.col_w, 0.0)
-        along = np.where(met, acc[:, 4] - acc[:, 3] + field.row_w, 0.0)
-        along_y = np.abs(cut.path.y[fed] - start[:, 1]) > np.abs(cut.path.x[fed] - start[:, 0])  # a_e along X
-        width = np.where(still, np.maximum(across, along), across)
+        moved_x = np.abs(cut.path.x[fed] - start[:, 0])
+        moved_y = np.abs(cut.path.y[fed] - start[:, 1])
+        still = (moved_x == 0.0) & (moved_y == 0.0)  # Z (or A) only: the larger extent
+        along_y = moved_y > moved_x  # a_e measured along X, to a row
+        if field.twist == 0.0:  # segments: `first` is across the motion (Y for a move in Z only), `second` along
+            across_y, across_x = np.where(along_y, 0.0, first), np.where(along_y, first, second)
+        else:  # the lead's stamps: `first` is across Y, `second` along X; a pass along the lead sweeps a section
+            # wider by sqrt(1 + (r twist)^2) at radius r
+            across_y, across_x = first / np.sqrt(1.0 + (np.maximum(acc[:, 5], 0.0) * field.twist) ** 2), second
+        across_y, across_x = across_y + field.col_w, across_x + field.row_w
+        width = np.where(engaged, np.where(still, np.maximum(across_y, across_x),
+                                           np.where(along_y, across_x, across_y)), 0.0)
         step = np.where(still, max(field.col_w, field.row_w), np.where(along_y, field.row_w, field.col_w))
         parts.append(dict(
             operation=(cut.name,) * len(fed), index=fed, space=cut.path.space[fed], level=cut.path.station[fed],
             diameter_mm=np.full(len(fed), d), radial_fraction=np.minimum(width, d) / d,
-            axial_depth_mm=np.where(met, acc[:, 5] - acc[:, 6], 0.0),
+            axial_depth_mm=np.where(engaged, acc[:, 5] - acc[:, 6], 0.0),
             removed_mm3=acc[:, 0] * field.row_w * field.col_w, minutes=move_minutes(cut.path)[fed],
             radial_step=step / d))
     return Engagement(
