@@ -13,7 +13,7 @@ from spur_cad.cam.machine import Machine, RoughingParams
 from spur_cad.cam.roughing import roughing_toolpath
 from spur_cad.cam.tools import Tool
 from spur_cad.geometry import GearSpec
-from spur_cad.job import load_job
+from spur_cad.job import load_job, parse_job
 from spur_cad.pipeline import job_stock, plan_cam, roughing_engagement
 from spur_cad.sim.engagement import (
     COLUMNS_PER_DIAMETER,
@@ -183,3 +183,30 @@ def test_the_helical_example_s_roughing_slots_once_per_level_and_steps_over_with
     assert e.max_axial_depth_mm <= params.max_level_depth_fraction * plan.roughing.tool.diameter_mm
     others = e.cutting & ~slots
     assert np.all(e.radial_fraction[others] <= params.step_over_fraction + 1.5 * e.radial_step[others])
+
+
+def test_two_stage_roughing_measures_the_bottom_tool_on_what_the_large_one_left():
+    """Both operations measured, in order, on one stock: the bottom tool meets what the large one left (much less
+    deep than the blank it would meet alone), within its own limits (fractions of its own diameter)."""
+    from tests.test_two_stage import JOB
+
+    job = parse_job(JOB, "two.toml")
+    plan = plan_cam(job)
+    e = roughing_engagement(job, plan)
+    params = job.roughing
+    assert engagement_warnings(e, EngagementLimits(params.max_level_depth_fraction, params.step_over_fraction)) == []
+    bottom = np.array(e.operation) == "roughing_bottom"
+    assert bottom.any() and (~bottom).any()
+    assert np.all(e.diameter_mm[bottom] == job.tools.bottom.diameter_mm)
+    assert np.any(e.cutting & bottom)
+    assert e.axial_depth_mm[bottom].max() <= params.max_level_depth_fraction * job.tools.bottom.diameter_mm + 1e-9
+    # without the large tool's moves the bottom tool's first level would meet the blank from its top: deeper
+    alone = measure_engagement(job.gear.teeth, *_stock(job), [MeasuredCut("roughing_bottom",
+                                                                          plan.roughing_bottom.toolpath,
+                                                                          plan.roughing_bottom.tool)])
+    assert alone.max_axial_depth_mm > e.axial_depth_mm[bottom].max() + 1.0
+
+
+def _stock(job):
+    stock = job_stock(job)
+    return stock.radius_mm, (stock.x_min, stock.x_max)
