@@ -122,12 +122,29 @@ def _lower(top, low, k, i, j, b, across, along, skim, acc):
 
 
 @njit(cache=True)
+def _segment_row(top, low, k, i, px, j_lo, j_hi, col0, col_w, ya, za, zb, ux, uy, length, radius, half_flat, rt, skim,
+                 acc):
+    """Row i (at px along X from the segment's start) of _stamp_segment, each cell at its distance from it."""
+    for j in range(j_lo, j_hi + 1):
+        py = col0 + (j + 0.5) * col_w - ya
+        t = min(max(px * ux + py * uy, 0.0), length)
+        across = py * ux - px * uy
+        along = px * ux + py * uy - t
+        d = math.sqrt(across * across + along * along)
+        if d > radius:
+            continue
+        _lower(top, low, k, i, j, za + t / max(length, 1e-300) * (zb - za) + _bottom(d, half_flat, rt), across,
+               along, skim, acc)
+
+
+@njit(cache=True)
 def _stamp_segment(top, low, k, row0, row_w, col0, col_w, c0, xa, xb, ya, yb, z, ux, uy, radius, half_flat, rt,
-                   skim, acc):
+                   skim, acc, env):
     """The tool moved horizontally from (xa, ya) to (xb, yb) at height z in the design frame turned by c0 (a
     single pose when both ends are one; (ux, uy) its move's horizontal direction, (0, 0) for none): a cell's
     bottom is the tool's bottom at its distance from the segment (exact); `across` is the cell's signed offset
-    across the motion, `along` along it (beyond the segment's ends)."""
+    across the motion, `along` along it (beyond the segment's ends). A pass along X has the same bottoms in
+    every row along it: computed once (`env`, all inf on entry and on return)."""
     c, s = math.cos(c0), math.sin(c0)
     ya, za = c * ya + s * z, -s * ya + c * z
     yb, zb = c * yb + s * z, -s * yb + c * z
@@ -141,18 +158,24 @@ def _stamp_segment(top, low, k, row0, row_w, col0, col_w, c0, xa, xb, ya, yb, z,
     i_hi = min(int(math.ceil((max(xa, xb) + radius - row0) / row_w)), n_rows - 1)
     j_lo = max(int(math.floor((min(ya, yb) - radius - col0) / col_w)), 0)
     j_hi = min(int(math.ceil((max(ya, yb) + radius - col0) / col_w)), n_cols - 1)
-    for i in range(i_lo, i_hi + 1):
-        px = row0 + (i + 0.5) * row_w - xa
+    along_x = uy == 0.0 and za == zb
+    if along_x:
         for j in range(j_lo, j_hi + 1):
             py = col0 + (j + 0.5) * col_w - ya
-            t = min(max(px * ux + py * uy, 0.0), length)
-            across = py * ux - px * uy
-            along = px * ux + py * uy - t
-            d = math.sqrt(across * across + along * along)
-            if d > radius:
-                continue
-            _lower(top, low, k, i, j, za + t / max(length, 1e-300) * (zb - za) + _bottom(d, half_flat, rt), across,
-                   along, skim, acc)
+            if abs(py) <= radius:
+                env[j] = za + _bottom(abs(py), half_flat, rt)
+    for i in range(i_lo, i_hi + 1):
+        px = row0 + (i + 0.5) * row_w - xa
+        if along_x and 0.0 <= px * ux <= length:  # beside the segment: its distance is |py|
+            for j in range(j_lo, j_hi + 1):
+                if env[j] != np.inf:
+                    _lower(top, low, k, i, j, env[j], (col0 + (j + 0.5) * col_w - ya) * ux, 0.0, skim, acc)
+            continue
+        _segment_row(top, low, k, i, px, j_lo, j_hi, col0, col_w, ya, za, zb, ux, uy, length, radius, half_flat, rt,
+                     skim, acc)
+    if along_x:
+        for j in range(j_lo, j_hi + 1):
+            env[j] = np.inf
 
 
 @njit(cache=True)
@@ -235,7 +258,7 @@ def _stamp_all(top, low, row0, row_w, col0, col_w, stamps, move_of, n_moves, rad
                         half_flat, rt, twist, skim, acc[move_of[n]], env, across, along, used)
         else:
             _stamp_segment(top, low, int(st[0]), row0, row_w, col0, col_w, st[1], st[2], st[3], st[4], st[5], st[6],
-                           st[8], st[9], radius, half_flat, rt, skim, acc[move_of[n]])
+                           st[8], st[9], radius, half_flat, rt, skim, acc[move_of[n]], env)
     return acc
 
 
