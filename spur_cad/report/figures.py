@@ -249,8 +249,8 @@ def engagement_png(engagement: Engagement, step_over_fraction: float, max_depth_
     for col, (value, limit, label) in enumerate(zip(values, (step_over_fraction, max_depth_fraction),
                                                     ("radial engagement a_e / D", "axial depth a_p / D"))):
         ax = fig.add_subplot(1, 2, col + 1)
-        top = max(1.0, float(value[cutting].max(initial=0.0)), limit) * 1.05
-        bins = np.linspace(0.0, top, 43)
+        top = max(1.0, float(value[cutting].max(initial=0.0)), limit)
+        bins = (np.arange(math.ceil(top / 0.025) + 2) - 0.5) * 0.025  # bins centred on 0, 0.025, ..., 1 D
         ax.hist([value[cutting & (operation == name)] for name in names], bins=bins, stacked=True,
                 label=names, color=["tab:blue", "tab:orange"][:len(names)])
         ax.axvline(limit, color="tab:red", lw=1.0, ls="--", label="limit")
@@ -258,8 +258,8 @@ def engagement_png(engagement: Engagement, step_over_fraction: float, max_depth_
         ax.set_ylabel("moves", fontsize=8)
         ax.tick_params(labelsize=7)
         ax.grid(True, lw=0.3)
-        if col == 0:
-            ax.legend(fontsize=7, loc="upper center")
+        if col == 1:  # beyond the depth limit: empty unless a move overloads
+            ax.legend(fontsize=7, loc="upper right")
     n = int(cutting.sum())
     fig.suptitle(f"roughing engagement measured on the simulated stock ({n} moves removing material)", fontsize=9)
     return _png(fig)
