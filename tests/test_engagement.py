@@ -210,3 +210,18 @@ def test_two_stage_roughing_measures_the_bottom_tool_on_what_the_large_one_left(
 def _stock(job):
     stock = job_stock(job)
     return stock.radius_mm, (stock.x_min, stock.x_max)
+
+
+def test_a_height_field_beyond_the_cell_limit_is_sampled_coarser_and_still_measures_a_slot(monkeypatch):
+    from spur_cad.sim import engagement
+
+    monkeypatch.setattr(engagement, "MAX_CELLS", 30_000)
+    blank, face = 30.0, 29.0
+    cuts = [MeasuredCut("face", _passes(1, [(0.0, face)], -25.0, 45.0), Tool(diameter_mm=40.0, tool_number=1)),
+            MeasuredCut("slot", _passes(2, [(0.0, face - 1.0)], -5.0, 25.0), Tool(diameter_mm=4.0, tool_number=2))]
+    e = measure_engagement(6, blank, (0.0, 20.0), cuts)
+    fine = 4.0 / COLUMNS_PER_DIAMETER
+    assert e.column_mm > 1.5 * fine  # 6 spaces x 25 rows x 750 columns at full sampling
+    slot = _cut_moves(e)[1]
+    assert e.radial_fraction[slot] == pytest.approx(1.0, abs=e.column_mm / 4.0)
+    assert e.axial_depth_mm[slot] == pytest.approx(1.0)

@@ -32,6 +32,9 @@ ROWS_PER_DIAMETER = 5
 LEAD_SAMPLES = 9  # slices sampled across a helical sweep's tool width
 SKIM_FRACTION = 0.005  # a layer thinner than this x D is counted in the volume only, not in a_e or a_p
 _EPS_MM = 1e-9
+MAX_CELLS = 20_000_000
+"""Largest height field (cells of all spaces, 160 MB); beyond it rows and columns are spaced wider alike (the
+reference job has about 0.3 million)."""
 
 
 @dataclass(frozen=True)
@@ -373,9 +376,13 @@ def measure_engagement(teeth: int, blank_radius_mm: float, x_range_mm: tuple[flo
                        cuts: Sequence[MeasuredCut], twist_rad_per_mm: float = 0.0) -> Engagement:
     """Cut the operations in order on a fresh stock and measure every fed move (docs/simulation.md)."""
     smallest = min(cut.tool.diameter_mm for cut in cuts)
-    column_mm = smallest / COLUMNS_PER_DIAMETER
-    field = StockHeightField(teeth, blank_radius_mm, x_range_mm[0], x_range_mm[1], column_mm,
-                             smallest / ROWS_PER_DIAMETER, twist_rad_per_mm)
+    column_mm, row_mm = smallest / COLUMNS_PER_DIAMETER, smallest / ROWS_PER_DIAMETER
+    half_width = blank_radius_mm * math.sin(math.pi / teeth) if teeth > 2 else blank_radius_mm
+    cells = teeth * (2.0 * half_width / column_mm + 1) * ((x_range_mm[1] - x_range_mm[0]) / row_mm + 1)
+    coarser = math.sqrt(max(cells / MAX_CELLS, 1.0))  # a huge gear with a small tool: coarser, within memory
+    field = StockHeightField(teeth, blank_radius_mm, x_range_mm[0], x_range_mm[1], column_mm * coarser,
+                             row_mm * coarser, twist_rad_per_mm)
+    column_mm = field.col_w
     parts = []
     for cut in cuts:
         acc = field.cut(cut.path, cut.tool, column_mm)
