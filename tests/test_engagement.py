@@ -111,7 +111,7 @@ def test_the_planned_roughing_of_gears_of_module_1_to_5_stays_within_its_limits(
     blank = spec.tip_radius_mm + 0.5
     path, e = _planned(spec, tool, params, blank)
     assert engagement_warnings(e, EngagementLimits(params.max_level_depth_fraction, params.step_over_fraction)) == []
-    cutting = e.cutting
+    cutting = e.cutting & e.measured  # the tip lands' passes straddle two spaces' fields: not measured
     assert e.max_radial_fraction == pytest.approx(1.0, abs=1e-9)
     assert e.max_axial_depth_mm <= params.max_level_depth_fraction * tool.diameter_mm + 1e-9
     first = np.array([np.nonzero(cutting & (e.space == k))[0][0] for k in range(spec.teeth)])
@@ -177,11 +177,11 @@ def test_the_helical_example_s_roughing_slots_once_per_level_and_steps_over_with
     e = roughing_engagement(job, plan)
     params = job.roughing
     assert engagement_warnings(e, EngagementLimits(params.max_level_depth_fraction, params.step_over_fraction)) == []
-    slots = e.cutting & (e.radial_fraction > 0.99)
+    slots = e.cutting & e.measured & (e.radial_fraction > 0.99)
     assert slots.sum() == job.gear.teeth * len(plan.roughing.levels.heights_mm)
     assert e.max_radial_fraction <= 1.0
     assert e.max_axial_depth_mm <= params.max_level_depth_fraction * plan.roughing.tool.diameter_mm
-    others = e.cutting & ~slots
+    others = e.cutting & e.measured & ~slots
     assert np.all(e.radial_fraction[others] <= params.step_over_fraction + 1.5 * e.radial_step[others])
 
 
@@ -225,3 +225,15 @@ def test_a_height_field_beyond_the_cell_limit_is_sampled_coarser_and_still_measu
     slot = _cut_moves(e)[1]
     assert e.radial_fraction[slot] == pytest.approx(1.0, abs=e.column_mm / 4.0)
     assert e.axial_depth_mm[slot] == pytest.approx(1.0)
+
+
+def test_tip_land_moves_are_cut_in_the_model_but_not_measured():
+    """The reference roughing's tip-land moves (level -1) remove material (the volume counts) but give no a_e or
+    a_p to the maxima or the warnings: the per-space fields cannot hold a pass centred on a tooth."""
+    job = load_job(REFERENCE_JOB)
+    plan = plan_cam(job)
+    e = roughing_engagement(job, plan)
+    tips = e.level < 0
+    assert (e.cutting & tips).any() and not e.measured[tips].any() and e.measured[~tips].all()
+    assert e.max_radial_fraction == pytest.approx(float(e.radial_fraction[e.measured].max()))
+

@@ -242,7 +242,7 @@ def engagement_png(engagement: Engagement, step_over_fraction: float, max_depth_
     """Histograms of the roughing moves that removed material: radial engagement a_e / D and axial depth
     a_p / D, per operation, with the job's step-over and slotting depth limits."""
     fig = figure(7.5, 2.6, left=0.08, right=0.98, bottom=0.19, top=0.86)
-    cutting = engagement.cutting
+    cutting = engagement.cutting & engagement.measured
     names = list(dict.fromkeys(np.array(engagement.operation)[cutting]))
     operation = np.array(engagement.operation)
     values = (engagement.radial_fraction, engagement.axial_depth_mm / engagement.diameter_mm)

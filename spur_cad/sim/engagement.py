@@ -71,12 +71,20 @@ class Engagement:
         return self.removed_mm3 > 0.0
 
     @property
+    def measured(self) -> np.ndarray:
+        """Moves whose a_e and a_p the model measures: not the tip lands' moves (level -1). A tip-land pass is
+        centred on a tooth, over the centre line between two spaces' height fields, which the model holds apart;
+        it is cut in the model (the volume counts), and its engagement is bounded by construction (the first
+        pass a slot no deeper than the level depth limit, the others a step-over apart, cam.roughing)."""
+        return self.level >= 0
+
+    @property
     def max_radial_fraction(self) -> float:
-        return float(self.radial_fraction.max(initial=0.0))
+        return float(self.radial_fraction[self.measured].max(initial=0.0))
 
     @property
     def max_axial_depth_mm(self) -> float:
-        return float(self.axial_depth_mm.max(initial=0.0))
+        return float(self.axial_depth_mm[self.measured].max(initial=0.0))
 
     @property
     def mean_removal_rate_mm3_min(self) -> float:
@@ -428,8 +436,8 @@ def engagement_warnings(engagement: Engagement, limits: EngagementLimits) -> lis
     e = engagement
     tol_ae = 1.5 * e.radial_step
     max_depth = limits.max_level_depth_fraction * e.diameter_mm
-    deep = e.axial_depth_mm > max_depth + 1e-3
-    wide = (e.radial_fraction > limits.step_over_fraction + tol_ae) & (e.radial_fraction < 1.0 - tol_ae)
+    deep = e.measured & (e.axial_depth_mm > max_depth + 1e-3)
+    wide = e.measured & (e.radial_fraction > limits.step_over_fraction + tol_ae) & (e.radial_fraction < 1.0 - tol_ae)
     out = []
     for mask, what, limit_text in (
             (deep, "axial depth {ap:.3f} mm", "beyond the slotting depth limit {lim:.3f} mm ([roughing] "
