@@ -126,6 +126,14 @@ panel.set_value("FinishingToolDiameter", before["FinishingToolDiameter"])
 panel.set_value("MaxFeed", 1.0)                        # unusually low feed: refused, in in/min
 RESULT["imperial_feed_error"] = panel_texts()
 panel.set_value("MaxFeed", 5000.0)
+lathe_was = panel.widgets["WriteLatheProgram"].isChecked()
+panel.set_value("WriteLatheProgram", True)
+lathe_feed_was = panel.widgets["LatheFinishingFeed"].value()
+panel.widgets["LatheFinishingFeed"].setValue(80.0)       # in/rev: far beyond the key's range, refused in in/rev
+panel.revalidate()
+RESULT["imperial_lathe_error"] = panel_texts()
+panel.widgets["LatheFinishingFeed"].setValue(lathe_feed_was)
+panel.set_value("WriteLatheProgram", lathe_was)
 
 def type_into(prop, text):
     box = panel.widgets[prop]
@@ -212,7 +220,7 @@ def test_inspection_values_have_4_decimals_in_mm_and_follow_an_imperial_schema(u
 @pytest.mark.freecad
 def test_the_panel_shows_inches_under_an_imperial_schema_and_keeps_the_values(units_result):
     r = units_result
-    for name in ("imperial_texts", "imperial_error", "imperial_feed_error"):
+    for name in ("imperial_texts", "imperial_error", "imperial_feed_error", "imperial_lathe_error"):
         shown = {key: text for key, text in r[name].items() if MM.search(text)}
         assert shown == {}, (name, shown)
     texts = r["imperial_texts"]
@@ -227,6 +235,8 @@ def test_the_panel_shows_inches_under_an_imperial_schema_and_keeps_the_values(un
     assert error["message:Finishing tool"].startswith("Finishing tool: diameter at most ")
     assert " in " in error["message:Finishing tool"] or error["message:Finishing tool"].endswith(" in")
     assert "in/min" in r["imperial_feed_error"]["message:Machine"]
+    lathe = r["imperial_lathe_error"]["message:Lathe tools"]  # at the field's own group
+    assert "in/rev" in lathe and lathe.endswith("got 80 in/rev"), lathe  # as typed, in its unit
     assert r["typed_texts"][0] == "0.2 in" and r["typed_texts"][1] == "200 in/min"
     assert r["accepted"] is True, r["messages_before_ok"]
     job_file, before = r["job_file"], r["before"]

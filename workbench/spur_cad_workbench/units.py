@@ -20,10 +20,12 @@ RESOLUTIONS = {"mm": MESSAGE_RESOLUTION_MM, "deg": 0.0001, "mm/min": 0.1, "mm/s^
 """Smallest step each job-file unit needs to show (in that unit)."""
 FIELD_MIN_DECIMALS = 2  # FreeCAD's default number of decimals: fields look like FreeCAD's own
 _NUMBER = r"-?\d+(?:\.\d+)?(?:[eE][-+]?\d+)?"
-_UNIT = r"(mm/min|mm)(?![\w/^])"
+_UNITS = r"mm/min|mm/rev|mm/s\^2|mm"
+_UNIT = rf"({_UNITS})(?![\w/^])"
 _LENGTH_OR_FEED = re.compile(  # '[0.05, 100] mm' (a range: both ends in one unit) or '3.55 mm'
-    rf"(?P<open>[\[(])(?P<low>{_NUMBER}), (?P<high>{_NUMBER})(?P<close>[\])]) (?P<range_unit>mm/min|mm)(?![\w/^])"
+    rf"(?P<open>[\[(])(?P<low>{_NUMBER}), (?P<high>{_NUMBER})(?P<close>[\])]) (?P<range_unit>{_UNITS})(?![\w/^])"
     rf"|(?<![\w.])(?P<value>{_NUMBER}) {_UNIT}")
+PER_REVOLUTION_RESOLUTION = 0.0001  # mm/rev: a lathe feed to 0.1 um per revolution
 
 
 def preferred(value: float, unit: str, units) -> tuple[float, str, float]:
@@ -92,13 +94,27 @@ def display_unit(unit: str, units) -> tuple[str, float]:
     return unit, 1.0
 
 
+def _number_field_text(value: float, unit: str, units) -> str:
+    """A value of a unit FreeCAD has no quantity for (mm/rev, mm/s^2) as the panel's number field shows it."""
+    name, per_unit = display_unit(unit, units)
+    resolution = PER_REVOLUTION_RESOLUTION if unit == "mm/rev" else RESOLUTIONS.get(unit, MESSAGE_RESOLUTION_MM)
+    shown = float(value) / per_unit
+    return f"{shown:.{decimals(shown, per_unit, resolution)}f} {name}"
+
+
 def message(sentence: str, units=None) -> str:
-    """A message with its lengths and feeds ('[0.05, 100] mm', '3.55 mm', '1 mm/min') in the user's schema."""
+    """A message with its lengths and feeds ('[0.05, 100] mm', '3.55 mm', '1 mm/min', '0.1 mm/rev') in the
+    user's schema (mm/rev and mm/s^2 as the panel's number fields show them)."""
+    def one(value: float, unit: str, like: float | None = None) -> str:
+        if unit in ("mm/rev", "mm/s^2"):
+            return _number_field_text(value, unit, units)
+        return text(value, unit, units, like=like)
+
     def converted(found: re.Match) -> str:
         if found.group("value") is not None:
-            return text(float(found.group("value")), found.group(found.lastindex), units)
+            return one(float(found.group("value")), found.group(found.lastindex))
         high, unit = float(found.group("high")), found.group("range_unit")
-        low_text, high_text = (text(float(found.group(end)), unit, units, like=high) for end in ("low", "high"))
+        low_text, high_text = (one(float(found.group(end)), unit, like=high) for end in ("low", "high"))
         return f"{found.group('open')}{low_text}, {high_text}{found.group('close')}"
 
     return _LENGTH_OR_FEED.sub(converted, sentence)

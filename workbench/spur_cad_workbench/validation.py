@@ -99,7 +99,7 @@ _TIP_MODE_LIMIT = re.compile(r"largest diameter for tip mode with this corner ra
 
 
 _GOT_NUMBER = re.compile(r"got (-?\d+(?:\.\d+)?(?:[eE][-+]?\d+)?)$")
-_UNITS_IN_MESSAGES = ("mm", "mm/min")
+_UNITS_IN_MESSAGES = ("mm", "mm/min", "mm/rev", "mm/s^2")
 
 
 def _with_unit(body: str, field) -> str:
@@ -173,7 +173,7 @@ def sentence(exc: SpurCadError, source: str, units=None) -> str:
 def _problem(exc: SpurCadError, source: str, values: dict, units=None) -> Problem:
     message = _strip_source(str(exc), source)
     field = field_of(exc.section, exc.field)
-    group = SECTION_GROUPS.get(exc.section or "", group_of(message))
+    group = SECTION_GROUPS.get(exc.section or "") or (field.group if field is not None else group_of(message))
     return Problem(group, field.prop if field is not None else None, message,
                    advice(message, exc.section, exc.field, values, units))
 
