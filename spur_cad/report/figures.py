@@ -63,10 +63,7 @@ def finishing_png(spec: GearSpec, tool: Tool, y: np.ndarray, z: np.ndarray, a_de
     to each corner-circle centre."""
     from spur_cad.geometry.frames import machine_to_part
 
-    fig = figure(7.5, 6.0)
-    ax = fig.add_subplot(1, 1, 1)
     outline = _space_outline(spec)
-    ax.plot(outline[:, 0], outline[:, 1], "-", color="k", lw=1.2, label="design")
     r_t, half_flat = tool.effective_corner_radius_mm, tool.flat_width_mm / 2.0
     from spur_cad.sim.design import sample_space
 
@@ -80,20 +77,29 @@ def finishing_png(spec: GearSpec, tool: Tool, y: np.ndarray, z: np.ndarray, a_de
         touching = np.abs(d[np.arange(len(centres)), nearest] - r_t) < 0.01
         contacts.append(dense[nearest[touching]])
     contacts = np.concatenate(contacts)
-    ax.plot(tips[:, 0], tips[:, 1], ".", ms=2, color="tab:blue", label="cutter locations (tip centre)")
-    ax.plot(contacts[:, 0], contacts[:, 1], ".", ms=3, color="tab:red", label="contact points")
     phi = np.linspace(0.0, math.pi / 2, 12)
-    top = 3.0 * tool.diameter_mm
+    top = tool.diameter_mm  # the tool drawn one diameter up from its tip
     profile_y = np.concatenate([[-half_flat - r_t], -half_flat - r_t * np.sin(phi[::-1]),
                                 half_flat + r_t * np.sin(phi), [half_flat + r_t]])
     profile_z = np.concatenate([[top], r_t - r_t * np.cos(phi[::-1]), r_t - r_t * np.cos(phi), [top]])
-    for i in range(0, len(y), every):
-        shape = machine_to_part(y[i] + profile_y, z[i] + profile_z, np.full(len(profile_y), a_deg[i]))
+    shapes = [machine_to_part(y[i] + profile_y, z[i] + profile_z, np.full(len(profile_y), a_deg[i]))
+              for i in range(0, len(y), every)]
+    drawn = np.concatenate([outline, tips, *shapes]) if shapes else np.concatenate([outline, tips])
+    y_low, y_high = spec.root_radius_mm - 1.0, max(spec.tip_radius_mm + 1.5, float(drawn[:, 1].max()) + 0.5)
+    inside = drawn[(drawn[:, 1] >= y_low) & (drawn[:, 1] <= y_high)]
+    x_low, x_high = float(inside[:, 0].min()) - 0.5, float(inside[:, 0].max()) + 0.5
+    fig = figure_for_extent(7.5, x_high - x_low, y_high - y_low)  # the height follows the data
+    ax = fig.add_subplot(1, 1, 1)
+    ax.plot(outline[:, 0], outline[:, 1], "-", color="k", lw=1.2, label="design")
+    ax.plot(tips[:, 0], tips[:, 1], ".", ms=2, color="tab:blue", label="cutter locations (tip centre)")
+    ax.plot(contacts[:, 0], contacts[:, 1], ".", ms=3, color="tab:red", label="contact points")
+    for shape in shapes:
         ax.plot(shape[:, 0], shape[:, 1], "-", color="0.6", lw=0.5)
     ax.set_aspect("equal")
     ax.set_xlabel("part Y [mm] (space 0, A = 0)")
     ax.set_ylabel("part Z [mm]")
-    ax.set_ylim(spec.root_radius_mm - 1.0, spec.tip_radius_mm + 1.5)
+    ax.set_xlim(x_low, x_high)
+    ax.set_ylim(y_low, y_high)
     ax.set_title(f"finishing: {len(y)} poses per space, {tool.kind} D {tool.diameter_mm:g} mm r {r_t:g} mm "
                  f"(every {every}th tool drawn)", fontsize=9)
     ax.legend(fontsize=8, loc="lower right")
