@@ -21,6 +21,7 @@ import pytest
 from tests.freecad_helper import describe
 from tests.workbench_helper import (
     ARTIFACTS,
+    GUI_PRELUDE,
     ROOT,
     SMALL_JOB_PROPERTIES,
     SMALL_STOCK_PROPERTIES,
@@ -32,19 +33,7 @@ from tests.workbench_helper import (
 TEETH = 13
 DIALOG_SHOT = ARTIFACTS / "workbench_restart_dialog.png"
 
-BODY = r"""
-import os, sys, time, traceback
-import FreeCAD, FreeCADGui
-from PySide import QtCore, QtGui
-
-hooked = []
-sys.excepthook = lambda kind, value, tb: hooked.append("".join(traceback.format_exception(kind, value, tb)))
-main_window = FreeCADGui.getMainWindow()
-report = main_window.findChild(QtGui.QTextEdit, "Report view")
-
-def settle(times=8):
-    for _ in range(times):
-        QtGui.QApplication.processEvents()
+BODY = GUI_PRELUDE + r"""
 
 def report_colour(needle):
     # the colour the report view draws the last line containing `needle` in (its per-level format)

@@ -18,6 +18,7 @@ import pytest
 from tests.freecad_helper import describe
 from tests.workbench_helper import (
     ARTIFACTS,
+    GUI_PRELUDE,
     SMALL_GEAR_PROPERTIES,
     SMALL_STOCK_PROPERTIES,
     run_workbench_code,
@@ -27,19 +28,7 @@ IMPERIAL_SHOT = ARTIFACTS / "workbench_panel_imperial.png"
 MM = re.compile(r"(?<![A-Za-z])mm(?![A-Za-z])")
 KEY_NAME = re.compile(r"\b[a-z]+(?:_[a-z0-9]+)+\b")  # a job-file key such as module_mm
 
-BODY = r"""
-import sys, traceback
-import FreeCAD, FreeCADGui
-from PySide import QtGui
-
-hooked = []
-sys.excepthook = lambda kind, value, tb: hooked.append("".join(traceback.format_exception(kind, value, tb)))
-main_window = FreeCADGui.getMainWindow()
-report = main_window.findChild(QtGui.QTextEdit, "Report view")
-
-def settle(times=8):
-    for _ in range(times):
-        QtGui.QApplication.processEvents()
+BODY = GUI_PRELUDE + r"""
 
 def badge_red(obj):
     # share of strongly red pixels in the lower left quarter of the object's tree icon

@@ -16,6 +16,7 @@ import pytest
 from tests.freecad_helper import describe
 from tests.workbench_helper import (
     ARTIFACTS,
+    GUI_PRELUDE,
     SMALL_GEAR_PROPERTIES,
     SMALL_JOB_PROPERTIES,
     SMALL_STOCK_PROPERTIES,
@@ -28,19 +29,7 @@ SIMULATION_SHOT = ARTIFACTS / "workbench_simulation_on_top.png"
 REOPENED_SHOT = ARTIFACTS / "workbench_reopened_simulation.png"
 ERROR_WORDS = ("error", "traceback", "exception", "failed")
 
-COMMON = r"""
-import sys, traceback
-import FreeCAD, FreeCADGui
-from PySide import QtCore, QtGui
-
-hooked = []
-sys.excepthook = lambda kind, value, tb: hooked.append("".join(traceback.format_exception(kind, value, tb)))
-main_window = FreeCADGui.getMainWindow()
-report = main_window.findChild(QtGui.QTextEdit, "Report view")
-
-def settle(times=8):
-    for _ in range(times):
-        QtGui.QApplication.processEvents()
+COMMON = GUI_PRELUDE + r"""
 
 def camera(doc, objects):
     # the view direction and where the objects' bounding box corners land on the screen (pixels)

@@ -56,6 +56,24 @@ SMALL_JOB_PROPERTIES = dict(JobName="small quick gear", ProfileTolerance=0.002, 
                             FinishingCornerRadius=0.5, TargetScallop=0.05, FinishingStepOver=1.5)
 
 
+GUI_PRELUDE = r"""
+import os, sys, time, traceback
+import FreeCAD, FreeCADGui
+from PySide import QtCore, QtGui
+
+hooked = []
+sys.excepthook = lambda kind, value, tb: hooked.append("".join(traceback.format_exception(kind, value, tb)))
+main_window = FreeCADGui.getMainWindow()
+report = main_window.findChild(QtGui.QTextEdit, "Report view")
+
+def settle(times=8):
+    for _ in range(times):
+        QtGui.QApplication.processEvents()
+"""
+"""The start of a test body run in FreeCAD's GUI: uncaught exceptions collected in `hooked` (a test asserts it
+stays empty), the main window and its report view, and `settle()` (let Qt process pending events)."""
+
+
 def small_job_text(teeth: int = 12, finishing_diameter: float = 1.5) -> str:
     return SMALL_JOB.format(teeth=teeth, finishing_diameter=finishing_diameter)
 
