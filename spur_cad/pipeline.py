@@ -185,6 +185,10 @@ def program_comments(job: Job, plan: CamPlan, operation: str) -> tuple[str, ...]
         planned = getattr(plan, operation)
         strategy = (f"strategy: {len(planned.levels.heights_mm)} levels per space, flank allowance "
                     f"{job.roughing.flank_allowance_mm:g} mm")
+        if planned.flank is not None:
+            turns = ", ".join(f"{abs(s.turn_deg):.1f}" for s in planned.flank.segments)
+            strategy = (f"strategy: by flanks, {len(planned.flank.passes)} passes per space, A turned +-{turns} "
+                        f"deg, flank allowance {job.roughing.flank_allowance_mm:g} mm")
         if plan.two_stage is not None:
             stage = "upper levels, then roughing_bottom" if operation == "roughing" else "bottom levels, after roughing"
             strategy += (f"; two-stage ({stage}), split {plan.two_stage.split_height_above_root_mm:.3f} mm above "
@@ -267,13 +271,15 @@ def simulate_stage(job: Job, plan: CamPlan, progress: Callable[[float], None] | 
 
 
 def roughing_engagement(job: Job, plan: CamPlan) -> Engagement | None:
-    """a_e, a_p and removal rate of every roughing move, on the material it meets (spur_cad.sim.engagement)."""
+    """a_e, a_p and removal rate of every roughing move, on the material it meets (spur_cad.sim.engagement; the
+    flank strategy's turned passes on the section model, spur_cad.sim.section_engagement)."""
     from spur_cad.sim.engagement import MeasuredCut, measure_engagement
+    from spur_cad.sim.section_engagement import measure_section_engagement
 
     cuts = [MeasuredCut(name, planned.toolpath, planned.tool) for name, planned in
             (("roughing", plan.roughing), ("roughing_bottom", plan.roughing_bottom)) if planned is not None]
     if not cuts:
         return None
     stock = job_stock(job)
-    return measure_engagement(job.gear.teeth, stock.radius_mm, (stock.x_min, stock.x_max), cuts,
-                              job.gear.section_turn_rad(1.0))
+    measure = measure_section_engagement if plan.roughing.flank is not None else measure_engagement
+    return measure(job.gear.teeth, stock.radius_mm, (stock.x_min, stock.x_max), cuts, job.gear.section_turn_rad(1.0))

@@ -137,6 +137,10 @@ class RoughingFacts:
     max_radial_engagement_fraction: float | None = None  # a_e / D
     max_axial_depth_mm: float | None = None  # a_p
     mean_removal_rate_mm3_min: float | None = None  # removed volume / time of the moves removing it
+    # The flank strategy (cam.flank_roughing): passes of one space and its flank segments' turns of A; None / ()
+    # for roughing by levels.
+    passes_per_space: int | None = None
+    flank_turns_deg: tuple[float, ...] = ()
 
 
 @dataclass(frozen=True)

@@ -64,7 +64,7 @@ def build_result(job, samples: ProfileSamples, cad: CadResult, plan: CamPlan, po
         profile=ProfileFacts(job.job.profile_tolerance_mm, len(samples), counts), cad=cad,
         tools=tools_facts(plan, job.machine, job.tools.roughing, job.tools.finishing),
         roughing=roughing_facts(plan, job.machine, simulation), finishing=finishing_facts(plan.finishing),
-        warnings=tuple(plan.warnings) + engagement_warnings(simulation, job.roughing),
+        warnings=tuple(plan.warnings) + engagement_warnings(simulation, job.roughing, plan),
         post=PostFacts(post.dialect, post.folded, tuple(ProgramFacts(name, p.lines, p.bytes, p.subprograms)
                                                         for name, p in programs.items())),
         simulation=simulation_facts(simulation, job.simulation.resolution_mm), grading=grading,
@@ -97,12 +97,15 @@ def setup_facts(job, plan: CamPlan, post: PostSettings) -> SetupFacts:
     z = np.concatenate([path.z[path.motion_mask] for path in paths]) if paths else np.zeros(0)
     x_min, x_max = stock.blank_x_range_mm(spec)
     tool = job.tools.roughing
+    flank = plan.roughing.flank if plan.roughing is not None else None
+    steps = ((flank.limits.axial_depth_mm, flank.limits.radial_engagement_mm) if flank is not None else
+             (rough.max_level_depth_fraction * tool.diameter_mm, rough.step_over_fraction * tool.diameter_mm)
+             if tool is not None else (None, None))
     return SetupFacts(
         job.machine.name, 2.0 * stock.blank_radius_mm(spec), x_min, x_max, stock.stub_diameter_mm,
         stock.stub_length_mm, post.work_offset, post.rotary_sign, post.coolant, job.machine.clearance_mm,
         float(z.min()) if z.size else None, float(z.max()) if z.size else None, rough.finish_stock_mm,
-        rough.flank_allowance_mm, rough.max_level_depth_fraction * tool.diameter_mm if tool is not None else None,
-        rough.step_over_fraction * tool.diameter_mm if tool is not None else None)
+        rough.flank_allowance_mm, *steps)
 
 
 def tools_facts(plan: CamPlan, machine: Machine, roughing_tool: Tool | None,
@@ -114,20 +117,33 @@ def tools_facts(plan: CamPlan, machine: Machine, roughing_tool: Tool | None,
 
 
 def _roughing(roughing: RoughingPlan) -> RoughingFacts:
+    flank = roughing.flank
     return RoughingFacts(len(roughing.levels.heights_mm), roughing.lowest_level_above_root_mm,
                          tuple(float(h) for h in roughing.levels.heights_mm), roughing.estimate,
-                         tip_heights_mm=tuple(float(h) for h in roughing.tip_heights_mm))
+                         tip_heights_mm=tuple(float(h) for h in roughing.tip_heights_mm),
+                         passes_per_space=len(flank.passes) if flank is not None else None,
+                         flank_turns_deg=tuple(float(s.turn_deg) for s in flank.segments) if flank is not None else ())
 
 
-def engagement_warnings(simulation: SimResult | None, params: RoughingParams) -> tuple[str, ...]:
-    """Roughing moves the simulated stock shows beyond the job's depth or step-over limits."""
+def engagement_limits(params: RoughingParams, plan: CamPlan):
+    """The limits the job's roughing keeps (sim.engagement.EngagementLimits): the flank strategy's (one tool), or
+    the levels' (levels, and two-stage roughing, which runs by levels)."""
+    from spur_cad.cam.flank_roughing import FlankLimits
+    from spur_cad.sim.engagement import EngagementLimits
+
+    if params.strategy == "flank" and plan.roughing is not None and plan.roughing_bottom is None:
+        return EngagementLimits(params.max_level_depth_fraction, params.max_radial_engagement_fraction,
+                                FlankLimits.of(plan.roughing.tool, params).axial_depth_mm)
+    return EngagementLimits(params.max_level_depth_fraction, params.step_over_fraction)
+
+
+def engagement_warnings(simulation: SimResult | None, params: RoughingParams, plan: CamPlan) -> tuple[str, ...]:
+    """Roughing moves the simulated stock shows beyond the job's depth or engagement limits."""
     if simulation is None or simulation.engagement is None:
         return ()
-    from spur_cad.sim.engagement import EngagementLimits
     from spur_cad.sim.engagement import engagement_warnings as warnings
 
-    limits = EngagementLimits(params.max_level_depth_fraction, params.step_over_fraction)
-    return tuple(warnings(simulation.engagement, limits))
+    return tuple(warnings(simulation.engagement, engagement_limits(params, plan)))
 
 
 def roughing_facts(plan: CamPlan, machine: Machine, simulation: SimResult | None = None) -> RoughingFacts | None:
@@ -260,6 +276,9 @@ def roughing_json(roughing: RoughingFacts, measured: bool = True) -> dict:
              "lowest_level_height_mm": roughing.lowest_level_height_mm,
              "level_heights_mm": list(roughing.level_heights_mm),
              "tip_pass_heights_mm": list(roughing.tip_heights_mm), **estimate_json(roughing.estimate)}
+    if roughing.passes_per_space is not None:  # the flank strategy (the levels' keys above: its lowest level)
+        facts.update(strategy="flank", passes_per_space=roughing.passes_per_space,
+                     flank_segment_turns_deg=list(roughing.flank_turns_deg))
     if measured:
         facts.update(max_radial_engagement_fraction=roughing.max_radial_engagement_fraction,
                      max_axial_depth_mm=roughing.max_axial_depth_mm,

@@ -63,11 +63,13 @@ def test_finishing_cuts_every_flank_downward(name):
         assert len(runs) == spec.teeth * len(np.unique(path.station)) and all(runs)
 
 
+@pytest.mark.parametrize("strategy", ["flank", "levels"])
 @pytest.mark.parametrize("name", CAM_GEARS)
-def test_roughing_respects_finish_stock_and_flank_allowance(name, design_polygons):
+def test_roughing_respects_finish_stock_and_flank_allowance(name, strategy, design_polygons):
     spec = spec_of(name)
     tool, finishing = tools_for(name)
-    params = RoughingParams(flank_allowance_mm=0.1 * spec.module_mm, finish_stock_mm=0.005 * spec.module_mm)
+    params = RoughingParams(flank_allowance_mm=0.1 * spec.module_mm, finish_stock_mm=0.005 * spec.module_mm,
+                            strategy=strategy)
     blank = spec.tip_radius_mm + 0.5
     path = roughing_toolpath(spec, tool, Machine(), params, blank)
     rows = path.motion_mask & (path.space == 0)
@@ -75,9 +77,10 @@ def test_roughing_respects_finish_stock_and_flank_allowance(name, design_polygon
     # Never closer than the finish stock to the design: no reach into the design grown by it.
     grown = design_polygons[name].buffer(params.finish_stock_mm - 1e-6, quad_segs=256)
     assert silhouette.max_penetration_mm(grown, sils) <= HALF_MICRON
-    # At most the flank allowance left on the flanks above the lowest pass, read from the toolpath itself
-    # (space 0 is cut at A = 0, so a pass's Z is its height on the space axis).
-    lowest = float(path.z[rows & (path.feature == Feature.LEVEL)].min())
+    # At most the flank allowance left on the flanks above the lowest pass at A = 0, read from the toolpath itself
+    # (space 0 is cut at A = 0, so such a pass's Z is its height on the space axis; the flank strategy's passes
+    # at other turns reach no lower on the flanks than its middle slot's lowest level).
+    lowest = float(path.z[rows & (path.feature == Feature.LEVEL) & (path.a == 0.0)].min())
     points, labels = silhouette.design_boundary(spec, [0], labels=("fillet", "involute"))
     above = points[:, 1] >= lowest
     leftover = silhouette.leftover_mm(points[above], sils)
@@ -103,14 +106,16 @@ def _left_above_tip_mm(spec, path, tool, blank: float) -> float:
     return float((radius.ravel()[left] - spec.tip_radius_mm).max(initial=0.0))
 
 
+@pytest.mark.parametrize("strategy", ["flank", "levels"])
 @pytest.mark.parametrize("name", CAM_GEARS)
-def test_roughing_takes_the_blank_down_to_the_tip_circle_plus_the_finish_stock(name, design_polygons):
+def test_roughing_takes_the_blank_down_to_the_tip_circle_plus_the_finish_stock(name, strategy, design_polygons):
     """The tip passes never come nearer the design than the finish stock, and leave over the tooth at most the
     finish stock plus the height of the flat tool bottom over the circle at its passes' edge, within what the
     finishing tool takes off the tips in one pass (a slot: half its diameter)."""
     spec = spec_of(name)
     tool, finishing = tools_for(name)
-    params = RoughingParams(flank_allowance_mm=0.1 * spec.module_mm, finish_stock_mm=0.005 * spec.module_mm)
+    params = RoughingParams(flank_allowance_mm=0.1 * spec.module_mm, finish_stock_mm=0.005 * spec.module_mm,
+                            strategy=strategy)
     blank = spec.tip_radius_mm + 0.5
     path = roughing_toolpath(spec, tool, Machine(), params, blank)
     tips = path.motion_mask & (path.feature == Feature.TIP)
@@ -124,9 +129,13 @@ def test_roughing_takes_the_blank_down_to_the_tip_circle_plus_the_finish_stock(n
     left = _left_above_tip_mm(spec, path, tool, blank)
     assert left <= math.hypot(edge, floor) - spec.tip_radius_mm + 0.005
     assert left <= 0.5 * finishing.diameter_mm
-    # without the tip passes the whole allowance stands there
+    # without the tip passes the whole allowance stands there (levels), or more than with them (the flank runs
+    # take some of it beside the tip edges)
     without = roughing_toolpath(spec, tool, Machine(), params, blank, tips=False)
-    assert _left_above_tip_mm(spec, without, tool, blank) == pytest.approx(0.5)
+    if strategy == "levels":
+        assert _left_above_tip_mm(spec, without, tool, blank) == pytest.approx(0.5)
+    else:
+        assert _left_above_tip_mm(spec, without, tool, blank) > left + 0.1
     # the work limit's estimate still bounds the moves, with several cuts over the tips on a large blank
     for radius in (blank, blank + 3.0):
         moves = len(roughing_toolpath(spec, tool, Machine(), params, radius))

@@ -59,6 +59,7 @@ RESULT["tool_numbers"] = [job.RoughingToolNumber, job.FinishingToolNumber]
 RESULT["job_times"] = [job.RoughingTimeWithAcceleration + job.BottomRoughingTimeWithAcceleration,
                        job.FinishingTimeWithAcceleration, job.RoughingTime + job.BottomRoughingTime, job.FinishingTime]
 RESULT["bottom_tool"] = [job.UseBottomTool, job.BottomToolDiameter.Value, job.RoughingToolDiameter.Value]
+RESULT["roughing_strategy"] = job.RoughingStrategy
 
 FreeCADGui.ActiveDocument.setEdit(job.Name)
 settle()
@@ -356,8 +357,9 @@ def test_the_summary_gives_cycle_times_of_both_estimators_and_the_tool_limits(pa
     assert figures.split(" with")[0] == f"Cycle time {shown}", (figures, total_acc, total)
     assert "from the job's last recompute" in figures
     two_stage, bottom_d, roughing_d = r["bottom_tool"]
-    assert two_stage and roughing_d > bottom_d  # a new job roughs in two stages when it pays
-    assert "Bottom tool: D at most" in limits and "corner radius at most" in limits
+    # a new job roughs by flanks with one tool: two-stage roughing (by levels) does not save a tenth of that here
+    assert not two_stage and r["roughing_strategy"] == "flank"
+    assert "Roughing tool: D at most" in limits and "corner radius at most" in limits
     assert "press Plan" in r["changed_summary"] and r["planned"] is True
     assert "planned by this panel" in r["planned_summary"] and "Cycle time" in r["planned_summary"]
 

@@ -173,32 +173,33 @@ def _new_job(wb, **gear):
     return values
 
 
-def test_the_default_new_job_is_valid_two_stage_and_within_a_shift(wb):
-    """Issue 28: a new job for the default gear (z23 m4, rho 0.38 m: the roughing tool that reaches the root is
-    under 2 mm) starts from tools that take a gear maker's time: two-stage roughing, within one shift, and a
-    tenth or more faster than the bottom tool alone; the panel's cycle time counts all three programs."""
+def test_the_default_new_job_is_valid_roughs_by_flanks_and_is_within_a_shift(wb):
+    """Issues 28 and 29: a new job for the default gear (z23 m4, rho 0.38 m: the roughing tool that reaches the root
+    is under 2 mm) starts from tools and a strategy that take a gear maker's time: roughing by flanks with the
+    suggested tool (two-stage roughing by levels saves no tenth of that), within one shift; the panel's cycle time
+    counts every program."""
     values = _new_job(wb)
     result = wb.validation.validate(values)
     assert result.ok, result.messages
     job = result.job
-    assert job.tools.bottom is not None and job.tools.roughing.diameter_mm > job.tools.bottom.diameter_mm
-    assert job.roughing.flank_allowance_mm == pytest.approx(0.3)
+    assert job.roughing.strategy == "flank" and job.roughing.flank_allowance_mm == pytest.approx(0.3)
     plan = plan_cam(job)
-    stage = plan.two_stage
-    assert stage is not None and stage.two_stage_time_s <= 0.9 * stage.bottom_tool_alone_time_s
+    programs = [p for p in (plan.roughing, plan.roughing_bottom, plan.finishing) if p is not None]
     figures = wb.summary.plan_figures(job, plan)
-    programs = (plan.roughing, plan.roughing_bottom, plan.finishing)
     total_s = sum(p.estimate.time_with_acceleration_s for p in programs)
     assert figures.seconds_with_acceleration == pytest.approx(total_s)
-    assert total_s < wb.summary.LONG_JOB_S  # today about 4 h 48 min (18 h 36 min before issue 28)
-    text = wb.summary.figures_text(figures)
-    assert "Roughing the bottom (bottom tool):" in text and text.startswith(
-        f"Cycle time {wb.summary.duration_text(total_s)}")
-    # the same gear with the one roughing tool that reaches the root takes far longer: two-stage paid
-    single = {**values, "job": {**values["job"], "UseBottomTool": False,
-                                "RoughingToolDiameter": values["job"]["BottomToolDiameter"]}}
-    alone = plan_cam(wb.validation.validate(single).job)
-    assert alone.roughing.estimate.time_s == pytest.approx(plan.two_stage.bottom_tool_alone_time_s)
+    assert total_s < wb.summary.LONG_JOB_S  # today about 4 h 0 min (4 h 48 min by two-stage levels, issue 28)
+    assert wb.summary.figures_text(figures).startswith(f"Cycle time {wb.summary.duration_text(total_s)}")
+    # the same tool by levels takes far longer; two-stage roughing by levels would not save a tenth
+    by_levels = plan_cam(wb.validation.validate({**values, "job": {**values["job"],
+                                                                   "RoughingStrategy": "levels"}}).job)
+    assert by_levels.roughing.estimate.time_s > 2.0 * plan.roughing.estimate.time_s
+    from spur_cad.cam.plan import TWO_STAGE_PAYS_FRACTION, suggested_two_stage
+    from spur_cad.pipeline import cam_inputs
+
+    suggestion = suggested_two_stage(cam_inputs(job))
+    assert job.tools.bottom is None and (suggestion is None or suggestion.two_stage_time_s
+                                         > TWO_STAGE_PAYS_FRACTION * suggestion.bottom_tool_alone_time_s)
 
 
 @pytest.mark.parametrize("gear", [dict(Teeth=17, Module=2.0, RackTipRadius=0.5, FaceWidth=10.0, ProfileShift=0.3),

@@ -1,5 +1,6 @@
-"""What every CAM generator shares: the safe height for indexing, the plunge feed, and the
-conversion of simultaneous rotary moves to inverse-time feeds (docs/method.md)."""
+"""What every CAM generator shares: the safe height for indexing, the plunge feed, the conversion of
+simultaneous rotary moves to inverse-time feeds (docs/method.md), and the flank offset by the finish stock that
+both roughing strategies work against."""
 
 from __future__ import annotations
 
@@ -7,6 +8,8 @@ import numpy as np
 
 from spur_cad.cam.ir import MoveKind, Toolpath, relative_path_lengths
 from spur_cad.cam.machine import Machine
+from spur_cad.geometry.sampling import sample_profile
+from spur_cad.geometry.spec import GearSpec
 
 PLUNGE_FEED_FRACTION = 0.5
 """Plunges (Z moves into the cut) run at this fraction of the tool's cutting feed."""
@@ -35,3 +38,18 @@ def apply_inverse_time(path: Toolpath, machine: Machine) -> Toolpath:
     inverse = path.inverse_time.copy()
     inverse[idx] = True
     return path.replace(feed=feed, inverse_time=inverse)
+
+
+def offset_flank(spec: GearSpec, finish_stock_mm: float) -> tuple[np.ndarray, np.ndarray, float | None]:
+    """Right flank (root arc, fillet, involute) offset into the space by the finish stock, root to tip
+    edge, with each point's label and the height of the fillet/involute junction."""
+    samples = sample_profile(spec.tooth_space_profile(), 1e-6 * spec.module_mm)
+    names = np.array(samples.label_names())
+    keep = names != "tip"
+    points = samples.points[keep] + finish_stock_mm * samples.normals[keep]
+    labels = names[keep]
+    junction = None
+    involute = np.nonzero(labels == "involute")[0]
+    if len(involute) and involute[0] > 0:
+        junction = float(points[involute[0], 1])
+    return points, labels, junction

@@ -139,8 +139,12 @@ def check_travel(machine: Machine, x, y, z, a, operation: str) -> None:
 
 @dataclass(frozen=True)
 class RoughingParams:
-    """[roughing]: roughing by levels (docs/method.md); allowances are measured from the designed flank."""
+    """[roughing]: roughing by levels or by flanks (docs/method.md); allowances are measured from the designed
+    flank."""
 
+    strategy: str = key("levels", choices=("levels", "flank"), label="RoughingStrategy", group="Roughing strategy",
+                        meaning="flank: A turned to each flank segment, the tool's side at full depth (constant "
+                                "engagement); levels: horizontal levels of zig-zag passes")
     flank_allowance_mm: float = key(0.1, unit="mm", low=0.0, high=5.0, low_open=True, label="FlankAllowance",
                                     group="Roughing strategy",
                                     meaning="largest staircase roughing leaves on the flanks (ofst)")
@@ -148,9 +152,22 @@ class RoughingParams:
                                  meaning="roughing never comes closer than this to the design "
                                          "(below flank_allowance_mm)")
     step_over_fraction: float = key(0.5, low=0.0, high=1.0, low_open=True, label="StepOverFraction",
-                                    group="Roughing strategy", meaning="Y step between passes of a level, x D")
+                                    group="Roughing strategy",
+                                    meaning="levels: Y step between passes of a level, x D")
     max_level_depth_fraction: float = key(0.5, low=0.0, high=2.0, low_open=True, label="MaxLevelDepthFraction",
-                                          group="Roughing strategy", meaning="slotting depth limit per level, x D")
+                                          group="Roughing strategy",
+                                          meaning="slotting depth limit per level (flank strategy: of a pass "
+                                                  "engaged wider than its radial engagement), x D")
+    max_radial_engagement_fraction: float = key(0.2, low=0.0, high=0.5, low_open=True,
+                                                label="MaxRadialEngagementFraction", group="Roughing strategy",
+                                                meaning="flank strategy: largest radial engagement of a pass deeper "
+                                                        "than a slot, x D")
+    max_axial_depth_mm: float = key(0.0, unit="mm", low=0.0, high=200.0, label="MaxAxialDepth",
+                                    group="Roughing strategy",
+                                    meaning="flank strategy: largest axial depth of a pass; 0: the flute length, "
+                                            "at most 3 D")
+    max_feed_factor: float = key(2.0, low=1.0, high=4.0, label="MaxFeedFactor", group="Roughing strategy",
+                                 meaning="flank strategy: largest chip-thinning raise of the feed")
     bottom_tool_above_root_mm: float = key(0.0, unit="mm", low=0.0, high=1000.0, label="BottomToolAboveRoot",
                                            group="Roughing strategy",
                                            meaning="two-stage roughing ([tools.bottom]): the roughing tool's levels "

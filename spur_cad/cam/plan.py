@@ -16,6 +16,7 @@ from spur_cad.cad.specs import StockSpec
 from spur_cad.cam.contacts import ContactCounts, contact_counts
 from spur_cad.cam.estimate import Estimate, estimate, move_seconds
 from spur_cad.cam.finishing import plan_finishing
+from spur_cad.cam.flank_roughing import FlankPlan
 from spur_cad.cam.ir import MAX_TOOLPATH_MOVES, Toolpath
 from spur_cad.cam.machine import Machine, MachineError, RoughingParams, check_travel
 from spur_cad.cam.machine_limits import check_machine_limits
@@ -32,6 +33,7 @@ from spur_cad.cam.roughing import (
     RoughingLevels,
     check_helical_roughing_machine,
     estimated_roughing_moves,
+    flank_plan_for,
     roughing_levels,
     roughing_toolpath,
     tip_heights_mm,
@@ -74,6 +76,7 @@ class RoughingPlan:
     toolpath: Toolpath
     estimate: Estimate
     tip_heights_mm: np.ndarray = field(default_factory=lambda: np.zeros(0))  # passes over each tip land
+    flank: FlankPlan | None = None  # the flank strategy's plan of one space (its engagement figures)
 
 
 @dataclass(frozen=True)
@@ -338,15 +341,24 @@ def _plan_two_stage(inputs: CamInputs, levels: RoughingLevels,
     roughing tool's levels: the one [roughing] bottom_tool_above_root_mm names (the lowest at or above that
     height), or the one with the shortest estimated time of both programs. Below the split the bottom tool's
     own levels keep the staircase and depth limits (its next level above is at or above the split)."""
+    job_inputs, inputs = inputs, by_levels(inputs)
     spec, bottom = inputs.spec, inputs.bottom_tool
     bottom_levels = roughing_levels(spec, bottom, inputs.roughing, blank)
     alone = _plan_roughing(inputs, bottom_levels, blank, bottom)
     _, j, below = _two_stage_split(inputs, levels, blank, bottom_levels, alone)
+    if job_inputs.roughing.strategy != "levels":  # the comparison: the bottom tool alone by the job's strategy
+        alone = _plan_roughing(job_inputs, bottom_levels, blank, bottom)
     upper = _plan_roughing(inputs, _levels_where(levels, np.arange(len(levels.heights_mm)) <= j), blank)
     lower = _plan_roughing(inputs, _levels_where(bottom_levels, below), blank, bottom, tips=False)
     chosen = "set" if inputs.roughing.bottom_tool_above_root_mm > 0.0 else "shortest time"
     return upper, lower, TwoStage(float(levels.heights_mm[j] - spec.root_radius_mm), chosen,
                                   upper.estimate.time_s + lower.estimate.time_s, alone.estimate.time_s)
+
+
+def by_levels(inputs: CamInputs) -> CamInputs:
+    """The inputs with [roughing] strategy = "levels": two-stage roughing splits the space between the tools by
+    levels (the flank strategy cuts a whole space with one tool)."""
+    return dataclasses.replace(inputs, roughing=dataclasses.replace(inputs.roughing, strategy="levels"))
 
 
 def _two_stage_split(inputs: CamInputs, levels: RoughingLevels, blank: float, bottom_levels: RoughingLevels,
@@ -399,11 +411,14 @@ class TwoStageSuggestion:
 def suggested_two_stage(inputs: CamInputs) -> TwoStageSuggestion | None:
     """Two-stage roughing when it pays: with the job's roughing tool as the bottom tool, the larger flat end mill
     (whole millimetres, up to the space width at the reference circle) whose upper levels make the shortest
-    roughing; None when none saves at least 1 - TWO_STAGE_PAYS_FRACTION of the bottom tool's time alone."""
+    roughing; None when none saves at least 1 - TWO_STAGE_PAYS_FRACTION of the bottom tool's time alone (by the job's
+    strategy; the two stages run by levels)."""
     spec, bottom = inputs.spec, inputs.roughing_tool
     if bottom is None or spec.is_helical:  # not suggested for helical gears (each of their roughing plans takes
         return None                        # seconds); a job file may still name a [tools.bottom] for one
     blank = inputs.stock.blank_radius_mm(spec)
+    job_strategy = _plan_roughing(inputs, roughing_levels(spec, bottom, inputs.roughing, blank), blank, bottom)
+    inputs = by_levels(inputs)
     bottom_levels = roughing_levels(spec, bottom, inputs.roughing, blank)
     alone = _plan_roughing(dataclasses.replace(inputs, bottom_tool=bottom), bottom_levels, blank, bottom)
     widest_mm = 2.0 * space_half_width_mm(flank_polyline(spec), spec.reference_radius_mm)
@@ -421,7 +436,7 @@ def suggested_two_stage(inputs: CamInputs) -> TwoStageSuggestion | None:
         except SpurCadError:  # the larger tool reaches no higher than the bottom tool, or no level fits
             continue
         if best is None or seconds < best.two_stage_time_s:
-            best = TwoStageSuggestion(float(diameter), seconds, alone.estimate.time_s)
+            best = TwoStageSuggestion(float(diameter), seconds, job_strategy.estimate.time_s)
     if best is None or best.two_stage_time_s > TWO_STAGE_PAYS_FRACTION * best.bottom_tool_alone_time_s:
         return None
     return best
@@ -440,11 +455,14 @@ def _plan_roughing(inputs: CamInputs, levels: RoughingLevels, blank: float, tool
     spec, stock = inputs.spec, inputs.stock
     tool = tool or inputs.roughing_tool
     lowest_above_root = levels.lowest_height_mm - spec.root_radius_mm
+    flank = flank_plan_for(spec, tool, inputs.roughing, blank, levels, tips) if inputs.roughing.strategy == "flank" \
+        else None
     path = roughing_toolpath(spec, tool, inputs.machine, inputs.roughing, blank, stock.back_margin_mm,
-                             stock.stub_diameter_mm / 2.0, stock.front_margin_mm, levels=levels, tips=tips)
+                             stock.stub_diameter_mm / 2.0, stock.front_margin_mm, levels=levels, tips=tips,
+                             flank_plan=flank)
     check_travel(inputs.machine, path.x, path.y, path.z, path.a, "roughing")
     heights = tip_heights_mm(spec, tool, inputs.roughing, blank) if tips else np.zeros(0)
-    return RoughingPlan(tool, levels, lowest_above_root, path, estimate(path, inputs.machine), heights)
+    return RoughingPlan(tool, levels, lowest_above_root, path, estimate(path, inputs.machine), heights, flank)
 
 
 def check_finishing_work(spec: GearSpec, tool: Tool, machine: Machine, section: FinishingParams,

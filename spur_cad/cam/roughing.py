@@ -24,12 +24,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from spur_cad.cam.common import PLUNGE_FEED_FRACTION, apply_inverse_time, safe_height_mm
+from spur_cad.cam.common import PLUNGE_FEED_FRACTION, apply_inverse_time, offset_flank, safe_height_mm
 from spur_cad.cam.ir import Feature, MoveKind, Operation, Toolpath, ToolpathBuilder
 from spur_cad.cam.machine import Machine, MachineError, RoughingParams
 from spur_cad.cam.recommend import space_half_width_mm
 from spur_cad.cam.tools import Tool, ToolError
-from spur_cad.geometry.sampling import sample_profile
 from spur_cad.geometry.spec import GearSpec
 
 
@@ -46,21 +45,6 @@ class RoughingLevels:
         return float(self.heights_mm[-1])
 
 
-def offset_flank(spec: GearSpec, finish_stock_mm: float) -> tuple[np.ndarray, np.ndarray, float | None]:
-    """Right flank (root arc, fillet, involute) offset into the space by the finish stock, root to tip
-    edge, with each point's label and the height of the fillet/involute junction."""
-    samples = sample_profile(spec.tooth_space_profile(), 1e-6 * spec.module_mm)
-    names = np.array(samples.label_names())
-    keep = names != "tip"
-    points = samples.points[keep] + finish_stock_mm * samples.normals[keep]
-    labels = names[keep]
-    junction = None
-    involute = np.nonzero(labels == "involute")[0]
-    if len(involute) and involute[0] > 0:
-        junction = float(points[involute[0], 1])
-    return points, labels, junction
-
-
 def estimated_roughing_moves(spec: GearSpec, tool: Tool, params: RoughingParams,
                              blank_radius_mm: float) -> tuple[int, str]:
     """An upper bound of the moves roughing_toolpath makes, from the inputs alone (no levels computed),
@@ -71,6 +55,8 @@ def estimated_roughing_moves(spec: GearSpec, tool: Tool, params: RoughingParams,
     level: the widest level is narrower than a pitch. The tip lands: at most as many cuts as the depth limit
     needs, each at most 2 r_blank tan(pi / z) wide (tip_half_width_mm)."""
     max_depth = params.max_level_depth_fraction * tool.diameter_mm
+    if params.strategy == "flank":
+        return _estimated_flank_moves(spec, tool, params, blank_radius_mm)
     budget = params.flank_allowance_mm - params.finish_stock_mm
     depth_levels = math.ceil((blank_radius_mm - spec.root_radius_mm) / max_depth)
     flank_levels = math.ceil(spec.pitch_mm / 2.0 / budget)
@@ -81,6 +67,27 @@ def estimated_roughing_moves(spec: GearSpec, tool: Tool, params: RoughingParams,
                           + depth_levels * (2 * tip_passes + 4) + 6)
     driver = max((depth_levels, "max_level_depth_fraction"), (flank_levels, "flank_allowance_mm"),
                  (passes, "step_over_fraction"))[1]
+    return moves, driver
+
+
+def _estimated_flank_moves(spec: GearSpec, tool: Tool, params: RoughingParams,
+                           blank_radius_mm: float) -> tuple[int, str]:
+    """An upper bound of the flank strategy's moves (cam.flank_roughing), from the inputs alone: per space at most
+    2 MAX_SEGMENTS_PER_FLANK + 1 runs, each at most (twice the space's width at the blank, the positions toward and
+    beyond the other flank) / the radial engagement + 2 positions, each in at most (blank - root) / the slot depth
+    + 1 tiers, each pass with at most 5 moves (its link's three, itself, a return); the tip lands as the levels'."""
+    from spur_cad.cam.flank_roughing import MAX_SEGMENTS_PER_FLANK
+
+    step = params.max_radial_engagement_fraction * tool.diameter_mm
+    slot = params.max_level_depth_fraction * tool.diameter_mm
+    width = 2.0 * blank_radius_mm * math.tan(math.pi / spec.teeth)
+    positions = math.ceil(2.0 * width / step) + 2
+    tiers = math.ceil((blank_radius_mm - spec.root_radius_mm) / slot) + 1
+    tip_passes = math.ceil(2.0 * blank_radius_mm * math.tan(math.pi / spec.teeth)
+                           / (params.step_over_fraction * tool.diameter_mm)) + 1
+    moves = spec.teeth * ((2 * MAX_SEGMENTS_PER_FLANK + 1) * positions * tiers * 5 + 6
+                          + tiers * (2 * tip_passes + 4))
+    driver = "max_radial_engagement_fraction" if positions >= tiers else "max_level_depth_fraction"
     return moves, driver
 
 
@@ -208,10 +215,10 @@ def check_helical_roughing_machine(spec: GearSpec, machine: Machine) -> None:
 def roughing_toolpath(spec: GearSpec, tool: Tool, machine: Machine, params: RoughingParams,
                       blank_radius_mm: float, back_margin_mm: float = 0.0, stub_radius_mm: float = 0.0,
                       front_margin_mm: float = 0.0, levels: RoughingLevels | None = None,
-                      tips: bool = True) -> Toolpath:
+                      tips: bool = True, flank_plan=None) -> Toolpath:
     """The roughing operation as IR (pure function); `levels` when the caller has computed them already. `tips`:
     after each space, the passes over the tip land beside it (tip_heights_mm; two-stage roughing's bottom tool
-    leaves them to the larger tool)."""
+    leaves them to the larger tool). `flank_plan`: the flank strategy's plan when the caller has it (flank_plan_for)."""
     params.validate()
     machine.validate()
     tool.validate("roughing")
@@ -231,6 +238,10 @@ def roughing_toolpath(spec: GearSpec, tool: Tool, machine: Machine, params: Roug
     feed = tool.feed_mm_min(machine)
     step = params.step_over_fraction * tool.diameter_mm
     pitch_deg = 360.0 / spec.teeth
+    if params.strategy == "flank":
+        return _flank_toolpath(spec, tool, machine, params, blank_radius_mm, back_margin_mm, stub_radius_mm,
+                               front_margin_mm, flank_plan or flank_plan_for(spec, tool, params, blank_radius_mm,
+                                                                             levels, tips), tips)
     space_offsets = [_pass_offsets(max(half_width - sweep_radius, 0.0), step) for half_width in levels.half_widths_mm]
     tip_heights = tip_heights_mm(spec, tool, params, blank_radius_mm) if tips else np.zeros(0)
     tip_offsets = _pass_offsets(tip_half_width_mm(spec, tool, params, levels, blank_radius_mm) - radius, step)
@@ -333,3 +344,110 @@ def follow_lead(path: Toolpath, spec: GearSpec, machine: Machine) -> Toolpath:
     feeds of moves that now turn A in inverse time; markers follow their pose."""
     turn_deg = np.degrees(spec.section_turn_rad(1.0)) * path.x
     return apply_inverse_time(path.replace(a=path.a - turn_deg), machine)
+
+
+def _tip_offsets_mm(spec: GearSpec, tool: Tool, params: RoughingParams) -> np.ndarray:
+    """Y of the flank strategy's tip passes (the tooth's axis up): the tool's edge from one tip edge of the land
+    (grown by the finish stock) to the other and a tool radius beyond, where the flank runs leave what stands
+    above the tip circle."""
+    tip_edge = offset_flank(spec, params.finish_stock_mm)[0][-1]
+    half_pitch = math.pi / spec.teeth
+    edge = tip_edge[0] * math.cos(half_pitch) - tip_edge[1] * math.sin(half_pitch)  # the edge in the tooth's frame
+    return _pass_offsets(abs(edge), params.step_over_fraction * tool.diameter_mm)
+
+
+def _link_poses(previous, following) -> list[tuple[float, float, float]]:
+    """The (Y, Z, turn) poses a link between two passes goes through after leaving the first: straight within a
+    run; between runs up to the higher pass's Z first, across (Y and A), then down."""
+    if previous is None or previous.run == following.run:
+        return [(following.y_mm, following.z_mm, following.turn_deg)]
+    high = max(previous.z_mm, following.z_mm)
+    return [(previous.y_mm, high, previous.turn_deg), (following.y_mm, high, following.turn_deg),
+            (following.y_mm, following.z_mm, following.turn_deg)]
+
+
+def _closest_to_axis_mm(plan, radius: float) -> float:
+    """The flat tool bottom's least distance from the gear axis over a space's passes and links (Y and Z
+    interpolated along each leg, sampled at 65 points; A does not change the distance)."""
+    points, previous = [], None
+    for p in plan.passes:
+        points.extend((y, z) for y, z, _ in _link_poses(previous, p))
+        previous = p
+    points = np.array(points)
+    t = np.linspace(0.0, 1.0, 65)[:, None, None]
+    path = (points[:-1] + t * (points[1:] - points[:-1])).reshape(-1, 2) if len(points) > 1 else points
+    y, z = np.abs(path[:, 0]), path[:, 1]
+    return float(np.where(y <= radius, z, np.hypot(y - radius, z)).min())
+
+
+def flank_plan_for(spec: GearSpec, tool: Tool, params: RoughingParams, blank_radius_mm: float,
+                   levels: RoughingLevels, tips: bool = True):
+    """The flank strategy's plan of one space (cam.flank_roughing) for these levels' lowest height."""
+    from spur_cad.cam.flank_roughing import plan_flank_roughing
+
+    tip_offsets = _tip_offsets_mm(spec, tool, params)
+    return plan_flank_roughing(spec, tool, params, blank_radius_mm, levels.lowest_height_mm,
+                               transverse_radius_mm(spec, tool, blank_radius_mm),
+                               float(tip_offsets[-1]) + tool.diameter_mm / 2.0 if tips else 0.0)
+
+
+def _flank_toolpath(spec: GearSpec, tool: Tool, machine: Machine, params: RoughingParams, blank_radius_mm: float,
+                    back_margin_mm: float, stub_radius_mm: float, front_margin_mm: float, plan, tips: bool) -> Toolpath:
+    """The flank strategy (cam.flank_roughing) as IR: every space's passes in the plan's order, linked outside the
+    blank (the passes run from in front of it to beyond its back, or back to the front along their own cleared
+    column where a holding stub stands higher than the passes), then the tip land's passes."""
+    from spur_cad.cam.flank_roughing import UNCUT_MM2
+
+    radius = tool.diameter_mm / 2.0
+    tip_offsets = _tip_offsets_mm(spec, tool, params)
+    free_back = stub_radius_mm + machine.clearance_mm <= _closest_to_axis_mm(plan, radius)
+    x_front = -(front_margin_mm + radius + machine.clearance_mm)
+    x_back = spec.face_width_mm + radius + machine.clearance_mm + (back_margin_mm if free_back else 0.0)
+    if not free_back and back_margin_mm < radius + machine.clearance_mm:
+        raise MachineError(f"the roughing tool would cut into the holding stub: its passes run to X = {x_back:.3f} mm; "
+                           f"make [stock] back_margin_mm at least {radius + machine.clearance_mm:.3f} mm",
+                           field="back_margin_mm", section="stock")
+    safe_z = safe_height_mm(blank_radius_mm, machine)
+    feed = tool.feed_mm_min(machine)
+    air = machine.max_feed_mm_min
+    pitch_deg = 360.0 / spec.teeth
+    tip_heights = tip_heights_mm(spec, tool, params, blank_radius_mm) if tips else np.zeros(0)
+    builder = ToolpathBuilder(Operation.ROUGHING, tool.tool_number, tool.spindle_rpm(machine))
+    for k in range(spec.teeth):
+        a = -k * pitch_deg
+        first = plan.passes[0]
+        if params.clamp_rotary and k > 0:
+            builder.move(MoveKind.UNCLAMP_ROTARY, *builder.last_pose(), space=k)
+        builder.move(MoveKind.RAPID, x_front, first.y_mm, safe_z, a + first.turn_deg, space=k)
+        x_here, previous = x_front, None
+        for p in plan.passes:
+            a_pass = a + p.turn_deg
+            # the link, outside the blank at this end of the passes (in the air: the machine's largest feed)
+            for y_link, z_link, turn_link in _link_poses(previous, p):
+                builder.move(MoveKind.LINEAR, x_here, y_link, z_link, a + turn_link, air, space=k, station=p.run)
+            previous = p
+            x_end = x_back if x_here == x_front else x_front
+            builder.move(MoveKind.LINEAR, x_end, p.y_mm, p.z_mm, a_pass, min(feed * p.feed_factor, air), space=k,
+                         station=p.run, feature=Feature.LEVEL)
+            if free_back:
+                x_here = x_end
+            else:  # back to the front along the column this pass cleared, just above its floor
+                lift = min(0.1, 0.5 * machine.clearance_mm)
+                builder.move(MoveKind.LINEAR, x_end, p.y_mm, p.z_mm + lift, a_pass, air, space=k, station=p.run)
+                builder.move(MoveKind.LINEAR, x_front, p.y_mm, p.z_mm + lift, a_pass, air, space=k, station=p.run)
+        builder.move(MoveKind.LINEAR, x_here, builder.last_pose()[1], safe_z, builder.last_pose()[3], air, space=k)
+        if len(tip_heights):  # the tip land of the tooth between spaces k and k + 1, its axis up
+            a_tip = a - pitch_deg / 2.0
+            builder.move(MoveKind.RAPID, x_front, tip_offsets[0], safe_z, a_tip, space=k)
+            passes = _Passes(builder, x_front, x_back, safe_z, feed)
+            passes.levels(a_tip, k, tip_heights, [tip_offsets] * len(tip_heights), [-1] * len(tip_heights),
+                          Feature.TIP)
+    path = builder.build()
+    if plan.uncut_mm2 > UNCUT_MM2:
+        path = path.replace(warnings=path.warnings + (
+            f"flank roughing leaves {plan.uncut_mm2:.3g} mm^2 of each tooth space's section farther than "
+            "flank_allowance_mm from the design (its stock model); finishing would meet it: choose [roughing] "
+            "strategy = \"levels\"",))
+    if spec.is_helical:
+        path = follow_lead(path, spec, machine)
+    return path

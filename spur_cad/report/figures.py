@@ -13,6 +13,7 @@ from spur_cad.geometry.spec import GearSpec
 from spur_cad.report.plots import _png, figure, figure_for_extent
 
 if TYPE_CHECKING:
+    from spur_cad.cam.flank_roughing import FlankPlan
     from spur_cad.cam.tools import Tool
     from spur_cad.grade.grading import Grading
     from spur_cad.sim.engagement import Engagement
@@ -45,6 +46,37 @@ def roughing_levels_png(spec: GearSpec, heights_mm: np.ndarray, half_widths_mm: 
     ax.set_ylabel("Z [mm]")
     ax.set_ylim(spec.root_radius_mm - 0.5, blank_radius_mm + 1.0)
     ax.set_title(f"roughing: {len(heights_mm)} levels, flat end mill D {tool.diameter_mm:g} mm", fontsize=9)
+    ax.legend(fontsize=8, loc="lower right")
+    ax.grid(True, lw=0.3)
+    return _png(fig)
+
+
+def roughing_flank_png(spec: GearSpec, plan: FlankPlan, tool: Tool, blank_radius_mm: float) -> bytes:
+    """The tooth space with the flank strategy's passes: each tool drawn over the depth it cuts, turned back from
+    its run's A into the space's frame, a colour per run."""
+    fig = figure(7.5, 6.0)
+    ax = fig.add_subplot(1, 1, 1)
+    outline = _space_outline(spec)
+    ax.plot(outline[:, 0], outline[:, 1], "-", color="k", lw=1.5, label="design")
+    span = np.linspace(-math.pi / spec.teeth, math.pi / spec.teeth, 200)
+    ax.plot(blank_radius_mm * np.sin(span), blank_radius_mm * np.cos(span), ":", color="0.5", lw=1, label="blank")
+    radius = tool.diameter_mm / 2.0
+    colours = ("tab:blue", "tab:orange", "tab:green", "tab:red", "tab:purple", "tab:brown", "tab:pink", "tab:olive")
+    for p in plan.passes:
+        corners = np.array([[p.y_mm - radius, p.z_mm], [p.y_mm + radius, p.z_mm],
+                            [p.y_mm + radius, p.z_mm + p.axial_depth_mm], [p.y_mm - radius, p.z_mm + p.axial_depth_mm],
+                            [p.y_mm - radius, p.z_mm]])
+        turn = math.radians(p.turn_deg)  # the machine frame turned back into the space's: R(-turn)
+        c, s = math.cos(turn), math.sin(turn)
+        ax.plot(c * corners[:, 0] + s * corners[:, 1], -s * corners[:, 0] + c * corners[:, 1], "-", lw=0.7,
+                color=colours[p.run % len(colours)])
+    ax.set_aspect("equal")
+    ax.set_xlabel("Y [mm] (space axis up)")
+    ax.set_ylabel("Z [mm]")
+    ax.set_ylim(spec.root_radius_mm - 0.5, blank_radius_mm + 1.0)
+    turns = ", ".join(f"{abs(s.turn_deg):.1f}" for s in plan.segments)
+    ax.set_title(f"roughing by flanks: {len(plan.passes)} passes per space, A turned +-({turns}) deg, flat end mill "
+                 f"D {tool.diameter_mm:g} mm", fontsize=9)
     ax.legend(fontsize=8, loc="lower right")
     ax.grid(True, lw=0.3)
     return _png(fig)
@@ -244,9 +276,11 @@ def passes_png(spec: GearSpec, tool: Tool, passes: tuple, blank_radius_mm: float
     return _png(fig)
 
 
-def engagement_png(engagement: Engagement, step_over_fraction: float, max_depth_fraction: float) -> bytes:
+def engagement_png(engagement: Engagement, step_over_fraction: float, max_depth_fraction: float,
+                   slot_depth_fraction: float | None = None) -> bytes:
     """Histograms of the roughing moves that removed material: radial engagement a_e / D and axial depth
-    a_p / D, per operation, with the job's step-over and slotting depth limits."""
+    a_p / D, per operation, with the job's step-over and depth limits (flank roughing: its radial engagement and
+    axial depth limits, and `slot_depth_fraction`, the depth above which a_e must keep the radial limit)."""
     fig = figure(7.5, 2.6, left=0.08, right=0.98, bottom=0.19, top=0.86)
     cutting = engagement.cutting & engagement.measured
     names = list(dict.fromkeys(np.array(engagement.operation)[cutting]))
@@ -260,6 +294,8 @@ def engagement_png(engagement: Engagement, step_over_fraction: float, max_depth_
         ax.hist([value[cutting & (operation == name)] for name in names], bins=bins, stacked=True,
                 label=names, color=["tab:blue", "tab:orange"][:len(names)])
         ax.axvline(limit, color="tab:red", lw=1.0, ls="--", label="limit")
+        if col == 1 and slot_depth_fraction is not None:
+            ax.axvline(slot_depth_fraction, color="0.4", lw=1.0, ls=":", label="wider only up to here")
         ax.set_xlabel(label, fontsize=8)
         ax.set_ylabel("moves", fontsize=8)
         ax.tick_params(labelsize=7)

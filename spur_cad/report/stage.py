@@ -20,10 +20,18 @@ def report_html(result: JobResult, profile_png: bytes, spec: GearSpec, blank_rad
     """report.html for a job (pure: bytes out): values from the typed result, levels and contact poses from the
     plan and the deviation map from the simulation (not recomputed); `template_text`: a shop's own template
     (default spur_cad's), `template_source` names it in messages."""
-    from spur_cad.report.figures import deviation_map_png, finishing_png, passes_png, roughing_levels_png
+    from spur_cad.report.figures import (
+        deviation_map_png,
+        finishing_png,
+        passes_png,
+        roughing_flank_png,
+        roughing_levels_png,
+    )
 
     images = {"profile": profile_png}
-    if plan.roughing is not None:
+    if plan.roughing is not None and plan.roughing.flank is not None:
+        images["roughing"] = roughing_flank_png(spec, plan.roughing.flank, plan.roughing.tool, blank_radius_mm)
+    elif plan.roughing is not None:
         levels = plan.roughing.levels
         images["roughing"] = roughing_levels_png(spec, levels.heights_mm, levels.half_widths_mm, plan.roughing.tool,
                                                  blank_radius_mm)
@@ -44,8 +52,10 @@ def report_html(result: JobResult, profile_png: bytes, spec: GearSpec, blank_rad
         from spur_cad.report.figures import engagement_png
 
         diameter = result.tools.roughing.diameter_mm
+        flank = plan.roughing.flank if plan.roughing is not None and plan.roughing_bottom is None else None
         images["engagement"] = engagement_png(sim.engagement, rough.roughing_step_over_mm / diameter,
-                                              rough.roughing_step_down_mm / diameter)
+                                              rough.roughing_step_down_mm / diameter,
+                                              flank.limits.slot_depth_mm / diameter if flank is not None else None)
     if result.grading is not None and result.grading.has_profile_traces:
         from spur_cad.report.figures import k_chart_png
 

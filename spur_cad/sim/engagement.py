@@ -65,6 +65,7 @@ class Engagement:
     minutes: np.ndarray
     radial_step: np.ndarray  # the model's sampling in a_e's direction / D (columns across, rows along X)
     column_mm: float  # the model's sampling across the space
+    axial_step_mm: float = 0.0  # the model's sampling of a_p (0: exact heights)
 
     @property
     def cutting(self) -> np.ndarray:
@@ -95,10 +96,14 @@ class Engagement:
 
 @dataclass(frozen=True)
 class EngagementLimits:
-    """The job's roughing limits as fractions of the tool diameter ([roughing] keys)."""
+    """The job's roughing limits ([roughing] keys). Levels (`max_axial_depth_mm` None): no pass deeper than
+    max_level_depth_fraction x D, none engaged wider than step_over_fraction x D unless it is a slot. Flank strategy:
+    no pass deeper than max_axial_depth_mm, none deeper than the slot limit engaged wider than step_over_fraction x D
+    (its max_radial_engagement_fraction)."""
 
     max_level_depth_fraction: float
     step_over_fraction: float
+    max_axial_depth_mm: float | None = None
 
 
 @njit(cache=True)
@@ -430,26 +435,37 @@ MAX_WARNED_MOVES = 5
 
 
 def engagement_warnings(engagement: Engagement, limits: EngagementLimits) -> list[str]:
-    """One warning per kind of overload (at most MAX_WARNED_MOVES moves named, then how many more): a_p above
-    max_level_depth_fraction x D, or a_e above step_over_fraction x D in a move that is not a slot. Tolerances:
-    1.5 x the model's sampling in a_e's direction, 1 um in depth."""
+    """One warning per kind of overload (at most MAX_WARNED_MOVES moves named, then how many more), by the rules of
+    EngagementLimits. Tolerances: 1.5 x the model's sampling in a_e's direction, in depth 1 um or 1.5 x its
+    sampling there."""
     e = engagement
     tol_ae = 1.5 * e.radial_step
-    max_depth = limits.max_level_depth_fraction * e.diameter_mm
-    deep = e.measured & (e.axial_depth_mm > max_depth + 1e-3)
-    wide = e.measured & (e.radial_fraction > limits.step_over_fraction + tol_ae) & (e.radial_fraction < 1.0 - tol_ae)
+    slot_depth = limits.max_level_depth_fraction * e.diameter_mm
+    wider = e.measured & (e.radial_fraction > limits.step_over_fraction + tol_ae)
+    if limits.max_axial_depth_mm is None:
+        max_depth = slot_depth
+        deep_text = ("beyond the slotting depth limit {lim:.3f} mm ([roughing] max_level_depth_fraction {f:g} x D "
+                     "{d:g} mm)")
+        wide = wider & (e.radial_fraction < 1.0 - tol_ae)
+        wide_text = "beyond the step-over {f:g} D and not a slot ([roughing] step_over_fraction)"
+        deep_fraction = limits.max_level_depth_fraction
+    else:
+        max_depth = np.full(len(e.diameter_mm), limits.max_axial_depth_mm)
+        deep_text = "beyond the axial depth limit {lim:.3f} mm ([roughing] max_axial_depth_mm)"
+        wide = wider & (e.axial_depth_mm > slot_depth + max(1e-3, 1.5 * e.axial_step_mm))
+        wide_text = ("beyond {f:g} D deeper than a slot ([roughing] max_radial_engagement_fraction; "
+                     "max_level_depth_fraction)")
+        deep_fraction = 0.0
+    deep = e.measured & (e.axial_depth_mm > max_depth + max(1e-3, 1.5 * e.axial_step_mm))
     out = []
-    for mask, what, limit_text in (
-            (deep, "axial depth {ap:.3f} mm", "beyond the slotting depth limit {lim:.3f} mm ([roughing] "
-                                              "max_level_depth_fraction {f:g} x D {d:g} mm)"),
-            (wide, "radial engagement {ae:.2f} D", "beyond the step-over {f:g} D and not a slot ([roughing] "
-                                                   "step_over_fraction)")):
+    for mask, what, limit_text in ((deep, "axial depth {ap:.3f} mm", deep_text),
+                                   (wide, "radial engagement {ae:.2f} D", wide_text)):
         moves = np.nonzero(mask)[0]
         if not len(moves):
             continue
         named = []
         for i in moves[:MAX_WARNED_MOVES]:
-            fraction = limits.max_level_depth_fraction if what.startswith("axial") else limits.step_over_fraction
+            fraction = deep_fraction if what.startswith("axial") else limits.step_over_fraction
             named.append(f"{e.operation[i]} move {e.index[i]} (tooth space {e.space[i]}, level {e.level[i]}): "
                          + what.format(ap=e.axial_depth_mm[i], ae=e.radial_fraction[i]) + " "
                          + limit_text.format(lim=max_depth[i], f=fraction, d=e.diameter_mm[i]))

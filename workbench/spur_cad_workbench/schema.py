@@ -330,6 +330,8 @@ _TITLES = {"UseRoughingTool": "Rough with this tool", "UseFinishingTool": "Finis
            "UseBottomTool": "Rough the bottom with this tool", "WriteLatheProgram": "Write the lathe program",
            "StickOut": "Stick-out", "StepOverFraction": "Step-over (fraction of D)",
            "MaxLevelDepthFraction": "Level depth (fraction of D)", "FinishingStrategy": "Strategy",
+           "RoughingStrategy": "Strategy", "MaxRadialEngagementFraction": "Radial engagement (fraction of D)",
+           "MaxAxialDepth": "Axial depth (0: flute length)", "MaxFeedFactor": "Feed raise (times)",
            "FinishingStepOver": "Step-over", "MaxSpindleRpm": "Max spindle speed", "SimulationEnabled": "Simulate",
            "SimulationResolution": "Resolution", "PostDialect": "Dialect", "JobName": "Name",
            "MachineName": "Name", "ThicknessAllowancePercent": "Thickness allowance (%)",

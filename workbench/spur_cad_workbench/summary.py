@@ -171,7 +171,8 @@ def group_summary(group: str, job: dict[str, object], units=None) -> str:
         scallop = length_text(float(job.get("TargetScallop", 0.0)), "mm", units)
         text = f"{job.get('FinishingStrategy', '')}, scallop {scallop}"
     elif group == "Roughing strategy":
-        text = f"flank allowance {length_text(float(job.get('FlankAllowance', 0.0)), 'mm', units)}"
+        text = (f"{job.get('RoughingStrategy', 'levels')}, flank allowance "
+                f"{length_text(float(job.get('FlankAllowance', 0.0)), 'mm', units)}")
     elif group == "Machine":
         text = str(job.get("MachineName", ""))
     elif group == "Post":

@@ -1,0 +1,534 @@
+"""Flank roughing (docs/method.md, "Roughing at the tool's limit"): each tooth space cleared by the end mill's side at
+full depth, the rotary table turned so that a flank segment's chord is parallel to the tool axis.
+
+Frames: the space frame has the space's centre line up (+Z, heights are radii) and the gear axis at the origin;
+turning A by `theta` from the space's own A shows the section as R(theta) p (counter-clockwise), the "turned
+frame" in which the tool is a vertical half-strip [y - D/2, y + D/2] x [z_tip, oo) (spur gears). A helical pass
+follows the lead (roughing.follow_lead): the tool's slice at dx from its axis sees the section turned by a further
+dx tan(beta) / r, so the tool's section is the union of those slices turned (its reach and its corners' sag
+follow from that union exactly, `_Slices`).
+
+Plan of one space (the same for every space, so computed once):
+
+1. Each flank (offset by the finish stock) is cut into segments from the lowest level (where the space is as wide
+   as the tool) to the tip edge; a segment is as long as the material the tool's side leaves on it, measured
+   horizontally in its turned frame, stays within flank_allowance_mm - finish_stock_mm.
+2. For a segment, A is turned so that its chord is vertical; the tool's finishing position is the farthest toward
+   the flank at which no point of the design grown by the finish stock lies inside the tool; its tip is at the
+   segment's lower end.
+3. Passes step from the cleared middle of the space toward that position, a radial engagement of at most
+   max_radial_engagement_fraction x D apart, each at full depth (tiers of at most the axial depth limit). The
+   first position is the one next to where the tool finds no more material; when the tool reaches the other
+   flank first, that position is cut as a slot in levels of at most max_level_depth_fraction x D.
+4. A stock model of the section (shapely polygons) follows every pass: it gives each pass's radial engagement and
+   axial depth, and the feed raised by chip thinning so the largest chip equals feed_per_tooth_mm.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from spur_cad.cam.common import offset_flank
+from spur_cad.cam.machine import MachineError, RoughingParams
+from spur_cad.cam.tools import Tool, ToolError
+from spur_cad.geometry.sampling import full_space_points, sample_profile
+from spur_cad.geometry.spec import GearSpec
+
+HELICAL_SLICES = 201
+"""Slices of the tool across X for a helical gear: the sampled reach of their union is within about
+(2 R / (n - 1))^2 / (8 R) of the exact one (0.02 um for R = 1.75 mm)."""
+MAX_SEGMENTS_PER_FLANK = 16
+EMPTY_AREA_MM2 = 1e-8  # the stock model's slivers below this are no material
+TOL_MM = 1e-9
+MAX_POSITIONS = 100_000  # a run's positions (bounded by the space's width over the radial engagement)
+UNCUT_MM2 = 1e-4  # a plan leaving more than this (stock model) beyond the flank allowance is incomplete
+UNCUT_SPIKE_FRACTION = 0.25  # ... not counting the joints' spikes: where two segments' columns meet, the material
+# between them may stand a little farther from the design than any flank point's leftover (which the plan keeps)
+
+
+def chip_thinning_factor(radial_engagement_mm: float, diameter_mm: float, cap: float) -> float:
+    """Feed factor that keeps the largest chip at f_z: D / (2 sqrt(a_e (D - a_e))) below half the diameter (the
+    chip's thickest point is where the edge leaves the cut), 1 from there on; at most `cap`."""
+    a_e = radial_engagement_mm
+    if a_e >= diameter_mm / 2.0:
+        return 1.0
+    if a_e <= 0.0:
+        return cap
+    return min(cap, diameter_mm / (2.0 * math.sqrt(a_e * (diameter_mm - a_e))))
+
+
+@dataclass(frozen=True)
+class FlankLimits:
+    """The engagement limits a flank roughing plan keeps (from [roughing] and the tool)."""
+
+    diameter_mm: float
+    radial_engagement_mm: float  # largest a_e of a pass deeper than a slot
+    axial_depth_mm: float  # largest a_p of any pass
+    slot_depth_mm: float  # largest a_p of a pass wider than radial_engagement_mm
+    feed_factor_cap: float
+
+    @staticmethod
+    def of(tool: Tool, params: RoughingParams) -> FlankLimits:
+        axial = params.max_axial_depth_mm or default_axial_depth_mm(tool)
+        slot = min(params.max_level_depth_fraction * tool.diameter_mm, axial)
+        return FlankLimits(tool.diameter_mm, params.max_radial_engagement_fraction * tool.diameter_mm, axial, slot,
+                           params.max_feed_factor)
+
+
+def default_axial_depth_mm(tool: Tool) -> float:
+    """The axial depth limit when [roughing] max_axial_depth_mm is 0: the flute length, at most 2 D (a common
+    catalogue limit for side milling with solid carbide end mills)."""
+    return min(tool.flute_length_mm, 3.0 * tool.diameter_mm) if tool.flute_length_mm > 0.0 else \
+        3.0 * tool.diameter_mm
+
+
+@dataclass(frozen=True)
+class FlankSegment:
+    """One segment of the right flank and how it is cut (turned frame); the left flank's are its mirror."""
+
+    turn_deg: float
+    tip_z_mm: float
+    side_y_mm: float  # tool centre at the finishing position
+    far_y_mm: float  # tool centre where it meets the other flank
+    leftover_mm: float  # largest material left on the segment (horizontal, offset flank)
+    low_height_mm: float  # the segment's ends on the space axis (space frame), for reports
+    high_height_mm: float
+
+
+@dataclass(frozen=True)
+class FlankPass:
+    """One pass along X of a space (turned frame: machine Y, Z at A = the space's A + turn)."""
+
+    turn_deg: float
+    y_mm: float
+    z_mm: float
+    radial_engagement_mm: float
+    axial_depth_mm: float
+    feed_factor: float
+    run: int  # index of the (segment, side) run
+    removed_mm2: float = 0.0  # the section's material the pass cuts (stock model)
+
+
+@dataclass(frozen=True)
+class FlankPlan:
+    segments: tuple[FlankSegment, ...]
+    passes: tuple[FlankPass, ...]
+    limits: FlankLimits
+    uncut_mm2: float  # what the plan leaves beyond the flank allowance (stock model; 0 when complete)
+
+    @property
+    def lowest_z_mm(self) -> float:
+        return min(p.z_mm for p in self.passes)
+
+    @property
+    def max_radial_engagement_fraction(self) -> float:
+        return max(p.radial_engagement_mm for p in self.passes) / self.limits.diameter_mm
+
+    @property
+    def max_axial_depth_mm(self) -> float:
+        return max(p.axial_depth_mm for p in self.passes)
+
+    @property
+    def removed_mm2(self) -> float:
+        """Section area one space's passes remove (stock model)."""
+        return sum(p.removed_mm2 for p in self.passes)
+
+
+def _rotate(points: np.ndarray, angle_rad: float | np.ndarray) -> np.ndarray:
+    """R(angle) p for points (n, 2) (y, z); several angles (m,) give (m, n, 2)."""
+    c, s = np.cos(angle_rad), np.sin(angle_rad)
+    y, z = points[..., 0], points[..., 1]
+    if np.ndim(angle_rad) == 0:
+        return np.stack([c * y - s * z, s * y + c * z], axis=-1)
+    c, s = c[:, None], s[:, None]
+    return np.stack([c * y - s * z, s * y + c * z], axis=-1)
+
+
+@dataclass(frozen=True)
+class _Slices:
+    """The tool's section as slices: half-widths and the extra turn each sees (one unturned slice for spur)."""
+
+    half_widths_mm: np.ndarray
+    turns_rad: np.ndarray
+
+    @staticmethod
+    def of(spec: GearSpec, tool: Tool) -> _Slices:
+        radius = tool.diameter_mm / 2.0
+        twist = abs(spec.section_turn_rad(1.0))
+        if twist == 0.0:
+            return _Slices(np.array([radius]), np.array([0.0]))
+        dx = np.linspace(-radius, radius, HELICAL_SLICES)
+        return _Slices(np.sqrt(np.maximum(radius * radius - dx * dx, 0.0)), twist * dx)
+
+
+class _SpaceGeometry:
+    """The design grown by the finish stock around one space: its boundary points right and left of the space's
+    centre line (exact offsets, dense), and as a polygon for the stock model."""
+
+    def __init__(self, spec: GearSpec, tool: Tool, params: RoughingParams, blank_radius_mm: float):
+        import shapely
+
+        self.blank = blank_radius_mm
+        samples = sample_profile(spec.tooth_space_profile(), 1e-6 * spec.module_mm)
+        points = samples.points + params.finish_stock_mm * samples.normals  # offset right half, root to tooth centre
+        involute = np.array(samples.label_names()) == "involute"
+        corner, normal_in = samples.points[involute][-1], samples.normals[involute][-1]  # the tip edge
+        radial = corner / np.linalg.norm(corner)
+        start, end = math.atan2(normal_in[1], normal_in[0]), math.atan2(radial[1], radial[0])
+        arc = corner + params.finish_stock_mm * np.stack(
+            [np.cos(np.linspace(start, end, 64)), np.sin(np.linspace(start, end, 64))], axis=1)
+        self.right = np.concatenate([points, arc])  # the corner's round (the grown design's) included
+        self.left = self.right * np.array([-1.0, 1.0])
+        self.max_radius_mm = float(np.hypot(*self.right.T).max())
+        self.flank, _, _ = offset_flank(spec, params.finish_stock_mm)
+        self.slices = _Slices.of(spec, tool)
+        pitch = 2.0 * math.pi / spec.teeth
+        space = full_space_points(sample_profile(spec.tooth_space_profile(), 1e-4 * spec.module_mm))
+        chunks = [_rotate(space, k * pitch) for k in (-1, 0, 1)]  # spaces -1, 0, 1: the teeth beside space 0
+        ring = np.concatenate(chunks + [np.zeros((1, 2))])
+        design = shapely.Polygon(ring).buffer(0.0)
+        self.design = design
+        grown = design.buffer(params.finish_stock_mm, quad_segs=16) if params.finish_stock_mm > 0.0 else design
+        angles = np.linspace(-pitch, pitch, 129)
+        wedge = shapely.Polygon(np.concatenate(
+            [[[0.0, 0.0]], (blank_radius_mm + 1.0) * np.stack([np.sin(angles), np.cos(angles)], axis=1)]))
+        blank = shapely.Point(0.0, 0.0).buffer(blank_radius_mm, quad_segs=512)
+        self.stock = blank.intersection(wedge).difference(grown)
+        self.keep = design.buffer(params.flank_allowance_mm, quad_segs=16)
+
+    def limits(self, turn_rad: float, tip_z_mm: float, sides: str = "both") -> tuple[float, float]:
+        """(largest tool-centre y short of the right side, smallest short of the left side) at this turn and tip
+        height: no point of the grown design inside any slice of the tool (its boundary's vertices above the tip
+        and the points where its edges cross the tip's height). `sides` "left": only the second (the first inf)."""
+        right = math.inf if sides == "left" else -self._reach(self.right, turn_rad, tip_z_mm, 1.0)
+        return right, self._reach(self.left, turn_rad, tip_z_mm, -1.0)
+
+    def _reach(self, points: np.ndarray, turn_rad: float, tip_z_mm: float, sign: float) -> float:
+        """-min (sign 1) or max (sign -1) over the slices of (y -/+ half-width) of the polyline's points at or
+        above the tip height. The slices' extra turns move a point by at most |p| max|turn| (`shift`): only points
+        within that (and a radius) of the unturned slice's extreme can decide, so only they are turned."""
+        slices = self.slices
+        half = slices.half_widths_mm
+        radius = float(half.max())
+        turned = _rotate(points, turn_rad)
+        shift = float(np.abs(slices.turns_rad).max()) * self.max_radius_mm
+        if shift == 0.0:
+            low, high = _edge_reach(turned[None], tip_z_mm)
+            return float(-(low[0] - radius)) if sign > 0 else float(high[0] + radius)
+        y = sign * turned[:, 0]  # the side's y, toward +y
+        near = turned[:, 1] >= tip_z_mm - shift - 1e-9  # above the tip in some slice
+        if not near.any():
+            return -math.inf
+        sure = turned[:, 1] >= tip_z_mm + shift  # above it in every slice: they bound the answer
+        keep = near & (y <= y[sure].min() + 2.0 * shift + radius) if sure.any() else near
+        keep = keep | np.roll(keep, 1) | np.roll(keep, -1)  # the neighbours: the edges crossing the tip height
+        keep[0], keep[-1] = keep[0] or keep[1], keep[-1] or keep[-2]
+        index = np.flatnonzero(keep)
+        subset = _rotate(points[index], turn_rad + slices.turns_rad)
+        low, high = _edge_reach(subset, tip_z_mm, np.diff(index) == 1)
+        if sign > 0:
+            return float(-np.min(low - half))
+        return float(np.max(high + half))
+
+
+def _edge_reach(points: np.ndarray, tip_z_mm: float,
+                edges: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """Per slice (points (m, n, 2), a polyline each), the least and the largest y of the polyline at or above the
+    height: its vertices above it and its edges' crossings of it (inf / -inf where none); `edges` (n - 1,): which
+    consecutive points are joined (all by default)."""
+    y, z = points[..., 0], points[..., 1]
+    above = z >= tip_z_mm - 1e-12  # a vertex at the tip height touches the flat bottom
+    low_y = np.where(above, y, np.inf).min(axis=1)
+    high_y = np.where(above, y, -np.inf).max(axis=1)
+    za, zb, ya, yb = z[:, :-1], z[:, 1:], y[:, :-1], y[:, 1:]
+    crosses = (za - tip_z_mm) * (zb - tip_z_mm) < 0.0
+    if edges is not None:
+        crosses = crosses & edges
+    t = np.where(crosses, (tip_z_mm - za) / np.where(crosses, zb - za, 1.0), 0.0)
+    at = ya + t * (yb - ya)
+    low_y = np.minimum(low_y, np.where(crosses, at, np.inf).min(axis=1))
+    high_y = np.maximum(high_y, np.where(crosses, at, -np.inf).max(axis=1))
+    return low_y, high_y
+
+
+def _evaluate(geo: _SpaceGeometry, i0: int, i1: int, radius: float) -> FlankSegment | None:
+    """The segment of offset-flank points i0..i1 cut with its chord vertical, or turned less (where the tool does
+    not fit between the flanks at that turn, or where the flank above overhangs it): of the turns tried, the one
+    leaving least on the segment; None if the tool fits at none."""
+    points = geo.flank[i0:i1 + 1]
+    chord = points[-1] - points[0]
+    full = math.atan2(chord[0], chord[1])
+    best = None
+    for fraction in (1.0, 0.75, 0.5, 0.25, 0.0):
+        turn = full * fraction
+        turned = _rotate(points, turn)
+        tip_z = float(turned[:, 1].min())
+        side, far = geo.limits(turn, tip_z)
+        if far <= side + TOL_MM:
+            leftover = max(float((turned[:, 0] - (side + radius)).max()), 0.0)
+            if best is None or leftover < best.leftover_mm - 1e-9:
+                best = FlankSegment(math.degrees(turn), tip_z, side, far, leftover, float(points[0, 1]),
+                                    float(points[-1, 1]))
+    return best
+
+
+def flank_segments(geo: _SpaceGeometry, lowest_height_mm: float, budget_mm: float, radius: float,
+                   params: RoughingParams) -> list[FlankSegment]:
+    """Segments of the right offset flank from the lowest level to its tip edge, each the longest whose leftover
+    stays within the budget (bisection over the end point), bottom to top."""
+    heights = geo.flank[:, 1]
+    i0 = int(np.searchsorted(heights, lowest_height_mm)) if np.all(np.diff(heights) >= 0) else \
+        int(np.argmax(heights >= lowest_height_mm))
+    i0 = min(max(i0, 0), len(heights) - 2)
+    last = len(heights) - 1
+    segments: list[FlankSegment] = []
+    while i0 < last:
+        if len(segments) == MAX_SEGMENTS_PER_FLANK:
+            raise MachineError(f"[roughing] flank_allowance_mm = {params.flank_allowance_mm:g} would need more than "
+                               f"{MAX_SEGMENTS_PER_FLANK} flank segments per flank; raise it",
+                               field="flank_allowance_mm", section="roughing")
+        whole = _evaluate(geo, i0, last, radius)
+        if whole is not None and whole.leftover_mm <= budget_mm:
+            segments.append(whole)
+            break
+        lo, hi, best = i0 + 1, last, None
+        while lo <= hi:
+            mid = (lo + hi) // 2
+            segment = _evaluate(geo, i0, mid, radius)
+            if segment is not None and segment.leftover_mm <= budget_mm:
+                best, lo = (mid, segment), mid + 1
+            else:
+                hi = mid - 1
+        if best is None:
+            raise MachineError(f"[roughing] flank_allowance_mm = {params.flank_allowance_mm:g}: the tool's side "
+                               f"cannot rough the flank at height {heights[i0]:.3f} mm within it; raise it or "
+                               "choose strategy = \"levels\"", field="flank_allowance_mm", section="roughing")
+        i0 = best[0]
+        segments.append(best[1])
+    return segments
+
+
+class _Stock:
+    """The material of one space's section (space frame) as the passes leave it, in shapely polygons."""
+
+    def __init__(self, polygon):
+        self.polygon = polygon
+
+    def view(self, turn_deg: float, side: int):
+        """The stock in a run's frame: turned, and mirrored for the left flank so that the passes step toward +u."""
+        from shapely import affinity
+
+        turned = affinity.rotate(self.polygon, turn_deg, origin=(0.0, 0.0))
+        return turned if side > 0 else affinity.scale(turned, -1.0, 1.0, origin=(0.0, 0.0))
+
+    def store(self, view, turn_deg: float, side: int) -> None:
+        from shapely import affinity
+
+        back = view if side > 0 else affinity.scale(view, -1.0, 1.0, origin=(0.0, 0.0))
+        self.polygon = affinity.rotate(back, -turn_deg, origin=(0.0, 0.0))
+
+
+def _polygons(geometry):
+    """The polygonal parts of a shapely result with some area (intersections also return lines and points)."""
+    import shapely
+
+    parts = shapely.get_parts(geometry)
+    return [part for part in parts if part.geom_type == "Polygon" and part.area >= EMPTY_AREA_MM2]
+
+
+def _material(view, cut):
+    import shapely
+
+    parts = _polygons(view.intersection(cut))
+    return shapely.MultiPolygon(parts) if parts else None
+
+
+BAND_SAMPLE_MM = 0.02  # heights at which a pass's material is measured across
+
+
+def _tiers(material, u: float, radius: float, z_tip: float, step: float, limits: FlankLimits,
+           direction: int = 1) -> list[tuple[float, float, float]]:
+    """The tiers (z of the tool tip, top of the material it cuts, a_e) that cut the material in the tool's reach at
+    position u, top first, each as deep as allowed: at most the slot depth where the material reaches farther than
+    `step` from the tool's leading edge (u + radius; u - radius for `direction` -1), else at most the axial depth
+    limit. The reach is measured on lines BAND_SAMPLE_MM apart, each line's taken as the largest of it and its
+    neighbours, then checked exactly on the tier."""
+    import shapely
+
+    top = material.bounds[3]
+    count = max(2, math.ceil((top - z_tip) / BAND_SAMPLE_MM) + 1)
+    heights = np.linspace(z_tip, top, count)
+    lines = shapely.linestrings(np.stack([np.stack([np.full(count, u - radius - 1.0), heights], axis=1),
+                                          np.stack([np.full(count, u + radius + 1.0), heights], axis=1)], axis=1))
+    bounds = shapely.bounds(shapely.intersection(material, lines))
+    far_side = bounds[:, 0] if direction > 0 else bounds[:, 2]
+    reach = np.where(np.isnan(far_side), 0.0, np.minimum(direction * (u - far_side) + radius, 2.0 * radius))
+    padded = np.concatenate([[reach[0]], reach, [reach[-1]]])
+    reach = np.maximum(reach, np.maximum(padded[:-2], padded[2:]))
+    tiers = []
+    high = top
+    while high > z_tip + 1e-9:
+        low = max(high - limits.axial_depth_mm, z_tip)
+        wide = (heights >= low - 1e-12) & (heights <= high + 1e-12) & (reach > step + 1e-6)
+        if wide.any():
+            highest_wide = float(heights[wide].max())
+            low = highest_wide + BAND_SAMPLE_MM if highest_wide < high - limits.slot_depth_mm else \
+                max(high - limits.slot_depth_mm, z_tip)
+        a_e, top_here = _reach(material, u, radius, low, high, direction)
+        if a_e > step + 1e-6 and high - low > limits.slot_depth_mm:  # wider between the lines: a slot tier
+            low = max(high - limits.slot_depth_mm, z_tip)
+            a_e, top_here = _reach(material, u, radius, low, high, direction)
+        if a_e > 0.0:
+            tiers.append((low, top_here, a_e))
+        high = low
+    return tiers
+
+
+def _reach(material, u: float, radius: float, low: float, high: float, direction: int = 1) -> tuple[float, float]:
+    """How far the material between two heights reaches from the tool's leading edge (u + radius advancing
+    toward +u, `direction` 1; u - radius toward -u), and its top (0, low: none there)."""
+    import shapely
+
+    parts = _material(material, shapely.box(u - radius, low, u + radius, high))
+    if parts is None:
+        return 0.0, low
+    far_side = parts.bounds[0] if direction > 0 else parts.bounds[2]
+    return float(min(direction * (u - far_side) + radius, 2.0 * radius)), float(parts.bounds[3])
+
+
+def _floor_mm(geo: _SpaceGeometry, segment: FlankSegment, u: float, top_z: float) -> float:
+    """The lowest tool tip at position u of a segment's run: the segment's tip where the tool is clear of the
+    other flank there, else the height from which it is (bisection: the far limit falls as the tip rises)."""
+    if u >= segment.far_y_mm - TOL_MM:
+        return segment.tip_z_mm
+    turn = math.radians(segment.turn_deg)
+    low, high = segment.tip_z_mm, top_z
+    if geo.limits(turn, high, "left")[1] > u:
+        return top_z
+    while high - low > 1e-7:
+        mid = 0.5 * (low + high)
+        low, high = (mid, high) if geo.limits(turn, mid, "left")[1] > u else (low, mid)
+    return high
+
+
+def _run_order(geo: _SpaceGeometry, segment: FlankSegment, step: float, own_material,
+               top_z: float) -> list[tuple[float, float, int]]:
+    """A run's positions in cutting order as (u, tip height, the side the tool advances into: 1 toward +u), see
+    _run_passes; `own_material(u, floor)`: whether the tool there meets material it must cut."""
+    u_final, u_far, tip = segment.side_y_mm, segment.far_y_mm, segment.tip_z_mm
+    for k in range(MAX_POSITIONS):
+        u = u_final - k * step
+        if u <= u_far + TOL_MM:  # the other flank: its column first, then beyond it, then back to the flank
+            beyond = []
+            for j in range(1, MAX_POSITIONS):
+                floor = _floor_mm(geo, segment, u_far - j * step, top_z)
+                if floor >= top_z or not own_material(u_far - j * step, floor):
+                    break
+                beyond.append((u_far - j * step, floor, -1))
+            return [(u_far, tip, 1)] + beyond + [(v, tip, 1) for v in np.linspace(u_far, u_final, k + 1)[1:]]
+        if not own_material(u, tip):
+            return [(v, tip, 1) for v in u_final - step * np.arange(k)[::-1]]
+    raise MachineError(f"flank roughing: a run would need more than {MAX_POSITIONS} positions", field="diameter_mm",
+                       section="tools.roughing")
+
+
+def _run_passes(stock: _Stock, geo: _SpaceGeometry, segment: FlankSegment, side: int, run: int,
+                limits: FlankLimits, model_radius: float, top_z: float, centre: bool = False) -> list[FlankPass]:
+    """The passes of one run (a segment's turn, one flank), the stock model updated after each; each position is
+    cut at full depth in tiers (slot levels where the tool would be engaged wider than the radial limit).
+    Positions step from the flank toward the middle of the space until the tool finds no more material that needs
+    cutting on its own side of the space's centre line; they are then cut from there to the flank. Where the tool
+    meets the other flank first, the column touching it is cut first (a slot in levels), then the positions beyond
+    it with the tip raised clear of that flank, stepping away from the flank, then the positions back to the
+    flank. `centre`: the one position of a segment on the space's centre line (the bottom's clean-up)."""
+    import shapely
+    from shapely import affinity
+
+    turn = segment.turn_deg * side
+    view = stock.view(turn, side)
+    keep = _Stock(geo.keep).view(turn, side)  # within the flank allowance of the design: need not be cut
+    half = affinity.rotate(shapely.box(0.0, -1e3, 1e3, 1e3), turn * side, origin=(0.0, 0.0))  # own side, turned
+    u_final, tip = segment.side_y_mm, segment.tip_z_mm
+    step = limits.radial_engagement_mm
+
+    def box(u: float, floor: float):
+        return shapely.box(u - model_radius, floor, u + model_radius, top_z)
+
+    def own_material(u: float, floor: float) -> bool:
+        return _material(view.intersection(half).difference(keep), box(u, floor)) is not None
+
+    order = [(u_final, tip, 1)] if centre else _run_order(geo, segment, step, own_material, top_z)
+    passes: list[FlankPass] = []
+    for u, floor, direction in order:
+        material = _material(view, box(u, floor))
+        needed = _material(view.difference(keep), box(u, floor))
+        if material is None or (needed is None and u != u_final):  # the flank's own column is always cut
+            continue
+        tiers = _tiers(material, u, model_radius, floor, step, limits, direction)
+        if u != u_final:  # the tiers below the last needed material are left out
+            lowest_needed = needed.bounds[1]
+            while len(tiers) > 1 and tiers[-1][1] <= lowest_needed + 1e-9 and tiers[-2][0] >= lowest_needed - 1e-9:
+                tiers.pop()
+        ceiling = top_z
+        for low, high, a_e in tiers:
+            factor = chip_thinning_factor(a_e, limits.diameter_mm, limits.feed_factor_cap)
+            area = material.intersection(shapely.box(u - model_radius, low, u + model_radius, ceiling)).area
+            passes.append(FlankPass(turn, u * side, low, a_e, high - low, factor, run, float(area)))
+            ceiling = low
+        view = view.difference(box(u, tiers[-1][0]))
+    stock.store(view, turn, side)
+    return passes
+
+
+def plan_flank_roughing(spec: GearSpec, tool: Tool, params: RoughingParams, blank_radius_mm: float,
+                        lowest_height_mm: float, model_radius_mm: float, land_half_width_mm: float) -> FlankPlan:
+    """The passes of one tooth space (module docstring); `lowest_height_mm`: the lowest level (the space as wide
+    as the tool's transverse width), `model_radius_mm`: the tool's half-width in the stock model (its transverse
+    radius for a helical gear), `land_half_width_mm`: how far the tip passes clear each side of a tooth's centre
+    line (what they leave is not the runs' to take). Pure."""
+    geo = _SpaceGeometry(spec, tool, params, blank_radius_mm)
+    limits = FlankLimits.of(tool, params)
+    budget = params.flank_allowance_mm - params.finish_stock_mm
+    segments = flank_segments(geo, lowest_height_mm, budget, tool.diameter_mm / 2.0, params)
+    if not segments:
+        raise ToolError("flank roughing: no flank segment above the lowest level", field="diameter_mm",
+                        section="tools.roughing")
+    stock = _Stock(geo.stock)
+    passes: list[FlankPass] = []
+    run = 0
+    for side in (1, -1):
+        for segment in segments:  # the lowest (longest) first: the higher ones take what it leaves
+            passes.extend(_run_passes(stock, geo, segment, side, run, limits, model_radius_mm,
+                                      blank_radius_mm + 1.0))
+            run += 1
+    # the bottom of the space between the lowest segments' columns, straight down the middle to the lowest level
+    bottom = FlankSegment(0.0, lowest_height_mm, 0.0, 0.0, 0.0, lowest_height_mm, lowest_height_mm)
+    passes.extend(_run_passes(stock, geo, bottom, 1, run, limits, model_radius_mm, blank_radius_mm + 1.0,
+                              centre=True))
+    return FlankPlan(tuple(segments), tuple(passes), limits,
+                     _uncut_mm2(geo, stock, spec, params, lowest_height_mm, land_half_width_mm))
+
+
+def _uncut_mm2(geo: _SpaceGeometry, stock: _Stock, spec: GearSpec, params: RoughingParams,
+               lowest_height_mm: float, land_half_width_mm: float) -> float:
+    """Area of the stock model's section the plan leaves in the space farther than flank_allowance_mm from the
+    design above the lowest level, less the tip lands' columns (their passes reach `land_half_width_mm` each side of
+    a tooth's centre line); 0 when the plan is complete."""
+    import shapely
+    from shapely import affinity
+
+    half = math.pi / spec.teeth
+    angles = np.linspace(-half, half, 65)
+    sector = shapely.Polygon(np.concatenate([[[0.0, 0.0]], 2.0 * geo.blank * np.stack([np.sin(angles),
+                                                                                       np.cos(angles)], axis=1)]))
+    above = shapely.box(-geo.blank, lowest_height_mm, geo.blank, 2.0 * geo.blank)
+    band = geo.design.buffer(params.flank_allowance_mm + UNCUT_SPIKE_FRACTION * (params.flank_allowance_mm
+                                                                                 - params.finish_stock_mm) + 1e-3,
+                             quad_segs=32)
+    lands = shapely.union_all([affinity.rotate(shapely.box(-land_half_width_mm, spec.tip_radius_mm, land_half_width_mm,
+                                                           2.0 * geo.blank), sign * math.degrees(half),
+                                               origin=(0.0, 0.0)) for sign in (-1.0, 1.0)])
+    return float(stock.polygon.intersection(sector).intersection(above).difference(band).difference(lands).area)
