@@ -155,3 +155,26 @@ def test_a_machine_s_largest_feed_caps_the_raised_feed():
     path = roughing_toolpath(spec, tool, slow, params, spec.tip_radius_mm + 0.5)
     cutting = (path.feature == Feature.LEVEL) & (path.kind == MoveKind.LINEAR)
     assert path.feed[cutting].max() <= slow.max_feed_mm_min + 1e-9
+
+
+def test_clamp_rotary_holds_a_for_every_cut_and_releases_it_for_every_turn():
+    """[roughing] clamp_rotary with the flank strategy: A turns between runs of one space, so the table is
+    released before every move that turns A and clamped before every cutting move (read from the IR alone)."""
+    from spur_cad.cam.roughing import roughing_toolpath
+
+    spec = spec_of("reference_z23_m4")
+    tool, _ = tools_for("reference_z23_m4")
+    machine = Machine(rotary_clamp_code="M10", rotary_unclamp_code="M11")
+    params = RoughingParams(flank_allowance_mm=0.3, finish_stock_mm=0.02, strategy="flank", clamp_rotary=True)
+    path = roughing_toolpath(spec, tool, machine, params, spec.tip_radius_mm + 0.5)
+    clamped, a, turns_while_clamped, cuts_unclamped = False, path.a[0], 0, 0
+    for i in range(len(path)):
+        if path.kind[i] in (MoveKind.CLAMP_ROTARY, MoveKind.UNCLAMP_ROTARY):
+            clamped = path.kind[i] == MoveKind.CLAMP_ROTARY
+            continue
+        turns_while_clamped += int(clamped and path.a[i] != a)
+        cuts_unclamped += int(path.feature[i] in (Feature.LEVEL, Feature.TIP) and not clamped)
+        a = path.a[i]
+    assert turns_while_clamped == 0 and cuts_unclamped == 0
+    runs = len(np.unique(path.station[(path.space == 0) & (path.feature == Feature.LEVEL)]))
+    assert np.count_nonzero((path.kind == MoveKind.CLAMP_ROTARY) & (path.space == 0)) >= runs + 1  # + the tip land

@@ -356,6 +356,26 @@ def _tip_offsets_mm(spec: GearSpec, tool: Tool, params: RoughingParams) -> np.nd
     return _pass_offsets(abs(edge), params.step_over_fraction * tool.diameter_mm)
 
 
+@dataclass
+class _Clamp:
+    """[roughing] clamp_rotary for the flank strategy: A clamped before every cut, unclamped before every move
+    that turns it (between runs, to the tip land, to the next space); nothing without the key."""
+
+    builder: ToolpathBuilder
+    enabled: bool
+    held: bool = False
+
+    def hold(self, space: int) -> None:
+        if self.enabled and not self.held:
+            self.builder.move(MoveKind.CLAMP_ROTARY, *self.builder.last_pose(), space=space)
+            self.held = True
+
+    def release(self, space: int) -> None:
+        if self.enabled and self.held:
+            self.builder.move(MoveKind.UNCLAMP_ROTARY, *self.builder.last_pose(), space=space)
+            self.held = False
+
+
 def _link_poses(previous, following) -> list[tuple[float, float, float]]:
     """The (Y, Z, turn) poses a link between two passes goes through after leaving the first: straight within a
     run; between runs up to the higher pass's Z first, across (Y and A), then down."""
@@ -413,18 +433,21 @@ def _flank_toolpath(spec: GearSpec, tool: Tool, machine: Machine, params: Roughi
     pitch_deg = 360.0 / spec.teeth
     tip_heights = tip_heights_mm(spec, tool, params, blank_radius_mm) if tips else np.zeros(0)
     builder = ToolpathBuilder(Operation.ROUGHING, tool.tool_number, tool.spindle_rpm(machine))
+    clamp = _Clamp(builder, params.clamp_rotary)
     for k in range(spec.teeth):
         a = -k * pitch_deg
         first = plan.passes[0]
-        if params.clamp_rotary and k > 0:
-            builder.move(MoveKind.UNCLAMP_ROTARY, *builder.last_pose(), space=k)
+        clamp.release(k)
         builder.move(MoveKind.RAPID, x_front, first.y_mm, safe_z, a + first.turn_deg, space=k)
         x_here, previous = x_front, None
         for p in plan.passes:
             a_pass = a + p.turn_deg
             # the link, outside the blank at this end of the passes (in the air: the machine's largest feed)
             for y_link, z_link, turn_link in _link_poses(previous, p):
+                if a + turn_link != builder.last_pose()[3]:
+                    clamp.release(k)
                 builder.move(MoveKind.LINEAR, x_here, y_link, z_link, a + turn_link, air, space=k, station=p.run)
+            clamp.hold(k)
             previous = p
             x_end = x_back if x_here == x_front else x_front
             builder.move(MoveKind.LINEAR, x_end, p.y_mm, p.z_mm, a_pass, min(feed * p.feed_factor, air), space=k,
@@ -438,7 +461,9 @@ def _flank_toolpath(spec: GearSpec, tool: Tool, machine: Machine, params: Roughi
         builder.move(MoveKind.LINEAR, x_here, builder.last_pose()[1], safe_z, builder.last_pose()[3], air, space=k)
         if len(tip_heights):  # the tip land of the tooth between spaces k and k + 1, its axis up
             a_tip = a - pitch_deg / 2.0
+            clamp.release(k)
             builder.move(MoveKind.RAPID, x_front, tip_offsets[0], safe_z, a_tip, space=k)
+            clamp.hold(k)
             passes = _Passes(builder, x_front, x_back, safe_z, feed)
             passes.levels(a_tip, k, tip_heights, [tip_offsets] * len(tip_heights), [-1] * len(tip_heights),
                           Feature.TIP)
