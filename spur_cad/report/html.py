@@ -75,8 +75,14 @@ def program_notes(result: JobResult) -> tuple[str, ...]:
     if rough is not None:
         tips = (f"; {len(rough.tip_heights_mm)} over each tip land, down to "
                 f"{number(rough.tip_heights_mm[-1], 3)} mm from the axis" if rough.tip_heights_mm else "")
-        notes.append(f"Roughing: {rough.levels_per_space} levels per space, the lowest "
-                     f"{number(rough.lowest_level_height_mm, 3)} mm above the root circle{tips}.")
+        if rough.passes_per_space is not None:
+            turns = ", ".join(number(abs(turn), 1) for turn in rough.flank_turns_deg)
+            notes.append(f"Roughing by flanks: {rough.passes_per_space} passes per space, A turned by +-({turns}) "
+                         f"deg to the flank segments, down to {number(rough.lowest_level_height_mm, 3)} mm above "
+                         f"the root circle{tips}.")
+        else:
+            notes.append(f"Roughing: {rough.levels_per_space} levels per space, the lowest "
+                         f"{number(rough.lowest_level_height_mm, 3)} mm above the root circle{tips}.")
         stage = rough.two_stage
         if stage is not None:
             notes.append(f"Two-stage roughing: the bottom tool (T{stage.bottom_tool.tool_number}, D "

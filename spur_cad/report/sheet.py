@@ -200,7 +200,9 @@ def operation_table(result: JobResult) -> Table:
     for name, facts, tool in operations:
         program = program_file(result, name)
         if name.startswith("roughing"):
-            strategy = f"z-level roughing, {facts.levels_per_space} levels per space"
+            strategy = (f"roughing by flanks, {facts.passes_per_space} passes per space"
+                        if facts.passes_per_space is not None else
+                        f"z-level roughing, {facts.levels_per_space} levels per space")
             stock = (f"{number(setup.finish_stock_mm, 2)} to {number(setup.flank_allowance_mm, 2)} mm"
                      if setup is not None else "-")
             steps = (f"down {number(setup.roughing_step_down_mm, 2)} mm, "
