@@ -178,3 +178,21 @@ def test_clamp_rotary_holds_a_for_every_cut_and_releases_it_for_every_turn():
     assert turns_while_clamped == 0 and cuts_unclamped == 0
     runs = len(np.unique(path.station[(path.space == 0) & (path.feature == Feature.LEVEL)]))
     assert np.count_nonzero((path.kind == MoveKind.CLAMP_ROTARY) & (path.space == 0)) >= runs + 1  # + the tip land
+
+
+def test_the_summary_the_report_and_the_program_name_the_strategy(reference):
+    import json
+
+    from spur_cad.pipeline import run_job
+
+    job, plan = reference
+    result = run_job(job)
+    summary = json.loads(result.files["summary.json"])["roughing"]
+    flank = plan.roughing.flank
+    assert summary["strategy"] == "flank" and summary["passes_per_space"] == len(flank.passes)
+    assert summary["flank_segment_turns_deg"] == pytest.approx([s.turn_deg for s in flank.segments])
+    assert summary["max_axial_depth_mm"] > 2.0 * job.roughing.max_level_depth_fraction * job.tools.roughing.diameter_mm
+    report = result.files["report.html"].decode()
+    assert f"roughing by flanks, {len(flank.passes)} passes per space" in report and "z-level roughing" not in report
+    program = result.files["roughing.ngc"].decode()
+    assert f"(strategy: by flanks, {len(flank.passes)} passes per space" in program
