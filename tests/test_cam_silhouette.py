@@ -129,13 +129,14 @@ def test_roughing_takes_the_blank_down_to_the_tip_circle_plus_the_finish_stock(n
     left = _left_above_tip_mm(spec, path, tool, blank)
     assert left <= math.hypot(edge, floor) - spec.tip_radius_mm + 0.005
     assert left <= 0.5 * finishing.diameter_mm
-    # without the tip passes the whole allowance stands there (levels), or more than with them (the flank runs
-    # take some of it beside the tip edges)
+    # without the tip passes the whole allowance stands there (levels); by flanks, more than with them (the runs
+    # take what they can of the lands beside the tip edges: two-stage roughing, which leaves the tip passes out of
+    # its bottom program, runs by levels)
     without = roughing_toolpath(spec, tool, Machine(), params, blank, tips=False)
     if strategy == "levels":
         assert _left_above_tip_mm(spec, without, tool, blank) == pytest.approx(0.5)
     else:
-        assert _left_above_tip_mm(spec, without, tool, blank) > left + 0.1
+        assert _left_above_tip_mm(spec, without, tool, blank) > left + 0.05
     # the work limit's estimate still bounds the moves, with several cuts over the tips on a large blank
     for radius in (blank, blank + 3.0):
         moves = len(roughing_toolpath(spec, tool, Machine(), params, radius))
@@ -177,3 +178,30 @@ def test_along_x_strategy_is_as_safe_and_warns_about_marks(name, design_polygons
     passes = (path.kind == MoveKind.LINEAR) & (path.x != np.concatenate([[path.x[0]], path.x[:-1]]))
     assert path.x[passes].min() < -tool.diameter_mm / 2
     assert path.x[passes].max() > spec.face_width_mm + tool.diameter_mm / 2
+
+
+@pytest.mark.parametrize("strategy", ["flank", "levels"])
+@pytest.mark.parametrize("name", CAM_GEARS)
+def test_roughing_leaves_no_material_beyond_the_flank_allowance(name, strategy, design_polygons):
+    """The material itself, not only the design points' distance to the tools: of space 0's sector of the blank
+    above the lowest pass at A = 0, what no silhouette of spaces 0, 1 and z - 1 (their tip lands' passes
+    included) covered lies within the flank allowance of the design (+1 um)."""
+    spec = spec_of(name)
+    tool, _ = tools_for(name)
+    params = RoughingParams(flank_allowance_mm=0.1 * spec.module_mm, finish_stock_mm=0.005 * spec.module_mm,
+                            strategy=strategy)
+    blank = spec.tip_radius_mm + 0.5
+    path = roughing_toolpath(spec, tool, Machine(), params, blank)
+    rows = path.motion_mask & np.isin(path.space, [0, 1, spec.teeth - 1])
+    union = shapely.union_all(silhouette.silhouettes_in_part_frame(path, tool.diameter_mm, 0.0, TOOL_LENGTH,
+                                                                   mask=rows))
+    lowest = float(path.z[path.motion_mask & (path.space == 0) & (path.feature == Feature.LEVEL)
+                          & (path.a == 0.0)].min())
+    half = math.pi / spec.teeth
+    angles = np.linspace(-half, half, 129)
+    sector = Polygon(np.concatenate([[[0.0, 0.0]], 2.0 * blank * np.stack([np.sin(angles), np.cos(angles)], axis=1)]))
+    stock = shapely.Point(0.0, 0.0).buffer(blank, quad_segs=1024).intersection(sector)
+    stock = stock.intersection(shapely.box(-2.0 * blank, lowest, 2.0 * blank, 2.0 * blank))
+    left = stock.difference(union).difference(design_polygons[name].buffer(params.flank_allowance_mm + 1e-3,
+                                                                             quad_segs=64))
+    assert left.area <= 1e-4, (left.area, left.bounds)

@@ -459,7 +459,7 @@ def _plan_roughing(inputs: CamInputs, levels: RoughingLevels, blank: float, tool
         else None
     path = roughing_toolpath(spec, tool, inputs.machine, inputs.roughing, blank, stock.back_margin_mm,
                              stock.stub_diameter_mm / 2.0, stock.front_margin_mm, levels=levels, tips=tips,
-                             flank_plan=flank)
+                             flank_plan=flank, stub_length_mm=stock.stub_length_mm)
     check_travel(inputs.machine, path.x, path.y, path.z, path.a, "roughing")
     heights = tip_heights_mm(spec, tool, inputs.roughing, blank) if tips else np.zeros(0)
     return RoughingPlan(tool, levels, lowest_above_root, path, estimate(path, inputs.machine), heights, flank)

@@ -72,21 +72,24 @@ def estimated_roughing_moves(spec: GearSpec, tool: Tool, params: RoughingParams,
 
 def _estimated_flank_moves(spec: GearSpec, tool: Tool, params: RoughingParams,
                            blank_radius_mm: float) -> tuple[int, str]:
-    """An upper bound of the flank strategy's moves (cam.flank_roughing), from the inputs alone: per space at most
-    2 MAX_SEGMENTS_PER_FLANK + 1 runs, each at most (twice the space's width at the blank, the positions toward and
-    beyond the other flank) / the radial engagement + 2 positions, each in at most (blank - root) / the slot depth
-    + 1 tiers, each pass with at most 5 moves (its link's three, itself, a return); the tip lands as the levels'."""
-    from spur_cad.cam.flank_roughing import MAX_SEGMENTS_PER_FLANK
+    """An upper bound of the flank strategy's moves (cam.flank_roughing): its flank segments are found first (a
+    bounded search: at most MAX_SEGMENTS_PER_FLANK bisections over the flank's points), then per space 2 segments
+    + 1 runs, each at most (twice the space's width at the blank) / the radial engagement + 2 positions, each cut
+    in at most 2 (depth / slot depth) + 2 tiers (narrow and wide tiers alternate at worst), each pass with at most
+    8 moves (its link's three, itself, a return's two, a clamp and a release); the tip lands as the levels'."""
+    from spur_cad.cam.flank_roughing import flank_segment_count
 
+    points, _, junction = offset_flank(spec, params.finish_stock_mm)
+    flank = _OffsetFlank(points, junction, abs(spec.section_turn_rad(1.0)) * tool.diameter_mm / 2.0)
+    lowest = _lowest_level(flank, tool, transverse_radius_mm(spec, tool, blank_radius_mm))
+    runs = 2 * flank_segment_count(spec, tool, params, blank_radius_mm, lowest) + 1
     step = params.max_radial_engagement_fraction * tool.diameter_mm
     slot = params.max_level_depth_fraction * tool.diameter_mm
     width = 2.0 * blank_radius_mm * math.tan(math.pi / spec.teeth)
     positions = math.ceil(2.0 * width / step) + 2
-    tiers = math.ceil((blank_radius_mm - spec.root_radius_mm) / slot) + 1
-    tip_passes = math.ceil(2.0 * blank_radius_mm * math.tan(math.pi / spec.teeth)
-                           / (params.step_over_fraction * tool.diameter_mm)) + 1
-    moves = spec.teeth * ((2 * MAX_SEGMENTS_PER_FLANK + 1) * positions * tiers * 5 + 6
-                          + tiers * (2 * tip_passes + 4))
+    tiers = 2 * math.ceil((blank_radius_mm - spec.root_radius_mm) / slot) + 2
+    tip_passes = math.ceil(width / (params.step_over_fraction * tool.diameter_mm)) + 1
+    moves = spec.teeth * (runs * positions * tiers * 8 + 6 + tiers * (2 * tip_passes + 4))
     driver = "max_radial_engagement_fraction" if positions >= tiers else "max_level_depth_fraction"
     return moves, driver
 
@@ -215,10 +218,11 @@ def check_helical_roughing_machine(spec: GearSpec, machine: Machine) -> None:
 def roughing_toolpath(spec: GearSpec, tool: Tool, machine: Machine, params: RoughingParams,
                       blank_radius_mm: float, back_margin_mm: float = 0.0, stub_radius_mm: float = 0.0,
                       front_margin_mm: float = 0.0, levels: RoughingLevels | None = None,
-                      tips: bool = True, flank_plan=None) -> Toolpath:
+                      tips: bool = True, flank_plan=None, stub_length_mm: float = 0.0) -> Toolpath:
     """The roughing operation as IR (pure function); `levels` when the caller has computed them already. `tips`:
     after each space, the passes over the tip land beside it (tip_heights_mm; two-stage roughing's bottom tool
-    leaves them to the larger tool). `flank_plan`: the flank strategy's plan when the caller has it (flank_plan_for)."""
+    leaves them to the larger tool). `flank_plan`: the flank strategy's plan when the caller has it (flank_plan_for);
+    `stub_length_mm`: the holding stub's (whether the flank strategy's passes may run on over it)."""
     params.validate()
     machine.validate()
     tool.validate("roughing")
@@ -230,18 +234,16 @@ def roughing_toolpath(spec: GearSpec, tool: Tool, machine: Machine, params: Roug
     sweep_radius = transverse_radius_mm(spec, tool, blank_radius_mm)
     x_front = -(front_margin_mm + radius + machine.clearance_mm)
     x_back = spec.face_width_mm + radius + machine.clearance_mm
-    if stub_radius_mm > levels.lowest_height_mm and back_margin_mm < radius + machine.clearance_mm:
-        raise MachineError(f"the roughing tool would cut into the holding stub: its passes run to X = {x_back:.3f} mm; "
-                           f"make [stock] back_margin_mm at least {radius + machine.clearance_mm:.3f} mm",
-                           field="back_margin_mm", section="stock")
+    if params.strategy == "flank":
+        return _flank_toolpath(spec, tool, machine, params, blank_radius_mm, back_margin_mm, stub_radius_mm,
+                               front_margin_mm, flank_plan or flank_plan_for(spec, tool, params, blank_radius_mm,
+                                                                             levels, tips), tips, stub_length_mm)
+    if stub_radius_mm > levels.lowest_height_mm:
+        _check_stub_margin(x_back, radius, back_margin_mm, machine)
     safe_z = safe_height_mm(blank_radius_mm, machine)
     feed = tool.feed_mm_min(machine)
     step = params.step_over_fraction * tool.diameter_mm
     pitch_deg = 360.0 / spec.teeth
-    if params.strategy == "flank":
-        return _flank_toolpath(spec, tool, machine, params, blank_radius_mm, back_margin_mm, stub_radius_mm,
-                               front_margin_mm, flank_plan or flank_plan_for(spec, tool, params, blank_radius_mm,
-                                                                             levels, tips), tips)
     space_offsets = [_pass_offsets(max(half_width - sweep_radius, 0.0), step) for half_width in levels.half_widths_mm]
     tip_heights = tip_heights_mm(spec, tool, params, blank_radius_mm) if tips else np.zeros(0)
     tip_offsets = _pass_offsets(tip_half_width_mm(spec, tool, params, levels, blank_radius_mm) - radius, step)
@@ -356,6 +358,16 @@ def _tip_offsets_mm(spec: GearSpec, tool: Tool, params: RoughingParams) -> np.nd
     return _pass_offsets(abs(edge), params.step_over_fraction * tool.diameter_mm)
 
 
+def _check_stub_margin(x_back: float, radius: float, back_margin_mm: float, machine: Machine) -> None:
+    """A pass ending at x_back reaches x_back + D/2 beyond the gear's front face; a holding stub standing as high as
+    the passes starts back_margin_mm behind the back face: refuse a margin shorter than that reach."""
+    needed = 2.0 * radius + machine.clearance_mm  # the tool edge stands this far behind the back face
+    if back_margin_mm < needed - 1e-9:
+        raise MachineError(f"the roughing tool would cut into the holding stub: its passes run to X = {x_back:.3f} mm "
+                           f"(its edge {x_back + radius:.3f} mm); make [stock] back_margin_mm at least {needed:.3f} mm",
+                           field="back_margin_mm", section="stock")
+
+
 @dataclass
 class _Clamp:
     """[roughing] clamp_rotary for the flank strategy: A clamped before every cut, unclamped before every move
@@ -412,7 +424,8 @@ def flank_plan_for(spec: GearSpec, tool: Tool, params: RoughingParams, blank_rad
 
 
 def _flank_toolpath(spec: GearSpec, tool: Tool, machine: Machine, params: RoughingParams, blank_radius_mm: float,
-                    back_margin_mm: float, stub_radius_mm: float, front_margin_mm: float, plan, tips: bool) -> Toolpath:
+                    back_margin_mm: float, stub_radius_mm: float, front_margin_mm: float, plan, tips: bool,
+                    stub_length_mm: float) -> Toolpath:
     """The flank strategy (cam.flank_roughing) as IR: every space's passes in the plan's order, linked outside the
     blank (the passes run from in front of it to beyond its back, or back to the front along their own cleared
     column where a holding stub stands higher than the passes), then the tip land's passes."""
@@ -420,13 +433,14 @@ def _flank_toolpath(spec: GearSpec, tool: Tool, machine: Machine, params: Roughi
 
     radius = tool.diameter_mm / 2.0
     tip_offsets = _tip_offsets_mm(spec, tool, params)
-    free_back = stub_radius_mm + machine.clearance_mm <= _closest_to_axis_mm(plan, radius)
+    stub_below = stub_radius_mm + machine.clearance_mm <= _closest_to_axis_mm(plan, radius)
+    # beyond the blank's back only where nothing stands there: no stub, or one lower than every pass and long
+    # enough that the tool, 2 r + clearance beyond the margin, stays over it (not over what grips it)
+    free_back = stub_radius_mm <= 0.0 or (stub_below and stub_length_mm >= 2.0 * (radius + machine.clearance_mm))
     x_front = -(front_margin_mm + radius + machine.clearance_mm)
     x_back = spec.face_width_mm + radius + machine.clearance_mm + (back_margin_mm if free_back else 0.0)
-    if not free_back and back_margin_mm < radius + machine.clearance_mm:
-        raise MachineError(f"the roughing tool would cut into the holding stub: its passes run to X = {x_back:.3f} mm; "
-                           f"make [stock] back_margin_mm at least {radius + machine.clearance_mm:.3f} mm",
-                           field="back_margin_mm", section="stock")
+    if not free_back and not stub_below:
+        _check_stub_margin(x_back, radius, back_margin_mm, machine)
     safe_z = safe_height_mm(blank_radius_mm, machine)
     feed = tool.feed_mm_min(machine)
     air = machine.max_feed_mm_min

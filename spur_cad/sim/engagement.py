@@ -66,6 +66,7 @@ class Engagement:
     radial_step: np.ndarray  # the model's sampling in a_e's direction / D (columns across, rows along X)
     column_mm: float  # the model's sampling across the space
     axial_step_mm: float = 0.0  # the model's sampling of a_p (0: exact heights)
+    axial_slack_mm: np.ndarray | None = None  # per move, how much a_p may read deeper than the tool cuts (None: 0)
 
     @property
     def cutting(self) -> np.ndarray:
@@ -437,11 +438,12 @@ MAX_WARNED_MOVES = 5
 def engagement_warnings(engagement: Engagement, limits: EngagementLimits) -> list[str]:
     """One warning per kind of overload (at most MAX_WARNED_MOVES moves named, then how many more), by the rules of
     EngagementLimits. Tolerances: 1.5 x the model's sampling in a_e's direction, in depth 1 um or 1.5 x its
-    sampling there."""
+    sampling there, plus the move's `axial_slack_mm`."""
     e = engagement
     tol_ae = 1.5 * e.radial_step
     slot_depth = limits.max_level_depth_fraction * e.diameter_mm
     wider = e.measured & (e.radial_fraction > limits.step_over_fraction + tol_ae)
+    tol_ap = max(1e-3, 1.5 * e.axial_step_mm) + (e.axial_slack_mm if e.axial_slack_mm is not None else 0.0)
     if limits.max_axial_depth_mm is None:
         max_depth = slot_depth
         deep_text = ("beyond the slotting depth limit {lim:.3f} mm ([roughing] max_level_depth_fraction {f:g} x D "
@@ -452,11 +454,11 @@ def engagement_warnings(engagement: Engagement, limits: EngagementLimits) -> lis
     else:
         max_depth = np.full(len(e.diameter_mm), limits.max_axial_depth_mm)
         deep_text = "beyond the axial depth limit {lim:.3f} mm ([roughing] max_axial_depth_mm)"
-        wide = wider & (e.axial_depth_mm > slot_depth + max(1e-3, 1.5 * e.axial_step_mm))
+        wide = wider & (e.axial_depth_mm > slot_depth + tol_ap)
         wide_text = ("beyond {f:g} D deeper than a slot ([roughing] max_radial_engagement_fraction; "
                      "max_level_depth_fraction)")
         deep_fraction = 0.0
-    deep = e.measured & (e.axial_depth_mm > max_depth + max(1e-3, 1.5 * e.axial_step_mm))
+    deep = e.measured & (e.axial_depth_mm > max_depth + tol_ap)
     out = []
     for mask, what, limit_text in ((deep, "axial depth {ap:.3f} mm", deep_text),
                                    (wide, "radial engagement {ae:.2f} D", wide_text)):

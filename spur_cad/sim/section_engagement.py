@@ -146,7 +146,7 @@ def measure_section_engagement(teeth: int, blank_radius_mm: float, x_range_mm: t
         least_across = max(MIN_CELLS_PER_LINE, math.ceil(spread / cell) + 1)
         fed = np.nonzero(path.kind == MoveKind.LINEAR)[0]
         n = len(fed)
-        width, depth, removed = np.zeros(n), np.zeros(n), np.zeros(n)
+        width, depth, removed, slack = np.zeros(n), np.zeros(n), np.zeros(n), np.zeros(n)
         for row, i in enumerate(fed):
             x0, y0, z0, a0 = start[i]
             x1, y1, z1, a1 = path.x[i], path.y[i], path.z[i], path.a[i]
@@ -174,16 +174,19 @@ def measure_section_engagement(teeth: int, blank_radius_mm: float, x_range_mm: t
             removed[row] = cells * cell * cell * (x_hi - x_lo)
             across = _extent(counts_u, cell, least_across) / math.sqrt(1.0 + (z1 * twist_rad_per_mm) ** 2)
             width[row], depth[row] = min(across, tool.diameter_mm), _extent(counts_v, cell)
+            # a helical pass's slices, turned about the gear axis, put their bottoms at heights up to
+            # 2 |twist| R (|Y| + R) apart: the section shows the cut that much deeper than the tool's axial depth
+            slack[row] = 2.0 * abs(twist_rad_per_mm) * radius * (abs(y1) + radius)
         d = tool.diameter_mm
         parts.append(dict(
             operation=(cut.name,) * n, index=fed, space=path.space[fed], level=path.station[fed],
             diameter_mm=np.full(n, d), radial_fraction=width / d, axial_depth_mm=depth, removed_mm3=removed,
-            minutes=move_minutes(path)[fed], radial_step=np.full(n, cell / d)))
+            minutes=move_minutes(path)[fed], radial_step=np.full(n, cell / d), axial_slack_mm=slack))
     return Engagement(
         operation=tuple(name for p in parts for name in p["operation"]),
         **{key: np.concatenate([p[key] for p in parts]) for key in
            ("index", "space", "level", "diameter_mm", "radial_fraction", "axial_depth_mm", "removed_mm3", "minutes",
-            "radial_step")},
+            "radial_step", "axial_slack_mm")},
         column_mm=cell, axial_step_mm=cell)
 
 
