@@ -40,7 +40,7 @@ from spur_cad.geometry.spec import GearSpec
 HELICAL_SLICES = 201
 """Slices of the tool across X for a helical gear: the sampled reach of their union is within about
 (2 R / (n - 1))^2 / (8 R) of the exact one (0.02 um for R = 1.75 mm)."""
-MAX_SEGMENTS_PER_FLANK = 16
+MAX_SEGMENTS_PER_FLANK = 40
 EMPTY_AREA_MM2 = 1e-8  # the stock model's slivers below this are no material
 TOL_MM = 1e-9
 MAX_POSITIONS = 100_000  # a run's positions (bounded by the space's width over the radial engagement)
