@@ -429,7 +429,7 @@ def _without_auto(tables: dict, where: Callable[[str, str | None], str]) -> tupl
 def _resolve_auto(sections: dict, tables: dict, autos: dict[str, set[str]], spec: GearSpec, strategies: Strategies,
                   where: Callable[[str, str | None], str]) -> None:
     """Put the suggested tools' sizes (and kinds, where the table gives none) in place of the "auto" keys: the
-    finishing tool first (the roughing limit depends on its flat width), then the roughing tool."""
+    finishing tool first (the roughing limit depends on it and the finishing strategy), then the roughing tool."""
     from spur_cad.cam.strategies import get_strategy
     from spur_cad.cam.suggest import suggested_finishing, suggested_roughing
 
@@ -440,13 +440,13 @@ def _resolve_auto(sections: dict, tables: dict, autos: dict[str, set[str]], spec
         if role not in autos:
             continue
         name = f"tools.{role}"
+        strategy = get_strategy(finishing_section.strategy, strategies)
         if role == "finishing":
-            strategy = get_strategy(finishing_section.strategy, strategies)
             shape = suggested_finishing(spec, strategy, finishing_section.target_scallop_mm, blank,
                                         machine.clearance_mm)
         else:
-            shape = suggested_roughing(spec, sections.get("tools.finishing"),
-                                       sections.get("roughing", RoughingParams()), blank, machine.clearance_mm)
+            shape = suggested_roughing(spec, strategy, sections.get("tools.finishing"),
+                                       sections.get("roughing", RoughingParams()), stock, machine.clearance_mm)
         first = sorted(autos[role])[0]
         if shape is None:
             raise JobFileError(f"{where(name, first)}: [{name}] {first} = \"auto\": no {role} tool fits this gear "

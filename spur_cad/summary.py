@@ -254,7 +254,7 @@ def cad_json(cad: CadResult) -> dict:
 
 
 def recommendations_json(rec: ToolRecommendations) -> dict:
-    return dataclasses.asdict(rec)
+    return rec.as_dict()
 
 
 def tool_json(tool: ToolFacts | None, with_number: bool = False) -> dict | None:

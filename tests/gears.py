@@ -7,6 +7,7 @@ from pathlib import Path
 from hypothesis import strategies as st
 
 from spur_cad.cam.recommend import recommend_tools
+from spur_cad.cam.strategies import REGISTRY
 from spur_cad.cam.tools import Tool
 from spur_cad.errors import GearSpecError
 from spur_cad.geometry import GearSpec
@@ -55,11 +56,12 @@ CAM_GEARS = ["reference_z23_m4", "undercut_z8", "many_teeth_z120", "shifted_z12"
 def tools_for(name: str) -> tuple[Tool, Tool]:
     """Roughing and finishing tools sized from each gear's limits (as a user would pick them)."""
     spec = spec_of(name)
-    rec = recommend_tools(spec, spec.tip_radius_mm + 0.5, 1.0)
+    perimeter = REGISTRY["perimeter"]  # sized for the contact strategies: the roughing within its plunge allowance
+    rec = recommend_tools(spec, spec.tip_radius_mm + 0.5, 1.0, strategy=perimeter)
     r_t = round(0.6 * min(rec.finishing_max_corner_radius_mm, spec.rack_tip_radius_mm), 3)
     d = round(0.6 * rec.finishing_max_flat_width_mm, 3)
     finishing = Tool(diameter_mm=d + 2 * r_t, kind="bull_nose", corner_radius_mm=r_t)
-    rec_f = recommend_tools(spec, spec.tip_radius_mm + 0.5, 1.0, finishing)
+    rec_f = recommend_tools(spec, spec.tip_radius_mm + 0.5, 1.0, finishing, strategy=perimeter)
     roughing = Tool(diameter_mm=round(0.8 * rec_f.roughing_max_diameter_mm, 3), kind="flat", flutes=3)
     return roughing, finishing
 

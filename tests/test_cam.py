@@ -3,6 +3,7 @@ A-motion rule, inverse-time feeds from the true relative path, and the time esti
 
 from __future__ import annotations
 
+import dataclasses
 import math
 
 import numpy as np
@@ -27,7 +28,8 @@ from tests.gears import CAM_GEARS, spec_of, textbook_of, tools_for
 def test_recommendations_match_method_formulas(name):
     spec, g = spec_of(name), textbook_of(name)
     _, finishing = tools_for(name)
-    rec = recommend_tools(spec, spec.tip_radius_mm + 0.5, 1.0, finishing)
+    # the plunge allowance: the rule of the strategies whose flat bottom plunges at the root
+    rec = recommend_tools(spec, spec.tip_radius_mm + 0.5, 1.0, finishing, strategy=get_strategy("perimeter"))
     # Root arc length 2 v r_f with v = d_1 / r (docs/method.md, textbook rack).
     assert rec.finishing_max_flat_width_mm == pytest.approx(2 * g.corner_offset / g.r * g.rf, abs=1e-9)
     # Smallest fillet curvature radius: circumradius of close triples of dense fillet samples.
@@ -201,13 +203,66 @@ def test_roughing_that_leaves_too_much_above_the_root_is_an_error():
 
     spec = spec_of("reference_z23_m4")
     finishing = Tool(diameter_mm=2.0, kind="bull_nose", corner_radius_mm=0.5)
-    rec = recommend_tools(spec, 50.5, 1.0, finishing)
+    rec = recommend_tools(spec, 50.5, 1.0, finishing, strategy=get_strategy("perimeter"))
     at_limit = Tool(diameter_mm=rec.roughing_max_diameter_mm, flutes=3)
     levels = roughing_levels(spec, at_limit, RoughingParams(finish_stock_mm=0.05), 50.5)
     leftover = levels.lowest_height_mm - spec.root_radius_mm
     assert leftover > rec.plunge_allowance_mm
-    with pytest.raises(ToolError, match=r"more than the finishing tool can plunge \(A_p = 0.500 mm\)"):
+    with pytest.raises(ToolError, match=r"more than the finishing tool can plunge \(A_p = 0.500 mm: 0.5 x its flat "
+                                        r"width 1 mm\)"):
         check_roughing_reach(at_limit, leftover, rec)
     small = Tool(diameter_mm=3.0, flutes=3)
     check_roughing_reach(small, roughing_levels(spec, small, RoughingParams(), 50.5).lowest_height_mm
                          - spec.root_radius_mm, rec)
+
+
+def _space_width_mm(spec, height_mm: float) -> float:
+    """Width of the tooth space on its axis at `height_mm` from the gear's centre (shapely on the gear outline)."""
+    gear = Polygon(gear_outline(spec, 1e-6))
+    m = spec.module_mm
+    line = LineString([(-m * 3, height_mm), (m * 3, height_mm)]).difference(gear)
+    pieces = [piece for piece in getattr(line, "geoms", [line]) if piece.distance(shapely.Point(0, height_mm)) < 1e-9]
+    return pieces[0].length
+
+
+def test_the_bottom_allowance_is_the_finishing_strategys_rule():
+    """What roughing may leave above the root: by generation (no plunge; straight passes take it side-on) what
+    the finishing tool takes off in one pass, 0.5 D; perimeter and along_x (the flat bottom plunges at the root)
+    A_p = 0.5 x the flat width. The largest roughing tool is the space's width at that height, and a roughing
+    tool that leaves more is refused naming the rule."""
+    from spur_cad.cad.specs import StockSpec
+    from spur_cad.cam.plan import CamInputs, check_cam_inputs
+
+    spec = spec_of("reference_z23_m4")
+    finishing = Tool(diameter_mm=2.0, kind="bull_nose", corner_radius_mm=0.5)  # flat width 1 mm
+    blank = spec.tip_radius_mm + 0.5
+    generating, perimeter, along_x = (recommend_tools(spec, blank, 1.0, finishing, strategy=get_strategy(name))
+                                      for name in ("generating", "perimeter", "along_x"))
+    assert generating.plunge_allowance_mm == pytest.approx(0.5 * 2.0)
+    assert perimeter.plunge_allowance_mm == along_x.plunge_allowance_mm == pytest.approx(0.5 * 1.0)
+    assert recommend_tools(spec, blank, 1.0, finishing) == generating  # the job file's default strategy
+    for rec in (generating, perimeter):
+        assert rec.roughing_max_diameter_mm == pytest.approx(
+            _space_width_mm(spec, spec.root_radius_mm + rec.plunge_allowance_mm), abs=1e-5)
+    # without a finishing tool: the largest each strategy takes
+    no_tool = recommend_tools(spec, blank, 1.0, strategy=get_strategy("generating"))
+    assert no_tool.plunge_allowance_mm == pytest.approx(0.5 * no_tool.finishing_generating_max_diameter_mm)
+    no_tool = recommend_tools(spec, blank, 1.0, strategy=get_strategy("perimeter"))
+    assert no_tool.plunge_allowance_mm == pytest.approx(0.5 * no_tool.finishing_max_flat_width_mm)
+    # by the plan's checks (the job file's default strategy, generating): D 4.2 leaves more than 0.5 D above the
+    # root, refused naming the rule; D 4 leaves less and passes, but perimeter refuses it (A_p = 0.5 mm)
+    params = RoughingParams(finish_stock_mm=0.05)
+    inputs = CamInputs(spec, StockSpec(radial_allowance_mm=0.5), roughing_tool=Tool(diameter_mm=4.2, flutes=3),
+                       finishing_tool=finishing, roughing=params, finishing=FinishingParams(), machine=Machine())
+    assert inputs.finishing.strategy == "generating"
+    left = roughing_levels(spec, inputs.roughing_tool, params, blank).lowest_height_mm - spec.root_radius_mm
+    assert left > generating.plunge_allowance_mm
+    assert inputs.roughing_tool.diameter_mm < generating.roughing_max_diameter_mm
+    with pytest.raises(ToolError, match=r"leaves \d\.\d{3} mm above the root, more than the finishing tool takes "
+                                        r"off in one generating pass \(1\.000 mm: 0\.5 x D 2 mm, a slot's depth\)"):
+        check_cam_inputs(inputs)
+    within = dataclasses.replace(inputs, roughing_tool=Tool(diameter_mm=4.0, flutes=3))
+    check_cam_inputs(within)
+    with pytest.raises(ToolError, match=r"exceeds roughing_max_diameter_mm = 3\.6816 mm \(space width at root radius "
+                                        r"\+ what the finishing tool can plunge \(A_p = 0\.500 mm"):
+        check_cam_inputs(dataclasses.replace(within, finishing=FinishingParams(strategy="perimeter")))

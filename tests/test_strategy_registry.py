@@ -14,7 +14,12 @@ import pytest
 
 from spur_cad.cam.strategies import REGISTRY, strategy_names
 from spur_cad.cam.strategies.along_x import AlongXParams, AlongXStrategy
-from spur_cad.cam.strategies.base import ScallopParams, contact_largest_tool, contact_suggested_tool
+from spur_cad.cam.strategies.base import (
+    ScallopParams,
+    contact_bottom_allowance,
+    contact_largest_tool,
+    contact_suggested_tool,
+)
 from spur_cad.errors import JobFileError
 from spur_cad.job import parse_job
 from spur_cad.keydocs import job_file_reference_markdown
@@ -62,6 +67,9 @@ class RowsStrategy:
 
     def suggested_tool(self, spec, recommendations, target_scallop_mm: float, blank_radius_mm: float):
         return contact_suggested_tool(recommendations)
+
+    def bottom_allowance(self, tool, recommendations):
+        return contact_bottom_allowance(tool, recommendations)  # along_x's passes plunge at the root
 
     def check_tool(self, spec, tool) -> None:
         AlongXStrategy().check_tool(spec, tool)

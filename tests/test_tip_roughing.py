@@ -9,7 +9,6 @@ import json
 
 import pytest
 
-from spur_cad.errors import JobFileError
 from spur_cad.job import parse_job
 from spur_cad.pipeline import run_job
 from tests.rs274_helper import run_rs274
@@ -37,13 +36,6 @@ corner_radius_mm = "auto"
 resolution_mm = {resolution}
 """
 
-NO_ROUGHING_TOOL = pytest.mark.xfail(
-    raises=JobFileError, strict=True,
-    reason="no roughing tool is suggested: even 0.2 mm leaves more above the root than the plunge allowance A_p "
-           "(half the generating tool's flat, 0.02 mm at module 1) (issue 29); without roughing the blank's "
-           "0.5 mm is more than the finishing tool takes off the tips in one pass")
-
-
 def small_job(module: float, teeth: int):
     """The default job for the gear: ISO 53 rack (tip radius 0.38 m), default stock, tools "auto"."""
     return parse_job(JOB.format(module=module, teeth=teeth, rho=round(0.38 * module, 6), resolution=RESOLUTION_MM),
@@ -51,10 +43,7 @@ def small_job(module: float, teeth: int):
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("module, teeth", [pytest.param(0.5, 40, marks=NO_ROUGHING_TOOL),
-                                           pytest.param(0.8, 30, marks=NO_ROUGHING_TOOL),
-                                           pytest.param(1.0, 20, marks=NO_ROUGHING_TOOL),
-                                           (1.25, 20), (1.25, 40)])
+@pytest.mark.parametrize("module, teeth", [(0.5, 40), (0.8, 30), (1.0, 20), (1.25, 20), (1.25, 40)])
 def test_small_gear_on_the_default_stock_is_cut_to_the_design(module, teeth):
     job = small_job(module, teeth)
     blank = job.stock.blank_radius_mm(job.gear)

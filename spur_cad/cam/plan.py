@@ -21,6 +21,7 @@ from spur_cad.cam.ir import MAX_TOOLPATH_MOVES, Toolpath
 from spur_cad.cam.machine import Machine, MachineError, RoughingParams, check_travel
 from spur_cad.cam.machine_limits import check_machine_limits
 from spur_cad.cam.recommend import (
+    LAND_PASS_DEPTH_FRACTION,
     ToolRecommendations,
     check_roughing_reach,
     check_tools,
@@ -140,8 +141,8 @@ def check_cam_inputs(inputs: CamInputs) -> tuple[ToolRecommendations, RoughingLe
     roughing work bound and the roughing reach. Returns the
     recommendations and the roughing levels (None without a roughing tool)."""
     spec, machine, stock = inputs.spec, inputs.machine, inputs.stock
-    if spec.is_helical and inputs.finishing_tool is not None and \
-            not get_strategy(inputs.finishing.strategy, inputs.strategies).helical:
+    strategy = get_strategy(inputs.finishing.strategy, inputs.strategies)
+    if spec.is_helical and inputs.finishing_tool is not None and not strategy.helical:
         raise MachineError(f"[finishing] strategy = {shown(inputs.finishing.strategy)} is for spur gears; a "
                            f"helical gear (helix_angle_deg = {spec.helix_angle_deg:g}) is finished by "
                            "strategy = \"generating\"",
@@ -150,7 +151,7 @@ def check_cam_inputs(inputs: CamInputs) -> tuple[ToolRecommendations, RoughingLe
     check_blank_allowance(spec, stock, inputs.finishing_tool,
                           inputs.roughing if inputs.roughing_tool is not None else None)
     rec = recommend_tools(spec, blank, machine.clearance_mm, inputs.finishing_tool,
-                          inputs.finishing.target_scallop_mm)
+                          inputs.finishing.target_scallop_mm, strategy)
     if inputs.bottom_tool is not None:
         check_two_stage_tools(spec, rec, inputs.roughing_tool, inputs.bottom_tool, inputs.finishing_tool)
     else:
@@ -218,7 +219,7 @@ def conflicts_error(inputs: CamInputs, conflicts: list[ToolError]) -> ToolError:
     strategy = get_strategy(inputs.finishing.strategy, inputs.strategies)
     try:
         suggestion = suggested_tools(inputs.spec, strategy, inputs.finishing.target_scallop_mm, inputs.roughing,
-                                     inputs.stock.blank_radius_mm(inputs.spec), inputs.machine.clearance_mm)
+                                     inputs.stock, inputs.machine.clearance_mm)
     except SpurCadError:  # the suggestion's own limits (a work bound, say): the conflicts still come first
         suggestion = None
     if suggestion is None:
@@ -262,11 +263,6 @@ def check_two_stage_tools(spec: GearSpec, rec: ToolRecommendations, roughing_too
         raise ToolError(f"[tools.bottom] diameter_mm = {bottom.diameter_mm:g} must be smaller than the roughing "
                         f"tool's {roughing_tool.diameter_mm:g} mm (two-stage roughing: the larger tool roughs the "
                         "upper levels, the smaller one the bottom)", field="diameter_mm", section="tools.bottom")
-
-
-LAND_PASS_DEPTH_FRACTION = 0.5
-"""Deepest cut a finishing tool takes off a tip land in one pass, x its diameter: the first land pass cuts a
-full-width slot, and 0.5 D is the catalogue's slotting depth (the default roughing level depth too)."""
 
 
 def check_blank_allowance(spec: GearSpec, stock: StockSpec, finishing_tool: Tool | None,

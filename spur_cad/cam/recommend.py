@@ -6,6 +6,7 @@ them when the space axis points up the tool axis.
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass
 
 import numpy as np
@@ -15,6 +16,38 @@ from spur_cad.geometry.sampling import sample_profile
 from spur_cad.geometry.spec import GearSpec
 
 PLUNGE_CAPACITY_FRACTION = 0.5  # A_p = 0.5 d: what a finishing tool's bottom takes when it plunges
+LAND_PASS_DEPTH_FRACTION = 0.5
+"""Deepest cut a finishing tool takes in one pass, x its diameter: a full-width slot, and 0.5 D is the catalogue's
+slotting depth (the default roughing level depth too). It bounds what stands above the tip lands when finishing
+starts, and what roughing leaves above the root for finishing by generation."""
+
+
+@dataclass(frozen=True)
+class BottomAllowance:
+    """What roughing may leave above the root for the finishing strategy to take, and the rule that sets it (the
+    words follow "more than" in the messages)."""
+
+    allowance_mm: float
+    rule: str
+
+
+def plunge_allowance(flat_width_mm: float, largest: bool = False) -> BottomAllowance:
+    """Strategies whose flat bottom plunges at the root (perimeter, along_x): A_p = 0.5 x the finishing tool's flat
+    width (`largest`: the largest flat allowed, when the job has no finishing tool)."""
+    allowance = PLUNGE_CAPACITY_FRACTION * flat_width_mm
+    whose = "the largest allowed" if largest else "its"
+    return BottomAllowance(allowance, f"the finishing tool can plunge (A_p = {allowance:.3f} mm: "
+                                      f"{PLUNGE_CAPACITY_FRACTION:g} x {whose} flat width {flat_width_mm:g} mm)")
+
+
+def generating_pass_allowance(diameter_mm: float, largest: bool = False) -> BottomAllowance:
+    """Finishing by generation never plunges: its straight passes take what roughing left above the root side-on,
+    at most what the tool takes off in one pass as a slot, LAND_PASS_DEPTH_FRACTION x D (`largest`: the largest
+    generating tool, when the job has no finishing tool)."""
+    allowance = LAND_PASS_DEPTH_FRACTION * diameter_mm
+    diameter = "the largest generating tool's D" if largest else "D"
+    return BottomAllowance(allowance, f"the finishing tool takes off in one generating pass ({allowance:.3f} mm: "
+                                      f"{LAND_PASS_DEPTH_FRACTION:g} x {diameter} {diameter_mm:g} mm, a slot's depth)")
 
 
 def flank_polyline(spec: GearSpec, tolerance_mm: float | None = None) -> np.ndarray:
@@ -46,16 +79,18 @@ class ToolRecommendations:
 
     finishing_max_flat_width_mm: float  # root arc length 2 v r_f
     finishing_max_corner_radius_mm: float  # smallest fillet curvature radius
-    plunge_allowance_mm: float  # A_p = 0.5 x finishing flat width
-    roughing_max_diameter_mm: float  # space width at height r_f + A_p
+    plunge_allowance_mm: float  # what roughing may leave above the root: the finishing strategy's bottom allowance
+    roughing_max_diameter_mm: float  # space width at height r_f + that allowance
     required_flute_length_mm: float  # deepest cut below the stock surface (finishing reaches the root)
     required_stick_out_mm: float  # flute length + clearance above the blank
     # Finishing by generation (docs/cam.md), with either flank_tool_end; 0.0 when no such tool fits:
     finishing_generating_max_diameter_mm: float = 0.0  # largest tool with the advised corner radius rho
     finishing_flat_end_mill_max_diameter_mm: float = 0.0  # largest flat end mill (r_t = 0): its flat within 2 d_1
+    bottom_allowance_rule: str = ""  # the rule that sets plunge_allowance_mm, in words (BottomAllowance.rule)
 
     def as_dict(self) -> dict[str, float]:
-        return dict(self.__dict__)
+        """The figures (summary.json's `tools` keys), without the rule's words."""
+        return {name: value for name, value in self.__dict__.items() if name != "bottom_allowance_rule"}
 
 
 def generating_max_diameter_mm(spec: GearSpec, corner_radius_mm: float, target_scallop_mm: float,
@@ -81,27 +116,37 @@ def generating_max_diameter_mm(spec: GearSpec, corner_radius_mm: float, target_s
 
 
 def recommend_tools(spec: GearSpec, blank_radius_mm: float, clearance_mm: float,
-                    finishing_tool: Tool | None = None, target_scallop_mm: float = 0.005) -> ToolRecommendations:
-    """docs/method.md; A_p uses the chosen finishing tool's flat width, else the largest allowed. The
-    generating limits (docs/cam.md) use the target scallop's flank rolls."""
+                    finishing_tool: Tool | None = None, target_scallop_mm: float = 0.005,
+                    strategy=None) -> ToolRecommendations:
+    """docs/method.md; what roughing may leave above the root is the finishing `strategy`'s bottom allowance
+    (FinishingStrategy.bottom_allowance; None: the job file's default strategy, generating) for the chosen
+    finishing tool, else for the largest allowed. The generating limits (docs/cam.md) use the target scallop's
+    flank rolls."""
+    from spur_cad.cam.strategies.base import TargetScallopParams
+    from spur_cad.keys import key_of
+
+    if strategy is None:
+        from spur_cad.cam.strategies import DEFAULT_STRATEGY, REGISTRY
+
+        strategy = REGISTRY[DEFAULT_STRATEGY]
     profile = spec.tooth_space_profile()
     max_flat = 2.0 * profile.root_arc_half_angle_rad * spec.root_radius_mm
     max_corner = profile.min_fillet_curvature_radius_mm
     if not np.isfinite(max_corner):  # no fillet (sharp rack on the rolling line): the root corner is sharp
         max_corner = 0.0
-    flat = finishing_tool.flat_width_mm if finishing_tool is not None else max_flat
-    plunge = PLUNGE_CAPACITY_FRACTION * flat
-    roughing_max = 2.0 * space_half_width_mm(flank_polyline(spec), spec.root_radius_mm + plunge)
     flute = blank_radius_mm - spec.root_radius_mm
-    from spur_cad.cam.strategies.base import TargetScallopParams
-    from spur_cad.keys import key_of
-
     scallop = key_of(TargetScallopParams, "target_scallop_mm")  # advice within the key's range (not a check)
     target = min(max(target_scallop_mm, scallop.low), scallop.high)
     generating = generating_max_diameter_mm(spec, spec.rack_tip_radius_mm, target, blank_radius_mm)
     flat_end_mill = generating_max_diameter_mm(spec, 0.0, target, blank_radius_mm)
-    return ToolRecommendations(max_flat, max_corner, plunge, roughing_max, flute, flute + clearance_mm,
-                               generating, flat_end_mill)
+    # the finishing limits first (the strategy's allowance without a finishing tool is its largest tool's); the
+    # roughing fields follow from the allowance
+    limits = ToolRecommendations(max_flat, max_corner, 0.0, 0.0, flute, flute + clearance_mm, generating,
+                                 flat_end_mill)
+    allowance = strategy.bottom_allowance(finishing_tool, limits)
+    roughing_max = 2.0 * space_half_width_mm(flank_polyline(spec), spec.root_radius_mm + allowance.allowance_mm)
+    return dataclasses.replace(limits, plunge_allowance_mm=allowance.allowance_mm,
+                               roughing_max_diameter_mm=roughing_max, bottom_allowance_rule=allowance.rule)
 
 
 def check_tools(spec: GearSpec, recommendations: ToolRecommendations, roughing: Tool | None,
@@ -126,8 +171,8 @@ def check_tools(spec: GearSpec, recommendations: ToolRecommendations, roughing: 
                             field="kind", section="tools.roughing")
         if roughing.diameter_mm > rec.roughing_max_diameter_mm + 1e-9:
             raise ToolError(f"roughing tool diameter {roughing.diameter_mm:.4f} mm exceeds roughing_max_diameter_mm = "
-                            f"{rec.roughing_max_diameter_mm:.4f} mm (space width at root radius + "
-                            f"A_p = {rec.plunge_allowance_mm:.4f} mm)", field="diameter_mm", section="tools.roughing")
+                            f"{rec.roughing_max_diameter_mm:.4f} mm (space width at root radius + what "
+                            f"{rec.bottom_allowance_rule})", field="diameter_mm", section="tools.roughing")
         _check_lengths(roughing, "roughing", rec)
 
 
@@ -170,13 +215,12 @@ def small_tool_warnings(rec: ToolRecommendations, smallest_end_mill_mm: float, s
 
 
 def check_roughing_reach(roughing: Tool, lowest_level_above_root_mm: float, rec: ToolRecommendations) -> None:
-    """The material roughing leaves above the root must be within the finishing tool's plunge
-    capacity A_p (docs/method.md); raise ToolError otherwise."""
+    """The material roughing leaves above the root must be within the finishing strategy's bottom allowance
+    (rec.plunge_allowance_mm, the rule in rec.bottom_allowance_rule; docs/method.md); raise ToolError otherwise."""
     if lowest_level_above_root_mm > rec.plunge_allowance_mm + 1e-9:
         raise ToolError(f"roughing tool diameter {roughing.diameter_mm:g} mm leaves "
-                        f"{lowest_level_above_root_mm:.3f} mm "
-                        f"above the root, more than the finishing tool can plunge (A_p = "
-                        f"{rec.plunge_allowance_mm:.3f} mm); use a smaller roughing tool", field="diameter_mm",
+                        f"{lowest_level_above_root_mm:.3f} mm above the root, more than "
+                        f"{rec.bottom_allowance_rule}; use a smaller roughing tool", field="diameter_mm",
                         section="tools.roughing")
 
 

@@ -2,15 +2,17 @@
 what `diameter_mm = "auto"` takes (the job file), and what a tool-fit error proposes instead of the job's tools.
 
 The finishing tool comes first (the job's strategy suggests it: by generation r_t = rho and 95 % of the
-largest diameter in 0.05 mm steps), because the roughing limit depends on its flat width (the plunge
-allowance A_p); then the roughing tool: the largest flat end mill in 0.1 mm steps that passes the tool limits
-and reaches the bottom of the spaces with the job's roughing levels.
+largest diameter in 0.05 mm steps), because the roughing limit depends on it (what the strategy lets roughing
+leave above the root: FinishingStrategy.bottom_allowance); then the roughing tool: the largest flat end mill
+in 0.1 mm steps that passes the tool limits, reaches the bottom of the spaces with the job's roughing levels
+and, beside a holding stub, turns within the back margin.
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass
 
+from spur_cad.cad.specs import StockSpec
 from spur_cad.cam.ir import MAX_TOOLPATH_MOVES
 from spur_cad.cam.machine import RoughingParams
 from spur_cad.cam.recommend import check_roughing_reach, check_tools, recommend_tools
@@ -56,7 +58,7 @@ class SuggestedTools:
 def suggested_finishing(spec: GearSpec, strategy, target_scallop_mm: float, blank_radius_mm: float,
                         clearance_mm: float) -> ToolShape | None:
     """The finishing tool the strategy suggests for the gear (None when none fits)."""
-    rec = recommend_tools(spec, blank_radius_mm, clearance_mm)
+    rec = recommend_tools(spec, blank_radius_mm, clearance_mm, strategy=strategy)
     suggested = strategy.suggested_tool(spec, rec, target_scallop_mm, blank_radius_mm)
     if suggested is None:
         return None
@@ -65,11 +67,13 @@ def suggested_finishing(spec: GearSpec, strategy, target_scallop_mm: float, blan
     return ToolShape(kind, round(flat + 2.0 * corner, 6), round(corner, 6))
 
 
-def suggested_roughing(spec: GearSpec, finishing: Tool | None, roughing: RoughingParams, blank_radius_mm: float,
+def suggested_roughing(spec: GearSpec, strategy, finishing: Tool | None, roughing: RoughingParams, stock: StockSpec,
                        clearance_mm: float) -> ToolShape | None:
-    """The largest flat end mill (0.1 mm steps) that passes the roughing limits with this finishing tool and
-    reaches the bottom of the spaces with these roughing levels; None when even 0.2 mm does not."""
-    rec = recommend_tools(spec, blank_radius_mm, clearance_mm, finishing)
+    """The largest flat end mill (0.1 mm steps) that passes the roughing limits with this finishing strategy and
+    tool, reaches the bottom of the spaces with these roughing levels and, beside a holding stub that stands
+    within the clearance of the root, turns within the back margin (stub_fits); None when even 0.2 mm does not."""
+    blank_radius_mm = stock.blank_radius_mm(spec)
+    rec = recommend_tools(spec, blank_radius_mm, clearance_mm, finishing, strategy=strategy)
     diameter = floor_to_step(rec.roughing_max_diameter_mm, ROUGHING_STEP_MM)
     while diameter >= SMALLEST_SUGGESTED_MM - 1e-9:
         candidate = Tool(diameter_mm=round(diameter, 6), kind="flat")
@@ -79,17 +83,27 @@ def suggested_roughing(spec: GearSpec, finishing: Tool | None, roughing: Roughin
             if finishing is not None and moves <= MAX_TOOLPATH_MOVES:  # else the plan refuses [roughing] itself
                 levels = roughing_levels(spec, candidate, roughing, blank_radius_mm)
                 check_roughing_reach(candidate, levels.lowest_height_mm - spec.root_radius_mm, rec)
-            return ToolShape("flat", candidate.diameter_mm, 0.0)
+            if stub_fits(spec, stock, candidate, clearance_mm):
+                return ToolShape("flat", candidate.diameter_mm, 0.0)
         except ToolError:
-            diameter -= ROUGHING_STEP_MM
+            pass
+        diameter -= ROUGHING_STEP_MM
     return None
 
 
+def stub_fits(spec: GearSpec, stock: StockSpec, tool: Tool, clearance_mm: float) -> bool:
+    """Whether the roughing tool's passes stay clear of the holding stub: they run D/2 + clearance beyond the
+    face, into the back margin, where the stub stands within the clearance of the root circle (the roughing
+    programs refuse more; a conservative test, before the levels or the flank passes are planned)."""
+    reaches_root = stock.stub_diameter_mm / 2.0 + clearance_mm > spec.root_radius_mm
+    return not reaches_root or stock.back_margin_mm >= tool.diameter_mm / 2.0 + clearance_mm - 1e-9
+
+
 def suggested_tools(spec: GearSpec, strategy, target_scallop_mm: float, roughing: RoughingParams,
-                    blank_radius_mm: float, clearance_mm: float) -> SuggestedTools:
+                    stock: StockSpec, clearance_mm: float) -> SuggestedTools:
     """Finishing then roughing tool for the gear (see the module docstring)."""
-    finishing = suggested_finishing(spec, strategy, target_scallop_mm, blank_radius_mm, clearance_mm)
+    finishing = suggested_finishing(spec, strategy, target_scallop_mm, stock.blank_radius_mm(spec), clearance_mm)
     finishing_tool = (Tool(diameter_mm=finishing.diameter_mm, kind=finishing.kind,
                            corner_radius_mm=finishing.corner_radius_mm) if finishing is not None else None)
-    return SuggestedTools(finishing, suggested_roughing(spec, finishing_tool, roughing, blank_radius_mm,
+    return SuggestedTools(finishing, suggested_roughing(spec, strategy, finishing_tool, roughing, stock,
                                                         clearance_mm))

@@ -124,8 +124,15 @@ def gear_rows(result: JobResult) -> tuple[Row, ...]:
 def limit_rows(result: JobResult) -> tuple[Row, ...]:
     """The gear's tool limits, labelled (0 shown as 'none fits')."""
     rec = result.tools.recommendations
-    return tuple(Row(label, number(getattr(rec, name), 3) if getattr(rec, name) > 0.0 else "none fits",
-                     "mm" if getattr(rec, name) > 0.0 else "") for name, label in LIMIT_LABELS)
+    return tuple(Row(_limit_label(rec, name, label), number(getattr(rec, name), 3) if getattr(rec, name) > 0.0
+                     else "none fits", "mm" if getattr(rec, name) > 0.0 else "") for name, label in LIMIT_LABELS)
+
+
+def _limit_label(rec, name: str, label: str) -> str:
+    """The label, with the finishing strategy's rule for what roughing may leave above the root."""
+    if name == "plunge_allowance_mm" and rec.bottom_allowance_rule:
+        return f"{label}: as much as {rec.bottom_allowance_rule}"
+    return label
 
 
 def advice_rows(result: JobResult) -> tuple[Row, ...]:

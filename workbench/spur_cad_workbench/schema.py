@@ -203,7 +203,9 @@ STOCK_OUTPUTS = (
 JOB_OUTPUTS = (
     _f("FinishingMaxFlatWidth", "length", TOOL_LIMITS, "", "", "largest finishing flat width D - 2 r_t"),
     _f("FinishingMaxCornerRadius", "length", TOOL_LIMITS, "", "", "largest finishing corner radius r_t"),
-    _f("PlungeAllowance", "length", TOOL_LIMITS, "", "", "A_p: what the finishing tool takes by plunging"),
+    _f("PlungeAllowance", "length", TOOL_LIMITS, "", "",
+       "what roughing may leave above the root: A_p = 0.5 x the finishing flat width (perimeter, along_x: it "
+       "plunges), or one generating pass, 0.5 x D (generating)"),
     _f("RoughingMaxDiameter", "length", TOOL_LIMITS, "", "", "largest roughing diameter"),
     _f("RequiredFluteLength", "length", TOOL_LIMITS, "", "", "flute length the job needs"),
     _f("RequiredStickOut", "length", TOOL_LIMITS, "", "", "stick-out the job needs"),

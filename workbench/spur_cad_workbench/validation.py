@@ -185,6 +185,7 @@ def validate(values: dict[str, dict[str, object]], source: str = "job", units=No
     """
     from spur_cad.cam.plan import check_cam_inputs
     from spur_cad.cam.recommend import recommend_tools
+    from spur_cad.cam.strategies import get_strategy
     from spur_cad.job import job_from_dict
     from spur_cad.pipeline import cam_inputs
 
@@ -196,16 +197,18 @@ def validate(values: dict[str, dict[str, object]], source: str = "job", units=No
         return Validation(None, (_problem(exc, source, values, units),), None)
     spec, blank = without_tools.gear, without_tools.stock.blank_radius_mm(without_tools.gear)
     clearance = without_tools.machine.clearance_mm
+    strategy = get_strategy(without_tools.finishing.strategy, without_tools.strategies)  # its bottom allowance
     try:
         job = job_from_dict(data, source)
     except SpurCadError as exc:
-        return Validation(None, (_problem(exc, source, values, units),), recommend_tools(spec, blank, clearance))
+        return Validation(None, (_problem(exc, source, values, units),),
+                          recommend_tools(spec, blank, clearance, strategy=strategy))
     try:
         rec, _ = check_cam_inputs(cam_inputs(job))
     except SpurCadError as exc:
         problem = _problem(exc, source, values, units)
         finishing = None if problem.group == SECTION_GROUPS["tools.finishing"] else job.tools.finishing
-        return Validation(None, (problem,), recommend_tools(spec, blank, clearance, finishing))
+        return Validation(None, (problem,), recommend_tools(spec, blank, clearance, finishing, strategy=strategy))
     return Validation(job, (), rec)
 
 
@@ -220,7 +223,8 @@ def recommendation_notes(rec, two_stage: bool = False, units=None) -> dict[str, 
         return unit_text.text(value_mm, "mm", units)
 
     notes = {
-        "RoughingToolDiameter": f"at most {length(rec.roughing_max_diameter_mm)} (space width at root + A_p)",
+        "RoughingToolDiameter": f"at most {length(rec.roughing_max_diameter_mm)} (space width at root + what the "
+                                f"finishing strategy lets roughing leave, {length(rec.plunge_allowance_mm)})",
         "FinishingToolDiameter": f"perimeter, along_x: flat width D - 2 r_t at most "
                                  f"{length(rec.finishing_max_flat_width_mm)} (root arc length); generating: within "
                                  "the rack's tip flat and the flank limit",
@@ -318,8 +322,8 @@ def suggest_tools(values: dict[str, dict[str, object]]) -> dict[str, object]:
         return {}
     job = check.job
     strategy = get_strategy(job.finishing.strategy, job.strategies)
-    suggested = suggested_tools(job.gear, strategy, job.finishing.target_scallop_mm, job.roughing,
-                                job.stock.blank_radius_mm(job.gear), job.machine.clearance_mm)
+    suggested = suggested_tools(job.gear, strategy, job.finishing.target_scallop_mm, job.roughing, job.stock,
+                                job.machine.clearance_mm)
     if suggested.finishing is None:
         return {}
     finishing = suggested.finishing

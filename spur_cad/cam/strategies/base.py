@@ -19,6 +19,7 @@ import numpy as np
 from spur_cad.cam.contacts import SpacePoses
 from spur_cad.cam.ir import Operation, Toolpath, ToolpathBuilder
 from spur_cad.cam.machine import Machine, MachineError
+from spur_cad.cam.recommend import BottomAllowance, plunge_allowance
 from spur_cad.cam.tools import Tool, ToolError
 from spur_cad.geometry.spec import GearSpec
 from spur_cad.keys import check_section, key
@@ -127,6 +128,12 @@ class FinishingStrategy(Protocol):
         suggests it), within this strategy's limits; None when no tool fits."""
         ...
 
+    def bottom_allowance(self, tool: Tool | None, recommendations: Any) -> BottomAllowance:
+        """What roughing may leave above the root for this strategy to take with the finishing `tool` (None: the
+        largest it takes, from the finishing limits of `recommendations`): its size and the rule in words. It
+        sets the largest roughing tool and the roughing reach check (recommend_tools)."""
+        ...
+
     def check_tool(self, spec: GearSpec, tool: Tool) -> None:
         """ToolError (naming the tool key) when the tool's shape cannot do this strategy on this gear;
         cheap (the plan's and the workbench's checks run it before generating)."""
@@ -146,6 +153,14 @@ def contact_largest_tool(recommendations: Any) -> tuple[str, float]:
             rec.finishing_max_flat_width_mm + 2.0 * rec.finishing_max_corner_radius_mm)
 
 
+def contact_bottom_allowance(tool: Tool | None, recommendations: Any) -> BottomAllowance:
+    """The strategies whose flat bottom plunges at the root (perimeter, along_x): the plunge allowance A_p = 0.5 x
+    the tool's flat width (without a tool: the largest flat allowed, the root arc)."""
+    if tool is None:
+        return plunge_allowance(recommendations.finishing_max_flat_width_mm, largest=True)
+    return plunge_allowance(tool.flat_width_mm)
+
+
 def floor_to_step(value: float, step: float) -> float:
     """`value` rounded down to a multiple of `step` (a catalogue-like size)."""
     return math.floor(value / step + 1e-9) * step
@@ -162,9 +177,12 @@ def contact_suggested_tool(recommendations: Any) -> tuple[float, float] | None:
 
 class ContactStrategy:
     """What the strategies placing the tool's corner on transverse flank contacts share (perimeter, along_x):
-    spur gears only, and their largest and suggested tools."""
+    spur gears only, their largest and suggested tools, and the plunge allowance at the root."""
 
     helical = False  # transverse contacts of a spur gear
+
+    def bottom_allowance(self, tool: Tool | None, recommendations: Any) -> BottomAllowance:
+        return contact_bottom_allowance(tool, recommendations)
 
     def largest_tool(self, recommendations: Any) -> tuple[str, float]:
         return contact_largest_tool(recommendations)

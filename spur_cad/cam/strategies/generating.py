@@ -16,6 +16,7 @@ from spur_cad.cam.common import PLUNGE_FEED_FRACTION, safe_height_mm
 from spur_cad.cam.contacts import SpacePoses, TransversePoses
 from spur_cad.cam.ir import Feature, MoveKind, Operation, Toolpath, ToolpathBuilder
 from spur_cad.cam.machine import Machine
+from spur_cad.cam.recommend import BottomAllowance, generating_pass_allowance
 from spur_cad.cam.strategies.base import FinishingResult, floor_to_step
 from spur_cad.cam.strategies.generating_advice import passes_flute_length_mm, tool_advice
 from spur_cad.cam.strategies.generating_flat import flat_deviation_mm
@@ -92,6 +93,14 @@ class GeneratingStrategy:
     def largest_tool(self, recommendations) -> tuple[str, float]:
         """The largest tool with the advised corner radius rho."""
         return "finishing_generating_max_diameter_mm", recommendations.finishing_generating_max_diameter_mm
+
+    def bottom_allowance(self, tool: Tool | None, recommendations) -> BottomAllowance:
+        """The passes never plunge: near the root they take what roughing left above it side-on, one roll at a
+        time, at most a slot's depth, LAND_PASS_DEPTH_FRACTION x D (without a tool: of the largest generating
+        tool, recommendations.finishing_generating_max_diameter_mm)."""
+        if tool is None:
+            return generating_pass_allowance(recommendations.finishing_generating_max_diameter_mm, largest=True)
+        return generating_pass_allowance(tool.diameter_mm)
 
     def suggested_tool(self, spec: GearSpec, recommendations, target_scallop_mm: float,
                        blank_radius_mm: float) -> tuple[float, float] | None:
