@@ -264,7 +264,9 @@ def test_valid_job_has_no_messages_and_the_recommendations(wb):
     # Independent of the code under test: root arc 2 v r_f with v = d_1 / r, flute length = blank - root.
     assert rec.finishing_max_flat_width_mm == pytest.approx(2 * book.corner_offset / book.r * book.rf, abs=1e-9)
     assert rec.required_flute_length_mm == pytest.approx(book.ra + job.stock.radial_allowance_mm - book.rf)
-    assert rec.plunge_allowance_mm == pytest.approx(0.5 * job.tools.finishing.flat_width_mm)
+    # finishing by generation (the job's strategy) never plunges: roughing may leave one pass's slot, 0.5 x D
+    assert job.finishing.strategy == "generating"
+    assert rec.plunge_allowance_mm == pytest.approx(0.5 * job.tools.finishing.diameter_mm)
     notes = wb.validation.recommendation_notes(rec)  # without FreeCAD's unit schema: mm to 0.1 um
     for prop, limit in (("RoughingToolDiameter", rec.roughing_max_diameter_mm),
                         ("FinishingToolDiameter", rec.finishing_max_flat_width_mm)):
@@ -286,7 +288,8 @@ def _cli_message(text: str) -> str:
 @pytest.mark.parametrize("changes, group, old, new", [
     ({"FinishingToolDiameter": 9.0}, "Finishing tool", "diameter_mm = 1.5", "diameter_mm = 9.0"),
     ({"RoughingToolDiameter": -1.0}, "Roughing tool", "diameter_mm = 2.0", "diameter_mm = -1.0"),
-    ({"RoughingToolDiameter": 3.0}, "Roughing tool", "diameter_mm = 2.0", "diameter_mm = 3.0"),
+    # 4 mm: above the roughing limit (3.19 mm since generating lets roughing leave 0.5 D above the root; 3 mm fits)
+    ({"RoughingToolDiameter": 4.0}, "Roughing tool", "diameter_mm = 2.0", "diameter_mm = 4.0"),
     ({"TargetScallop": 0.5}, "Finishing strategy", "target_scallop_mm = 0.05", "target_scallop_mm = 0.5"),
 ])
 def test_invalid_values_give_the_command_lines_message_in_their_group(wb, changes, group, old, new):
