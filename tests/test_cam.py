@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+from types import SimpleNamespace
 
 import numpy as np
 import pytest
@@ -244,6 +245,13 @@ def test_the_bottom_allowance_is_the_finishing_strategys_rule():
     for rec in (generating, perimeter):
         assert rec.roughing_max_diameter_mm == pytest.approx(
             _space_width_mm(spec, spec.root_radius_mm + rec.plunge_allowance_mm), abs=1e-5)
+    # the report's limits table says which rule applies
+    from spur_cad.report.sheet import limit_rows
+
+    result = SimpleNamespace(tools=SimpleNamespace(recommendations=generating))
+    rows = {row.label: row.value for row in limit_rows(result)}
+    assert rows["material roughing may leave above the root: as much as the finishing tool takes off in one generating "
+                "pass (1.000 mm: 0.5 x D 2 mm, a slot's depth)"] == "1.000"
     # without a finishing tool: the largest each strategy takes
     no_tool = recommend_tools(spec, blank, 1.0, strategy=get_strategy("generating"))
     assert no_tool.plunge_allowance_mm == pytest.approx(0.5 * no_tool.finishing_generating_max_diameter_mm)
