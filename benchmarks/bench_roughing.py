@@ -18,6 +18,7 @@ from spur_cad.cam.estimate import estimate
 from spur_cad.cam.machine import Machine, RoughingParams
 from spur_cad.cam.recommend import recommend_tools
 from spur_cad.cam.roughing import roughing_toolpath
+from spur_cad.cam.strategies import REGISTRY
 from spur_cad.cam.tools import Tool
 from spur_cad.geometry import GearSpec
 from spur_cad.job import load_job
@@ -37,12 +38,14 @@ GEARS = {
 
 def _tool(spec: GearSpec, blank: float) -> Tool:
     """The roughing tool a user would pick: 0.8 x the largest that reaches the root next to a finishing tool of
-    0.6 x its limits (tests/gears.tools_for), flutes 3 D long."""
-    rec = recommend_tools(spec, blank, 1.0)
+    0.6 x its limits (tests/gears.tools_for: within perimeter finishing's plunge allowance), flutes 3 D long."""
+    perimeter = REGISTRY["perimeter"]
+    rec = recommend_tools(spec, blank, 1.0, strategy=perimeter)
     corner = round(0.6 * min(rec.finishing_max_corner_radius_mm, spec.rack_tip_radius_mm), 3)
     finishing = Tool(diameter_mm=round(0.6 * rec.finishing_max_flat_width_mm, 3) + 2 * corner, kind="bull_nose",
                      corner_radius_mm=corner)
-    diameter = round(0.8 * recommend_tools(spec, blank, 1.0, finishing).roughing_max_diameter_mm, 3)
+    diameter = round(0.8 * recommend_tools(spec, blank, 1.0, finishing, strategy=perimeter).roughing_max_diameter_mm,
+                     3)
     return Tool(diameter_mm=diameter, kind="flat", flutes=3, flute_length_mm=3.0 * diameter)
 
 

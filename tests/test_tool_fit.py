@@ -93,9 +93,10 @@ def test_the_suggested_set_runs_and_equals_what_auto_takes(tmp_path):
     assert auto_tools["roughing"]["diameter_mm"] <= auto_tools["roughing_max_diameter_mm"]
     # The next 0.1 mm size up would not fit: the suggestion is the largest, not merely one that fits. Since
     # finishing by generation lets roughing leave 0.5 D above the root (not the plunge allowance), the roughing
-    # limit (2.76 mm) is above what turns beside the reference job's holding stub (stub radius 40 mm above this
-    # gear's root; D/2 + clearance 1 mm within back_margin_mm = 2 mm): that bounds the suggestion here.
-    stub_limit = 2.0 * (2.0 - 1.0)
+    # limit (2.76 mm) is above what passes beside the reference job's holding stub (stub radius 40 mm above this
+    # gear's root: the tool's far edge, D + clearance 1 mm behind the back face, within back_margin_mm = 2 mm):
+    # that bounds the suggestion here.
+    stub_limit = 2.0 - 1.0
     assert auto_tools["roughing"]["diameter_mm"] <= stub_limit
     assert auto_tools["roughing"]["diameter_mm"] + 0.1 > min(auto_tools["roughing_max_diameter_mm"], stub_limit)
     assert auto_tools["finishing"]["corner_radius_mm"] == 0.8

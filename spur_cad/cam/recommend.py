@@ -11,43 +11,17 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from spur_cad.cam.allowances import (  # noqa: F401  (re-exported: the names callers know from here)
+    LAND_PASS_DEPTH_FRACTION,
+    PLUNGE_CAPACITY_FRACTION,
+    BottomAllowance,
+    generating_bottom_allowance,
+    generating_pass_allowance,
+    plunge_allowance,
+)
 from spur_cad.cam.tools import Tool, ToolError
 from spur_cad.geometry.sampling import sample_profile
 from spur_cad.geometry.spec import GearSpec
-
-PLUNGE_CAPACITY_FRACTION = 0.5  # A_p = 0.5 d: what a finishing tool's bottom takes when it plunges
-LAND_PASS_DEPTH_FRACTION = 0.5
-"""Deepest cut a finishing tool takes in one pass, x its diameter: a full-width slot, and 0.5 D is the catalogue's
-slotting depth (the default roughing level depth too). It bounds what stands above the tip lands when finishing
-starts, and what roughing leaves above the root for finishing by generation."""
-
-
-@dataclass(frozen=True)
-class BottomAllowance:
-    """What roughing may leave above the root for the finishing strategy to take, and the rule that sets it (the
-    words follow "more than" in the messages)."""
-
-    allowance_mm: float
-    rule: str
-
-
-def plunge_allowance(flat_width_mm: float, largest: bool = False) -> BottomAllowance:
-    """Strategies whose flat bottom plunges at the root (perimeter, along_x): A_p = 0.5 x the finishing tool's flat
-    width (`largest`: the largest flat allowed, when the job has no finishing tool)."""
-    allowance = PLUNGE_CAPACITY_FRACTION * flat_width_mm
-    whose = "the largest allowed" if largest else "its"
-    return BottomAllowance(allowance, f"the finishing tool can plunge (A_p = {allowance:.3f} mm: "
-                                      f"{PLUNGE_CAPACITY_FRACTION:g} x {whose} flat width {flat_width_mm:g} mm)")
-
-
-def generating_pass_allowance(diameter_mm: float, largest: bool = False) -> BottomAllowance:
-    """Finishing by generation never plunges: its straight passes take what roughing left above the root side-on,
-    at most what the tool takes off in one pass as a slot, LAND_PASS_DEPTH_FRACTION x D (`largest`: the largest
-    generating tool, when the job has no finishing tool)."""
-    allowance = LAND_PASS_DEPTH_FRACTION * diameter_mm
-    diameter = "the largest generating tool's D" if largest else "D"
-    return BottomAllowance(allowance, f"the finishing tool takes off in one generating pass ({allowance:.3f} mm: "
-                                      f"{LAND_PASS_DEPTH_FRACTION:g} x {diameter} {diameter_mm:g} mm, a slot's depth)")
 
 
 def flank_polyline(spec: GearSpec, tolerance_mm: float | None = None) -> np.ndarray:
@@ -125,10 +99,6 @@ def recommend_tools(spec: GearSpec, blank_radius_mm: float, clearance_mm: float,
     from spur_cad.cam.strategies.base import TargetScallopParams
     from spur_cad.keys import key_of
 
-    if strategy is None:
-        from spur_cad.cam.strategies import DEFAULT_STRATEGY, REGISTRY
-
-        strategy = REGISTRY[DEFAULT_STRATEGY]
     profile = spec.tooth_space_profile()
     max_flat = 2.0 * profile.root_arc_half_angle_rad * spec.root_radius_mm
     max_corner = profile.min_fillet_curvature_radius_mm
@@ -143,7 +113,8 @@ def recommend_tools(spec: GearSpec, blank_radius_mm: float, clearance_mm: float,
     # roughing fields follow from the allowance
     limits = ToolRecommendations(max_flat, max_corner, 0.0, 0.0, flute, flute + clearance_mm, generating,
                                  flat_end_mill)
-    allowance = strategy.bottom_allowance(finishing_tool, limits)
+    allowance = (strategy.bottom_allowance(finishing_tool, limits) if strategy is not None
+                 else generating_bottom_allowance(finishing_tool, limits))  # the default strategy's rule
     roughing_max = 2.0 * space_half_width_mm(flank_polyline(spec), spec.root_radius_mm + allowance.allowance_mm)
     return dataclasses.replace(limits, plunge_allowance_mm=allowance.allowance_mm,
                                roughing_max_diameter_mm=roughing_max, bottom_allowance_rule=allowance.rule)

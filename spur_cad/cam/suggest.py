@@ -92,11 +92,11 @@ def suggested_roughing(spec: GearSpec, strategy, finishing: Tool | None, roughin
 
 
 def stub_fits(spec: GearSpec, stock: StockSpec, tool: Tool, clearance_mm: float) -> bool:
-    """Whether the roughing tool's passes stay clear of the holding stub: they run D/2 + clearance beyond the
-    face, into the back margin, where the stub stands within the clearance of the root circle (the roughing
+    """Whether the roughing tool's passes stay clear of the holding stub: their far edge runs D + clearance beyond
+    the face, into the back margin, where the stub stands within the clearance of the root circle (the roughing
     programs refuse more; a conservative test, before the levels or the flank passes are planned)."""
     reaches_root = stock.stub_diameter_mm / 2.0 + clearance_mm > spec.root_radius_mm
-    return not reaches_root or stock.back_margin_mm >= tool.diameter_mm / 2.0 + clearance_mm - 1e-9
+    return not reaches_root or stock.back_margin_mm >= tool.diameter_mm + clearance_mm - 1e-9
 
 
 def suggested_tools(spec: GearSpec, strategy, target_scallop_mm: float, roughing: RoughingParams,

@@ -16,10 +16,10 @@ from typing import Any, Protocol
 
 import numpy as np
 
+from spur_cad.cam.allowances import BottomAllowance, plunge_allowance
 from spur_cad.cam.contacts import SpacePoses
 from spur_cad.cam.ir import Operation, Toolpath, ToolpathBuilder
 from spur_cad.cam.machine import Machine, MachineError
-from spur_cad.cam.recommend import BottomAllowance, plunge_allowance
 from spur_cad.cam.tools import Tool, ToolError
 from spur_cad.geometry.spec import GearSpec
 from spur_cad.keys import check_section, key

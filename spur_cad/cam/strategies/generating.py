@@ -12,11 +12,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from spur_cad.cam.allowances import BottomAllowance, generating_bottom_allowance
 from spur_cad.cam.common import PLUNGE_FEED_FRACTION, safe_height_mm
 from spur_cad.cam.contacts import SpacePoses, TransversePoses
 from spur_cad.cam.ir import Feature, MoveKind, Operation, Toolpath, ToolpathBuilder
 from spur_cad.cam.machine import Machine
-from spur_cad.cam.recommend import BottomAllowance, generating_pass_allowance
 from spur_cad.cam.strategies.base import FinishingResult, floor_to_step
 from spur_cad.cam.strategies.generating_advice import passes_flute_length_mm, tool_advice
 from spur_cad.cam.strategies.generating_flat import flat_deviation_mm
@@ -98,9 +98,7 @@ class GeneratingStrategy:
         """The passes never plunge: near the root they take what roughing left above it side-on, one roll at a
         time, at most a slot's depth, LAND_PASS_DEPTH_FRACTION x D (without a tool: of the largest generating
         tool, recommendations.finishing_generating_max_diameter_mm)."""
-        if tool is None:
-            return generating_pass_allowance(recommendations.finishing_generating_max_diameter_mm, largest=True)
-        return generating_pass_allowance(tool.diameter_mm)
+        return generating_bottom_allowance(tool, recommendations)
 
     def suggested_tool(self, spec: GearSpec, recommendations, target_scallop_mm: float,
                        blank_radius_mm: float) -> tuple[float, float] | None:
