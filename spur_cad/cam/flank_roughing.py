@@ -8,20 +8,24 @@ follows the lead (roughing.follow_lead): the tool's slice at dx from its axis se
 dx tan(beta) / r, so the tool's section is the union of those slices turned (its reach and its corners' sag
 follow from that union exactly, `_Slices`).
 
-Plan of one space (the same for every space, so computed once):
+Plan of one space (the same for every space, so computed once; docs/cam.md "Flank roughing"):
 
 1. Each flank (offset by the finish stock) is cut into segments from the lowest level (where the space is as wide
    as the tool) to the tip edge; a segment is as long as the material the tool's side leaves on it, measured
-   horizontally in its turned frame, stays within flank_allowance_mm - finish_stock_mm.
-2. For a segment, A is turned so that its chord is vertical; the tool's finishing position is the farthest toward
-   the flank at which no point of the design grown by the finish stock lies inside the tool; its tip is at the
-   segment's lower end.
-3. Passes step from the cleared middle of the space toward that position, a radial engagement of at most
-   max_radial_engagement_fraction x D apart, each at full depth (tiers of at most the axial depth limit). The
-   first position is the one next to where the tool finds no more material; when the tool reaches the other
-   flank first, that position is cut as a slot in levels of at most max_level_depth_fraction x D.
+   horizontally in its turned frame, stays within SEGMENT_BUDGET_FRACTION x (flank_allowance_mm -
+   finish_stock_mm).
+2. For a segment, A is turned so that its chord is vertical (or less, where the tool would not fit); the tool's
+   finishing position is the farthest toward the flank at which no point of the design grown by the finish stock
+   lies inside the tool; its tip is at the segment's lower end.
+3. Each segment is a run per flank: positions a radial engagement of at most max_radial_engagement_fraction x D
+   apart, from where the tool finds nothing more to cut on its side of the space toward the flank, each at full
+   depth in tiers (at most the axial depth limit; at most max_level_depth_fraction x D where the tool is engaged
+   wider). A run that meets the other flank first cuts the column touching it first, then the positions beyond
+   it with the tip raised clear of that flank, then back to its flank. A column down the middle takes the bottom,
+   and a column each the pieces left where two segments' columns meet.
 4. A stock model of the section (shapely polygons) follows every pass: it gives each pass's radial engagement and
-   axial depth, and the feed raised by chip thinning so the largest chip equals feed_per_tooth_mm.
+   axial depth, the feed raised by chip thinning so the largest chip equals feed_per_tooth_mm, and the check that
+   nothing farther than the flank allowance from the design is left (`uncut_mm2`).
 """
 
 from __future__ import annotations
