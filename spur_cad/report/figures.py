@@ -25,41 +25,48 @@ def _space_outline(spec: GearSpec) -> np.ndarray:
     return full_space_points(sample_profile(spec.tooth_space_profile(), 1e-3 * spec.module_mm))
 
 
-def roughing_levels_png(spec: GearSpec, heights_mm: np.ndarray, half_widths_mm: np.ndarray, tool: Tool,
-                        blank_radius_mm: float) -> bytes:
-    """The tooth space with each roughing level: the tool bottom's reach at that height, the tool drawn at
-    both ends of the lowest level."""
+def _space_axes(spec: GearSpec, blank_radius_mm: float):
+    """A roughing figure's axes with the design's tooth space and the blank's arc over it."""
     fig = figure(7.5, 6.0)
     ax = fig.add_subplot(1, 1, 1)
     outline = _space_outline(spec)
     ax.plot(outline[:, 0], outline[:, 1], "-", color="k", lw=1.5, label="design")
     span = np.linspace(-math.pi / spec.teeth, math.pi / spec.teeth, 200)
     ax.plot(blank_radius_mm * np.sin(span), blank_radius_mm * np.cos(span), ":", color="0.5", lw=1, label="blank")
+    return fig, ax
+
+
+def _space_png(fig, ax, spec: GearSpec, blank_radius_mm: float, title: str) -> bytes:
+    """A roughing figure finished: equal scales from below the root to above the blank, labels, title, legend."""
+    ax.set_aspect("equal")
+    ax.set_xlabel("Y [mm] (space axis up)")
+    ax.set_ylabel("Z [mm]")
+    ax.set_ylim(spec.root_radius_mm - 0.5, blank_radius_mm + 1.0)
+    ax.set_title(title, fontsize=9)
+    ax.legend(fontsize=8, loc="lower right")
+    ax.grid(True, lw=0.3)
+    return _png(fig)
+
+
+def roughing_levels_png(spec: GearSpec, heights_mm: np.ndarray, half_widths_mm: np.ndarray, tool: Tool,
+                        blank_radius_mm: float) -> bytes:
+    """The tooth space with each roughing level: the tool bottom's reach at that height, the tool drawn at
+    both ends of the lowest level."""
+    fig, ax = _space_axes(spec, blank_radius_mm)
     radius = tool.diameter_mm / 2.0
     for i, (h, w) in enumerate(zip(heights_mm, half_widths_mm)):
         ax.plot([-w, w], [h, h], "-", color="tab:orange", lw=1.2, label="levels (tool edge reach)" if i == 0 else None)
     h, w = heights_mm[-1], half_widths_mm[-1]
     for centre in (-(w - radius), w - radius):
         ax.add_patch(_rectangle(centre - radius, h, tool.diameter_mm, 2.5 * tool.diameter_mm))
-    ax.set_aspect("equal")
-    ax.set_xlabel("Y [mm] (space axis up)")
-    ax.set_ylabel("Z [mm]")
-    ax.set_ylim(spec.root_radius_mm - 0.5, blank_radius_mm + 1.0)
-    ax.set_title(f"roughing: {len(heights_mm)} levels, flat end mill D {tool.diameter_mm:g} mm", fontsize=9)
-    ax.legend(fontsize=8, loc="lower right")
-    ax.grid(True, lw=0.3)
-    return _png(fig)
+    return _space_png(fig, ax, spec, blank_radius_mm,
+                      f"roughing: {len(heights_mm)} levels, flat end mill D {tool.diameter_mm:g} mm")
 
 
 def roughing_flank_png(spec: GearSpec, plan: FlankPlan, tool: Tool, blank_radius_mm: float) -> bytes:
     """The tooth space with the flank strategy's passes: each tool drawn over the depth it cuts, turned back from
     its run's A into the space's frame, a colour per run."""
-    fig = figure(7.5, 6.0)
-    ax = fig.add_subplot(1, 1, 1)
-    outline = _space_outline(spec)
-    ax.plot(outline[:, 0], outline[:, 1], "-", color="k", lw=1.5, label="design")
-    span = np.linspace(-math.pi / spec.teeth, math.pi / spec.teeth, 200)
-    ax.plot(blank_radius_mm * np.sin(span), blank_radius_mm * np.cos(span), ":", color="0.5", lw=1, label="blank")
+    fig, ax = _space_axes(spec, blank_radius_mm)
     radius = tool.diameter_mm / 2.0
     colours = ("tab:blue", "tab:orange", "tab:green", "tab:red", "tab:purple", "tab:brown", "tab:pink", "tab:olive")
     for p in plan.passes:
@@ -70,16 +77,10 @@ def roughing_flank_png(spec: GearSpec, plan: FlankPlan, tool: Tool, blank_radius
         c, s = math.cos(turn), math.sin(turn)
         ax.plot(c * corners[:, 0] + s * corners[:, 1], -s * corners[:, 0] + c * corners[:, 1], "-", lw=0.7,
                 color=colours[p.run % len(colours)])
-    ax.set_aspect("equal")
-    ax.set_xlabel("Y [mm] (space axis up)")
-    ax.set_ylabel("Z [mm]")
-    ax.set_ylim(spec.root_radius_mm - 0.5, blank_radius_mm + 1.0)
     turns = ", ".join(f"{abs(s.turn_deg):.1f}" for s in plan.segments)
-    ax.set_title(f"roughing by flanks: {len(plan.passes)} passes per space, A turned +-({turns}) deg, flat end mill "
-                 f"D {tool.diameter_mm:g} mm", fontsize=9)
-    ax.legend(fontsize=8, loc="lower right")
-    ax.grid(True, lw=0.3)
-    return _png(fig)
+    return _space_png(fig, ax, spec, blank_radius_mm,
+                      f"roughing by flanks: {len(plan.passes)} passes per space, A turned +-({turns}) deg, flat end "
+                      f"mill D {tool.diameter_mm:g} mm")
 
 
 def _rectangle(y0: float, z0: float, width: float, height: float):

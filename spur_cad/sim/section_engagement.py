@@ -26,22 +26,18 @@ import numpy as np
 from numba import njit
 
 from spur_cad.cam.ir import MoveKind
-from spur_cad.sim.engagement import COLUMNS_PER_DIAMETER, LEAD_SAMPLES, Engagement, MeasuredCut, move_minutes
+from spur_cad.sim.engagement import (
+    COLUMNS_PER_DIAMETER,
+    LEAD_SAMPLES,
+    Engagement,
+    MeasuredCut,
+    _bottom,
+    move_minutes,
+)
 
 MAX_SECTION_CELLS = 20_000_000
 """Largest raster (cells of all spaces, 20 MB); beyond it the cells are larger."""
 MIN_CELLS_PER_LINE = 2  # a column or row of removed cells counts toward a_e / a_p from this many cells
-
-
-@njit(cache=True)
-def _bottom(d, half_flat, rt):
-    """Height of the tool's bottom above its tip at distance d from its axis (inf beyond its radius)."""
-    if d <= half_flat:
-        return 0.0
-    e = d - half_flat
-    if e > rt:
-        return np.inf
-    return rt - math.sqrt(rt * rt - e * e)
 
 
 @njit(cache=True)
