@@ -25,6 +25,14 @@ SCALLOP = 0.005
 TOOL_LENGTH = 30.0
 
 
+def _roughed(spec, tool, strategy: str):
+    """The roughing the checks below read: allowance 0.1 m, finish stock 0.005 m, blank 0.5 mm above the tips."""
+    params = RoughingParams(flank_allowance_mm=0.1 * spec.module_mm, finish_stock_mm=0.005 * spec.module_mm,
+                            strategy=strategy)
+    blank = spec.tip_radius_mm + 0.5
+    return params, blank, roughing_toolpath(spec, tool, Machine(), params, blank)
+
+
 def _spaces(teeth: int) -> list[int]:
     return [0, 1, teeth - 1]
 
@@ -68,10 +76,7 @@ def test_finishing_cuts_every_flank_downward(name):
 def test_roughing_respects_finish_stock_and_flank_allowance(name, strategy, design_polygons):
     spec = spec_of(name)
     tool, finishing = tools_for(name)
-    params = RoughingParams(flank_allowance_mm=0.1 * spec.module_mm, finish_stock_mm=0.005 * spec.module_mm,
-                            strategy=strategy)
-    blank = spec.tip_radius_mm + 0.5
-    path = roughing_toolpath(spec, tool, Machine(), params, blank)
+    params, blank, path = _roughed(spec, tool, strategy)
     rows = path.motion_mask & (path.space == 0)
     sils = silhouette.silhouettes_in_part_frame(path, tool.diameter_mm, 0.0, TOOL_LENGTH, mask=rows)
     # Never closer than the finish stock to the design: no reach into the design grown by it.
@@ -114,10 +119,7 @@ def test_roughing_takes_the_blank_down_to_the_tip_circle_plus_the_finish_stock(n
     finishing tool takes off the tips in one pass (a slot: half its diameter)."""
     spec = spec_of(name)
     tool, finishing = tools_for(name)
-    params = RoughingParams(flank_allowance_mm=0.1 * spec.module_mm, finish_stock_mm=0.005 * spec.module_mm,
-                            strategy=strategy)
-    blank = spec.tip_radius_mm + 0.5
-    path = roughing_toolpath(spec, tool, Machine(), params, blank)
+    params, blank, path = _roughed(spec, tool, strategy)
     tips = path.motion_mask & (path.feature == Feature.TIP)
     assert np.count_nonzero(tips & (path.space == 0)) >= 1  # at least one pass along X over the land
     floor = spec.tip_radius_mm + params.finish_stock_mm
@@ -188,10 +190,7 @@ def test_roughing_leaves_no_material_beyond_the_flank_allowance(name, strategy, 
     included) covered lies within the flank allowance of the design (+1 um)."""
     spec = spec_of(name)
     tool, _ = tools_for(name)
-    params = RoughingParams(flank_allowance_mm=0.1 * spec.module_mm, finish_stock_mm=0.005 * spec.module_mm,
-                            strategy=strategy)
-    blank = spec.tip_radius_mm + 0.5
-    path = roughing_toolpath(spec, tool, Machine(), params, blank)
+    params, blank, path = _roughed(spec, tool, strategy)
     rows = path.motion_mask & np.isin(path.space, [0, 1, spec.teeth - 1])
     union = shapely.union_all(silhouette.silhouettes_in_part_frame(path, tool.diameter_mm, 0.0, TOOL_LENGTH,
                                                                    mask=rows))
