@@ -134,6 +134,7 @@ class ToolsSection:
     roughing: Tool | None = None
     finishing: Tool | None = None
     bottom: Tool | None = None  # two-stage roughing: a smaller tool for the bottom of the spaces
+    roughing_top: Tool | None = None  # two-stage roughing offered: a larger tool for the upper part of the spaces
 
 
 @dataclass(frozen=True)
@@ -179,6 +180,7 @@ SECTIONS: dict[str, type] = {
     "tools.roughing": Tool,
     "tools.finishing": Tool,
     "tools.bottom": Tool,
+    "tools.roughing_top": Tool,
     "roughing": RoughingParams,
     "finishing": FinishingParams,
     "machine": Machine,
@@ -194,7 +196,7 @@ def job_sections(strategies: Strategies = REGISTRY) -> dict[str, type]:
     return {**SECTIONS, "finishing": finishing_section_type(strategies)}
 
 
-_TOOL_ROLES = ("roughing", "finishing", "bottom")
+_TOOL_ROLES = ("roughing", "finishing", "bottom", "roughing_top")
 MAX_JOB_FILE_BYTES = 1024 * 1024
 """Job files larger than this are refused before they are parsed."""
 
@@ -359,6 +361,8 @@ DEFAULT_FINISHING_TOOL_NUMBER = 2
 """The finishing tool's number when its section gives none (the roughing tool's default is 1)."""
 DEFAULT_BOTTOM_TOOL_NUMBER = 3
 """The bottom roughing tool's number when its section gives none."""
+DEFAULT_ROUGHING_TOP_TOOL_NUMBER = 4
+"""The larger roughing tool's number ([tools.roughing_top]) when its section gives none."""
 
 
 def _tool_label(tool: Tool) -> str:
@@ -381,9 +385,10 @@ def _check_tool_numbers(first_role: str, first: Tool, role: str, tool: Tool, whe
 
 
 def _tools_section(sections: dict, tables: dict, where: Callable[[str, str | None], str]) -> ToolsSection:
-    """The tools, with the default numbers of tools whose sections give none (T2 finishing, T3 bottom), and no
-    two different tools under one number."""
-    for role, number in (("finishing", DEFAULT_FINISHING_TOOL_NUMBER), ("bottom", DEFAULT_BOTTOM_TOOL_NUMBER)):
+    """The tools, with the default numbers of tools whose sections give none (T2 finishing, T3 bottom, T4
+    roughing_top), and no two different tools under one number."""
+    for role, number in (("finishing", DEFAULT_FINISHING_TOOL_NUMBER), ("bottom", DEFAULT_BOTTOM_TOOL_NUMBER),
+                         ("roughing_top", DEFAULT_ROUGHING_TOP_TOOL_NUMBER)):
         if f"tools.{role}" in sections and "tool_number" not in tables[f"tools.{role}"]:
             sections[f"tools.{role}"] = dataclasses.replace(sections[f"tools.{role}"], tool_number=number)
     tools = ToolsSection(**{role: sections.get(f"tools.{role}") for role in _TOOL_ROLES})
@@ -395,6 +400,29 @@ def _tools_section(sections: dict, tables: dict, where: Callable[[str, str | Non
             _check_tool_numbers(first_role, getattr(tools, first_role), role, getattr(tools, role),
                                 where(f"tools.{blamed}", "tool_number"), blamed)
     return tools
+
+
+def _check_roughing_top(tools: ToolsSection, where: Callable[[str, str | None], str]) -> None:
+    """[tools.roughing_top] offers two-stage roughing with a larger flat end mill above [tools.roughing]: it needs
+    that section, not [tools.bottom] as well (each makes a pair of roughing tools), and a larger diameter."""
+    top, roughing = tools.roughing_top, tools.roughing
+    if top is None:
+        return
+    name = "tools.roughing_top"
+    if roughing is None:
+        problem, key = ("needs [tools.roughing]: the larger tool roughs the upper part of the spaces, the roughing "
+                        "tool what it leaves"), "diameter_mm"
+    elif tools.bottom is not None:
+        problem, key = ("and [tools.bottom] both make two-stage roughing: give one of them (roughing_top: a larger "
+                        "tool above [tools.roughing]; bottom: a smaller one below it)"), "diameter_mm"
+    elif top.kind != "flat":
+        problem, key = f"kind = {shown(top.kind)}: roughing uses a flat end mill", "kind"
+    elif top.diameter_mm <= roughing.diameter_mm:
+        problem, key = (f"diameter_mm = {top.diameter_mm:g} must be larger than the roughing tool's "
+                        f"{roughing.diameter_mm:g} mm (it roughs the upper part of the spaces)"), "diameter_mm"
+    else:
+        return
+    raise JobFileError(f"{where(name, key)}: [{name}] {problem}", section=name, field=key)
 
 
 AUTO = "auto"
@@ -504,6 +532,7 @@ def _job_from_data(data: dict, source: str, text: str, strategies: Strategies = 
             raise JobFileError(f"{where(name, blamed)}: invalid [{name}]: {exc}", section=name, field=blamed) from None
     _validate_sections(sections, tables, types, autos, spec, strategies, where)
     tools = _tools_section(sections, tables, where)
+    _check_roughing_top(tools, where)
     try:
         check_machine_limits(spec, sections.get("stock", StockSpec()), sections.get("machine", Machine()),
                              {role: tool for role in _TOOL_ROLES if (tool := getattr(tools, role)) is not None})

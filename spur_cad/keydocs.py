@@ -59,7 +59,12 @@ Notes:
   `smallest_end_mill_mm` are warnings (see [shop-floor.md](shop-floor.md)).
 - `[tools.bottom]`: two-stage roughing, a flat end mill smaller than `[tools.roughing]` for the
   bottom of the spaces (T3 when it gives no number); the split is chosen for the shortest time
-  unless `[roughing] bottom_tool_above_root_mm` sets it.
+  unless `[roughing] bottom_tool_above_root_mm` sets it (by flanks: the larger tool takes all it
+  reaches). Roughing uses the quicker of two-stage roughing and the smaller tool alone.
+- `[tools.roughing_top]`: the same pair the other way round, a flat end mill larger than
+  `[tools.roughing]` for the upper part of the spaces (T4 when it gives no number); not with
+  `[tools.bottom]`. Where two-stage roughing cannot be planned with it, `[tools.roughing]` roughs
+  alone (a warning says why).
 - `[lathe]`: with the section the blank's lathe program `blank.<ext>` is written too (see
   [lathe.md](lathe.md)).
 """

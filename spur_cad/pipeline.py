@@ -189,7 +189,12 @@ def program_comments(job: Job, plan: CamPlan, operation: str) -> tuple[str, ...]
             turns = ", ".join(f"{abs(s.turn_deg):.1f}" for s in planned.flank.segments)
             strategy = (f"strategy: by flanks, {len(planned.flank.passes)} passes per space, A turned +-{turns} "
                         f"deg, flank allowance {job.roughing.flank_allowance_mm:g} mm")
-        if plan.two_stage is not None:
+        if plan.two_stage is not None and planned.flank is not None:
+            stage = "the upper part, then roughing_bottom" if operation == "roughing" else \
+                "what roughing leaves, after roughing"
+            strategy += f"; two-stage ({stage}), the roughing tool down to " \
+                f"{plan.two_stage.split_height_above_root_mm:.3f} mm above the root"
+        elif plan.two_stage is not None:
             stage = "upper levels, then roughing_bottom" if operation == "roughing" else "bottom levels, after roughing"
             strategy += (f"; two-stage ({stage}), split {plan.two_stage.split_height_above_root_mm:.3f} mm above "
                          "the root")
@@ -240,7 +245,7 @@ def build_cad(job: Job, checkpoint: Callable[[], None] | None = None,
 def cam_inputs(job: Job) -> CamInputs:
     """The part of a job the CAM stage reads."""
     return CamInputs(job.gear, job.stock, job.tools.roughing, job.tools.finishing, job.roughing, job.finishing,
-                     job.machine, job.tools.bottom, job.strategies)
+                     job.machine, job.tools.bottom, top_tool=job.tools.roughing_top, strategies=job.strategies)
 
 
 def plan_cam(job: Job, checkpoint: Callable[[], None] | None = None) -> CamPlan:

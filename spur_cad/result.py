@@ -123,6 +123,15 @@ class TwoStageFacts:
 
 
 @dataclass(frozen=True)
+class DeclinedTwoStageFacts:
+    """Two-stage roughing the job's tools allow, not used: the bottom tool alone is quicker."""
+
+    roughing_tool: ToolFacts  # the larger tool, which would have roughed the upper part
+    two_stage_time_s: float
+    bottom_tool_alone_time_s: float
+
+
+@dataclass(frozen=True)
 class RoughingFacts:
     """One roughing operation: its levels and its estimate (and two-stage roughing's bottom operation)."""
 
@@ -141,6 +150,7 @@ class RoughingFacts:
     # for roughing by levels.
     passes_per_space: int | None = None
     flank_turns_deg: tuple[float, ...] = ()
+    two_stage_declined: DeclinedTwoStageFacts | None = None
 
 
 @dataclass(frozen=True)

@@ -21,6 +21,7 @@ from spur_cad.post.program import PostedProgram
 from spur_cad.post.settings import PostSettings
 from spur_cad.result import (
     CadResult,
+    DeclinedTwoStageFacts,
     FeatureDeviation,
     FinishingFacts,
     JobFacts,
@@ -62,7 +63,8 @@ def build_result(job, samples: ProfileSamples, cad: CadResult, plan: CamPlan, po
         version=__version__, job=JobFacts(job.job.name, job.source), gear=job.gear.facts(),
         inspection=inspection_facts(job.gear),
         profile=ProfileFacts(job.job.profile_tolerance_mm, len(samples), counts), cad=cad,
-        tools=tools_facts(plan, job.machine, job.tools.roughing, job.tools.finishing),
+        tools=tools_facts(plan, job.machine, plan.roughing.tool if plan.roughing is not None else job.tools.roughing,
+                          job.tools.finishing),
         roughing=roughing_facts(plan, job.machine, simulation), finishing=finishing_facts(plan.finishing),
         warnings=tuple(plan.warnings) + engagement_warnings(simulation, job.roughing, plan),
         post=PostFacts(post.dialect, post.folded, tuple(ProgramFacts(name, p.lines, p.bytes, p.subprograms)
@@ -126,14 +128,16 @@ def _roughing(roughing: RoughingPlan) -> RoughingFacts:
 
 
 def engagement_limits(params: RoughingParams, plan: CamPlan):
-    """The limits the job's roughing keeps (sim.engagement.EngagementLimits): the flank strategy's (one tool), or
-    the levels' (levels, and two-stage roughing, which runs by levels)."""
+    """The limits the job's roughing keeps (sim.engagement.EngagementLimits): the flank strategy's (each tool's
+    axial depth limit in two-stage roughing), or the levels'."""
     from spur_cad.cam.flank_roughing import FlankLimits
     from spur_cad.sim.engagement import EngagementLimits
 
-    if params.strategy == "flank" and plan.roughing is not None and plan.roughing_bottom is None:
+    if params.strategy == "flank" and plan.roughing is not None:
+        by_operation = {name: FlankLimits.of(planned.tool, params).axial_depth_mm for name, planned in
+                        (("roughing", plan.roughing), ("roughing_bottom", plan.roughing_bottom)) if planned is not None}
         return EngagementLimits(params.max_level_depth_fraction, params.max_radial_engagement_fraction,
-                                FlankLimits.of(plan.roughing.tool, params).axial_depth_mm)
+                                max(by_operation.values()), by_operation)
     return EngagementLimits(params.max_level_depth_fraction, params.step_over_fraction)
 
 
@@ -157,6 +161,10 @@ def roughing_facts(plan: CamPlan, machine: Machine, simulation: SimResult | None
         facts = dataclasses.replace(facts, max_radial_engagement_fraction=engagement.max_radial_fraction,
                                     max_axial_depth_mm=engagement.max_axial_depth_mm,
                                     mean_removal_rate_mm3_min=engagement.mean_removal_rate_mm3_min)
+    declined = plan.two_stage_declined
+    if declined is not None:
+        facts = dataclasses.replace(facts, two_stage_declined=DeclinedTwoStageFacts(
+            tool_facts(declined.roughing_tool, machine), declined.two_stage_time_s, declined.bottom_tool_alone_time_s))
     if plan.roughing_bottom is None:
         return facts
     stage, bottom = plan.two_stage, plan.roughing_bottom
@@ -290,6 +298,12 @@ def roughing_json(roughing: RoughingFacts, measured: bool = True) -> dict:
             "split_height_above_root_mm": stage.split_height_above_root_mm, "split_chosen_by": stage.split_chosen_by,
             "bottom": roughing_json(stage.bottom, measured=False), "two_stage_time_s": stage.two_stage_time_s,
             "bottom_tool_alone_time_s": stage.bottom_tool_alone_time_s, "time_saved_s": stage.time_saved_s}
+    declined = roughing.two_stage_declined
+    if declined is not None:
+        facts["two_stage_declined"] = {
+            "roughing_tool": tool_json(declined.roughing_tool, with_number=True),
+            "two_stage_time_s": declined.two_stage_time_s,
+            "bottom_tool_alone_time_s": declined.bottom_tool_alone_time_s}
     return facts
 
 

@@ -132,8 +132,8 @@ def test_roughing_takes_the_blank_down_to_the_tip_circle_plus_the_finish_stock(n
     assert left <= math.hypot(edge, floor) - spec.tip_radius_mm + 0.005
     assert left <= 0.5 * finishing.diameter_mm
     # without the tip passes the whole allowance stands there (levels); by flanks, more than with them (the runs
-    # take what they can of the lands beside the tip edges: two-stage roughing, which leaves the tip passes out of
-    # its bottom program, runs by levels)
+    # take what they can of the lands beside the tip edges; two-stage roughing's bottom program leaves the lands
+    # to the larger tool)
     without = roughing_toolpath(spec, tool, Machine(), params, blank, tips=False)
     if strategy == "levels":
         assert _left_above_tip_mm(spec, without, tool, blank) == pytest.approx(0.5)

@@ -74,6 +74,23 @@ def test_the_measured_engagement_is_within_the_job_s_limits_and_the_feed_keeps_t
     ).mean_removal_rate_mm3_min
 
 
+def test_the_passes_cross_the_air_beyond_the_stock_at_the_largest_feed_and_cut_only_at_their_own(reference):
+    """Every pass leaves the largest feed before the tool can meet the stock: the legs at the machine's largest feed
+    along X remove nothing in the section model (tip lands included), and they are a real share of the passes."""
+    job, plan = reference
+    path = plan.roughing.toolpath
+    e = roughing_engagement(job, plan)
+    start = path.start_poses()
+    along_x = (path.kind == MoveKind.LINEAR) & (path.x != start[:, 0]) & (path.y == start[:, 1]) & (
+        path.z == start[:, 2])
+    air = along_x & (path.feed == job.machine.max_feed_mm_min) & (path.feature == Feature.NONE)
+    rows = np.isin(e.index, np.flatnonzero(air))
+    assert rows.sum() >= np.count_nonzero(along_x & (path.feature != Feature.NONE))  # at least one per pass
+    assert e.removed_mm3[rows].max() == 0.0
+    cutting = along_x & (path.feature != Feature.NONE)
+    assert np.all(path.feed[cutting] < job.machine.max_feed_mm_min)
+
+
 def test_a_hand_made_overload_is_flagged(reference):
     """Planted fault: one side pass of space 5 moved back onto the column before it, so that the next pass meets
     twice the radial engagement at full depth: the section model measures it and the warning names that move."""

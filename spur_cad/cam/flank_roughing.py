@@ -127,6 +127,8 @@ class FlankPlan:
     passes: tuple[FlankPass, ...]
     limits: FlankLimits
     uncut_mm2: float  # what the plan leaves beyond the flank allowance (stock model; 0 when complete)
+    stock: object = None  # shapely polygon: the section of space 0 and its neighbours' halves as the passes leave it
+    start_stock: object = None  # the same before the passes
 
     @property
     def lowest_z_mm(self) -> float:
@@ -372,6 +374,9 @@ def _material(view, cut):
     return shapely.MultiPolygon(parts) if parts else None
 
 
+SMALL_TIER_FRACTION = 0.05
+"""A tier under another at a position before the flank's own is left to later passes when it cuts less than this
+fraction of a full side pass (radial engagement x axial depth)."""
 BAND_SAMPLE_MM = 0.02  # heights at which a pass's material is measured across
 
 
@@ -397,6 +402,9 @@ def _tiers(material, u: float, radius: float, z_tip: float, step: float, limits:
     tiers = []
     high = top
     while high > z_tip + 1e-9:
+        high = _reach(material, u, radius, z_tip, high, direction)[1]  # each tier's depth from the material's top
+        if high <= z_tip + 1e-9:
+            break
         low = max(high - limits.axial_depth_mm, z_tip)
         wide = (heights >= low - 1e-12) & (heights <= high + 1e-12) & (reach > step + 1e-6)
         if wide.any():
@@ -462,14 +470,17 @@ def _run_order(geo: _SpaceGeometry, segment: FlankSegment, step: float, own_mate
 
 
 def _run_passes(stock: _Stock, geo: _SpaceGeometry, segment: FlankSegment, side: int, run: int,
-                limits: FlankLimits, model_radius: float, top_z: float, centre: bool = False) -> list[FlankPass]:
+                limits: FlankLimits, model_radius: float, top_z: float, centre: bool = False,
+                final_always: bool = True) -> list[FlankPass]:
     """The passes of one run (a segment's turn, one flank), the stock model updated after each; each position is
     cut at full depth in tiers (slot levels where the tool would be engaged wider than the radial limit).
     Positions step from the flank toward the middle of the space until the tool finds no more material that needs
     cutting on its own side of the space's centre line; they are then cut from there to the flank. Where the tool
     meets the other flank first, the column touching it is cut first (a slot in levels), then the positions beyond
     it with the tip raised clear of that flank, stepping away from the flank, then the positions back to the
-    flank. `centre`: the one position of a segment on the space's centre line (the bottom's clean-up)."""
+    flank. `centre`: the one position of a segment on the space's centre line (the bottom's clean-up).
+    `final_always`: the flank's own column is cut even where nothing in it needs cutting (it leaves the flank
+    even); a second tool's plan leaves it out there."""
     import shapely
     from shapely import affinity
 
@@ -494,13 +505,17 @@ def _run_passes(stock: _Stock, geo: _SpaceGeometry, segment: FlankSegment, side:
     for u, floor, direction in order:
         material = _material(view, box(u, floor))
         needed = _material(view.difference(keep), box(u, floor))
-        if material is None or (needed is None and u != u_final):  # the flank's own column is always cut
+        if material is None or (needed is None and (u != u_final or not final_always)):
             continue
         tiers = _tiers(material, u, model_radius, floor, step, limits, direction)
         if u != u_final:  # the tiers below the last needed material are left out
             lowest_needed = needed.bounds[1]
             while len(tiers) > 1 and tiers[-1][1] <= lowest_needed + 1e-9 and tiers[-2][0] >= lowest_needed - 1e-9:
                 tiers.pop()
+            small = SMALL_TIER_FRACTION * step * limits.axial_depth_mm
+            while len(tiers) > 1 and material.intersection(shapely.box(u - model_radius, tiers[-1][0], u + model_radius,
+                                                                       tiers[-2][0])).area < small:
+                tiers.pop()  # a sliver at the bottom: later positions, the bottom column or a clean-up column take it
         ceiling = top_z
         for low, high, a_e in tiers:
             factor = chip_thinning_factor(a_e, limits.diameter_mm, limits.feed_factor_cap)
@@ -513,11 +528,13 @@ def _run_passes(stock: _Stock, geo: _SpaceGeometry, segment: FlankSegment, side:
 
 
 def plan_flank_roughing(spec: GearSpec, tool: Tool, params: RoughingParams, blank_radius_mm: float,
-                        lowest_height_mm: float, model_radius_mm: float, land_half_width_mm: float) -> FlankPlan:
+                        lowest_height_mm: float, model_radius_mm: float, land_half_width_mm: float,
+                        start_stock=None) -> FlankPlan:
     """The passes of one tooth space (module docstring); `lowest_height_mm`: the lowest level (the space as wide
     as the tool's transverse width), `model_radius_mm`: the tool's half-width in the stock model (its transverse
     radius for a helical gear), `land_half_width_mm`: how far the tip passes clear each side of a tooth's centre
-    line (what they leave is not the runs' to take). Pure."""
+    line (what they leave is not the runs' to take). `start_stock`: the section as a first tool left it
+    (stock_after_all_spaces), for a second tool's plan (two-stage roughing). Pure."""
     import shapely.affinity
 
     geo = _SpaceGeometry(spec, tool, params, blank_radius_mm)
@@ -527,13 +544,14 @@ def plan_flank_roughing(spec: GearSpec, tool: Tool, params: RoughingParams, blan
     if not segments:
         raise ToolError("flank roughing: no flank segment above the lowest level", field="diameter_mm",
                         section="tools.roughing")
-    stock = _Stock(geo.stock)
+    first = geo.stock if start_stock is None else start_stock
+    stock = _Stock(first)
     passes: list[FlankPass] = []
     run = 0
     for side in (1, -1):
         for segment in segments:  # the lowest (longest) first: the higher ones take what it leaves
             passes.extend(_run_passes(stock, geo, segment, side, run, limits, model_radius_mm,
-                                      blank_radius_mm + 1.0))
+                                      blank_radius_mm + 1.0, final_always=start_stock is None))
             run += 1
     # the bottom of the space between the lowest segments' columns, straight down the middle to the lowest level
     bottom = FlankSegment(0.0, lowest_height_mm, 0.0, 0.0, 0.0, lowest_height_mm, lowest_height_mm)
@@ -552,7 +570,30 @@ def plan_flank_roughing(spec: GearSpec, tool: Tool, params: RoughingParams, blan
             passes.extend(_run_passes(stock, geo, column, side, run, limits, model_radius_mm, blank_radius_mm + 1.0,
                                       centre=True))
     uncut = _uncut(geo, stock, spec, params, lowest_height_mm, land_half_width_mm)
-    return FlankPlan(tuple(segments), tuple(passes), limits, float(uncut.area))
+    return FlankPlan(tuple(segments), tuple(passes), limits, float(uncut.area), stock.polygon, first)
+
+
+def stock_after_all_spaces(spec: GearSpec, plan: FlankPlan, land_half_width_mm: float, finish_stock_mm: float):
+    """The section stock a plan leaves once every space is cut, for a second tool's plan to start from: its stock
+    model cuts space 0 with its neighbours uncut, so what space 0's passes removed, turned by a pitch each way, is
+    removed too; and the tip lands' columns (`land_half_width_mm` each side of a tooth's centre line) down to the
+    tip radius + finish stock (the tip passes' floor)."""
+    import shapely
+    from shapely import affinity
+
+    pitch_deg = 360.0 / spec.teeth
+    removed = shapely.difference(plan.start_stock, plan.stock, grid_size=GRID_MM)
+    top = 2.0 * (spec.tip_radius_mm + 10.0 * spec.module_mm)
+    lands = [affinity.rotate(shapely.box(-land_half_width_mm, spec.tip_radius_mm + finish_stock_mm, land_half_width_mm,
+                                         top), sign * pitch_deg / 2.0, origin=(0.0, 0.0)) for sign in (-1.0, 1.0)]
+    cuts = [affinity.rotate(removed, sign * pitch_deg, origin=(0.0, 0.0)) for sign in (-1.0, 0.0, 1.0)] + lands
+    stock = shapely.difference(plan.start_stock, shapely.union_all(cuts, grid_size=GRID_MM), grid_size=GRID_MM)
+    return shapely.union_all(_polygons(stock))
+
+
+GRID_MM = 1e-7
+"""The precision grid of stock_after_all_spaces's overlays (turned copies of one outline meet at nearly the same
+points: without a grid GEOS may find them not noded)."""
 
 
 def _uncut(geo: _SpaceGeometry, stock: _Stock, spec: GearSpec, params: RoughingParams, lowest_height_mm: float,

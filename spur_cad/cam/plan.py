@@ -96,12 +96,14 @@ class FinishingPlan:
 
 @dataclass(frozen=True)
 class TwoStage:
-    """Two-stage roughing: where the bottom tool takes over and what it saves against that tool alone."""
+    """Two-stage roughing: where the bottom tool takes over and what it saves against that tool alone (times with
+    the machine's accelerations)."""
 
     split_height_above_root_mm: float  # the roughing tool's lowest level; the bottom tool's levels are below it
-    chosen: str  # "shortest time" or "set" ([roughing] bottom_tool_above_root_mm)
+    chosen: str  # "shortest time", "set" ([roughing] bottom_tool_above_root_mm) or "reach" (by flanks)
     two_stage_time_s: float
     bottom_tool_alone_time_s: float
+    roughing_tool: Tool | None = None  # the larger tool (the upper program's)
 
     @property
     def gain_s(self) -> float:
@@ -118,6 +120,9 @@ class CamPlan:
     warnings: tuple[str, ...]
     roughing_bottom: RoughingPlan | None = None
     two_stage: TwoStage | None = None
+    # two-stage roughing the job's tools allow but not used: the bottom tool alone is quicker (roughing is then that
+    # tool's single program)
+    two_stage_declined: TwoStage | None = None
 
 
 @dataclass(frozen=True)
@@ -132,6 +137,7 @@ class CamInputs:
     finishing: FinishingParams
     machine: Machine
     bottom_tool: Tool | None = None  # two-stage roughing: the smaller tool for the bottom of the spaces
+    top_tool: Tool | None = None  # two-stage roughing offered: a larger tool above roughing_tool ([tools.roughing_top])
     strategies: Strategies = field(default_factory=lambda: dict(REGISTRY))  # where [finishing] strategy is found
 
 
@@ -304,11 +310,11 @@ def plan_cam(inputs: CamInputs, checkpoint: Callable[[], None] | None = None) ->
     warnings.extend(small_tool_warnings(rec, inputs.machine.smallest_end_mill_mm, strategy.name,
                                         strategy.largest_tool(rec),
                                         inputs.finishing_tool.kind if inputs.finishing_tool is not None else None))
-    bottom = two_stage = None
-    if levels is not None and inputs.bottom_tool is not None:
+    bottom = two_stage = declined = None
+    if levels is not None and (inputs.bottom_tool is not None or inputs.top_tool is not None):
         check()
-        roughing, bottom, two_stage = _plan_two_stage(inputs, levels, blank)
-        warnings.extend(roughing.toolpath.warnings + bottom.toolpath.warnings)
+        roughing, bottom, two_stage, declined, notes = _plan_tool_pair(inputs, levels, blank)
+        warnings.extend(notes + roughing.toolpath.warnings + (bottom.toolpath.warnings if bottom else ()))
     elif levels is not None:
         check()
         roughing = _plan_roughing(inputs, levels, blank)
@@ -317,7 +323,7 @@ def plan_cam(inputs: CamInputs, checkpoint: Callable[[], None] | None = None) ->
         check()
         finishing = _plan_finishing(inputs, blank, check)
         warnings.extend(finishing.toolpath.warnings)
-    return CamPlan(rec, roughing, finishing, tuple(warnings), bottom, two_stage)
+    return CamPlan(rec, roughing, finishing, tuple(warnings), bottom, two_stage, declined)
 
 
 def check_moves(operation: str, moves: int, section: str, field: str) -> None:
@@ -331,24 +337,76 @@ def _levels_where(levels: RoughingLevels, keep: np.ndarray) -> RoughingLevels:
     return RoughingLevels(levels.heights_mm[keep], levels.half_widths_mm[keep], levels.junction_height_mm)
 
 
+def _plan_tool_pair(inputs: CamInputs, levels: RoughingLevels, blank: float):
+    """Roughing with two tools given: two-stage roughing or the smaller tool alone, whichever is quicker (with the
+    machine's accelerations). [tools.bottom] names the smaller tool (`levels` are the larger roughing tool's);
+    [tools.roughing_top] the larger (`levels` are the roughing tool's), and where two-stage roughing cannot be
+    planned with it the roughing tool roughs alone, with a warning saying why. Returns (roughing, bottom or None,
+    the two-stage roughing used or None, the one declined or None, warnings)."""
+    notes: tuple[str, ...] = ()
+    if inputs.top_tool is None:
+        upper, lower, stage, alone = _plan_two_stage(inputs, levels, blank)
+    else:
+        spec, top = inputs.spec, inputs.top_tool
+        staged = dataclasses.replace(inputs, roughing_tool=top, bottom_tool=inputs.roughing_tool, top_tool=None)
+        try:
+            moves, driver = estimated_roughing_moves(spec, top, inputs.roughing, blank)
+            check_moves("roughing with [tools.roughing_top]", moves, "roughing", driver)
+            upper, lower, stage, alone = _plan_two_stage(staged, roughing_levels(spec, top, inputs.roughing, blank),
+                                                         blank)
+        except SpurCadError as exc:
+            return (_plan_roughing(inputs, levels, blank), None, None, None,
+                    (f"[tools.roughing_top] is not used: two-stage roughing with it cannot be planned ({exc}); "
+                     "roughing uses [tools.roughing] alone",))
+    if stage.two_stage_time_s < stage.bottom_tool_alone_time_s:
+        return upper, lower, stage, None, notes
+    return alone, None, None, stage, notes
+
+
 def _plan_two_stage(inputs: CamInputs, levels: RoughingLevels,
-                    blank: float) -> tuple[RoughingPlan, RoughingPlan, TwoStage]:
-    """The roughing tool's levels down to a split, the bottom tool's levels below it. The split is one of the
-    roughing tool's levels: the one [roughing] bottom_tool_above_root_mm names (the lowest at or above that
-    height), or the one with the shortest estimated time of both programs. Below the split the bottom tool's
-    own levels keep the staircase and depth limits (its next level above is at or above the split)."""
-    job_inputs, inputs = inputs, by_levels(inputs)
+                    blank: float) -> tuple[RoughingPlan, RoughingPlan, TwoStage, RoughingPlan]:
+    """Two-stage roughing by the job's strategy: the upper (roughing tool's) and lower (bottom tool's) programs,
+    their comparison with the bottom tool alone, and that tool's plan alone.
+
+    By levels: the roughing tool's levels down to a split, the bottom tool's levels below it. The split is one of
+    the roughing tool's levels: the one [roughing] bottom_tool_above_root_mm names (the lowest at or above that
+    height), or the one with the shortest feed-bound time of both programs. Below the split the bottom tool's own
+    levels keep the staircase and depth limits (its next level above is at or above the split). By flanks
+    (_plan_flank_two_stage): the roughing tool takes all it reaches, the bottom tool what it leaves."""
+    if inputs.roughing.strategy == "flank":
+        return _plan_flank_two_stage(inputs, levels, blank)
     spec, bottom = inputs.spec, inputs.bottom_tool
     bottom_levels = roughing_levels(spec, bottom, inputs.roughing, blank)
     alone = _plan_roughing(inputs, bottom_levels, blank, bottom)
     _, j, below = _two_stage_split(inputs, levels, blank, bottom_levels, alone)
-    if job_inputs.roughing.strategy != "levels":  # the comparison: the bottom tool alone by the job's strategy
-        alone = _plan_roughing(job_inputs, bottom_levels, blank, bottom)
     upper = _plan_roughing(inputs, _levels_where(levels, np.arange(len(levels.heights_mm)) <= j), blank)
     lower = _plan_roughing(inputs, _levels_where(bottom_levels, below), blank, bottom, tips=False)
     chosen = "set" if inputs.roughing.bottom_tool_above_root_mm > 0.0 else "shortest time"
     return upper, lower, TwoStage(float(levels.heights_mm[j] - spec.root_radius_mm), chosen,
-                                  upper.estimate.time_s + lower.estimate.time_s, alone.estimate.time_s)
+                                  _seconds(upper) + _seconds(lower), _seconds(alone), upper.tool), alone
+
+
+def _seconds(planned: RoughingPlan) -> float:
+    return planned.estimate.time_with_acceleration_s
+
+
+def _plan_flank_two_stage(inputs: CamInputs, levels: RoughingLevels,
+                          blank: float) -> tuple[RoughingPlan, RoughingPlan, TwoStage, RoughingPlan]:
+    """Two-stage roughing by flanks: the roughing tool's flank plan (with the tip lands) down to its own lowest
+    level, then the bottom tool's from the section the first leaves in every space (its stock model starts there:
+    flank_roughing.stock_after_all_spaces), whose completeness check covers the whole space."""
+    spec, bottom, params = inputs.spec, inputs.bottom_tool, inputs.roughing
+    upper = _plan_roughing(inputs, levels, blank)
+    bottom_levels = roughing_levels(spec, bottom, params, blank)
+    flank = flank_plan_for(spec, bottom, params, blank, bottom_levels, tips=False, first=(upper.flank, upper.tool))
+    if not flank.passes:
+        raise MachineError(f"two-stage roughing: the roughing tool (D {inputs.roughing_tool.diameter_mm:g} mm) leaves "
+                           f"nothing for the bottom tool (D {bottom.diameter_mm:g} mm) to cut; leave out "
+                           "[tools.bottom]", field="diameter_mm", section="tools.bottom")
+    lower = _plan_roughing(inputs, bottom_levels, blank, bottom, tips=False, flank=flank)
+    alone = _plan_roughing(inputs, bottom_levels, blank, bottom)
+    return upper, lower, TwoStage(upper.lowest_level_above_root_mm, "reach", _seconds(upper) + _seconds(lower),
+                                  _seconds(alone), upper.tool), alone
 
 
 def by_levels(inputs: CamInputs) -> CamInputs:
@@ -446,13 +504,14 @@ def _level_seconds(path: Toolpath, machine: Machine, levels: int) -> np.ndarray:
 
 
 def _plan_roughing(inputs: CamInputs, levels: RoughingLevels, blank: float, tool: Tool | None = None,
-                   tips: bool = True) -> RoughingPlan:
-    """One roughing program: the spaces' levels, and the tip lands' passes when `tips`."""
+                   tips: bool = True, flank: FlankPlan | None = None) -> RoughingPlan:
+    """One roughing program: the spaces' levels, and the tip lands' passes when `tips`; `flank`: the flank
+    strategy's plan when the caller has made it."""
     spec, stock = inputs.spec, inputs.stock
     tool = tool or inputs.roughing_tool
     lowest_above_root = levels.lowest_height_mm - spec.root_radius_mm
-    flank = flank_plan_for(spec, tool, inputs.roughing, blank, levels, tips) if inputs.roughing.strategy == "flank" \
-        else None
+    if flank is None and inputs.roughing.strategy == "flank":
+        flank = flank_plan_for(spec, tool, inputs.roughing, blank, levels, tips)
     path = roughing_toolpath(spec, tool, inputs.machine, inputs.roughing, blank, stock.back_margin_mm,
                              stock.stub_diameter_mm / 2.0, stock.front_margin_mm, levels=levels, tips=tips,
                              flank_plan=flank, stub_length_mm=stock.stub_length_mm)

@@ -76,7 +76,8 @@ def _estimated_flank_moves(spec: GearSpec, tool: Tool, params: RoughingParams,
     bounded search: at most MAX_SEGMENTS_PER_FLANK bisections over the flank's points), then per space 2 segments
     + 1 runs, each at most (twice the space's width at the blank) / the radial engagement + 2 positions, each cut
     in at most 2 (depth / slot depth) + 2 tiers (narrow and wide tiers alternate at worst), each pass with at most
-    8 moves (its link's three, itself, a return's two, a clamp and a release); the tip lands as the levels'."""
+    10 moves (its link's three, itself in three legs, a return's two, a clamp and a release); the tip lands as
+    the levels'."""
     from spur_cad.cam.flank_roughing import flank_segment_count
 
     points, _, junction = offset_flank(spec, params.finish_stock_mm)
@@ -89,7 +90,7 @@ def _estimated_flank_moves(spec: GearSpec, tool: Tool, params: RoughingParams,
     positions = math.ceil(2.0 * width / step) + 2
     tiers = 2 * math.ceil((blank_radius_mm - spec.root_radius_mm) / slot) + 2
     tip_passes = math.ceil(width / (params.step_over_fraction * tool.diameter_mm)) + 1
-    moves = spec.teeth * (runs * positions * tiers * 8 + 6 + tiers * (2 * tip_passes + 4))
+    moves = spec.teeth * (runs * positions * tiers * 10 + 6 + tiers * (2 * tip_passes + 4))
     driver = "max_radial_engagement_fraction" if positions >= tiers else "max_level_depth_fraction"
     return moves, driver
 
@@ -281,28 +282,33 @@ class _Passes:
     x_back: float
     safe_z: float
     feed: float
+    air_feed: float = math.nan  # with x_material: the passes cross the air outside it at this feed, and the tool
+    x_material: tuple[float, float] | None = None  # goes down in front of the blank and up at the passes' ends at it
 
     def levels(self, a: float, space: int, heights, offsets, stations, feature: Feature) -> None:
         """From the front at each height (back to the front above the cleared level before going down), Y steps
         beside the part; then up to the safe height."""
         builder, x_front, safe_z, feed = self.builder, self.x_front, self.safe_z, self.feed
+        up, down = (feed, PLUNGE_FEED_FRACTION * feed) if self.x_material is None else (self.air_feed, self.air_feed)
         x_here = x_front
         for height, ys, station in zip(heights, offsets, stations):
             if x_here != x_front:  # come back to the front, above the cleared level, before going down
-                builder.move(MoveKind.LINEAR, x_here, builder.last_pose()[1], safe_z, a, feed, space=space,
+                builder.move(MoveKind.LINEAR, x_here, builder.last_pose()[1], safe_z, a, up, space=space,
                              station=station)
                 builder.move(MoveKind.RAPID, x_front, ys[0], safe_z, a, space=space, station=station)
                 x_here = x_front
-            builder.move(MoveKind.LINEAR, x_front, ys[0], height, a, PLUNGE_FEED_FRACTION * feed, space=space,
-                         station=station)
+            builder.move(MoveKind.LINEAR, x_front, ys[0], height, a, down, space=space, station=station)
             for j, y in enumerate(ys):
                 if j > 0:
                     builder.move(MoveKind.LINEAR, x_here, y, height, a, feed, space=space, station=station,
                                  feature=feature)
-                x_here = self.x_back if x_here == x_front else x_front
-                builder.move(MoveKind.LINEAR, x_here, y, height, a, feed, space=space, station=station,
-                             feature=feature)
-        builder.move(MoveKind.LINEAR, x_here, builder.last_pose()[1], safe_z, a, feed, space=space)
+                x_to = self.x_back if x_here == x_front else x_front
+                legs = [(x_to, True)] if self.x_material is None else _pass_legs(x_here, x_to, self.x_material)
+                for x_leg, cutting in legs:
+                    builder.move(MoveKind.LINEAR, x_leg, y, height, a, feed if cutting else self.air_feed,
+                                 space=space, station=station, feature=feature if cutting else Feature.NONE)
+                x_here = x_to
+        builder.move(MoveKind.LINEAR, x_here, builder.last_pose()[1], safe_z, a, up, space=space)
 
 
 def _pass_offsets(reach_mm: float, step_mm: float) -> np.ndarray:
@@ -349,13 +355,18 @@ def follow_lead(path: Toolpath, spec: GearSpec, machine: Machine) -> Toolpath:
 
 
 def _tip_offsets_mm(spec: GearSpec, tool: Tool, params: RoughingParams) -> np.ndarray:
-    """Y of the flank strategy's tip passes (the tooth's axis up): the tool's edge from one tip edge of the land
-    (grown by the finish stock) to the other and a tool radius beyond, where the flank runs leave what stands
-    above the tip circle."""
+    """Y of the flank strategy's tip passes (the tooth's axis up): the tool's centre from one tip edge of the land
+    (grown by the finish stock) to the other, so that its side reaches a tool radius beyond, where the flank runs
+    leave what stands above the tip circle. The passes are at most the slot depth deep (tip_heights_mm), so each
+    may be engaged across the whole diameter: they step by TIP_STEP_FRACTION x D."""
     tip_edge = offset_flank(spec, params.finish_stock_mm)[0][-1]
     half_pitch = math.pi / spec.teeth
     edge = tip_edge[0] * math.cos(half_pitch) - tip_edge[1] * math.sin(half_pitch)  # the edge in the tooth's frame
-    return _pass_offsets(abs(edge), params.step_over_fraction * tool.diameter_mm)
+    return _pass_offsets(abs(edge), TIP_STEP_FRACTION * tool.diameter_mm)
+
+
+TIP_STEP_FRACTION = 0.9
+"""The flank strategy's step between tip passes, x D (a little overlap between neighbouring passes)."""
 
 
 def _check_stub_margin(x_back: float, radius: float, back_margin_mm: float, machine: Machine) -> None:
@@ -388,22 +399,47 @@ class _Clamp:
             self.held = False
 
 
-def _link_poses(previous, following) -> list[tuple[float, float, float]]:
+def _link_poses(previous, following, floor_z_mm: float) -> list[tuple[float, float, float]]:
     """The (Y, Z, turn) poses a link between two passes goes through after leaving the first: straight within a
-    run; between runs up to the higher pass's Z first, across (Y and A), then down."""
+    run; between runs up to the higher pass's Z (at least `floor_z_mm`) first, across (Y and A), then down. With
+    the floor at the passes' least distance from the axis (_passes_floor_mm), a link across comes no nearer the
+    axis (and a holding stub) than the passes do."""
     if previous is None or previous.run == following.run:
         return [(following.y_mm, following.z_mm, following.turn_deg)]
-    high = max(previous.z_mm, following.z_mm)
+    high = max(previous.z_mm, following.z_mm, floor_z_mm)
     return [(previous.y_mm, high, previous.turn_deg), (following.y_mm, high, following.turn_deg),
             (following.y_mm, following.z_mm, following.turn_deg)]
+
+
+def _passes_floor_mm(plan, radius: float) -> float:
+    """The flat tool bottom's least distance from the gear axis over a space's passes."""
+    return min(p.z_mm if abs(p.y_mm) <= radius else math.hypot(abs(p.y_mm) - radius, p.z_mm) for p in plan.passes)
+
+
+ENTRY_GAP_MM = 0.2
+"""How far before the stock's end a flank pass slows from the largest feed to its cutting feed (at most the
+machine's clearance)."""
+
+
+def _pass_legs(x_from: float, x_to: float, x_material: tuple[float, float]) -> list[tuple[float, bool]]:
+    """The legs of a pass along X from x_from to x_to as (end X, cutting): the air before and after the X range
+    where the tool can meet the stock (`x_material`, low to high) is crossed at the largest feed."""
+    low, high = x_material
+    ends = [x for x in ((low, high) if x_to > x_from else (high, low)) if min(x_from, x_to) < x < max(x_from, x_to)]
+    legs, x_here = [], x_from
+    for x in ends + [x_to]:
+        middle = 0.5 * (x_here + x)
+        legs.append((x, low <= middle <= high))
+        x_here = x
+    return legs
 
 
 def _closest_to_axis_mm(plan, radius: float) -> float:
     """The flat tool bottom's least distance from the gear axis over a space's passes and links (Y and Z
     interpolated along each leg, sampled at 65 points; A does not change the distance)."""
-    points, previous = [], None
+    points, previous, floor = [], None, _passes_floor_mm(plan, radius)
     for p in plan.passes:
-        points.extend((y, z) for y, z, _ in _link_poses(previous, p))
+        points.extend((y, z) for y, z, _ in _link_poses(previous, p, floor))
         previous = p
     points = np.array(points)
     t = np.linspace(0.0, 1.0, 65)[:, None, None]
@@ -413,14 +449,26 @@ def _closest_to_axis_mm(plan, radius: float) -> float:
 
 
 def flank_plan_for(spec: GearSpec, tool: Tool, params: RoughingParams, blank_radius_mm: float,
-                   levels: RoughingLevels, tips: bool = True):
-    """The flank strategy's plan of one space (cam.flank_roughing) for these levels' lowest height."""
-    from spur_cad.cam.flank_roughing import plan_flank_roughing
+                   levels: RoughingLevels, tips: bool = True, first=None):
+    """The flank strategy's plan of one space (cam.flank_roughing) for these levels' lowest height; `first`: the
+    flank plan and tool of two-stage roughing's first tool, whose stock this plan starts from (the first tool cuts
+    the tip lands)."""
+    from spur_cad.cam.flank_roughing import plan_flank_roughing, stock_after_all_spaces
 
-    tip_offsets = _tip_offsets_mm(spec, tool, params)
-    return plan_flank_roughing(spec, tool, params, blank_radius_mm, levels.lowest_height_mm,
-                               transverse_radius_mm(spec, tool, blank_radius_mm),
-                               float(tip_offsets[-1]) + tool.diameter_mm / 2.0 if tips else 0.0)
+    radius = transverse_radius_mm(spec, tool, blank_radius_mm)
+    if first is None:
+        return plan_flank_roughing(spec, tool, params, blank_radius_mm, levels.lowest_height_mm, radius,
+                                   land_half_width_mm(spec, tool, params) if tips else 0.0)
+    first_plan, first_tool = first
+    land = land_half_width_mm(spec, first_tool, params)
+    return plan_flank_roughing(spec, tool, params, blank_radius_mm, levels.lowest_height_mm, radius, land,
+                               stock_after_all_spaces(spec, first_plan, land, params.finish_stock_mm))
+
+
+def land_half_width_mm(spec: GearSpec, tool: Tool, params: RoughingParams) -> float:
+    """How far the flank strategy's tip passes clear each side of a tooth's centre line (the tool's side beyond
+    the last pass)."""
+    return float(_tip_offsets_mm(spec, tool, params)[-1]) + tool.diameter_mm / 2.0
 
 
 def _flank_toolpath(spec: GearSpec, tool: Tool, machine: Machine, params: RoughingParams, blank_radius_mm: float,
@@ -433,6 +481,7 @@ def _flank_toolpath(spec: GearSpec, tool: Tool, machine: Machine, params: Roughi
 
     radius = tool.diameter_mm / 2.0
     tip_offsets = _tip_offsets_mm(spec, tool, params)
+    floor = _passes_floor_mm(plan, radius)
     stub_below = stub_radius_mm + machine.clearance_mm <= _closest_to_axis_mm(plan, radius)
     # beyond the blank's back only where nothing stands there: no stub, or one lower than every pass and long
     # enough that the tool, 2 r + clearance beyond the margin, stays over it (not over what grips it)
@@ -446,6 +495,11 @@ def _flank_toolpath(spec: GearSpec, tool: Tool, machine: Machine, params: Roughi
     air = machine.max_feed_mm_min
     pitch_deg = 360.0 / spec.teeth
     tip_heights = tip_heights_mm(spec, tool, params, blank_radius_mm) if tips else np.zeros(0)
+    # where the tool can meet the stock along X (its edge at the stock's ends, an entry gap before): the passes
+    # cross the air beyond at the largest feed
+    gap = min(ENTRY_GAP_MM, machine.clearance_mm)
+    x_material = (-(front_margin_mm + radius + gap),
+                  spec.face_width_mm + back_margin_mm + radius + gap if free_back else x_back)
     builder = ToolpathBuilder(Operation.ROUGHING, tool.tool_number, tool.spindle_rpm(machine))
     clamp = _Clamp(builder, params.clamp_rotary)
     for k in range(spec.teeth):
@@ -457,15 +511,17 @@ def _flank_toolpath(spec: GearSpec, tool: Tool, machine: Machine, params: Roughi
         for p in plan.passes:
             a_pass = a + p.turn_deg
             # the link, outside the blank at this end of the passes (in the air: the machine's largest feed)
-            for y_link, z_link, turn_link in _link_poses(previous, p):
+            for y_link, z_link, turn_link in _link_poses(previous, p, floor):
                 if a + turn_link != builder.last_pose()[3]:
                     clamp.release(k)
                 builder.move(MoveKind.LINEAR, x_here, y_link, z_link, a + turn_link, air, space=k, station=p.run)
             clamp.hold(k)
             previous = p
             x_end = x_back if x_here == x_front else x_front
-            builder.move(MoveKind.LINEAR, x_end, p.y_mm, p.z_mm, a_pass, min(feed * p.feed_factor, air), space=k,
-                         station=p.run, feature=Feature.LEVEL)
+            for x_to, cutting in _pass_legs(x_here, x_end, x_material):
+                builder.move(MoveKind.LINEAR, x_to, p.y_mm, p.z_mm, a_pass,
+                             min(feed * p.feed_factor, air) if cutting else air, space=k, station=p.run,
+                             feature=Feature.LEVEL if cutting else Feature.NONE)
             if free_back:
                 x_here = x_end
             else:  # back to the front along the column this pass cleared, just above its floor
@@ -478,7 +534,7 @@ def _flank_toolpath(spec: GearSpec, tool: Tool, machine: Machine, params: Roughi
             clamp.release(k)
             builder.move(MoveKind.RAPID, x_front, tip_offsets[0], safe_z, a_tip, space=k)
             clamp.hold(k)
-            passes = _Passes(builder, x_front, x_back, safe_z, feed)
+            passes = _Passes(builder, x_front, x_back, safe_z, feed, air, x_material)
             passes.levels(a_tip, k, tip_heights, [tip_offsets] * len(tip_heights), [-1] * len(tip_heights),
                           Feature.TIP)
     path = builder.build()

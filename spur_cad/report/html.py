@@ -84,7 +84,16 @@ def program_notes(result: JobResult) -> tuple[str, ...]:
             notes.append(f"Roughing: {rough.levels_per_space} levels per space, the lowest "
                          f"{number(rough.lowest_level_height_mm, 3)} mm above the root circle{tips}.")
         stage = rough.two_stage
-        if stage is not None:
+        if stage is not None and stage.bottom.passes_per_space is not None:
+            larger = result.tools.roughing
+            notes.append(f"Two-stage roughing by flanks: the larger tool (T{larger.tool_number}, D "
+                         f"{number(larger.diameter_mm, 3)} mm) down to {number(stage.split_height_above_root_mm, 3)} "
+                         f"mm above the root circle, then the smaller (T{stage.bottom_tool.tool_number}, D "
+                         f"{number(stage.bottom_tool.diameter_mm, 3)} mm) takes what it leaves, "
+                         f"{stage.bottom.passes_per_space} passes per space: {duration(stage.two_stage_time_s)} in "
+                         f"all, {duration(stage.time_saved_s)} less than the smaller tool alone "
+                         f"({duration(stage.bottom_tool_alone_time_s)}).")
+        elif stage is not None:
             notes.append(f"Two-stage roughing: the bottom tool (T{stage.bottom_tool.tool_number}, D "
                          f"{number(stage.bottom_tool.diameter_mm, 3)} mm) roughs {stage.bottom.levels_per_space} "
                          f"levels per space below {number(stage.split_height_above_root_mm, 3)} mm above the root "
@@ -92,6 +101,14 @@ def program_notes(result: JobResult) -> tuple[str, ...]:
                          f"(split chosen by {stage.split_chosen_by}): {duration(stage.two_stage_time_s)} in all, "
                          f"{duration(stage.time_saved_s)} less than the bottom tool alone "
                          f"({duration(stage.bottom_tool_alone_time_s)}).")
+        declined = rough.two_stage_declined
+        if declined is not None:
+            notes.append(f"Two-stage roughing with the larger tool (T{declined.roughing_tool.tool_number}, D "
+                         f"{number(declined.roughing_tool.diameter_mm, 3)} mm) over the upper part would take "
+                         f"{duration(declined.two_stage_time_s)}, "
+                         f"{duration(declined.two_stage_time_s - declined.bottom_tool_alone_time_s)} more than the "
+                         f"smaller tool alone ({duration(declined.bottom_tool_alone_time_s)}): roughing uses the "
+                         "smaller tool alone, the quicker of the two.")
     if finish is not None:
         notes.append(finish.report_text)
     return tuple(notes)

@@ -76,8 +76,8 @@ class Engagement:
     def measured(self) -> np.ndarray:
         """Moves whose a_e and a_p the model measures: not the tip lands' moves (level -1). A tip-land pass is
         centred on a tooth, over the centre line between two spaces' height fields, which the model holds apart;
-        it is cut in the model (the volume counts), and its engagement is bounded by construction (the first
-        pass a slot no deeper than the level depth limit, the others a step-over apart, cam.roughing)."""
+        it is cut in the model (the volume counts), and its engagement is bounded by construction (every pass no
+        deeper than the level depth limit, a slot's, whatever its width; cam.roughing)."""
         return self.level >= 0
 
     @property
@@ -100,11 +100,13 @@ class EngagementLimits:
     """The job's roughing limits ([roughing] keys). Levels (`max_axial_depth_mm` None): no pass deeper than
     max_level_depth_fraction x D, none engaged wider than step_over_fraction x D unless it is a slot. Flank strategy:
     no pass deeper than max_axial_depth_mm, none deeper than the slot limit engaged wider than step_over_fraction x D
-    (its max_radial_engagement_fraction)."""
+    (its max_radial_engagement_fraction). `axial_depth_by_operation`: the flank strategy's axial depth limit of each
+    operation where two-stage roughing's tools have their own (max_axial_depth_mm is then the larger)."""
 
     max_level_depth_fraction: float
     step_over_fraction: float
     max_axial_depth_mm: float | None = None
+    axial_depth_by_operation: dict[str, float] | None = None
 
 
 @njit(cache=True)
@@ -452,7 +454,9 @@ def engagement_warnings(engagement: Engagement, limits: EngagementLimits) -> lis
         wide_text = "beyond the step-over {f:g} D and not a slot ([roughing] step_over_fraction)"
         deep_fraction = limits.max_level_depth_fraction
     else:
-        max_depth = np.full(len(e.diameter_mm), limits.max_axial_depth_mm)
+        by_operation = limits.axial_depth_by_operation or {}
+        max_depth = np.array([by_operation.get(operation, limits.max_axial_depth_mm) for operation in e.operation],
+                             dtype=float)
         deep_text = "beyond the axial depth limit {lim:.3f} mm ([roughing] max_axial_depth_mm)"
         wide = wider & (e.axial_depth_mm > slot_depth + tol_ap)
         wide_text = ("beyond {f:g} D deeper than a slot ([roughing] max_radial_engagement_fraction; "

@@ -153,9 +153,16 @@ def section_enabled(job_values: dict[str, object], section: str) -> bool:
 SECTION_OBJECTS = {"gear": "gear", "stock": "stock"}
 
 
+JOB_FILE_ONLY = ("tools.roughing_top",)
+"""Sections the panel leaves to the job file: [tools.roughing_top] is the pair of roughing tools the panel holds
+as the roughing and bottom tools (values_from_job turns one into the other)."""
+
+
 def _input_fields() -> dict[str, tuple[Field, ...]]:
     fields: dict[str, list[Field]] = {"gear": [], "stock": [], "job": []}
     for section, cls in SECTIONS.items():
+        if section in JOB_FILE_ONLY:
+            continue
         target = fields[SECTION_OBJECTS.get(section, "job")]
         if section in SECTION_SWITCHES:
             target.append(SECTION_SWITCHES[section])
@@ -285,7 +292,14 @@ def default_values() -> dict[str, dict[str, object]]:
 
 
 def values_from_job(job) -> dict[str, dict[str, object]]:
-    """Property values ({'gear': {...}, 'stock': {...}, 'job': {...}}) that hold a validated Job."""
+    """Property values ({'gear': {...}, 'stock': {...}, 'job': {...}}) that hold a validated Job; a job's
+    [tools.roughing_top] becomes the roughing tool and its [tools.roughing] the bottom tool (the same pair of
+    tools: roughing plans the quicker of two-stage roughing and the smaller tool alone either way)."""
+    import dataclasses
+
+    if job.tools.roughing_top is not None:
+        job = dataclasses.replace(job, tools=dataclasses.replace(job.tools, roughing=job.tools.roughing_top,
+                                                                 bottom=job.tools.roughing, roughing_top=None))
     defaults = _section_defaults()
     values: dict[str, dict[str, object]] = {}
     for role, fields in FIELDS.items():
