@@ -82,11 +82,48 @@ def figures(runs: int = 3) -> dict:
     return out
 
 
+TWO_STAGE = {"reference_gear.toml": (4.5, 6.0, 8.0), "z120 m1": (1.0, 1.5, 2.0), "z40 m6": (5.0, 6.0, 8.0)}
+"""Larger tools tried above the roughing tool (two-stage roughing by flanks, the same cutting data)."""
+
+
+def two_stage_figures() -> dict:
+    """Two-stage roughing by flanks against the roughing tool alone (estimated with accelerations; the plan uses the
+    quicker): each larger tool (flutes 3 D long, or the job tool's length if longer) above the example's or the
+    sized tool."""
+    from spur_cad.cad.specs import StockSpec
+    from spur_cad.cam.plan import CamInputs, plan_cam
+    from spur_cad.cam.strategies import FinishingParams
+
+    out = {}
+    for name, sizes in TWO_STAGE.items():
+        if name in GEARS:
+            z, m, pa, x, rho = GEARS[name]
+            spec = GearSpec(teeth=z, module_mm=m, pressure_angle_deg=pa, profile_shift_coefficient=x,
+                            rack_tip_radius_mm=rho, face_width_mm=max(5.0 * m, 6.0))
+            stock = StockSpec(radial_allowance_mm=0.5)
+            tool = _tool(spec, spec.tip_radius_mm + 0.5)
+            params = RoughingParams(flank_allowance_mm=0.075 * m, finish_stock_mm=0.005 * m, strategy="flank")
+            machine = Machine()
+        else:
+            job = load_job(EXAMPLES / name)
+            spec, stock, tool, machine = job.gear, job.stock, job.tools.roughing, job.machine
+            params = dataclasses.replace(job.roughing, strategy="flank")
+        for diameter in sizes:
+            top = dataclasses.replace(tool, diameter_mm=diameter, tool_number=4,
+                                      flute_length_mm=max(tool.flute_length_mm, 3.0 * diameter))
+            plan = plan_cam(CamInputs(spec, stock, tool, None, params, FinishingParams(), machine, top_tool=top))
+            stage = plan.two_stage or plan.two_stage_declined
+            out[f"{name} D{diameter:g} over D{tool.diameter_mm:g}"] = {
+                "two_stage_min": round(stage.two_stage_time_s / 60.0, 1),
+                "alone_min": round(stage.bottom_tool_alone_time_s / 60.0, 1), "used": plan.two_stage is not None}
+    return out
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__)
     parser.add_argument("--runs", type=int, default=3)
     args = parser.parse_args()
-    print(json.dumps(figures(args.runs), indent=2))
+    print(json.dumps({"strategies": figures(args.runs), "two_stage": two_stage_figures()}, indent=2))
 
 
 if __name__ == "__main__":

@@ -139,6 +139,7 @@ def main() -> None:
     from benchmarks.bench_helical import HELICAL_JOB
     from benchmarks.bench_helical import figures as helical_figures
     from benchmarks.bench_roughing import figures as roughing_figures
+    from benchmarks.bench_roughing import two_stage_figures
     from benchmarks.bench_run import figures as run_figures
     from benchmarks.bench_shop_floor import figures as shop_floor_figures
     from benchmarks.bench_sim import bench_sim
@@ -154,6 +155,7 @@ def main() -> None:
                "helical": helical_figures(load_job(HELICAL_JOB), args.run_runs),
                "verify": verify_figures(args.run_runs), "verify_large": large_program_figures(args.run_runs),
                "shop_floor": shop_floor_figures(args.run_runs), "roughing": roughing_figures(args.run_runs),
+               "roughing_two_stage": two_stage_figures(),
                "fresh_runs": run_figures(args.cad_runs), "workbench_generate": workbench_figures(),
                "run_s": {strategy: end_to_end_seconds(strategy, args.run_runs)
                          for strategy in ("generating", "perimeter")}}

@@ -19,13 +19,16 @@ Plan of one space (the same for every space, so computed once; docs/cam.md "Flan
    lies inside the tool; its tip is at the segment's lower end.
 3. Each segment is a run per flank: positions a radial engagement of at most max_radial_engagement_fraction x D
    apart, from where the tool finds nothing more to cut on its side of the space toward the flank, each at full
-   depth in tiers (at most the axial depth limit; at most max_level_depth_fraction x D where the tool is engaged
-   wider). A run that meets the other flank first cuts the column touching it first, then the positions beyond
-   it with the tip raised clear of that flank, then back to its flank. A column down the middle takes the bottom,
-   and a column each the pieces left where two segments' columns meet.
+   depth in tiers (each from the top of the material left under the one before: at most the axial depth limit;
+   at most max_level_depth_fraction x D where the tool is engaged wider; a sliver of a bottom tier before the
+   flank's own position is left to later passes). A run that meets the other flank first cuts the column touching
+   it first, then the positions beyond it with the tip raised clear of that flank, then back to its flank. A
+   column down the middle takes the bottom, and a column each the pieces left where two segments' columns meet.
 4. A stock model of the section (shapely polygons) follows every pass: it gives each pass's radial engagement and
    axial depth, the feed raised by chip thinning so the largest chip equals feed_per_tooth_mm, and the check that
    nothing farther than the flank allowance from the design is left (`uncut_mm2`).
+5. Two-stage roughing: a second, smaller tool's plan starts from the section the first leaves in every space
+   (stock_after_all_spaces) and cuts only what needs cutting there.
 """
 
 from __future__ import annotations
