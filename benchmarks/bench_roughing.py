@@ -88,8 +88,8 @@ TWO_STAGE = {"reference_gear.toml": (4.5, 6.0, 8.0), "z120 m1": (1.0, 1.5, 2.0),
 
 def two_stage_figures() -> dict:
     """Two-stage roughing by flanks against the roughing tool alone (estimated with accelerations; the plan uses the
-    quicker): each larger tool (flutes 3 D long, or the job tool's length if longer) above the example's or the
-    sized tool."""
+    quicker): each larger tool (flutes 3 D long, or the job tool's length if longer) above the example's tool or
+    the sized one (its flute length not given), the same cutting data."""
     from spur_cad.cad.specs import StockSpec
     from spur_cad.cam.plan import CamInputs, plan_cam
     from spur_cad.cam.strategies import FinishingParams
@@ -101,7 +101,8 @@ def two_stage_figures() -> dict:
             spec = GearSpec(teeth=z, module_mm=m, pressure_angle_deg=pa, profile_shift_coefficient=x,
                             rack_tip_radius_mm=rho, face_width_mm=max(5.0 * m, 6.0))
             stock = StockSpec(radial_allowance_mm=0.5)
-            tool = _tool(spec, spec.tip_radius_mm + 0.5)
+            tool = dataclasses.replace(_tool(spec, spec.tip_radius_mm + 0.5), flute_length_mm=0.0)  # 3 D: shorter
+            # than this blank's spaces need, so "not given" (the axial depth limit stays 3 D)
             params = RoughingParams(flank_allowance_mm=0.075 * m, finish_stock_mm=0.005 * m, strategy="flank")
             machine = Machine()
         else:

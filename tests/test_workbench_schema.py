@@ -237,6 +237,18 @@ def test_job_round_trips_through_properties(wb, text):
     assert again == job
 
 
+def test_a_roughing_top_job_opens_as_the_same_pair_of_roughing_and_bottom_tools(wb):
+    """The panel has no [tools.roughing_top]: a job file's larger tool becomes its roughing tool and the job's
+    roughing tool its bottom tool, which plans the same two programs (tests/test_two_stage.py)."""
+    text = small_job_text() + ("\n[tools.roughing_top]\nkind = \"flat\"\ndiameter_mm = 9.5\nflutes = 4\n"
+                               "tool_number = 7\n")
+    job = parse_job(text, "top.toml")
+    assert not any(f.section == "tools.roughing_top" for fields in wb.schema.FIELDS.values() for f in fields)
+    again = job_from_dict(json.loads(json.dumps(wb.schema.job_data(wb.schema.values_from_job(job)))), "top.toml")
+    assert again.tools.roughing == job.tools.roughing_top and again.tools.bottom == job.tools.roughing
+    assert again.tools.roughing_top is None
+
+
 def test_tool_switch_off_drops_the_tool_section(wb):
     values = wb.schema.values_from_job(load_job(REFERENCE_JOB))
     values["job"]["UseRoughingTool"] = False
