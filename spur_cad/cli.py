@@ -73,6 +73,9 @@ def _parser() -> argparse.ArgumentParser:
                         "simulation's resolution)")
     verify.add_argument("--leftover-tolerance-mm", type=float, help="largest leftover that passes (default: the "
                         "finishing target scallop plus the resolution)")
+    verify.add_argument("--a-offset-deg", type=float, default=0.0, metavar="DEG",
+                        help="programs written with another A zero: the job's A where the programs' A is 0, added "
+                             "to every A read (default 0)")
     verify.add_argument("--quiet", action="store_true", help="print nothing but errors and the verdict")
     verify.add_argument("--debug", action="store_true", help="show tracebacks of internal errors")
     grade = sub.add_parser("grade", help="grade a real gear by ISO 1328-1:2013 from points measured on it")
@@ -243,7 +246,8 @@ def _verify(args: argparse.Namespace, received: list[int], loaded: list) -> int:
     out_dir = check_output_folder(args.out) if args.out else None
     loaded.append(load_job(args.job))
     job = loaded[0]
-    options = VerifyOptions(args.point, args.gouge_tolerance_mm, args.leftover_tolerance_mm, tuple(args.point_tools))
+    options = VerifyOptions(args.point, args.gouge_tolerance_mm, args.leftover_tolerance_mm, tuple(args.point_tools),
+                            args.a_offset_deg)
     options.validate()
     dialect = args.dialect or job.post.dialect
     known = DIALECTS.get(dialect)  # None for a name the table does not hold (the reader says so)

@@ -284,9 +284,74 @@ def test_direction_codes_turn_the_way_they_say():
     text = "G0 X0 Y0 Z30 A350\nA10 M15\nA350 M16\nA10 M16\nM30\n"
     moves = read_program(text, "okuma", "p")
     assert np.allclose(moves.a, [350.0, 370.0, 350.0, 10.0])  # +20, -20, -340: each the way its code says
-    with pytest.raises(ProgramReadError, match=r"p:2: with M15, A must be an angle in \[0, 360\)"):
+    with pytest.raises(ProgramReadError, match=r"p:2: with M15, A must be an angle in \[0, 360\], got 400"):
         read_program("G0 X0 Y0 Z30 A0\nA400 M15\nM30\n", "okuma", "p")
+    with pytest.raises(ProgramReadError, match=r"p:2: with M16, A must be an angle in \[0, 360\], got -10"):
+        read_program("G0 X0 Y0 Z30 A0\nA-10 M16\nM30\n", "okuma", "p")
     assert math.isclose(read_program("G0 X0 Y0 Z30 A0\nA10 M16\nM30\n", "okuma", "p").a[-1], -350.0)
+
+
+def test_a_directed_move_to_the_angle_already_reached_past_a_turn_is_no_move():
+    # 3.6 -> 1.4 turning positively unwinds to 361.4, computed 361.40000000000003: (1.4 - that) % 360 is
+    # 359.99999999999994, which read as a step turned A a full turn more (M15) or one less (M16)
+    text = "G0 X0 Y0 Z30 A3.6\nA1.4 M15\nG1 X5 A1.4 M15 F100\nA1.4 M16\nX6 M15\nA3.6 M16\nM30\n"
+    assert np.allclose(read_program(text, "okuma", "p").a, [3.6, 361.4, 361.4, 361.4, 361.4, 3.6], atol=1e-9)
+    # A360 in a directed block is the angle 0 (legacy Okuma programs write it); 360 + 1e-3 is still refused
+    moves = read_program("G0 X0 Y0 Z30 A10\nA360.000 M16\nA360 M15\nA90 M15\nA360.000 M16\nM30\n", "okuma", "p")
+    assert np.allclose(moves.a, [10.0, 0.0, 0.0, 90.0, 0.0], atol=1e-9)
+    with pytest.raises(ProgramReadError, match=r"p:2: with M15, A must be an angle in \[0, 360\], got 360.001"):
+        read_program("G0 X0 Y0 Z30 A0\nA360.001 M15\nM30\n", "okuma", "p")
+    assert read_program("G0 X0 Y0 Z30 A360\nG0 A720\nM30\n", "okuma", "p").a.tolist() == [360.0, 720.0]  # absolute A
+
+
+def _hand_written(path, dialect: str) -> str:
+    """A program written by hand from a toolpath in the grammar of `dialect`, as old shop programs are: every block
+    gives every axis; A is written to 3 decimals, unwound on LinuxCNC, on Okuma as an angle with 0 written 360.000
+    and M15 or M16 in every block (where A does not change, the angle already reached, the code of the last turn)."""
+    okuma = dialect == "okuma"
+    lines = (["O1000"] if okuma else []) + ["G90 G94 G17", f"T{path.tool_number} M6", f"S{path.spindle_rpm:.0f} M3"]
+    previous, inverse, direction = None, False, "M15"
+    for i in np.nonzero(path.motion_mask)[0]:
+        a = round(float(path.a[i]), 3)
+        words = ["G0" if path.kind[i] == MoveKind.RAPID else "G1"]
+        if words[0] == "G1" and bool(path.inverse_time[i]) != inverse:
+            inverse = bool(path.inverse_time[i])
+            words.insert(0, "G93" if inverse else "G94")
+        words += [f"X{path.x[i]:.4f}", f"Y{path.y[i]:.4f}", f"Z{path.z[i]:.4f}"]
+        if okuma:
+            angle = f"{a % 360.0:.3f}"
+            if previous is not None and a != previous:
+                direction = "M15" if a > previous else "M16"
+            words += [f"A{'360.000' if angle == '0.000' else angle}", direction]
+        else:
+            words.append(f"A{a:.3f}")
+        if words[-1 if not okuma else -2][0] == "A" and path.kind[i] != MoveKind.RAPID:
+            words.append(f"F{path.feed[i]:.1f}")
+        lines.append(" ".join(words))
+        previous = a
+    return "\n".join(lines + ["M30"]) + "\n"
+
+
+def test_an_okuma_program_unwound_past_a_turn_reads_and_verifies_as_its_linuxcnc_twin(small, tmp_path):
+    job, plan = small
+    # finishing by generation turns A from about +49 deg to -379 deg: past a full turn, and back
+    programs = {dialect: {f"{name}.{ext}": _hand_written(getattr(plan, name).toolpath, dialect).encode()
+                          for name in ("roughing", "finishing")} for dialect, ext in (("okuma", "min"),
+                                                                                      ("linuxcnc", "ngc"))}
+    finishing = programs["okuma"]["finishing.min"].decode()
+    assert re.search(r"A360\.000 M1[56]", programs["okuma"]["roughing.min"].decode())  # legacy A360 words
+    okuma_a = read_program(finishing, "okuma", "o").a
+    linuxcnc = read_program(programs["linuxcnc"]["finishing.ngc"].decode(), "linuxcnc", "l")
+    assert okuma_a.min() < -360.0 and len(okuma_a) == len(linuxcnc)
+    assert np.abs(okuma_a - linuxcnc.a).max() <= 1e-9  # the same moves: no extra turn anywhere
+    results = {dialect: _verify(tmp_path / dialect, _job_text(), programs[dialect], "--dialect", dialect)[1]
+               for dialect in programs}
+    okuma, twin = results["okuma"], results["linuxcnc"]
+    assert twin["passed"] and twin["max_gouge_mm"] <= RESOLUTION
+    for key in ("max_gouge_mm", "max_leftover_mm", "moves"):
+        assert okuma[key] == pytest.approx(twin[key], abs=1e-9), key
+    assert [s["max_gouge_mm"] for s in okuma["spaces"]] == pytest.approx([s["max_gouge_mm"] for s in twin["spaces"]],
+                                                                         abs=1e-9)
 
 
 @pytest.mark.linuxcnc
@@ -366,3 +431,27 @@ def test_point_applies_to_the_tools_named(small, tmp_path):
                                 "--point-tools", "1")
     assert everywhere["max_gouge_mm"] > 0.1  # the finishing tool (r 0.5) goes r_t deep
     assert finishing_only["max_gouge_mm"] <= RESOLUTION  # only the flat roughing tool named: nothing changes
+
+
+def test_the_a_offset_adds_to_every_a_word_of_programs_written_with_another_a_zero(small, tmp_path):
+    from spur_cad.verify.verify import toolpaths
+
+    job, plan = small
+    zero_deg = 7.5  # a quarter pitch: read at the wrong zero, every flank is cut 7.5 deg off
+    programs = {f"{name}.ngc": _hand_written(getattr(plan, name).toolpath, "linuxcnc") for name in ("roughing",
+                                                                                                   "finishing")}
+    shifted = {name: re.sub(r"A(-?\d+\.\d+)", lambda m: f"A{float(m.group(1)) - zero_deg:.3f}", text).encode()
+               for name, text in programs.items()}
+    moves = read_program(shifted["finishing.ngc"].decode(), "linuxcnc", "f")
+    tools = {job.tools.finishing.tool_number: job.tools.finishing}
+    cut, = toolpaths(moves, tools, None, "tip", a_offset_deg=zero_deg)
+    assert np.array_equal(cut.path.a, moves.a + zero_deg) and np.array_equal(cut.path.x, moves.x)
+    original = read_program(programs["finishing.ngc"], "linuxcnc", "o").a
+    assert np.abs(cut.path.a - original).max() <= 1e-9  # the program's own A zero is back at the job's
+    code, result = _verify(tmp_path / "offset", _job_text(), shifted, "--dialect", "linuxcnc", "--a-offset-deg",
+                           str(zero_deg))
+    assert code == 0 and result["max_gouge_mm"] <= RESOLUTION
+    code, result = _verify(tmp_path / "none", _job_text(), shifted, "--dialect", "linuxcnc")
+    assert code == 1 and result["max_gouge_mm"] > 0.1
+    code, result = _verify(tmp_path / "bad", _job_text(), shifted, "--a-offset-deg", "nan")
+    assert code == 2 and result == {}

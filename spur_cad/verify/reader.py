@@ -15,7 +15,8 @@ programs in the same dialects:
 
 Modal motion (G0 / G1 stay in effect, so bare axis words move), one axis per block, G93 inverse time
 and G94, F, T/M6, S. Rotary direction: in a block with M15 (positive) or M16 (negative), A is an angle
-in [0, 360) reached turning that way (Okuma); elsewhere A is the absolute, unwound axis. Anything this
+in [0, 360] (360 read as 0) reached turning that way (Okuma), and an angle already reached (within
+DIRECTED_TOLERANCE_DEG) is no move; elsewhere A is the absolute, unwound axis. Anything this
 reader does not execute (incremental G91, arcs, other plane or unit codes, unknown M codes, macro
 statements) is an error naming the file and line, never a silent skip. Siemens `WORKPIECE(...)` blank
 definitions are ignored; Okuma's work offset selection `G15 H<n>` is taken as the job's frame (like G54..G59).
@@ -62,6 +63,10 @@ MAX_SUBPROGRAMS = 100_000  # subprograms, loops and labels defined
 MAX_VARIABLES = 10_000  # distinct variables set (LinuxCNC has 5,400 numbered parameters)
 MAX_CALL_DEPTH = 8
 MAX_REPEAT = 100_000
+# A directed move (Okuma M15/M16) to an angle this close to where A is moves 0: far below the finest A word a
+# dialect writes (4 decimals, 1e-4 deg; 1e-6 deg is 1.7 nm at 100 mm radius) and far above the rounding of
+# an unwound angle (about 1e-13 deg at 10,000 deg), which made such a move a spurious full turn.
+DIRECTED_TOLERANCE_DEG = 1e-6
 CHECK_EVERY_BLOCKS = 100_000  # how often a long read calls its checkpoint (the CLI stops there on a signal)
 LOCAL_VARIABLES = 33  # #1..#33: a call's arguments, restored when it returns
 
@@ -623,7 +628,7 @@ class _Reader:
                 self._word(letter, value, line, target)
         if self.block_codes:
             self._check_block_codes(words, line)
-        if direction is not None and not math.isnan(target[3]):
+        if direction is not None and any(letter == "A" for letter, _ in words):  # M15/M16 turn this block's A
             target[3] = _directed(self.pose[3], target[3], direction, self, line)
         if moves:
             self._move(target, line)
@@ -790,15 +795,18 @@ class _Reader:
 
 def _directed(current: float, target: float, direction: str, reader: _Reader, line: _Line) -> float:
     """The unwound A reached from `current` turning positively (M15) or negatively (M16) to the angle `target`
-    in [0, 360); `direction` is the code without M (a key of reader.directions)."""
-    if not 0.0 <= target < 360.0:
-        raise reader.error(line, f"with M{direction}, A must be an angle in [0, 360), got {target:g}")
+    in [0, 360] (360 is 0, as legacy Okuma programs write it); `direction` is the code without M (a key of
+    reader.directions). A target within DIRECTED_TOLERANCE_DEG of where A is moves 0, not a full turn."""
+    if not 0.0 <= target <= 360.0:
+        raise reader.error(line, f"with M{direction}, A must be an angle in [0, 360], got {target:g}")
+    target %= 360.0
     if math.isnan(current):
         return target
-    step = (target - current) % 360.0
-    return current + step if reader.directions[direction] else current - ((360.0 - step) % 360.0)
-
-
+    step = (target - current) % 360.0  # in [0, 360]: rounding of an unwound `current` may give 359.99999999999994
+    if min(step, 360.0 - step) <= DIRECTED_TOLERANCE_DEG:
+        return current
+    reached = current + step if reader.directions[direction] else current - (360.0 - step)
+    return target + 360.0 * round((reached - target) / 360.0)  # the angle as written plus whole turns: no drift
 
 
 def _digits(text: str) -> str:

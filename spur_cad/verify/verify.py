@@ -32,10 +32,13 @@ class VerifyOptions:
     gouge_tolerance_mm: float | None = None
     leftover_tolerance_mm: float | None = None
     point_tools: tuple[int, ...] = ()  # the tools `point` applies to (empty: every tool)
+    a_offset_deg: float = 0.0  # added to every A read: the job's A of the programs' A zero (another A zero)
 
     def validate(self) -> None:
         if self.point not in POINTS:
             raise SpurCadError(f"--point must be one of {', '.join(POINTS)}, got {shown(self.point)}")
+        if not (math.isfinite(self.a_offset_deg) and abs(self.a_offset_deg) <= 360.0):
+            raise SpurCadError(f"--a-offset-deg must be in [-360, 360] deg, got {self.a_offset_deg:g}")
         for name in ("gouge_tolerance_mm", "leftover_tolerance_mm"):
             value = getattr(self, name)
             if value is not None and not (math.isfinite(value) and 0.0 <= value <= 10.0):
@@ -110,8 +113,9 @@ class VerifyResult:
 
 
 def toolpaths(moves: ProgramMoves, tools: dict, roughing_number: int | None, point: str,
-              point_tools: tuple[int, ...] = ()) -> list:
-    """(Toolpath, Tool) per run of moves with one tool in the spindle; the job's `tools` by tool number."""
+              point_tools: tuple[int, ...] = (), a_offset_deg: float = 0.0) -> list:
+    """(Toolpath, Tool) per run of moves with one tool in the spindle; the job's `tools` by tool number; A is
+    the program's plus `a_offset_deg` (VerifyOptions)."""
     from spur_cad.sim.simulate import Cut
 
     cuts = []
@@ -134,7 +138,8 @@ def toolpaths(moves: ProgramMoves, tools: dict, roughing_number: int | None, poi
         count = end - begin
         path = Toolpath(
             kind=np.where(moves.rapid[part], MoveKind.RAPID, MoveKind.LINEAR).astype(np.int8),
-            x=moves.x[part], y=moves.y[part], z=z, a=moves.a[part],  # views: the moves are not changed
+            x=moves.x[part], y=moves.y[part], z=z,  # views: the moves are not changed
+            a=moves.a[part] + a_offset_deg if a_offset_deg else moves.a[part],
             feed=moves.feed[part], inverse_time=moves.inverse_time[part],
             space=np.full(count, -1, np.int32), station=np.full(count, -1, np.int32),
             feature=np.full(count, Feature.NONE, np.int8),
@@ -196,7 +201,7 @@ def verify_moves(job, programs: list[ProgramMoves], options: VerifyOptions = Ver
     tools = {tool.tool_number: tool for tool in (job.tools.roughing, job.tools.finishing) if tool is not None}
     roughing_number = job.tools.roughing.tool_number if job.tools.roughing is not None else None
     cuts = [cut for moves in programs for cut in toolpaths(moves, tools, roughing_number, options.point,
-                                                           options.point_tools)]
+                                                           options.point_tools, options.a_offset_deg)]
     if not cuts:
         raise SpurCadError("the programs have no moves to verify")
     finishing = [cut.path for cut in cuts if cut.path.operation == Operation.FINISHING]
