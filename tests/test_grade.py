@@ -237,3 +237,33 @@ def test_bad_measured_files_are_one_line(tmp_path, capsys, text, message):
     code, grading = _grade_cli(tmp_path, text)
     err = capsys.readouterr().err.strip()
     assert code == 2 and grading == {} and len(err.splitlines()) == 1 and message in err, err
+
+
+def test_the_k_charts_tolerance_band_is_centred_on_the_design_not_on_the_traces_mean():
+    from spur_cad.grade.grading import Grading, Trace
+    from spur_cad.report.figures import k_chart_figure
+
+    spec = parse_job(small_job_text(), "small.toml").gear
+    grade = 8
+    d, b, m = 2.0 * spec.reference_radius_mm, spec.face_width_mm, spec.module_mm
+    half = {kind: 0.5 * tolerance_um(name, grade, d, b, m) for kind, name in (("profile", "F_aT"), ("helix", "F_bT"))}
+    s = np.linspace(0.0, 4.0, 41)
+    # every trace 0.7 of the half band above the design, rippling 0.2 of it: in class everywhere, its mean far from 0
+    traces = tuple(Trace(kind, 3, side, 1.0 if kind == "profile" else None, s,
+                         half[kind] * (0.7 + 0.2 * np.sin(3.0 * s)), (0.5, 3.5))
+                   for kind in ("profile", "helix") for side in ("right", "left"))
+    grading = Grading({}, {}, {}, grade, (), traces)
+    fig = k_chart_figure(spec, grading)
+    charts = [ax for ax in fig.axes if ax.get_lines()]
+    assert len(charts) == 4
+    for ax in charts:
+        kind = "profile" if "profile" in ax.get_title() else "helix"
+        trace = next(line.get_ydata() for line in ax.get_lines() if line.get_label().startswith("X =")
+                     or line.get_label() == "reference circle")
+        edges = sorted(float(line.get_ydata()[0]) for line in ax.get_lines() if line.get_gid() == "tolerance band")
+        design, = [float(line.get_ydata()[0]) for line in ax.get_lines() if line.get_gid() == "design"]
+        assert design == 0.0 and edges == pytest.approx([-half[kind], half[kind]], abs=1e-12)  # around the design
+        assert abs(np.mean(trace)) > 0.6 * half[kind]  # far from the band's centre ...
+        assert edges[0] <= trace.min() and trace.max() <= edges[1]  # ... and inside the band, as it is in class
+        low, high = ax.get_ylim()
+        assert low <= edges[0] and edges[1] <= high  # the band is in view

@@ -13,6 +13,8 @@ from spur_cad.geometry.spec import GearSpec
 from spur_cad.report.plots import _png, figure, figure_for_extent
 
 if TYPE_CHECKING:
+    from matplotlib.figure import Figure
+
     from spur_cad.cam.flank_roughing import FlankPlan
     from spur_cad.cam.tools import Tool
     from spur_cad.grade.grading import Grading
@@ -180,10 +182,16 @@ def deviation_map_png(result: SimResult) -> bytes:
 
 
 def k_chart_png(spec: GearSpec, grading: Grading) -> bytes:
+    """`k_chart_figure` as PNG bytes."""
+    return _png(k_chart_figure(spec, grading))
+
+
+def k_chart_figure(spec: GearSpec, grading: Grading) -> Figure:
     """A gear measuring machine's chart for the tooth space with the largest total profile deviation: its
     right and left profile traces (deviation against roll length, the three face positions) and helix traces,
-    the evaluation ranges and the tolerance band of the gear's class (the total tolerance F_aT / F_bT, drawn
-    around each trace's mean)."""
+    the evaluation ranges, the design (deviation 0: the traces are deviations from the design, which has no
+    profile or helix modification) and the tolerance band of the gear's class around it (the total tolerance
+    F_aT / F_bT, half each side, as measuring machines print it: a trace in class stays inside)."""
     from spur_cad.grade.iso1328 import tolerance_um
 
     traces = grading.traces
@@ -207,11 +215,12 @@ def k_chart_png(spec: GearSpec, grading: Grading) -> bytes:
             for trace, style in zip(chosen, ("-", "--", ":", "-.") * len(chosen)):  # coinciding traces stay visible
                 label = f"X = {trace.x_mm:.2f} mm" if trace.x_mm is not None else "reference circle"
                 ax.plot(trace.position_mm, trace.deviation_um, style, lw=1.1, label=label)
-                mean = float(np.mean(trace.deviation_um))
-                for edge in (-0.5 * band, 0.5 * band):
-                    ax.axhline(mean + edge, color="tab:red", lw=0.6, ls="--")
                 for edge in trace.evaluation:
                     ax.axvline(edge, color="k", lw=0.5, ls=":")
+            if chosen:
+                ax.axhline(0.0, color="k", lw=0.8, gid="design")
+                for edge in (-0.5 * band, 0.5 * band):
+                    ax.axhline(edge, color="tab:red", lw=0.6, ls="--", gid="tolerance band")
             ax.set_title(f"space {worst}, {side} flank: {kind} (band: class {grade} "
                          f"{'F_aT' if kind == 'profile' else 'F_bT'} = {band:g} \u00b5m)", fontsize=8)
             ax.set_xlabel("roll length [mm]" if kind == "profile" else "X (face width) [mm]", fontsize=8)
@@ -221,7 +230,7 @@ def k_chart_png(spec: GearSpec, grading: Grading) -> bytes:
                 ax.legend(fontsize=6)
             else:
                 ax.text(0.5, 0.5, "not measured", transform=ax.transAxes, ha="center", fontsize=8)
-    return _png(fig)
+    return fig
 
 
 _PASS_COLOURS = {"flank": "tab:blue", "tip": "tab:green", "land": "tab:purple"}
