@@ -191,7 +191,9 @@ def k_chart_figure(spec: GearSpec, grading: Grading) -> Figure:
     right and left profile traces (deviation against roll length, the three face positions) and helix traces,
     the evaluation ranges, the design (deviation 0: the traces are deviations from the design, which has no
     profile or helix modification) and the tolerance band of the gear's class around it (the total tolerance
-    F_aT / F_bT, half each side, as measuring machines print it: a trace in class stays inside)."""
+    F_aT / F_bT, half each side, as measuring machines print it). The class counts a trace's own spread, not its
+    offset: a flank standing off the design as a whole (tooth size, the finish's scallops on one side) pokes out of
+    the band while its spread is in class."""
     from spur_cad.grade.iso1328 import tolerance_um
 
     traces = grading.traces
