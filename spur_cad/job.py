@@ -24,6 +24,7 @@ from pathlib import Path
 from spur_cad.cad.specs import BlankFeatures, StockSpec
 from spur_cad.cam.machine import Machine, RoughingParams
 from spur_cad.cam.machine_limits import check_machine_limits
+from spur_cad.cam.probing import ProbeSection
 from spur_cad.cam.strategies import REGISTRY, FinishingParams, Strategies, finishing_section_type
 from spur_cad.cam.tools import Tool
 from spur_cad.cam.turning import LatheSection, check_lathe_blank
@@ -153,6 +154,7 @@ class Job:
     post: PostSettings = field(default_factory=PostSettings)
     simulation: SimulationSection = field(default_factory=SimulationSection)
     lathe: LatheSection | None = None  # [lathe] present: the blank's lathe program is written too
+    probe: ProbeSection | None = None  # [probe] present: the on-machine probing program is written too
     text: str = field(default="", repr=False, compare=False)  # the file's text, to point at lines
     report_template_text: str | None = field(default=None, repr=False, compare=False)  # [job] report_template's
     strategies: Strategies = field(default_factory=lambda: dict(REGISTRY), repr=False, compare=False)  # [finishing]'s
@@ -187,6 +189,7 @@ SECTIONS: dict[str, type] = {
     "simulation": SimulationSection,
     "post": PostSettings,
     "lathe": LatheSection,
+    "probe": ProbeSection,
 }
 
 
@@ -489,7 +492,8 @@ def _validate_sections(sections: dict, tables: dict, types: dict, autos: dict[st
                        strategies: Strategies, where: Callable[[str, str | None], str]) -> None:
     """Every section's own checks, the tools last: their "auto" keys are resolved once the sections the
     suggestion depends on (machine, roughing, finishing) have passed theirs."""
-    for name in ("machine", "roughing", "finishing", "post", "lathe", *(f"tools.{role}" for role in _TOOL_ROLES)):
+    for name in ("machine", "roughing", "finishing", "post", "lathe", "probe",
+                 *(f"tools.{role}" for role in _TOOL_ROLES)):
         if name not in sections:
             continue
         is_tool = name.startswith("tools.")
@@ -545,11 +549,35 @@ def _job_from_data(data: dict, source: str, text: str, strategies: Strategies = 
             name = exc.section if exc.section in ("stock", "lathe") else "lathe"
             blamed = _blamed_key(exc, name, tables.get(name, {}))
             raise JobFileError(f"{where(name, blamed)}: {exc}", section=name, field=blamed) from None
-    optional = {name: sections[name] for name in ("stock", "roughing", "machine", "post", "simulation", "lathe")
-                if name in sections}
+    if "probe" in sections:
+        _check_probe(spec, sections, tools, tables, where)
+    optional = {name: sections[name] for name in ("stock", "roughing", "machine", "post", "simulation", "lathe",
+                                                  "probe") if name in sections}
     finishing = sections["finishing"] if "finishing" in sections else types["finishing"]()  # the registry's default
     return Job(source=source, job=sections.get("job", JobSection()), gear_section=gear_section, gear=spec,
                tools=tools, finishing=finishing, **optional, text=text, strategies=dict(strategies))
+
+
+def _check_probe(spec: GearSpec, sections: dict, tools: ToolsSection, tables: dict,
+                 where: Callable[[str, str | None], str]) -> None:
+    """[probe] needs a dialect with probing words, a tool number of its own, a spur gear and a ball that reaches
+    every point (spur_cad.cam.probing.plan_probe): one line at the key to blame."""
+    from spur_cad.cam.probing import ProbeError, plan_probe
+    from spur_cad.post.probe import probing_dialect
+
+    probe: ProbeSection = sections["probe"]
+    try:
+        probing_dialect(sections.get("post", PostSettings()).dialect)
+        for role in _TOOL_ROLES:
+            tool = getattr(tools, role)
+            if tool is not None and tool.tool_number == probe.tool_number:
+                raise ProbeError(f"[probe] tool_number = {probe.tool_number} is the {role} tool's number too; the "
+                                 "probe needs a tool number of its own", field="tool_number")
+        plan_probe(spec, sections.get("stock", StockSpec()), sections.get("machine", Machine()), probe)
+    except SpurCadError as exc:
+        name = exc.section if exc.section in ("post", "probe") else "probe"
+        blamed = _blamed_key(exc, name, tables.get(name, {}))
+        raise JobFileError(f"{where(name, blamed)}: {exc}", section=name, field=blamed) from None
 
 
 MAX_TEMPLATE_BYTES = 256 * 1024

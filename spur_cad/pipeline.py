@@ -84,6 +84,9 @@ def run_job(job: Job, progress: Callable[[str, float], None] | None = None,
     if job.lathe is not None:
         name, text = timed("lathe", None, lambda: lathe_program(job))
         program_files[name] = text
+    if job.probe is not None:
+        name, text = timed("probe", None, lambda: probe_program(job))
+        program_files[name] = text
     sim_result = timed("simulation", "simulation",
                        lambda: simulate_stage(job, plan, lambda fraction: tell("simulation", fraction)))
     grading = timed("grading", None, lambda: grade_stage(job, sim_result))
@@ -156,6 +159,20 @@ def lathe_program(job: Job) -> tuple[str, bytes]:
     text = post_lathe(plan_lathe(spec, stock, job.lathe), job.lathe, f"spur_cad {__version__} blank: {job.job.name}",
                       comments)
     return f"blank.{lathe_extension(job.lathe.dialect)}", text.encode()
+
+
+def probe_program(job: Job) -> tuple[str, bytes]:
+    """The on-machine probing program ([probe], spur_cad.cam.probing): its file name probe.<ext> and text."""
+    from spur_cad.cam.probing import plan_probe
+    from spur_cad.post.probe import post_probe, probing_dialect
+
+    spec = job.gear
+    gear = (f"gear: z = {spec.teeth}, m = {spec.module_mm:g} mm, alpha = {spec.pressure_angle_deg:g} deg, "
+            f"x = {spec.profile_shift_coefficient:g}, b = {spec.face_width_mm:g} mm, reference radius "
+            f"{spec.reference_radius_mm:.4f} mm, form radius {spec.form_radius_mm:.4f} mm")
+    plan = plan_probe(spec, job.stock, job.machine, job.probe)
+    text = post_probe(plan, job.post, f"spur_cad {__version__} probe: {job.job.name}", gear)
+    return f"probe.{probing_dialect(job.post.dialect).extension}", text.encode()
 
 
 def restart_program(job: Job, plan: CamPlan, point: RestartPoint) -> tuple[str, bytes]:

@@ -118,7 +118,7 @@ def test_the_table_is_consistent():
     assert set(LATHE_DIALECTS) == set(lathe_names())  # [lathe]'s choices (cam cannot import the table)
     for d in DIALECTS.values():
         assert d.comments.style in d.comments.reads and d.subprograms.structure in ("o_words", "labels", "numbered")
-        assert d.probing is None  # room for probing words; no probing program is written yet
+        assert (d.probing is not None) == (d.name in ("linuxcnc", "fanuc", "haas"))  # probe.<ext> (docs/probing.md)
         assert len(d.ignored_words) == len(set(d.ignored_words)) and d.ignored_words.isupper()
     assert [d.name for d in DIALECTS.values() if d.rs274_checkable] == ["linuxcnc"]
     assert dialect(ACME) is ACME and lathe_dialect(ACME) is ACME and lathe_extension(ACME) == "acm"

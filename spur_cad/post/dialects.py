@@ -99,12 +99,15 @@ class LatheWords:
 
 @dataclass(frozen=True)
 class ProbingWords:
-    """Room for probing words (no probing program is written yet; every dialect has `probing=None`): the
-    probe move and the comments that open and close the control's log of probed points."""
+    """The on-machine probing program on this control (docs/probing.md): the probe move and how the ball
+    centre at each trip is recorded. `{...}` are str.format templates."""
 
-    probe_move: str  # e.g. LinuxCNC's G38.2
-    log_open: str  # e.g. "(PROBEOPEN {file})"
-    log_close: str  # e.g. "(PROBECLOSE)"
+    probe_move: str  # the move that stops when the probe trips: LinuxCNC G38.2 (an error without a trip), G31
+    log_open: str  # opens the record of trips: "(PROBEOPEN probe.log)", Fanuc POPEN
+    log_close: str  # closes it: "(PROBECLOSE)", PCLOS
+    record: str = ""  # a block after each probe move writing the trip position, "" when the control logs itself
+    no_trip_check: str = ""  # stops the program when the move ended without a trip: {y}, {z} the target, {tol}
+    log_name: str = ""  # what the docs call the record: probe.log, the DPRNT output
 
 
 @dataclass(frozen=True)
@@ -138,7 +141,7 @@ class Dialect:
     ignored_words: str = "HDP"  # address letters the reader skips: tool offsets, G64 P, G96 D, G15 H
     lathe: LatheWords | None = None  # None: no lathe program (the lathe post and the reader's lathe mode refuse)
     rs274_checkable: bool = False  # LinuxCNC's interpreter rs274 reads these programs (spur-cad verify)
-    probing: ProbingWords | None = None  # room for probing words; None everywhere today
+    probing: ProbingWords | None = None  # None: no probing program (the [probe] section refuses the dialect)
 
 
 LINUXCNC = Dialect(
@@ -154,6 +157,9 @@ LINUXCNC = Dialect(
     lathe=LatheWords(setup=("G7", "G18 G21 G90 G40 G95"), spindle_limit="", tool_change="T{tool} M6 G43",
                      constant_speed="G96 D{rpm} S{vc} {direction}", feed_codes=("95", "94"), diameter_word="G7",
                      diameter_codes=("7", "8")),
+    # G38.2 stops at the trip and logs the 9 axes (X Y Z A B C U V W) to the PROBEOPEN file; no trip is an error.
+    probing=ProbingWords(probe_move="G38.2", log_open="(PROBEOPEN probe.log)", log_close="(PROBECLOSE)",
+                         log_name="probe.log"),
     rs274_checkable=True)
 
 FANUC = Dialect(
@@ -170,7 +176,13 @@ FANUC = Dialect(
     lathe=LatheWords(setup=("G21 G18 G40 G99",), spindle_limit="G50 S{rpm}", tool_change="T{tool:02d}{tool:02d}",
                      constant_speed="G96 S{vc} {direction}", feed_codes=("99", "98"), diameter_word=None,
                      padded_m_codes=True, end=("G97",), spindle_limit_code="50", cycle_codes=("90", "94"),
-                     turret=True, tool_offset_t=True))
+                     turret=True, tool_offset_t=True),
+    # G31 (skip) stops at the trip; #5061..#5064 hold X Y Z A there (the block's end when nothing tripped, which
+    # the check turns into alarm 3000); DPRNT writes them to the POPEN device (docs/probing.md).
+    probing=ProbingWords(probe_move="G31", log_open="POPEN", log_close="PCLOS",
+                         record="DPRNT[X#5061[44]Y#5062[44]Z#5063[44]A#5064[34]]",
+                         no_trip_check="IF[[ABS[#5062-[{y}]]+ABS[#5063-[{z}]]]LT{tol}]THEN#3000=1(PROBE NOT TRIPPED)",
+                         log_name="the DPRNT output"))
 
 # Haas differs from Fanuc in the program number's digits and in folding: local subprograms
 # (M97 P<N label> in the same file) with their parameters in common variables. No lathe words.

@@ -30,8 +30,10 @@ MAX_COORDINATE_MM = 100_000.0
 """Largest |X|, |Y|, |Z| a program may command (100 m: beyond any machining centre, far inside every
 control's number format); larger or non-finite values are refused."""
 
-_ACTIVE_COMMENT = re.compile(r"(msg|debug|print|log\w*|probe\w*|abort|py\w*)\s*,", re.IGNORECASE)
-"""Comment words a LinuxCNC interpreter acts on (messages, log files, probe files, aborts, Python)."""
+_ACTIVE_COMMENT = re.compile(r"(msg|debug|print|log\w*|probe\w*|abort|py\w*)\s*,|(probeopen|probeclose|logclose)\b",
+                             re.IGNORECASE)
+"""Comment words a LinuxCNC interpreter acts on (messages, log files, probe files, aborts, Python); PROBEOPEN takes
+its file name after a space, PROBECLOSE and LOGCLOSE take nothing."""
 
 _COMMENT_TRANSLATION = str.maketrans({"(": "[", ")": "]", ";": ",", "%": "?"})
 
