@@ -181,6 +181,8 @@ def group_summary(group: str, job: dict[str, object], units=None) -> str:
         text = "on" if job.get("SimulationEnabled") else "off"
     elif group == "Lathe":
         text = "program written" if job.get("WriteLatheProgram") else "no program"
+    elif group == "Probe":
+        text = "program written" if job.get("WriteProbeProgram") else "no program"
     elif group == "Job":
         text = str(job.get("JobName", ""))
     else:
