@@ -46,7 +46,7 @@ FIT_TOLERANCE_MM = 0.001
 PATH_SAMPLES = 24
 """Positions checked along each straight move."""
 PROBE_CODE = re.compile(r"M[0-9]{1,4}( P[0-9]{1,5})?")
-"""A probe on/off code: one M code, with a P number for controls that switch outputs so (Haas M59 P1133)."""
+"""A probe on/off code: one M code, with a P number for controls that switch outputs so (Haas M59 P<output>)."""
 
 _GROUP = "Probe"
 
@@ -97,8 +97,8 @@ class ProbeSection:
     program_number: int = key(3000, low=1, high=9999, label="ProbeProgramNumber", group=_GROUP,
                               meaning="program number (Fanuc and Haas O word)")
     probe_on_code: str = key("", label="ProbeOnCode", group=_GROUP,
-                             meaning="M code switching the probe on after the tool change, e.g. M59 P1133 "
-                                     "(Haas), '': none")
+                             meaning="M code switching the probe on after the tool change (with a P number "
+                                     "on Haas: M59 P<output>), '': none")
     probe_off_code: str = key("", label="ProbeOffCode", group=_GROUP,
                               meaning="M code switching the probe off at the end, '': none")
 
@@ -113,7 +113,7 @@ class ProbeSection:
             code = getattr(self, name)
             if code and (not PROBE_CODE.fullmatch(code) or int(code.split()[0][1:]) in RESERVED_M_CODES):
                 raise ProbeError(f"[probe] {name} = {shown(code, 20)} must be one M code (with a P number at "
-                                 "most, e.g. 'M59 P1133') that does not stop, end or call a program or drive the "
+                                 "most, e.g. 'M59 P1') that does not stop, end or call a program or drive the "
                                  "spindle, tool or coolant", field=name)
         if not (self.pitch or self.profile or self.helix):
             raise ProbeError("[probe] pitch, profile and helix are all false: nothing to probe", field="pitch")
