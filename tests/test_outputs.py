@@ -170,7 +170,7 @@ def test_every_name_a_run_writes_is_in_the_vocabulary():
 
     extensions = {dialect(name).extension for name in dialect_names()} | set(LATHE_EXTENSIONS.values())
     for extension in extensions:
-        for stem in ("roughing", "roughing_bottom", "finishing", "blank"):
+        for stem in ("roughing", "roughing_bottom", "finishing", "blank", "probe"):
             assert is_output_name(f"{stem}.{extension}"), (stem, extension)
         for point in ("roughing:space=5", "roughing:space=5,level=2", "finishing:station=40",
                       "finishing:space=3,pass=7", "roughing_bottom:space=22,level=9999999"):

@@ -227,3 +227,15 @@ def test_without_probe_no_program_and_the_probe_words_never_come_from_user_text(
     assert _job(probe="").probe is None
     for text in ("PROBEOPEN /etc/passwd", "probeclose", "LOGCLOSE"):
         assert inert_comment_text(text, 80).startswith("_")  # LinuxCNC would act on them as comments
+
+
+def test_a_run_writes_probe_ngc_into_the_output_set(tmp_path):
+    from spur_cad.outputs import write_output_set
+    from spur_cad.pipeline import run_job
+
+    gear = REFERENCE[REFERENCE.index("[gear]"):REFERENCE.index("[stock]")]
+    job = parse_job(f"{gear}\n[simulation]\nenabled = false\n{PROBE}", "gear.toml")  # no tools: no CAM
+    files = run_job(job).files
+    assert files["probe.ngc"] == probe_program(job)[1]
+    written = {path.name for path in write_output_set(tmp_path, files)}
+    assert "probe.ngc" in written and (tmp_path / "probe.ngc").read_bytes() == files["probe.ngc"]
