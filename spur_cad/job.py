@@ -22,8 +22,10 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from spur_cad.cad.specs import BlankFeatures, StockSpec
+from spur_cad.cam.calibration import CalibrationTable, parse_calibration_table
 from spur_cad.cam.machine import Machine, RoughingParams
 from spur_cad.cam.machine_limits import check_machine_limits
+from spur_cad.cam.materials import DEFAULT_MATERIAL, MATERIALS
 from spur_cad.cam.probing import ProbeSection
 from spur_cad.cam.strategies import REGISTRY, FinishingParams, Strategies, finishing_section_type
 from spur_cad.cam.tools import Tool
@@ -53,6 +55,9 @@ class JobSection:
     report_template: str = key("", label="ReportTemplate", group="Job",
                                meaning="report.html's Jinja2 template, a file relative to the job file (empty: "
                                        "spur_cad's own, spur_cad/report/templates/report.html.j2: copy it to start)")
+    material: str = key(DEFAULT_MATERIAL, choices=tuple(MATERIALS), label="Material", group="Job",
+                        meaning="the gear's material: its specific cutting force (Kienzle k_c1.1, m_c; "
+                                "spur_cad/cam/materials.py) sets the finishing tool's deflection in the error budget")
 
 
 @dataclass(frozen=True)
@@ -157,6 +162,7 @@ class Job:
     probe: ProbeSection | None = None  # [probe] present: the on-machine probing program is written too
     text: str = field(default="", repr=False, compare=False)  # the file's text, to point at lines
     report_template_text: str | None = field(default=None, repr=False, compare=False)  # [job] report_template's
+    rotary_calibration: CalibrationTable | None = field(default=None, repr=False, compare=False)  # [machine]'s file
     strategies: Strategies = field(default_factory=lambda: dict(REGISTRY), repr=False, compare=False)  # [finishing]'s
 
     def located(self, error: SpurCadError) -> str:
@@ -607,9 +613,43 @@ def with_report_template(job: Job, folder: Path) -> Job:
     return dataclasses.replace(job, report_template_text=text)
 
 
+MAX_CALIBRATION_BYTES = 1024 * 1024
+"""Largest rotary calibration table read (a table of every 0.1 deg is about 60 kB)."""
+
+
+def with_rotary_calibration(job: Job, folder: Path) -> Job:
+    """The job with its [machine] rotary_calibration_file read (relative to `folder`, the job file's): a missing
+    file, one that is not a regular file, larger than MAX_CALIBRATION_BYTES, not UTF-8 or with a line that is
+    not 'A_deg error_arcsec' is one JobFileError at the key's line."""
+    name = job.machine.rotary_calibration_file
+    if not name:
+        return job
+    from spur_cad.inputs import read_regular_file
+
+    path = folder / name
+    where = _where(job.source, job.text, "machine", "rotary_calibration_file")
+    try:
+        text = read_regular_file(path, "calibration table", MAX_CALIBRATION_BYTES, JobFileError).decode("utf-8")
+        table = parse_calibration_table(text, shown_path(path))
+    except UnicodeDecodeError:
+        raise JobFileError(f"{where}: [machine] rotary_calibration_file: {shown_path(path)} is not UTF-8 text",
+                           section="machine", field="rotary_calibration_file") from None
+    except (JobFileError, ValueError) as exc:
+        raise JobFileError(f"{where}: [machine] rotary_calibration_file: {exc}", section="machine",
+                           field="rotary_calibration_file") from None
+    return dataclasses.replace(job, rotary_calibration=table)
+
+
+def with_files(job: Job, folder: Path) -> Job:
+    """The job with the files it names read from `folder` (the job file's): the report template and the rotary
+    calibration table."""
+    return with_rotary_calibration(with_report_template(job, folder), folder)
+
+
 def load_job(path: str | Path, strategies: Strategies = REGISTRY) -> Job:
     """Read and validate a job file from disk (a regular file of at most MAX_JOB_FILE_BYTES: a FIFO or a device
-    is refused before it is read); [job] report_template is read from the job file's folder."""
+    is refused before it is read); the files it names ([job] report_template, [machine] rotary_calibration_file) are
+    read from the job file's folder."""
     from spur_cad.inputs import read_regular_file
 
     source = shown_path(path)  # messages name the file with its control characters escaped
@@ -620,4 +660,4 @@ def load_job(path: str | Path, strategies: Strategies = REGISTRY) -> Job:
         raise JobFileError(f"{source}: the job file is not UTF-8 text") from None
     if "\x00" in text:
         raise JobFileError(f"{source}: the job file contains NUL characters (not a text file)")
-    return with_report_template(parse_job(text, source, strategies), Path(path).parent)
+    return with_files(parse_job(text, source, strategies), Path(path).parent)

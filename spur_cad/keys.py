@@ -37,7 +37,9 @@ REQUIRED = dataclasses.MISSING  # the default of a key the file must give
 UNITS = {
     "": "dimensionless (a count, a coefficient, a name or a flag)",
     "mm": "millimetre",
+    "um": "micrometre",
     "deg": "degree",
+    "arcsec": "second of arc (1/3600 degree)",
     "%": "percent",
     "s": "second",
     "mm/min": "millimetres per minute (feeds)",

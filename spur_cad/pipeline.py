@@ -90,7 +90,8 @@ def run_job(job: Job, progress: Callable[[str, float], None] | None = None,
     sim_result = timed("simulation", "simulation",
                        lambda: simulate_stage(job, plan, lambda fraction: tell("simulation", fraction)))
     grading = timed("grading", None, lambda: grade_stage(job, sim_result))
-    result = build_result(job, samples, cad, plan, job.post, programs, sim_result, grading, seconds)
+    budget = timed("error_budget", None, lambda: budget_stage(job, plan, sim_result, grading))
+    result = build_result(job, samples, cad, plan, job.post, programs, sim_result, grading, seconds, budget)
     template_source = shown_path(job.job.report_template) if job.job.report_template else "report.html.j2"
     report = timed("report", "report", lambda: report_html(result, png, job.gear,
                                                           job.stock.blank_radius_mm(job.gear), plan, sim_result,
@@ -114,6 +115,36 @@ def grade_stage(job: Job, sim_result: SimResult | None) -> Grading | None:
     from spur_cad.grade.simulated import grade_simulation
 
     return grade_simulation(job.gear, sim_result)
+
+
+def error_budget(job: Job, plan: CamPlan):
+    """The job's error budget (spur_cad.sim.budget.ErrorBudget): [machine]'s accuracy keys, the calibration table
+    and the finishing tool's deflection in the job's material (on the finish stock roughing leaves)."""
+    from spur_cad.cam.materials import MATERIALS
+    from spur_cad.sim.budget import ErrorBudget, finishing_deflection
+
+    machine, tool = job.machine, plan.finishing.tool if plan.finishing is not None else None
+    deflection = None if tool is None else finishing_deflection(
+        tool.diameter_mm, tool.effective_corner_radius_mm, tool.stick_out_mm, tool.feed_per_tooth_mm,
+        job.roughing.finish_stock_mm, MATERIALS[job.job.material])
+    return ErrorBudget(machine.rotary_accuracy_arcsec, machine.rotary_repeatability_arcsec, job.rotary_calibration,
+                       machine.spindle_runout_um + machine.tool_runout_um, machine.tool_radius_error_um,
+                       machine.linear_accuracy_um, deflection)
+
+
+def budget_stage(job: Job, plan: CamPlan, sim_result: SimResult | None, grading: Grading | None):
+    """The simulated gear on the budget's machine, graded (spur_cad.result.ErrorBudgetFacts; None without a
+    simulation): the budget acts on the simulated flanks, the cut is not simulated again."""
+    if sim_result is None or grading is None:
+        return None
+    from spur_cad.grade.simulated import grade_simulation
+    from spur_cad.sim.budget import apply_budget
+    from spur_cad.summary import error_budget_facts
+
+    budget = error_budget(job, plan)
+    deviation, terms = apply_budget(sim_result.grid, sim_result.deviation, budget)
+    expected = grade_simulation(job.gear, dataclasses.replace(sim_result, deviation=deviation))
+    return error_budget_facts(job, terms, budget.deflection, grading, expected)
 
 
 def build_programs(job: Job, plan: CamPlan) -> tuple[dict[str, PostedProgram], dict[str, bytes]]:

@@ -18,6 +18,7 @@ if TYPE_CHECKING:  # annotations only: the CAD kernel and the simulator load whe
     from spur_cad.geometry.inspection import InspectionSheet
     from spur_cad.geometry.spec import GearFacts
     from spur_cad.grade.grading import Grading
+    from spur_cad.sim.budget import BudgetTerms, Deflection
     from spur_cad.sim.simulate import DeviationPlace
 
 
@@ -244,6 +245,22 @@ class LatheFacts:
 
 
 @dataclass(frozen=True)
+class ErrorBudgetFacts:
+    """The simulated gear cut on the machine of the job's error budget (spur_cad.sim.budget): the budget's
+    inputs, the terms as applied, the finishing tool's deflection, the expected grade, each deviation's share
+    from the budget (expected minus ideal, um and percent of the expected) and the change of the tooth
+    thickness (arc on the reference circle, um; + thicker)."""
+
+    inputs: dict[str, Any]
+    terms: BudgetTerms
+    deflection: Deflection | None
+    grading: Grading
+    share_um: dict[str, float]
+    share_percent: dict[str, float | None]
+    tooth_thickness_change_um: float
+
+
+@dataclass(frozen=True)
 class JobResult:
     """Everything a run found, and the output set's files ({name: bytes}, written by spur_cad.outputs)."""
 
@@ -264,3 +281,4 @@ class JobResult:
     timings_s: dict[str, float]
     files: dict[str, bytes] = field(default_factory=dict)
     setup: SetupFacts | None = None  # the report's set-up sheet (not in summary.json)
+    error_budget: ErrorBudgetFacts | None = None  # the expected grade with the machine's errors (None: no simulation)

@@ -22,6 +22,7 @@ from spur_cad.post.settings import PostSettings
 from spur_cad.result import (
     CadResult,
     DeclinedTwoStageFacts,
+    ErrorBudgetFacts,
     FeatureDeviation,
     FinishingFacts,
     JobFacts,
@@ -55,7 +56,7 @@ __all__ = ["CadResult", "build_result", "simulation_facts", "summary_json"]
 
 def build_result(job, samples: ProfileSamples, cad: CadResult, plan: CamPlan, post: PostSettings,
                  programs: dict[str, PostedProgram], simulation: SimResult | None, grading: Grading | None,
-                 seconds: dict[str, float]) -> JobResult:
+                 seconds: dict[str, float], error_budget: ErrorBudgetFacts | None = None) -> JobResult:
     """The run's typed result (`job` is a spur_cad.job.Job); `files` are added by the pipeline."""
     labels = np.array(samples.label_names())
     counts = SegmentCounts(*(int(np.count_nonzero(labels == name)) for name in SEGMENT_NAMES))
@@ -70,7 +71,24 @@ def build_result(job, samples: ProfileSamples, cad: CadResult, plan: CamPlan, po
         post=PostFacts(post.dialect, post.folded, tuple(ProgramFacts(name, p.lines, p.bytes, p.subprograms)
                                                         for name, p in programs.items())),
         simulation=simulation_facts(simulation, job.simulation.resolution_mm), grading=grading,
-        lathe=lathe_facts(job), timings_s=seconds, setup=setup_facts(job, plan, post))
+        lathe=lathe_facts(job), timings_s=seconds, setup=setup_facts(job, plan, post), error_budget=error_budget)
+
+
+BUDGET_INPUTS = ("rotary_accuracy_arcsec", "rotary_repeatability_arcsec", "rotary_calibration_file",
+                 "spindle_runout_um", "tool_runout_um", "tool_radius_error_um", "linear_accuracy_um")
+
+
+def error_budget_facts(job, terms, deflection, ideal: Grading, expected: Grading) -> ErrorBudgetFacts:
+    """The budget's part of the result (`job` is a spur_cad.job.Job): its [machine] and [job] inputs, the terms
+    as applied, the expected grade and each deviation's share from the budget."""
+    inputs = {**{name: getattr(job.machine, name) for name in BUDGET_INPUTS}, "material": job.job.material}
+    share = {name: round(value - ideal.deviations_um.get(name, 0.0), 3)
+             for name, value in expected.deviations_um.items()}
+    percent = {name: (round(100.0 * share[name] / value, 1) if value else None)
+               for name, value in expected.deviations_um.items()}
+    cos_alpha = job.gear.base_radius_mm / job.gear.reference_radius_mm  # a normal shift is shift / cos on the arc
+    thickness = round(2.0 * terms.flank_shift_um["total"] / cos_alpha, 3)
+    return ErrorBudgetFacts(inputs, terms, deflection, expected, share, percent, thickness)
 
 
 def lathe_facts(job) -> LatheFacts | None:
@@ -236,10 +254,22 @@ def summary_json(result: JobResult) -> dict:
     summary["post"] = post_json(result.post)
     summary["simulation"] = simulation_json(result.simulation)
     summary["grading"] = result.grading.to_json() if result.grading is not None else None
+    summary["error_budget"] = error_budget_json(result.error_budget)
     if result.lathe is not None:
         summary["lathe"] = dataclasses.asdict(result.lathe)
     summary["timings_s"] = dict(result.timings_s)
     return summary
+
+
+def error_budget_json(budget: ErrorBudgetFacts | None) -> dict | None:
+    """The expected grade with the machine's errors (`grading` is the ideal machine's), the budget's share of
+    each deviation, and how the budget was applied."""
+    if budget is None:
+        return None
+    return {"inputs": dict(budget.inputs), "grading": budget.grading.to_json(),
+            "budget_share_um": dict(budget.share_um), "budget_share_percent": dict(budget.share_percent),
+            "tooth_thickness_change_um": budget.tooth_thickness_change_um, **budget.terms.to_json(),
+            "deflection": dataclasses.asdict(budget.deflection) if budget.deflection is not None else None}
 
 
 def facts_json(facts: object) -> dict:

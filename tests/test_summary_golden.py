@@ -11,7 +11,9 @@ the simulated deviations are unchanged (the helical removed volume grew by 0.003
 issue 29's point 5, what roughing may leave above the root is the finishing strategy's rule: both examples
 finish by generation, which never plunges, so tools.plunge_allowance_mm is 0.5 x D of their 2 mm finishing tool
 (it was A_p, half its flat width) and tools.roughing_max_diameter_mm the space's width at that height
-(CHANGED_ON_PURPOSE); their tools, programs and everything else are unchanged.
+(CHANGED_ON_PURPOSE); their tools, programs and everything else are unchanged. Issue 30 added one key to the
+recorded summaries, `error_budget` after `grading` (the expected grade with the machine's error budget, from the
+[machine] accuracy keys' defaults): `grading` stays the ideal machine's, unchanged, and no other key changed.
 
 Their STEP files and programs are byte-identical to that run's (SHA-256 below), but for the header's time
 (set to a fixed value before hashing; SOURCE_DATE_EPOCH sets it, tested below) and, in job.step, the order

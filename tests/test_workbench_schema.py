@@ -139,7 +139,8 @@ def _section_classes() -> dict[str, type]:
     """Job-file sections and their dataclasses, read from spur_cad.job.Job's fields (so new sections count)."""
     hints = typing.get_type_hints(Job)
     sections = {("gear" if f.name == "gear_section" else f.name): hints[f.name] for f in dataclasses.fields(Job)
-                if f.name not in ("source", "gear", "tools", "text", "strategies", "report_template_text")}
+                if f.name not in ("source", "gear", "tools", "text", "strategies", "report_template_text",
+                                                                               "rotary_calibration")}
     sections["tools.roughing"] = sections["tools.finishing"] = sections["tools.bottom"] = Tool
     # an optional section (`lathe: LatheSection | None`) is its dataclass
     return {name: next((a for a in typing.get_args(cls) if a is not type(None)), cls) for name, cls in sections.items()}

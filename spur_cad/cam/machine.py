@@ -82,6 +82,34 @@ class Machine:
                                       group="Machine limits",
                                       meaning="smallest end mill the shop buys (catalogue: 1 mm); a smaller tool or "
                                               "a job needing one is warned about")
+    rotary_accuracy_arcsec: float = key(15.0, unit="arcsec", low=0.0, high=3600.0, label="RotaryAccuracy",
+                                        group="Machine accuracy",
+                                        meaning="error budget: the rotary table's positioning accuracy +- (datasheets "
+                                                "of worm-driven tables: 10 to 20); applied as a once-per-turn sine "
+                                                "of this amplitude unless rotary_calibration_file is given")
+    rotary_repeatability_arcsec: float = key(10.0, unit="arcsec", low=0.0, high=3600.0,
+                                             label="RotaryRepeatability", group="Machine accuracy",
+                                             meaning="error budget: the rotary table's repeatability (datasheets: 4 "
+                                                     "to 10); a seeded draw per space in +- half of it")
+    rotary_calibration_file: str = key("", label="RotaryCalibrationFile", group="Machine accuracy",
+                                       meaning="error budget: the rotary table's measured error, a file relative to "
+                                               "the job file of lines 'A_deg error_arcsec' as compensation tables "
+                                               "hold it (empty: the accuracy's sine)")
+    spindle_runout_um: float = key(2.0, unit="um", low=0.0, high=100.0, label="SpindleRunout",
+                                   group="Machine accuracy",
+                                   meaning="error budget: the spindle's runout, total indicated (datasheets: 1 to 3)")
+    tool_runout_um: float = key(5.0, unit="um", low=0.0, high=200.0, label="ToolRunout", group="Machine accuracy",
+                                meaning="error budget: the finishing tool's runout in its holder, total indicated "
+                                        "(collet chucks 5 to 10, shrink fit about 3)")
+    tool_radius_error_um: float = key(0.0, unit="um", low=-500.0, high=500.0, label="ToolRadiusError",
+                                      group="Machine accuracy",
+                                      meaning="error budget: the finishing tool's radius above the one the program "
+                                              "assumes (measured on a presetter; + cuts deeper)")
+    linear_accuracy_um: float = key(5.0, unit="um", low=0.0, high=500.0, label="LinearAccuracy",
+                                    group="Machine accuracy",
+                                    meaning="error budget: the linear axes' positioning accuracy (ISO 230-2; "
+                                            "datasheets of machining centres: 5 to 10); half of it taken into the "
+                                            "material on every flank")
     rotary_clamp_code: str = key("", label="RotaryClampCode", group="Machine",
                                  meaning="M code clamping A (needed by [roughing] clamp_rotary; "
                                          "generating clamps for every pass when both codes are given)")

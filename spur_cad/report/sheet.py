@@ -366,12 +366,43 @@ DEVIATION_LABELS = {"f_pt": "single pitch f_pt", "F_p": "total cumulative pitch 
 
 
 def grading_table(result: JobResult) -> Table:
-    """ISO 1328-1 deviations of the worst flank (µm) and their classes."""
-    grading = result.grading
-    rows = () if grading is None else tuple(
-        (label, number(grading.deviations_um[name], 1), str(grading.classes[name] or "beyond 11"))
-        for name, label in DEVIATION_LABELS.items())
-    return Table(("deviation (worst flank)", f"[{MICRO}]", "class"), rows)
+    """ISO 1328-1 deviations of the worst flank (µm) and their classes: on the ideal machine, and with the
+    machine's error budget (expected) and the budget's share, when the run has one."""
+    grading, budget = result.grading, result.error_budget
+    if grading is None:
+        return Table(("deviation (worst flank)", f"[{MICRO}]", "class"), ())
+    ideal = {name: (number(grading.deviations_um[name], 1), str(grading.classes[name] or "beyond 11"))
+             for name in DEVIATION_LABELS}
+    if budget is None:
+        return Table(("deviation (worst flank)", f"[{MICRO}]", "class"),
+                     tuple((label, *ideal[name]) for name, label in DEVIATION_LABELS.items()))
+    expected = budget.grading
+    rows = tuple((label, *ideal[name], number(expected.deviations_um[name], 1),
+                  str(expected.classes[name] or "beyond 11"), signed(budget.share_um[name], 1))
+                 for name, label in DEVIATION_LABELS.items())
+    return Table(("deviation (worst flank)", f"ideal machine [{MICRO}]", "class", f"with the budget [{MICRO}]",
+                  "class", f"budget's share [{MICRO}]"), rows)
+
+
+def error_budget_text(result: JobResult) -> str:
+    """The report's sentence on the error budget: what it holds and the expected class."""
+    budget = result.error_budget
+    if budget is None:
+        return ""
+    terms, shift = budget.terms, budget.terms.flank_shift_um
+    klass = budget.grading.overall_class or "beyond 11"
+    deflection = budget.deflection
+    bent = (f"the finishing tool bent {number(deflection.deflection_um, 1)} {MICRO} by "
+            f"{number(deflection.force_n, 2)} N "
+            f"({deflection.material}, k_c1.1 {number(deflection.kc11_n_mm2, 0)} N/mm², m_c {number(deflection.mc, 2)})"
+            if deflection is not None else "no tool deflection (no finishing tool with a stick-out)")
+    return (f"With the machine's error budget the gear is expected in class {klass}: index errors from the "
+            f"{terms.index_source} and the repeatability drawn per space (seed {terms.random_seed}), largest "
+            f"{number(max(abs(e) for e in terms.index_error_arcsec), 1)} arcsec; every flank moved "
+            f"{signed(shift['total'], 1)} {MICRO} along its normal (runout {signed(shift['runout'], 1)}, tool radius "
+            f"{signed(shift['tool_radius'], 1)}, linear axes {signed(shift['linear'], 1)}, deflection "
+            f"{signed(shift['deflection'], 1)}), {bent}; the tooth is {signed(budget.tooth_thickness_change_um, 1)} "
+            f"{MICRO} thicker on the reference circle.")
 
 
 def warning_lines(result: JobResult) -> tuple[str, ...]:

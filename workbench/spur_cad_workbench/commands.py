@@ -157,14 +157,14 @@ def find_job(doc):
 def export_job(job_obj, out_dir: str) -> list[str]:
     """Write the job's files (STEP gear/stock/assembly, G-code, profile, summary) as `spur-cad run` does."""
     from spur_cad.errors import SpurCadError
-    from spur_cad.job import with_report_template
+    from spur_cad.job import with_files
     from spur_cad.outputs import write_output_set
     from spur_cad.pipeline import run_job
 
-    # A relative ReportTemplate is found beside the saved document (else in the current folder), as a job file's
-    # beside the job file.
+    # A relative ReportTemplate or RotaryCalibrationFile is found beside the saved document (else in the current
+    # folder), as a job file's beside the job file.
     document = job_obj.Document.FileName
-    job = with_report_template(job_of(job_obj), Path(document).parent if document else Path.cwd())
+    job = with_files(job_of(job_obj), Path(document).parent if document else Path.cwd())
     with WorkProgress("Export", EXPORT_STAGES) as work:
         files = run_job(job, progress=work.advance, checkpoint=work.events).files
     out = Path(out_dir)
