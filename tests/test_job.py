@@ -203,7 +203,7 @@ def test_declarations_are_complete_and_consistent():
 
     suffix_units = {"_mm": "mm", "_deg": "deg", "_percent": "%", "_s": "s", "_mm_min": "mm/min", "_m_min": "m/min",
                     "_deg_min": "deg/min", "_rpm": "1/min", "_mm_s2": "mm/s^2", "_deg_s2": "deg/s^2", "_kg": "kg",
-                    "_kg_dm3": "kg/dm^3", "_mm_rev": "mm/rev"}
+                    "_kg_dm3": "kg/dm^3", "_mm_rev": "mm/rev", "_um": "um", "_arcsec": "arcsec"}
     labels = []
     for section, cls in SECTIONS.items():
         keys = keys_of(cls)
