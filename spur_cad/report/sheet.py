@@ -401,8 +401,8 @@ def error_budget_text(result: JobResult) -> str:
             f"{number(max(abs(e) for e in terms.index_error_arcsec), 1)} arcsec; every flank moved "
             f"{signed(shift['total'], 1)} {MICRO} along its normal (runout {signed(shift['runout'], 1)}, tool radius "
             f"{signed(shift['tool_radius'], 1)}, linear axes {signed(shift['linear'], 1)}, deflection "
-            f"{signed(shift['deflection'], 1)}), {bent}; the tooth is {signed(budget.tooth_thickness_change_um, 1)} "
-            f"{MICRO} thicker on the reference circle.")
+            f"{signed(shift['deflection'], 1)}), {bent}; the tooth thickness on the reference circle changes by "
+            f"{signed(budget.tooth_thickness_change_um, 1)} {MICRO}.")
 
 
 def warning_lines(result: JobResult) -> tuple[str, ...]:
