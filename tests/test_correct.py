@@ -1,0 +1,89 @@
+"""Corrected programs from a measured gear (issue 30, point 4): a planted machine (tool 8 um larger in radius than
+the program assumes, rotary index error 25 arcsec x sin(A + 40 deg)) cuts the reference gear in simulation; its
+flank points, written as a scan would (turned and shifted), give back the size error and every space's index
+error; `spur-cad correct` writes the corrected programs."""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+
+import numpy as np
+import pytest
+
+from spur_cad.correct.correct import finishing_cut, ideal_flanks
+from spur_cad.correct.identify import identify
+from spur_cad.grade.measured import read_points_csv
+from spur_cad.job import load_job
+from spur_cad.pipeline import job_stock, plan_cam
+from tests.gears import REFERENCE_JOB
+
+TOOL_RADIUS_ERROR_UM = 8.0
+INDEX_AMPLITUDE_ARCSEC = 25.0
+INDEX_PHASE_DEG = 40.0
+ARCSEC_DEG = 1.0 / 3600.0
+SCAN_TURN_DEG = 2.7  # within half a pitch (7.8 deg) of the machine's frame: the scan's spaces keep their numbers
+SCAN_CENTRE_MM = (0.04, -0.025)
+SCAN_ROWS_MM = (8.0, 10.0, 12.0)
+
+
+def planted_index_arcsec(teeth: int) -> np.ndarray:
+    """The planted machine's index error of each space: 25 arcsec x sin(A + 40 deg) at the space's index angle
+    A = -k 360 / z (in [0, 360))."""
+    a_deg = np.mod(-360.0 * np.arange(teeth) / teeth, 360.0)
+    return INDEX_AMPLITUDE_ARCSEC * np.sin(np.radians(a_deg + INDEX_PHASE_DEG))
+
+
+def planted_cut(job, path, tool):
+    """The finishing toolpath cut on the planted machine: every move of space k stands e_k further in A than its
+    A word (an independent turn of the IR, not the correction's code), the tool 8 um larger in radius."""
+    a = path.a.copy()
+    spaces = path.space >= 0
+    a[spaces] += planted_index_arcsec(job.gear.teeth)[path.space[spaces]] * ARCSEC_DEG
+    bigger = dataclasses.replace(tool, diameter_mm=tool.diameter_mm + 2.0 * TOOL_RADIUS_ERROR_UM / 1000.0)
+    return finishing_cut(job.gear, path.replace(a=a), bigger, job_stock(job),
+                         (SCAN_ROWS_MM[0], SCAN_ROWS_MM[-1]))
+
+
+def scan_csv(result) -> str:
+    """The cut's involute points (the design point moved along its normal by the simulated deviation) in the rows
+    at SCAN_ROWS_MM, turned by SCAN_TURN_DEG and shifted by SCAN_CENTRE_MM as a scan's frame would be, in the
+    `spur-cad grade` CSV format."""
+    grid = result.grid
+    flank = np.array([name.endswith("involute") for name in grid.feature_names()])
+    turn = math.radians(SCAN_TURN_DEG)
+    c, s = math.cos(turn), math.sin(turn)
+    lines = ["x_mm,y_mm,X_mm"]
+    for x in SCAN_ROWS_MM:
+        row = int(np.argmin(np.abs(grid.rows_x - x)))
+        for k in range(grid.teeth):
+            points, normals = grid.space_points(k)[flank], grid.space_normals(k)[flank]
+            moved = points + result.deviation[k, flank, row][:, None] * normals
+            y = c * moved[:, 0] - s * moved[:, 1] + SCAN_CENTRE_MM[0]
+            z = s * moved[:, 0] + c * moved[:, 1] + SCAN_CENTRE_MM[1]
+            lines += [f"{a:.6f},{b:.6f},{grid.rows_x[row]:.4f}" for a, b in zip(y, z)]
+    return "\n".join(lines) + "\n"
+
+
+@pytest.fixture(scope="module")
+def reference():
+    job = load_job(str(REFERENCE_JOB))
+    plan = plan_cam(job)
+    return job, plan, ideal_flanks(job, plan)
+
+
+@pytest.fixture(scope="module")
+def planted_scan(reference):
+    job, plan, _ = reference
+    return scan_csv(planted_cut(job, plan.finishing.toolpath, plan.finishing.tool))
+
+
+def test_the_planted_machines_size_and_index_errors_are_identified(reference, planted_scan):
+    job, _, ideal = reference
+    found = identify(job.gear, read_points_csv(planted_scan, "scan.csv"), ideal)
+    assert found.size_um == pytest.approx(-TOOL_RADIUS_ERROR_UM, abs=1.0)  # a larger tool: less material
+    planted = planted_index_arcsec(job.gear.teeth)
+    assert np.all(np.isfinite(found.index_arcsec))
+    assert np.abs(found.index_arcsec - (planted - planted.mean())).max() < 2.0  # relative to their mean
+    assert found.scan_turn_deg == pytest.approx(SCAN_TURN_DEG, abs=0.01)
+    assert found.size_uncertainty_um < 1.0 and found.index_uncertainty_arcsec < 2.0
