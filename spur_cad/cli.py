@@ -85,6 +85,14 @@ def _parser() -> argparse.ArgumentParser:
     grade.add_argument("--required-class", type=int, choices=range(1, 12), metavar="1..11",
                        help="exit 1 when the gear is worse than this flank tolerance class")
     grade.add_argument("--debug", action="store_true", help="show tracebacks of internal errors")
+    correct = sub.add_parser("correct", help="identify the machine's errors from a measured gear and write corrected "
+                                             "programs (tool size, index table) with correction.json")
+    correct.add_argument("job", help="TOML job file the measured gear was cut with")
+    correct.add_argument("measured", help="CSV of measured points as spur-cad grade reads it (x_mm,y_mm[,X_mm]); "
+                                          "the scan's frame within half a pitch of the machine's (space 0 at A 0)")
+    correct.add_argument("--out", required=True, help="folder for the corrected programs and correction.json")
+    correct.add_argument("--quiet", action="store_true", help="print nothing but errors")
+    correct.add_argument("--debug", action="store_true", help="show tracebacks of internal errors")
     freecad = sub.add_parser("install-freecad", help="make the FreeCAD workbench and this spur_cad available "
                                                      "to your FreeCAD (undo with --uninstall)")
     freecad.add_argument("--uninstall", action="store_true", help="remove what install-freecad added")
@@ -317,6 +325,35 @@ def _grade(args: argparse.Namespace, received: list[int], loaded: list) -> int:
     return 0
 
 
+def _correct(args: argparse.Namespace, received: list[int], loaded: list) -> int:
+    """`spur-cad correct`: identify the size and index errors in the measured points, write the corrected set."""
+    import numpy as np
+
+    from spur_cad.correct.correct import correct_job
+    from spur_cad.errors import shown_path
+    from spur_cad.grade.measured import read_points_file
+    from spur_cad.job import load_job
+    from spur_cad.outputs import check_output_folder
+
+    _checkpoint(received)
+    out_dir = check_output_folder(args.out)
+    loaded.append(load_job(args.job))
+    measured = read_points_file(args.measured)
+    _checkpoint(received)
+    identified, files = correct_job(loaded[0], measured, shown_path(args.measured))
+    _checkpoint(received)
+    paths = _write(out_dir, files, received)
+    if not args.quiet:
+        print(f"size error: {identified.size_um:+.2f} um +- {identified.size_uncertainty_um:.2f} "
+              "(+: material left; the finishing tool is programmed for it)")
+        index = identified.index_arcsec
+        print(f"index errors: {np.nanmin(index):+.1f} to {np.nanmax(index):+.1f} arcsec +- "
+              f"{identified.index_uncertainty_arcsec:.1f} (relative to their mean; each space's A corrected)")
+        for path in paths:
+            print(f"wrote {escaped(str(path))}")
+    return 0
+
+
 def _main(argv: list[str] | None, received: list[int]) -> int:
     args = _parser().parse_args(argv)
     if not getattr(args, "debug", False):
@@ -332,6 +369,8 @@ def _main(argv: list[str] | None, received: list[int]) -> int:
             return _verify(args, received, loaded)
         if args.command == "grade":
             return _grade(args, received, loaded)
+        if args.command == "correct":
+            return _correct(args, received, loaded)
         paths, run_warnings = _run(args, received, loaded)
     except SpurCadError as exc:
         message = loaded[0].located(exc) if loaded and exc.section else str(exc)

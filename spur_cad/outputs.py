@@ -57,7 +57,8 @@ OUTPUT_NAME = re.compile(
     rf"|{_OPERATION}\.{_PROGRAM_EXTENSION}|(blank|probe)\.{_PROGRAM_EXTENSION}"  # programs
     rf"|{_OPERATION}_(space|station)\d{{1,7}}(_(level|pass)\d{{1,7}})?\.{_PROGRAM_EXTENSION}"  # restart programs
     r"|verify\.json|deviation_map\.csv"  # spur-cad verify
-    r"|grade\.json|k_chart\.png",  # spur-cad grade
+    r"|grade\.json|k_chart\.png"  # spur-cad grade
+    r"|correction\.json",  # spur-cad correct (with the corrected programs)
     re.ASCII)  # digits are 0-9 only
 """The vocabulary of output sets: every name spur_cad writes into an output folder (fullmatch)."""
 STAGING_NAME = re.compile(re.escape(STAGING_PREFIX) + r"[a-z0-9_]{8}", re.ASCII)  # 8 random characters (hex

@@ -147,8 +147,10 @@ def budget_stage(job: Job, plan: CamPlan, sim_result: SimResult | None, grading:
     return error_budget_facts(job, terms, budget.deflection, grading, expected)
 
 
-def build_programs(job: Job, plan: CamPlan) -> tuple[dict[str, PostedProgram], dict[str, bytes]]:
-    """G-code for each toolpath the plan has: (posted programs by operation, files roughing.<ext>, ...)."""
+def build_programs(job: Job, plan: CamPlan, notes: tuple[str, ...] = ()) -> tuple[dict[str, PostedProgram],
+                                                                                 dict[str, bytes]]:
+    """G-code for each toolpath the plan has: (posted programs by operation, files roughing.<ext>, ...); `notes`
+    are added to every header's comments (e.g. spur-cad correct's corrections)."""
     from spur_cad.post import dialect, post_program
 
     settings = job.post
@@ -158,7 +160,9 @@ def build_programs(job: Job, plan: CamPlan) -> tuple[dict[str, PostedProgram], d
                             ("finishing", plan.finishing)):
         if operation is None:
             continue
-        program = programs[name] = post_program(operation.toolpath, settings, program_info(job, plan, name))
+        info = program_info(job, plan, name)
+        info = dataclasses.replace(info, comments=info.comments + notes)
+        program = programs[name] = post_program(operation.toolpath, settings, info)
         files[f"{name}.{dialect(settings.dialect).extension}"] = program.text.encode()
     return programs, files
 

@@ -87,3 +87,51 @@ def test_the_planted_machines_size_and_index_errors_are_identified(reference, pl
     assert np.abs(found.index_arcsec - (planted - planted.mean())).max() < 2.0  # relative to their mean
     assert found.scan_turn_deg == pytest.approx(SCAN_TURN_DEG, abs=0.01)
     assert found.size_uncertainty_um < 1.0 and found.index_uncertainty_arcsec < 2.0
+
+
+@pytest.fixture(scope="module")
+def corrected(tmp_path_factory, planted_scan):
+    """`spur-cad correct` on the planted machine's scan: (exit code, output folder)."""
+    from spur_cad.cli import main
+
+    folder = tmp_path_factory.mktemp("correct")
+    (folder / "scan.csv").write_text(planted_scan)
+    code = main(["correct", str(REFERENCE_JOB), str(folder / "scan.csv"), "--out", str(folder / "out"), "--quiet"])
+    return code, folder / "out"
+
+
+def test_correct_writes_the_corrected_programs_and_correction_json(reference, corrected):
+    import json
+
+    job, _, _ = reference
+    code, out = corrected
+    assert code == 0
+    assert sorted(p.name for p in out.iterdir() if not p.name.startswith(".")) == \
+        ["correction.json", "finishing.ngc", "roughing.ngc"]
+    correction = json.loads((out / "correction.json").read_text())
+    size = correction["size_error_um"]
+    assert size["value"] == pytest.approx(-TOOL_RADIUS_ERROR_UM, abs=1.0) and 0.0 <= size["uncertainty"] < 1.0
+    tool = correction["corrections"]["finishing_tool_diameter_mm"]
+    assert tool["before"] == 2.0 and tool["programmed"] == pytest.approx(2.016, abs=0.002)  # the tool as it cuts
+    planted = planted_index_arcsec(job.gear.teeth)
+    index = np.array(correction["index_error_arcsec"]["values"])
+    assert np.abs(index - (planted - planted.mean())).max() < 2.0
+    a_correction = np.array(correction["corrections"]["a_correction_deg"]) * 3600.0
+    assert np.abs(a_correction + index).max() < 0.01  # each space's A turned back by its error
+    assert set(correction["not_corrected"]) >= {"profile_slope", "helix_slope", "form"}
+    header = (out / "finishing.ngc").read_text().split("\n", 40)[:40]
+    assert any("corrected from" in line and "D 2.016" in line for line in header)
+
+
+@pytest.mark.parametrize("text, message", [
+    ("x,y\n1,2\nthree,4\n", "scan.csv:3: not numbers"),
+    ("1,2\n", "scan.csv: 1 points; at least 10 are needed"),
+])
+def test_bad_measured_files_are_one_line_and_nothing_is_written(tmp_path, capsys, text, message):
+    from spur_cad.cli import main
+
+    (tmp_path / "scan.csv").write_text(text)
+    code = main(["correct", str(REFERENCE_JOB), str(tmp_path / "scan.csv"), "--out", str(tmp_path / "out")])
+    err = capsys.readouterr().err.strip()
+    assert code == 2 and len(err.splitlines()) == 1 and message in err, err
+    assert not (tmp_path / "out").exists()
