@@ -135,3 +135,83 @@ def test_bad_measured_files_are_one_line_and_nothing_is_written(tmp_path, capsys
     err = capsys.readouterr().err.strip()
     assert code == 2 and len(err.splitlines()) == 1 and message in err, err
     assert not (tmp_path / "out").exists()
+
+
+SECTION_X_MM = 10.0  # the transverse section of the 2-D cut (mid face)
+
+
+def _sweeps(program_text: str) -> np.ndarray:
+    """(Y, Z, A) of every cutting move of the program that sweeps along X through the section, as the independent
+    reader (tests/gcode_reader.py) interprets the text, in the order they run."""
+    from tests.gcode_reader import read_program
+
+    moves = read_program(program_text, "linuxcnc").moves
+    sweeps = [move.end[1:] for move in moves if not move.rapid and move.start[1:] == move.end[1:]
+              and min(move.start[0], move.end[0]) < SECTION_X_MM < max(move.start[0], move.end[0])]
+    return np.array(sweeps)
+
+
+def cut_2d(spec, program_text: str, tool_diameter_mm: float, corner_radius_mm: float,
+           index_arcsec: np.ndarray | None) -> dict[str, np.ndarray]:
+    """The section at SECTION_X_MM cut by the program's sweeps on a machine whose table stands index_arcsec[k]
+    further in A in space k (a program's spaces are its equal runs of sweeps, in order) with a tool of the given
+    size: shapely silhouettes (tests/silhouette.py), and each flank's mean signed distance of the design's involute
+    points in the profile evaluation range to the cut (um, + material), per side and space."""
+    import shapely
+
+    from spur_cad.grade.simulated import profile_range_mm
+    from tests.silhouette import design_boundary, place_silhouettes
+
+    sweeps = _sweeps(program_text)
+    per_space, rest = divmod(len(sweeps), spec.teeth)
+    assert rest == 0 and per_space > 10, len(sweeps)
+    a_deg = sweeps[:, 2].copy()
+    if index_arcsec is not None:
+        a_deg += np.repeat(index_arcsec, per_space) * ARCSEC_DEG
+    union = shapely.union_all(place_silhouettes(sweeps[:, 0], sweeps[:, 1], a_deg, tool_diameter_mm,
+                                                corner_radius_mm, 12.0))
+    points, _ = design_boundary(spec, range(spec.teeth), ("involute",))
+    rings = shapely.get_rings(shapely.get_parts(union))
+    segments = np.concatenate([np.stack([c[:-1], c[1:]], axis=1) for c in map(shapely.get_coordinates, rings)])
+    tree = shapely.STRtree(shapely.linestrings(segments))
+    (index, _), found = tree.query_nearest(shapely.points(points), return_distance=True, all_matches=False)
+    distance = np.full(len(points), np.nan)
+    distance[index] = found
+    distance[shapely.contains_xy(union, points[:, 0], points[:, 1])] *= -1.0  # inside the tool's sweep: gouged
+    angle = np.arctan2(points[:, 1], points[:, 0])
+    space = np.mod(np.rint((angle - math.pi / 2.0) / (2.0 * math.pi / spec.teeth)), spec.teeth).astype(int)
+    local = np.mod(angle - math.pi / 2.0 - space * 2.0 * math.pi / spec.teeth + math.pi, 2.0 * math.pi) - math.pi
+    # (space 0's gap is centred on +Z; local < 0 and > 0 are its two flanks)
+    roll = np.sqrt(np.maximum(np.hypot(points[:, 0], points[:, 1]) ** 2 - spec.base_radius_mm ** 2, 0.0))
+    start, end = profile_range_mm(spec)
+    in_range = (roll >= start) & (roll <= end)
+    flanks = {}
+    for name, on_side in (("minus", local < 0.0), ("plus", local > 0.0)):
+        flanks[name] = np.array([distance[in_range & on_side & (space == k)].mean() for k in range(spec.teeth)])
+        flanks[name] *= 1000.0
+    return flanks
+
+
+def pitch_total_um(spec, flank_um: np.ndarray) -> float:
+    """F_p of one side: the spread of the flanks' positions as arcs on the reference circle (normal / cos alpha)."""
+    return float(np.ptp(flank_um)) * spec.reference_radius_mm / spec.base_radius_mm
+
+
+def test_the_corrected_programs_cut_on_the_planted_machine_give_the_design(reference, corrected, tmp_path):
+    from spur_cad.cli import main
+
+    job, _, _ = reference
+    spec, tool = job.gear, job.tools.finishing
+    planted = planted_index_arcsec(spec.teeth)
+    real_diameter = tool.diameter_mm + 2.0 * TOOL_RADIUS_ERROR_UM / 1000.0
+    assert main(["run", str(REFERENCE_JOB), "--out", str(tmp_path / "original"), "--quiet"]) == 0
+    original = (tmp_path / "original" / "finishing.ngc").read_text()
+    ideal = cut_2d(spec, original, tool.diameter_mm, tool.corner_radius_mm, None)
+    before = cut_2d(spec, original, real_diameter, tool.corner_radius_mm, planted)
+    after = cut_2d(spec, (corrected[1] / "finishing.ngc").read_text(), real_diameter, tool.corner_radius_mm, planted)
+    for side in ("minus", "plus"):
+        assert pitch_total_um(spec, ideal[side]) < 0.5 and np.abs(ideal[side]).max() < 2.0  # the program's scallops
+        assert pitch_total_um(spec, before[side]) > 8.0 and np.abs(before[side]).max() > 5.0  # the planted machine
+        assert pitch_total_um(spec, after[side]) < 2.0, after[side]
+        assert np.abs(after[side]).max() < 2.0, after[side]
+        assert np.abs(after[side] - ideal[side]).max() < 0.5  # what the program cuts on an ideal machine
