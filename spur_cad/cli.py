@@ -80,7 +80,11 @@ def _parser() -> argparse.ArgumentParser:
     verify.add_argument("--debug", action="store_true", help="show tracebacks of internal errors")
     grade = sub.add_parser("grade", help="grade a real gear by ISO 1328-1:2013 from points measured on it")
     grade.add_argument("job", help="TOML job file (the gear's design)")
-    grade.add_argument("measured", help="CSV of measured points: x_mm,y_mm[,X_mm] in transverse planes")
+    grade.add_argument("measured", help="CSV of measured points (x_mm,y_mm[,X_mm] in transverse planes), or the "
+                       "probe log of the job's probe.ngc (nine numbers a line, recognised by its content)")
+    grade.add_argument("--datum", choices=("best-fit", "axis"), help="CSV: 'best-fit' (default) fits the centre "
+                       "and the turn; 'axis' takes the file's origin as the gear's datum axis and fits the turn only, "
+                       "so an eccentricity shows in F_p. A probe log is always graded against the A axis")
     grade.add_argument("--out", help="folder for grade.json and k_chart.png (created if missing)")
     grade.add_argument("--required-class", type=int, choices=range(1, 12), metavar="1..11",
                        help="exit 1 when the gear is worse than this flank tolerance class")
@@ -290,19 +294,30 @@ def _grade(args: argparse.Namespace, received: list[int], loaded: list) -> int:
     worse than --required-class."""
     import json
 
-    from spur_cad.grade.measured import grade_measured, read_points_file
+    from spur_cad.grade.measured import MeasuredPoints, grade_measured, read_measured_file
     from spur_cad.job import load_job
     from spur_cad.outputs import check_output_folder
 
     _checkpoint(received)
     out_dir = check_output_folder(args.out) if args.out else None
     loaded.append(load_job(args.job))
-    spec = loaded[0].gear
-    grading = grade_measured(spec, read_points_file(args.measured))
+    job = loaded[0]
+    measured = read_measured_file(args.measured)
+    if isinstance(measured, MeasuredPoints):
+        grading = grade_measured(job.gear, measured, args.datum or "best-fit")
+    else:
+        grading = _grade_probe_log(job, measured, args.datum)
+    spec = job.gear
     _checkpoint(received)
     fit = grading.fit
-    print(f"fit: rotation {fit.rotation_deg:.4f} deg, centre ({fit.centre_mm[0]:.4f}, "
-          f"{fit.centre_mm[1]:.4f}) mm, rms {fit.rms_deviation_um:.2f} um over {grading.points} points")
+    if fit.datum == "probe log":
+        print(f"probe log: {grading.points} trips, datum the A axis (no fit), rms {fit.rms_deviation_um:.2f} um "
+              "from the design")
+    else:
+        centre = "fixed: the datum axis" if fit.datum == "axis" else "fitted"
+        print(f"fit: rotation {fit.rotation_deg:.4f} deg, centre ({fit.centre_mm[0]:.4f}, "
+              f"{fit.centre_mm[1]:.4f}) mm ({centre}), rms {fit.rms_deviation_um:.2f} um over {grading.points} "
+              "points")
     for name, value in grading.deviations_um.items():
         grade = grading.classes[name]
         print(f"{name}: {value:.2f} um, class {grade if grade else 'beyond 11'}")
@@ -352,6 +367,21 @@ def _correct(args: argparse.Namespace, received: list[int], loaded: list) -> int
         for path in paths:
             print(f"wrote {escaped(str(path))}")
     return 0
+
+
+def _grade_probe_log(job, log, datum: str | None):
+    """The Grading of a probe log against the job's probing plan (recomputed from its [probe] section)."""
+    from spur_cad.cam.probing import plan_probe
+    from spur_cad.grade.probe_log import grade_probe_log
+
+    if datum == "best-fit":
+        raise SpurCadError(f"{log.source}: a probe log is graded against the A axis (the gear's datum axis in the "
+                           "cutting setup); --datum best-fit is for CSV scans")
+    if job.probe is None:
+        raise SpurCadError(f"{log.source}: a probe log, but the job has no [probe] section to name its trips (grade "
+                           "with the job that wrote the probing program)")
+    plan = plan_probe(job.gear, job.stock, job.machine, job.probe)
+    return grade_probe_log(job.gear, plan, log, job.post.rotary_sign)
 
 
 def _main(argv: list[str] | None, received: list[int]) -> int:

@@ -74,14 +74,17 @@ class SidePitch:
 
 @dataclass(frozen=True)
 class MeasuredFit:
-    """How measured points were fitted to the design: the scan's turn, its centre and the rms deviation."""
+    """How measured points were fitted to the design: the scan's turn, its centre, the rms deviation and the
+    datum: "best-fit" (centre and turn fitted), "axis" (the file's origin is the gear's axis: turn only) or
+    "probe log" (the A axis of the probing: no fit)."""
 
     rotation_deg: float
     centre_mm: tuple[float, float]
     rms_deviation_um: float
+    datum: str = "best-fit"
 
     def to_json(self) -> dict:
-        return {"rotation_deg": self.rotation_deg, "centre_mm": list(self.centre_mm),
+        return {"datum": self.datum, "rotation_deg": self.rotation_deg, "centre_mm": list(self.centre_mm),
                 "rms_deviation_um": self.rms_deviation_um}
 
 
