@@ -144,26 +144,29 @@ def test_a_run_grades_the_simulated_gear_in_the_summary_and_the_report():
     assert "Grade (ISO 1328-1:2013, from the simulated cut)" in report and 'alt="K-chart' in report
 
 
-def _measured_csv(planted: bool, angle_deg: float = 3.0, centre=(0.05, -0.03)) -> str:
+def _measured_csv(planted: bool, angle_deg: float = 3.0, centre=(0.05, -0.03), gear=GEAR) -> str:
     """Points on every flank of the small gear (a design grid sampled at another spacing than the grader's),
-    in five transverse planes, turned and shifted as a scan would be; with planted deviations: profile slope
-    +8 um (space 2 right), one flank 10 um ahead (space 4 left), helix slope 6 um (space 9 left)."""
-    grid = design_grid(GEAR, 0.037, 0.0, 0.0, np.zeros(0))
+    in five transverse planes (each turned by the helix for a helical gear), turned and shifted as a scan would
+    be; with planted deviations: profile slope +8 um (space 2 right), one flank 10 um ahead (space 4 left),
+    helix slope 6 um (space 9 left)."""
+    grid = design_grid(gear, 0.037, 0.0, 0.0, np.zeros(0))
     names = grid.feature_names()
     start, end = profile_range_mm(GEAR)
-    lo, hi = helix_range_mm(GEAR.face_width_mm, GEAR.module_mm)
-    cos_alpha = GEAR.base_radius_mm / GEAR.reference_radius_mm
+    lo, hi = helix_range_mm(gear.face_width_mm, gear.module_mm)
+    cos_alpha = gear.base_radius_mm / gear.reference_radius_mm
     radius = np.hypot(grid.points[:, 0], grid.points[:, 1])
-    roll = np.sqrt(np.maximum(radius ** 2 - GEAR.base_radius_mm ** 2, 0.0))
+    roll = np.sqrt(np.maximum(radius ** 2 - gear.base_radius_mm ** 2, 0.0))
     lines = ["x_mm,y_mm,X_mm"]
     turn = math.radians(angle_deg)
-    for k in range(GEAR.teeth):
-        points, normals = grid.space_points(k), grid.space_normals(k)
+    for k in range(gear.teeth):
         for x in np.linspace(lo, hi, 5):
+            points, normals = grid.row_points(k, x)  # the section at X: turned by the helix
             dev = np.zeros(len(points))
             if planted:
-                right = np.array([n == "right involute" for n in names])
-                left = np.array([n == "left involute" for n in names])
+                # a flank: its involute and its end on the form circle (sampled as the fillet's first point)
+                form = radius >= gear.form_radius_mm - 1e-6
+                right = np.array([n == "right involute" for n in names]) | (np.array(names) == "right fillet") & form
+                left = np.array([n == "left involute" for n in names]) | (np.array(names) == "left fillet") & form
                 if k == 2:
                     dev[right] += 8.0e-3 * (roll[right] - start) / (end - start)
                 if k == 4:
@@ -177,13 +180,13 @@ def _measured_csv(planted: bool, angle_deg: float = 3.0, centre=(0.05, -0.03)) -
     return "\n".join(lines) + "\n"
 
 
-def _grade_cli(tmp_path, csv_text: str, *extra: str) -> tuple[int, dict]:
+def _grade_cli(tmp_path, csv_text: str, *extra: str, job_text: str = small_job_text()) -> tuple[int, dict]:
     import json
 
     from spur_cad.cli import main
 
     tmp_path.mkdir(parents=True, exist_ok=True)
-    (tmp_path / "job.toml").write_text(small_job_text())
+    (tmp_path / "job.toml").write_text(job_text)
     (tmp_path / "measured.csv").write_text(csv_text)
     code = main(["grade", str(tmp_path / "job.toml"), str(tmp_path / "measured.csv"), "--out",
                  str(tmp_path / "grade"), *extra])
@@ -212,6 +215,20 @@ def test_measured_points_give_the_planted_deviations_and_their_classes(tmp_path)
     assert grading["classes"]["f_Ha"] == 7 and grading["classes"]["f_pt"] == 7 and grading["classes"]["f_Hb"] == 6
     assert code == 1 and grading["class"] == 7  # worse than the required class 6
     assert (tmp_path / "grade" / "k_chart.png").read_bytes()[:4] == b"\x89PNG"
+
+
+HELICAL_JOB = small_job_text().replace("face_width_mm = 6.0", "face_width_mm = 6.0\nhelix_angle_deg = 15.0")
+HELICAL = parse_job(HELICAL_JOB, "helical.toml").gear  # the small gear, 15 deg right hand: 4.9 deg over b
+
+
+def test_a_helical_gears_sections_turn_with_x_and_give_the_planted_deviations(tmp_path):
+    assert HELICAL.section_turn_rad(HELICAL.face_width_mm) > 0.08  # far more than the flank's 10 um over a pitch
+    code, grading = _grade_cli(tmp_path, _measured_csv(planted=True, gear=HELICAL), job_text=HELICAL_JOB)
+    found, where = grading["deviations_um"], grading["where"]
+    assert grading["fit"]["rotation_deg"] == pytest.approx(3.0, abs=1e-3) and abs(found["f_fa"]) < 0.5
+    assert found["f_Ha"] == pytest.approx(8.0, abs=0.5) and found["f_Hb"] == pytest.approx(6.0, abs=0.5)
+    assert found["f_pt"] == pytest.approx(10.0, abs=0.5) and found["F_p"] == pytest.approx(10.0, abs=0.5)
+    assert (where["f_Hb"]["space"] - where["f_Ha"]["space"]) % 12 == 7 and grading["class"] == 7
 
 
 def test_only_what_was_measured_is_graded(tmp_path):

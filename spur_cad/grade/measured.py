@@ -1,11 +1,15 @@
 """Grade a real gear from measured points (`spur-cad grade JOB MEASURED.csv`): best-fit the gear's rotation
-and centre, take each point's deviation from the design along the design normal, and evaluate profile,
-helix and pitch traces by ISO 1328-1:2013 as for a simulated gear (spur_cad.grade.simulated).
+and centre (or, with the datum "axis", the rotation only), take each point's deviation from the design along
+the design normal, and evaluate profile, helix and pitch traces by ISO 1328-1:2013 as for a simulated gear
+(spur_cad.grade.simulated). A probe log of the job's probing program is read here too and graded by
+spur_cad.grade.probe_log.
 
 CSV: one point per line, `x_mm,y_mm` in a transverse plane (any rotation and a centre near the gear's
 axis), optionally a third column `X_mm`, the axial position (several transverse planes give helix
 traces). A header line of names is allowed; `#` starts a comment. Points of several flanks and tooth
 spaces may be mixed: each point belongs to the flank of the design point nearest to it (after the fit).
+A helical gear's section at X is the section at X = 0 turned by spec.section_turn_rad(X); the points are turned
+back by it before they meet the design.
 """
 
 from __future__ import annotations
