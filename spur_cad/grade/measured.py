@@ -51,17 +51,15 @@ def read_points_csv(text: str, source: str) -> MeasuredPoints:
 
 
 def read_points_file(path: str | os.PathLike, source: str | None = None) -> MeasuredPoints:
-    """The points of a measured-points CSV file, read as a stream: a regular file (a FIFO or a device is refused
-    before reading) of at most MAX_MEASURED_BYTES; memory holds a line at a time besides the points."""
-    found = read_measured_file(path, source, probe_log=False)
-    assert isinstance(found, MeasuredPoints)
-    return found
+    """The points of a measured-points CSV file (read_measured_file, never taken for a probe log)."""
+    return read_measured_file(path, source, probe_log=False)
 
 
 def read_measured_file(path: str | os.PathLike, source: str | None = None, probe_log: bool = True):
-    """A measured file, read as a stream (as read_points_file): a probe log (spur_cad.grade.probe_log.ProbeLog)
-    when its first non-blank line is nine numbers separated by blanks, as LinuxCNC's PROBEOPEN log writes them
-    (and `probe_log` allows it), else the MeasuredPoints of a CSV."""
+    """A measured file, read as a stream: a regular file (a FIFO or a device is refused before reading) of at
+    most MAX_MEASURED_BYTES, memory holding a line at a time besides the values. A probe log
+    (spur_cad.grade.probe_log.ProbeLog) when its first non-blank line is nine numbers separated by blanks, as
+    LinuxCNC's PROBEOPEN log writes them (and `probe_log` allows it), else the MeasuredPoints of a CSV."""
     from itertools import chain
 
     from spur_cad.errors import shown_path
