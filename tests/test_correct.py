@@ -34,31 +34,36 @@ def planted_index_arcsec(teeth: int) -> np.ndarray:
     return INDEX_AMPLITUDE_ARCSEC * np.sin(np.radians(a_deg + INDEX_PHASE_DEG))
 
 
-def planted_cut(job, path, tool):
-    """The finishing toolpath cut on the planted machine: every move of space k stands e_k further in A than its
-    A word (an independent turn of the IR, not the correction's code), the tool 8 um larger in radius."""
+def planted_cut(job, path, tool, rows_mm=SCAN_ROWS_MM):
+    """The finishing toolpath cut on the planted machine over the rows' X range: every move of space k stands e_k
+    further in A than its A word (an independent turn of the IR, not the correction's code), the tool 8 um larger in
+    radius."""
     a = path.a.copy()
     spaces = path.space >= 0
     a[spaces] += planted_index_arcsec(job.gear.teeth)[path.space[spaces]] * ARCSEC_DEG
     bigger = dataclasses.replace(tool, diameter_mm=tool.diameter_mm + 2.0 * TOOL_RADIUS_ERROR_UM / 1000.0)
-    return finishing_cut(job.gear, path.replace(a=a), bigger, job_stock(job),
-                         (SCAN_ROWS_MM[0], SCAN_ROWS_MM[-1]))
+    return finishing_cut(job.gear, path.replace(a=a), bigger, job_stock(job), (rows_mm[0], rows_mm[-1]))
 
 
-def scan_csv(result) -> str:
+def scan_csv(result, rows_mm=SCAN_ROWS_MM, planted_mm=None) -> str:
     """The cut's involute points (the design point moved along its normal by the simulated deviation) in the rows
-    at SCAN_ROWS_MM, turned by SCAN_TURN_DEG and shifted by SCAN_CENTRE_MM as a scan's frame would be, in the
-    `spur-cad grade` CSV format."""
+    at rows_mm, turned by SCAN_TURN_DEG and shifted by SCAN_CENTRE_MM as a scan's frame would be, in the
+    `spur-cad grade` CSV format. planted_mm(side, radius_mm, x_mm): a deviation (mm, + material) added to each
+    point of that side and radius in the row at x, e.g. a slope."""
     grid = result.grid
-    flank = np.array([name.endswith("involute") for name in grid.feature_names()])
+    names = np.array(grid.feature_names())
+    flank = np.array([name.endswith("involute") for name in names])
+    side = np.array([name.split()[0] for name in names[flank]])
+    radius = np.hypot(grid.points[flank, 0], grid.points[flank, 1])
     turn = math.radians(SCAN_TURN_DEG)
     c, s = math.cos(turn), math.sin(turn)
     lines = ["x_mm,y_mm,X_mm"]
-    for x in SCAN_ROWS_MM:
+    for x in rows_mm:
         row = int(np.argmin(np.abs(grid.rows_x - x)))
+        planted = np.zeros(len(radius)) if planted_mm is None else planted_mm(side, radius, grid.rows_x[row])
         for k in range(grid.teeth):
             points, normals = grid.space_points(k)[flank], grid.space_normals(k)[flank]
-            moved = points + result.deviation[k, flank, row][:, None] * normals
+            moved = points + (result.deviation[k, flank, row] + planted)[:, None] * normals
             y = c * moved[:, 0] - s * moved[:, 1] + SCAN_CENTRE_MM[0]
             z = s * moved[:, 0] + c * moved[:, 1] + SCAN_CENTRE_MM[1]
             lines += [f"{a:.6f},{b:.6f},{grid.rows_x[row]:.4f}" for a, b in zip(y, z)]
@@ -118,7 +123,8 @@ def test_correct_writes_the_corrected_programs_and_correction_json(reference, co
     assert np.abs(index - (planted - planted.mean())).max() < 2.0
     a_correction = np.array(correction["corrections"]["a_correction_deg"]) * 3600.0
     assert np.abs(a_correction + index).max() < 0.01  # each space's A turned back by its error
-    assert set(correction["not_corrected"]) >= {"profile_slope", "helix_slope", "form"}
+    assert set(correction["not_corrected"]) >= {"slopes_off_the_involute", "form"}
+    assert correction["profile_slope_um"]["corrected"] and correction["helix_slope_um"]["corrected"]
     header = (out / "finishing.ngc").read_text().split("\n", 40)[:40]
     assert any("corrected from" in line and "D 2.016" in line for line in header)
 

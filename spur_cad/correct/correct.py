@@ -9,8 +9,9 @@ import math
 
 import numpy as np
 
+from spur_cad.cam.ir import Feature
 from spur_cad.correct.identify import ARCSEC_RAD, IdealFlanks, Identified
-from spur_cad.grade.simulated import SIDES
+from spur_cad.grade.simulated import SIDES, helix_range_mm, profile_range_mm
 
 IDEAL_RESOLUTION_MM = 0.002
 """The ideal cut is simulated this finely: its scallops' mean (1.6 um for the reference gear's 5 um target) must
@@ -71,11 +72,64 @@ def index_correction_deg(identified: Identified) -> np.ndarray:
     return -np.nan_to_num(identified.index_arcsec) * ARCSEC_RAD * 180.0 / math.pi
 
 
+SLOPE_STRATEGY = "generating"
+"""The finishing strategy whose passes can follow a slope: each generating flank pass is one straight line along X,
+tangent to the involute at one roll, its normal along the machine's Y (spur_cad.cam.strategies.generating_geometry)."""
+
+FLANK_SIDES = {Feature.RIGHT_FLANK: "right", Feature.LEFT_FLANK: "left"}
+
+
+def pressure_angle_change_deg(spec, profile_slope_um: float) -> float:
+    """The pressure angle as cut minus the design's (deg) that a profile slope f_Halpha over the evaluation length
+    L_alpha means (docs/correction.md): a base radius changed by eps r_b, the tooth thickness on the reference circle
+    held, moves the flank at roll length L by eps (L - L_ref) along its normal, so f_Halpha = eps L_alpha; with r_b =
+    r cos(alpha), eps = -tan(alpha) d_alpha: d_alpha = -f_Halpha / (L_alpha tan alpha)."""
+    start, end = profile_range_mm(spec)
+    return -math.degrees(profile_slope_um / 1000.0 / ((end - start) * math.tan(spec.pressure_angle_rad)))
+
+
+def slope_corrected_passes(spec, passes, identified: Identified) -> tuple:
+    """The generating passes with each flank pass moved along its normal (the machine's Y, toward the material it
+    cuts: `side`) by what the identified slopes left at its line: the profile slope at the pass's contact roll
+    length r_b t (0 at the middle of the evaluation range, so the flank's mean position is the size correction's)
+    and the helix slope along X (0 at the middle of the helix range): a Y offset and a Y rate along X. Fillet, root
+    and land passes keep their place."""
+    start, end = profile_range_mm(spec)
+    front, back = helix_range_mm(spec.face_width_mm, spec.module_mm)
+    moved = []
+    for p in passes:
+        side = FLANK_SIDES.get(p.feature)
+        if p.mode != "flank" or side is None:
+            moved.append(p)
+            continue
+        profile_mm = identified.profile_slope_um.get(side, 0.0) / 1000.0
+        helix_per_x = identified.helix_slope_um.get(side, 0.0) / 1000.0 / (back - front)
+        roll_mm = spec.base_radius_mm * p.roll_rad
+        remove_mm = profile_mm * (roll_mm - 0.5 * (start + end)) / (end - start) - helix_per_x * 0.5 * (front + back)
+        moved.append(dataclasses.replace(p, y_mm=p.y_mm + p.side * remove_mm,
+                                         dy_per_x=p.dy_per_x + p.side * helix_per_x))
+    return tuple(moved)
+
+
+def slope_corrected_finishing(job, finishing, identified: Identified):
+    """The finishing plan with its passes moved for the slopes (slope_corrected_passes), or unchanged (with the
+    reason) when its strategy has no straight passes to move."""
+    from spur_cad.cam.strategies.generating import passes_toolpath
+
+    if finishing.result.strategy != SLOPE_STRATEGY:
+        return finishing, (f"the {finishing.result.strategy} finishing strategy's moves are not straight passes "
+                           "tangent at one roll: the slopes are not corrected (generating finishing can follow them)")
+    spec = job.gear
+    passes = slope_corrected_passes(spec, finishing.result.passes, identified)
+    toolpath = passes_toolpath(spec, finishing.tool, job.machine, finishing.result.params, passes,
+                               job.stock.blank_radius_mm(spec))
+    return dataclasses.replace(finishing, toolpath=toolpath,
+                               result=dataclasses.replace(finishing.result, passes=passes)), None
+
+
 NOT_CORRECTED = {
-    "profile_slope": "not identified yet: a profile slope per side would change the passes' positions along the "
-                     "profile; the programs keep the design's",
-    "helix_slope": "not identified yet: a helix slope per side would turn the passes along X; the programs keep "
-                   "the design's",
+    "slopes_off_the_involute": "the fillet, root and land passes keep their place: a slope is measured on the "
+                               "involute only, and the generating flank passes move alone",
     "form": "form ripple (scallops, vibration, the table's error within one space's roll) is not a position the "
             "program can move: it is left as cut",
     "side_size_difference": "the left and right flanks' size difference: a scan's fitted rotation takes half of it, "
@@ -85,8 +139,36 @@ NOT_CORRECTED = {
 }
 
 
+def slope_summary(spec, identified: Identified, corrected: bool) -> dict:
+    """correction.json's `profile_slope_um` and `helix_slope_um`: per side the slope (f_Halpha, f_Hbeta, um over
+    the evaluation range), its uncertainty, and for the profile the pressure angle change as cut it means."""
+    start, end = profile_range_mm(spec)
+    front, back = helix_range_mm(spec.face_width_mm, spec.module_mm)
+
+    def rounded(value: float) -> float | None:
+        return round(value, 3) if math.isfinite(value) else None
+
+    profile = {side: {"value": rounded(value), "uncertainty": rounded(identified.profile_slope_uncertainty_um[side]),
+                      "pressure_angle_change_deg": round(pressure_angle_change_deg(spec, value), 6)}
+               for side, value in identified.profile_slope_um.items()}
+    helix = {side: {"value": rounded(value), "uncertainty": rounded(identified.helix_slope_uncertainty_um[side])}
+             for side, value in identified.helix_slope_um.items()}
+    return {
+        "profile_slope_um": {"by_side": profile, "evaluation_range_roll_mm": [round(start, 4), round(end, 4)],
+                             "corrected": corrected,
+                             "meaning": "f_Halpha (ISO 1328-1) less the ideal cut's, mean over the side's profile "
+                                        "traces: + material rising toward the tip; pressure_angle_change_deg = "
+                                        "-f_Halpha / (L_alpha tan alpha), the pressure angle as cut less the design's"},
+        "helix_slope_um": {"by_side": helix, "evaluation_range_x_mm": [round(front, 4), round(back, 4)],
+                           "corrected": corrected,
+                           "meaning": "f_Hbeta (ISO 1328-1), mean over the side's helix traces (three transverse "
+                                      "planes or more): + material rising toward +X (the back face)"},
+    }
+
+
 def correction_summary(spec, identified: Identified, finishing_tool_before, finishing_tool_after,
-                       a_correction_deg: np.ndarray, measured_source: str) -> dict:
+                       a_correction_deg: np.ndarray, measured_source: str, slopes_not_corrected: str | None = None
+                       ) -> dict:
     """correction.json: each error identified with its standard uncertainty, what the programs change, the flank
     positions before and as predicted after, and what was not corrected and why."""
     reference_arc_um = spec.reference_radius_mm * ARCSEC_RAD * 1000.0  # um of arc per arcsec on the reference circle
@@ -115,14 +197,19 @@ def correction_summary(spec, identified: Identified, finishing_tool_before, fini
                                                   "a controller's wear offset would not move it"},
             "a_correction_deg": [round(float(v), 7) for v in a_correction_deg],
             "unmeasured_spaces": [int(k) for k in np.nonzero(~measured)[0]],
+            **({} if slopes_not_corrected else {"flank_passes": (
+                "each generating flank pass moved along its normal (Y) by the side's profile slope at its contact "
+                "roll (0 at the middle of the evaluation range) and turned along X by the side's helix slope (0 at "
+                "the middle of the helix range): the slopes as measured are cut off")}),
         },
+        **slope_summary(spec, identified, slopes_not_corrected is None),
         "before": {"flank_position_um": round(identified.size_um, 3),
                    "index_spread_on_reference_circle_um": round(spread_um, 3)},
         "predicted_after": {"flank_position_um": 0.0, "flank_position_uncertainty_um":
                             round(identified.size_uncertainty_um, 3), "index_spread_on_reference_circle_um": 0.0,
                             "index_uncertainty_on_reference_circle_um":
                                 round(identified.index_uncertainty_arcsec * reference_arc_um, 3)},
-        "not_corrected": NOT_CORRECTED,
+        "not_corrected": {**({"slopes": slopes_not_corrected} if slopes_not_corrected else {}), **NOT_CORRECTED},
     }
 
 
@@ -148,15 +235,18 @@ def correct_job(job, measured, measured_source: str):
         raise SpurCadError(f"{measured_source}: {exc}") from None
     fixed = corrected_job(job, identified)
     fixed_plan = plan_cam(fixed)
+    finishing, slopes_not_corrected = slope_corrected_finishing(fixed, fixed_plan.finishing, identified)
+    fixed_plan = dataclasses.replace(fixed_plan, finishing=finishing)
     correction = index_correction_deg(identified)
     turned = {name: dataclasses.replace(planned, toolpath=turned_by_space(planned.toolpath, correction))
               for name in ("roughing", "roughing_bottom", "finishing")
               if (planned := getattr(fixed_plan, name)) is not None}
     notes = (f"corrected from {measured_source}: finishing tool programmed as D "
              f"{fixed.tools.finishing.diameter_mm:.4f} mm (size error {identified.size_um:+.2f} um), A of each space "
-             "turned by its index correction (correction.json)",)
+             "turned by its index correction" + ("" if slopes_not_corrected else ", flank passes moved for the "
+                                                  "profile and helix slopes") + " (correction.json)",)
     _, files = build_programs(fixed, dataclasses.replace(fixed_plan, **turned), notes)
     summary = correction_summary(spec, identified, job.tools.finishing, fixed.tools.finishing, correction,
-                                 measured_source)
+                                 measured_source, slopes_not_corrected)
     files["correction.json"] = (json.dumps(summary, indent=2) + "\n").encode()
     return identified, files

@@ -1,5 +1,6 @@
-"""Identify a machine's systematic errors from a measured gear (docs/correction.md): the tool's size error and
-each tooth space's index error, with their uncertainties. Pure functions of the design and the points.
+"""Identify a machine's systematic errors from a measured gear (docs/correction.md): the tool's size error, each
+tooth space's index error and each flank side's profile and helix slope, with their uncertainties. Pure functions
+of the design and the points.
 
 Model. Every involute point of space k and side s deviates along its design normal (mm, + material) by
 
@@ -19,12 +20,19 @@ are relative to their mean and the two sides' sizes are reported as measured, bu
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from dataclasses import dataclass
 
 import numpy as np
 
-from spur_cad.grade.measured import MeasuredPoints, _design, fit  # _design: the grader's design points
+from spur_cad.grade.iso1328 import evaluate_trace
+from spur_cad.grade.measured import (  # _design, _flank_traces: the grader's design points and traces
+    MeasuredPoints,
+    _design,
+    _flank_traces,
+    fit,
+)
 from spur_cad.grade.simulated import SIDES, profile_range_mm
 
 ARCSEC_RAD = math.pi / (180.0 * 3600.0)
@@ -50,7 +58,8 @@ class Identified:
     size_um: the flanks' shift by the tool, mean of both sides (+: material left, the tool cut too little);
     side_size_um: per side as measured (their difference is a scan's rotation: not the tool's);
     index_arcsec: per space (machine numbering), relative to the mean over the measured spaces; NaN where a
-    space has not both flanks measured."""
+    space has not both flanks measured; profile_slope_um / helix_slope_um: per side, f_Halpha / f_Hbeta of the
+    deviations less the ideal cut's (side_slopes), missing for a side without such traces."""
 
     size_um: float
     size_uncertainty_um: float
@@ -61,6 +70,39 @@ class Identified:
     points_used: int
     centre_shift_um: tuple[float, float]
     scan_turn_deg: float
+    profile_slope_um: dict[str, float] = dataclasses.field(default_factory=dict)
+    profile_slope_uncertainty_um: dict[str, float] = dataclasses.field(default_factory=dict)
+    helix_slope_um: dict[str, float] = dataclasses.field(default_factory=dict)
+    helix_slope_uncertainty_um: dict[str, float] = dataclasses.field(default_factory=dict)
+
+
+@dataclass(frozen=True)
+class Slopes:
+    """One side's slope (um over its ISO 1328 evaluation range, + material rising along the trace: toward the tip
+    for a profile, toward the back face (+X) for a helix): the mean over the side's traces, and its standard
+    uncertainty (the traces' spread over sqrt(n); NaN from a single trace)."""
+
+    value_um: float
+    uncertainty_um: float
+    traces: int
+
+
+def side_slopes(traces, kind: str) -> dict[str, Slopes]:
+    """Per side, the mean slope deviation (f_Halpha or f_Hbeta, ISO 1328-1: the rise of the trace's least-squares
+    line over the evaluation range) of the `kind` traces ("profile" or "helix") that have three points in range."""
+    found: dict[str, Slopes] = {}
+    for name in SIDES:
+        slopes = []
+        for trace in traces:
+            if trace.kind == kind and trace.side == name:
+                try:
+                    slopes.append(evaluate_trace(trace.position_mm, trace.deviation_um, *trace.evaluation).slope_um)
+                except ValueError:
+                    continue
+        if slopes:
+            spread = float(np.std(slopes, ddof=1) / math.sqrt(len(slopes))) if len(slopes) > 1 else math.nan
+            found[name] = Slopes(float(np.mean(slopes)), spread, len(slopes))
+    return found
 
 
 def space_numbering_offset(angle_rad: float, teeth: int) -> int:
@@ -117,6 +159,8 @@ def identify(spec, measured: MeasuredPoints, ideal: IdealFlanks | None = None) -
     turn = -difference / (flank_lever["right"] - flank_lever["left"])
     index = np.where(both, turn - np.nanmean(turn[both]), np.nan) / ARCSEC_RAD
     lever_span = float(np.nanmean(np.abs(flank_lever["right"] - flank_lever["left"])))
+    traces, _ = _flank_traces(spec, measured, corrected, nearest, design)
+    profile, helix = side_slopes(traces, "profile"), side_slopes(traces, "helix")
     return Identified(
         size_um=float(size) * 1000.0,
         size_uncertainty_um=sum_noise / (2.0 * math.sqrt(len(residual))) * 1000.0,
@@ -128,4 +172,8 @@ def identify(spec, measured: MeasuredPoints, ideal: IdealFlanks | None = None) -
         points_used=int(np.count_nonzero(used)),
         centre_shift_um=(float(cx) * 1000.0, float(cy) * 1000.0),
         scan_turn_deg=-math.degrees((params[0] + math.pi / spec.teeth) % (2 * math.pi / spec.teeth)
-                                    - math.pi / spec.teeth))
+                                    - math.pi / spec.teeth),
+        profile_slope_um={name: found.value_um for name, found in profile.items()},
+        profile_slope_uncertainty_um={name: found.uncertainty_um for name, found in profile.items()},
+        helix_slope_um={name: found.value_um for name, found in helix.items()},
+        helix_slope_uncertainty_um={name: found.uncertainty_um for name, found in helix.items()})

@@ -130,8 +130,7 @@ class GeneratingStrategy:
         params.validate()
         machine.validate()
         plan = plan_generating(spec, tool, params, lands=blank_radius_mm > spec.tip_radius_mm + LAND_ALLOWANCE_MM)
-        builder = ToolpathBuilder(Operation.FINISHING, tool.tool_number, tool.spindle_rpm(machine))
-        _passes(builder, spec, tool, machine, plan, params, safe_height_mm(blank_radius_mm, machine))
+        toolpath = passes_toolpath(spec, tool, machine, params, plan.passes, blank_radius_mm)
         advice = tool_advice(spec, tool, params, plan, blank_radius_mm)
         if tool.flute_length_mm and tool.flute_length_mm < advice.required_flute_length_mm:
             raise ToolError(f"finishing tool flute_length_mm = {tool.flute_length_mm:g} is shorter than the "
@@ -143,10 +142,19 @@ class GeneratingStrategy:
         result = FinishingResult(self.name, params, _space_poses(plan), 1, 0.0, np.zeros(0),
                                  passes_per_space=plan.passes_per_space,
                                  passes=plan.passes, facts=facts, tool_advice=advice)
-        return builder.build(), result
+        return toolpath, result
 
 
-def _passes(builder: ToolpathBuilder, spec: GearSpec, tool: Tool, machine: Machine, plan: GeneratingPlan,
+def passes_toolpath(spec: GearSpec, tool: Tool, machine: Machine, params: GeneratingParams,
+                    passes: tuple[GeneratingPass, ...], blank_radius_mm: float) -> Toolpath:
+    """The finishing toolpath of one space's passes run in every space: what `generate` builds from its plan, and
+    what spur-cad correct builds from passes it has moved (spur_cad.correct.correct)."""
+    builder = ToolpathBuilder(Operation.FINISHING, tool.tool_number, tool.spindle_rpm(machine))
+    _passes(builder, spec, tool, machine, passes, params, safe_height_mm(blank_radius_mm, machine))
+    return builder.build()
+
+
+def _passes(builder: ToolpathBuilder, spec: GearSpec, tool: Tool, machine: Machine, passes: tuple[GeneratingPass, ...],
             params: GeneratingParams, safe_z: float) -> None:
     """Every space runs the same passes relative to its base angle -k * 360/z (foldable)."""
     feed = tool.feed_mm_min(machine)
@@ -155,7 +163,7 @@ def _passes(builder: ToolpathBuilder, spec: GearSpec, tool: Tool, machine: Machi
     x_front, x_back = -margin, spec.face_width_mm + margin
     clamp = bool(machine.rotary_clamp_code and machine.rotary_unclamp_code)
     rows = []
-    for p in plan.passes:
+    for p in passes:
         direction = _pass_direction(p.side, params.cutting_direction)
         x0, x1 = (x_front, x_back) if direction > 0 else (x_back, x_front)
         y0, y1 = p.y_mm + x0 * p.dy_per_x, p.y_mm + x1 * p.dy_per_x
@@ -180,5 +188,5 @@ def _passes(builder: ToolpathBuilder, spec: GearSpec, tool: Tool, machine: Machi
 
 __all__ = ["GeneratingParams", "GeneratingPass", "GeneratingPlan", "GeneratingStrategy", "GeneratingToolLimits",
            "check_generating_tool", "flank_poses", "flank_rolls", "flat_deviation_mm", "generating_tool_limits",
-           "land_angles", "passes_flute_length_mm", "tool_advice",
+           "land_angles", "passes_flute_length_mm", "passes_toolpath", "tool_advice",
            "plan_generating", "rough_passes_per_space"]
