@@ -90,7 +90,8 @@ def _parser() -> argparse.ArgumentParser:
                        help="exit 1 when the gear is worse than this flank tolerance class")
     grade.add_argument("--debug", action="store_true", help="show tracebacks of internal errors")
     correct = sub.add_parser("correct", help="identify the machine's errors from a measured gear and write corrected "
-                                             "programs (tool size, index table) with correction.json")
+                                             "programs (tool size, index table, slopes) with correction.json and "
+                                             "report.html")
     correct.add_argument("job", help="TOML job file the measured gear was cut with")
     correct.add_argument("measured", help="CSV of measured points as spur-cad grade reads it (x_mm,y_mm[,X_mm]); "
                                           "the scan's frame within half a pitch of the machine's (space 0 at A 0)")
@@ -341,7 +342,8 @@ def _grade(args: argparse.Namespace, received: list[int], loaded: list) -> int:
 
 
 def _correct(args: argparse.Namespace, received: list[int], loaded: list) -> int:
-    """`spur-cad correct`: identify the size and index errors in the measured points, write the corrected set."""
+    """`spur-cad correct`: identify the size, index and slope errors in the measured points, write the corrected
+    set."""
     import numpy as np
 
     from spur_cad.correct.correct import correct_job
@@ -364,6 +366,10 @@ def _correct(args: argparse.Namespace, received: list[int], loaded: list) -> int
         index = identified.index_arcsec
         print(f"index errors: {np.nanmin(index):+.1f} to {np.nanmax(index):+.1f} arcsec +- "
               f"{identified.index_uncertainty_arcsec:.1f} (relative to their mean; each space's A corrected)")
+        for name, slopes in (("profile slope", identified.profile_slope_um),
+                             ("helix slope", identified.helix_slope_um)):
+            print(f"{name}: " + ", ".join(f"{side} {value:+.2f} um" for side, value in slopes.items())
+                  + " (correction.json says whether the finishing follows it)")
         for path in paths:
             print(f"wrote {escaped(str(path))}")
     return 0

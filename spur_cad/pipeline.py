@@ -44,12 +44,14 @@ def profile_csv(samples: ProfileSamples) -> bytes:
 
 
 def run_job(job: Job, progress: Callable[[str, float], None] | None = None,
-            checkpoint: Callable[[], None] | None = None, restart: RestartPoint | None = None) -> JobResult:
+            checkpoint: Callable[[], None] | None = None, restart: RestartPoint | None = None,
+            plan: CamPlan | None = None, correction: dict | None = None) -> JobResult:
     """Compute every output of the job in memory (no file I/O): the typed result with its output set in
     `files` ({name: bytes}, for spur_cad.outputs.write_output_set). `progress(stage, fraction)` is told how
     far each long stage is (the CLI draws progress bars with it); `checkpoint()` is called before every
     stage (the CLI stops there when a signal has arrived, never inside a library). `restart` adds a program
-    restarting an operation there (restart_program)."""
+    restarting an operation there (restart_program). spur-cad correct gives its corrected `plan` (else the job's is
+    planned) and its `correction` (correction.json), which the report shows."""
     from spur_cad.report.plots import tooth_space_png
     from spur_cad.report.stage import report_html
 
@@ -76,7 +78,8 @@ def run_job(job: Job, progress: Callable[[str, float], None] | None = None,
                                                             job.job.profile_tolerance_mm))
     png = timed("plot", None, lambda: tooth_space_png(job.gear, samples))
     cad, step = timed("cad_and_step", "CAD and STEP", lambda: build_cad(job, checkpoint, timestamp))
-    plan = timed("cam", "toolpaths", lambda: plan_cam(job, checkpoint))
+    if plan is None:
+        plan = timed("cam", "toolpaths", lambda: plan_cam(job, checkpoint))
     programs, program_files = timed("post", None, lambda: build_programs(job, plan))
     if restart is not None:
         name, text = restart_program(job, plan, restart)
@@ -92,6 +95,7 @@ def run_job(job: Job, progress: Callable[[str, float], None] | None = None,
     grading = timed("grading", None, lambda: grade_stage(job, sim_result))
     budget = timed("error_budget", None, lambda: budget_stage(job, plan, sim_result, grading))
     result = build_result(job, samples, cad, plan, job.post, programs, sim_result, grading, seconds, budget)
+    result = dataclasses.replace(result, correction=correction)
     template_source = shown_path(job.job.report_template) if job.job.report_template else "report.html.j2"
     report = timed("report", "report", lambda: report_html(result, png, job.gear,
                                                           job.stock.blank_radius_mm(job.gear), plan, sim_result,

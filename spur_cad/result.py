@@ -282,3 +282,4 @@ class JobResult:
     files: dict[str, bytes] = field(default_factory=dict)
     setup: SetupFacts | None = None  # the report's set-up sheet (not in summary.json)
     error_budget: ErrorBudgetFacts | None = None  # the expected grade with the machine's errors (None: no simulation)
+    correction: dict | None = None  # spur-cad correct's correction.json when the run is a corrected set (the report)

@@ -112,7 +112,7 @@ def test_correct_writes_the_corrected_programs_and_correction_json(reference, co
     code, out = corrected
     assert code == 0
     assert sorted(p.name for p in out.iterdir() if not p.name.startswith(".")) == \
-        ["correction.json", "finishing.ngc", "roughing.ngc"]
+        ["correction.json", "finishing.ngc", "report.html", "roughing.ngc"]
     correction = json.loads((out / "correction.json").read_text())
     size = correction["size_error_um"]
     assert size["value"] == pytest.approx(-TOOL_RADIUS_ERROR_UM, abs=1.0) and 0.0 <= size["uncertainty"] < 1.0
@@ -221,3 +221,75 @@ def test_the_corrected_programs_cut_on_the_planted_machine_give_the_design(refer
         assert pitch_total_um(spec, after[side]) < 2.0, after[side]
         assert np.abs(after[side]).max() < 2.0, after[side]
         assert np.abs(after[side] - ideal[side]).max() < 0.5  # what the program cuts on an ideal machine
+
+
+def correction_section_rows(page: str) -> dict[str, list[str]]:
+    """The rows of the table in report.html's Correction section (section id="correction"), by their first cell, as
+    the page's text (HTML entities resolved)."""
+    from html.parser import HTMLParser
+
+    class Rows(HTMLParser):
+        def __init__(self):
+            super().__init__()
+            self.depth, self.rows, self.cell = 0, [], None
+
+        def handle_starttag(self, tag, attrs):
+            if tag == "section" and ("id", "correction") in attrs:
+                self.depth = 1
+            elif self.depth and tag == "tr":
+                self.rows.append([])
+            elif self.depth and tag in ("td", "th"):
+                self.cell = ""
+
+        def handle_endtag(self, tag):
+            if tag == "section":
+                self.depth = 0
+            elif self.depth and tag in ("td", "th") and self.cell is not None:
+                self.rows[-1].append(self.cell.strip())
+                self.cell = None
+
+        def handle_data(self, data):
+            if self.cell is not None:
+                self.cell += data
+
+    parser = Rows()
+    parser.feed(page)
+    return {row[0]: row[1:] for row in parser.rows}
+
+
+def test_the_corrected_sets_report_has_a_correction_section_with_correction_json(corrected):
+    """report.html of the corrected set: its Correction table holds correction.json's figures (to the 0.1 um and
+    0.1 arcsec it prints): each error with its uncertainty, before and predicted after, and the reasons for what is
+    not corrected."""
+    import html
+    import json
+
+    out = corrected[1]
+    correction = json.loads((out / "correction.json").read_text())
+    page = (out / "report.html").read_text()
+    rows = correction_section_rows(page)
+    head = rows.pop("error")
+    assert head == ["identified", "uncertainty (1 s.d.)", "corrected by", "before", "predicted after"]
+
+    def near(cell: str, value: float) -> bool:
+        return abs(float(cell.replace("\u2212", "-")) - value) <= 0.05 + 1e-9
+
+    size, before, after = correction["size_error_um"], correction["before"], correction["predicted_after"]
+    row = rows["flank position (tool size) [\u00b5m]"]
+    assert near(row[0], size["value"]) and near(row[1], size["uncertainty"])
+    assert "D 2.0160 mm" in row[2] and near(row[3], before["flank_position_um"]) and near(row[4], 0.0)
+    index = [v for v in correction["index_error_arcsec"]["values"] if v is not None]
+    low, high = rows["index error, range over the spaces [arcsec]"][0].split(" to ")
+    assert near(low, min(index)) and near(high, max(index))
+    for side in ("right", "left"):
+        row = rows[f"F_p, {side} flanks [\u00b5m]"]
+        assert near(row[3], before["F_p_um"][side]) and near(row[4], after["F_p_um"][side])
+        assert before["F_p_um"][side] > 8.0 and after["F_p_um"][side] < 0.5  # the planted 25 arcsec table, removed
+        for name, label in (("profile_slope_um", "profile slope f_H\u03b1"),
+                            ("helix_slope_um", "helix slope f_H\u03b2")):
+            found = correction[name]["by_side"][side]
+            row = rows[f"{label}, {side} flanks [\u00b5m]"]
+            assert near(row[0], found["value"]) and near(row[1], found["uncertainty"])
+            assert near(row[3], before[name][side]) and near(row[4], after[name][side])
+    text = html.unescape(page)
+    assert all(reason in text for reason in correction["not_corrected"].values())

@@ -146,7 +146,7 @@ def slope_summary(spec, identified: Identified, corrected: bool) -> dict:
     front, back = helix_range_mm(spec.face_width_mm, spec.module_mm)
 
     def rounded(value: float) -> float | None:
-        return round(value, 3) if math.isfinite(value) else None
+        return round(value, 3) + 0.0 if math.isfinite(value) else None  # + 0.0: never -0.0
 
     profile = {side: {"value": rounded(value), "uncertainty": rounded(identified.profile_slope_uncertainty_um[side]),
                       "pressure_angle_change_deg": round(pressure_angle_change_deg(spec, value), 6)}
@@ -164,6 +164,20 @@ def slope_summary(spec, identified: Identified, corrected: bool) -> dict:
                            "meaning": "f_Hbeta (ISO 1328-1), mean over the side's helix traces (three transverse "
                                       "planes or more): + material rising toward +X (the back face)"},
     }
+
+
+def pitch_totals_um(spec, flank_um: dict[str, np.ndarray]) -> dict[str, float | None]:
+    """F_p per side (um of arc on the reference circle) of the flanks' normal positions: their spread / cos alpha;
+    None where a space was not measured (F_p needs every flank of a side)."""
+    cos_alpha = spec.base_radius_mm / spec.reference_radius_mm
+    return {side: round(float(np.ptp(values)) / cos_alpha, 3) if np.all(np.isfinite(values)) else None
+            for side, values in flank_um.items()}
+
+
+def slopes_as_measured(identified: Identified) -> dict[str, dict[str, float]]:
+    """The identified slopes per side (um), as correction.json's before holds them."""
+    return {"profile_slope_um": {side: round(v, 3) + 0.0 for side, v in identified.profile_slope_um.items()},
+            "helix_slope_um": {side: round(v, 3) + 0.0 for side, v in identified.helix_slope_um.items()}}
 
 
 def correction_summary(spec, identified: Identified, finishing_tool_before, finishing_tool_after,
@@ -204,11 +218,20 @@ def correction_summary(spec, identified: Identified, finishing_tool_before, fini
         },
         **slope_summary(spec, identified, slopes_not_corrected is None),
         "before": {"flank_position_um": round(identified.size_um, 3),
-                   "index_spread_on_reference_circle_um": round(spread_um, 3)},
+                   "index_spread_on_reference_circle_um": round(spread_um, 3),
+                   "F_p_um": pitch_totals_um(spec, identified.flank_position_um),
+                   **slopes_as_measured(identified)},
         "predicted_after": {"flank_position_um": 0.0, "flank_position_uncertainty_um":
                             round(identified.size_uncertainty_um, 3), "index_spread_on_reference_circle_um": 0.0,
                             "index_uncertainty_on_reference_circle_um":
-                                round(identified.index_uncertainty_arcsec * reference_arc_um, 3)},
+                                round(identified.index_uncertainty_arcsec * reference_arc_um, 3),
+                            "F_p_um": pitch_totals_um(spec, identified.flank_residual_um),
+                            **({name: {side: 0.0 for side in by_side} for name, by_side in
+                                slopes_as_measured(identified).items()} if slopes_not_corrected is None
+                               else slopes_as_measured(identified))},
+        "predicted_after_meaning": "the measured deviations less what the corrections remove: the size and the "
+                                   "index errors (F_p from the flanks' scatter the model leaves), the slopes when "
+                                   "corrected; on the machine that cut the measured gear",
         "not_corrected": {**({"slopes": slopes_not_corrected} if slopes_not_corrected else {}), **NOT_CORRECTED},
     }
 
@@ -216,12 +239,13 @@ def correction_summary(spec, identified: Identified, finishing_tool_before, fini
 def correct_job(job, measured, measured_source: str):
     """Identify the errors in `measured` (spur_cad.grade.measured.MeasuredPoints) and build the corrected output set:
     every program re-planned with the finishing tool as it cuts, each space's A words turned by its correction
-    (all operations: the table errs alike for each), and correction.json. Returns (Identified, {name: bytes})."""
+    (all operations: the table errs alike for each), correction.json, and report.html (the corrected job's run on its
+    corrected plan, with the Correction section). Returns (Identified, {name: bytes})."""
     import json
 
     from spur_cad.correct.identify import identify
     from spur_cad.errors import SpurCadError
-    from spur_cad.pipeline import build_programs, plan_cam
+    from spur_cad.pipeline import build_programs, plan_cam, run_job
 
     spec = job.gear
     if spec.is_helical:
@@ -245,8 +269,10 @@ def correct_job(job, measured, measured_source: str):
              f"{fixed.tools.finishing.diameter_mm:.4f} mm (size error {identified.size_um:+.2f} um), A of each space "
              "turned by its index correction" + ("" if slopes_not_corrected else ", flank passes moved for the "
                                                   "profile and helix slopes") + " (correction.json)",)
-    _, files = build_programs(fixed, dataclasses.replace(fixed_plan, **turned), notes)
+    corrected_plan = dataclasses.replace(fixed_plan, **turned)
+    _, files = build_programs(fixed, corrected_plan, notes)
     summary = correction_summary(spec, identified, job.tools.finishing, fixed.tools.finishing, correction,
                                  measured_source, slopes_not_corrected)
     files["correction.json"] = (json.dumps(summary, indent=2) + "\n").encode()
+    files["report.html"] = run_job(fixed, plan=corrected_plan, correction=summary).files["report.html"]
     return identified, files

@@ -58,8 +58,10 @@ class Identified:
     size_um: the flanks' shift by the tool, mean of both sides (+: material left, the tool cut too little);
     side_size_um: per side as measured (their difference is a scan's rotation: not the tool's);
     index_arcsec: per space (machine numbering), relative to the mean over the measured spaces; NaN where a
-    space has not both flanks measured; profile_slope_um / helix_slope_um: per side, f_Halpha / f_Hbeta of the
-    deviations less the ideal cut's (side_slopes), missing for a side without such traces."""
+    space has not both flanks measured; flank_position_um: per side and space, the flank's mean deviation about the
+    gear's axis (the fit's centre remainder taken off) less the side's size; flank_residual_um: that less the
+    index error's share, what the corrections leave; profile_slope_um / helix_slope_um: per side, f_Halpha /
+    f_Hbeta of the deviations less the ideal cut's (side_slopes), missing for a side without such traces."""
 
     size_um: float
     size_uncertainty_um: float
@@ -74,6 +76,8 @@ class Identified:
     profile_slope_uncertainty_um: dict[str, float] = dataclasses.field(default_factory=dict)
     helix_slope_um: dict[str, float] = dataclasses.field(default_factory=dict)
     helix_slope_uncertainty_um: dict[str, float] = dataclasses.field(default_factory=dict)
+    flank_position_um: dict[str, np.ndarray] = dataclasses.field(default_factory=dict)
+    flank_residual_um: dict[str, np.ndarray] = dataclasses.field(default_factory=dict)
 
 
 @dataclass(frozen=True)
@@ -159,13 +163,15 @@ def identify(spec, measured: MeasuredPoints, ideal: IdealFlanks | None = None) -
     turn = -difference / (flank_lever["right"] - flank_lever["left"])
     index = np.where(both, turn - np.nanmean(turn[both]), np.nan) / ARCSEC_RAD
     lever_span = float(np.nanmean(np.abs(flank_lever["right"] - flank_lever["left"])))
+    side_size = {name: float(np.nanmean(flank_mean[name] - flank_normal[name] @ centre)) for name in SIDES}
+    position = {name: flank_mean[name] - flank_normal[name] @ centre - side_size[name] for name in SIDES}
+    relative_turn = turn - np.nanmean(turn[both])
     traces, _ = _flank_traces(spec, measured, corrected, nearest, design)
     profile, helix = side_slopes(traces, "profile"), side_slopes(traces, "helix")
     return Identified(
         size_um=float(size) * 1000.0,
         size_uncertainty_um=sum_noise / (2.0 * math.sqrt(len(residual))) * 1000.0,
-        side_size_um={name: float(np.nanmean(flank_mean[name] - flank_normal[name] @ centre)) * 1000.0
-                      for name in SIDES},
+        side_size_um={name: value * 1000.0 for name, value in side_size.items()},
         index_arcsec=index,
         index_uncertainty_arcsec=sum_noise / lever_span / ARCSEC_RAD,  # a difference's noise is a sum's
         flank_mean_um={name: flank_mean[name] * 1000.0 for name in SIDES},
@@ -176,4 +182,7 @@ def identify(spec, measured: MeasuredPoints, ideal: IdealFlanks | None = None) -
         profile_slope_um={name: found.value_um for name, found in profile.items()},
         profile_slope_uncertainty_um={name: found.uncertainty_um for name, found in profile.items()},
         helix_slope_um={name: found.value_um for name, found in helix.items()},
-        helix_slope_uncertainty_um={name: found.uncertainty_um for name, found in helix.items()})
+        helix_slope_uncertainty_um={name: found.uncertainty_um for name, found in helix.items()},
+        flank_position_um={name: np.where(both, value, np.nan) * 1000.0 for name, value in position.items()},
+        flank_residual_um={name: np.where(both, position[name] + relative_turn * flank_lever[name], np.nan) * 1000.0
+                           for name in SIDES})

@@ -145,6 +145,8 @@ def report_context(result: JobResult, images: dict[str, bytes]) -> dict:
         "gouge_within_resolution": (not sim.enabled) or sim.max_gouge_mm <= sim.resolution_mm,
         "simulation_verdict": verdict, "feature_table": sheet.feature_table(result),
         "grading_table": sheet.grading_table(result),
+        "correction": result.correction, "correction_table": sheet.correction_table(result.correction),
+        "correction_notes": sheet.correction_notes(result.correction),
         "error_budget_text": sheet.error_budget_text(result),
         "overall_class": (grading.overall_class or "beyond 11") if grading is not None else "",
         "grading_validity": "; ".join(grading.validity) if grading is not None and grading.validity else "",

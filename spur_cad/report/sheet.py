@@ -418,3 +418,41 @@ def warning_lines(result: JobResult) -> tuple[str, ...]:
             items.append(f"simulation: {sim.uncut_points:,} design points keep more than "
                          f"{number(sim.leftover_range_mm, 1)} mm of material (never cut)")
     return tuple(items)
+
+
+def correction_table(correction: dict | None) -> Table | None:
+    """The corrected set's errors (spur-cad correct's correction.json): each one identified with its uncertainty,
+    what the programs change for it, and the deviation before and as predicted after on the machine that cut the
+    measured gear. None for a run that is not a correction."""
+    if correction is None:
+        return None
+    before, after = correction["before"], correction["predicted_after"]
+    size, index = correction["size_error_um"], correction["index_error_arcsec"]
+    tool = correction["corrections"]["finishing_tool_diameter_mm"]
+    measured = [v for v in index["values"] if v is not None]
+    rows = [(f"flank position (tool size) [{MICRO}]", signed(size["value"], 1), number(size["uncertainty"], 1),
+             f"finishing tool programmed as D {number(tool['programmed'], 4)} mm (D {number(tool['before'], 4)} mm "
+             "in the tool table)", signed(before["flank_position_um"], 1), signed(after["flank_position_um"], 1)),
+            ("index error, range over the spaces [arcsec]", f"{signed(min(measured), 1)} to {signed(max(measured), 1)}",
+             number(index["uncertainty"], 1), "each space's A words turned back by its error", "", "")]
+    rows += [(f"F_p, {side} flanks [{MICRO}]", "", "", "by the index correction", number(value, 1),
+              number(after["F_p_um"][side], 1)) for side, value in before["F_p_um"].items() if value is not None]
+    for name, label, symbol in (("profile_slope_um", "profile slope", "f_H\u03b1"),
+                                ("helix_slope_um", "helix slope", "f_H\u03b2")):
+        slope = correction[name]
+        for side, found in slope["by_side"].items():
+            how = "not corrected (below)"
+            if slope["corrected"]:
+                how = "flank passes moved along their normal"
+                if "pressure_angle_change_deg" in found:
+                    how += f" (pressure angle as cut {signed(found['pressure_angle_change_deg'], 4)} deg)"
+            rows.append((f"{label} {symbol}, {side} flanks [{MICRO}]", signed(found["value"], 1),
+                         number(found["uncertainty"], 1), how, signed(before[name][side], 1),
+                         signed(after[name][side], 1)))
+    return Table(("error", "identified", "uncertainty (1 s.d.)", "corrected by", "before", "predicted after"),
+                 tuple(rows))
+
+
+def correction_notes(correction: dict | None) -> tuple[str, ...]:
+    """What the corrected programs do not correct, and why (correction.json's not_corrected), one line each."""
+    return () if correction is None else tuple(correction["not_corrected"].values())
