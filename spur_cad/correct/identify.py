@@ -27,11 +27,11 @@ from dataclasses import dataclass
 import numpy as np
 
 from spur_cad.grade.iso1328 import evaluate_trace
-from spur_cad.grade.measured import (  # _design, _flank_traces: the grader's design points and traces
+from spur_cad.grade.measured import (  # _design: the grader's design points
     MeasuredPoints,
     _design,
-    _flank_traces,
     fit,
+    flank_traces,
 )
 from spur_cad.grade.simulated import SIDES, profile_range_mm
 
@@ -166,7 +166,7 @@ def identify(spec, measured: MeasuredPoints, ideal: IdealFlanks | None = None) -
     side_size = {name: float(np.nanmean(flank_mean[name] - flank_normal[name] @ centre)) for name in SIDES}
     position = {name: flank_mean[name] - flank_normal[name] @ centre - side_size[name] for name in SIDES}
     relative_turn = turn - np.nanmean(turn[both])
-    traces, _ = _flank_traces(spec, measured, corrected, nearest, design)
+    traces, _ = flank_traces(spec, measured.axial, corrected, space[nearest], side[nearest], roll[nearest])
     profile, helix = side_slopes(traces, "profile"), side_slopes(traces, "helix")
     return Identified(
         size_um=float(size) * 1000.0,
