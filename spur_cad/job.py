@@ -594,23 +594,14 @@ def with_report_template(job: Job, folder: Path) -> Job:
     """The job with its [job] report_template read (relative to `folder`, the job file's) and compiled: a missing
     or unreadable file, one that is not a regular file or larger than MAX_TEMPLATE_BYTES, or a template syntax
     error is one JobFileError at the key's line."""
-    name = job.job.report_template
-    if not name:
-        return job
-    from spur_cad.inputs import read_regular_file
-    from spur_cad.report.html import ReportTemplateError, compile_template
+    from spur_cad.report.html import compile_template
 
-    path = folder / name
-    where = _where(job.source, job.text, "job", "report_template")
-    try:
-        text = read_regular_file(path, "report template", MAX_TEMPLATE_BYTES, JobFileError).decode("utf-8")
-        compile_template(text, shown_path(path))
-    except UnicodeDecodeError:
-        raise JobFileError(f"{where}: [job] report_template: {shown_path(path)} is not UTF-8 text",
-                           section="job", field="report_template") from None
-    except (JobFileError, ReportTemplateError) as exc:
-        raise JobFileError(f"{where}: [job] report_template: {exc}", section="job", field="report_template") from None
-    return dataclasses.replace(job, report_template_text=text)
+    def compiled(text: str, source: str) -> str:
+        compile_template(text, source)  # a syntax error is refused now, before any work
+        return text
+
+    text = _named_file(job, folder, "job", "report_template", "report template", MAX_TEMPLATE_BYTES, compiled)
+    return job if text is None else dataclasses.replace(job, report_template_text=text)
 
 
 MAX_CALIBRATION_BYTES = 1024 * 1024
@@ -621,23 +612,30 @@ def with_rotary_calibration(job: Job, folder: Path) -> Job:
     """The job with its [machine] rotary_calibration_file read (relative to `folder`, the job file's): a missing
     file, one that is not a regular file, larger than MAX_CALIBRATION_BYTES, not UTF-8 or with a line that is
     not 'A_deg error_arcsec' is one JobFileError at the key's line."""
-    name = job.machine.rotary_calibration_file
-    if not name:
-        return job
-    from spur_cad.inputs import read_regular_file
+    table = _named_file(job, folder, "machine", "rotary_calibration_file", "calibration table", MAX_CALIBRATION_BYTES,
+                        parse_calibration_table)
+    return job if table is None else dataclasses.replace(job, rotary_calibration=table)
 
+
+def _named_file(job: Job, folder: Path, section: str, field_name: str, what: str, max_bytes: int, read):
+    """`read(text, shown path)` of the UTF-8 file [section] field_name names, relative to `folder`; None when the
+    key is empty. Every failure (the file, its encoding, what `read` raises: ValueError or a SpurCadError) is one
+    JobFileError at the key's line."""
+    from spur_cad.inputs import read_regular_file
+    from spur_cad.report.html import ReportTemplateError
+
+    name = getattr(job.section(section), field_name)
+    if not name:
+        return None
     path = folder / name
-    where = _where(job.source, job.text, "machine", "rotary_calibration_file")
+    where = f"{_where(job.source, job.text, section, field_name)}: [{section}] {field_name}"
     try:
-        text = read_regular_file(path, "calibration table", MAX_CALIBRATION_BYTES, JobFileError).decode("utf-8")
-        table = parse_calibration_table(text, shown_path(path))
+        return read(read_regular_file(path, what, max_bytes, JobFileError).decode("utf-8"), shown_path(path))
     except UnicodeDecodeError:
-        raise JobFileError(f"{where}: [machine] rotary_calibration_file: {shown_path(path)} is not UTF-8 text",
-                           section="machine", field="rotary_calibration_file") from None
-    except (JobFileError, ValueError) as exc:
-        raise JobFileError(f"{where}: [machine] rotary_calibration_file: {exc}", section="machine",
-                           field="rotary_calibration_file") from None
-    return dataclasses.replace(job, rotary_calibration=table)
+        raise JobFileError(f"{where}: {shown_path(path)} is not UTF-8 text", section=section,
+                           field=field_name) from None
+    except (JobFileError, ReportTemplateError, ValueError) as exc:
+        raise JobFileError(f"{where}: {exc}", section=section, field=field_name) from None
 
 
 def with_files(job: Job, folder: Path) -> Job:
