@@ -295,7 +295,8 @@ def _grade(args: argparse.Namespace, received: list[int], loaded: list) -> int:
     worse than --required-class."""
     import json
 
-    from spur_cad.grade.measured import MeasuredPoints, grade_measured, read_measured_file
+    from spur_cad.grade.measured import MeasuredPoints, grade_measured
+    from spur_cad.grade.probe_log import read_measured_file
     from spur_cad.job import load_job
     from spur_cad.outputs import check_output_folder
 

@@ -251,13 +251,14 @@ def test_restart_dialog_and_long_work_in_the_gui(freecad_gui, tmp_path):
     # from the export's first stage on (before it the bar may still show a reset -1 or an earlier run's full count,
     # seen in CI as [-1, 80, 80, 2, ...]), counting up through the export; FreeCAD's own progress (the STEP
     # writer's, on the same bar) may show the bar full for a moment before our count comes back (seen in CI as
-    # [..., 22, 80, 62, 80]): a full bar followed by a lower value is that, not our count
+    # [..., 22, 80, 62, 80], and for two samples running as [2, 80, 80, 22, ...]): a full bar with a lower value
+    # after it is that, not our count; our own count going down still fails
     first_stage = next((i for i, value in enumerate(values) if 0 <= value <= 20), None)
     assert first_stage is not None, values
     counted = values[first_stage:]
     full = max(counted)
     counted = [value for i, value in enumerate(counted)
-               if not (value == full and i + 1 < len(counted) and counted[i + 1] < full)]
+               if not (value == full and any(later < full for later in counted[i + 1:]))]
     assert counted == sorted(counted) and counted[-1] > 20, values
     assert all(wait for *_, wait in samples)
     assert result["after_export"] == [True, ""]

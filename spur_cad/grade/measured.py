@@ -14,6 +14,7 @@ back by it before they meet the design.
 
 from __future__ import annotations
 
+import contextlib
 import math
 import os
 from dataclasses import dataclass
@@ -47,21 +48,20 @@ class MeasuredPoints:
 
 def read_points_csv(text: str, source: str) -> MeasuredPoints:
     """The points of a measured-points CSV text (see the module docstring); one line naming the line on error."""
-    return _points(enumerate(text.splitlines(), start=1), source)
+    return points_from_lines(enumerate(text.splitlines(), start=1), source)
 
 
 def read_points_file(path: str | os.PathLike, source: str | None = None) -> MeasuredPoints:
-    """The points of a measured-points CSV file (read_measured_file, never taken for a probe log)."""
-    return read_measured_file(path, source, probe_log=False)
+    """The points of a measured-points CSV file, read as a stream (measured_lines; never taken for a probe log:
+    spur_cad.grade.probe_log.read_measured_file tells them apart)."""
+    with measured_lines(path, source) as (lines, shown_source):
+        return points_from_lines(lines, shown_source)
 
 
-def read_measured_file(path: str | os.PathLike, source: str | None = None, probe_log: bool = True):
-    """A measured file, read as a stream: a regular file (a FIFO or a device is refused before reading) of at
-    most MAX_MEASURED_BYTES, memory holding a line at a time besides the values. A probe log
-    (spur_cad.grade.probe_log.ProbeLog) when its first non-blank line is nine numbers separated by blanks, as
-    LinuxCNC's PROBEOPEN log writes them (and `probe_log` allows it), else the MeasuredPoints of a CSV."""
-    from itertools import chain
-
+@contextlib.contextmanager
+def measured_lines(path: str | os.PathLike, source: str | None = None):
+    """(the (line number, text) pairs of a measured file, the name its messages use) of a regular file (a FIFO or
+    a device is refused before reading) of at most MAX_MEASURED_BYTES, read a line at a time."""
     from spur_cad.errors import shown_path
     from spur_cad.inputs import open_regular_file
 
@@ -71,14 +71,7 @@ def read_measured_file(path: str | os.PathLike, source: str | None = None, probe
         if size > MAX_MEASURED_BYTES:
             raise MeasuredPointsError(f"{source}: the measured points file has {size:,} bytes; grade reads at most "
                                       f"{MAX_MEASURED_BYTES:,} ({MAX_MEASURED_BYTES // 2**20} MiB)")
-        lines = _file_lines(handle, source)
-        first = next(((number, text) for number, text in lines if text.strip()), None)
-        rest = chain([first], lines) if first is not None else iter(())
-        if probe_log and first is not None and looks_like_probe_log(first[1]):
-            from spur_cad.grade.probe_log import read_probe_log_lines
-
-            return read_probe_log_lines(rest, source)
-        return _points(rest, source)
+        yield _file_lines(handle, source), source
 
 
 def looks_like_probe_log(line: str) -> bool:
@@ -106,7 +99,7 @@ def _file_lines(handle, source: str):
             raise MeasuredPointsError(f"{source}:{number}: not a text file (not UTF-8)") from None
 
 
-def _points(lines, source: str) -> MeasuredPoints:
+def points_from_lines(lines, source: str) -> MeasuredPoints:
     """Points from (line number, text) pairs; compact columns (24 bytes a point), at most MAX_POINTS."""
     from array import array
 

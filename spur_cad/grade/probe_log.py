@@ -19,7 +19,15 @@ import numpy as np
 from spur_cad.errors import shown
 from spur_cad.geometry.frames import machine_to_part
 from spur_cad.grade.grading import Grading, MeasuredFit
-from spur_cad.grade.measured import MAX_POINTS, MeasuredPointsError, flank_traces, graded
+from spur_cad.grade.measured import (
+    MAX_POINTS,
+    MeasuredPointsError,
+    flank_traces,
+    graded,
+    looks_like_probe_log,
+    measured_lines,
+    points_from_lines,
+)
 
 LINE_TOLERANCE_MM = 0.005
 """A logged centre farther than this from its planned probe line is not that move's trip (another program, an
@@ -128,3 +136,16 @@ def grade_probe_log(spec, plan, log: ProbeLog, rotary_sign: int = 1) -> Grading:
         f"stopped early?): graded on those",)
     fitted = MeasuredFit(0.0, (0.0, 0.0), float(np.sqrt(np.mean(deviation ** 2)) * 1000.0), "probe log")
     return graded(spec, found, positions, axial, fitted, notes)
+
+
+def read_measured_file(path, source: str | None = None):
+    """A measured file (spur_cad.grade.measured.measured_lines): a ProbeLog when its first non-blank line is nine
+    numbers separated by blanks, as LinuxCNC's PROBEOPEN log writes them, else the MeasuredPoints of a CSV."""
+    from itertools import chain
+
+    with measured_lines(path, source) as (lines, shown_source):
+        first = next(((number, text) for number, text in lines if text.strip()), None)
+        rest = chain([first], lines) if first is not None else iter(())
+        if first is not None and looks_like_probe_log(first[1]):
+            return read_probe_log_lines(rest, shown_source)
+        return points_from_lines(rest, shown_source)
