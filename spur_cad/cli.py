@@ -93,8 +93,9 @@ def _parser() -> argparse.ArgumentParser:
                                              "programs (tool size, index table, slopes) with correction.json and "
                                              "report.html")
     correct.add_argument("job", help="TOML job file the measured gear was cut with")
-    correct.add_argument("measured", help="CSV of measured points as spur-cad grade reads it (x_mm,y_mm[,X_mm]); "
-                                          "the scan's frame within half a pitch of the machine's (space 0 at A 0)")
+    correct.add_argument("measured", help="CSV of measured points as spur-cad grade reads it (x_mm,y_mm[,X_mm]; "
+                                          "the scan's frame within half a pitch of the machine's, space 0 at A 0), "
+                                          "or the probe log of the job's probe program (size and slopes only)")
     correct.add_argument("--out", required=True, help="folder for the corrected programs and correction.json")
     correct.add_argument("--quiet", action="store_true", help="print nothing but errors")
     correct.add_argument("--debug", action="store_true", help="show tracebacks of internal errors")
@@ -349,14 +350,14 @@ def _correct(args: argparse.Namespace, received: list[int], loaded: list) -> int
 
     from spur_cad.correct.correct import correct_job
     from spur_cad.errors import shown_path
-    from spur_cad.grade.measured import read_points_file
+    from spur_cad.grade.probe_log import read_measured_file
     from spur_cad.job import load_job
     from spur_cad.outputs import check_output_folder
 
     _checkpoint(received)
     out_dir = check_output_folder(args.out)
     loaded.append(load_job(args.job))
-    measured = read_points_file(args.measured)
+    measured = read_measured_file(args.measured)  # a scan's CSV, or the job's probe log
     _checkpoint(received)
     identified, files = correct_job(loaded[0], measured, shown_path(args.measured))
     _checkpoint(received)
@@ -365,8 +366,12 @@ def _correct(args: argparse.Namespace, received: list[int], loaded: list) -> int
         print(f"size error: {identified.size_um:+.2f} um +- {identified.size_uncertainty_um:.2f} "
               "(+: material left; the finishing tool is programmed for it)")
         index = identified.index_arcsec
-        print(f"index errors: {np.nanmin(index):+.1f} to {np.nanmax(index):+.1f} arcsec +- "
-              f"{identified.index_uncertainty_arcsec:.1f} (relative to their mean; each space's A corrected)")
+        if identified.index_visible:
+            print(f"index errors: {np.nanmin(index):+.1f} to {np.nanmax(index):+.1f} arcsec +- "
+                  f"{identified.index_uncertainty_arcsec:.1f} (relative to their mean; each space's A corrected)")
+        else:
+            print("index errors: not seen by a probe log (the table's error is in the cutting and the probing): "
+                  "not corrected")
         for name, slopes in (("profile slope", identified.profile_slope_um),
                              ("helix slope", identified.helix_slope_um)):
             print(f"{name}: " + ", ".join(f"{side} {value:+.2f} um" for side, value in slopes.items())

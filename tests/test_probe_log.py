@@ -14,6 +14,7 @@ between that times cos(pi / z) and that.
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import math
 import re
@@ -189,3 +190,33 @@ def test_a_probe_log_needs_the_jobs_probe_section_and_the_axis_datum(eccentric, 
     assert "probe.log: a probe log, but the job has no [probe] section" in capsys.readouterr().err
     code, _ = grade(tmp_path, "bestfit", eccentric[0], "--datum", "best-fit")
     assert code == 2 and "--datum best-fit is for CSV scans" in capsys.readouterr().err
+
+
+def test_correct_reads_the_probe_log_for_the_tool_size_and_says_it_cannot_see_the_index_table(cut, tmp_path):
+    """`spur-cad correct JOB probe.log`: a gear probed 6 um larger than cut (material left: the tool as it cut was
+    smaller, or worn) gives a size error of +6 um (within 1 um: the ideal cut's scallops are simulated apart, at
+    2 um) and a finishing tool programmed 12 um smaller; the index errors are not identified and not corrected,
+    and correction.json and the report say why (the probe shares the table's error)."""
+    from spur_cad.cli import main
+
+    job, result, program = cut
+    size_mm = 0.006
+    shifted = dataclasses.replace(result, deviation=result.deviation + size_mm)
+    log, _, _ = probed(job, shifted, program)
+    work = tmp_path / "correct"
+    work.mkdir()
+    (work / "job.toml").write_text(JOB_TEXT)
+    (work / "probe.log").write_text(log)
+    assert main(["correct", str(work / "job.toml"), str(work / "probe.log"), "--out", str(work / "out"),
+                 "--quiet"]) == 0
+    correction = json.loads((work / "out" / "correction.json").read_text())
+    assert correction["size_error_um"]["value"] == pytest.approx(1000.0 * size_mm, abs=1.0)
+    programmed = correction["corrections"]["finishing_tool_diameter_mm"]
+    assert programmed["before"] - programmed["programmed"] == pytest.approx(2.0 * correction["size_error_um"]["value"]
+                                                                           / 1000.0, abs=1e-9)
+    assert correction["index_error_arcsec"]["values"] is None or all(
+        v is None for v in correction["index_error_arcsec"]["values"])
+    assert correction["corrections"]["a_correction_deg"] == [0.0] * job.gear.teeth
+    assert "invisible" in correction["not_corrected"]["index"]
+    report = (work / "out" / "report.html").read_text()
+    assert "not seen" in report and "shares the table" in report

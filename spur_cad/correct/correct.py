@@ -11,6 +11,7 @@ import numpy as np
 
 from spur_cad.cam.ir import Feature
 from spur_cad.correct.identify import ARCSEC_RAD, IdealFlanks, Identified
+from spur_cad.grade.measured import MeasuredPoints
 from spur_cad.grade.simulated import SIDES, helix_range_mm, profile_range_mm
 
 IDEAL_RESOLUTION_MM = 0.002
@@ -188,7 +189,10 @@ def correction_summary(spec, identified: Identified, finishing_tool_before, fini
     reference_arc_um = spec.reference_radius_mm * ARCSEC_RAD * 1000.0  # um of arc per arcsec on the reference circle
     index = identified.index_arcsec
     measured = np.isfinite(index)
-    spread_um = float(np.nanmax(index) - np.nanmin(index)) * reference_arc_um
+    spread_um = float(np.nanmax(index) - np.nanmin(index)) * reference_arc_um if measured.any() else None
+    unseen = {} if identified.index_visible else {"index": PROBE_SEES_NO_INDEX}
+    index_uncertainty = identified.index_uncertainty_arcsec
+    index_uncertainty = round(index_uncertainty, 3) if math.isfinite(index_uncertainty) else None
     return {
         "measured": measured_source,
         "model": "deviation = size - index error x (p x n) + the ideal cut's (docs/correction.md)",
@@ -200,9 +204,10 @@ def correction_summary(spec, identified: Identified, finishing_tool_before, fini
                           "by_side": {side: round(v, 3) for side, v in identified.side_size_um.items()},
                           "meaning": "+: material left (the tool cut too little); -: the tool cut too much"},
         "index_error_arcsec": {"values": [None if not ok else round(float(v), 3) for v, ok in zip(index, measured)],
-                               "uncertainty": round(identified.index_uncertainty_arcsec, 3),
+                               "uncertainty": index_uncertainty,
                                "meaning": "per space (machine numbering), relative to their mean: the table stood "
-                                          "this much further in A than commanded"},
+                                          "this much further in A than commanded" + (
+                                              "" if identified.index_visible else "; " + PROBE_SEES_NO_INDEX)},
         "corrections": {
             "finishing_tool_diameter_mm": {"before": finishing_tool_before.diameter_mm,
                                            "programmed": round(finishing_tool_after.diameter_mm, 6),
@@ -218,13 +223,14 @@ def correction_summary(spec, identified: Identified, finishing_tool_before, fini
         },
         **slope_summary(spec, identified, slopes_not_corrected is None),
         "before": {"flank_position_um": round(identified.size_um, 3),
-                   "index_spread_on_reference_circle_um": round(spread_um, 3),
+                   "index_spread_on_reference_circle_um": None if spread_um is None else round(spread_um, 3),
                    "F_p_um": pitch_totals_um(spec, identified.flank_position_um),
                    **slopes_as_measured(identified)},
         "predicted_after": {"flank_position_um": 0.0, "flank_position_uncertainty_um":
-                            round(identified.size_uncertainty_um, 3), "index_spread_on_reference_circle_um": 0.0,
+                            round(identified.size_uncertainty_um, 3),
+                            "index_spread_on_reference_circle_um": None if spread_um is None else 0.0,
                             "index_uncertainty_on_reference_circle_um":
-                                round(identified.index_uncertainty_arcsec * reference_arc_um, 3),
+                                None if index_uncertainty is None else round(index_uncertainty * reference_arc_um, 3),
                             "F_p_um": pitch_totals_um(spec, identified.flank_residual_um),
                             **({name: {side: 0.0 for side in by_side} for name, by_side in
                                 slopes_as_measured(identified).items()} if slopes_not_corrected is None
@@ -232,12 +238,40 @@ def correction_summary(spec, identified: Identified, finishing_tool_before, fini
         "predicted_after_meaning": "the measured deviations less what the corrections remove: the size and the "
                                    "index errors (F_p from the flanks' scatter the model leaves), the slopes when "
                                    "corrected; on the machine that cut the measured gear",
-        "not_corrected": {**({"slopes": slopes_not_corrected} if slopes_not_corrected else {}), **NOT_CORRECTED},
+        "not_corrected": {**unseen, **({"slopes": slopes_not_corrected} if slopes_not_corrected else {}),
+                          **NOT_CORRECTED},
     }
 
 
+PROBE_SEES_NO_INDEX = ("the index errors are not corrected: a probe log is measured in the cutting set-up, on the "
+                       "table that cut the gear, so its repeatable index error is in both and invisible to it "
+                       "(docs/probing.md); pitch needs an external measurement (a scan, spur-cad correct JOB scan.csv) "
+                       "or the table's calibration")
+
+
+def _identify_probe_log(job, log, ideal: IdealFlanks) -> Identified:
+    """identify_probed on a probe log's deviations from the job's probing plan (its [probe] section)."""
+    from spur_cad.cam.probing import plan_probe
+    from spur_cad.correct.identify import identify_probed
+    from spur_cad.errors import SpurCadError
+    from spur_cad.grade.probe_log import probe_deviations
+
+    spec = job.gear
+    if job.probe is None:
+        raise SpurCadError(f"{log.source}: a probe log, but the job has no [probe] section to name its trips "
+                           "(correct with the job that wrote the probing program)")
+    plan = plan_probe(spec, job.stock, job.machine, job.probe)
+    deviation = probe_deviations(spec, plan, log, job.post.rotary_sign)
+    points = plan.points[:len(deviation)]
+    radius = np.array([pt.radius_mm for pt in points])
+    return identify_probed(spec, np.array([pt.space for pt in points]), np.array([pt.side for pt in points]),
+                           np.sqrt(np.maximum(radius ** 2 - spec.base_radius_mm ** 2, 0.0)),
+                           np.array([pt.x_mm for pt in points]), deviation, ideal)
+
+
 def correct_job(job, measured, measured_source: str):
-    """Identify the errors in `measured` (spur_cad.grade.measured.MeasuredPoints) and build the corrected output set:
+    """Identify the errors in `measured` (spur_cad.grade.measured.MeasuredPoints, or a ProbeLog of the job's
+    probing program: then the size and slopes only, identify_probed) and build the corrected output set:
     every program re-planned with the finishing tool as it cuts, each space's A words turned by its correction
     (all operations: the table errs alike for each), correction.json, and report.html (the corrected job's run on its
     corrected plan, with the Correction section). Returns (Identified, {name: bytes})."""
@@ -254,7 +288,8 @@ def correct_job(job, measured, measured_source: str):
         raise SpurCadError("the job has no [tools.finishing]: there is no finishing program to correct")
     plan = plan_cam(job)
     try:
-        identified = identify(spec, measured, ideal_flanks(job, plan))
+        identified = identify(spec, measured, ideal_flanks(job, plan)) if isinstance(measured, MeasuredPoints) \
+            else _identify_probe_log(job, measured, ideal_flanks(job, plan))
     except ValueError as exc:
         raise SpurCadError(f"{measured_source}: {exc}") from None
     fixed = corrected_job(job, identified)

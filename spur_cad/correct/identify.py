@@ -78,6 +78,7 @@ class Identified:
     helix_slope_uncertainty_um: dict[str, float] = dataclasses.field(default_factory=dict)
     flank_position_um: dict[str, np.ndarray] = dataclasses.field(default_factory=dict)
     flank_residual_um: dict[str, np.ndarray] = dataclasses.field(default_factory=dict)
+    index_visible: bool = True  # False from an on-machine probe log: the probe shares the table's index errors
 
 
 @dataclass(frozen=True)
@@ -186,3 +187,46 @@ def identify(spec, measured: MeasuredPoints, ideal: IdealFlanks | None = None) -
         flank_position_um={name: np.where(both, value, np.nan) * 1000.0 for name, value in position.items()},
         flank_residual_um={name: np.where(both, position[name] + relative_turn * flank_lever[name], np.nan) * 1000.0
                            for name in SIDES})
+
+
+def identify_probed(spec, space: np.ndarray, side: np.ndarray, roll_mm: np.ndarray, axial_mm: np.ndarray,
+                    deviation_mm: np.ndarray, ideal: IdealFlanks | None = None) -> Identified:
+    """Size and slopes from an on-machine probe log's deviations (spur_cad.grade.probe_log: no fit, the A axis the
+    datum), each point labelled by space, side, roll length and X. The probe is carried by the axes and the table
+    that cut the gear, so the table's index errors, which it shares, are not seen: index errors and flank positions
+    are NaN (docs/probing.md). The size is the mean of the two sides' means of the flanks' mean deviations less the
+    ideal cut's; its uncertainty the flank means' spread about their side's mean over sqrt(n)."""
+    start, end = profile_range_mm(spec)
+    used = np.isin(side, SIDES) & (roll_mm >= start - 1e-9) & (roll_mm <= end + 1e-9)
+    corrected = np.asarray(deviation_mm, dtype=float).copy()
+    if ideal is not None:
+        for name in SIDES:
+            on = used & (side == name)
+            corrected[on] -= ideal.at(name, roll_mm[on])
+    flank_mean = {name: np.full(spec.teeth, np.nan) for name in SIDES}
+    for name in SIDES:
+        for k in range(spec.teeth):
+            on = used & (side == name) & (space == k)
+            if on.any():
+                flank_mean[name][k] = corrected[on].mean()
+    side_size = {name: float(np.nanmean(flank_mean[name])) for name in SIDES if np.isfinite(flank_mean[name]).any()}
+    if len(side_size) < 2:
+        raise ValueError("the probe log has no points of both flank sides in the profile evaluation range")
+    spread = np.concatenate([flank_mean[name][np.isfinite(flank_mean[name])] - side_size[name] for name in SIDES])
+    size = 0.5 * (side_size["right"] + side_size["left"])
+    noise = float(np.std(spread, ddof=1)) if len(spread) > 1 else math.nan
+    traces, _ = flank_traces(spec, axial_mm, corrected, space, side, roll_mm)
+    profile, helix = side_slopes(traces, "profile"), side_slopes(traces, "helix")
+    unseen = np.full(spec.teeth, np.nan)
+    return Identified(
+        size_um=size * 1000.0, size_uncertainty_um=noise / math.sqrt(len(spread)) * 1000.0,
+        side_size_um={name: value * 1000.0 for name, value in side_size.items()},
+        index_arcsec=unseen, index_uncertainty_arcsec=math.nan,
+        flank_mean_um={name: flank_mean[name] * 1000.0 for name in SIDES}, points_used=int(np.count_nonzero(used)),
+        centre_shift_um=(0.0, 0.0), scan_turn_deg=0.0,
+        profile_slope_um={name: found.value_um for name, found in profile.items()},
+        profile_slope_uncertainty_um={name: found.uncertainty_um for name, found in profile.items()},
+        helix_slope_um={name: found.value_um for name, found in helix.items()},
+        helix_slope_uncertainty_um={name: found.uncertainty_um for name, found in helix.items()},
+        flank_position_um={name: unseen for name in SIDES}, flank_residual_um={name: unseen for name in SIDES},
+        index_visible=False)

@@ -434,7 +434,9 @@ def correction_table(correction: dict | None) -> Table | None:
              f"finishing tool programmed as D {number(tool['programmed'], 4)} mm (D {number(tool['before'], 4)} mm "
              "in the tool table)", signed(before["flank_position_um"], 1), signed(after["flank_position_um"], 1)),
             ("index error, range over the spaces [arcsec]", f"{signed(min(measured), 1)} to {signed(max(measured), 1)}",
-             number(index["uncertainty"], 1), "each space's A words turned back by its error", "", "")]
+             number(index["uncertainty"], 1), "each space's A words turned back by its error", "", "") if measured else
+            ("index error [arcsec]", "not seen", "", "not corrected (below): a probe log shares the table's error",
+             "", "")]
     rows += [(f"F_p, {side} flanks [{MICRO}]", "", "", "by the index correction", number(value, 1),
               number(after["F_p_um"][side], 1)) for side, value in before["F_p_um"].items() if value is not None]
     for name, label, symbol in (("profile_slope_um", "profile slope", "f_H\u03b1"),
