@@ -239,9 +239,16 @@ def correction_summary(spec, identified: Identified, finishing_tool_before, fini
                                    "index errors (F_p from the flanks' scatter the model leaves), the slopes when "
                                    "corrected; on the machine that cut the measured gear",
         "not_corrected": {**unseen, **({"slopes": slopes_not_corrected} if slopes_not_corrected else {}),
-                          **NOT_CORRECTED},
+                          **(NOT_CORRECTED if identified.index_visible else PROBE_NOT_CORRECTED)},
     }
 
+
+PROBE_NOT_CORRECTED = {
+    **{name: why for name, why in NOT_CORRECTED.items() if name not in ("side_size_difference", "mean_index")},
+    "side_size_difference": "the left and right flanks' size difference (the probe log measures each side, with no "
+                            "fit): a tool offset moves both flanks alike; only the mean size is corrected",
+}
+"""What a probe log's correction leaves, and why: a scan's notes on its fitted rotation do not apply (no fit)."""
 
 PROBE_SEES_NO_INDEX = ("the index errors are not corrected: a probe log is measured in the cutting set-up, on the "
                        "table that cut the gear, so its repeatable index error is in both and invisible to it "
