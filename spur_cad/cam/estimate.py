@@ -23,7 +23,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from spur_cad.cam.ir import MoveKind, Toolpath, relative_path_lengths
+from spur_cad.cam.ir import MoveKind, Toolpath, arc_sweeps_rad, relative_path_lengths
 from spur_cad.cam.machine import Machine
 
 
@@ -49,9 +49,13 @@ def _lengths_and_minutes(path: Toolpath, machine: Machine) -> tuple[np.ndarray, 
     """Relative path length, feed-bound minutes and seconds (at least the block time) of every move."""
     x0, y0, z0, a0 = path.start_poses().T
     length = relative_path_lengths(x0, y0, z0, a0, path.x, path.y, path.z, path.a, substeps=8)
+    if path.center_x is not None:  # arcs (3-axis paths): their own length, not the chord's
+        radius, sweep = arc_sweeps_rad(path)
+        arcs = path.arc_mask
+        length[arcs] = np.hypot(radius[arcs] * sweep[arcs], path.z[arcs] - z0[arcs])
     rotary = np.abs(path.a - a0)
     rapid = path.kind == MoveKind.RAPID
-    linear = path.kind == MoveKind.LINEAR
+    linear = path.feed_mask
     minutes = np.zeros(len(path))
     minutes[rapid] = length[rapid] / machine.rapid_feed_mm_min
     inverse = linear & path.inverse_time
@@ -68,7 +72,7 @@ def estimate(path: Toolpath, machine: Machine) -> Estimate:
         return Estimate(int(len(path)), 0.0, 0.0, len(path) * machine.block_time_s, len(path) * machine.block_time_s)
     length, minutes, seconds = _lengths_and_minutes(path, machine)
     rapid = path.kind == MoveKind.RAPID
-    linear = path.kind == MoveKind.LINEAR
+    linear = path.feed_mask
     with_acceleration = acceleration_aware_seconds(path, machine, np.where(path.motion_mask, minutes * 60.0, 0.0))
     return Estimate(int(len(path)), float(length[linear].sum()), float(length[rapid].sum()), float(seconds.sum()),
                     float(with_acceleration.sum()))
@@ -124,9 +128,9 @@ def _compiled_planners():
 def acceleration_aware_seconds(path: Toolpath, machine: Machine, feed_bound_seconds: np.ndarray) -> np.ndarray:
     """Seconds of every move when the axes accelerate as the machine allows (see the module docstring).
 
-    Each move is a straight line in joint space (X, Y, Z in mm, A in deg) run at its feed-bound nominal
-    speed at most; its acceleration along the line is the largest that keeps every axis within its
-    limit. At a junction the speed is limited as a controller that rounds corners within the path
+    Each move is a straight line in joint space (X, Y, Z in mm, A in deg; an arc: its chord, an approximation)
+    run at its feed-bound nominal speed at most; its acceleration along the line is the largest that keeps
+    every axis within its limit. At a junction the speed is limited as a controller that rounds corners within the path
     tolerance limits it (centripetal acceleration on the largest arc within the tolerance: the "junction
     deviation" rule of look-ahead planners); markers (clamp codes) and the ends are exact stops.
     """

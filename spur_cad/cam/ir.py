@@ -8,6 +8,10 @@ centre of the tool tip. `a` is in degrees, right-hand about +X.
 `feed` is mm/min for linear moves where A does not move, inverse time (1/min: the move takes
 1/feed minutes) where A moves together with X/Y/Z (`inverse_time` True), and NaN for rapids
 and markers. Markers (clamp/unclamp of the rotary axis) carry the current pose unchanged.
+
+Arcs (ARC_CW / ARC_CCW, only in 3-axis toolpaths: [machine] axes = 3) turn in the machine's XY plane
+(G17) about the centre (`center_x`, `center_y`, absolute mm) from the previous pose to their own, seen
+from +Z; Z stays and A is 0. A toolpath without arcs has `center_x` and `center_y` None.
 """
 
 from __future__ import annotations
@@ -20,6 +24,8 @@ import numpy as np
 
 from spur_cad.geometry.frames import machine_to_part
 
+NAN = float("nan")
+
 MAX_TOOLPATH_MOVES = 10_000_000
 """Largest toolpath a plan builds (about 13 x the reference job's perimeter finishing: some 0.6 GB of
 IR and 0.4 GB of flat G-code); larger work is refused before it is generated (cam/plan.py)."""
@@ -30,6 +36,8 @@ class MoveKind(IntEnum):
     LINEAR = 1
     CLAMP_ROTARY = 2
     UNCLAMP_ROTARY = 3
+    ARC_CW = 4  # G2 in the XY plane
+    ARC_CCW = 5  # G3 in the XY plane
 
 
 class Operation(IntEnum):
@@ -66,6 +74,8 @@ class Toolpath:
     tool_number: int
     spindle_rpm: float
     warnings: tuple[str, ...] = ()
+    center_x: np.ndarray | None = None  # arcs' centres (absolute mm), NaN on other moves; None without arcs
+    center_y: np.ndarray | None = None
 
     def __len__(self) -> int:
         return len(self.kind)
@@ -82,7 +92,16 @@ class Toolpath:
 
     @property
     def motion_mask(self) -> np.ndarray:
-        return (self.kind == MoveKind.RAPID) | (self.kind == MoveKind.LINEAR)
+        return (self.kind == MoveKind.RAPID) | self.feed_mask
+
+    @property
+    def feed_mask(self) -> np.ndarray:
+        """Moves at feed: lines and arcs."""
+        return (self.kind == MoveKind.LINEAR) | self.arc_mask
+
+    @property
+    def arc_mask(self) -> np.ndarray:
+        return (self.kind == MoveKind.ARC_CW) | (self.kind == MoveKind.ARC_CCW)
 
     def replace(self, **arrays: np.ndarray) -> "Toolpath":
         """A copy with some arrays replaced (same length), e.g. feeds converted to inverse time."""
@@ -108,13 +127,20 @@ class ToolpathBuilder:
             "kind": np.array(cols[0], dtype=np.int8), "x": np.array(cols[1], float), "y": np.array(cols[2], float),
             "z": np.array(cols[3], float), "a": np.array(cols[4], float), "feed": np.array(cols[5], float),
             "inverse_time": np.array(cols[6], bool), "space": np.array(cols[7], np.int32),
-            "station": np.array(cols[8], np.int32), "feature": np.array(cols[9], np.int8)})
+            "station": np.array(cols[8], np.int32), "feature": np.array(cols[9], np.int8),
+            "center_x": np.array(cols[10], float), "center_y": np.array(cols[11], float)})
         self._rows = []
 
     def move(self, kind: MoveKind, x: float, y: float, z: float, a: float, feed: float = float("nan"), *,
              inverse_time: bool = False, space: int = -1, station: int = -1,
              feature: Feature = Feature.NONE) -> None:
-        self._rows.append((int(kind), x, y, z, a, feed, inverse_time, space, station, int(feature)))
+        self._rows.append((int(kind), x, y, z, a, feed, inverse_time, space, station, int(feature), NAN, NAN))
+
+    def arc(self, clockwise: bool, x: float, y: float, z: float, center_x: float, center_y: float, feed: float, *,
+            station: int = -1, feature: Feature = Feature.NONE) -> None:
+        """An arc in the XY plane from the last pose to (x, y, z) about (center_x, center_y), A = 0 (3-axis paths)."""
+        kind = MoveKind.ARC_CW if clockwise else MoveKind.ARC_CCW
+        self._rows.append((int(kind), x, y, z, 0.0, feed, False, -1, station, int(feature), center_x, center_y))
 
     def extend(self, kind: np.ndarray, x: np.ndarray, y: np.ndarray, z: np.ndarray, a: np.ndarray,
                feed: np.ndarray, inverse_time: np.ndarray, space: np.ndarray, station: np.ndarray,
@@ -129,7 +155,8 @@ class ToolpathBuilder:
         self._chunks.append({"kind": full(kind, np.int8), "x": full(x, float), "y": full(y, float),
                              "z": full(z, float), "a": full(a, float), "feed": full(feed, float),
                              "inverse_time": full(inverse_time, bool), "space": full(space, np.int32),
-                             "station": full(station, np.int32), "feature": full(feature, np.int8)})
+                             "station": full(station, np.int32), "feature": full(feature, np.int8),
+                             "center_x": np.full(n, NAN), "center_y": np.full(n, NAN)})
 
     def last_pose(self) -> tuple[float, float, float, float] | None:
         if self._rows:
@@ -147,8 +174,11 @@ class ToolpathBuilder:
             arrays = {k: np.concatenate([c[k] for c in self._chunks]) for k in keys}
         else:
             arrays = {k: np.zeros(0) for k in keys}
+        centers = {}
+        if self._chunks and any(np.isin(c["kind"], (MoveKind.ARC_CW, MoveKind.ARC_CCW)).any() for c in self._chunks):
+            centers = {k: np.concatenate([c[k] for c in self._chunks]) for k in ("center_x", "center_y")}
         return Toolpath(operation=self.operation, tool_number=self.tool_number, spindle_rpm=self.spindle_rpm,
-                        warnings=tuple(self.warnings), **arrays)
+                        warnings=tuple(self.warnings), **arrays, **centers)
 
 
 def relative_path_lengths(x0, y0, z0, a0, x1, y1, z1, a1, substeps: int = 16) -> np.ndarray:
@@ -160,3 +190,36 @@ def relative_path_lengths(x0, y0, z0, a0, x1, y1, z1, a1, substeps: int = 16) ->
     d = np.diff(p, axis=0)
     dx = np.diff(xs, axis=0)
     return np.sqrt(d[..., 0] ** 2 + d[..., 1] ** 2 + dx**2).sum(axis=0)
+
+
+def arc_sweeps_rad(path: Toolpath) -> tuple[np.ndarray, np.ndarray]:
+    """(radius mm, signed sweep rad: + counterclockwise seen from +Z) of every move; 0 for moves that are not arcs.
+    An arc whose end is its start is a full turn."""
+    radius, sweep = np.zeros(len(path)), np.zeros(len(path))
+    arcs = path.arc_mask
+    if not arcs.any():
+        return radius, sweep
+    x0, y0 = path.start_poses()[:, 0][arcs], path.start_poses()[:, 1][arcs]
+    cx, cy = path.center_x[arcs], path.center_y[arcs]
+    start = np.arctan2(y0 - cy, x0 - cx)
+    end = np.arctan2(path.y[arcs] - cy, path.x[arcs] - cx)
+    ccw = path.kind[arcs] == MoveKind.ARC_CCW
+    turn = np.where(ccw, np.mod(end - start, 2.0 * np.pi), -np.mod(start - end, 2.0 * np.pi))
+    turn = np.where(np.abs(turn) < 1e-12, np.where(ccw, 2.0 * np.pi, -2.0 * np.pi), turn)
+    radius[arcs] = np.hypot(x0 - cx, y0 - cy)
+    sweep[arcs] = turn
+    return radius, sweep
+
+
+def arc_points(path: Toolpath, index: int, max_chord_error_mm: float) -> np.ndarray:
+    """(n, 2) XY points along arc move `index`, its start and end included, chords within `max_chord_error_mm`."""
+    radius, sweep = arc_sweeps_rad(path)
+    r, s = float(radius[index]), float(sweep[index])
+    x0, y0 = path.start_poses()[index, :2]
+    cx, cy = float(path.center_x[index]), float(path.center_y[index])
+    step = 2.0 * np.arccos(max(0.0, 1.0 - max_chord_error_mm / max(r, 1e-12))) if r > max_chord_error_mm else np.pi
+    n = max(1, int(np.ceil(abs(s) / max(step, 1e-6))))
+    angles = np.arctan2(y0 - cy, x0 - cx) + s * np.linspace(0.0, 1.0, n + 1)
+    points = np.stack([cx + r * np.cos(angles), cy + r * np.sin(angles)], axis=-1)
+    points[-1] = path.x[index], path.y[index]
+    return points

@@ -17,6 +17,10 @@ class MachineError(SpurCadError, ValueError):
 class Machine:
     """[machine]: limits and habits of the machining centre and its rotary table (4th axis A)."""
 
+    axes: int = key(4, choices=(4, 3), label="MachineAxes", group="Machine",
+                    meaning="4: the gear on the rotary table (axis = X = A); 3: the blank clamped flat, gear axis = "
+                            "Z, Z0 on its top face, the outline cut by the end mill's side with arcs (spur gears "
+                            "only; docs/cam.md)")
     name: str = key("generic 4-axis VMC", label="MachineName", group="Machine",
                     meaning="machine name (summary, program headers)")
     max_spindle_rpm: float = key(7000.0, unit="1/min", low=100.0, high=100000.0, label="MaxSpindleRpm",

@@ -75,6 +75,7 @@ class ProgramInfo:
     blank_box_mm: tuple[float, float, float, float, float, float] | None = None  # x, y, z min then max (WORKPIECE)
     approach_z_mm: float | None = None  # restart programs: a Z-only rapid to this height before the first move
     first_space_a_reference_deg: float | None = None  # restart programs: A of the full program's run (see _runs)
+    rotary_axis: bool = True  # False: a 3-axis machine ([machine] axes = 3): no A words (A must stay 0)
 
 
 @dataclass(frozen=True)
@@ -117,7 +118,11 @@ def post_program(path: Toolpath, settings: PostSettings, info: ProgramInfo,
     feed = _program_feeds(path, d, settings.rotary_sign)
     runs = _runs(path, x, a_signed, rot, settings.rotary_sign * info.first_space_a_reference_deg
                  if info.first_space_a_reference_deg is not None else None)
-    columns = _Columns(path.kind, x, y, z, a_signed, path.inverse_time, feed, rot)
+    centers = None
+    if path.center_x is not None:
+        centers = (np.rint(np.nan_to_num(path.center_x) * lin).astype(np.int64),
+                   np.rint(np.nan_to_num(path.center_y) * lin).astype(np.int64))
+    columns = _Columns(path.kind, x, y, z, a_signed, path.inverse_time, feed, rot, centers)
     writer = _Writer(d, settings, info, columns, path.tool_number, int(round(path.spindle_rpm)))
 
     body: list[tuple[str, object]] = []  # ("lines", [...]) or ("call", (sub index, run))
@@ -144,6 +149,9 @@ def post_program(path: Toolpath, settings: PostSettings, info: ProgramInfo,
                          subprograms=len(sub_bodies), calls=sum(1 for kind, _ in body if kind == "call"))
 
 
+ARC_RADIUS_TOLERANCE_MM = 1e-4
+"""Largest difference of an arc's radius at its end from its start (LinuxCNC refuses 0.002 mm and 0.1 %)."""
+
 MAX_FEED_VALUE = 1e9
 """Largest feed word value accepted (mm/min, or 1/min in inverse time): far beyond any machine, small
 enough to be written without overflow."""
@@ -158,17 +166,38 @@ def _check_numbers(path: Toolpath, info: ProgramInfo) -> None:
         if not np.all(np.isfinite(values)) or np.abs(values).max() > limit:
             raise PostError(f"{shown(info.title)}: the toolpath has an {axis.upper()} value that is not a finite "
                             f"number within +-{limit:g}")
-    feeds = path.feed[path.kind == MoveKind.LINEAR]
+    feeds = path.feed[path.feed_mask]
     bad = ~(np.isfinite(feeds) & (feeds > 0.0) & (feeds <= MAX_FEED_VALUE))
     if bad.any():
-        index = int(np.nonzero(path.kind == MoveKind.LINEAR)[0][np.argmax(bad)])
+        index = int(np.nonzero(path.feed_mask)[0][np.argmax(bad)])
         raise PostError(f"{shown(info.title)}: move {index} has no usable feed ({float(path.feed[index])!r})")
     if not 1 <= path.tool_number <= 9999:
         raise PostError(f"{shown(info.title)}: tool number {path.tool_number} must be in 1..9999")
     if not (math.isfinite(path.spindle_rpm) and path.spindle_rpm >= 1.0):
         raise PostError(f"{shown(info.title)}: spindle speed {path.spindle_rpm:g} rpm would be written as S0")
+    arcs = path.arc_mask
+    if arcs.any():
+        _check_arcs(path, arcs, info)
     check_rotary_code(info.rotary_clamp_code, "rotary_clamp_code")
     check_rotary_code(info.rotary_unclamp_code, "rotary_unclamp_code")
+    if not info.rotary_axis and (np.any(path.a) or np.any(path.kind == MoveKind.CLAMP_ROTARY)
+                                 or np.any(path.kind == MoveKind.UNCLAMP_ROTARY)):
+        raise PostError(f"{shown(info.title)}: the toolpath turns or clamps A, and the machine has no rotary axis")
+
+
+def _check_arcs(path: Toolpath, arcs: np.ndarray, info: ProgramInfo) -> None:
+    """Refuse arcs a control would refuse or misread: a centre that is not a finite number within range, A turned,
+    an end off the start's circle, an end at the start (read as a full turn)."""
+    cx, cy, starts = path.center_x[arcs], path.center_y[arcs], path.start_poses()[arcs]
+    if not (np.all(np.isfinite(cx)) and np.all(np.isfinite(cy)) and max(np.abs(cx).max(), np.abs(cy).max())
+            <= MAX_COORDINATE_MM) or np.any(path.a[arcs]):
+        raise PostError(f"{shown(info.title)}: an arc has a centre that is not a finite number within "
+                        f"+-{MAX_COORDINATE_MM:g}, or turns A (arcs are in the XY plane of a 3-axis program)")
+    off = np.abs(np.hypot(path.x[arcs] - cx, path.y[arcs] - cy) - np.hypot(starts[:, 0] - cx, starts[:, 1] - cy))
+    if off.max() > ARC_RADIUS_TOLERANCE_MM:
+        raise PostError(f"{shown(info.title)}: an arc ends {off.max():.4f} mm off its circle (a control refuses it)")
+    if np.any((starts[:, 0] == path.x[arcs]) & (starts[:, 1] == path.y[arcs])):
+        raise PostError(f"{shown(info.title)}: an arc ends where it starts (a full turn); split it in two")
 
 
 def _check_shortest_path(path: Toolpath) -> None:
@@ -221,6 +250,7 @@ class _Columns:
     inverse: np.ndarray
     feed: np.ndarray
     rot: int
+    centers: tuple[np.ndarray, np.ndarray] | None = None  # arcs' centres in output units (None: no arcs)
 
 
 @functools.lru_cache(maxsize=1 << 16)
@@ -262,8 +292,9 @@ class _Writer:
         decimals = np.where(c.inverse[sl] & self.d.inverse_time, self.d.inverse_feed_decimals, self.d.feed_decimals)
         feed = np.rint(np.nan_to_num(c.feed[sl]) * 10.0 ** decimals).astype(np.int64)
         flag = b"x" if run.x_base is not None else b"-"
+        centers = [] if c.centers is None else [c.centers[0][sl].tobytes(), c.centers[1][sl].tobytes()]
         return b"".join([flag, c.kind[sl].tobytes(), x.tobytes(), c.y[sl].tobytes(), c.z[sl].tobytes(),
-                         a_rel.tobytes(), c.inverse[sl].tobytes(), feed.tobytes()])
+                         a_rel.tobytes(), c.inverse[sl].tobytes(), feed.tobytes(), *centers])
 
     def run_lines(self, run: _Run, *, folded: bool) -> list[str]:
         """One run's blocks; folded: X and A written relative to the dialect's base parameters."""
@@ -280,7 +311,11 @@ class _Writer:
                 if code:
                     lines.append(code)
                 continue
-            words, direction = self._position_words(run, folded, modal, (x, y, z, a_rel), a_exact)
+            arc = kind == MoveKind.ARC_CW or kind == MoveKind.ARC_CCW
+            if arc:
+                words, direction = self._arc_words(i, modal, (x, y, z, a_rel)), None
+            else:
+                words, direction = self._position_words(run, folded, modal, (x, y, z, a_rel), a_exact)
             if not words:
                 continue  # nothing moves at the output's precision
             modal.position, modal.a_exact = (x, y, z, a_rel), a_exact
@@ -291,6 +326,23 @@ class _Writer:
         if modal.feed_mode == "G93":
             lines.append("G94")
         return lines
+
+    def _arc_words(self, index: int, modal: "_Modal", position: tuple[int, int, int, int]) -> list[str]:
+        """An arc's words: X and Y always (an arc without them is a full turn), Z when it changes, and the centre as
+        I and J from the arc's start as written (G17, incremental centre in every dialect). [] for an arc shorter
+        than the output's precision."""
+        lin_dec = self.d.linear_decimals
+        x, y, z, _ = position
+        last_x, last_y, last_z, _ = modal.position
+        if last_x is None or last_y is None:
+            raise PostError(f"{shown(self.info.title)}: move {index} is an arc from an unknown position")
+        i, j = int(self.c.centers[0][index]) - last_x, int(self.c.centers[1][index]) - last_y
+        if (x, y) == (last_x, last_y):
+            return []  # shorter than the precision (a full turn, which this would be read as, is refused before)
+        words = ["X" + _number(x, lin_dec), "Y" + _number(y, lin_dec)]
+        if z != last_z:
+            words.append("Z" + _number(z, lin_dec))
+        return words + ["I" + _number(i, lin_dec), "J" + _number(j, lin_dec)]
 
     def _position_words(self, run: _Run, folded: bool, modal: "_Modal", position: tuple[int, int, int, int],
                         a_exact: float) -> tuple[list[str], str | None]:
@@ -308,7 +360,7 @@ class _Writer:
         if z != last_z:
             words.append("Z" + _number(z, lin_dec))
         direction = None
-        if a_rel != last_a:
+        if a_rel != last_a and self.info.rotary_axis:
             if folded:
                 offset = ("+" if a_rel > 0 else "") + _number(a_rel, rot_dec)
                 words.append(subs.param_word.format(address="A", param=subs.a_param) if a_rel == 0 else
@@ -338,9 +390,10 @@ class _Writer:
             head.append(mode)
             modal.feed_mode = mode
             modal.feed_units = None
-        if modal.motion != "G1":
-            head.append("G1")
-            modal.motion = "G1"
+        motion = {MoveKind.ARC_CW: "G2", MoveKind.ARC_CCW: "G3"}.get(kind, "G1")
+        if modal.motion != motion:
+            head.append(motion)
+            modal.motion = motion
         decimals = d.inverse_feed_decimals if inverse else d.feed_decimals
         if not (math.isfinite(feed) and feed > 0.0):
             raise PostError(f"{shown(self.info.title)}: move {index} has no usable feed ({feed!r})")

@@ -715,6 +715,9 @@ class _Reader:
             if self.inverse != (code == "93"):
                 self.feed = math.nan  # a feed mode change leaves no F in effect (LinuxCNC, Fanuc)
             self.inverse = code == "93"
+        elif code in ("2", "3"):
+            raise self.error(line, f"G{value} (an arc) is not read: spur-cad verify reads the rotary-table programs "
+                                   "(G0/G1); a 3-axis program with arcs is checked by LinuxCNC's rs274 (docs/cam.md)")
         elif code not in SETUP_G and code not in self.d.extra_setup_g:  # e.g. G71: metric on the 840D
             raise self.error(line, f"G{value} is not supported by this reader (it reads G0/G1 moves, G90, G93/G94)")
 
@@ -762,7 +765,8 @@ class _Reader:
                 self.pose = target
                 return
             missing = "".join(axis for axis, t in zip("XYZA", target) if math.isnan(t))
-            raise self.error(line, f"a feed move before every axis is known ({missing} unknown)")
+            hint = "; a 3-axis program (no A)? spur-cad verify reads rotary-table programs" if missing == "A" else ""
+            raise self.error(line, f"a feed move before every axis is known ({missing} unknown{hint})")
         if not rapid and not (math.isfinite(self.feed) and self.feed > 0.0):
             raise self.error(line, "a feed move without a positive F")
         if not rapid and self.inverse and not self.feed_in_block:
