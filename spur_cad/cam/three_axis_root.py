@@ -1,0 +1,123 @@
+"""The root a flat end mill's side leaves on a gear cut lying flat ([machine] axes = 3, docs/cam.md).
+
+The tool's circle (radius r_t) rolls along the exact tooth-space outline; where the outline is concave more
+tightly than r_t (the rack-generated fillet near the root) or the space is too narrow, the circle cannot follow
+it and leaves a fillet of radius r_t instead. What is left is the outline "closed" by a disk of r_t. This module
+finds where the tool's contour leaves the involute (the form radius that results) and compares it with the start
+of the active profile: the involute must be cut down to there.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.spatial import cKDTree
+
+from spur_cad.geometry.spec import GearSpec
+
+ROOT_SAMPLE_SPACING_MM = 0.005
+"""Spacing of the exact outline's samples the tool circle is tested against: the nearest sample is farther than
+the curve by at most (spacing / 2)^2 / (2 r_t), 6 nm for r_t = 0.5 mm. The involute's lowest reached point is then
+refined to 1/200 of it."""
+
+
+@dataclass(frozen=True)
+class FlatMillRoot:
+    """What a flat end mill of radius `tool_radius_mm` leaves at the root of every space."""
+
+    tool_radius_mm: float
+    form_radius_mm: float  # where the tool's contour leaves the involute (the rack-generated form radius at least)
+    rack_form_radius_mm: float  # the rack-generated involute's start
+    active_start_radius_mm: float  # start of the active profile (mesh with the basic rack)
+    fillet_radius_mm: float  # the smallest concave radius of the root that results (r_t when the tool leaves the
+    #                          rack's fillet, else the rack fillet's own smallest radius)
+    tool_leaves_rack_fillet: bool  # the tool cannot follow the rack-generated fillet everywhere
+
+    @property
+    def fits(self) -> bool:
+        """The involute is cut down to the start of the active profile."""
+        return self.form_radius_mm <= self.active_start_radius_mm + 1e-9
+
+
+def active_profile_start_radius_mm(spec: GearSpec) -> float:
+    """Radius where the active profile starts in mesh with the basic rack: the line of action meets the mating
+    rack's addendum line (h_a* m below the rolling line shifted by x m); the base radius if that is below it."""
+    alpha = spec.pressure_angle_rad
+    r, rb = spec.reference_radius_mm, spec.base_radius_mm
+    depth = (spec.addendum_coefficient - spec.profile_shift_coefficient) * spec.module_mm
+    along = r * math.sin(alpha) - depth / math.sin(alpha)  # from the base circle's tangent point
+    return math.sqrt(rb * rb + max(along, 0.0) ** 2)
+
+
+def _dense(segment, spacing_mm: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Points, normals (into the space) and parameters of one exact segment, about `spacing_mm` apart."""
+    coarse = segment.points(np.linspace(segment.start, segment.end, 257))
+    length = float(np.hypot(*np.diff(coarse, axis=0).T).sum())
+    parameters = np.linspace(segment.start, segment.end, max(2, math.ceil(length / spacing_mm) + 1))
+    return segment.points(parameters), segment.normals(parameters), parameters
+
+
+@dataclass(frozen=True)
+class _SpaceSamples:
+    """The exact outline of one space sampled once (a tree of both sides) and its involute's and fillet's points
+    with normals into the space."""
+
+    tree: cKDTree
+    involute: tuple[np.ndarray, np.ndarray, np.ndarray]  # points, normals, parameters
+    fillet: tuple[np.ndarray, np.ndarray, np.ndarray] | None
+
+
+def _space_samples(spec: GearSpec) -> _SpaceSamples:
+    profile = spec.tooth_space_profile()
+    parts = {segment.label: _dense(segment, ROOT_SAMPLE_SPACING_MM) for segment in profile.segments}
+    right = np.concatenate([p for p, _, _ in parts.values()])
+    tree = cKDTree(np.concatenate([right, right * np.array([-1.0, 1.0])]))
+    return _SpaceSamples(tree, parts["involute"], parts.get("fillet"))
+
+
+def flat_mill_root(spec: GearSpec, tool_radius_mm: float, samples: _SpaceSamples | None = None) -> FlatMillRoot:
+    """The root a flat end mill of radius `tool_radius_mm` leaves (see the module docstring): the involute's
+    lowest point whose tool circle (centre on the normal into the space, r_t away) stays clear of the whole space
+    outline (both sides, root, fillets) within 0.1 um."""
+    profile = spec.tooth_space_profile()
+    samples = samples or _space_samples(spec)
+    limit = tool_radius_mm - 1e-7  # only whether a sample is closer than this matters (a fast query)
+
+    def lowest_reached(points: np.ndarray, normals: np.ndarray) -> int:
+        clearance, _ = samples.tree.query(points + tool_radius_mm * normals, distance_upper_bound=limit)
+        unreached = np.flatnonzero(clearance < limit)
+        return 0 if len(unreached) == 0 else min(int(unreached[-1]) + 1, len(points) - 1)
+
+    points, normals, parameters = samples.involute
+    first = lowest_reached(points, normals)
+    form = float(np.hypot(*points[first]))
+    if first > 0:  # refined between the last sample not reached and the first reached
+        involute = profile.segment("involute")
+        fine = np.linspace(parameters[first - 1], parameters[first], 201)
+        fine_points = involute.points(fine)
+        form = float(np.hypot(*fine_points[lowest_reached(fine_points, involute.normals(fine))]))
+    follows = profile.min_fillet_curvature_radius_mm >= tool_radius_mm and first == 0
+    if samples.fillet is not None and follows:  # the tool follows the fillet's curvature: is the space wide enough?
+        fillet_points, fillet_normals, _ = samples.fillet
+        follows = bool(np.all(samples.tree.query(fillet_points + tool_radius_mm * fillet_normals,
+                                                 distance_upper_bound=limit)[0] >= limit))
+    fillet_radius = profile.min_fillet_curvature_radius_mm if follows and samples.fillet is not None \
+        else tool_radius_mm
+    return FlatMillRoot(tool_radius_mm, max(form, profile.form_radius_mm), profile.form_radius_mm,
+                        active_profile_start_radius_mm(spec), float(fillet_radius), not follows)
+
+
+def largest_flat_mill_radius_mm(spec: GearSpec, resolution_mm: float = 0.005) -> float:
+    """The largest flat end mill radius (to `resolution_mm`, rounded down) whose root leaves the involute no higher
+    than the start of the active profile; 0 when none does."""
+    samples = _space_samples(spec)
+    low, high = 0.0, spec.space_width_mm / 2.0
+    while high - low > resolution_mm:
+        middle = 0.5 * (low + high)
+        if flat_mill_root(spec, middle, samples).fits:
+            low = middle
+        else:
+            high = middle
+    return math.floor(low / resolution_mm) * resolution_mm
