@@ -1,0 +1,158 @@
+"""The 3-axis variant ([machine] axes = 3): LinuxCNC programs through rs274, and the tool-centre path it interprets
+(lines and arcs) checked at full depth against the exact outline (profile.py's segments, not the fitted arcs):
+no gouge, leftover on the active involute within the scallop target, a root fillet of the tool radius at least."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from scipy.spatial import cKDTree
+
+from spur_cad.cam.machine import Machine, RoughingParams
+from spur_cad.cam.three_axis import check_three_axis, finishing_toolpath, roughing_toolpath
+from spur_cad.cam.tools import Tool, ToolError
+from spur_cad.errors import SpurCadError
+from spur_cad.geometry import GearSpec
+from spur_cad.post import ProgramInfo, post_program
+from spur_cad.post.settings import PostSettings
+from tests.rs274_helper import canon_args, run_rs274
+
+REFERENCE = GearSpec(teeth=23, module_mm=4.0, rack_tip_radius_mm=0.8, thickness_allowance_fraction=0.05,
+                     face_width_mm=20.0)
+MODULE_1 = GearSpec(teeth=30, module_mm=1.0, rack_tip_radius_mm=0.25, face_width_mm=5.0)
+GOUGE_MM = 0.001
+SCALLOP_TARGET_MM = 0.005
+TOLERANCE_MM = 0.001  # chordal tolerance of the finishing arcs
+
+
+def flat(diameter_mm: float, number: int) -> Tool:
+    return Tool(diameter_mm=diameter_mm, kind="flat", tool_number=number, cutting_speed_m_min=100.0,
+                feed_per_tooth_mm=0.02)
+
+
+def interpreted_path(canon: list[str], spacing_mm: float = 0.002):
+    """Dense XY points of the tool centre on the deepest Z of the rs274 canonical calls (STRAIGHT_FEED and
+    ARC_FEED, arcs walked by their own centre and turn), and the number of arcs."""
+    x = y = z = math.nan
+    points, depths, arcs = [], [], 0
+    for line in canon:
+        if line.startswith(("STRAIGHT_FEED", "STRAIGHT_TRAVERSE")):
+            nx, ny, nz = canon_args(line)[:3]
+            if line.startswith("STRAIGHT_FEED") and nz == z:
+                n = max(1, math.ceil(math.hypot(nx - x, ny - y) / spacing_mm))
+                t = np.linspace(0.0, 1.0, n + 1)
+                points.append(np.stack([x + (nx - x) * t, y + (ny - y) * t], axis=-1))
+                depths.append(np.full(n + 1, z))
+            x, y, z = nx, ny, nz
+        elif line.startswith("ARC_FEED"):
+            ex, ey, cx, cy, rotation, ez = canon_args(line)[:6]
+            arcs += 1
+            r = math.hypot(x - cx, y - cy)
+            a0, a1 = math.atan2(y - cy, x - cx), math.atan2(ey - cy, ex - cx)
+            sweep = (a1 - a0) % (2 * math.pi) if rotation > 0 else -((a0 - a1) % (2 * math.pi))
+            n = max(1, math.ceil(abs(sweep) * r / spacing_mm))
+            angles = a0 + sweep * np.linspace(0.0, 1.0, n + 1)
+            points.append(np.stack([cx + r * np.cos(angles), cy + r * np.sin(angles)], axis=-1))
+            depths.append(np.full(n + 1, ez))
+            x, y, z = ex, ey, ez
+    points, depths = np.concatenate(points), np.concatenate(depths)
+    return points[depths == depths.min()], arcs
+
+
+def exact_outline(spec: GearSpec, spacing_mm: float = 0.002):
+    """The exact outline of every space (both halves of profile.py's segments), its labels and its points' radii."""
+    profile = spec.tooth_space_profile()
+    parts, labels = [], []
+    for segment in profile.segments:
+        dense = segment.points(np.linspace(segment.start, segment.end, 20001))
+        length = float(np.hypot(*np.diff(dense, axis=0).T).sum())
+        points = segment.points(np.linspace(segment.start, segment.end, max(2, math.ceil(length / spacing_mm))))
+        parts += [points, points * np.array([-1.0, 1.0])]
+        labels += [segment.label] * (2 * len(points))
+    space, labels = np.concatenate(parts), np.array(labels)
+    turns = 2 * math.pi * np.arange(spec.teeth) / spec.teeth
+    c, s = np.cos(turns)[:, None], np.sin(turns)[:, None]
+    everything = np.concatenate([np.stack([space[:, 0] * ci - space[:, 1] * si, space[:, 0] * si + space[:, 1] * ci],
+                                          axis=-1) for ci, si in zip(c, s)])
+    return everything, np.tile(labels, spec.teeth)
+
+
+def active_start_radius_mm(spec: GearSpec) -> float:
+    """Start of the active profile with the basic rack (textbook: the line of action meets the mating rack's
+    addendum line (1 - x) m inside the rolling line)."""
+    alpha = math.radians(spec.pressure_angle_deg)
+    r = spec.reference_radius_mm
+    along = r * math.sin(alpha) - (1.0 - spec.profile_shift_coefficient) * spec.module_mm / math.sin(alpha)
+    return math.hypot(r * math.cos(alpha), max(along, 0.0))
+
+
+def three_axis_program(spec: GearSpec, tool: Tool, tmp_path):
+    check_three_axis(spec, tool, None)
+    path, levels, _ = finishing_toolpath(spec, tool, Machine(), TOLERANCE_MM, spec.tip_radius_mm + 0.5)
+    text = post_program(path, PostSettings(), ProgramInfo("finishing", (), rotary_axis=False)).text
+    target = tmp_path / "finishing.ngc"
+    target.write_text(text)
+    return target, text, levels
+
+
+@pytest.mark.linuxcnc
+@pytest.mark.parametrize("spec, diameter_mm", [(REFERENCE, 2.0), (MODULE_1, 1.0)], ids=["reference_d2", "m1_d1"])
+def test_finishing_cuts_the_exact_outline_with_arcs(spec, diameter_mm, tmp_path):
+    program, text, levels = three_axis_program(spec, flat(diameter_mm, 2), tmp_path)
+    ok, canon, messages = run_rs274(program)
+    assert ok, messages
+    centres, arcs = interpreted_path(canon)
+    assert arcs > 0 and "G2" in text and "G3" in text
+    assert min(levels) <= -spec.face_width_mm  # through the face width
+    radius = diameter_mm / 2.0
+    outline, labels = exact_outline(spec)
+    clearance, _ = cKDTree(centres).query(outline)
+    gouge = radius - clearance  # > 0: the tool circle reaches inside the exact outline
+    assert gouge.max() <= GOUGE_MM, f"gouge {gouge.max() * 1000:.2f} um"
+    radii = np.hypot(*outline.T)
+    active = (labels == "involute") & (radii >= active_start_radius_mm(spec))
+    leftover = clearance[active] - radius
+    assert leftover.max() <= SCALLOP_TARGET_MM, f"leftover {leftover.max() * 1000:.2f} um on the active involute"
+    # the root the tool leaves: its deepest tool circles reach the root circle but no deeper, and every concave
+    # part of what is left is a tool circle (radius r) or wider: a circle of r inside the cut touches each point
+    cut_bottom = (np.hypot(*centres.T) - radius).min()
+    assert cut_bottom >= spec.root_radius_mm - GOUGE_MM
+    root_region = labels != "tip"
+    left = outline[root_region]
+    offsets = np.hypot(*left.T)
+    near_root = offsets < active_start_radius_mm(spec)
+    _, nearest = cKDTree(centres).query(left[near_root])
+    boundary = centres[nearest] + radius * (left[near_root] - centres[nearest]) / np.linalg.norm(
+        left[near_root] - centres[nearest], axis=1)[:, None]  # where the tool circle touches toward the outline
+    inside = cKDTree(centres).query(boundary)[0]
+    assert inside.min() >= radius - GOUGE_MM  # each such point has a whole tool circle of radius r in the cut
+
+
+@pytest.mark.linuxcnc
+def test_roughing_program_is_accepted_and_leaves_the_finish_stock(tmp_path):
+    spec, tool = MODULE_1, flat(1.0, 1)
+    params = RoughingParams()
+    path, levels, offsets = roughing_toolpath(spec, tool, Machine(), params, spec.tip_radius_mm + 0.5)
+    program = tmp_path / "roughing.ngc"
+    program.write_text(post_program(path, PostSettings(), ProgramInfo("roughing", (), rotary_axis=False)).text)
+    ok, canon, messages = run_rs274(program)
+    assert ok, messages
+    centres, _ = interpreted_path(canon)
+    outline, _ = exact_outline(spec)
+    clearance, _ = cKDTree(centres).query(outline)
+    assert clearance.min() - tool.diameter_mm / 2.0 >= params.finish_stock_mm - 0.001
+    assert max(abs(z) for z in levels[:1]) <= params.max_level_depth_fraction * tool.diameter_mm + 1e-9
+
+
+def test_a_tool_too_large_for_the_root_is_refused_naming_the_largest_that_works():
+    with pytest.raises(ToolError, match=r"largest tool radius that works is 0\.5\d\d mm"):
+        check_three_axis(MODULE_1, flat(2.0, 2), None)
+
+
+def test_helical_gears_are_refused_at_the_axes_key():
+    helical = GearSpec(teeth=30, module_mm=1.0, rack_tip_radius_mm=0.25, face_width_mm=5.0, helix_angle_deg=15.0)
+    with pytest.raises(SpurCadError, match=r"axes = 3 cuts spur gears only") as caught:
+        check_three_axis(helical, flat(1.0, 2), None)
+    assert caught.value.field == "axes"
