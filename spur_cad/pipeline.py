@@ -180,11 +180,15 @@ def program_info(job: Job, plan: CamPlan, operation: str, restart_comment: str |
     radius = stock.blank_radius_mm(spec)
     x_front, x_back = stock.blank_x_range_mm(spec)
     box = (x_front, -radius, -radius, x_back + stock.stub_length_mm, radius, radius)
+    three_axes = job.machine.axes == 3
+    if three_axes:  # the blank lying flat, Z0 on its top face
+        box = (-radius, -radius, -spec.face_width_mm, radius, radius, 0.0)
     title = f"spur_cad {__version__} {operation}" + (" restart" if restart_comment else "") + f": {job.job.name}"
     comments = program_comments(job, plan, operation) + ((restart_comment,) if restart_comment else ())
     return ProgramInfo(title=title, comments=comments, rotary_clamp_code=job.machine.rotary_clamp_code,
                        rotary_unclamp_code=job.machine.rotary_unclamp_code, blank_box_mm=box,
-                       approach_z_mm=approach_z_mm, first_space_a_reference_deg=a_reference_deg)
+                       approach_z_mm=approach_z_mm, first_space_a_reference_deg=a_reference_deg,
+                       rotary_axis=not three_axes)
 
 
 def lathe_program(job: Job) -> tuple[str, bytes]:
@@ -237,6 +241,8 @@ def restart_program(job: Job, plan: CamPlan, point: RestartPoint) -> tuple[str, 
 def program_comments(job: Job, plan: CamPlan, operation: str) -> tuple[str, ...]:
     """Header comments of a program: gear data, tool, strategy, estimated time (no date: outputs are reproducible)."""
     spec = job.gear
+    if job.machine.axes == 3:
+        return _three_axis_comments(job, plan, operation)
     if operation in ("roughing", "roughing_bottom"):
         planned = getattr(plan, operation)
         strategy = (f"strategy: {len(planned.levels.heights_mm)} levels per space, flank allowance "
@@ -280,6 +286,30 @@ def program_comments(job: Job, plan: CamPlan, operation: str) -> tuple[str, ...]
     )
 
 
+def _three_axis_comments(job: Job, plan: CamPlan, operation: str) -> tuple[str, ...]:
+    """Header comments of a 3-axis program ([machine] axes = 3): gear, tool, what it does, the set-up."""
+    spec, planned = job.gear, getattr(plan, operation)
+    tool = planned.tool
+    if operation == "roughing":
+        what = (f"3-axis roughing: {len(planned.levels.heights_mm)} levels, concentric passes from the blank to "
+                f"{job.roughing.finish_stock_mm:g} mm from the outline")
+    else:
+        facts = planned.result.facts
+        what = (f"3-axis finishing: the outline as arcs offset by the tool radius, {facts.step_downs} step-downs, "
+                f"climb; form diameter {facts.form_diameter_mm:.3f} mm, root fillet >= "
+                f"{facts.root_fillet_radius_mm:.3f} mm")
+    return (
+        f"gear: z = {spec.teeth}, m = {spec.module_mm:g} mm, alpha = {spec.pressure_angle_deg:g} deg, "
+        f"x = {spec.profile_shift_coefficient:g}, b = {spec.face_width_mm:g} mm, tip diameter "
+        f"{2 * spec.tip_radius_mm:.4f} mm",
+        f"tool: T{tool.tool_number} {tool.kind} D {tool.diameter_mm:g} mm",
+        what,
+        f"estimated time: {planned.estimate.time_s / 60.0:.1f} min ({planned.estimate.moves} moves)",
+        "frame: gear axis = Z, X0 Y0 on it, Z0 on the blank's top face, blank clamped flat; tool tip centre "
+        "programmed",
+    )
+
+
 def build_cad(job: Job, checkpoint: Callable[[], None] | None = None,
               timestamp: str | None = None) -> tuple[CadResult, dict[str, bytes]]:
     """Gear solid, stock and STEP files; returns (CAD facts, files). `checkpoint()` between the steps;
@@ -301,7 +331,8 @@ def build_cad(job: Job, checkpoint: Callable[[], None] | None = None,
 def cam_inputs(job: Job) -> CamInputs:
     """The part of a job the CAM stage reads."""
     return CamInputs(job.gear, job.stock, job.tools.roughing, job.tools.finishing, job.roughing, job.finishing,
-                     job.machine, job.tools.bottom, top_tool=job.tools.roughing_top, strategies=job.strategies)
+                     job.machine, job.tools.bottom, top_tool=job.tools.roughing_top, strategies=job.strategies,
+                     profile_tolerance_mm=job.job.profile_tolerance_mm)
 
 
 def plan_cam(job: Job, checkpoint: Callable[[], None] | None = None) -> CamPlan:
@@ -323,7 +354,7 @@ def simulate_stage(job: Job, plan: CamPlan, progress: Callable[[float], None] | 
 
     operations = [Cut(planned.toolpath, planned.tool) for planned in (plan.roughing, plan.roughing_bottom,
                                                                       plan.finishing) if planned is not None]
-    if not job.simulation.enabled or not operations:
+    if not job.simulation.enabled or not operations or job.machine.axes == 3:  # 3 axes: not simulated (a warning)
         return None
     stations = plan.finishing.result.station_x_mm if plan.finishing is not None else np.zeros(0)
     result = simulate(job.gear, job_stock(job), operations, SimSettings(resolution_mm=job.simulation.resolution_mm),

@@ -156,3 +156,20 @@ def test_helical_gears_are_refused_at_the_axes_key():
     with pytest.raises(SpurCadError, match=r"axes = 3 cuts spur gears only") as caught:
         check_three_axis(helical, flat(1.0, 2), None)
     assert caught.value.field == "axes"
+
+
+def test_a_three_axis_job_runs_through_the_pipeline_without_a_rotary_axis(tmp_path):
+    from spur_cad.job import load_job
+    from spur_cad.pipeline import run_job
+    from tests.gears import REFERENCE_JOB
+
+    job_file = tmp_path / "three.toml"
+    job_file.write_text(REFERENCE_JOB.read_text().replace('kind = "bull_nose"', 'kind = "flat"').replace(
+        "corner_radius_mm = 0.5\n", "").replace("[machine]\n", "[machine]\naxes = 3\n"))
+    result = run_job(load_job(job_file))
+    finishing = result.files["finishing.ngc"].decode()
+    roughing = result.files["roughing.ngc"].decode()
+    assert "G2 " in finishing and "G3 " in finishing and "gear axis = Z" in finishing
+    for program in (finishing, roughing):
+        assert not [line for line in program.splitlines() if not line.startswith("(") and " A" in line]
+    assert any("not simulated" in w for w in result.warnings)

@@ -139,6 +139,7 @@ class CamInputs:
     bottom_tool: Tool | None = None  # two-stage roughing: the smaller tool for the bottom of the spaces
     top_tool: Tool | None = None  # two-stage roughing offered: a larger tool above roughing_tool ([tools.roughing_top])
     strategies: Strategies = field(default_factory=lambda: dict(REGISTRY))  # where [finishing] strategy is found
+    profile_tolerance_mm: float = 0.001  # [job] profile_tolerance_mm: the 3-axis finishing arcs' chordal tolerance
 
 
 def check_cam_inputs(inputs: CamInputs) -> tuple[ToolRecommendations, RoughingLevels | None]:
@@ -300,6 +301,8 @@ def plan_cam(inputs: CamInputs, checkpoint: Callable[[], None] | None = None) ->
     """Tool recommendations always; toolpaths and estimates for the tools the job gives (pure).
     `checkpoint()` is called between the steps (a front end may stop there)."""
     check = checkpoint if checkpoint is not None else (lambda: None)
+    if inputs.machine.axes == 3:  # the blank lying flat (spur_cad.cam.three_axis)
+        return _plan_three_axis(inputs, inputs.profile_tolerance_mm)
     rec, levels = check_cam_inputs(inputs)
     blank = inputs.stock.blank_radius_mm(inputs.spec)
     roughing = finishing = None
@@ -578,3 +581,45 @@ def _comparison_estimate(spec: GearSpec, tool: Tool, machine: Machine, blank: fl
         return strategy.estimate(spec, tool, simultaneous, params, blank)  # without building its toolpath
     except (WorkLimitError, MachineError, ToolError):
         return None
+
+
+def _plan_three_axis(inputs: CamInputs, tolerance_mm: float) -> CamPlan:
+    """The CAM plan of a 3-axis job ([machine] axes = 3): the checks of three_axis.check_three_axis, roughing and
+    finishing as spur_cad.cam.three_axis says; no tool recommendations for the rotary-table strategies
+    (empty), no simulation (a warning says so)."""
+    from spur_cad.cam.roughing import RoughingLevels
+    from spur_cad.cam.three_axis import (
+        ThreeAxisFinishingFacts,
+        check_three_axis,
+        finishing_toolpath,
+        roughing_toolpath,
+    )
+
+    spec, machine, stock = inputs.spec, inputs.machine, inputs.stock
+    if inputs.finishing_tool is not None and inputs.roughing_tool is None:
+        raise ToolError("[machine] axes = 3 needs [tools.roughing]: finishing cuts only the finish stock around the "
+                        "outline", field="diameter_mm", section="tools.roughing")
+    root = check_three_axis(spec, inputs.finishing_tool, inputs.roughing_tool)
+    blank = stock.blank_radius_mm(spec)
+    rec = recommend_tools(spec, blank, machine.clearance_mm, inputs.finishing_tool, inputs.finishing.target_scallop_mm)
+    roughing = finishing = None
+    if inputs.roughing_tool is not None:
+        inputs.roughing.validate()
+        tool = inputs.roughing_tool
+        path, levels, offsets = roughing_toolpath(spec, tool, machine, inputs.roughing, blank)
+        check_travel(machine, path.x, path.y, path.z, path.a, "roughing")
+        roughing = RoughingPlan(tool, RoughingLevels(np.array(levels), np.array(offsets[:1] * len(levels)), None),
+                                0.0, path, estimate(path, machine))
+    if inputs.finishing_tool is not None:
+        tool = inputs.finishing_tool
+        path, levels, segments = finishing_toolpath(spec, tool, machine, tolerance_mm, blank)
+        check_travel(machine, path.x, path.y, path.z, path.a, "finishing")
+        arcs = int(path.arc_mask.sum()) // len(levels) - 2  # less the lead-in and lead-out arcs
+        facts = ThreeAxisFinishingFacts(tool.diameter_mm / 2.0, 2 * root.form_radius_mm, 2 * root.rack_form_radius_mm,
+                                        2 * root.active_start_radius_mm, root.fillet_radius_mm, len(levels),
+                                        segments, arcs)
+        result = FinishingResult("three_axis", None, None, len(levels), 0.0, np.zeros(0), facts=facts)
+        finishing = FinishingPlan(tool, result, path, estimate(path, machine), None, None)
+    warnings = ("[machine] axes = 3: the cut is not simulated nor graded (the simulator models the rotary table's "
+                "stock); the LinuxCNC programs are checked by rs274 in the tests",)
+    return CamPlan(rec, roughing, finishing, warnings)

@@ -202,3 +202,26 @@ def _started_at_nearest(coords: np.ndarray, point: np.ndarray) -> np.ndarray:
     feet = a + t[:, None] * d
     i = int(np.argmin(np.hypot(*(feet - point).T)))
     return np.concatenate([[feet[i]], coords[i + 1:], coords[:i + 1], [feet[i]]])
+
+
+@dataclass(frozen=True)
+class ThreeAxisFinishingFacts:
+    """The finishing facts of the 3-axis variant (FinishingResult.facts: summary and report)."""
+
+    tool_radius_mm: float
+    form_diameter_mm: float  # where the tool's contour leaves the involute
+    rack_form_diameter_mm: float  # the rack-generated involute's start
+    active_start_diameter_mm: float  # the active profile's start (mesh with the basic rack)
+    root_fillet_radius_mm: float  # the smallest concave radius the root is left with
+    step_downs: int
+    segments_per_loop: int  # arcs and lines of one finishing loop
+    arcs_per_loop: int
+
+    def report_text(self) -> str:
+        return (f"Finishing (3 axes): the outline as {self.arcs_per_loop} arcs and "
+                f"{self.segments_per_loop - self.arcs_per_loop} lines per loop, offset by the tool radius "
+                f"{self.tool_radius_mm:g} mm, in {self.step_downs} step-downs (climb). The tool's side leaves the "
+                f"involute at diameter {self.form_diameter_mm:.3f} mm (rack-generated {self.rack_form_diameter_mm:.3f}"
+                f" mm, active profile from {self.active_start_diameter_mm:.3f} mm) and a root fillet of "
+                f"{self.root_fillet_radius_mm:.3f} mm radius at least.")
+

@@ -29,13 +29,17 @@ def report_html(result: JobResult, profile_png: bytes, spec: GearSpec, blank_rad
     )
 
     images = {"profile": profile_png}
-    if plan.roughing is not None and plan.roughing.flank is not None:
+    if plan.finishing is not None and plan.finishing.result.strategy == "three_axis":
+        pass  # [machine] axes = 3: no level or contact figures (the report's text says what was planned)
+    elif plan.roughing is not None and plan.roughing.flank is not None:
         images["roughing"] = roughing_flank_png(spec, plan.roughing.flank, plan.roughing.tool, blank_radius_mm)
     elif plan.roughing is not None:
         levels = plan.roughing.levels
         images["roughing"] = roughing_levels_png(spec, levels.heights_mm, levels.half_widths_mm, plan.roughing.tool,
                                                  blank_radius_mm)
-    if plan.finishing is not None and plan.finishing.result.passes:
+    if plan.finishing is not None and plan.finishing.result.strategy == "three_axis":
+        pass
+    elif plan.finishing is not None and plan.finishing.result.passes:
         images["finishing"] = passes_png(spec, plan.finishing.tool, plan.finishing.result.passes, blank_radius_mm)
     elif plan.finishing is not None:
         poses = plan.finishing.result.poses
