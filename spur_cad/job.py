@@ -134,6 +134,25 @@ class SimulationSection:
 
 
 @dataclass(frozen=True)
+class ExportSection:
+    """[export]: the gear's transverse outline as 2-D drawings for wire EDM, laser and waterjet (docs/geometry.md):
+    closed loops of arcs and lines within [job] profile_tolerance_mm, offset by offset_mm."""
+
+    dxf: bool = key(False, label="ExportDxf", group="2-D export",
+                    meaning="write gear.dxf: one closed LWPOLYLINE with arcs per loop, layers OUTLINE and BORE, mm "
+                            "(spur gears only)")
+    svg: bool = key(False, label="ExportSvg", group="2-D export",
+                    meaning="write gear.svg: the same loops as SVG paths with arcs, in mm (spur gears only)")
+    offset_mm: float = key(0.0, unit="mm", low=-10.0, high=10.0, label="ExportOffset", group="2-D export",
+                           meaning="loops offset this far away from the material (outside the gear, inside the bore): "
+                                   "wire radius plus spark gap for wire EDM, half the kerf for laser and waterjet, "
+                                   "so the file is the path of the cut's centre; 0: the part's own outline")
+
+    def validate(self) -> None:
+        check_section(self, "export", JobFileError)
+
+
+@dataclass(frozen=True)
 class ToolsSection:
     """[tools]: the roughing and finishing tools (without them the job stops after the CAD stage)."""
 
@@ -158,6 +177,7 @@ class Job:
     machine: Machine = field(default_factory=Machine)
     post: PostSettings = field(default_factory=PostSettings)
     simulation: SimulationSection = field(default_factory=SimulationSection)
+    export: ExportSection = field(default_factory=ExportSection)
     lathe: LatheSection | None = None  # [lathe] present: the blank's lathe program is written too
     probe: ProbeSection | None = None  # [probe] present: the on-machine probing program is written too
     text: str = field(default="", repr=False, compare=False)  # the file's text, to point at lines
@@ -193,6 +213,7 @@ SECTIONS: dict[str, type] = {
     "finishing": FinishingParams,
     "machine": Machine,
     "simulation": SimulationSection,
+    "export": ExportSection,
     "post": PostSettings,
     "lathe": LatheSection,
     "probe": ProbeSection,
@@ -498,7 +519,7 @@ def _validate_sections(sections: dict, tables: dict, types: dict, autos: dict[st
                        strategies: Strategies, where: Callable[[str, str | None], str]) -> None:
     """Every section's own checks, the tools last: their "auto" keys are resolved once the sections the
     suggestion depends on (machine, roughing, finishing) have passed theirs."""
-    for name in ("machine", "roughing", "finishing", "post", "lathe", "probe",
+    for name in ("machine", "roughing", "finishing", "post", "export", "lathe", "probe",
                  *(f"tools.{role}" for role in _TOOL_ROLES)):
         if name not in sections:
             continue
@@ -557,8 +578,10 @@ def _job_from_data(data: dict, source: str, text: str, strategies: Strategies = 
             raise JobFileError(f"{where(name, blamed)}: {exc}", section=name, field=blamed) from None
     if "probe" in sections:
         _check_probe(spec, sections, tools, tables, where)
-    optional = {name: sections[name] for name in ("stock", "roughing", "machine", "post", "simulation", "lathe",
-                                                  "probe") if name in sections}
+    if "export" in sections:
+        _check_export(spec, gear_section, sections["export"], tables, where)
+    optional = {name: sections[name] for name in ("stock", "roughing", "machine", "post", "simulation", "export",
+                                                  "lathe", "probe") if name in sections}
     finishing = sections["finishing"] if "finishing" in sections else types["finishing"]()  # the registry's default
     return Job(source=source, job=sections.get("job", JobSection()), gear_section=gear_section, gear=spec,
                tools=tools, finishing=finishing, **optional, text=text, strategies=dict(strategies))
@@ -584,6 +607,32 @@ def _check_probe(spec: GearSpec, sections: dict, tools: ToolsSection, tables: di
         name = exc.section if exc.section in ("post", "probe") else "probe"
         blamed = _blamed_key(exc, name, tables.get(name, {}))
         raise JobFileError(f"{where(name, blamed)}: {exc}", section=name, field=blamed) from None
+
+
+def _check_export(spec: GearSpec, gear_section: GearSection, export: ExportSection, tables: dict,
+                  where: Callable[[str, str | None], str]) -> None:
+    """[export] with dxf or svg: a spur gear (a wire, laser or waterjet cuts straight teeth only), and an offset
+    that leaves the root fillet and every loop intact (computed here, before the run): one line at the key."""
+    from spur_cad.outline_export import ExportError, gear_layers
+
+    if not (export.dxf or export.svg):
+        return
+    blamed = "dxf" if export.dxf else "svg"
+    if spec.is_helical:
+        raise JobFileError(f"{where('export', blamed)}: [export] {blamed} = true: a helical gear's teeth are not "
+                           "straight, and a wire, laser or waterjet cuts straight (spur) teeth only",
+                           section="export", field=blamed)
+    fillet_radius = spec.tooth_space_profile().min_fillet_curvature_radius_mm
+    if export.offset_mm >= fillet_radius:
+        raise JobFileError(f"{where('export', 'offset_mm')}: [export] offset_mm = {export.offset_mm:g} mm is too big "
+                           f"for the root: it must stay below the root fillet's smallest curvature radius "
+                           f"{fillet_radius:.4f} mm, or the cut rounds the fillet off", section="export",
+                           field="offset_mm")
+    try:
+        gear_layers(spec, 0.01, export.offset_mm, gear_section.bore_diameter_mm, gear_section.keyway_width_mm,
+                    gear_section.keyway_depth_mm)
+    except ExportError as exc:
+        raise JobFileError(f"{where('export', 'offset_mm')}: {exc}", section="export", field="offset_mm") from None
 
 
 MAX_TEMPLATE_BYTES = 256 * 1024

@@ -67,6 +67,16 @@ Notes:
   alone (a warning says why).
 - `[lathe]`: with the section the blank's lathe program `blank.<ext>` is written too (see
   [lathe.md](lathe.md)).
+- `[export]`: `dxf = true` / `svg = true` write `gear.dxf` / `gear.svg`, the gear's transverse
+  outline as closed loops of arcs and lines (root and tip arcs exact, fillet and involute by
+  tangent-continuous biarcs within `[job] profile_tolerance_mm`): layer `OUTLINE`, and `BORE` (the
+  bore with its keyway) when `[gear]` has a bore. `offset_mm` moves every loop away from the material
+  (outside the gear, into the bore) exactly, arcs to concentric arcs, so a positive value is the wire
+  or beam centre's path: wire radius plus spark gap for wire EDM, half the kerf for laser and waterjet;
+  0 writes the part's outline for a machine that compensates itself. An offset at or above the root
+  fillet's smallest curvature radius is refused (the cut would round the fillet off), as is one that
+  breaks a loop. Helical gears are refused (a wire cuts straight teeth only). See
+  [geometry.md](geometry.md).
 """
 
 _TYPE_WORDS = {float: "number", int: "integer", bool: "boolean", str: "string"}

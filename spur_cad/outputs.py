@@ -54,6 +54,7 @@ _PROGRAM_EXTENSION = r"(ngc|nc|mpf|min)"  # every milling and lathe dialect's (c
 _OPERATION = r"(roughing|roughing_bottom|finishing)"
 OUTPUT_NAME = re.compile(
     r"profile\.(csv|png)|(gear|stock|job)\.step|report\.html|summary\.json"  # spur-cad run
+    r"|gear\.(dxf|svg)"  # [export]
     rf"|{_OPERATION}\.{_PROGRAM_EXTENSION}|(blank|probe)\.{_PROGRAM_EXTENSION}"  # programs
     rf"|{_OPERATION}_(space|station)\d{{1,7}}(_(level|pass)\d{{1,7}})?\.{_PROGRAM_EXTENSION}"  # restart programs
     r"|verify\.json|deviation_map\.csv"  # spur-cad verify

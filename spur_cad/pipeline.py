@@ -90,6 +90,7 @@ def run_job(job: Job, progress: Callable[[str, float], None] | None = None,
     if job.probe is not None:
         name, text = timed("probe", None, lambda: probe_program(job))
         program_files[name] = text
+    drawings = timed("export", None, lambda: export_files(job)) if job.export.dxf or job.export.svg else {}
     sim_result = timed("simulation", "simulation",
                        lambda: simulate_stage(job, plan, lambda fraction: tell("simulation", fraction)))
     grading = timed("grading", None, lambda: grade_stage(job, sim_result))
@@ -106,6 +107,7 @@ def run_job(job: Job, progress: Callable[[str, float], None] | None = None,
         "profile.png": png,
         **step,
         **program_files,
+        **drawings,
         "report.html": report,
         "summary.json": (json.dumps(summary_json(result), indent=2, sort_keys=False) + "\n").encode(),
     }
@@ -216,6 +218,24 @@ def probe_program(job: Job) -> tuple[str, bytes]:
     plan = plan_probe(spec, job.stock, job.machine, job.probe)
     text = post_probe(plan, job.post, f"spur_cad {__version__} probe: {job.job.name}", gear)
     return f"probe.{probing_dialect(job.post.dialect).extension}", text.encode()
+
+
+def export_files(job: Job) -> dict[str, bytes]:
+    """[export]: gear.dxf and gear.svg, the outline (and bore) offset by offset_mm (spur_cad.outline_export)."""
+    from spur_cad.outline_export import dxf_bytes, gear_layers, svg_bytes
+
+    export, gear = job.export, job.gear_section
+    if not (export.dxf or export.svg):
+        return {}
+    layers = gear_layers(job.gear, job.job.profile_tolerance_mm, export.offset_mm, gear.bore_diameter_mm,
+                         gear.keyway_width_mm, gear.keyway_depth_mm)
+    files = {}
+    if export.dxf:
+        files["gear.dxf"] = dxf_bytes(layers)
+    if export.svg:
+        title = f"spur_cad {__version__}: {job.job.name}, outline offset {export.offset_mm:g} mm"
+        files["gear.svg"] = svg_bytes(layers, title)
+    return files
 
 
 def restart_program(job: Job, plan: CamPlan, point: RestartPoint) -> tuple[str, bytes]:

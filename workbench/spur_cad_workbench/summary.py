@@ -183,6 +183,10 @@ def group_summary(group: str, job: dict[str, object], units=None) -> str:
         text = "program written" if job.get("WriteLatheProgram") else "no program"
     elif group == "Probe":
         text = "program written" if job.get("WriteProbeProgram") else "no program"
+    elif group == "2-D export":
+        formats = [name for name, prop in (("DXF", "ExportDxf"), ("SVG", "ExportSvg")) if job.get(prop)]
+        offset = length_text(float(job.get("ExportOffset", 0.0)), "mm", units)
+        text = f"{' + '.join(formats)}, offset {offset}" if formats else "not written"
     elif group == "Job":
         text = str(job.get("JobName", ""))
     else:
