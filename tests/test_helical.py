@@ -302,10 +302,11 @@ def test_spur_cad_run_writes_the_helical_job_and_refuses_a_wrong_corner_naming_t
     assert f"normal section; needs face width &gt; {summary['inspection']['span_min_face_width_mm']:.2f} mm" in report
     assert f'<th>lead</th><td class="num">{summary["gear"]["lead_mm"]:.3f}</td><td class="unit">mm</td>' in report
     job = tmp_path / "helical.toml"
-    with_tools = HELICAL_JOB + "[tools.finishing]\nkind = 'bull_nose'\ndiameter_mm = 2.0\ncorner_radius_mm = 0.5\n"
+    with_tools = HELICAL_JOB + "[tools.finishing]\nkind = 'bull_nose'\ndiameter_mm = 2.0\ncorner_radius_mm = 0.9\n"
     job.write_text(with_tools)
     result = run_cli("run", str(job), "--out", str(tmp_path / "out2"))
-    assert result.returncode == 2 and len(result.stderr.strip().splitlines()) == 1
-    line = 1 + with_tools.splitlines().index("corner_radius_mm = 0.5")
-    assert f"helical.toml:{line}: " in result.stderr and "must equal the rack tip radius rho = 0.8" in result.stderr
+    assert result.returncode == 2 and len(result.stderr.strip().splitlines()) == 1, result.stderr
+    line = 1 + with_tools.splitlines().index("corner_radius_mm = 0.9")
+    assert f"helical.toml:{line}: " in result.stderr, result.stderr
+    assert "larger than the rack tip radius rho = 0.8" in result.stderr, result.stderr
     assert not (tmp_path / "out2").exists()

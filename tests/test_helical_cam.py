@@ -322,9 +322,9 @@ def test_helical_finishing_tools_and_strategies_are_refused_with_their_reason():
     from spur_cad.errors import SpurCadError
 
     job = _job()
-    smaller = dataclasses.replace(job.tools.finishing, corner_radius_mm=0.5)
-    with pytest.raises(ToolError, match="must equal the rack tip radius rho = 0.8") as error:
-        plan_cam(dataclasses.replace(job, tools=dataclasses.replace(job.tools, finishing=smaller)))
+    larger = dataclasses.replace(job.tools.finishing, corner_radius_mm=0.9)
+    with pytest.raises(ToolError, match="larger than the rack tip radius rho = 0.8") as error:
+        plan_cam(dataclasses.replace(job, tools=dataclasses.replace(job.tools, finishing=larger)))
     assert error.value.field == "corner_radius_mm"
     wide = dataclasses.replace(job.tools.finishing, diameter_mm=3.6)
     with pytest.raises(ToolError, match="wider than the rack's normal tip flat"):
@@ -434,3 +434,109 @@ def test_the_helical_simulation_gives_the_same_bits_on_any_number_of_threads(fin
     assert np.array_equal(one.deviation, three.deviation)
     # the space was cut: the blades hold different lengths (finished flanks; a tip land roughed to the finish stock)
     assert np.ptp(one.deviation[0]) > job.roughing.finish_stock_mm
+
+
+# Issue 31.4: a helical gear whose rack tip radius (0.6 mm) is not a stock corner, finished with a 0.5 mm corner.
+SMALL_CORNER_RHO_MM, SMALL_CORNER_MM = 0.6, 0.5
+
+
+@pytest.fixture(scope="module")
+def small_corner():
+    job = _job()
+    gear = dataclasses.replace(job.gear, rack_tip_radius_mm=SMALL_CORNER_RHO_MM)
+    tool = dataclasses.replace(job.tools.finishing, corner_radius_mm=SMALL_CORNER_MM)
+    job = dataclasses.replace(job, gear=gear, tools=dataclasses.replace(job.tools, finishing=tool))
+    return job, plan_cam(job)
+
+
+def _corner_passes(path, z_of_contact: float):
+    """Rows of space 0's right-fillet cutting moves whose tip height is `z_of_contact` (one contact angle)."""
+    return ((path.space == 0) & (path.feature == Feature.RIGHT_FLANK) & (path.kind == MoveKind.LINEAR)
+            & np.isclose(path.z, z_of_contact, rtol=0.0, atol=1e-9))
+
+
+def test_a_smaller_corner_finishes_a_helical_gear_without_gouge_within_the_target(small_corner):
+    """The exact sweep of every finishing move of space 0 against the design at three sections: no penetration
+    beyond 0.5 um, the leftover within the target + 0.5 um; the corner's passes sit at several heights (one per
+    contact angle on the rack round, r_f + (rho - r_t)(1 - cos b)) between r_f and r_f + rho - r_t."""
+    job, plan = small_corner
+    path = plan.finishing.toolpath
+    deepest, leftover = _sweep_check(job, path)
+    assert deepest <= 0.0005, deepest
+    assert leftover <= job.finishing.target_scallop_mm + 0.0005, leftover
+    tip = [p for p in plan.finishing.result.passes if p.mode == "tip" and p.feature == Feature.RIGHT_FLANK]
+    heights = np.unique(np.round([p.z_mm for p in tip], 9))
+    rf, gap = job.gear.root_radius_mm, SMALL_CORNER_RHO_MM - SMALL_CORNER_MM
+    assert len(heights) >= 3 and heights.min() >= rf - 1e-9 and heights.max() <= rf + gap + 1e-9
+
+
+@pytest.mark.slow
+def test_the_smaller_corner_check_finds_planted_faults(small_corner):
+    """The corner's passes 3 um too low gouge the fillet; the passes of one contact angle left out leave more
+    than the target."""
+    from spur_cad.sim import shifted
+
+    job, plan = small_corner
+    path = plan.finishing.toolpath
+    fillet = (path.space == 0) & (path.feature == Feature.RIGHT_FLANK) & (path.z < job.gear.root_radius_mm + 0.2)
+    deepest, _ = _sweep_check(job, shifted(path, fillet, dz=-0.003))
+    assert deepest > 0.0025
+    heights = sorted({round(p.z_mm, 9) for p in plan.finishing.result.passes
+                      if p.mode == "tip" and p.feature == Feature.RIGHT_FLANK})
+    _, leftover = _sweep_check(job, subset(path, ~_corner_passes(path, heights[len(heights) // 2])))
+    assert leftover > job.finishing.target_scallop_mm + 0.001, leftover
+
+
+def test_the_smaller_corner_job_simulated_is_within_target_and_resolution(small_corner):
+    """Three spaces roughed and finished with the 0.5 mm corner, the middle one measured over the whole face."""
+    job, plan = small_corner
+
+    def of(path):
+        return subset(path, np.isin(path.space, [0, 1, 2]))
+
+    result = simulate(job.gear, job_stock(job), [Cut(of(plan.roughing.toolpath), job.tools.roughing),
+                                                 Cut(of(plan.finishing.toolpath), job.tools.finishing)],
+                      SimSettings(resolution_mm=RES))
+    middle = result.deviation[1][:, result.gear_rows]
+    assert -middle.min() <= RES
+    assert middle.max() <= job.finishing.target_scallop_mm + RES
+
+
+def test_the_smaller_corner_advice_and_recommendations_accept_any_corner_up_to_rho(small_corner):
+    """The advice gives this corner's largest diameter (2 d_n + 2 r_t), the recommendations a flat end mill's
+    refusal that asks for 0 < r_t <= rho, and a corner above rho is refused naming rho."""
+    from spur_cad.cam.recommend import check_tools, generating_max_diameter_mm, recommend_tools
+    from spur_cad.cam.strategies import get_strategy
+    from spur_cad.cam.tools import Tool, ToolError
+    from spur_cad.geometry.profile import rack_corner
+
+    job, plan = small_corner
+    spec = job.gear
+    d_n = rack_corner(spec).normal_corner_offset_mm
+    advice = plan.finishing.result.tool_advice
+    assert advice.advised_corner_radius_mm == SMALL_CORNER_RHO_MM
+    assert advice.tip_mode_max_diameter_mm == pytest.approx(2.0 * d_n + 2.0 * SMALL_CORNER_MM, abs=1e-12)
+    assert generating_max_diameter_mm(spec, SMALL_CORNER_MM, 0.005, spec.tip_radius_mm) == pytest.approx(
+        2.0 * d_n + 2.0 * SMALL_CORNER_MM, abs=1e-12)
+    rec = recommend_tools(spec, spec.tip_radius_mm + 0.5, 1.0)
+    with pytest.raises(ToolError, match=r"corner radius 0 < r_t <= the rack tip radius rho = 0.6 mm") as error:
+        check_tools(spec, rec, None, Tool(diameter_mm=1.0, kind="flat", flutes=2))
+    assert "equal" not in str(error.value)
+    with pytest.raises(ToolError, match=r"r_t = 0.7 mm is larger than the rack tip radius rho = 0.6 mm"):
+        get_strategy("generating").check_tool(spec, Tool(diameter_mm=2.0, kind="bull_nose", corner_radius_mm=0.7))
+
+
+@pytest.mark.linuxcnc
+def test_rs274_runs_the_smaller_corner_finishing_program(small_corner, tmp_path):
+    from spur_cad.post import PostSettings, ProgramInfo, post_program
+    from tests.rs274_helper import run_rs274
+    from tests.test_post import assert_same_moves, canonical_moves
+
+    _, plan = small_corner
+    path = plan.finishing.toolpath
+    program = post_program(path, PostSettings(folded=True), ProgramInfo("helical small corner test", ()))
+    target = tmp_path / "finishing.ngc"
+    target.write_text(program.text)
+    ok, canon, messages = run_rs274(target)
+    assert ok, messages
+    assert_same_moves(canonical_moves(canon), path, 4, 4)

@@ -71,8 +71,8 @@ def generating_max_diameter_mm(spec: GearSpec, corner_radius_mm: float, target_s
                                blank_radius_mm: float) -> float:
     """Largest finishing tool with this corner radius that finishes the gear by generation (either flank tool
     end): the smaller of the tip-mode limit (flat within the rack's tip flat) and the flank-mode limit (no flank
-    pass reaches into the design); 0.0 when none fits. Helical gears: the corner must be rho, the diameter
-    within the normal tip flat 2 d_n + 2 rho."""
+    pass reaches into the design); 0.0 when none fits. Helical gears: any corner 0 < r_t <= rho (a flat end mill
+    only for a sharp rack), the diameter within the normal tip flat 2 d_n + 2 r_t."""
     from spur_cad.cam.strategies.generating_geometry import generating_tool_limits
     from spur_cad.geometry.profile import rack_corner
 
@@ -80,9 +80,9 @@ def generating_max_diameter_mm(spec: GearSpec, corner_radius_mm: float, target_s
     if corner_radius_mm > rho + 1e-12:
         return 0.0
     if spec.is_helical:
-        if abs(corner_radius_mm - rho) > 1e-6:
+        if corner_radius_mm == 0.0 and rho > 0.0:
             return 0.0
-        return max(2.0 * rack_corner(spec).normal_corner_offset_mm + 2.0 * rho, 0.0)
+        return max(2.0 * rack_corner(spec).normal_corner_offset_mm + 2.0 * corner_radius_mm, 0.0)
     limits = generating_tool_limits(spec, corner_radius_mm, target_scallop_mm, blank_radius_mm)
     flank = max(limits.flank_mode_max_diameter_mm, limits.flank_mode_max_diameter_raised_mm)
     largest = min(limits.tip_mode_max_diameter_mm, flank)
@@ -153,7 +153,7 @@ def _check_flat_finishing(spec: GearSpec, tool: Tool, rec: ToolRecommendations) 
     largest = rec.finishing_flat_end_mill_max_diameter_mm
     if largest <= 0.0:
         if spec.is_helical:
-            why = (f"a helical gear is finished by generation with the corner radius equal to the rack tip radius "
+            why = (f"a helical gear is finished by generation with a corner radius 0 < r_t <= the rack tip radius "
                    f"rho = {spec.rack_tip_radius_mm:g} mm")
         else:
             why = "by generation its flat finds no room in the rack's tip flat and the flank passes"

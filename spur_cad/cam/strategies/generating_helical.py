@@ -21,13 +21,21 @@ dY/dX = -h tan(beta) cos(gamma), dZ/dX = -h tan(beta) sin(gamma).
   Y) and its end is the lowest at which the tool still lies inside the rack tooth (bisection on
   the clearance). Rolls are evenly spaced so that the generating flats leave at most the target
   at the largest roll any section sees (the flat deviation grows with the roll).
-- **Tip mode (fillets and root)** needs the tool's corner radius equal to rho: with A = phi and
-  the pass along d (gamma = 0) the tool's projection is its own profile, and its corner *is* the
-  rack's round over the whole pass. A smaller corner would touch the round at one angle, and one
-  pass along d would then generate the fillet in a single transverse section only. Per roll: the
-  tool's right corner on the right round, its left corner on the left round, and, where the tip
-  flat generates the root somewhere over the face width, flat passes between them. Rolls are
-  evenly spaced so that the cusps left by the elliptic transverse round stay within the target.
+- **Tip mode (fillets and root)** with A = phi and the pass along d (gamma = 0): the tool's projection
+  along d is its own profile, so in the normal section it plays a rack round of radius r_t <= rho.
+  With r_t = rho its corner *is* the rack's round over the whole pass. Per roll: the tool's right
+  corner on the right round, its left corner on the left round, and, where the tip flat generates
+  the root somewhere over the face width, flat passes between them. Rolls are evenly spaced so that
+  the cusps left by the elliptic transverse round stay within the target.
+  A smaller corner (0 < r_t < rho) is placed as for spur gears, internally tangent to the round at a
+  normal-section angle b (from straight down toward the flank): corner centre at the round's centre
+  + (rho - r_t)(sin b, -cos b), so the tool stays inside the rack tooth over the whole pass. A pass
+  along d touches the round along one line only, while the rack's contact line crosses the round:
+  section X at roll phi touches it at the angle b with r phi_e = d_1 + rho sin(b) (1/cos(beta) -
+  cos(beta)) - B cos(beta) tan(b), phi_e = phi + X h tan(beta) / r. So each roll gets one pass per
+  contact angle of a fixed grid over [0, 90 deg - alpha_n] that some section sees at that roll, the
+  grid spaced so that the tool leaves at most `CORNER_GAP_SHARE` of the target on the round between
+  its angles, the rolls spaced for the rest.
   A sharp rack (rho = 0) is played by a flat end mill; its corner leaves wedge-shaped cusps, so the
   rolls are spaced for the target / sqrt(2) measured to the outline (thicker along the normal).
 - Rolls (and land angles) cover what every section needs: the spur ranges widened by the turn of
@@ -51,7 +59,9 @@ from spur_cad.geometry.spec import GearSpec
 CLEARANCE_TOLERANCE_MM = 1e-6
 """A pass may touch its rack tooth's boundary within this (the flank side lies on it by design)."""
 CORNER_MATCH_MM = 1e-6
-"""The tool's corner radius must equal the rack tip radius within this for helical tip mode."""
+"""A tool corner radius within this of the rack tip radius plays the round itself (one tip pass per side)."""
+CORNER_GAP_SHARE = 0.3
+"""With r_t < rho: the share of the target left to the tool between its contact angles on the round."""
 _SAFETY = 0.95
 MAX_TIP_ROLLS = 1000
 """Most tip-mode rolls whose leftover `tip_roll_step` checks (the helical example needs about 60 at 5 um and
@@ -114,15 +124,19 @@ def rack_clearance_mm(spec: GearSpec, points: np.ndarray, a_rad: float, phi: flo
 
 
 def check_helical_generating_tool(spec: GearSpec, tool: Tool) -> None:
-    """ToolError unless the tool's corner radius is the rack tip radius and its flat fits the rack's tip flat."""
+    """ToolError unless the tool's corner fits inside the rack's round (0 < r_t <= rho; a flat end mill only for a
+    sharp rack) and its flat fits the rack's tip flat."""
     tool.validate("finishing")
     rho, r_t = spec.rack_tip_radius_mm, tool.effective_corner_radius_mm
-    if abs(r_t - rho) > CORNER_MATCH_MM:
-        flat = " (a flat end mill only for a sharp rack, rho = 0)" if r_t == 0.0 else ""
-        raise ToolError(f"finishing strategy generating for a helical gear: tool corner radius r_t = {r_t:g} mm must "
-                        f"equal the rack tip radius rho = {rho:g} mm{flat} (the corner then is the rack's round along "
-                        "the whole pass; a smaller one would generate the fillet in one transverse section only)",
+    if r_t > rho + CORNER_MATCH_MM:
+        raise ToolError(f"finishing strategy generating for a helical gear: tool corner radius r_t = {r_t:g} mm is "
+                        f"larger than the rack tip radius rho = {rho:g} mm; the tool's corner must fit inside the "
+                        "rack's tip round: use r_t <= rho (r_t = rho needs the fewest passes)",
                         field="corner_radius_mm", section="tools.finishing")
+    if r_t == 0.0 and rho > 0.0:
+        raise ToolError(f"finishing strategy generating for a helical gear: a flat end mill (r_t = 0) plays only a "
+                        f"sharp rack (rho = 0); this rack's tip radius is rho = {rho:g} mm: use a corner radius "
+                        f"0 < r_t <= {rho:g} mm", field="corner_radius_mm", section="tools.finishing")
     d_n = rack_corner(spec).normal_corner_offset_mm
     if tool.flat_width_mm > 2.0 * d_n + 1e-12:
         raise ToolError(f"finishing strategy generating: tool flat width d = {tool.flat_width_mm:g} mm (D - 2 r_t) is "
@@ -214,10 +228,11 @@ def tip_roll_step(spec: GearSpec, target_mm: float) -> float:
                          "target_scallop_mm", field="target_scallop_mm", section="finishing")
 
 
-def helical_passes_estimate(spec: GearSpec, target_mm: float) -> float:
+def helical_passes_estimate(spec: GearSpec, target_mm: float, tool: Tool | None = None) -> float:
     """Passes per space from closed forms alone (before any planning, to bound the work): both flanks at the
     largest roll any section sees, tip mode at the root's spacing sqrt(8 target / r_f) / r_f over the widened
-    fillet-to-fillet range with up to four passes per roll."""
+    fillet-to-fillet range with up to four passes per roll (a `tool` corner below rho: two more per contact
+    angle, the rolls spaced for the rest of the target)."""
     involute = spec.tooth_space_profile().segment("involute")
     lo, hi = face_turn_range(spec)
     t_worst = involute.end + (hi - lo)
@@ -226,8 +241,12 @@ def helical_passes_estimate(spec: GearSpec, target_mm: float) -> float:
     corner = rack_corner(spec)
     r = spec.reference_radius_mm
     tip_range = 2.0 * (corner.corner_offset_mm + corner.corner_depth_mm / math.tan(spec.pressure_angle_rad)) / r
+    per_roll = 4.0
+    if tool is not None and tool.effective_corner_radius_mm < spec.rack_tip_radius_mm - CORNER_MATCH_MM:
+        per_roll += 2.0 * (len(corner_angles(spec, tool, target_mm)[0]) - 1)
+        goal *= 1.0 - CORNER_GAP_SHARE
     tip = (tip_range + hi - lo) / _first_tip_step(spec, goal)
-    return 2.0 * flank + 4.0 * tip
+    return 2.0 * flank + per_roll * tip
 
 
 def _first_tip_step(spec: GearSpec, goal: float) -> float:
@@ -302,6 +321,34 @@ def _lowest_end(spec: GearSpec, points: np.ndarray, a: float, phi: float, y0: fl
     return high
 
 
+def contact_roll_rad(spec: GearSpec, b_rad: np.ndarray) -> np.ndarray:
+    """Effective roll phi_e at which the right rack round touches the gear at normal-section angle b (from
+    straight down toward the flank): r phi_e = d_1 + rho sin(b) (1/cos(beta) - cos(beta)) - B cos(beta) tan(b)
+    (the round's normal there meets the pitch line; spur: d_1 - B tan(b))."""
+    corner = rack_corner(spec)
+    rho, cos_beta = spec.rack_tip_radius_mm, math.cos(spec.helix_angle_rad)
+    b = np.asarray(b_rad, float)
+    return (corner.corner_offset_mm + rho * np.sin(b) * (1.0 / cos_beta - cos_beta)
+            - corner.corner_depth_mm * cos_beta * np.tan(b)) / spec.reference_radius_mm
+
+
+def corner_angles(spec: GearSpec, tool: Tool, target_mm: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The contact angles b on the rack round (0 -> 90 deg - alpha_n) of a corner r_t < rho, spaced so that
+    between them the tool leaves at most CORNER_GAP_SHARE of the target on the round, and the range of
+    effective rolls (lowest, highest) at which the rack touches within half a spacing of each."""
+    rho, r_t = spec.rack_tip_radius_mm, tool.effective_corner_radius_mm
+    e, gap = rho - r_t, CORNER_GAP_SHARE * target_mm
+    # A round point Delta away from the tangency lies sqrt(rho^2 + e^2 - 2 rho e cos(Delta)) - r_t from the tool.
+    cos_half = (rho * rho + e * e - (r_t + gap) ** 2) / (2.0 * rho * e)
+    half = math.acos(min(max(cos_half, -1.0), 1.0))
+    b_max = 0.5 * math.pi - spec.normal_pressure_angle_rad
+    angles = _even(0.0, b_max, 2.0 * half)
+    spacing = angles[1] - angles[0]
+    cells = np.clip(angles[:, None] + np.linspace(-0.5, 0.5, 65)[None, :] * spacing, 0.0, b_max)
+    rolls = contact_roll_rad(spec, cells)
+    return angles, rolls.min(axis=1), rolls.max(axis=1)
+
+
 def _tip_passes(spec: GearSpec, tool: Tool, target_mm: float) -> list[tuple]:
     """Tip-mode passes (rolls descending: right fillet -> root -> left fillet)."""
     corner = rack_corner(spec)
@@ -309,24 +356,39 @@ def _tip_passes(spec: GearSpec, tool: Tool, target_mm: float) -> list[tuple]:
     d1 = corner.corner_offset_mm
     d_n, rho = corner.normal_corner_offset_mm, spec.rack_tip_radius_mm
     alpha_n, alpha_t = spec.normal_pressure_angle_rad, spec.pressure_angle_rad
+    r_f, r_t = spec.root_radius_mm, tool.effective_corner_radius_mm
     half_flat = tool.flat_width_mm / 2.0
     lo, hi = face_turn_range(spec)
     # Transverse point T (flank/round tangency) and the roll at which its normal passes the pitch point.
     t_y = (d_n + rho * math.cos(alpha_n)) / math.cos(beta)
-    t_z = spec.root_radius_mm + rho - rho * math.sin(alpha_n)
+    t_z = r_f + rho - rho * math.sin(alpha_n)
     phi_t = (t_y - (r - t_z) / math.tan(alpha_t)) / r
     phi_bottom = d1 / r
     sy, _ = pass_slopes(spec, 0.0)
-    reach_n = math.sqrt(2.0 * max(tool.effective_corner_radius_mm, 1e-9) * 0.5 * target_mm)  # corner drop
+    reach_n = math.sqrt(2.0 * max(r_t, 1e-9) * 0.5 * target_mm)  # corner drop
     spread = spec.hand_sign * spec.face_width_mm * math.sin(beta)  # the root contact's travel in n over the face
     inner = d_n - half_flat  # tool axis offset with a corner on a round
+    exact = abs(r_t - rho) <= CORNER_MATCH_MM  # the corner is the round: one pass per side and roll
+    first, last = min(phi_t, -phi_bottom) - hi, max(phi_bottom, -phi_t) - lo
+    roll_target = target_mm
+    if not exact:
+        angles, cell_low, cell_high = corner_angles(spec, tool, target_mm)
+        low, high = min(phi_t, phi_bottom, cell_low.min()), max(phi_t, phi_bottom, cell_high.max())
+        first, last = min(low, -high) - hi, max(high, -low) - lo
+        # Corner positions (tool axis n, tip Z) internally tangent to the round at each angle, flank -> root.
+        e = rho - r_t
+        corners = [(inner + e * math.sin(b), r_f + e * (1.0 - math.cos(b)), low, high)
+                   for b, low, high in zip(angles[::-1], cell_low[::-1], cell_high[::-1])]
+        roll_target = (1.0 - CORNER_GAP_SHARE) * target_mm
     out = []
-    first = min(phi_t, -phi_bottom) - hi
-    last = max(phi_bottom, -phi_t) - lo
-    for phi in _even(first, last, tip_roll_step(spec, target_mm))[::-1]:
-        positions: list[tuple[float, Feature, int]] = []
-        if phi_t - hi <= phi <= phi_bottom - lo:
-            positions.append((inner, Feature.RIGHT_FLANK, 1))
+    for phi in _even(first, last, tip_roll_step(spec, roll_target))[::-1]:
+        positions: list[tuple[float, float, Feature, int]] = []
+        if exact:
+            if phi_t - hi <= phi <= phi_bottom - lo:
+                positions.append((inner, r_f, Feature.RIGHT_FLANK, 1))
+        else:  # the angles some section sees at this roll (effective rolls phi + lo .. phi + hi)
+            positions.extend((n, z, Feature.RIGHT_FLANK, 1) for n, z, low, high in corners
+                             if low - hi <= phi <= high - lo)
         # The root contact (Y = 0 in every section) meets the rack's tip plane at n = r phi cos(beta) + X h sin(beta).
         n_a = max(r * phi * math.cos(beta) + min(0.0, spread), -d_n)
         n_b = min(r * phi * math.cos(beta) + max(0.0, spread), d_n)
@@ -335,12 +397,16 @@ def _tip_passes(spec: GearSpec, tool: Tool, target_mm: float) -> list[tuple]:
             hi_axis = float(np.clip(max(n_b - half_flat, 0.5 * (n_a + n_b)), -inner, inner))
             axes = [lo_axis] if hi_axis - lo_axis < 1e-9 else _even(lo_axis, hi_axis, 2.0 * (half_flat + reach_n))
             side = 1 if phi >= 0.0 else -1
-            positions.extend((float(n), Feature.ROOT, side) for n in axes)
-        if -phi_bottom - hi <= phi <= -phi_t - lo:
-            positions.append((-inner, Feature.LEFT_FLANK, -1))
-        for n, feature, side in positions:
+            positions.extend((float(n), r_f, Feature.ROOT, side) for n in axes)
+        if exact:
+            if -phi_bottom - hi <= phi <= -phi_t - lo:
+                positions.append((-inner, r_f, Feature.LEFT_FLANK, -1))
+        else:  # the left round mirrors the right one: it touches at effective roll -phi_e(b)
+            positions.extend((-n, z, Feature.LEFT_FLANK, -1) for n, z, low, high in corners[::-1]
+                             if -high - hi <= phi <= -low - lo)
+        for n, z, feature, side in positions:
             y0 = -r * phi + n / math.cos(beta)
-            out.append(("tip", feature, float(phi), float(phi), y0, spec.root_radius_mm, sy, 0.0, side))
+            out.append(("tip", feature, float(phi), float(phi), y0, z, sy, 0.0, side))
     return out
 
 
@@ -381,5 +447,5 @@ def helical_passes(spec: GearSpec, tool: Tool, target_mm: float, blank_radius_mm
 
 
 __all__ = ["check_helical_generating_tool", "face_turn_range", "flank_roll_step", "helical_passes",
-           "helical_passes_estimate", "pass_slopes",
+           "contact_roll_rad", "corner_angles", "helical_passes_estimate", "pass_slopes",
            "rack_clearance_mm", "rack_tooth_signed_distance_mm", "tip_roll_step", "tool_hull_points"]

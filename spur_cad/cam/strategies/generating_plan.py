@@ -174,7 +174,7 @@ def plan_generating(spec: GearSpec, tool: Tool, params: GeneratingParams, *, lan
 def _plan_helical(spec: GearSpec, tool: Tool, params: GeneratingParams, lands: bool) -> GeneratingPlan:
     """The helical gear's passes (spur_cad.cam.strategies.generating_helical) as a plan."""
     target = params.target_scallop_mm
-    rough = helical_passes_estimate(spec, target)
+    rough = helical_passes_estimate(spec, target, tool)
     if rough > MAX_PASSES_PER_SPACE:
         raise WorkLimitError(f"generating finishing would need about {rough:.3g} passes per tooth space (limit "
                              f"{MAX_PASSES_PER_SPACE:,}) for target_scallop_mm = {target:.3g}; raise [finishing] "
