@@ -34,6 +34,8 @@ from spur_cad.cam.strategies.generating_geometry import (
     tip_rolls,
 )
 from spur_cad.cam.strategies.generating_helical import (
+    CORNER_GAP_SHARE,
+    CORNER_MATCH_MM,
     face_turn_range,
     flank_roll_step,
     helical_passes,
@@ -192,5 +194,9 @@ def _plan_helical(spec: GearSpec, tool: Tool, params: GeneratingParams, lands: b
     land = np.array([p.roll_rad for p in passes if p.mode == "land"])
     step = flank_roll_step(spec, target)
     t_worst = spec.tooth_space_profile().segment("involute").end + hi - lo
+    tip_bound = TIP_SAFETY_HELICAL * target
+    if tool.effective_corner_radius_mm < spec.rack_tip_radius_mm - CORNER_MATCH_MM:
+        # rolls spaced for the rest of the target, plus what the corner leaves between its contact angles
+        tip_bound = (TIP_SAFETY_HELICAL * (1.0 - CORNER_GAP_SHARE) + CORNER_GAP_SHARE) * target
     return GeneratingPlan(tuple(passes), flank, np.zeros(0), tips, land,
-                          flat_leftover_mm(rb, t_worst - step, t_worst), TIP_SAFETY_HELICAL * target)
+                          flat_leftover_mm(rb, t_worst - step, t_worst), tip_bound)
