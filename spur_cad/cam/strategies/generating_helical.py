@@ -33,9 +33,11 @@ dY/dX = -h tan(beta) cos(gamma), dZ/dX = -h tan(beta) sin(gamma).
   along d touches the round along one line only, while the rack's contact line crosses the round:
   section X at roll phi touches it at the angle b with r phi_e = d_1 + rho sin(b) (1/cos(beta) -
   cos(beta)) - B cos(beta) tan(b), phi_e = phi + X h tan(beta) / r. So each roll gets one pass per
-  contact angle of a fixed grid over [0, 90 deg - alpha_n] that some section sees at that roll, the
-  grid spaced so that the tool leaves at most `CORNER_GAP_SHARE` of the target on the round between
-  its angles, the rolls spaced for the rest.
+  contact of a fixed grid (`corner_contacts`: angles over [0, 90 deg - alpha_n], then a few points
+  of the flank line just above T, where the smaller corner falls away from the line faster than the
+  round) that some section sees within a roll spacing of that roll, the grid spaced so that the
+  tool leaves at most `CORNER_GAP_SHARE` of the target between its contacts, the rolls spaced for
+  the rest.
   A sharp rack (rho = 0) is played by a flat end mill; its corner leaves wedge-shaped cusps, so the
   rolls are spaced for the target / sqrt(2) measured to the outline (thicker along the normal).
 - Rolls (and land angles) cover what every section needs: the spur ranges widened by the turn of
@@ -61,7 +63,8 @@ CLEARANCE_TOLERANCE_MM = 1e-6
 CORNER_MATCH_MM = 1e-6
 """A tool corner radius within this of the rack tip radius plays the round itself (one tip pass per side)."""
 CORNER_GAP_SHARE = 0.3
-"""With r_t < rho: the share of the target left to the tool between its contact angles on the round."""
+"""With r_t < rho: the share of the target left to the tool between its contacts on the rack."""
+"""With r_t < rho: the share of the target left to the tool between its contacts on the rack."""
 _SAFETY = 0.95
 MAX_TIP_ROLLS = 1000
 """Most tip-mode rolls whose leftover `tip_roll_step` checks (the helical example needs about 60 at 5 um and
@@ -243,7 +246,7 @@ def helical_passes_estimate(spec: GearSpec, target_mm: float, tool: Tool | None 
     tip_range = 2.0 * (corner.corner_offset_mm + corner.corner_depth_mm / math.tan(spec.pressure_angle_rad)) / r
     per_roll = 4.0
     if tool is not None and tool.effective_corner_radius_mm < spec.rack_tip_radius_mm - CORNER_MATCH_MM:
-        per_roll += 2.0 * (len(corner_angles(spec, tool, target_mm)[0]) - 1)
+        per_roll += 2.0 * (len(corner_contacts(spec, tool, target_mm)[0]) - 1)
         goal *= 1.0 - CORNER_GAP_SHARE
     tip = (tip_range + hi - lo) / _first_tip_step(spec, goal)
     return 2.0 * flank + per_roll * tip
@@ -332,21 +335,40 @@ def contact_roll_rad(spec: GearSpec, b_rad: np.ndarray) -> np.ndarray:
             - corner.corner_depth_mm * cos_beta * np.tan(b)) / spec.reference_radius_mm
 
 
-def corner_angles(spec: GearSpec, tool: Tool, target_mm: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """The contact angles b on the rack round (0 -> 90 deg - alpha_n) of a corner r_t < rho, spaced so that
-    between them the tool leaves at most CORNER_GAP_SHARE of the target on the round, and the range of
-    effective rolls (lowest, highest) at which the rack touches within half a spacing of each."""
+def corner_contacts(spec: GearSpec, tool: Tool, target_mm: float) -> tuple[np.ndarray, ...]:
+    """Where a corner r_t < rho touches the rack in tip mode, root -> flank: the corner centre's offset from the
+    round's centre (normal section: across, up; mm) and the range of effective rolls (lowest, highest) at which
+    the rack touches within half a spacing of each contact. Contacts: angles b on the round (0 -> 90 deg -
+    alpha_n), spaced so that between them the tool leaves at most CORNER_GAP_SHARE of the target on the round,
+    then contacts on the rack's flank line above T, as far apart, up to where a corner of radius rho tangent
+    at T (the exact tool) leaves the target, sqrt(2 rho target) (a corner tangent to the line above T from
+    inside stays inside the rack: the round bends away from the line below T)."""
     rho, r_t = spec.rack_tip_radius_mm, tool.effective_corner_radius_mm
     e, gap = rho - r_t, CORNER_GAP_SHARE * target_mm
+    corner, alpha_n, cos_beta = rack_corner(spec), spec.normal_pressure_angle_rad, math.cos(spec.helix_angle_rad)
     # A round point Delta away from the tangency lies sqrt(rho^2 + e^2 - 2 rho e cos(Delta)) - r_t from the tool.
     cos_half = (rho * rho + e * e - (r_t + gap) ** 2) / (2.0 * rho * e)
     half = math.acos(min(max(cos_half, -1.0), 1.0))
-    b_max = 0.5 * math.pi - spec.normal_pressure_angle_rad
+    b_max = 0.5 * math.pi - alpha_n
     angles = _even(0.0, b_max, 2.0 * half)
     spacing = angles[1] - angles[0]
     cells = np.clip(angles[:, None] + np.linspace(-0.5, 0.5, 65)[None, :] * spacing, 0.0, b_max)
     rolls = contact_roll_rad(spec, cells)
-    return angles, rolls.min(axis=1), rolls.max(axis=1)
+    across, up = e * np.sin(angles), -e * np.cos(angles)
+    # On the flank line, s above T: a line point u from the tangency lies u^2 / (2 r_t) from the tool.
+    step_s = 2.0 * math.sqrt(2.0 * r_t * gap)
+    s = step_s * np.arange(1, max(1, math.ceil(math.sqrt(2.0 * rho * target_mm) / step_s)) + 1)
+    s_cells = np.maximum(s[:, None] + np.linspace(-0.5, 0.5, 65)[None, :] * step_s, 0.0)
+    # the flank point's normal (angle b_max) meets the pitch line: as contact_roll_rad with the point moved by s
+    t_across = rho * math.sin(b_max) + s_cells * math.sin(alpha_n)
+    t_depth = rho * math.cos(b_max) - s_cells * math.cos(alpha_n)
+    s_rolls = (corner.corner_offset_mm + t_across / cos_beta
+               - (corner.corner_depth_mm + t_depth) * cos_beta * math.tan(b_max)) / spec.reference_radius_mm
+    across = np.concatenate([across, e * math.sin(b_max) + s * math.sin(alpha_n)])
+    up = np.concatenate([up, -e * math.cos(b_max) + s * math.cos(alpha_n)])
+    low = np.concatenate([rolls.min(axis=1), s_rolls.min(axis=1)])
+    high = np.concatenate([rolls.max(axis=1), s_rolls.max(axis=1)])
+    return across, up, low, high
 
 
 def _tip_passes(spec: GearSpec, tool: Tool, target_mm: float) -> list[tuple]:
@@ -372,23 +394,23 @@ def _tip_passes(spec: GearSpec, tool: Tool, target_mm: float) -> list[tuple]:
     first, last = min(phi_t, -phi_bottom) - hi, max(phi_bottom, -phi_t) - lo
     roll_target = target_mm
     if not exact:
-        angles, cell_low, cell_high = corner_angles(spec, tool, target_mm)
+        across, up, cell_low, cell_high = corner_contacts(spec, tool, target_mm)
         low, high = min(phi_t, phi_bottom, cell_low.min()), max(phi_t, phi_bottom, cell_high.max())
         first, last = min(low, -high) - hi, max(high, -low) - lo
-        # Corner positions (tool axis n, tip Z) internally tangent to the round at each angle, flank -> root.
-        e = rho - r_t
-        corners = [(inner + e * math.sin(b), r_f + e * (1.0 - math.cos(b)), low, high)
-                   for b, low, high in zip(angles[::-1], cell_low[::-1], cell_high[::-1])]
+        # Corner positions (tool axis n, tip Z) tangent to the rack at each contact, flank -> root.
+        corners = [(d_n - half_flat + a, r_f + rho + u - r_t, lo_, hi_)
+                   for a, u, lo_, hi_ in zip(across[::-1], up[::-1], cell_low[::-1], cell_high[::-1])]
         roll_target = (1.0 - CORNER_GAP_SHARE) * target_mm
     out = []
-    for phi in _even(first, last, tip_roll_step(spec, roll_target))[::-1]:
+    step = tip_roll_step(spec, roll_target)
+    for phi in _even(first, last, step)[::-1]:
         positions: list[tuple[float, float, Feature, int]] = []
         if exact:
             if phi_t - hi <= phi <= phi_bottom - lo:
                 positions.append((inner, r_f, Feature.RIGHT_FLANK, 1))
         else:  # the angles some section sees at this roll (effective rolls phi + lo .. phi + hi)
             positions.extend((n, z, Feature.RIGHT_FLANK, 1) for n, z, low, high in corners
-                             if low - hi <= phi <= high - lo)
+                             if low - hi - step <= phi <= high - lo + step)
         # The root contact (Y = 0 in every section) meets the rack's tip plane at n = r phi cos(beta) + X h sin(beta).
         n_a = max(r * phi * math.cos(beta) + min(0.0, spread), -d_n)
         n_b = min(r * phi * math.cos(beta) + max(0.0, spread), d_n)
@@ -403,7 +425,7 @@ def _tip_passes(spec: GearSpec, tool: Tool, target_mm: float) -> list[tuple]:
                 positions.append((-inner, r_f, Feature.LEFT_FLANK, -1))
         else:  # the left round mirrors the right one: it touches at effective roll -phi_e(b)
             positions.extend((-n, z, Feature.LEFT_FLANK, -1) for n, z, low, high in corners[::-1]
-                             if -high - hi <= phi <= -low - lo)
+                             if -high - hi - step <= phi <= -low - lo + step)
         for n, z, feature, side in positions:
             y0 = -r * phi + n / math.cos(beta)
             out.append(("tip", feature, float(phi), float(phi), y0, z, sy, 0.0, side))
@@ -447,5 +469,5 @@ def helical_passes(spec: GearSpec, tool: Tool, target_mm: float, blank_radius_mm
 
 
 __all__ = ["check_helical_generating_tool", "face_turn_range", "flank_roll_step", "helical_passes",
-           "contact_roll_rad", "corner_angles", "helical_passes_estimate", "pass_slopes",
+           "contact_roll_rad", "corner_contacts", "helical_passes_estimate", "pass_slopes",
            "rack_clearance_mm", "rack_tooth_signed_distance_mm", "tip_roll_step", "tool_hull_points"]
