@@ -188,6 +188,11 @@ class GearSpec:
         return self.helix_angle_deg != 0.0
 
     @property
+    def is_internal(self) -> bool:
+        """False: an external gear (spur_cad.geometry.internal.InternalGearSpec says True)."""
+        return False
+
+    @property
     def hand_sign(self) -> int:
         """+1 right hand, -1 left hand: a transverse section at X is turned by hand_sign X tan(beta) / r."""
         return 1 if self.hand == "right" else -1

@@ -1,0 +1,131 @@
+"""Internal spur gears: the shaper-cut ring's exact profile against an independent envelope of the cutter's rolling
+motion, the checks' one-line messages, the inspection sheet against independent formulas, the ring's B-rep."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from scipy.optimize import brentq
+from shapely.geometry import Polygon
+
+from spur_cad.geometry import gear_outline, sample_profile
+from spur_cad.geometry.internal import InternalGearSpec
+from spur_cad.geometry.spec import GearSpec
+from tests.textbook import inv
+
+RING = dict(teeth=60, module_mm=2.0, addendum_coefficient=0.9, rack_tip_radius_mm=0.4, shaper_cutter_teeth=20,
+            rim_outer_diameter_mm=140.0, face_width_mm=10.0)
+
+
+def _ring(**changes) -> InternalGearSpec:
+    return InternalGearSpec(**{**RING, **changes})
+
+
+def _cutter_polygon(ring: InternalGearSpec) -> np.ndarray:
+    """The cutter as a dense polygon, a tooth on +y: the external gear the rack generates (spur_cad's external
+    code) with its tip corners rounded independently, by a morphological opening with a disc of radius rho."""
+    cutter = GearSpec(teeth=ring.shaper_cutter_teeth, module_mm=ring.module_mm,
+                      pressure_angle_deg=ring.pressure_angle_deg,
+                      profile_shift_coefficient=ring.shaper_cutter_profile_shift_coefficient,
+                      addendum_coefficient=ring.dedendum_coefficient, dedendum_coefficient=ring.dedendum_coefficient,
+                      rack_tip_radius_mm=ring.rack_tip_radius_mm)
+    outline = gear_outline(cutter, 2e-5)
+    turn = math.pi / cutter.teeth  # space 0 on +y -> tooth 0 on +y
+    c, s = math.cos(turn), math.sin(turn)
+    outline = outline @ np.array([[c, -s], [s, c]])
+    rho = ring.rack_tip_radius_mm
+    opened = Polygon(outline).buffer(-rho, quad_segs=512).buffer(rho, quad_segs=512)
+    ring_xy = np.asarray(opened.exterior.coords)[:-1]
+    angle = np.arctan2(ring_xy[:, 0], ring_xy[:, 1])
+    start = int(np.argmin(np.abs(np.abs(angle) - math.pi)))  # a vertex opposite tooth 0: teeth near +y contiguous
+    ring_xy, angle = np.roll(ring_xy, -start, axis=0), np.roll(angle, -start)
+    keep = np.abs(angle) < 4.5 * 2.0 * math.pi / cutter.teeth
+    return ring_xy[keep]
+
+
+def _cutting_centre_distance_mm(ring: InternalGearSpec) -> float:
+    """Textbook internal mesh without backlash (no allowance): inv(a_w) = inv(a) - 2 tan(a) (x + x_0) / (z - z_0),
+    a_0 = m (z - z_0) cos(a) / (2 cos(a_w))."""
+    alpha = math.radians(ring.pressure_angle_deg)
+    z, z0 = ring.teeth, ring.shaper_cutter_teeth
+    inv_w = inv(alpha) - 2.0 * math.tan(alpha) * (ring.profile_shift_coefficient
+                                                   + ring.shaper_cutter_profile_shift_coefficient) / (z - z0)
+    alpha_w = brentq(lambda a: inv(a) - inv_w, 1e-6, 1.2)
+    return ring.module_mm * (z - z0) * math.cos(alpha) / (2.0 * math.cos(alpha_w))
+
+
+def _placed(vertices: np.ndarray, lam: float, ring: InternalGearSpec) -> np.ndarray:
+    """The cutter's vertices when its centre is at a_0 (sin l, cos l) and its pitch circle rolled without slip
+    inside the ring's (the cutter turned clockwise by l (1 - z / z_0) from tooth 0 on +y)."""
+    a0 = _cutting_centre_distance_mm(ring)
+    turn = lam * (1.0 - ring.teeth / ring.shaper_cutter_teeth)
+    c, s = math.cos(turn), math.sin(turn)
+    x = vertices[:, 0] * c + vertices[:, 1] * s
+    y = -vertices[:, 0] * s + vertices[:, 1] * c
+    return np.stack([x + a0 * math.sin(lam), y + a0 * math.cos(lam)], -1)
+
+
+def _right_crossings(points: np.ndarray, radii: np.ndarray, half_pitch: float) -> np.ndarray:
+    """For each radius R: the largest polar angle (clockwise from +y, within one pitch of space 0) where the
+    polygon's edges cross the circle R (-inf where none); the crossing solved on the straight edge."""
+    a, b = points[:-1], points[1:]
+    ra, rb = np.hypot(*a.T), np.hypot(*b.T)
+    d = b - a
+    out = np.full(len(radii), -np.inf)
+    for i, radius in enumerate(radii):
+        hit = (ra - radius) * (rb - radius) <= 0.0
+        if not hit.any():
+            continue
+        pa, dd = a[hit], d[hit]
+        qa, qb, qc = np.sum(dd * dd, 1), 2.0 * np.sum(pa * dd, 1), np.sum(pa * pa, 1) - radius * radius
+        root = np.sqrt(np.maximum(qb * qb - 4.0 * qa * qc, 0.0))
+        for t in ((-qb + root) / (2.0 * qa), (-qb - root) / (2.0 * qa)):
+            ok = (t >= -1e-9) & (t <= 1.0 + 1e-9)
+            p = pa[ok] + t[ok, None] * dd[ok]
+            theta = np.arctan2(p[:, 0], p[:, 1])
+            theta = theta[np.abs(theta) < half_pitch]
+            if theta.size:
+                out[i] = max(out[i], theta.max())
+    return out
+
+
+def _envelope_angles(ring: InternalGearSpec, radii: np.ndarray) -> np.ndarray:
+    """The right edge of the region the rolling cutter sweeps, on each circle R: the largest crossing angle over
+    cutter positions, from a coarse roll grid refined twice around each radius's best position."""
+    cutter = _cutter_polygon(ring)
+    half_pitch = math.pi / ring.teeth
+    coarse = np.linspace(-0.6, 0.6, 1201)
+    table = np.array([_right_crossings(_placed(cutter, lam, ring), radii, half_pitch) for lam in coarse])
+    best = coarse[np.argmax(table, axis=0)]
+    result = np.empty(len(radii))
+    for i, radius in enumerate(radii):
+        centre, width = best[i], 2e-3
+        for _ in range(3):
+            grid = np.linspace(centre - width, centre + width, 41)
+            values = [_right_crossings(_placed(cutter, lam, ring), np.array([radius]), half_pitch)[0] for lam in grid]
+            centre, width = grid[int(np.argmax(values))], width / 10.0
+            result[i] = max(values)
+    return result
+
+
+def test_ring_profile_matches_an_independent_envelope_of_the_rolling_cutter():
+    """z = 60, m = 2, cut by a 20-tooth cutter: fillet and involute within 1.5 um of the envelope (normal distance:
+    the angular difference on the circle times the profile's radius and |n . e_theta|); root circle from the cutter's
+    farthest reach."""
+    ring = _ring()
+    samples = sample_profile(ring.tooth_space_profile(), 2e-4)
+    pts, normals = samples.points, samples.normals
+    radius = np.hypot(*pts.T)
+    theta = np.arctan2(pts[:, 0], pts[:, 1])
+    e_theta = np.stack([np.cos(theta), -np.sin(theta)], -1)
+    across = np.abs(np.sum(normals * e_theta, 1))
+    use = (across > 0.2) & (radius > ring.tip_radius_mm + 0.01) & (radius < ring.root_radius_mm - 1e-4)
+    assert use.sum() > 20
+    envelope = _envelope_angles(ring, radius[use])
+    deviation_mm = radius[use] * (envelope - theta[use]) * across[use]
+    assert np.max(np.abs(deviation_mm)) < 1.5e-3, np.max(np.abs(deviation_mm))
+    cutter = _cutter_polygon(ring)
+    reach = max(np.hypot(*_placed(cutter, lam, ring).T).max() for lam in np.linspace(-1e-3, 1e-3, 21))
+    assert reach == pytest.approx(ring.root_radius_mm, abs=1.5e-3)
