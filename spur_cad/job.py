@@ -40,6 +40,7 @@ from spur_cad.errors import (
     shown,
     shown_path,
 )
+from spur_cad.geometry.internal import InternalGearSpec
 from spur_cad.geometry.spec import MAX_TEETH, MIN_TEETH, GearSpec
 from spur_cad.keys import check_section, coerce, key, keys_of, section_problems, type_problem
 from spur_cad.post.settings import PostSettings
@@ -92,6 +93,21 @@ class GearSection:
                                          "values)")
     hand: str = key("right", label="Hand", group="Gear", choices=("right", "left"),
                     meaning="hand of the helix (helical gears)")
+    internal: bool = key(False, label="Internal", group="Gear",
+                         meaning="internal spur gear (ring gear) cut by a pinion-type shaper cutter; its CAM needs the "
+                                 "3-axis variant (docs/geometry.md, Internal gears)")
+    shaper_cutter_teeth: int = key(20, low=MIN_TEETH, high=MAX_TEETH, label="ShaperCutterTeeth", group="Gear",
+                                   meaning="internal gears: teeth z_0 of the shaper cutter (the external gear the rack "
+                                           "generates, tip corners rounded by rack_tip_radius_mm)")
+    shaper_cutter_profile_shift_coefficient: float = key(
+        0.0, low=-1.0, high=1.5, label="ShaperCutterProfileShift", group="Gear",
+        meaning="internal gears: profile shift coefficient x_0 of the shaper cutter")
+    rim_outer_diameter_mm: float = key(0.0, unit="mm", low=0.0, high=4000.0, label="RimOuterDiameter", group="Gear",
+                                       meaning="internal gears: outside diameter of the ring's rim (at least 2 modules "
+                                               "below the root circle)")
+    mating_pinion_teeth: int = key(0, low=0, high=MAX_TEETH, label="MatingPinionTeeth", group="Gear",
+                                   meaning="internal gears: teeth of the mating pinion for the tip interference check, "
+                                           "0: not checked")
     bore_diameter_mm: float = key(0.0, unit="mm", low=0.0, high=2000.0, label="BoreDiameter", group="Bore",
                                   meaning="through bore diameter, 0: none")
     keyway_width_mm: float = key(0.0, unit="mm", low=0.0, high=500.0, label="KeywayWidth", group="Bore",
@@ -100,7 +116,8 @@ class GearSection:
                                  meaning="hub keyway depth from the bore surface, 0: none")
 
     def to_spec(self) -> GearSpec:
-        return GearSpec(
+        """The GearSpec ([gear] internal = true: an InternalGearSpec, spur only)."""
+        common = dict(
             teeth=self.teeth, module_mm=self.module_mm, pressure_angle_deg=self.pressure_angle_deg,
             profile_shift_coefficient=self.profile_shift_coefficient,
             addendum_coefficient=self.addendum_coefficient, dedendum_coefficient=self.dedendum_coefficient,
@@ -109,6 +126,15 @@ class GearSection:
             thickness_allowance_mm=self.thickness_allowance_mm, face_width_mm=self.face_width_mm,
             helix_angle_deg=self.helix_angle_deg, hand=self.hand,
         )
+        if not self.internal:
+            return GearSpec(**common)
+        if self.helix_angle_deg != 0.0:
+            raise GearSpecError("internal = true: internal gears are spur only (helix_angle_deg must be 0)",
+                                field="helix_angle_deg")
+        return InternalGearSpec(**common, shaper_cutter_teeth=self.shaper_cutter_teeth,
+                                shaper_cutter_profile_shift_coefficient=self.shaper_cutter_profile_shift_coefficient,
+                                rim_outer_diameter_mm=self.rim_outer_diameter_mm,
+                                mating_pinion_teeth=self.mating_pinion_teeth)
 
     def blank_features(self) -> BlankFeatures:
         return BlankFeatures(self.bore_diameter_mm, self.keyway_width_mm, self.keyway_depth_mm)
@@ -554,6 +580,11 @@ def _job_from_data(data: dict, source: str, text: str, strategies: Strategies = 
     except GearSpecError as exc:
         blamed = _blamed_key(exc, 'gear', tables['gear'])
         raise JobFileError(f"{where('gear', blamed)}: invalid gear: {exc}", section="gear", field=blamed) from None
+    if spec.is_internal and any(name.startswith("tools") for name in tables) and getattr(
+            sections.get("machine", Machine()), "axes", 4) != 3:
+        raise JobFileError(f"{where('gear', 'internal')}: internal = true: the rotary table cannot cut an internal "
+                           "gear (its tool cannot reach inside the ring along the rotary axis); use [machine] axes = 3",
+                           section="gear", field="internal")
     for check, name in ((gear_section.blank_features().validate, "gear"),
                         (sections.get("stock", StockSpec()).validate, "stock")):
         try:

@@ -10,9 +10,12 @@ import pytest
 from scipy.optimize import brentq
 from shapely.geometry import Polygon
 
+from spur_cad.errors import GearSpecError, JobFileError
 from spur_cad.geometry import gear_outline, sample_profile
+from spur_cad.geometry.inspection import inspection_facts
 from spur_cad.geometry.internal import InternalGearSpec
 from spur_cad.geometry.spec import GearSpec
+from spur_cad.job import parse_job
 from tests.textbook import inv
 
 RING = dict(teeth=60, module_mm=2.0, addendum_coefficient=0.9, rack_tip_radius_mm=0.4, shaper_cutter_teeth=20,
@@ -129,3 +132,48 @@ def test_ring_profile_matches_an_independent_envelope_of_the_rolling_cutter():
     cutter = _cutter_polygon(ring)
     reach = max(np.hypot(*_placed(cutter, lam, ring).T).max() for lam in np.linspace(-1e-3, 1e-3, 21))
     assert reach == pytest.approx(ring.root_radius_mm, abs=1.5e-3)
+
+
+@pytest.mark.parametrize("changes", [{}, {"teeth": 61, "profile_shift_coefficient": 0.2}])
+def test_dimension_between_pins_against_khk_and_the_exact_profile(changes):
+    """KHK's internal-gear formula inv(phi) = pi/(2z) + inv(a) - D/(z m cos a) - 2 x tan(a)/z, M = d_b/cos(phi) - D
+    (odd z: times cos(90/z deg)); and the pin placed on the space axis at r_M touches the exact flank (D/2 from
+    it, nowhere closer)."""
+    ring = _ring(**changes)
+    sheet = inspection_facts(ring)
+    z, m, x, pin = ring.teeth, ring.module_mm, ring.profile_shift_coefficient, sheet.pin_diameter_mm
+    alpha = math.radians(ring.pressure_angle_deg)
+    phi = brentq(lambda a: inv(a) - (math.pi / (2 * z) + inv(alpha) - pin / (z * m * math.cos(alpha))
+                                     - 2 * x * math.tan(alpha) / z), 1e-6, 1.2)
+    db = z * m * math.cos(alpha)
+    factor = 1.0 if z % 2 == 0 else math.cos(math.pi / (2 * z))
+    assert sheet.pins_between and sheet.span_measurement_mm is None
+    assert sheet.dimension_over_pins_mm == pytest.approx(db / math.cos(phi) * factor - pin, abs=1e-9)
+    centre = np.array([0.0, db / (2.0 * math.cos(phi))])
+    flank = sample_profile(ring.tooth_space_profile(), 1e-5).points
+    distance = np.hypot(*(flank - centre).T)
+    assert distance.min() == pytest.approx(pin / 2.0, abs=2e-5)
+    assert ring.tip_radius_mm < sheet.pin_contact_radius_mm < ring.form_radius_mm
+
+
+@pytest.mark.parametrize("changes, key, words", [
+    ({"addendum_coefficient": 1.0}, "addendum_coefficient", "involute interference"),
+    ({"shaper_cutter_teeth": 50}, "shaper_cutter_teeth", "trimming"),
+    ({"mating_pinion_teeth": 55}, "mating_pinion_teeth", "tip interference"),
+    ({"rim_outer_diameter_mm": 128.0}, "rim_outer_diameter_mm", "rim"),
+    ({"helix_angle_deg": 10.0}, "helix_angle_deg", "spur only"),
+])
+def test_checks_give_one_line_at_the_key(changes, key, words):
+    with pytest.raises(GearSpecError) as caught:
+        _ring(**changes)
+    assert caught.value.field == key and words in str(caught.value) and "\n" not in str(caught.value)
+
+
+def test_rotary_table_refuses_an_internal_gear_at_the_key():
+    text = "\n".join(["[gear]", "teeth = 60", "module_mm = 2.0", "face_width_mm = 10.0", "addendum_coefficient = 0.9",
+                      "rack_tip_radius_mm = 0.4", "internal = true", "shaper_cutter_teeth = 20",
+                      "rim_outer_diameter_mm = 140.0", ""])
+    assert parse_job(text, "ring.toml").gear.is_internal  # no tools: geometry, inspection, CAD only
+    with pytest.raises(JobFileError) as caught:
+        parse_job(text + "[tools.finishing]\ndiameter_mm = 2.0\n", "ring.toml")
+    assert str(caught.value).startswith("ring.toml:7: internal = true: the rotary table cannot cut an internal gear")

@@ -32,6 +32,9 @@ class BlankFeatures:
                 raise GearSpecError(f"{name} must be a number, got {type(value).__name__}", field=name)
             if not math.isfinite(value) or value < 0.0:
                 raise GearSpecError(f"{name} = {value:g} mm must be zero (none) or positive", field=name)
+        if spec.is_internal and (self.bore_diameter_mm > 0.0 or self.keyway_width_mm > 0.0):
+            raise GearSpecError("an internal gear has no bore or keyway (its inside is the teeth; the rim is "
+                                "rim_outer_diameter_mm)", field="bore_diameter_mm")
         wall = spec.module_mm
         if self.bore_diameter_mm > 0.0 and self.bore_diameter_mm / 2.0 > spec.root_radius_mm - wall:
             raise GearSpecError(

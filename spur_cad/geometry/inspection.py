@@ -12,6 +12,7 @@ import math
 from dataclasses import dataclass
 
 from spur_cad.errors import require_instance
+from spur_cad.geometry.internal import InternalGearSpec
 from spur_cad.geometry.involute import inverse_involute_function, involute_function
 from spur_cad.geometry.spec import GearSpec
 
@@ -186,6 +187,55 @@ class InspectionSheet:
     thickness_reduction_mm: float
     min_teeth_without_undercut: int
     min_teeth_without_undercut_exact: float
+    pins_between: bool = False  # internal gear: dimension_over_pins_mm is the dimension BETWEEN pins
+
+
+def between_pins(spec: InternalGearSpec, pin_diameter_mm: float) -> OverPinsMeasurement:
+    """Internal gear: dimension between two pins in opposite (or nearly opposite) spaces. The pin centre lies on
+    the involute parallel to the flank, turned by D / (2 r_b) toward the space axis: inv(a_M) = e / (2 r) +
+    inv(alpha) - D / (2 r_b), r_M = r_b / cos(a_M); even teeth M = 2 r_M - D, odd M = 2 r_M cos(pi / (2 z)) - D
+    (KHK's formula with e = m (pi/2 - 2 x tan(alpha)) when there is no allowance)."""
+    if pin_diameter_mm <= 0.0:
+        raise ValueError(f"pin diameter must be positive, got {pin_diameter_mm}")
+    rb = spec.base_radius_mm
+    inv_alpha_m = spec.base_half_space_angle_rad - pin_diameter_mm / (2.0 * rb)
+    if inv_alpha_m <= 0.0:
+        raise ValueError(f"a pin of {pin_diameter_mm} mm does not fit the space above the base circle")
+    alpha_m = inverse_involute_function(inv_alpha_m)
+    centre_radius = rb / math.cos(alpha_m)
+    factor = 1.0 if spec.teeth % 2 == 0 else math.cos(math.pi / (2.0 * spec.teeth))
+    contact = rb * math.hypot(1.0, alpha_m + spec.base_half_space_angle_rad)  # roll t_c = a_M + theta_b
+    return OverPinsMeasurement(pin_diameter_mm, 2.0 * centre_radius * factor - pin_diameter_mm, centre_radius,
+                               contact)
+
+
+def recommended_inside_pin_diameter_mm(spec: InternalGearSpec) -> float:
+    """Pin touching the ring's flanks at radius r - x m (the middle of the flank when that is off the involute):
+    roll t_c there, a_M = t_c - theta_b, D = 2 r_b (t_c - tan(a_M)); rounded to gauge-pin steps."""
+    rb = spec.base_radius_mm
+    target = spec.reference_radius_mm - spec.profile_shift_coefficient * spec.module_mm
+    if not spec.tip_radius_mm < target < spec.form_radius_mm:
+        target = 0.5 * (spec.tip_radius_mm + spec.form_radius_mm)
+    roll = math.sqrt((target / rb) ** 2 - 1.0)
+    diameter = 2.0 * rb * (roll - math.tan(roll - spec.base_half_space_angle_rad))
+    return max(PIN_DIAMETER_STEP_MM, round(diameter / PIN_DIAMETER_STEP_MM) * PIN_DIAMETER_STEP_MM)
+
+
+def internal_inspection_facts(spec: InternalGearSpec) -> InspectionSheet:
+    """An internal gear's sheet: dimension between pins and chordal thickness at the reference circle (height
+    from the tip circle, which lies inside it); no span (base tangent length): calipers' anvils cannot sit on a
+    ring's flanks, so it is given as None (and k = 0)."""
+    pin = recommended_inside_pin_diameter_mm(spec)
+    pins = between_pins(spec, pin)
+    radius = spec.reference_radius_mm
+    half_angle = spec.tooth_thickness_at_radius_mm(radius) / (2.0 * radius)
+    return InspectionSheet(
+        span_teeth_k=0, span_measurement_mm=None, span_contact_radius_mm=0.0, span_min_face_width_mm=0.0,
+        pin_diameter_mm=pin, dimension_over_pins_mm=pins.dimension_mm, pin_contact_radius_mm=pins.contact_radius_mm,
+        chordal_thickness_mm=2.0 * radius * math.sin(half_angle),
+        chordal_height_mm=radius * math.cos(half_angle) - spec.tip_radius_mm, chordal_measuring_radius_mm=radius,
+        tooth_thickness_mm=spec.tooth_thickness_mm, thickness_reduction_mm=spec.thickness_reduction_mm,
+        min_teeth_without_undercut=0, min_teeth_without_undercut_exact=0.0, pins_between=True)
 
 
 def inspection_facts(spec: GearSpec) -> InspectionSheet:
@@ -193,6 +243,8 @@ def inspection_facts(spec: GearSpec) -> InspectionSheet:
     normal section, over balls; the span's k is lowered until the anvils fit the face width (b > W sin(beta_b)),
     and the span is None when not even k = 1 fits (measure over balls)."""
     require_instance(spec, GearSpec, "spec")
+    if isinstance(spec, InternalGearSpec):
+        return internal_inspection_facts(spec)
     k = recommended_span_teeth(spec)
     span = span_measurement(spec, k)
     while k > 1 and span_min_face_width_mm(spec, span) >= spec.face_width_mm:  # helical: the anvils must fit
