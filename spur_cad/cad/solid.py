@@ -119,6 +119,8 @@ def fit_segment(segment: Segment, fit_tolerance_mm: float) -> FittedCurve:
         points = segment.points(params)
         normals = segment.normals(params)
         tangents = np.stack([normals[:, 1], -normals[:, 0]], axis=-1)  # travel direction (normal turned right)
+        if np.dot(tangents[0], points[-1] - points[0]) < 0.0:  # an internal gear's space lies right of travel
+            tangents = -tangents
         curve = _interpolate(points, tangents)
         check = np.concatenate([np.linspace(a, b, _CHECK_POINTS_PER_SPAN, endpoint=False)[1:]
                                 for a, b in zip(params, params[1:])])
@@ -259,9 +261,21 @@ def _x_cylinder(radius: float, x0: float, x1: float) -> TopoDS_Shape:
     return BRepPrimAPI_MakeCylinder(gp_Ax2(gp_Pnt(x0, 0, 0), gp_Dir(1, 0, 0)), radius, x1 - x0).Shape()
 
 
+def _ring_shape(edges: list[TopoDS_Edge], spec: GearSpec) -> TopoDS_Shape:
+    """An internal gear: the rim cylinder (rim_outer_diameter_mm, 0 <= X <= b) less the toothed inner outline
+    extruded 1 mm beyond both faces (no coplanar faces in the boolean cut)."""
+    b = spec.face_width_mm
+    inner = _extrude(edges, b + 2.0)
+    shift = gp_Trsf()
+    shift.SetTranslation(gp_Vec(-1.0, 0.0, 0.0))
+    inner = BRepBuilderAPI_Transform(inner, shift, True).Shape()
+    return _cut(_x_cylinder(spec.rim_outer_diameter_mm / 2.0, 0.0, b), inner)
+
+
 def build_gear_shape(spec: GearSpec, features: BlankFeatures = BlankFeatures(),
                      fit_tolerance_mm: float | None = None) -> tuple[TopoDS_Shape, GearSolidReport]:
-    """The gear as an OCP solid in the machine frame, with a report of the spline fits.
+    """The gear as an OCP solid in the machine frame, with a report of the spline fits (an internal gear: a ring
+    whose outside is the rim, rim_outer_diameter_mm).
 
     `fit_tolerance_mm` defaults to 2.5e-6 x module (see default_fit_tolerance_mm)."""
     require_instance(spec, GearSpec, "spec")
@@ -270,7 +284,10 @@ def build_gear_shape(spec: GearSpec, features: BlankFeatures = BlankFeatures(),
     tolerance = default_fit_tolerance_mm(spec) if fit_tolerance_mm is None else fit_tolerance_mm
     edges, report = gear_face_edges(spec, tolerance)
     b = spec.face_width_mm
-    shape = _sweep_helical(edges, spec) if spec.is_helical else _extrude(edges, b)
+    if spec.is_internal:
+        shape = _ring_shape(edges, spec)
+    else:
+        shape = _sweep_helical(edges, spec) if spec.is_helical else _extrude(edges, b)
     if features.bore_diameter_mm > 0.0:
         shape = _cut(shape, _x_cylinder(features.bore_diameter_mm / 2.0, -1.0, b + 1.0))
     if features.keyway_width_mm > 0.0:
