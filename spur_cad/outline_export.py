@@ -19,7 +19,15 @@ from dataclasses import dataclass
 from xml.sax.saxutils import escape, quoteattr
 
 from spur_cad.errors import SpurCadError
-from spur_cad.geometry.outline2d import Arc2D, Line2D, Outline2D, Segment2D, gear_outline_arcs, offset_outline
+from spur_cad.geometry.outline2d import (
+    Arc2D,
+    Line2D,
+    Outline2D,
+    Segment2D,
+    gear_outline_arcs,
+    internal_gear_outline_arcs,
+    offset_outline,
+)
 from spur_cad.geometry.spec import GearSpec
 
 OUTLINE_LAYER = "OUTLINE"
@@ -60,15 +68,19 @@ def bore_loop(bore_diameter_mm: float, keyway_width_mm: float = 0.0, keyway_dept
 
 def gear_layers(spec: GearSpec, tolerance_mm: float, offset_mm: float, bore_diameter_mm: float = 0.0,
                 keyway_width_mm: float = 0.0, keyway_depth_mm: float = 0.0) -> tuple[Layer, ...]:
-    """An external spur gear's layers: OUTLINE, and BORE when it has a bore, offset by offset_mm away from the
+    """A spur gear's layers: OUTLINE (an internal gear's: the rim and the toothed inner loop), and BORE when it has
+    a bore, offset by offset_mm away from the
     material (ExportError at offset_mm where the offset breaks a loop)."""
-    loops = {OUTLINE_LAYER: gear_outline_arcs(spec, tolerance_mm)}
+    if spec.is_internal:  # the rim circle and the toothed inner outline, both on OUTLINE
+        loops = {OUTLINE_LAYER: internal_gear_outline_arcs(spec, tolerance_mm)}
+    else:
+        loops = {OUTLINE_LAYER: (gear_outline_arcs(spec, tolerance_mm),)}
     if bore_diameter_mm > 0.0:
-        loops[BORE_LAYER] = bore_loop(bore_diameter_mm, keyway_width_mm, keyway_depth_mm)
+        loops[BORE_LAYER] = (bore_loop(bore_diameter_mm, keyway_width_mm, keyway_depth_mm),)
     layers = []
-    for name, loop in loops.items():
+    for name, group in loops.items():
         try:
-            layers.append(Layer(name, (offset_outline(loop, offset_mm),)))
+            layers.append(Layer(name, tuple(offset_outline(loop, offset_mm) for loop in group)))
         except ValueError as exc:
             what = "the gear's outline" if name == OUTLINE_LAYER else "the bore"
             raise ExportError(f"[export] offset_mm = {offset_mm:g}: {what}: {exc}", field="offset_mm",

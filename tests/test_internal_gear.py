@@ -7,6 +7,7 @@ import math
 
 import numpy as np
 import pytest
+import shapely
 from scipy.optimize import brentq
 from shapely.geometry import Polygon
 
@@ -177,6 +178,8 @@ def test_rotary_table_refuses_an_internal_gear_at_the_key():
     with pytest.raises(JobFileError) as caught:
         parse_job(text + "[tools.finishing]\ndiameter_mm = 2.0\n", "ring.toml")
     assert str(caught.value).startswith("ring.toml:7: internal = true: the rotary table cannot cut an internal gear")
+    with pytest.raises(JobFileError, match=r"^ring.toml:7: internal = true: the 3-axis plan does not cut"):
+        parse_job(text + "[tools.finishing]\ndiameter_mm = 2.0\n[machine]\naxes = 3\n", "ring.toml")
 
 
 def test_ring_solid_is_valid_exact_and_survives_step(tmp_path):
@@ -226,3 +229,34 @@ def test_ring_solid_is_valid_exact_and_survives_step(tmp_path):
     assert front_face_area_mm2(back.wrapped) == pytest.approx(area, rel=5e-8)
     box = back.BoundingBox()
     assert (box.ymin, box.ymax, box.xmax) == pytest.approx((-rim, rim, ring.face_width_mm), abs=1e-6)
+
+
+def _loop_points(loop, per_segment: int = 12) -> np.ndarray:
+    return np.concatenate([np.array([s.point_at(t) for t in np.linspace(0.0, 1.0, per_segment)])
+                           for s in loop.segments])
+
+
+def test_internal_outline_arcs_and_their_offset_lie_on_the_exact_curves():
+    """internal_gear_outline_arcs: the rim circle counter-clockwise, the toothed loop clockwise (material on the
+    left), closed, within 1 um of the exact outline; offset by 0.1 mm away from the material, every point lies
+    0.1 mm from the exact inner outline (within 1 um) and the rim grows by 0.1 mm."""
+    from spur_cad.geometry.outline2d import internal_gear_outline_arcs, offset_outline
+    from spur_cad.geometry.sampling import polygon_area
+
+    ring = _ring()
+    rim, teeth = internal_gear_outline_arcs(ring, 1e-3)
+    dense = gear_outline(ring, 1e-7)
+    tree = shapely.STRtree(shapely.linestrings(np.stack([dense, np.roll(dense, -1, axis=0)], axis=1)))
+
+    def distance_to_exact(xy: np.ndarray) -> np.ndarray:
+        return tree.query_nearest(shapely.points(xy), return_distance=True, all_matches=False)[1]
+
+    points = _loop_points(teeth)
+    assert polygon_area(points) < 0.0 < polygon_area(_loop_points(rim))
+    assert distance_to_exact(points).max() < 1e-3
+    assert np.hypot(*_loop_points(rim).T) == pytest.approx(70.0, abs=1e-12)
+    grown_rim, grown_teeth = offset_outline(rim, 0.1), offset_outline(teeth, 0.1)
+    assert np.hypot(*_loop_points(grown_rim).T) == pytest.approx(70.1, abs=1e-12)
+    moved = _loop_points(grown_teeth)
+    assert np.abs(distance_to_exact(moved) - 0.1).max() < 1e-3
+    assert shapely.Polygon(gear_outline(ring, 1e-4)).contains(shapely.points(moved)).all()  # into the air

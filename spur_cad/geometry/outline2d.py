@@ -278,8 +278,9 @@ def fit_biarcs(points_xy: np.ndarray, tangents_xy: np.ndarray, tolerance_mm: flo
 
 # --- the gear outline -----------------------------------------------------------------------------
 
-def _fitted_segment(segment: Segment, tolerance_mm: float) -> list[Segment2D]:
-    """One exact profile segment (root to tip direction) as arcs and lines within tolerance_mm."""
+def _fitted_segment(segment: Segment, tolerance_mm: float, internal: bool = False) -> list[Segment2D]:
+    """One exact profile segment (root to tip direction) as arcs and lines within tolerance_mm (`internal`: a
+    ring's segment, whose space lies right of its direction)."""
     if isinstance(segment, CircularArc):
         a, b = segment.points(np.array([segment.start, segment.end]))
         # polar angle grows clockwise in the profile frame: start -> end is clockwise about the axis
@@ -288,6 +289,8 @@ def _fitted_segment(segment: Segment, tolerance_mm: float) -> list[Segment2D]:
     points = segment.points(params)
     normals = segment.normals(params)
     tangents = np.stack([normals[:, 1], -normals[:, 0]], axis=-1)  # root -> tip, normal into the space
+    if internal:
+        tangents = -tangents
     if float(np.sum(tangents[:-1] * np.diff(points, axis=0))) <= 0.0:
         raise ValueError(f"the {segment.label}'s normals do not match its direction")
     return fit_biarcs(points, tangents, tolerance_mm * _FIT_FRACTION)
@@ -300,7 +303,7 @@ def _space_segments(spec: GearSpec, tolerance_mm: float) -> list[Segment2D]:
     for segment in profile.segments:
         if segment.label in ("root", "tip"):
             continue
-        right.extend(_fitted_segment(segment, tolerance_mm))
+        right.extend(_fitted_segment(segment, tolerance_mm, spec.is_internal))
     right = list(closed_chain(right))
     left = [s.mirrored() for s in right]
     down = [s.reversed() for s in reversed(right)]
@@ -336,12 +339,32 @@ def gear_outline_arcs(spec: GearSpec, tolerance_mm: float) -> Outline2D:
     """
     if not (math.isfinite(tolerance_mm) and tolerance_mm > 0.0):
         raise ValueError(f"tolerance must be a positive number, got {tolerance_mm}")
+    if spec.is_internal:
+        raise ValueError("an internal gear's outline is two loops: use internal_gear_outline_arcs")
+    return _toothed_loop(spec, tolerance_mm)
+
+
+def _toothed_loop(spec: GearSpec, tolerance_mm: float) -> Outline2D:
+    """All teeth's spaces, counter-clockwise (an external gear's outline; a ring's inner outline reversed)."""
     space = _space_segments(spec, tolerance_mm)
     pitch = 2.0 * math.pi / spec.teeth
     segments: list[Segment2D] = []
     for k in range(spec.teeth):
         segments.extend(space if k == 0 else [_turned(s, k * pitch) for s in space])
     return closed_loop(segments)
+
+
+def internal_gear_outline_arcs(spec: GearSpec, tolerance_mm: float) -> tuple[Outline2D, Outline2D]:
+    """An internal gear's transverse outline: the rim circle (counter-clockwise) and the toothed inner outline
+    (clockwise: the material on its left), arcs exact and fillet and involute by biarcs within tolerance_mm."""
+    if not (math.isfinite(tolerance_mm) and tolerance_mm > 0.0):
+        raise ValueError(f"tolerance must be a positive number, got {tolerance_mm}")
+    if not spec.is_internal:
+        raise ValueError("not an internal gear: use gear_outline_arcs")
+    rim_top = (0.0, spec.rim_outer_diameter_mm / 2.0)
+    rim = Outline2D((Arc2D(rim_top, rim_top, (0.0, 0.0), True),))
+    teeth = _toothed_loop(spec, tolerance_mm)
+    return rim, Outline2D(tuple(segment.reversed() for segment in reversed(teeth.segments)))
 
 
 # --- exact offset ---------------------------------------------------------------------------------
