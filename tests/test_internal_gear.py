@@ -260,3 +260,17 @@ def test_internal_outline_arcs_and_their_offset_lie_on_the_exact_curves():
     moved = _loop_points(grown_teeth)
     assert np.abs(distance_to_exact(moved) - 0.1).max() < 1e-3
     assert shapely.Polygon(gear_outline(ring, 1e-4)).contains(shapely.points(moved)).all()  # into the air
+
+
+def test_report_sheet_says_between_pins_and_no_span():
+    from types import SimpleNamespace
+
+    from spur_cad.report.sheet import inspection_rows
+
+    ring = _ring()
+    rows = {row.label: row.value for row in inspection_rows(SimpleNamespace(inspection=inspection_facts(ring),
+                                                                             gear=ring))}
+    assert rows["span measurement"].startswith("not for an internal gear")
+    assert float(rows["dimension between pins (balls)"]) == pytest.approx(inspection_facts(ring).dimension_over_pins_mm,
+                                                                          abs=1e-4)
+    assert not any("over pins" in label or "undercut" in label for label in rows)

@@ -81,8 +81,13 @@ class StockSpec:
     def validate(self, spec: GearSpec) -> None:
         """Raise StockError for keys outside their ranges, a half-given stub or one wider than the blank."""
         check_section(self, "stock", StockError)
+        if spec.is_internal:
+            rim = spec.rim_outer_diameter_mm
+            if 0.0 < self.blank_diameter_mm < rim - 1e-9:
+                raise StockError(f"blank_diameter_mm = {self.blank_diameter_mm:g} is smaller than the internal gear's "
+                                 f"rim_outer_diameter_mm ({rim:g} mm)", field="blank_diameter_mm")
         tip_diameter = 2.0 * spec.tip_radius_mm
-        if 0.0 < self.blank_diameter_mm < tip_diameter - 1e-9:
+        if not spec.is_internal and 0.0 < self.blank_diameter_mm < tip_diameter - 1e-9:
             short = (tip_diameter - self.blank_diameter_mm) / 2.0
             raise StockError(f"blank_diameter_mm = {self.blank_diameter_mm:g} is smaller than the tip diameter "
                              f"{tip_diameter:.4f} mm: the teeth would be {short:.4f} mm short of the tip circle",
@@ -100,7 +105,9 @@ class StockSpec:
         return -self.front_margin_mm, spec.face_width_mm + self.back_margin_mm
 
     def blank_radius_mm(self, spec: GearSpec) -> float:
-        """The blank's radius: half the given blank diameter, else tip radius + radial allowance."""
+        """The blank's radius: half the given blank diameter, else tip radius (an internal gear: rim radius) +
+        radial allowance."""
         if self.blank_diameter_mm > 0.0:
             return self.blank_diameter_mm / 2.0
-        return spec.tip_radius_mm + self.radial_allowance_mm
+        outside = spec.rim_outer_diameter_mm / 2.0 if spec.is_internal else spec.tip_radius_mm
+        return outside + self.radial_allowance_mm

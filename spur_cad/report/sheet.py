@@ -309,6 +309,14 @@ def inspection_rows(result: JobResult) -> tuple[Row, ...]:
         Row("thickness allowance (upper deviation)", signed(-ins.thickness_reduction_mm, 4), "mm"),
         Row("fewest teeth without undercut", str(ins.min_teeth_without_undercut)),
     ]
+    if ins.pins_between:  # an internal gear: no span (anvils cannot sit on a ring's flanks), pins between, no rack
+        rows = [Row("span measurement", "not for an internal gear: measure between pins"),
+                Row("pin (ball) diameter", number(ins.pin_diameter_mm, 4), "mm"),
+                Row("dimension between pins (balls)", number(ins.dimension_over_pins_mm, 4), "mm"),
+                *rows[4:6],
+                Row(f"at chordal height from the tip circle (measuring radius "
+                    f"{number(ins.chordal_measuring_radius_mm, 3)} mm)", number(ins.chordal_height_mm, 4), "mm"),
+                *rows[7:-1]]
     return tuple(rows)
 
 
