@@ -580,14 +580,11 @@ def _job_from_data(data: dict, source: str, text: str, strategies: Strategies = 
     except GearSpecError as exc:
         blamed = _blamed_key(exc, 'gear', tables['gear'])
         raise JobFileError(f"{where('gear', blamed)}: invalid gear: {exc}", section="gear", field=blamed) from None
-    if spec.is_internal and any(name.startswith("tools") for name in tables):
-        if sections.get("machine", Machine()).axes != 3:
-            why = ("the rotary table cannot cut an internal gear (its tool cannot reach inside the ring along the "
-                   "rotary axis)")
-        else:
-            why = "the 3-axis plan does not cut internal gears yet (geometry, inspection, CAD and 2-D export do)"
-        raise JobFileError(f"{where('gear', 'internal')}: internal = true: {why}; leave out [tools] for now",
-                           section="gear", field="internal")
+    if spec.is_internal and any(name.startswith("tools") for name in tables) \
+            and sections.get("machine", Machine()).axes != 3:
+        raise JobFileError(f"{where('gear', 'internal')}: internal = true: the rotary table cannot cut an internal "
+                           "gear (its tool cannot reach inside the ring along the rotary axis); cut it with [machine] "
+                           "axes = 3 or leave out [tools]", section="gear", field="internal")
     for check, name in ((gear_section.blank_features().validate, "gear"),
                         (sections.get("stock", StockSpec()).validate, "stock")):
         try:

@@ -66,6 +66,10 @@ class StockSpec:
     blank_diameter_mm: float = key(0.0, unit="mm", low=0.0, high=20000.0, label="BlankDiameter", group="Stock",
                                    meaning="the blank's diameter as turned, 0: tip diameter + 2 x radial_allowance_mm; "
                                            "smaller than the tip diameter is refused")
+    inner_diameter_mm: float = key(0.0, unit="mm", low=0.0, high=20000.0, label="InnerDiameter", group="Stock",
+                                   meaning="internal gears: the bore the blank comes with (a tube or a turned ring), "
+                                           "below the tip diameter; 0: a solid disc (3-axis roughing enters it "
+                                           "by a helix at the centre)")
     front_margin_mm: float = key(1.0, unit="mm", low=0.0, high=500.0, label="FrontMargin", group="Stock",
                                  meaning="blank beyond the front face X = 0")
     back_margin_mm: float = key(1.0, unit="mm", low=0.0, high=500.0, label="BackMargin", group="Stock",
@@ -87,6 +91,12 @@ class StockSpec:
                 raise StockError(f"blank_diameter_mm = {self.blank_diameter_mm:g} is smaller than the internal gear's "
                                  f"rim_outer_diameter_mm ({rim:g} mm)", field="blank_diameter_mm")
         tip_diameter = 2.0 * spec.tip_radius_mm
+        if self.inner_diameter_mm > 0.0 and not spec.is_internal:
+            raise StockError("inner_diameter_mm is an internal gear's blank bore (an external gear's bore is [gear] "
+                             "bore_diameter_mm)", field="inner_diameter_mm")
+        if spec.is_internal and self.inner_diameter_mm > tip_diameter - 1e-9:
+            raise StockError(f"inner_diameter_mm = {self.inner_diameter_mm:g} is not below the ring's tip diameter "
+                             f"{tip_diameter:.4f} mm: the teeth would be short", field="inner_diameter_mm")
         if not spec.is_internal and 0.0 < self.blank_diameter_mm < tip_diameter - 1e-9:
             short = (tip_diameter - self.blank_diameter_mm) / 2.0
             raise StockError(f"blank_diameter_mm = {self.blank_diameter_mm:g} is smaller than the tip diameter "

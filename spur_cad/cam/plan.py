@@ -600,6 +600,8 @@ def _plan_three_axis(inputs: CamInputs, tolerance_mm: float) -> CamPlan:
         raise ToolError("[machine] axes = 3 needs [tools.roughing]: finishing cuts only the finish stock around the "
                         "outline", field="diameter_mm", section="tools.roughing")
     root = check_three_axis(spec, inputs.finishing_tool, inputs.roughing_tool)
+    if spec.is_internal:
+        return _plan_three_axis_ring(inputs, tolerance_mm, root)
     blank = stock.blank_radius_mm(spec)
     rec = recommend_tools(spec, blank, machine.clearance_mm, inputs.finishing_tool, inputs.finishing.target_scallop_mm)
     roughing = finishing = None
@@ -622,4 +624,42 @@ def _plan_three_axis(inputs: CamInputs, tolerance_mm: float) -> CamPlan:
         finishing = FinishingPlan(tool, result, path, estimate(path, machine), None, None)
     warnings = ("[machine] axes = 3: the cut is not simulated nor graded (the simulator models the rotary table's "
                 "stock); the LinuxCNC programs are checked by rs274 in the tests",)
+    return CamPlan(rec, roughing, finishing, warnings)
+
+
+def _plan_three_axis_ring(inputs: CamInputs, tolerance_mm: float, root) -> CamPlan:
+    """The 3-axis plan of an internal gear (spur_cad.cam.three_axis_ring): the hole roughed from the centre out
+    (from [stock] inner_diameter_mm's bore, or a helix into a solid blank), the toothed inner outline finished;
+    no tool recommendations, no simulation (a warning says so)."""
+    from spur_cad.cam.roughing import RoughingLevels
+    from spur_cad.cam.three_axis import ThreeAxisFinishingFacts
+    from spur_cad.cam.three_axis_ring import (
+        ring_finishing_toolpath,
+        ring_roughing_toolpath,
+        ring_tool_recommendations,
+    )
+
+    spec, machine = inputs.spec, inputs.machine
+    rec = ring_tool_recommendations(spec, machine.clearance_mm)
+    roughing = finishing = None
+    if inputs.roughing_tool is not None:
+        inputs.roughing.validate()
+        tool = inputs.roughing_tool
+        path, levels, offsets = ring_roughing_toolpath(spec, tool, machine, inputs.roughing,
+                                                       inputs.stock.inner_diameter_mm / 2.0)
+        check_travel(machine, path.x, path.y, path.z, path.a, "roughing")
+        roughing = RoughingPlan(tool, RoughingLevels(np.array(levels), np.array(offsets[:1] * len(levels)), None),
+                                0.0, path, estimate(path, machine))
+    if inputs.finishing_tool is not None:
+        tool = inputs.finishing_tool
+        path, levels, segments = ring_finishing_toolpath(spec, tool, machine, tolerance_mm)
+        check_travel(machine, path.x, path.y, path.z, path.a, "finishing")
+        arcs = int(path.arc_mask.sum()) // len(levels) - 2  # less the lead-in and lead-out arcs
+        facts = ThreeAxisFinishingFacts(tool.diameter_mm / 2.0, 2 * root.form_radius_mm, 2 * root.rack_form_radius_mm,
+                                        2 * root.active_start_radius_mm, root.fillet_radius_mm, len(levels),
+                                        segments, arcs)
+        result = FinishingResult("three_axis", None, None, len(levels), 0.0, np.zeros(0), facts=facts)
+        finishing = FinishingPlan(tool, result, path, estimate(path, machine), None, None)
+    warnings = ("[machine] axes = 3: the ring's cut is not simulated nor graded; the LinuxCNC programs are checked "
+                "by rs274 in the tests",)
     return CamPlan(rec, roughing, finishing, warnings)

@@ -68,6 +68,10 @@ def check_three_axis(spec: GearSpec, finishing_tool: Tool | None, roughing_tool:
                             f"{tool.kind}", field="kind", section=f"tools.{role}")
     if finishing_tool is None:
         return None
+    if spec.is_internal:  # a ring: its spaces open outward (spur_cad.cam.three_axis_ring)
+        from spur_cad.cam.three_axis_ring import check_ring_root
+
+        return check_ring_root(spec, finishing_tool)
     root = flat_mill_root(spec, finishing_tool.diameter_mm / 2.0)
     if not root.fits:
         largest = largest_flat_mill_radius_mm(spec)

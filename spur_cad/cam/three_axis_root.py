@@ -34,16 +34,22 @@ class FlatMillRoot:
     fillet_radius_mm: float  # the smallest concave radius of the root that results (r_t when the tool leaves the
     #                          rack's fillet, else the rack fillet's own smallest radius)
     tool_leaves_rack_fillet: bool  # the tool cannot follow the rack-generated fillet everywhere
+    internal: bool = False  # a ring: its spaces open toward the axis, root and form radius above the active profile
 
     @property
     def fits(self) -> bool:
-        """The involute is cut down to the start of the active profile."""
+        """The involute is cut down to (a ring: out to) the start of the active profile."""
+        if self.internal:
+            return self.form_radius_mm >= self.active_start_radius_mm - 1e-9
         return self.form_radius_mm <= self.active_start_radius_mm + 1e-9
 
 
 def active_profile_start_radius_mm(spec: GearSpec) -> float:
     """Radius where the active profile starts in mesh with the basic rack: the line of action meets the mating
-    rack's addendum line (h_a* m below the rolling line shifted by x m); the base radius if that is below it."""
+    rack's addendum line (h_a* m below the rolling line shifted by x m); the base radius if that is below it.
+    A ring's: ring_active_profile_start(spec)'s radius."""
+    if spec.is_internal:
+        return ring_active_profile_start(spec)[0]
     alpha = spec.pressure_angle_rad
     r, rb = spec.reference_radius_mm, spec.base_radius_mm
     depth = (spec.addendum_coefficient - spec.profile_shift_coefficient) * spec.module_mm
@@ -105,8 +111,9 @@ def flat_mill_root(spec: GearSpec, tool_radius_mm: float, samples: _SpaceSamples
                                                  distance_upper_bound=limit)[0] >= limit))
     fillet_radius = profile.min_fillet_curvature_radius_mm if follows and samples.fillet is not None \
         else tool_radius_mm
-    return FlatMillRoot(tool_radius_mm, max(form, profile.form_radius_mm), profile.form_radius_mm,
-                        active_profile_start_radius_mm(spec), float(fillet_radius), not follows)
+    form = min(form, profile.form_radius_mm) if spec.is_internal else max(form, profile.form_radius_mm)
+    return FlatMillRoot(tool_radius_mm, form, profile.form_radius_mm, active_profile_start_radius_mm(spec),
+                        float(fillet_radius), not follows, spec.is_internal)
 
 
 def largest_flat_mill_radius_mm(spec: GearSpec, resolution_mm: float = 0.005) -> float:
@@ -121,3 +128,26 @@ def largest_flat_mill_radius_mm(spec: GearSpec, resolution_mm: float = 0.005) ->
         else:
             high = middle
     return math.floor(low / resolution_mm) * resolution_mm
+
+
+def ring_active_profile_start(spec: GearSpec) -> tuple[float, str]:
+    """Where an internal gear's active profile starts (its largest radius on the involute) and what sets it: the
+    mating pinion's tip circle when `mating_pinion_teeth` is given (no shift, addendum h_a* m, at the
+    zero-backlash centre distance), else the shaper cutter's teeth and shift as a mating gear with the addendum
+    (h_a* + x_0) m at the cutting centre distance (the ring's analogue of the basic rack's addendum line). Along
+    the line of action the ring's roll length is the pinion's plus a sin(alpha_w) (both base tangent points lie on
+    one side of the pitch point)."""
+    from spur_cad.geometry.internal import mating_pinion_mesh
+
+    m = spec.module_mm
+    if spec.mating_pinion_teeth:
+        centre_distance, alpha_w, pinion_base, pinion_tip = mating_pinion_mesh(spec)
+        source = f"the {spec.mating_pinion_teeth}-tooth mating pinion's tips"
+    else:
+        cutter, mesh = spec.shaper_cutter().spec, spec.cutting_mesh()
+        centre_distance, alpha_w = mesh.centre_distance_mm, spec.cutting_pressure_angle_rad
+        pinion_base = cutter.base_radius_mm
+        pinion_tip = cutter.reference_radius_mm + (spec.addendum_coefficient + cutter.profile_shift_coefficient) * m
+        source = f"the {cutter.teeth}-tooth shaper cutter's mesh (as a mating gear of addendum h_a* m)"
+    roll_mm = centre_distance * math.sin(alpha_w) + math.sqrt(max(pinion_tip**2 - pinion_base**2, 0.0))
+    return math.hypot(spec.base_radius_mm, roll_mm), source

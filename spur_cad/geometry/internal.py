@@ -444,22 +444,30 @@ def _trimming_margin(z: int, rb: float, ra: float, z1: int, rb1: float, ra1: flo
     return theta1 + inv_a1 - inv_w - (z / z1) * (theta2 + inv_a2 - inv_w)
 
 
-def _check_pinion_tip_interference(spec: InternalGearSpec) -> None:
-    """Tip (trochoid) interference with the mating pinion (z_1 teeth, no shift, addendum h_a*, mounted at the
-    zero-backlash centre distance): KHK 4.4, theta_1 z_1/z + inv(a_w) - inv(a_a2) >= theta_2 with
-    cos t_1 = (r_a2^2 - r_a1^2 - a^2) / (2 a r_a1), theta_1 = t_1 + inv(a_a1) - inv(a_w),
-    theta_2 = acos((a^2 + r_a2^2 - r_a1^2) / (2 a r_a2))."""
+def mating_pinion_mesh(spec: InternalGearSpec) -> tuple[float, float, float, float]:
+    """The mating pinion (mating_pinion_teeth z_1, no shift, addendum h_a* m) in zero-backlash mesh with the ring,
+    as the cutter's mesh: (centre distance a, working pressure angle alpha_w, its base radius, its tip radius)."""
     z, z1, m = spec.teeth, spec.mating_pinion_teeth, spec.module_mm
     alpha = spec.pressure_angle_rad
     pinion_thickness = m * math.pi / 2.0
-    # Zero-backlash mesh of the ring's space with the standard pinion tooth: as the cutter's mesh.
     ring_space = 2.0 * spec.base_half_space_angle_rad
     pinion_tooth = pinion_thickness / (m * z1 / 2.0) + 2.0 * involute_function(alpha)
     inv_w = (z * ring_space - z1 * pinion_tooth) / (2.0 * (z - z1))
     alpha_w = inverse_involute_function(max(inv_w, 1e-12))
     rb1 = m * z1 / 2.0 * math.cos(alpha)
     a = (spec.base_radius_mm - rb1) / math.cos(alpha_w)
-    ra1, ra2 = m * z1 / 2.0 + spec.addendum_coefficient * m, spec.tip_radius_mm
+    return a, alpha_w, rb1, m * z1 / 2.0 + spec.addendum_coefficient * m
+
+
+def _check_pinion_tip_interference(spec: InternalGearSpec) -> None:
+    """Tip (trochoid) interference with the mating pinion (z_1 teeth, no shift, addendum h_a*, mounted at the
+    zero-backlash centre distance): KHK 4.4, theta_1 z_1/z + inv(a_w) - inv(a_a2) >= theta_2 with
+    cos t_1 = (r_a2^2 - r_a1^2 - a^2) / (2 a r_a1), theta_1 = t_1 + inv(a_a1) - inv(a_w),
+    theta_2 = acos((a^2 + r_a2^2 - r_a1^2) / (2 a r_a2))."""
+    z, z1 = spec.teeth, spec.mating_pinion_teeth
+    a, alpha_w, rb1, ra1 = mating_pinion_mesh(spec)
+    inv_w = involute_function(alpha_w)
+    ra2 = spec.tip_radius_mm
     cos_t1 = (ra2**2 - ra1**2 - a**2) / (2.0 * a * ra1)
     cos_t2 = (a**2 + ra2**2 - ra1**2) / (2.0 * a * ra2)
     if not (-1.0 <= cos_t1 <= 1.0 and -1.0 <= cos_t2 <= 1.0):
