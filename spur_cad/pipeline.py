@@ -93,7 +93,7 @@ def run_job(job: Job, progress: Callable[[str, float], None] | None = None,
     drawings = timed("export", None, lambda: export_files(job)) if job.export.dxf or job.export.svg else {}
     sim_result = timed("simulation", "simulation",
                        lambda: simulate_stage(job, plan, lambda fraction: tell("simulation", fraction)))
-    grading = timed("grading", None, lambda: grade_stage(job, sim_result))
+    grading = timed("grading", None, lambda: grade_stage(job, sim_result, plan))
     budget = timed("error_budget", None, lambda: budget_stage(job, plan, sim_result, grading))
     result = build_result(job, samples, cad, plan, job.post, programs, sim_result, grading, seconds, budget)
     result = dataclasses.replace(result, correction=correction)
@@ -114,13 +114,21 @@ def run_job(job: Job, progress: Callable[[str, float], None] | None = None,
     return dataclasses.replace(result, files=files)
 
 
-def grade_stage(job: Job, sim_result: SimResult | None) -> Grading | None:
-    """The simulated gear's ISO 1328-1 grade (None without a simulation), computed once per run."""
+def grade_stage(job: Job, sim_result: SimResult | None, plan: CamPlan | None = None) -> Grading | None:
+    """The simulated gear's ISO 1328-1 grade (None without a simulation), computed once per run; a 3-axis plan's
+    profiles are evaluated from where its finishing tool leaves the involute (its form diameter)."""
     if sim_result is None:
         return None
     from spur_cad.grade.simulated import grade_simulation
 
-    return grade_simulation(job.gear, sim_result)
+    return grade_simulation(job.gear, sim_result, three_axis_profile_start_mm(plan))
+
+
+def three_axis_profile_start_mm(plan: CamPlan | None) -> float | None:
+    """Where a 3-axis plan's finishing tool leaves the involute (radius, mm); None for any other plan."""
+    if plan is None or plan.finishing is None or plan.finishing.result.strategy != "three_axis":
+        return None
+    return plan.finishing.result.facts.form_diameter_mm / 2.0
 
 
 def error_budget(job: Job, plan: CamPlan):
@@ -140,8 +148,9 @@ def error_budget(job: Job, plan: CamPlan):
 
 def budget_stage(job: Job, plan: CamPlan, sim_result: SimResult | None, grading: Grading | None):
     """The simulated gear on the budget's machine, graded (spur_cad.result.ErrorBudgetFacts; None without a
-    simulation): the budget acts on the simulated flanks, the cut is not simulated again."""
-    if sim_result is None or grading is None:
+    simulation): the budget acts on the simulated flanks, the cut is not simulated again. None for 3 axes: its
+    index errors are the rotary table's (docs/simulation.md)."""
+    if sim_result is None or grading is None or job.machine.axes == 3:
         return None
     from spur_cad.grade.simulated import grade_simulation
     from spur_cad.sim.budget import apply_budget
@@ -374,8 +383,18 @@ def simulate_stage(job: Job, plan: CamPlan, progress: Callable[[float], None] | 
 
     operations = [Cut(planned.toolpath, planned.tool) for planned in (plan.roughing, plan.roughing_bottom,
                                                                       plan.finishing) if planned is not None]
-    if not job.simulation.enabled or not operations or job.machine.axes == 3:  # 3 axes: not simulated (a warning)
+    if not job.simulation.enabled or not operations:
         return None
+    if job.machine.axes == 3:  # the blank lying flat: swept areas level by level (spur_cad.sim.flat)
+        from spur_cad.sim.flat import simulate_flat
+
+        depths = -plan.finishing.toolpath.z[plan.finishing.toolpath.motion_mask] if plan.finishing is not None \
+            else np.zeros(0)
+        result = simulate_flat(job.gear, job.stock.blank_radius_mm(job.gear), operations,
+                               SimSettings(resolution_mm=job.simulation.resolution_mm), np.unique(depths))
+        if progress is not None:
+            progress(1.0)
+        return result
     stations = plan.finishing.result.station_x_mm if plan.finishing is not None else np.zeros(0)
     result = simulate(job.gear, job_stock(job), operations, SimSettings(resolution_mm=job.simulation.resolution_mm),
                       station_x=stations, progress=progress)

@@ -172,4 +172,5 @@ def test_a_three_axis_job_runs_through_the_pipeline_without_a_rotary_axis(tmp_pa
     assert "G2 " in finishing and "G3 " in finishing and "gear axis = Z" in finishing
     for program in (finishing, roughing):
         assert not [line for line in program.splitlines() if not line.startswith("(") and " A" in line]
-    assert any("not simulated" in w for w in result.warnings)
+    assert any("error budget is not applied" in w for w in result.warnings)
+    assert result.grading is not None and result.simulation is not None

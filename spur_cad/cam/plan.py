@@ -586,7 +586,7 @@ def _comparison_estimate(spec: GearSpec, tool: Tool, machine: Machine, blank: fl
 def _plan_three_axis(inputs: CamInputs, tolerance_mm: float) -> CamPlan:
     """The CAM plan of a 3-axis job ([machine] axes = 3): the checks of three_axis.check_three_axis, roughing and
     finishing as spur_cad.cam.three_axis says; no tool recommendations for the rotary-table strategies
-    (empty), no simulation (a warning says so)."""
+    (empty), no error budget (a warning says so; the cut is simulated by spur_cad.sim.flat)."""
     from spur_cad.cam.roughing import RoughingLevels
     from spur_cad.cam.three_axis import (
         ThreeAxisFinishingFacts,
@@ -620,6 +620,6 @@ def _plan_three_axis(inputs: CamInputs, tolerance_mm: float) -> CamPlan:
                                         segments, arcs)
         result = FinishingResult("three_axis", None, None, len(levels), 0.0, np.zeros(0), facts=facts)
         finishing = FinishingPlan(tool, result, path, estimate(path, machine), None, None)
-    warnings = ("[machine] axes = 3: the cut is not simulated nor graded (the simulator models the rotary table's "
-                "stock); the LinuxCNC programs are checked by rs274 in the tests",)
+    warnings = ("[machine] axes = 3: the error budget is not applied (its index errors are the rotary table's); "
+                "the simulation and grade are those of an ideal 3-axis machine",)
     return CamPlan(rec, roughing, finishing, warnings)
