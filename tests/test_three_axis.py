@@ -174,3 +174,49 @@ def test_a_three_axis_job_runs_through_the_pipeline_without_a_rotary_axis(tmp_pa
         assert not [line for line in program.splitlines() if not line.startswith("(") and " A" in line]
     assert any("error budget is not applied" in w for w in result.warnings)
     assert result.grading is not None and result.simulation is not None
+
+
+def tooth_chord_from_centres(centres: np.ndarray, radius_mm: float, circle_mm: float, teeth: int) -> float:
+    """Tooth 0's chord on the circle `circle_mm` as the tool circles about `centres` leave it: each edge where the
+    circle's points stop being within the tool radius of a centre (bisection on the angle, 1e-9 rad)."""
+    tree = cKDTree(centres)
+    middle = math.pi / 2 + math.pi / teeth
+
+    def cut(angle: float) -> bool:
+        return tree.query([circle_mm * math.cos(angle), circle_mm * math.sin(angle)])[0] <= radius_mm
+
+    edges = []
+    for side in (-1.0, 1.0):
+        inside, outside = middle, middle + side * math.pi / teeth  # the tooth's centre stays, the space is cut
+        assert not cut(inside) and cut(outside)
+        while abs(outside - inside) > 1e-9:
+            half = 0.5 * (inside + outside)
+            inside, outside = (inside, half) if cut(half) else (half, outside)
+        edges.append(inside)
+    return 2 * circle_mm * math.sin(abs(edges[1] - edges[0]) / 2)
+
+
+def test_root_thickness_against_the_involute_and_the_cut_the_finishing_path_leaves():
+    """At the root form circle the rack-generated chord is the involute's (textbook thickness at a radius); a tool
+    that follows the rack's fillet (reference, r 1 mm < its 1.15 mm) leaves the same root; one that cannot (z 30
+    m 1, r 0.5 mm > the fillet's 0.31 mm) leaves the tooth thicker at the fillet's middle, as thick as the circles
+    of the finishing path's tool centres leave it (within 0.5 um: the 1 um arc fit)."""
+    from spur_cad.cam.three_axis_root import root_thickness
+    from spur_cad.geometry.involute import involute_function
+    from tests.test_three_axis_sim import walked_centres
+
+    following = root_thickness(REFERENCE, 1.0)
+    rho, r, rb = following.form_diameter_mm / 2, REFERENCE.reference_radius_mm, REFERENCE.base_radius_mm
+    alpha, alpha_rho = math.acos(rb / r), math.acos(rb / rho)
+    half_angle = REFERENCE.tooth_thickness_mm / (2 * r) + involute_function(alpha) - involute_function(alpha_rho)
+    assert following.rack_form_thickness_mm == pytest.approx(2 * rho * math.sin(half_angle), abs=5e-5)
+    assert following.form_thickness_mm == pytest.approx(following.rack_form_thickness_mm, abs=1e-4)
+    assert following.fillet_thickness_mm == pytest.approx(following.rack_fillet_thickness_mm, abs=1e-4)
+
+    tool = flat(1.0, 2)
+    leaving = root_thickness(MODULE_1, 0.5)
+    assert leaving.fillet_thickness_mm > leaving.rack_fillet_thickness_mm + 0.01
+    path, _, _ = finishing_toolpath(MODULE_1, tool, Machine(), TOLERANCE_MM, MODULE_1.tip_radius_mm + 0.5)
+    walked = tooth_chord_from_centres(walked_centres(path, 0.0005), 0.5, leaving.fillet_diameter_mm / 2,
+                                      MODULE_1.teeth)
+    assert leaving.fillet_thickness_mm == pytest.approx(walked, abs=0.0005)

@@ -594,6 +594,7 @@ def _plan_three_axis(inputs: CamInputs, tolerance_mm: float) -> CamPlan:
         finishing_toolpath,
         roughing_toolpath,
     )
+    from spur_cad.cam.three_axis_root import root_thickness
 
     spec, machine, stock = inputs.spec, inputs.machine, inputs.stock
     if inputs.finishing_tool is not None and inputs.roughing_tool is None:
@@ -617,7 +618,7 @@ def _plan_three_axis(inputs: CamInputs, tolerance_mm: float) -> CamPlan:
         arcs = int(path.arc_mask.sum()) // len(levels) - 2  # less the lead-in and lead-out arcs
         facts = ThreeAxisFinishingFacts(tool.diameter_mm / 2.0, 2 * root.form_radius_mm, 2 * root.rack_form_radius_mm,
                                         2 * root.active_start_radius_mm, root.fillet_radius_mm, len(levels),
-                                        segments, arcs)
+                                        segments, arcs, root_thickness(spec, tool.diameter_mm / 2.0))
         result = FinishingResult("three_axis", None, None, len(levels), 0.0, np.zeros(0), facts=facts)
         finishing = FinishingPlan(tool, result, path, estimate(path, machine), None, None)
     warnings = ("[machine] axes = 3: the error budget is not applied (its index errors are the rotary table's); "

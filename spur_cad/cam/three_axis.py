@@ -26,7 +26,12 @@ import numpy as np
 
 from spur_cad.cam.ir import MoveKind, Operation, Toolpath, ToolpathBuilder
 from spur_cad.cam.machine import Machine, MachineError, RoughingParams
-from spur_cad.cam.three_axis_root import FlatMillRoot, flat_mill_root, largest_flat_mill_radius_mm
+from spur_cad.cam.three_axis_root import (
+    FlatMillRoot,
+    RootThickness,
+    flat_mill_root,
+    largest_flat_mill_radius_mm,
+)
 from spur_cad.cam.tools import Tool, ToolError
 from spur_cad.geometry.outline2d import Arc2D, Line2D, Outline2D, Segment2D, gear_outline_arcs, offset_outline
 from spur_cad.geometry.sampling import gear_outline
@@ -216,12 +221,18 @@ class ThreeAxisFinishingFacts:
     step_downs: int
     segments_per_loop: int  # arcs and lines of one finishing loop
     arcs_per_loop: int
+    root_thickness: RootThickness  # the tooth's chord at the root form circle and mid-fillet, cut vs rack-generated
 
     def report_text(self) -> str:
+        t = self.root_thickness
         return (f"Finishing (3 axes): the outline as {self.arcs_per_loop} arcs and "
                 f"{self.segments_per_loop - self.arcs_per_loop} lines per loop, offset by the tool radius "
                 f"{self.tool_radius_mm:g} mm, in {self.step_downs} step-downs (climb). The tool's side leaves the "
                 f"involute at diameter {self.form_diameter_mm:.3f} mm (rack-generated {self.rack_form_diameter_mm:.3f}"
                 f" mm, active profile from {self.active_start_diameter_mm:.3f} mm) and a root fillet of "
-                f"{self.root_fillet_radius_mm:.3f} mm radius at least.")
+                f"{self.root_fillet_radius_mm:.3f} mm radius at least. Root thickness (tooth chord): "
+                f"{t.form_thickness_mm:.4f} mm at the root form diameter {t.form_diameter_mm:.3f} mm (rack-generated "
+                f"{t.rack_form_thickness_mm:.4f} mm), {t.fillet_thickness_mm:.4f} mm at diameter "
+                f"{t.fillet_diameter_mm:.3f} mm, the fillet's middle (rack-generated "
+                f"{t.rack_fillet_thickness_mm:.4f} mm).")
 
