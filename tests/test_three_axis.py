@@ -220,3 +220,32 @@ def test_root_thickness_against_the_involute_and_the_cut_the_finishing_path_leav
     walked = tooth_chord_from_centres(walked_centres(path, 0.0005), 0.5, leaving.fillet_diameter_mm / 2,
                                       MODULE_1.teeth)
     assert leaving.fillet_thickness_mm == pytest.approx(walked, abs=0.0005)
+
+
+def test_finishing_steps_down_no_deeper_than_a_slot_where_roughing_cannot_reach_the_root():
+    """z 30 m 1 roughed with D 2 (wider than the spaces' bottoms) and finished with D 1: the finishing tool cuts
+    almost a full slot at the root (its centre's depth in what roughing leaves measured here as its distance from
+    the roughing program's walked tool centres less their radius), so its step-down is the slot depth [roughing]
+    allows; the reference gear (roughing reaches the root) keeps one tool diameter."""
+    from spur_cad.cam.three_axis import finishing_engagement, finishing_loop, roughing_leaves
+    from tests.test_three_axis_sim import walked_centres
+
+    params, rough, finish = RoughingParams(), flat(2.0, 1), flat(1.0, 2)
+    path, _, offsets = roughing_toolpath(MODULE_1, rough, Machine(), params, MODULE_1.tip_radius_mm + 0.5)
+    loop = finishing_loop(MODULE_1, finish, TOLERANCE_MM)
+    engagement = finishing_engagement(loop, finish, roughing_leaves(MODULE_1, rough, offsets[-1]), params)
+    loop_points = np.array([s.point_at(t) for s in loop for t in np.linspace(0.0, 1.0, 20)])
+    depth = cKDTree(walked_centres(path, 0.002)).query(loop_points)[0] - rough.diameter_mm / 2.0
+    independent = float(np.clip(finish.diameter_mm / 2.0 + depth, 0.0, finish.diameter_mm).max()) / finish.diameter_mm
+    assert independent > 0.9 and engagement.max_radial_fraction == pytest.approx(independent, abs=0.005)
+    assert engagement.limited and engagement.step_down_mm == pytest.approx(params.max_level_depth_fraction * 1.0)
+    _, levels, _ = finishing_toolpath(MODULE_1, finish, Machine(), TOLERANCE_MM, MODULE_1.tip_radius_mm + 0.5,
+                                      engagement.step_down_mm)
+    assert max(-np.diff([0.0, *levels])) <= params.max_level_depth_fraction * finish.diameter_mm + 1e-9
+
+    rough, finish = flat(3.5, 1), flat(2.0, 2)
+    path, _, offsets = roughing_toolpath(REFERENCE, rough, Machine(), params, REFERENCE.tip_radius_mm + 0.5)
+    reference = finishing_engagement(finishing_loop(REFERENCE, finish, TOLERANCE_MM), finish,
+                                     roughing_leaves(REFERENCE, rough, offsets[-1]), params)
+    assert reference.max_radial_fraction <= params.max_radial_engagement_fraction and not reference.limited
+    assert reference.step_down_mm == pytest.approx(finish.diameter_mm)

@@ -591,7 +591,10 @@ def _plan_three_axis(inputs: CamInputs, tolerance_mm: float) -> CamPlan:
     from spur_cad.cam.three_axis import (
         ThreeAxisFinishingFacts,
         check_three_axis,
+        finishing_engagement,
+        finishing_loop,
         finishing_toolpath,
+        roughing_leaves,
         roughing_toolpath,
     )
     from spur_cad.cam.three_axis_root import root_thickness
@@ -613,12 +616,16 @@ def _plan_three_axis(inputs: CamInputs, tolerance_mm: float) -> CamPlan:
                                 0.0, path, estimate(path, machine))
     if inputs.finishing_tool is not None:
         tool = inputs.finishing_tool
-        path, levels, segments = finishing_toolpath(spec, tool, machine, tolerance_mm, blank)
+        engagement = None if roughing is None else finishing_engagement(
+            finishing_loop(spec, tool, tolerance_mm), tool,
+            roughing_leaves(spec, inputs.roughing_tool, offsets[-1]), inputs.roughing)
+        path, levels, segments = finishing_toolpath(spec, tool, machine, tolerance_mm, blank,
+                                                    None if engagement is None else engagement.step_down_mm)
         check_travel(machine, path.x, path.y, path.z, path.a, "finishing")
         arcs = int(path.arc_mask.sum()) // len(levels) - 2  # less the lead-in and lead-out arcs
         facts = ThreeAxisFinishingFacts(tool.diameter_mm / 2.0, 2 * root.form_radius_mm, 2 * root.rack_form_radius_mm,
                                         2 * root.active_start_radius_mm, root.fillet_radius_mm, len(levels),
-                                        segments, arcs, root_thickness(spec, tool.diameter_mm / 2.0))
+                                        segments, arcs, root_thickness(spec, tool.diameter_mm / 2.0), engagement)
         result = FinishingResult("three_axis", None, None, len(levels), 0.0, np.zeros(0), facts=facts)
         finishing = FinishingPlan(tool, result, path, estimate(path, machine), None, None)
     warnings = ("[machine] axes = 3: the error budget is not applied (its index errors are the rotary table's); "

@@ -130,15 +130,65 @@ def _add_segment(builder: ToolpathBuilder, segment: Segment2D, z: float, feed: f
                     station=station)
 
 
-def finishing_toolpath(spec: GearSpec, tool: Tool, machine: Machine, tolerance_mm: float,
-                       blank_radius_mm: float) -> tuple[Toolpath, list[float], int]:
-    """The finishing program (see the module docstring): (toolpath, Z levels, segments per loop)."""
+ENGAGEMENT_SPACING_MM = 0.01
+"""Spacing of the finishing loop's points whose radial engagement is measured."""
+
+
+@dataclass(frozen=True)
+class FinishingEngagement:
+    """How wide the finishing tool cuts into what roughing leaves, and the step-down that allows."""
+
+    max_radial_fraction: float  # largest radial engagement a_e / D along the loop (1: a full slot)
+    step_down_mm: float  # the finishing step-down chosen
+    limited: bool  # the step-down was cut to the slot depth [roughing] allows (the tool engages wider than a flank
+    #                pass may: max_radial_engagement_fraction)
+
+
+def finishing_loop(spec: GearSpec, tool: Tool, tolerance_mm: float) -> list[Segment2D]:
+    """The finishing tool centre's loop: the outline's arcs offset by the tool radius, climb, from a tip's middle."""
+    return _entry_split(_climb(offset_outline(gear_outline_arcs(spec, tolerance_mm), tool.diameter_mm / 2.0)))
+
+
+def roughing_leaves(spec: GearSpec, roughing_tool: Tool, innermost_offset_mm: float):
+    """The section roughing leaves at every level (shapely polygon): what its innermost pass's tool circles (centre
+    `innermost_offset_mm` from the outline) do not reach."""
+    from shapely.geometry import Polygon
+
+    gear = Polygon(gear_outline(spec, ROUGHING_OUTLINE_TOLERANCE_MM))
+    ring = gear.buffer(innermost_offset_mm, quad_segs=ROUGHING_ARC_SEGMENTS)
+    return ring.buffer(-roughing_tool.diameter_mm / 2.0, quad_segs=4 * ROUGHING_ARC_SEGMENTS)
+
+
+def finishing_engagement(loop: list[Segment2D], tool: Tool, material, params: RoughingParams) -> FinishingEngagement:
+    """The radial engagement of the finishing loop in `material` (what roughing leaves): at each point a_e = r + the
+    depth of the tool centre inside the material (negative outside), from 0 to D (a full slot). A loop engaged wider
+    than `max_radial_engagement_fraction` x D is a pass deeper than a slot, which [roughing] limits to
+    `max_level_depth_fraction` x D; the finishing step-down is cut to that (else one tool diameter)."""
+    import shapely
+
     radius = tool.diameter_mm / 2.0
-    loop = _entry_split(_climb(offset_outline(gear_outline_arcs(spec, tolerance_mm), radius)))
+    points = np.concatenate([[segment.point_at(t) for t in np.linspace(0.0, 1.0, max(2, math.ceil(
+        segment.length_mm / ENGAGEMENT_SPACING_MM) + 1))] for segment in loop])
+    depth = shapely.distance(material.boundary, shapely.points(points))
+    inside = shapely.contains_xy(material, points[:, 0], points[:, 1])
+    engaged = np.clip(radius + np.where(inside, depth, -depth), 0.0, tool.diameter_mm)
+    fraction = float(engaged.max()) / tool.diameter_mm
+    limited = fraction > params.max_radial_engagement_fraction + 1e-9
+    step = (params.max_level_depth_fraction if limited else FINISH_STEP_DOWN_DIAMETERS) * tool.diameter_mm
+    return FinishingEngagement(fraction, min(step, FINISH_STEP_DOWN_DIAMETERS * tool.diameter_mm), limited)
+
+
+def finishing_toolpath(spec: GearSpec, tool: Tool, machine: Machine, tolerance_mm: float, blank_radius_mm: float,
+                       step_down_mm: float | None = None) -> tuple[Toolpath, list[float], int]:
+    """The finishing program (see the module docstring): (toolpath, Z levels, segments per loop); step-downs of at
+    most `step_down_mm` (default one tool diameter)."""
+    radius = tool.diameter_mm / 2.0
+    loop = finishing_loop(spec, tool, tolerance_mm)
     lead = max(radius, 0.5)
     start, end, centre, ccw = _lead_arcs(loop[0].start_xy, loop[0].start_tangent, lead)
     feed, safe_z = tool.feed_mm_min(machine), machine.clearance_mm
-    levels = _levels(spec.face_width_mm + BREAK_THROUGH_MM, FINISH_STEP_DOWN_DIAMETERS * tool.diameter_mm)
+    step = FINISH_STEP_DOWN_DIAMETERS * tool.diameter_mm if step_down_mm is None else step_down_mm
+    levels = _levels(spec.face_width_mm + BREAK_THROUGH_MM, step)
     builder = ToolpathBuilder(Operation.FINISHING, tool.tool_number, tool.spindle_rpm(machine))
     for index, z in enumerate(levels):
         builder.move(MoveKind.RAPID, start[0], start[1], safe_z, 0.0)
@@ -222,6 +272,7 @@ class ThreeAxisFinishingFacts:
     segments_per_loop: int  # arcs and lines of one finishing loop
     arcs_per_loop: int
     root_thickness: RootThickness  # the tooth's chord at the root form circle and mid-fillet, cut vs rack-generated
+    engagement: FinishingEngagement | None = None  # against what roughing leaves (None without roughing)
 
     def report_text(self) -> str:
         t = self.root_thickness
@@ -234,5 +285,14 @@ class ThreeAxisFinishingFacts:
                 f"{t.form_thickness_mm:.4f} mm at the root form diameter {t.form_diameter_mm:.3f} mm (rack-generated "
                 f"{t.rack_form_thickness_mm:.4f} mm), {t.fillet_thickness_mm:.4f} mm at diameter "
                 f"{t.fillet_diameter_mm:.3f} mm, the fillet's middle (rack-generated "
-                f"{t.rack_fillet_thickness_mm:.4f} mm).")
+                f"{t.rack_fillet_thickness_mm:.4f} mm).{self._engagement_text()}")
+
+    def _engagement_text(self) -> str:
+        e = self.engagement
+        if e is None:
+            return ""
+        text = (f" Its radial engagement in what roughing leaves reaches {100 * e.max_radial_fraction:.0f} % of D, "
+                f"step-down {e.step_down_mm:.3f} mm")
+        return text + (" (the slot depth [roughing] max_level_depth_fraction allows: roughing cannot reach the root)."
+                       if e.limited else ".")
 
