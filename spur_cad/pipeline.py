@@ -327,6 +327,12 @@ def _three_axis_comments(job: Job, plan: CamPlan, operation: str) -> tuple[str, 
         what = (f"3-axis finishing: the outline as arcs offset by the tool radius, {facts.step_downs} step-downs, "
                 f"climb; form diameter {facts.form_diameter_mm:.3f} mm, root fillet >= "
                 f"{facts.root_fillet_radius_mm:.3f} mm")
+    holding = job.three_axis
+    if holding.tabs:
+        what += (f"; {holding.tabs} holding tabs on tips ({holding.tab_width_mm:g} mm wide, {holding.tab_height_mm:g} "
+                 "mm high from the bottom face): break them off and file them after the cut")
+    elif holding.onion_skin_mm > 0.0:
+        what += f"; an onion skin of {holding.onion_skin_mm:g} mm left on the bottom face"
     return (
         f"gear: z = {spec.teeth}, m = {spec.module_mm:g} mm, alpha = {spec.pressure_angle_deg:g} deg, "
         f"x = {spec.profile_shift_coefficient:g}, b = {spec.face_width_mm:g} mm, tip diameter "
@@ -361,7 +367,7 @@ def cam_inputs(job: Job) -> CamInputs:
     """The part of a job the CAM stage reads."""
     return CamInputs(job.gear, job.stock, job.tools.roughing, job.tools.finishing, job.roughing, job.finishing,
                      job.machine, job.tools.bottom, top_tool=job.tools.roughing_top, strategies=job.strategies,
-                     profile_tolerance_mm=job.job.profile_tolerance_mm)
+                     profile_tolerance_mm=job.job.profile_tolerance_mm, three_axis=job.three_axis)
 
 
 def plan_cam(job: Job, checkpoint: Callable[[], None] | None = None) -> CamPlan:

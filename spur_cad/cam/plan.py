@@ -47,6 +47,7 @@ from spur_cad.cam.strategies import (
     get_strategy,
     params_from_section,
 )
+from spur_cad.cam.three_axis_tabs import ThreeAxisSection
 from spur_cad.cam.tools import Tool, ToolError
 from spur_cad.errors import SpurCadError, StockError, WorkLimitError, shown
 from spur_cad.geometry.spec import GearSpec
@@ -140,6 +141,7 @@ class CamInputs:
     top_tool: Tool | None = None  # two-stage roughing offered: a larger tool above roughing_tool ([tools.roughing_top])
     strategies: Strategies = field(default_factory=lambda: dict(REGISTRY))  # where [finishing] strategy is found
     profile_tolerance_mm: float = 0.001  # [job] profile_tolerance_mm: the 3-axis finishing arcs' chordal tolerance
+    three_axis: ThreeAxisSection = field(default_factory=ThreeAxisSection)  # [three_axis]: tabs or an onion skin
 
 
 def check_cam_inputs(inputs: CamInputs) -> tuple[ToolRecommendations, RoughingLevels | None]:
@@ -604,13 +606,14 @@ def _plan_three_axis(inputs: CamInputs, tolerance_mm: float) -> CamPlan:
         raise ToolError("[machine] axes = 3 needs [tools.roughing]: finishing cuts only the finish stock around the "
                         "outline", field="diameter_mm", section="tools.roughing")
     root = check_three_axis(spec, inputs.finishing_tool, inputs.roughing_tool)
+    inputs.three_axis.validate(spec.face_width_mm)
     blank = stock.blank_radius_mm(spec)
     rec = recommend_tools(spec, blank, machine.clearance_mm, inputs.finishing_tool, inputs.finishing.target_scallop_mm)
     roughing = finishing = None
     if inputs.roughing_tool is not None:
         inputs.roughing.validate()
         tool = inputs.roughing_tool
-        path, levels, offsets = roughing_toolpath(spec, tool, machine, inputs.roughing, blank)
+        path, levels, offsets = roughing_toolpath(spec, tool, machine, inputs.roughing, blank, inputs.three_axis)
         check_travel(machine, path.x, path.y, path.z, path.a, "roughing")
         roughing = RoughingPlan(tool, RoughingLevels(np.array(levels), np.array(offsets[:1] * len(levels)), None),
                                 0.0, path, estimate(path, machine))
@@ -620,7 +623,8 @@ def _plan_three_axis(inputs: CamInputs, tolerance_mm: float) -> CamPlan:
             finishing_loop(spec, tool, tolerance_mm), tool,
             roughing_leaves(spec, inputs.roughing_tool, offsets[-1]), inputs.roughing)
         path, levels, segments = finishing_toolpath(spec, tool, machine, tolerance_mm, blank,
-                                                    None if engagement is None else engagement.step_down_mm)
+                                                    None if engagement is None else engagement.step_down_mm,
+                                                    inputs.three_axis)
         check_travel(machine, path.x, path.y, path.z, path.a, "finishing")
         arcs = int(path.arc_mask.sum()) // len(levels) - 2  # less the lead-in and lead-out arcs
         facts = ThreeAxisFinishingFacts(tool.diameter_mm / 2.0, 2 * root.form_radius_mm, 2 * root.rack_form_radius_mm,

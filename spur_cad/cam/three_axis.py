@@ -32,6 +32,14 @@ from spur_cad.cam.three_axis_root import (
     flat_mill_root,
     largest_flat_mill_radius_mm,
 )
+from spur_cad.cam.three_axis_tabs import (
+    TabBand,
+    ThreeAxisSection,
+    cut_depth_mm,
+    split_at_bands,
+    tab_bands,
+    tab_top_mm,
+)
 from spur_cad.cam.tools import Tool, ToolError
 from spur_cad.geometry.outline2d import Arc2D, Line2D, Outline2D, Segment2D, gear_outline_arcs, offset_outline
 from spur_cad.geometry.sampling import gear_outline
@@ -94,10 +102,11 @@ def _climb(outline: Outline2D) -> list[Segment2D]:
     return [s.reversed() for s in reversed(outline.segments)]
 
 
-def _entry_split(loop: list[Segment2D]) -> list[Segment2D]:
-    """The loop started at the middle of its longest arc about the gear axis (a tip: convex, outside)."""
+def _entry_split(loop: list[Segment2D], bands: tuple[TabBand, ...] = ()) -> list[Segment2D]:
+    """The loop started at the middle of its longest arc about the gear axis (a tip: convex, outside) that holds
+    no tab."""
     tips = [i for i, s in enumerate(loop) if isinstance(s, Arc2D) and s.center_xy == (0.0, 0.0)
-            and not s.counterclockwise]
+            and not s.counterclockwise and not any(band.holds(s.point_at(0.5)) for band in bands)]
     if not tips:
         raise MachineError("the finishing outline has no tip arc to enter on", field="axes", section="machine")
     i = max(tips, key=lambda k: loop[k].length_mm)
@@ -144,9 +153,26 @@ class FinishingEngagement:
     #                pass may: max_radial_engagement_fraction)
 
 
-def finishing_loop(spec: GearSpec, tool: Tool, tolerance_mm: float) -> list[Segment2D]:
-    """The finishing tool centre's loop: the outline's arcs offset by the tool radius, climb, from a tip's middle."""
-    return _entry_split(_climb(offset_outline(gear_outline_arcs(spec, tolerance_mm), tool.diameter_mm / 2.0)))
+def finishing_loop(spec: GearSpec, tool: Tool, tolerance_mm: float,
+                   bands: tuple[TabBand, ...] = ()) -> list[Segment2D]:
+    """The finishing tool centre's loop: the outline's arcs offset by the tool radius, climb, from the middle of a
+    tip without a tab."""
+    return _entry_split(_climb(offset_outline(gear_outline_arcs(spec, tolerance_mm), tool.diameter_mm / 2.0)),
+                        bands)
+
+
+def _add_held(builder: ToolpathBuilder, pieces: list[tuple[Segment2D, bool]], z: float, tab_top: float,
+              feed: float, station: int) -> None:
+    """The pieces at Z `z`, those in a tab's band at the tab's top (risen to and come down from vertically)."""
+    here = z
+    for piece, held in pieces:
+        target = max(z, tab_top) if held else z
+        if target != here:
+            builder.move(MoveKind.LINEAR, *piece.start_xy, target, 0.0, feed, station=station)
+            here = target
+        _add_segment(builder, piece, target, feed, station)
+    if here != z:
+        builder.move(MoveKind.LINEAR, *pieces[-1][0].end_xy, z, 0.0, feed, station=station)
 
 
 def roughing_leaves(spec: GearSpec, roughing_tool: Tool, innermost_offset_mm: float):
@@ -179,31 +205,40 @@ def finishing_engagement(loop: list[Segment2D], tool: Tool, material, params: Ro
 
 
 def finishing_toolpath(spec: GearSpec, tool: Tool, machine: Machine, tolerance_mm: float, blank_radius_mm: float,
-                       step_down_mm: float | None = None) -> tuple[Toolpath, list[float], int]:
+                       step_down_mm: float | None = None,
+                       holding: ThreeAxisSection | None = None) -> tuple[Toolpath, list[float], int]:
     """The finishing program (see the module docstring): (toolpath, Z levels, segments per loop); step-downs of at
-    most `step_down_mm` (default one tool diameter)."""
+    most `step_down_mm` (default one tool diameter); `holding`: tabs or an onion skin (three_axis_tabs)."""
     radius = tool.diameter_mm / 2.0
-    loop = finishing_loop(spec, tool, tolerance_mm)
+    holding = holding or ThreeAxisSection()
+    bands = tuple(tab_bands(spec, holding, radius))
+    loop = finishing_loop(spec, tool, tolerance_mm, bands)
+    pieces = split_at_bands(loop, list(bands))
+    tab_top = tab_top_mm(spec, holding)
     lead = max(radius, 0.5)
     start, end, centre, ccw = _lead_arcs(loop[0].start_xy, loop[0].start_tangent, lead)
     feed, safe_z = tool.feed_mm_min(machine), machine.clearance_mm
     step = FINISH_STEP_DOWN_DIAMETERS * tool.diameter_mm if step_down_mm is None else step_down_mm
-    levels = _levels(spec.face_width_mm + BREAK_THROUGH_MM, step)
+    levels = _levels(cut_depth_mm(spec, holding, BREAK_THROUGH_MM), step)
     builder = ToolpathBuilder(Operation.FINISHING, tool.tool_number, tool.spindle_rpm(machine))
     for index, z in enumerate(levels):
         builder.move(MoveKind.RAPID, start[0], start[1], safe_z, 0.0)
         builder.move(MoveKind.LINEAR, start[0], start[1], z, 0.0, feed / 2.0, station=index)
         builder.arc(not ccw, *loop[0].start_xy, z, *centre, feed, station=index)
-        for segment in loop:
-            _add_segment(builder, segment, z, feed, index)
+        if bands and z < tab_top:
+            _add_held(builder, pieces, z, tab_top, feed, index)
+        else:
+            for segment in loop:
+                _add_segment(builder, segment, z, feed, index)
         builder.arc(not ccw, end[0], end[1], z, *centre, feed, station=index)
         builder.move(MoveKind.RAPID, end[0], end[1], safe_z, 0.0)
     return builder.build(), levels, len(loop)
 
 
-def roughing_toolpath(spec: GearSpec, tool: Tool, machine: Machine, params: RoughingParams,
-                      blank_radius_mm: float) -> tuple[Toolpath, list[float], list[float]]:
-    """The roughing program (see the module docstring): (toolpath, Z levels, tool-centre offsets outermost first)."""
+def roughing_toolpath(spec: GearSpec, tool: Tool, machine: Machine, params: RoughingParams, blank_radius_mm: float,
+                      holding: ThreeAxisSection | None = None) -> tuple[Toolpath, list[float], list[float]]:
+    """The roughing program (see the module docstring): (toolpath, Z levels, tool-centre offsets outermost first);
+    `holding`: tabs or an onion skin (three_axis_tabs)."""
     from shapely.geometry import Point, Polygon
     from shapely.geometry.polygon import orient
 
@@ -225,10 +260,16 @@ def roughing_toolpath(spec: GearSpec, tool: Tool, machine: Machine, params: Roug
                                field="diameter_mm", section="tools.roughing")
         rings.append((offset, shapes[0].exterior))
     feed, safe_z = tool.feed_mm_min(machine), machine.clearance_mm
-    levels = _levels(spec.face_width_mm + BREAK_THROUGH_MM, params.max_level_depth_fraction * tool.diameter_mm)
+    holding = holding or ThreeAxisSection()
+    bands, tab_top = tab_bands(spec, holding, radius), tab_top_mm(spec, holding)
+    levels = _levels(cut_depth_mm(spec, holding, BREAK_THROUGH_MM), params.max_level_depth_fraction * tool.diameter_mm)
     outside = blank_radius_mm + radius + machine.clearance_mm
     builder = ToolpathBuilder(Operation.ROUGHING, tool.tool_number, tool.spindle_rpm(machine))
     for index, z in enumerate(levels):
+        if bands and z < tab_top:
+            _roughing_level_with_tabs(builder, rings, z, tab_top, bands, outside, feed, safe_z, index,
+                                      machine.clearance_mm)
+            continue
         here = None
         for _, ring in rings:
             coords = np.asarray(ring.coords)[:-1]
@@ -247,6 +288,29 @@ def roughing_toolpath(spec: GearSpec, tool: Tool, machine: Machine, params: Roug
             here = ordered[-1]
         builder.move(MoveKind.RAPID, float(here[0]), float(here[1]), safe_z, 0.0)
     return builder.build(), levels, offsets
+
+
+def _roughing_level_with_tabs(builder: ToolpathBuilder, rings: list, z: float, tab_top: float, bands: list[TabBand],
+                              outside: float, feed: float, safe_z: float, index: int, clearance_mm: float) -> None:
+    """One roughing level below the tabs' top: the same passes as without tabs (entered the same way), the lines
+    in a tab's band at the tab's top."""
+    points = []
+    for _, ring in rings:
+        coords = np.asarray(ring.coords)[:-1]
+        if not points:
+            start = int(np.argmax(np.hypot(coords[:, 0], coords[:, 1])))
+            first = coords[start]
+            away = first / np.hypot(*first) * max(outside, float(np.hypot(*first)) + clearance_mm)
+            points = [away, *np.concatenate([coords[start:], coords[:start + 1]])]
+        else:
+            points.extend(_started_at_nearest(coords, points[-1]))
+    builder.move(MoveKind.RAPID, float(points[0][0]), float(points[0][1]), safe_z, 0.0)
+    builder.move(MoveKind.LINEAR, float(points[0][0]), float(points[0][1]), z, 0.0, feed / 2.0, station=index)
+    lines = [Line2D((float(a[0]), float(a[1])), (float(b[0]), float(b[1]))) for a, b in zip(points[:-1], points[1:])
+             if (a[0], a[1]) != (b[0], b[1])]
+    pieces = split_at_bands(lines, bands)
+    _add_held(builder, pieces, z, tab_top, feed, index)
+    builder.move(MoveKind.RAPID, float(points[-1][0]), float(points[-1][1]), safe_z, 0.0)
 
 
 def _started_at_nearest(coords: np.ndarray, point: np.ndarray) -> np.ndarray:
