@@ -349,13 +349,22 @@ def build_cad(job: Job, checkpoint: Callable[[], None] | None = None,
               timestamp: str | None = None) -> tuple[CadResult, dict[str, bytes]]:
     """Gear solid, stock and STEP files; returns (CAD facts, files). `checkpoint()` between the steps;
     `timestamp` is the STEP headers' time (step_timestamp)."""
-    from spur_cad.cad.solid import build_gear_shape, build_stock_shape, front_face_area_mm2, solid_volume_mm3
+    from spur_cad.cad.solid import (
+        build_flat_stock_shape,
+        build_gear_shape,
+        build_stock_shape,
+        front_face_area_mm2,
+        solid_volume_mm3,
+    )
     from spur_cad.cad.step import step_files
 
     shape, report = build_gear_shape(job.gear, job.gear_section.blank_features())
     if checkpoint is not None:
         checkpoint()
-    stock = build_stock_shape(job.gear, job.stock)
+    if job.machine.axes == 3:  # the blank lying flat: a disk of the face width, clamped on its bore
+        stock = build_flat_stock_shape(job.gear, job.stock, job.gear_section.blank_features())
+    else:
+        stock = build_stock_shape(job.gear, job.stock)
     files = step_files(shape, stock, timestamp)
     gear_volume = front_face_area_mm2(shape) * job.gear.face_width_mm  # exact: a section moved along X
     facts = CadResult(report, gear_volume, solid_volume_mm3(stock),

@@ -158,6 +158,26 @@ def test_helical_gears_are_refused_at_the_axes_key():
     assert caught.value.field == "axes"
 
 
+def step_volume_and_box(path) -> tuple[float, tuple[float, ...]]:
+    """The volume and bounding box (x0, y0, z0, x1, y1, z1) of the solid a STEP file holds, read by OCCT."""
+    from OCP.Bnd import Bnd_Box
+    from OCP.BRepBndLib import BRepBndLib
+    from OCP.BRepGProp import BRepGProp
+    from OCP.GProp import GProp_GProps
+    from OCP.STEPControl import STEPControl_Reader
+
+    reader = STEPControl_Reader()
+    assert reader.ReadFile(str(path)) == 1  # IFSelect_RetDone
+    reader.TransferRoots()
+    shape = reader.OneShape()
+    props = GProp_GProps()
+    BRepGProp.VolumeProperties_s(shape, props)
+    box = Bnd_Box()
+    box.SetGap(0.0)
+    BRepBndLib.AddOptimal_s(shape, box, False, False)
+    return props.Mass(), box.Get()
+
+
 def test_a_three_axis_job_runs_through_the_pipeline_without_a_rotary_axis(tmp_path):
     from spur_cad.job import load_job
     from spur_cad.pipeline import run_job
@@ -165,8 +185,15 @@ def test_a_three_axis_job_runs_through_the_pipeline_without_a_rotary_axis(tmp_pa
 
     job_file = tmp_path / "three.toml"
     job_file.write_text(REFERENCE_JOB.read_text().replace('kind = "bull_nose"', 'kind = "flat"').replace(
-        "corner_radius_mm = 0.5\n", "").replace("[machine]\n", "[machine]\naxes = 3\n"))
+        "corner_radius_mm = 0.5\n", "").replace("[machine]\n", "[machine]\naxes = 3\n").replace(
+        "face_width_mm = 20.0\n", "face_width_mm = 20.0\nbore_diameter_mm = 30.0\n"))
     result = run_job(load_job(job_file))
+    stock = tmp_path / "stock.step"
+    stock.write_bytes(result.files["stock.step"])
+    volume, box = step_volume_and_box(stock)  # the flat blank: a disk of the face width through its bore
+    blank_radius = REFERENCE.tip_radius_mm + 0.5
+    assert volume == pytest.approx(math.pi * (blank_radius ** 2 - 15.0 ** 2) * 20.0, rel=1e-6)
+    assert box == pytest.approx((0.0, -blank_radius, -blank_radius, 20.0, blank_radius, blank_radius), abs=1e-3)
     finishing = result.files["finishing.ngc"].decode()
     roughing = result.files["roughing.ngc"].decode()
     assert "G2 " in finishing and "G3 " in finishing and "gear axis = Z" in finishing
