@@ -200,6 +200,8 @@ def test_a_three_axis_job_runs_through_the_pipeline_without_a_rotary_axis(tmp_pa
     for program in (finishing, roughing):
         assert not [line for line in program.splitlines() if not line.startswith("(") and " A" in line]
     assert any("error budget is not applied" in w for w in result.warnings)
+    report = result.files["report.html"].decode()  # the set-up sheet of the blank lying flat, not the rotary table's
+    assert "blank thickness (faced to the face width)" in report and "A zero" not in report
     assert result.grading is not None and result.simulation is not None
 
 

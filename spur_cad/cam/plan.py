@@ -50,6 +50,7 @@ from spur_cad.cam.strategies import (
 from spur_cad.cam.three_axis_tabs import ThreeAxisSection
 from spur_cad.cam.tools import Tool, ToolError
 from spur_cad.errors import SpurCadError, StockError, WorkLimitError, shown
+from spur_cad.geometry.outline2d import Arc2D
 from spur_cad.geometry.spec import GearSpec
 
 MAX_CONTACTS_PER_FLANK = 20_000
@@ -619,14 +620,15 @@ def _plan_three_axis(inputs: CamInputs, tolerance_mm: float) -> CamPlan:
                                 0.0, path, estimate(path, machine))
     if inputs.finishing_tool is not None:
         tool = inputs.finishing_tool
+        loop = finishing_loop(spec, tool, tolerance_mm)
         engagement = None if roughing is None else finishing_engagement(
-            finishing_loop(spec, tool, tolerance_mm), tool,
+            loop, tool,
             roughing_leaves(spec, inputs.roughing_tool, offsets[-1]), inputs.roughing)
         path, levels, segments = finishing_toolpath(spec, tool, machine, tolerance_mm, blank,
                                                     None if engagement is None else engagement.step_down_mm,
                                                     inputs.three_axis)
         check_travel(machine, path.x, path.y, path.z, path.a, "finishing")
-        arcs = int(path.arc_mask.sum()) // len(levels) - 2  # less the lead-in and lead-out arcs
+        arcs = sum(isinstance(segment, Arc2D) for segment in loop)  # (tabs split them at some levels)
         facts = ThreeAxisFinishingFacts(tool.diameter_mm / 2.0, 2 * root.form_radius_mm, 2 * root.rack_form_radius_mm,
                                         2 * root.active_start_radius_mm, root.fillet_radius_mm, len(levels),
                                         segments, arcs, root_thickness(spec, tool.diameter_mm / 2.0), engagement)
