@@ -28,6 +28,7 @@ from spur_cad.cam.machine_limits import check_machine_limits
 from spur_cad.cam.materials import DEFAULT_MATERIAL, MATERIALS
 from spur_cad.cam.probing import ProbeSection
 from spur_cad.cam.strategies import REGISTRY, FinishingParams, Strategies, finishing_section_type
+from spur_cad.cam.three_axis_tabs import ThreeAxisSection
 from spur_cad.cam.tools import Tool
 from spur_cad.cam.turning import LatheSection, check_lathe_blank
 from spur_cad.errors import (
@@ -201,6 +202,7 @@ class Job:
     roughing: RoughingParams = field(default_factory=RoughingParams)
     finishing: FinishingParams = field(default_factory=FinishingParams)
     machine: Machine = field(default_factory=Machine)
+    three_axis: ThreeAxisSection = field(default_factory=ThreeAxisSection)  # [machine] axes = 3: tabs, onion skin
     post: PostSettings = field(default_factory=PostSettings)
     simulation: SimulationSection = field(default_factory=SimulationSection)
     export: ExportSection = field(default_factory=ExportSection)
@@ -238,6 +240,7 @@ SECTIONS: dict[str, type] = {
     "roughing": RoughingParams,
     "finishing": FinishingParams,
     "machine": Machine,
+    "three_axis": ThreeAxisSection,
     "simulation": SimulationSection,
     "export": ExportSection,
     "post": PostSettings,
@@ -545,7 +548,7 @@ def _validate_sections(sections: dict, tables: dict, types: dict, autos: dict[st
                        strategies: Strategies, where: Callable[[str, str | None], str]) -> None:
     """Every section's own checks, the tools last: their "auto" keys are resolved once the sections the
     suggestion depends on (machine, roughing, finishing) have passed theirs."""
-    for name in ("machine", "roughing", "finishing", "post", "export", "lathe", "probe",
+    for name in ("machine", "three_axis", "roughing", "finishing", "post", "export", "lathe", "probe",
                  *(f"tools.{role}" for role in _TOOL_ROLES)):
         if name not in sections:
             continue
@@ -556,6 +559,8 @@ def _validate_sections(sections: dict, tables: dict, types: dict, autos: dict[st
         try:
             if is_tool:
                 sections[name].validate(name.removeprefix("tools."))
+            elif name == "three_axis":  # its heights are checked against the face width
+                sections[name].validate(spec.face_width_mm)
             else:
                 sections[name].validate()
         except SpurCadError as exc:
@@ -611,8 +616,8 @@ def _job_from_data(data: dict, source: str, text: str, strategies: Strategies = 
         _check_probe(spec, sections, tools, tables, where)
     if "export" in sections:
         _check_export(spec, gear_section, sections["export"], tables, where)
-    optional = {name: sections[name] for name in ("stock", "roughing", "machine", "post", "simulation", "export",
-                                                  "lathe", "probe") if name in sections}
+    optional = {name: sections[name] for name in ("stock", "roughing", "machine", "three_axis", "post", "simulation",
+                                                  "export", "lathe", "probe") if name in sections}
     finishing = sections["finishing"] if "finishing" in sections else types["finishing"]()  # the registry's default
     return Job(source=source, job=sections.get("job", JobSection()), gear_section=gear_section, gear=spec,
                tools=tools, finishing=finishing, **optional, text=text, strategies=dict(strategies))

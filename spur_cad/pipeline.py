@@ -93,7 +93,7 @@ def run_job(job: Job, progress: Callable[[str, float], None] | None = None,
     drawings = timed("export", None, lambda: export_files(job)) if job.export.dxf or job.export.svg else {}
     sim_result = timed("simulation", "simulation",
                        lambda: simulate_stage(job, plan, lambda fraction: tell("simulation", fraction)))
-    grading = timed("grading", None, lambda: grade_stage(job, sim_result))
+    grading = timed("grading", None, lambda: grade_stage(job, sim_result, plan))
     budget = timed("error_budget", None, lambda: budget_stage(job, plan, sim_result, grading))
     result = build_result(job, samples, cad, plan, job.post, programs, sim_result, grading, seconds, budget)
     result = dataclasses.replace(result, correction=correction)
@@ -114,13 +114,21 @@ def run_job(job: Job, progress: Callable[[str, float], None] | None = None,
     return dataclasses.replace(result, files=files)
 
 
-def grade_stage(job: Job, sim_result: SimResult | None) -> Grading | None:
-    """The simulated gear's ISO 1328-1 grade (None without a simulation), computed once per run."""
+def grade_stage(job: Job, sim_result: SimResult | None, plan: CamPlan | None = None) -> Grading | None:
+    """The simulated gear's ISO 1328-1 grade (None without a simulation), computed once per run; a 3-axis plan's
+    profiles are evaluated from where its finishing tool leaves the involute (its form diameter)."""
     if sim_result is None:
         return None
     from spur_cad.grade.simulated import grade_simulation
 
-    return grade_simulation(job.gear, sim_result)
+    return grade_simulation(job.gear, sim_result, three_axis_profile_start_mm(plan))
+
+
+def three_axis_profile_start_mm(plan: CamPlan | None) -> float | None:
+    """Where a 3-axis plan's finishing tool leaves the involute (radius, mm); None for any other plan."""
+    if plan is None or plan.finishing is None or plan.finishing.result.strategy != "three_axis":
+        return None
+    return plan.finishing.result.facts.form_diameter_mm / 2.0
 
 
 def error_budget(job: Job, plan: CamPlan):
@@ -140,8 +148,9 @@ def error_budget(job: Job, plan: CamPlan):
 
 def budget_stage(job: Job, plan: CamPlan, sim_result: SimResult | None, grading: Grading | None):
     """The simulated gear on the budget's machine, graded (spur_cad.result.ErrorBudgetFacts; None without a
-    simulation): the budget acts on the simulated flanks, the cut is not simulated again."""
-    if sim_result is None or grading is None:
+    simulation): the budget acts on the simulated flanks, the cut is not simulated again. None for 3 axes: its
+    index errors are the rotary table's (docs/simulation.md)."""
+    if sim_result is None or grading is None or job.machine.axes == 3:
         return None
     from spur_cad.grade.simulated import grade_simulation
     from spur_cad.sim.budget import apply_budget
@@ -310,7 +319,12 @@ def _three_axis_comments(job: Job, plan: CamPlan, operation: str) -> tuple[str, 
     """Header comments of a 3-axis program ([machine] axes = 3): gear, tool, what it does, the set-up."""
     spec, planned = job.gear, getattr(plan, operation)
     tool = planned.tool
-    if operation == "roughing":
+    if operation == "roughing" and spec.is_internal:
+        entry = "a plunge in the blank's bore" if job.stock.inner_diameter_mm > 0.0 else "a helix at the centre"
+        what = (f"3-axis roughing of the ring's hole: {len(planned.levels.heights_mm)} levels, {entry}, concentric "
+                f"passes from the centre out to {job.roughing.finish_stock_mm:g} mm from the outline; the rim's "
+                "outside is not cut")
+    elif operation == "roughing":
         what = (f"3-axis roughing: {len(planned.levels.heights_mm)} levels, concentric passes from the blank to "
                 f"{job.roughing.finish_stock_mm:g} mm from the outline")
     else:
@@ -318,6 +332,12 @@ def _three_axis_comments(job: Job, plan: CamPlan, operation: str) -> tuple[str, 
         what = (f"3-axis finishing: the outline as arcs offset by the tool radius, {facts.step_downs} step-downs, "
                 f"climb; form diameter {facts.form_diameter_mm:.3f} mm, root fillet >= "
                 f"{facts.root_fillet_radius_mm:.3f} mm")
+    holding = job.three_axis
+    if holding.tabs:
+        what += (f"; {holding.tabs} holding tabs on tips ({holding.tab_width_mm:g} mm wide, {holding.tab_height_mm:g} "
+                 "mm high from the bottom face): break them off and file them after the cut")
+    elif holding.onion_skin_mm > 0.0:
+        what += f"; an onion skin of {holding.onion_skin_mm:g} mm left on the bottom face"
     return (
         f"gear: z = {spec.teeth}, m = {spec.module_mm:g} mm, alpha = {spec.pressure_angle_deg:g} deg, "
         f"x = {spec.profile_shift_coefficient:g}, b = {spec.face_width_mm:g} mm, tip diameter "
@@ -334,13 +354,22 @@ def build_cad(job: Job, checkpoint: Callable[[], None] | None = None,
               timestamp: str | None = None) -> tuple[CadResult, dict[str, bytes]]:
     """Gear solid, stock and STEP files; returns (CAD facts, files). `checkpoint()` between the steps;
     `timestamp` is the STEP headers' time (step_timestamp)."""
-    from spur_cad.cad.solid import build_gear_shape, build_stock_shape, front_face_area_mm2, solid_volume_mm3
+    from spur_cad.cad.solid import (
+        build_flat_stock_shape,
+        build_gear_shape,
+        build_stock_shape,
+        front_face_area_mm2,
+        solid_volume_mm3,
+    )
     from spur_cad.cad.step import step_files
 
     shape, report = build_gear_shape(job.gear, job.gear_section.blank_features())
     if checkpoint is not None:
         checkpoint()
-    stock = build_stock_shape(job.gear, job.stock)
+    if job.machine.axes == 3:  # the blank lying flat: a disk of the face width, clamped on its bore
+        stock = build_flat_stock_shape(job.gear, job.stock, job.gear_section.blank_features())
+    else:
+        stock = build_stock_shape(job.gear, job.stock)
     files = step_files(shape, stock, timestamp)
     gear_volume = front_face_area_mm2(shape) * job.gear.face_width_mm  # exact: a section moved along X
     facts = CadResult(report, gear_volume, solid_volume_mm3(stock),
@@ -352,7 +381,7 @@ def cam_inputs(job: Job) -> CamInputs:
     """The part of a job the CAM stage reads."""
     return CamInputs(job.gear, job.stock, job.tools.roughing, job.tools.finishing, job.roughing, job.finishing,
                      job.machine, job.tools.bottom, top_tool=job.tools.roughing_top, strategies=job.strategies,
-                     profile_tolerance_mm=job.job.profile_tolerance_mm)
+                     profile_tolerance_mm=job.job.profile_tolerance_mm, three_axis=job.three_axis)
 
 
 def plan_cam(job: Job, checkpoint: Callable[[], None] | None = None) -> CamPlan:
@@ -374,8 +403,18 @@ def simulate_stage(job: Job, plan: CamPlan, progress: Callable[[float], None] | 
 
     operations = [Cut(planned.toolpath, planned.tool) for planned in (plan.roughing, plan.roughing_bottom,
                                                                       plan.finishing) if planned is not None]
-    if not job.simulation.enabled or not operations or job.machine.axes == 3:  # 3 axes: not simulated (a warning)
+    if not job.simulation.enabled or not operations or job.gear.is_internal:  # a ring's cut: not simulated yet
         return None
+    if job.machine.axes == 3:  # the blank lying flat: swept areas level by level (spur_cad.sim.flat)
+        from spur_cad.sim.flat import simulate_flat
+
+        depths = -plan.finishing.toolpath.z[plan.finishing.toolpath.motion_mask] if plan.finishing is not None \
+            else np.zeros(0)
+        result = simulate_flat(job.gear, job.stock.blank_radius_mm(job.gear), operations,
+                               SimSettings(resolution_mm=job.simulation.resolution_mm), np.unique(depths))
+        if progress is not None:
+            progress(1.0)
+        return result
     stations = plan.finishing.result.station_x_mm if plan.finishing is not None else np.zeros(0)
     result = simulate(job.gear, job_stock(job), operations, SimSettings(resolution_mm=job.simulation.resolution_mm),
                       station_x=stations, progress=progress)

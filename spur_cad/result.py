@@ -97,6 +97,7 @@ class SetupFacts:
     flank_allowance_mm: float
     roughing_step_down_mm: float | None
     roughing_step_over_mm: float | None
+    axes: int = 4  # [machine] axes: 3, the blank lying flat (the sheet describes that set-up)
 
 
 @dataclass(frozen=True)

@@ -125,7 +125,7 @@ def setup_facts(job, plan: CamPlan, post: PostSettings) -> SetupFacts:
         job.machine.name, 2.0 * stock.blank_radius_mm(spec), x_min, x_max, stock.stub_diameter_mm,
         stock.stub_length_mm, post.work_offset, post.rotary_sign, post.coolant, job.machine.clearance_mm,
         float(z.min()) if z.size else None, float(z.max()) if z.size else None, rough.finish_stock_mm,
-        rough.flank_allowance_mm, *steps)
+        rough.flank_allowance_mm, *steps, axes=job.machine.axes)
 
 
 def tools_facts(plan: CamPlan, machine: Machine, roughing_tool: Tool | None,

@@ -158,6 +158,26 @@ def test_helical_gears_are_refused_at_the_axes_key():
     assert caught.value.field == "axes"
 
 
+def step_volume_and_box(path) -> tuple[float, tuple[float, ...]]:
+    """The volume and bounding box (x0, y0, z0, x1, y1, z1) of the solid a STEP file holds, read by OCCT."""
+    from OCP.Bnd import Bnd_Box
+    from OCP.BRepBndLib import BRepBndLib
+    from OCP.BRepGProp import BRepGProp
+    from OCP.GProp import GProp_GProps
+    from OCP.STEPControl import STEPControl_Reader
+
+    reader = STEPControl_Reader()
+    assert reader.ReadFile(str(path)) == 1  # IFSelect_RetDone
+    reader.TransferRoots()
+    shape = reader.OneShape()
+    props = GProp_GProps()
+    BRepGProp.VolumeProperties_s(shape, props)
+    box = Bnd_Box()
+    box.SetGap(0.0)
+    BRepBndLib.AddOptimal_s(shape, box, False, False)
+    return props.Mass(), box.Get()
+
+
 def test_a_three_axis_job_runs_through_the_pipeline_without_a_rotary_axis(tmp_path):
     from spur_cad.job import load_job
     from spur_cad.pipeline import run_job
@@ -165,11 +185,96 @@ def test_a_three_axis_job_runs_through_the_pipeline_without_a_rotary_axis(tmp_pa
 
     job_file = tmp_path / "three.toml"
     job_file.write_text(REFERENCE_JOB.read_text().replace('kind = "bull_nose"', 'kind = "flat"').replace(
-        "corner_radius_mm = 0.5\n", "").replace("[machine]\n", "[machine]\naxes = 3\n"))
+        "corner_radius_mm = 0.5\n", "").replace("[machine]\n", "[machine]\naxes = 3\n").replace(
+        "face_width_mm = 20.0\n", "face_width_mm = 20.0\nbore_diameter_mm = 30.0\n"))
     result = run_job(load_job(job_file))
+    stock = tmp_path / "stock.step"
+    stock.write_bytes(result.files["stock.step"])
+    volume, box = step_volume_and_box(stock)  # the flat blank: a disk of the face width through its bore
+    blank_radius = REFERENCE.tip_radius_mm + 0.5
+    assert volume == pytest.approx(math.pi * (blank_radius ** 2 - 15.0 ** 2) * 20.0, rel=1e-6)
+    assert box == pytest.approx((0.0, -blank_radius, -blank_radius, 20.0, blank_radius, blank_radius), abs=1e-3)
     finishing = result.files["finishing.ngc"].decode()
     roughing = result.files["roughing.ngc"].decode()
     assert "G2 " in finishing and "G3 " in finishing and "gear axis = Z" in finishing
     for program in (finishing, roughing):
         assert not [line for line in program.splitlines() if not line.startswith("(") and " A" in line]
-    assert any("not simulated" in w for w in result.warnings)
+    assert any("error budget is not applied" in w for w in result.warnings)
+    report = result.files["report.html"].decode()  # the set-up sheet of the blank lying flat, not the rotary table's
+    assert "blank thickness (faced to the face width)" in report and "A zero" not in report
+    assert result.grading is not None and result.simulation is not None
+
+
+def tooth_chord_from_centres(centres: np.ndarray, radius_mm: float, circle_mm: float, teeth: int) -> float:
+    """Tooth 0's chord on the circle `circle_mm` as the tool circles about `centres` leave it: each edge where the
+    circle's points stop being within the tool radius of a centre (bisection on the angle, 1e-9 rad)."""
+    tree = cKDTree(centres)
+    middle = math.pi / 2 + math.pi / teeth
+
+    def cut(angle: float) -> bool:
+        return tree.query([circle_mm * math.cos(angle), circle_mm * math.sin(angle)])[0] <= radius_mm
+
+    edges = []
+    for side in (-1.0, 1.0):
+        inside, outside = middle, middle + side * math.pi / teeth  # the tooth's centre stays, the space is cut
+        assert not cut(inside) and cut(outside)
+        while abs(outside - inside) > 1e-9:
+            half = 0.5 * (inside + outside)
+            inside, outside = (inside, half) if cut(half) else (half, outside)
+        edges.append(inside)
+    return 2 * circle_mm * math.sin(abs(edges[1] - edges[0]) / 2)
+
+
+def test_root_thickness_against_the_involute_and_the_cut_the_finishing_path_leaves():
+    """At the root form circle the rack-generated chord is the involute's (textbook thickness at a radius); a tool
+    that follows the rack's fillet (reference, r 1 mm < its 1.15 mm) leaves the same root; one that cannot (z 30
+    m 1, r 0.5 mm > the fillet's 0.31 mm) leaves the tooth thicker at the fillet's middle, as thick as the circles
+    of the finishing path's tool centres leave it (within 0.5 um: the 1 um arc fit)."""
+    from spur_cad.cam.three_axis_root import root_thickness
+    from spur_cad.geometry.involute import involute_function
+    from tests.test_three_axis_sim import walked_centres
+
+    following = root_thickness(REFERENCE, 1.0)
+    rho, r, rb = following.form_diameter_mm / 2, REFERENCE.reference_radius_mm, REFERENCE.base_radius_mm
+    alpha, alpha_rho = math.acos(rb / r), math.acos(rb / rho)
+    half_angle = REFERENCE.tooth_thickness_mm / (2 * r) + involute_function(alpha) - involute_function(alpha_rho)
+    assert following.rack_form_thickness_mm == pytest.approx(2 * rho * math.sin(half_angle), abs=5e-5)
+    assert following.form_thickness_mm == pytest.approx(following.rack_form_thickness_mm, abs=1e-4)
+    assert following.fillet_thickness_mm == pytest.approx(following.rack_fillet_thickness_mm, abs=1e-4)
+
+    tool = flat(1.0, 2)
+    leaving = root_thickness(MODULE_1, 0.5)
+    assert leaving.fillet_thickness_mm > leaving.rack_fillet_thickness_mm + 0.01
+    path, _, _ = finishing_toolpath(MODULE_1, tool, Machine(), TOLERANCE_MM, MODULE_1.tip_radius_mm + 0.5)
+    walked = tooth_chord_from_centres(walked_centres(path, 0.0005), 0.5, leaving.fillet_diameter_mm / 2,
+                                      MODULE_1.teeth)
+    assert leaving.fillet_thickness_mm == pytest.approx(walked, abs=0.0005)
+
+
+def test_finishing_steps_down_no_deeper_than_a_slot_where_roughing_cannot_reach_the_root():
+    """z 30 m 1 roughed with D 2 (wider than the spaces' bottoms) and finished with D 1: the finishing tool cuts
+    almost a full slot at the root (its centre's depth in what roughing leaves measured here as its distance from
+    the roughing program's walked tool centres less their radius), so its step-down is the slot depth [roughing]
+    allows; the reference gear (roughing reaches the root) keeps one tool diameter."""
+    from spur_cad.cam.three_axis import finishing_engagement, finishing_loop, roughing_leaves
+    from tests.test_three_axis_sim import walked_centres
+
+    params, rough, finish = RoughingParams(), flat(2.0, 1), flat(1.0, 2)
+    path, _, offsets = roughing_toolpath(MODULE_1, rough, Machine(), params, MODULE_1.tip_radius_mm + 0.5)
+    loop = finishing_loop(MODULE_1, finish, TOLERANCE_MM)
+    engagement = finishing_engagement(loop, finish, roughing_leaves(MODULE_1, rough, offsets[-1]), params)
+    loop_points = np.array([s.point_at(t) for s in loop for t in np.linspace(0.0, 1.0, 20)])
+    depth = cKDTree(walked_centres(path, 0.002)).query(loop_points)[0] - rough.diameter_mm / 2.0
+    independent = float(np.clip(finish.diameter_mm / 2.0 + depth, 0.0, finish.diameter_mm).max()) / finish.diameter_mm
+    assert independent > 0.9 and engagement.max_radial_fraction == pytest.approx(independent, abs=0.005)
+    assert engagement.limited and engagement.step_down_mm == pytest.approx(params.max_level_depth_fraction * 1.0)
+    _, levels, _ = finishing_toolpath(MODULE_1, finish, Machine(), TOLERANCE_MM, MODULE_1.tip_radius_mm + 0.5,
+                                      engagement.step_down_mm)
+    assert max(-np.diff([0.0, *levels])) <= params.max_level_depth_fraction * finish.diameter_mm + 1e-9
+
+    rough, finish = flat(3.5, 1), flat(2.0, 2)
+    path, _, offsets = roughing_toolpath(REFERENCE, rough, Machine(), params, REFERENCE.tip_radius_mm + 0.5)
+    reference = finishing_engagement(finishing_loop(REFERENCE, finish, TOLERANCE_MM), finish,
+                                     roughing_leaves(REFERENCE, rough, offsets[-1]), params)
+    assert reference.max_radial_fraction <= params.max_radial_engagement_fraction and not reference.limited
+    assert reference.step_down_mm == pytest.approx(finish.diameter_mm)

@@ -153,3 +153,20 @@ def test_the_ring_example_runs_through_the_pipeline_on_three_axes():
     assert "G2 " in finishing and "G3 " in finishing and "gear axis = Z" in finishing
     for program in (finishing, roughing):
         assert not [line for line in program.splitlines() if not line.startswith("(") and " A" in line]
+
+
+def test_the_ring_root_thickness_is_the_tooth_between_two_spaces():
+    """At the ring's generated form circle the tooth's chord is the involute's (textbook arc thickness of an internal
+    gear at that radius, as a chord); a tool that follows the fillet (r 0.3 < its 0.54 mm) leaves it, a D 2 leaves
+    more there and at mid-fillet."""
+    from spur_cad.cam.three_axis_root import root_thickness
+
+    spec = ring_job().gear
+    form = spec.tooth_space_profile().form_radius_mm
+    arc = 2 * form * (math.pi / spec.teeth - spec.space_width_mm / (2 * spec.reference_radius_mm)
+                      - (math.tan(math.radians(spec.pressure_angle_deg)) - math.radians(spec.pressure_angle_deg))
+                      + math.tan(math.acos(spec.base_radius_mm / form)) - math.acos(spec.base_radius_mm / form))
+    chord = 2 * form * math.sin(arc / (2 * form))
+    follows, wide = root_thickness(spec, 0.3), root_thickness(spec, 1.0)
+    assert abs(follows.rack_form_thickness_mm - chord) < 2e-4 and abs(follows.form_thickness_mm - chord) < 2e-4
+    assert wide.form_thickness_mm > chord + 0.05 and wide.fillet_thickness_mm > wide.rack_fillet_thickness_mm + 0.1

@@ -262,11 +262,11 @@ def test_a_legacy_program_verifies_as_the_original_and_the_wrong_rotary_directio
 
 
 @pytest.mark.parametrize("program, message", [
-    ("G90\nG2 X1 Y1 I1 J0\nM30\n", ":2: G2 is not supported by this reader"),
+    ("G90\nG2 X1 Y1 I1 J0\nM30\n", ":2: G2 (an arc) is not read"),
     ("G91\nG0 X1 Y0 Z30 A0\nM30\n", ":1: G91 is not supported"),
     ("T1 M6\nG0 X1 Y0 Z30 A0\nT7 M6\nG1 X2 F100\nM30\n", ":4: moves with tool T7, which the job does not have"),
     ("G0 X1 Y0 Z30 A0\nM30\n", ":1: a move before any tool is loaded"),
-    ("G0 X1 Y0 Z30\nG1 X2 F100\nM30\n", ":2: a feed move before every axis is known (A unknown)"),
+    ("G0 X1 Y0 Z30\nG1 X2 F100\nM30\n", ":2: a feed move before every axis is known (A unknown"),
     ("G0 X1 Y0 Z30 A0\nG1 X2\nM30\n", ":2: a feed move without a positive F"),
     ("T1 M6\nG0 X1 Y0 Z30 A0\n", ": no end of program (M30 or M2)"),
     ("o100 call\nM30\n", ":1: calls subprogram 100, which the program does not define"),

@@ -318,6 +318,20 @@ def build_stock_shape(spec: GearSpec, stock: StockSpec = StockSpec()) -> TopoDS_
     return shape
 
 
+def build_flat_stock_shape(spec: GearSpec, stock: StockSpec, features: BlankFeatures = BlankFeatures()) -> TopoDS_Shape:
+    """The blank of a gear cut lying flat ([machine] axes = 3): a disk of the blank diameter over the face width
+    (X 0 to b: the programs' Z0 is its top face, the gear's), through its bore when the job gives one (it is
+    clamped on it; a ring's: [stock] inner_diameter_mm, clamped on its rim); no holding stub."""
+    require_instance(spec, GearSpec, "spec")
+    require_instance(stock, StockSpec, "stock")
+    stock.validate(spec)
+    shape = _x_cylinder(stock.blank_radius_mm(spec), 0.0, spec.face_width_mm)
+    bore_mm = stock.inner_diameter_mm if spec.is_internal else features.bore_diameter_mm  # a ring: its blank's bore
+    if bore_mm > 0.0:
+        shape = _cut(shape, _x_cylinder(bore_mm / 2.0, -1.0, spec.face_width_mm + 1.0))
+    return shape
+
+
 def make_gear(spec: GearSpec, features: BlankFeatures = BlankFeatures(),
               fit_tolerance_mm: float | None = None):
     """The gear solid as a CadQuery Workplane (machine frame: axis X, front face at X = 0). CadQuery is

@@ -47,8 +47,10 @@ from spur_cad.cam.strategies import (
     get_strategy,
     params_from_section,
 )
+from spur_cad.cam.three_axis_tabs import ThreeAxisSection
 from spur_cad.cam.tools import Tool, ToolError
 from spur_cad.errors import SpurCadError, StockError, WorkLimitError, shown
+from spur_cad.geometry.outline2d import Arc2D
 from spur_cad.geometry.spec import GearSpec
 
 MAX_CONTACTS_PER_FLANK = 20_000
@@ -140,6 +142,7 @@ class CamInputs:
     top_tool: Tool | None = None  # two-stage roughing offered: a larger tool above roughing_tool ([tools.roughing_top])
     strategies: Strategies = field(default_factory=lambda: dict(REGISTRY))  # where [finishing] strategy is found
     profile_tolerance_mm: float = 0.001  # [job] profile_tolerance_mm: the 3-axis finishing arcs' chordal tolerance
+    three_axis: ThreeAxisSection = field(default_factory=ThreeAxisSection)  # [three_axis]: tabs or an onion skin
 
 
 def check_cam_inputs(inputs: CamInputs) -> tuple[ToolRecommendations, RoughingLevels | None]:
@@ -586,20 +589,25 @@ def _comparison_estimate(spec: GearSpec, tool: Tool, machine: Machine, blank: fl
 def _plan_three_axis(inputs: CamInputs, tolerance_mm: float) -> CamPlan:
     """The CAM plan of a 3-axis job ([machine] axes = 3): the checks of three_axis.check_three_axis, roughing and
     finishing as spur_cad.cam.three_axis says; no tool recommendations for the rotary-table strategies
-    (empty), no simulation (a warning says so)."""
+    (empty), no error budget (a warning says so; the cut is simulated by spur_cad.sim.flat)."""
     from spur_cad.cam.roughing import RoughingLevels
     from spur_cad.cam.three_axis import (
         ThreeAxisFinishingFacts,
         check_three_axis,
+        finishing_engagement,
+        finishing_loop,
         finishing_toolpath,
+        roughing_leaves,
         roughing_toolpath,
     )
+    from spur_cad.cam.three_axis_root import root_thickness
 
     spec, machine, stock = inputs.spec, inputs.machine, inputs.stock
     if inputs.finishing_tool is not None and inputs.roughing_tool is None:
         raise ToolError("[machine] axes = 3 needs [tools.roughing]: finishing cuts only the finish stock around the "
                         "outline", field="diameter_mm", section="tools.roughing")
     root = check_three_axis(spec, inputs.finishing_tool, inputs.roughing_tool)
+    inputs.three_axis.validate(spec.face_width_mm)
     if spec.is_internal:
         return _plan_three_axis_ring(inputs, tolerance_mm, root)
     blank = stock.blank_radius_mm(spec)
@@ -608,22 +616,28 @@ def _plan_three_axis(inputs: CamInputs, tolerance_mm: float) -> CamPlan:
     if inputs.roughing_tool is not None:
         inputs.roughing.validate()
         tool = inputs.roughing_tool
-        path, levels, offsets = roughing_toolpath(spec, tool, machine, inputs.roughing, blank)
+        path, levels, offsets = roughing_toolpath(spec, tool, machine, inputs.roughing, blank, inputs.three_axis)
         check_travel(machine, path.x, path.y, path.z, path.a, "roughing")
         roughing = RoughingPlan(tool, RoughingLevels(np.array(levels), np.array(offsets[:1] * len(levels)), None),
                                 0.0, path, estimate(path, machine))
     if inputs.finishing_tool is not None:
         tool = inputs.finishing_tool
-        path, levels, segments = finishing_toolpath(spec, tool, machine, tolerance_mm, blank)
+        loop = finishing_loop(spec, tool, tolerance_mm)
+        engagement = None if roughing is None else finishing_engagement(
+            loop, tool,
+            roughing_leaves(spec, inputs.roughing_tool, offsets[-1]), inputs.roughing)
+        path, levels, segments = finishing_toolpath(spec, tool, machine, tolerance_mm, blank,
+                                                    None if engagement is None else engagement.step_down_mm,
+                                                    inputs.three_axis)
         check_travel(machine, path.x, path.y, path.z, path.a, "finishing")
-        arcs = int(path.arc_mask.sum()) // len(levels) - 2  # less the lead-in and lead-out arcs
+        arcs = sum(isinstance(segment, Arc2D) for segment in loop)  # (tabs split them at some levels)
         facts = ThreeAxisFinishingFacts(tool.diameter_mm / 2.0, 2 * root.form_radius_mm, 2 * root.rack_form_radius_mm,
                                         2 * root.active_start_radius_mm, root.fillet_radius_mm, len(levels),
-                                        segments, arcs)
+                                        segments, arcs, root_thickness(spec, tool.diameter_mm / 2.0), engagement)
         result = FinishingResult("three_axis", None, None, len(levels), 0.0, np.zeros(0), facts=facts)
         finishing = FinishingPlan(tool, result, path, estimate(path, machine), None, None)
-    warnings = ("[machine] axes = 3: the cut is not simulated nor graded (the simulator models the rotary table's "
-                "stock); the LinuxCNC programs are checked by rs274 in the tests",)
+    warnings = ("[machine] axes = 3: the error budget is not applied (its index errors are the rotary table's); "
+                "the simulation and grade are those of an ideal 3-axis machine",)
     return CamPlan(rec, roughing, finishing, warnings)
 
 
@@ -632,14 +646,21 @@ def _plan_three_axis_ring(inputs: CamInputs, tolerance_mm: float, root) -> CamPl
     (from [stock] inner_diameter_mm's bore, or a helix into a solid blank), the toothed inner outline finished;
     no tool recommendations, no simulation (a warning says so)."""
     from spur_cad.cam.roughing import RoughingLevels
-    from spur_cad.cam.three_axis import ThreeAxisFinishingFacts
+    from spur_cad.cam.three_axis import ThreeAxisFinishingFacts, finishing_engagement
     from spur_cad.cam.three_axis_ring import (
+        ring_finishing_loop,
         ring_finishing_toolpath,
+        ring_roughing_leaves,
         ring_roughing_toolpath,
         ring_tool_recommendations,
     )
+    from spur_cad.cam.three_axis_root import root_thickness
 
     spec, machine = inputs.spec, inputs.machine
+    if inputs.three_axis.tabs or inputs.three_axis.onion_skin_mm:
+        raise MachineError("[three_axis] tabs and onion_skin_mm hold a through-cut external gear; a ring is clamped "
+                           "on its rim and its hole is milled away whole: leave them out",
+                           field="tabs" if inputs.three_axis.tabs else "onion_skin_mm", section="three_axis")
     rec = ring_tool_recommendations(spec, machine.clearance_mm)
     roughing = finishing = None
     if inputs.roughing_tool is not None:
@@ -652,12 +673,16 @@ def _plan_three_axis_ring(inputs: CamInputs, tolerance_mm: float, root) -> CamPl
                                 0.0, path, estimate(path, machine))
     if inputs.finishing_tool is not None:
         tool = inputs.finishing_tool
-        path, levels, segments = ring_finishing_toolpath(spec, tool, machine, tolerance_mm)
+        engagement = None if roughing is None else finishing_engagement(
+            ring_finishing_loop(spec, tool, tolerance_mm), tool,
+            ring_roughing_leaves(spec, inputs.roughing_tool, offsets[0]), inputs.roughing)
+        path, levels, segments = ring_finishing_toolpath(spec, tool, machine, tolerance_mm,
+                                                         None if engagement is None else engagement.step_down_mm)
         check_travel(machine, path.x, path.y, path.z, path.a, "finishing")
         arcs = int(path.arc_mask.sum()) // len(levels) - 2  # less the lead-in and lead-out arcs
         facts = ThreeAxisFinishingFacts(tool.diameter_mm / 2.0, 2 * root.form_radius_mm, 2 * root.rack_form_radius_mm,
                                         2 * root.active_start_radius_mm, root.fillet_radius_mm, len(levels),
-                                        segments, arcs)
+                                        segments, arcs, root_thickness(spec, tool.diameter_mm / 2.0), engagement)
         result = FinishingResult("three_axis", None, None, len(levels), 0.0, np.zeros(0), facts=facts)
         finishing = FinishingPlan(tool, result, path, estimate(path, machine), None, None)
     warnings = ("[machine] axes = 3: the ring's cut is not simulated nor graded; the LinuxCNC programs are checked "

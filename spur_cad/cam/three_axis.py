@@ -26,7 +26,20 @@ import numpy as np
 
 from spur_cad.cam.ir import MoveKind, Operation, Toolpath, ToolpathBuilder
 from spur_cad.cam.machine import Machine, MachineError, RoughingParams
-from spur_cad.cam.three_axis_root import FlatMillRoot, flat_mill_root, largest_flat_mill_radius_mm
+from spur_cad.cam.three_axis_root import (
+    FlatMillRoot,
+    RootThickness,
+    flat_mill_root,
+    largest_flat_mill_radius_mm,
+)
+from spur_cad.cam.three_axis_tabs import (
+    TabBand,
+    ThreeAxisSection,
+    cut_depth_mm,
+    split_at_bands,
+    tab_bands,
+    tab_top_mm,
+)
 from spur_cad.cam.tools import Tool, ToolError
 from spur_cad.geometry.outline2d import Arc2D, Line2D, Outline2D, Segment2D, gear_outline_arcs, offset_outline
 from spur_cad.geometry.sampling import gear_outline
@@ -93,10 +106,11 @@ def _climb(outline: Outline2D) -> list[Segment2D]:
     return [s.reversed() for s in reversed(outline.segments)]
 
 
-def _entry_split(loop: list[Segment2D]) -> list[Segment2D]:
-    """The loop started at the middle of its longest arc about the gear axis (a tip: convex, outside)."""
+def _entry_split(loop: list[Segment2D], bands: tuple[TabBand, ...] = ()) -> list[Segment2D]:
+    """The loop started at the middle of its longest arc about the gear axis (a tip: convex, outside) that holds
+    no tab."""
     tips = [i for i, s in enumerate(loop) if isinstance(s, Arc2D) and s.center_xy == (0.0, 0.0)
-            and not s.counterclockwise]
+            and not s.counterclockwise and not any(band.holds(s.point_at(0.5)) for band in bands)]
     if not tips:
         raise MachineError("the finishing outline has no tip arc to enter on", field="axes", section="machine")
     i = max(tips, key=lambda k: loop[k].length_mm)
@@ -129,30 +143,106 @@ def _add_segment(builder: ToolpathBuilder, segment: Segment2D, z: float, feed: f
                     station=station)
 
 
-def finishing_toolpath(spec: GearSpec, tool: Tool, machine: Machine, tolerance_mm: float,
-                       blank_radius_mm: float) -> tuple[Toolpath, list[float], int]:
-    """The finishing program (see the module docstring): (toolpath, Z levels, segments per loop)."""
+ENGAGEMENT_SPACING_MM = 0.01
+"""Spacing of the finishing loop's points whose radial engagement is measured."""
+
+
+@dataclass(frozen=True)
+class FinishingEngagement:
+    """How wide the finishing tool cuts into what roughing leaves, and the step-down that allows."""
+
+    max_radial_fraction: float  # largest radial engagement a_e / D along the loop (1: a full slot)
+    step_down_mm: float  # the finishing step-down chosen
+    limited: bool  # the step-down was cut to the slot depth [roughing] allows (the tool engages wider than a flank
+    #                pass may: max_radial_engagement_fraction)
+
+
+def finishing_loop(spec: GearSpec, tool: Tool, tolerance_mm: float,
+                   bands: tuple[TabBand, ...] = ()) -> list[Segment2D]:
+    """The finishing tool centre's loop: the outline's arcs offset by the tool radius, climb, from the middle of a
+    tip without a tab."""
+    return _entry_split(_climb(offset_outline(gear_outline_arcs(spec, tolerance_mm), tool.diameter_mm / 2.0)),
+                        bands)
+
+
+def _add_held(builder: ToolpathBuilder, pieces: list[tuple[Segment2D, bool]], z: float, tab_top: float,
+              feed: float, station: int) -> None:
+    """The pieces at Z `z`, those in a tab's band at the tab's top (risen to and come down from vertically)."""
+    here = z
+    for piece, held in pieces:
+        target = max(z, tab_top) if held else z
+        if target != here:
+            builder.move(MoveKind.LINEAR, *piece.start_xy, target, 0.0, feed, station=station)
+            here = target
+        _add_segment(builder, piece, target, feed, station)
+    if here != z:
+        builder.move(MoveKind.LINEAR, *pieces[-1][0].end_xy, z, 0.0, feed, station=station)
+
+
+def roughing_leaves(spec: GearSpec, roughing_tool: Tool, innermost_offset_mm: float):
+    """The section roughing leaves at every level (shapely polygon): what its innermost pass's tool circles (centre
+    `innermost_offset_mm` from the outline) do not reach."""
+    from shapely.geometry import Polygon
+
+    gear = Polygon(gear_outline(spec, ROUGHING_OUTLINE_TOLERANCE_MM))
+    ring = gear.buffer(innermost_offset_mm, quad_segs=ROUGHING_ARC_SEGMENTS)
+    return ring.buffer(-roughing_tool.diameter_mm / 2.0, quad_segs=4 * ROUGHING_ARC_SEGMENTS)
+
+
+def finishing_engagement(loop: list[Segment2D], tool: Tool, material, params: RoughingParams) -> FinishingEngagement:
+    """The radial engagement of the finishing loop in `material` (what roughing leaves): at each point a_e = r + the
+    depth of the tool centre inside the material (negative outside), from 0 to D (a full slot). A loop engaged wider
+    than `max_radial_engagement_fraction` x D is a pass deeper than a slot, which [roughing] limits to
+    `max_level_depth_fraction` x D; the finishing step-down is cut to that (else one tool diameter)."""
+    import shapely
+
     radius = tool.diameter_mm / 2.0
-    loop = _entry_split(_climb(offset_outline(gear_outline_arcs(spec, tolerance_mm), radius)))
+    points = np.concatenate([[segment.point_at(t) for t in np.linspace(0.0, 1.0, max(2, math.ceil(
+        segment.length_mm / ENGAGEMENT_SPACING_MM) + 1))] for segment in loop])
+    depth = shapely.distance(material.boundary, shapely.points(points))
+    inside = shapely.contains_xy(material, points[:, 0], points[:, 1])
+    engaged = np.clip(radius + np.where(inside, depth, -depth), 0.0, tool.diameter_mm)
+    fraction = float(engaged.max()) / tool.diameter_mm
+    limited = fraction > params.max_radial_engagement_fraction + 1e-9
+    step = (params.max_level_depth_fraction if limited else FINISH_STEP_DOWN_DIAMETERS) * tool.diameter_mm
+    return FinishingEngagement(fraction, min(step, FINISH_STEP_DOWN_DIAMETERS * tool.diameter_mm), limited)
+
+
+def finishing_toolpath(spec: GearSpec, tool: Tool, machine: Machine, tolerance_mm: float, blank_radius_mm: float,
+                       step_down_mm: float | None = None,
+                       holding: ThreeAxisSection | None = None) -> tuple[Toolpath, list[float], int]:
+    """The finishing program (see the module docstring): (toolpath, Z levels, segments per loop); step-downs of at
+    most `step_down_mm` (default one tool diameter); `holding`: tabs or an onion skin (three_axis_tabs)."""
+    radius = tool.diameter_mm / 2.0
+    holding = holding or ThreeAxisSection()
+    bands = tuple(tab_bands(spec, holding, radius))
+    loop = finishing_loop(spec, tool, tolerance_mm, bands)
+    pieces = split_at_bands(loop, list(bands))
+    tab_top = tab_top_mm(spec, holding)
     lead = max(radius, 0.5)
     start, end, centre, ccw = _lead_arcs(loop[0].start_xy, loop[0].start_tangent, lead)
     feed, safe_z = tool.feed_mm_min(machine), machine.clearance_mm
-    levels = _levels(spec.face_width_mm + BREAK_THROUGH_MM, FINISH_STEP_DOWN_DIAMETERS * tool.diameter_mm)
+    step = FINISH_STEP_DOWN_DIAMETERS * tool.diameter_mm if step_down_mm is None else step_down_mm
+    levels = _levels(cut_depth_mm(spec, holding, BREAK_THROUGH_MM), step)
     builder = ToolpathBuilder(Operation.FINISHING, tool.tool_number, tool.spindle_rpm(machine))
     for index, z in enumerate(levels):
         builder.move(MoveKind.RAPID, start[0], start[1], safe_z, 0.0)
         builder.move(MoveKind.LINEAR, start[0], start[1], z, 0.0, feed / 2.0, station=index)
         builder.arc(not ccw, *loop[0].start_xy, z, *centre, feed, station=index)
-        for segment in loop:
-            _add_segment(builder, segment, z, feed, index)
+        if bands and z < tab_top:
+            _add_held(builder, pieces, z, tab_top, feed, index)
+        else:
+            for segment in loop:
+                _add_segment(builder, segment, z, feed, index)
         builder.arc(not ccw, end[0], end[1], z, *centre, feed, station=index)
         builder.move(MoveKind.RAPID, end[0], end[1], safe_z, 0.0)
     return builder.build(), levels, len(loop)
 
 
-def roughing_toolpath(spec: GearSpec, tool: Tool, machine: Machine, params: RoughingParams,
-                      blank_radius_mm: float) -> tuple[Toolpath, list[float], list[float]]:
-    """The roughing program (see the module docstring): (toolpath, Z levels, tool-centre offsets outermost first)."""
+def roughing_toolpath(spec: GearSpec, tool: Tool, machine: Machine, params: RoughingParams, blank_radius_mm: float,
+                      holding: ThreeAxisSection | None = None) -> tuple[Toolpath, list[float], list[float]]:
+    """The roughing program (see the module docstring): (toolpath, Z levels, tool-centre offsets outermost first);
+    `holding`: tabs or an onion skin (three_axis_tabs)."""
     from shapely.geometry import Point, Polygon
     from shapely.geometry.polygon import orient
 
@@ -174,10 +264,16 @@ def roughing_toolpath(spec: GearSpec, tool: Tool, machine: Machine, params: Roug
                                field="diameter_mm", section="tools.roughing")
         rings.append((offset, shapes[0].exterior))
     feed, safe_z = tool.feed_mm_min(machine), machine.clearance_mm
-    levels = _levels(spec.face_width_mm + BREAK_THROUGH_MM, params.max_level_depth_fraction * tool.diameter_mm)
+    holding = holding or ThreeAxisSection()
+    bands, tab_top = tab_bands(spec, holding, radius), tab_top_mm(spec, holding)
+    levels = _levels(cut_depth_mm(spec, holding, BREAK_THROUGH_MM), params.max_level_depth_fraction * tool.diameter_mm)
     outside = blank_radius_mm + radius + machine.clearance_mm
     builder = ToolpathBuilder(Operation.ROUGHING, tool.tool_number, tool.spindle_rpm(machine))
     for index, z in enumerate(levels):
+        if bands and z < tab_top:
+            _roughing_level_with_tabs(builder, rings, z, tab_top, bands, outside, feed, safe_z, index,
+                                      machine.clearance_mm)
+            continue
         here = None
         for _, ring in rings:
             coords = np.asarray(ring.coords)[:-1]
@@ -196,6 +292,29 @@ def roughing_toolpath(spec: GearSpec, tool: Tool, machine: Machine, params: Roug
             here = ordered[-1]
         builder.move(MoveKind.RAPID, float(here[0]), float(here[1]), safe_z, 0.0)
     return builder.build(), levels, offsets
+
+
+def _roughing_level_with_tabs(builder: ToolpathBuilder, rings: list, z: float, tab_top: float, bands: list[TabBand],
+                              outside: float, feed: float, safe_z: float, index: int, clearance_mm: float) -> None:
+    """One roughing level below the tabs' top: the same passes as without tabs (entered the same way), the lines
+    in a tab's band at the tab's top."""
+    points = []
+    for _, ring in rings:
+        coords = np.asarray(ring.coords)[:-1]
+        if not points:
+            start = int(np.argmax(np.hypot(coords[:, 0], coords[:, 1])))
+            first = coords[start]
+            away = first / np.hypot(*first) * max(outside, float(np.hypot(*first)) + clearance_mm)
+            points = [away, *np.concatenate([coords[start:], coords[:start + 1]])]
+        else:
+            points.extend(_started_at_nearest(coords, points[-1]))
+    builder.move(MoveKind.RAPID, float(points[0][0]), float(points[0][1]), safe_z, 0.0)
+    builder.move(MoveKind.LINEAR, float(points[0][0]), float(points[0][1]), z, 0.0, feed / 2.0, station=index)
+    lines = [Line2D((float(a[0]), float(a[1])), (float(b[0]), float(b[1]))) for a, b in zip(points[:-1], points[1:])
+             if (a[0], a[1]) != (b[0], b[1])]
+    pieces = split_at_bands(lines, bands)
+    _add_held(builder, pieces, z, tab_top, feed, index)
+    builder.move(MoveKind.RAPID, float(points[-1][0]), float(points[-1][1]), safe_z, 0.0)
 
 
 def _started_at_nearest(coords: np.ndarray, point: np.ndarray) -> np.ndarray:
@@ -220,12 +339,28 @@ class ThreeAxisFinishingFacts:
     step_downs: int
     segments_per_loop: int  # arcs and lines of one finishing loop
     arcs_per_loop: int
+    root_thickness: RootThickness  # the tooth's chord at the root form circle and mid-fillet, cut vs rack-generated
+    engagement: FinishingEngagement | None = None  # against what roughing leaves (None without roughing)
 
     def report_text(self) -> str:
+        t = self.root_thickness
         return (f"Finishing (3 axes): the outline as {self.arcs_per_loop} arcs and "
                 f"{self.segments_per_loop - self.arcs_per_loop} lines per loop, offset by the tool radius "
                 f"{self.tool_radius_mm:g} mm, in {self.step_downs} step-downs (climb). The tool's side leaves the "
                 f"involute at diameter {self.form_diameter_mm:.3f} mm (rack-generated {self.rack_form_diameter_mm:.3f}"
                 f" mm, active profile from {self.active_start_diameter_mm:.3f} mm) and a root fillet of "
-                f"{self.root_fillet_radius_mm:.3f} mm radius at least.")
+                f"{self.root_fillet_radius_mm:.3f} mm radius at least. Root thickness (tooth chord): "
+                f"{t.form_thickness_mm:.4f} mm at the root form diameter {t.form_diameter_mm:.3f} mm (rack-generated "
+                f"{t.rack_form_thickness_mm:.4f} mm), {t.fillet_thickness_mm:.4f} mm at diameter "
+                f"{t.fillet_diameter_mm:.3f} mm, the fillet's middle (rack-generated "
+                f"{t.rack_fillet_thickness_mm:.4f} mm).{self._engagement_text()}")
+
+    def _engagement_text(self) -> str:
+        e = self.engagement
+        if e is None:
+            return ""
+        text = (f" Its radial engagement in what roughing leaves reaches {100 * e.max_radial_fraction:.0f} % of D, "
+                f"step-down {e.step_down_mm:.3f} mm")
+        return text + (" (the slot depth [roughing] max_level_depth_fraction allows: roughing cannot reach the root)."
+                       if e.limited else ".")
 

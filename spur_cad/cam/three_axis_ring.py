@@ -113,14 +113,16 @@ def _lead_arcs_inside(entry: tuple[float, float], tangent: tuple[float, float], 
     return start, end, (cx, cy), counterclockwise
 
 
-def ring_finishing_toolpath(spec: GearSpec, tool: Tool, machine: Machine,
-                            tolerance_mm: float) -> tuple[Toolpath, list[float], int]:
-    """The ring's finishing program (see the module docstring): (toolpath, Z levels, segments per loop)."""
+def ring_finishing_toolpath(spec: GearSpec, tool: Tool, machine: Machine, tolerance_mm: float,
+                            step_down_mm: float | None = None) -> tuple[Toolpath, list[float], int]:
+    """The ring's finishing program (see the module docstring): (toolpath, Z levels, segments per loop); step-downs
+    of at most `step_down_mm` (default one tool diameter)."""
     loop = ring_finishing_loop(spec, tool, tolerance_mm)
     lead = max(tool.diameter_mm / 2.0, 0.5)
     start, end, centre, ccw = _lead_arcs_inside(loop[0].start_xy, loop[0].start_tangent, lead)
     feed, safe_z = tool.feed_mm_min(machine), machine.clearance_mm
-    levels = _levels(spec.face_width_mm + BREAK_THROUGH_MM, FINISH_STEP_DOWN_DIAMETERS * tool.diameter_mm)
+    step = FINISH_STEP_DOWN_DIAMETERS * tool.diameter_mm if step_down_mm is None else step_down_mm
+    levels = _levels(spec.face_width_mm + BREAK_THROUGH_MM, step)
     builder = ToolpathBuilder(Operation.FINISHING, tool.tool_number, tool.spindle_rpm(machine))
     for index, z in enumerate(levels):
         builder.move(MoveKind.RAPID, start[0], start[1], safe_z, 0.0)
@@ -131,6 +133,17 @@ def ring_finishing_toolpath(spec: GearSpec, tool: Tool, machine: Machine,
         builder.arc(not ccw, end[0], end[1], z, *centre, feed, station=index)
         builder.move(MoveKind.RAPID, end[0], end[1], safe_z, 0.0)
     return builder.build(), levels, len(loop)
+
+
+def ring_roughing_leaves(spec: GearSpec, roughing_tool: Tool, outermost_offset_mm: float):
+    """The section roughing leaves at every level (shapely polygon): the rim's disc less what the outermost pass's
+    tool circles (centre `outermost_offset_mm` from the outline) and those inside it reach."""
+    from shapely.geometry import Point, Polygon
+
+    hole = Polygon(gear_outline(spec, ROUGHING_OUTLINE_TOLERANCE_MM))
+    reached = hole.buffer(-outermost_offset_mm, quad_segs=ROUGHING_ARC_SEGMENTS).buffer(
+        roughing_tool.diameter_mm / 2.0, quad_segs=4 * ROUGHING_ARC_SEGMENTS)
+    return Point(0.0, 0.0).buffer(spec.rim_outer_diameter_mm / 2.0, quad_segs=64).difference(reached)
 
 
 def ring_roughing_rings(spec: GearSpec, tool: Tool, params: RoughingParams, inner_radius_mm: float,

@@ -151,3 +151,63 @@ def ring_active_profile_start(spec: GearSpec) -> tuple[float, str]:
         source = f"the {cutter.teeth}-tooth shaper cutter's mesh (as a mating gear of addendum h_a* m)"
     roll_mm = centre_distance * math.sin(alpha_w) + math.sqrt(max(pinion_tip**2 - pinion_base**2, 0.0))
     return math.hypot(spec.base_radius_mm, roll_mm), source
+
+
+ROOT_THICKNESS_TOLERANCE_MM = 0.0002
+"""Chordal tolerance of the outline the root thickness is measured on (shapely polygons; their disks' arcs are
+finer: ROOT_THICKNESS_QUAD_SEGMENTS)."""
+ROOT_THICKNESS_QUAD_SEGMENTS = 256
+"""Segments per quarter circle of the tool's disk when the tooth is closed by it (sag r (1 - cos(pi / 1024)): 5 nm
+per mm of tool radius)."""
+
+
+@dataclass(frozen=True)
+class RootThickness:
+    """The tooth's chordal thickness near the root, cut by a flat end mill's side (radius `tool_radius_mm`) and as
+    the basic rack generates it: at the rack's form circle (the root form circle, where its involute starts) and at
+    the fillet's middle (halfway between the root and form circles)."""
+
+    tool_radius_mm: float
+    form_diameter_mm: float
+    form_thickness_mm: float  # cut by the tool
+    rack_form_thickness_mm: float
+    fillet_diameter_mm: float
+    fillet_thickness_mm: float
+    rack_fillet_thickness_mm: float
+
+
+def root_thickness(spec: GearSpec, tool_radius_mm: float) -> RootThickness:
+    """The tooth's root thickness the tool leaves beside the rack-generated one (see RootThickness): what a disk of
+    the tool's radius cannot reach in the spaces stays (the gear closed by the disk, shapely buffers), and each
+    tooth's chord is where a circle about the axis crosses it."""
+    from shapely.geometry import LineString, Polygon
+
+    from spur_cad.geometry.sampling import gear_outline
+
+    outline = Polygon(gear_outline(spec, ROOT_THICKNESS_TOLERANCE_MM))
+    if spec.is_internal:  # a ring: the rim disc less the hole; the tool's disk opens the hole instead
+        from shapely.geometry import Point
+
+        rim = Point(0.0, 0.0).buffer(spec.rim_outer_diameter_mm / 2.0, quad_segs=ROOT_THICKNESS_QUAD_SEGMENTS)
+        gear = rim.difference(outline)
+        cut = rim.difference(outline.buffer(-tool_radius_mm, quad_segs=ROOT_THICKNESS_QUAD_SEGMENTS).buffer(
+            tool_radius_mm, quad_segs=ROOT_THICKNESS_QUAD_SEGMENTS))
+    else:
+        gear = outline
+        cut = gear.buffer(tool_radius_mm, quad_segs=ROOT_THICKNESS_QUAD_SEGMENTS).buffer(
+            -tool_radius_mm, quad_segs=ROOT_THICKNESS_QUAD_SEGMENTS)
+    form = spec.tooth_space_profile().form_radius_mm
+    fillet = 0.5 * (spec.root_radius_mm + form)
+    middle = math.pi / 2.0 + math.pi / spec.teeth  # tooth 0's centre: between spaces 0 (on +Y) and 1
+
+    def chord(shape, radius_mm: float) -> float:
+        turns = middle + np.linspace(-math.pi / spec.teeth, math.pi / spec.teeth, 20001)
+        arc = LineString(np.stack([radius_mm * np.cos(turns), radius_mm * np.sin(turns)], axis=1))
+        pieces = shape.intersection(arc)
+        pieces = getattr(pieces, "geoms", [pieces])
+        piece = max(pieces, key=lambda p: p.length)
+        (x0, y0), (x1, y1) = piece.coords[0], piece.coords[-1]
+        return math.hypot(x1 - x0, y1 - y0)
+
+    return RootThickness(tool_radius_mm, 2 * form, chord(cut, form), chord(gear, form), 2 * fillet,
+                         chord(cut, fillet), chord(gear, fillet))

@@ -43,10 +43,12 @@ def helix_range_mm(face_width_mm: float, module_mm: float) -> tuple[float, float
     return cut, face_width_mm - cut
 
 
-def profile_range_mm(spec) -> tuple[float, float]:
-    """The profile evaluation range in roll length: form circle to 95 % of the way to the tip circle."""
+def profile_range_mm(spec, start_radius_mm: float | None = None) -> tuple[float, float]:
+    """The profile evaluation range in roll length: form circle (or `start_radius_mm`: where a 3-axis tool leaves
+    the involute, above the rack's form circle) to 95 % of the way to the tip circle."""
     rb = spec.base_radius_mm
-    start = math.sqrt(max(spec.form_radius_mm ** 2 - rb ** 2, 0.0))
+    start_radius = spec.form_radius_mm if start_radius_mm is None else start_radius_mm
+    start = math.sqrt(max(start_radius ** 2 - rb ** 2, 0.0))
     tip = math.sqrt(spec.tip_radius_mm ** 2 - rb ** 2)
     return start, start + (1.0 - TIP_EXCLUDED_FRACTION) * (tip - start)
 
@@ -56,14 +58,15 @@ def _flank_points(grid, side: str) -> np.ndarray:
     return np.array([name == f"{side} involute" for name in names])
 
 
-def traces(spec, result) -> list[Trace]:
-    """Profile traces (three face positions) and a helix trace for both flanks of every tooth space."""
+def traces(spec, result, profile_start_radius_mm: float | None = None) -> list[Trace]:
+    """Profile traces (three face positions) and a helix trace for both flanks of every tooth space (profiles from
+    `profile_start_radius_mm`, default the form circle)."""
     grid = result.grid
     rows = np.nonzero(result.gear_rows)[0]
     x = grid.rows_x[rows]
     helix_lo, helix_hi = helix_range_mm(spec.face_width_mm, spec.module_mm)
     face_rows = [rows[np.argmin(np.abs(x - target))] for target in (helix_lo, 0.5 * (helix_lo + helix_hi), helix_hi)]
-    profile_range = profile_range_mm(spec)
+    profile_range = profile_range_mm(spec, profile_start_radius_mm)
     found = []
     for side in SIDES:
         mask = _flank_points(grid, side)
@@ -92,10 +95,11 @@ def flank_positions_um(spec, result, side: str) -> np.ndarray:
     return np.array([result.deviation[k][mask][reference, middle] * 1000.0 / cos_alpha for k in range(grid.teeth)])
 
 
-def grade_simulation(spec, result) -> Grading:
+def grade_simulation(spec, result, profile_start_radius_mm: float | None = None) -> Grading:
     """The gear's ISO 1328-1 grade from the simulated cut: worst deviations over all flanks, their classes, the
-    gear's class, the class-5 tolerances, every space's pitch, the validity of the formulas and the traces."""
-    measured = traces(spec, result)
+    gear's class, the class-5 tolerances, every space's pitch, the validity of the formulas and the traces
+    (profiles evaluated from `profile_start_radius_mm`, default the form circle)."""
+    measured = traces(spec, result, profile_start_radius_mm)
     worst, where = worst_deviations(measured)
     pitch = {side: add_pitch(worst, where, side, flank_positions_um(spec, result, side)) for side in SIDES}
     classes, overall = classes_of(spec, worst, set(worst))

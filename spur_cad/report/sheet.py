@@ -239,7 +239,8 @@ def totals_rows(result: JobResult) -> tuple[Row, ...]:
     rows = [Row("operations", str(len(operations))),
             Row("tools", str(len({tool.tool_number for tool in tools})))]
     if setup is not None and setup.z_min_mm is not None:
-        rows.append(Row("programmed tool-tip Z (from the rotary axis)",
+        rows.append(Row("programmed tool-tip Z (from the blank's top face)" if setup.axes == 3 else
+                        "programmed tool-tip Z (from the rotary axis)",
                         f"{number(setup.z_min_mm, 3)} to {number(setup.z_max_mm, 3)}", "mm"))
     if tools:
         rows += [Row("largest spindle speed", number(max(t.spindle_rpm for t in tools), 0), "rpm"),
@@ -254,6 +255,8 @@ def setup_rows(result: JobResult) -> tuple[Row, ...]:
     setup, gear = result.setup, result.gear
     if setup is None:
         return ()
+    if setup.axes == 3:
+        return _flat_setup_rows(setup, gear)
     rows = [Row("machine", setup.machine_name),
             Row("blank diameter", number(setup.blank_diameter_mm, 3), "mm"),
             Row("blank along X (front face of the gear at X = 0)",
@@ -270,6 +273,20 @@ def setup_rows(result: JobResult) -> tuple[Row, ...]:
         Row("clearance above the blank for moves that turn A", number(setup.clearance_mm, 3), "mm"),
     ]
     return tuple(rows)
+
+
+def _flat_setup_rows(setup, gear) -> tuple[Row, ...]:
+    """The set-up of the 3-axis variant ([machine] axes = 3): the blank lying flat, Z0 on its top face."""
+    return (
+        Row("machine", setup.machine_name),
+        Row("blank diameter", number(setup.blank_diameter_mm, 3), "mm"),
+        Row("blank thickness (faced to the face width)", number(gear.face_width_mm, 3), "mm"),
+        Row("work offset", f"{setup.work_offset}: X = 0 and Y = 0 on the gear axis (the bore's centre), Z = 0 on "
+                           "the blank's top face"),
+        Row("tooth space 0", "its axis points to +Y"),
+        Row("gear axis", "machine Z: the blank clamped flat on its bore or a fixture, relieved 0.5 mm under the "
+                         "outline (the programs cut through unless [three_axis] leaves tabs or a skin)"),
+    )
 
 
 def program_table(result: JobResult) -> Table:
