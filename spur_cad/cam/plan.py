@@ -682,7 +682,8 @@ def _plan_three_axis_ring(inputs: CamInputs, tolerance_mm: float, root) -> CamPl
         arcs = int(path.arc_mask.sum()) // len(levels) - 2  # less the lead-in and lead-out arcs
         facts = ThreeAxisFinishingFacts(tool.diameter_mm / 2.0, 2 * root.form_radius_mm, 2 * root.rack_form_radius_mm,
                                         2 * root.active_start_radius_mm, root.fillet_radius_mm, len(levels),
-                                        segments, arcs, root_thickness(spec, tool.diameter_mm / 2.0), engagement)
+                                        segments, arcs, root_thickness(spec, tool.diameter_mm / 2.0), engagement,
+                                        "cutter")
         result = FinishingResult("three_axis", None, None, len(levels), 0.0, np.zeros(0), facts=facts)
         finishing = FinishingPlan(tool, result, path, estimate(path, machine), None, None)
     warnings = ("[machine] axes = 3: the ring's cut is not simulated nor graded; the LinuxCNC programs are checked "

@@ -341,18 +341,19 @@ class ThreeAxisFinishingFacts:
     arcs_per_loop: int
     root_thickness: RootThickness  # the tooth's chord at the root form circle and mid-fillet, cut vs rack-generated
     engagement: FinishingEngagement | None = None  # against what roughing leaves (None without roughing)
+    generated_by: str = "rack"  # what generates the reference profile: the basic "rack", a ring's shaper "cutter"
 
     def report_text(self) -> str:
-        t = self.root_thickness
+        t, generated = self.root_thickness, f"{self.generated_by}-generated"
         return (f"Finishing (3 axes): the outline as {self.arcs_per_loop} arcs and "
                 f"{self.segments_per_loop - self.arcs_per_loop} lines per loop, offset by the tool radius "
                 f"{self.tool_radius_mm:g} mm, in {self.step_downs} step-downs (climb). The tool's side leaves the "
-                f"involute at diameter {self.form_diameter_mm:.3f} mm (rack-generated {self.rack_form_diameter_mm:.3f}"
+                f"involute at diameter {self.form_diameter_mm:.3f} mm ({generated} {self.rack_form_diameter_mm:.3f}"
                 f" mm, active profile from {self.active_start_diameter_mm:.3f} mm) and a root fillet of "
                 f"{self.root_fillet_radius_mm:.3f} mm radius at least. Root thickness (tooth chord): "
-                f"{t.form_thickness_mm:.4f} mm at the root form diameter {t.form_diameter_mm:.3f} mm (rack-generated "
+                f"{t.form_thickness_mm:.4f} mm at the root form diameter {t.form_diameter_mm:.3f} mm ({generated} "
                 f"{t.rack_form_thickness_mm:.4f} mm), {t.fillet_thickness_mm:.4f} mm at diameter "
-                f"{t.fillet_diameter_mm:.3f} mm, the fillet's middle (rack-generated "
+                f"{t.fillet_diameter_mm:.3f} mm, the fillet's middle ({generated} "
                 f"{t.rack_fillet_thickness_mm:.4f} mm).{self._engagement_text()}")
 
     def _engagement_text(self) -> str:

@@ -240,8 +240,7 @@ def ring_tool_recommendations(spec: GearSpec, clearance_mm: float):
     flute = spec.face_width_mm + BREAK_THROUGH_MM
     largest = largest_flat_mill_radius_mm(spec)
     return ToolRecommendations(0.0, 0.0, 0.0, 2.0 * spec.tip_radius_mm, flute, flute + clearance_mm, 0.0,
-                               2.0 * largest, "3-axis ring: the tool's side cuts, its bottom never plunges into "
-                               "material")
+                               2.0 * largest)
 
 
 def _circle(builder: ToolpathBuilder, radius_mm: float, here: np.ndarray, z_mm: float, feed: float,
