@@ -230,6 +230,15 @@ def simulation_facts(result: SimResult | None, resolution_mm: float) -> Simulati
 # --- the one serialisation ------------------------------------------------------------------------------------
 
 
+def _inspection_json(inspection) -> dict:
+    """The inspection sheet's figures; `pins_between` only for an internal gear (an external gear's summary keeps
+    the keys it had, so scripts and golden files that read it are unchanged)."""
+    facts = dataclasses.asdict(inspection)
+    if not facts.get("pins_between"):
+        facts.pop("pins_between", None)
+    return facts
+
+
 def summary_json(result: JobResult) -> dict:
     """summary.json's content: every key as users' scripts read it."""
     tools = result.tools
@@ -237,7 +246,7 @@ def summary_json(result: JobResult) -> dict:
         "spur_cad_version": result.version,
         "job": {"name": result.job.name, "file": result.job.file},
         "gear": dataclasses.asdict(result.gear),
-        "inspection": dataclasses.asdict(result.inspection),
+        "inspection": _inspection_json(result.inspection),
         "profile": {"tolerance_mm": result.profile.tolerance_mm, "points": result.profile.points,
                     "points_per_segment": dataclasses.asdict(result.profile.points_per_segment)},
         "cad": cad_json(result.cad),
