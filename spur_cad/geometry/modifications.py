@@ -31,6 +31,7 @@ from scipy.optimize import brentq
 
 from spur_cad.errors import GearSpecError
 from spur_cad.geometry.profile import CircularArc, Segment, ToothSpaceProfile
+from spur_cad.geometry.sampling import ProfileSamples, sample_profile, segment_parameters
 
 SIDES = ("right", "left")
 RELIEF_SHAPES = ("linear", "parabolic")
@@ -319,3 +320,15 @@ def modified_tooth_space_profile(profile: ToothSpaceProfile, flank: FlankModific
             segments.append(seg)
     return replace(profile, segments=tuple(segments))
 
+
+
+
+def sample_modified_profile(profile: ToothSpaceProfile, tolerance_mm: float) -> tuple[ProfileSamples, np.ndarray]:
+    """`sample_profile` of a modified profile and the unmodified points under its samples (each sample's design
+    segment at the same parameter; the unmodified tip arc point where the modified flank meets it)."""
+    samples = sample_profile(profile, tolerance_mm)
+    design = []
+    for index, segment in enumerate(profile.segments):
+        params = segment_parameters(segment, tolerance_mm)
+        design.append(getattr(segment, "base", segment).points(params[1:] if index > 0 else params))
+    return samples, np.concatenate(design)
