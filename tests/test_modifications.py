@@ -134,7 +134,9 @@ def _section_points(shape, x: float, per_edge: int = 200) -> np.ndarray:
     from OCP.TopExp import TopExp_Explorer
     from OCP.TopoDS import TopoDS
 
-    section = BRepAlgoAPI_Section(shape, gp_Pln(gp_Pnt(x, 0, 0), gp_Dir(1, 0, 0)))
+    section = BRepAlgoAPI_Section(shape, gp_Pln(gp_Pnt(x, 0, 0), gp_Dir(1, 0, 0)), False)
+    section.SetRunParallel(True)
+    section.Approximation(False)  # the exact intersection curves, not approximations of them
     section.Build()
     assert section.IsDone()
     points = []
@@ -202,3 +204,34 @@ def test_step_sections_are_the_design_involute_moved_by_the_modification(text, v
         assert roll.min() < math.sqrt(low**2 - rb**2) + 0.5 and roll.max() > math.sqrt(high**2 - rb**2) - 0.5
         assert gaps.max() < 0.3, x  # every flank is there, not only some
         assert on_involute.sum() > 2 * spec.teeth * 20
+
+
+def test_the_inspection_sheet_lists_the_modifications_and_says_where_span_and_pins_touch():
+    from spur_cad.pipeline import run_job
+
+    result = run_job(parse_job(SPUR + "[gear.modifications.left]\ntip_relief_um = 11\n", "f.toml"))
+    report = result.files["report.html"].decode()
+    assert "flank modification tip relief C_a (right / left)" in report and "15.0 / 11.0" in report
+    assert "lead crowning C_beta" in report
+    assert "measured where the flanks are unmodified" in report
+    summary = result.files["summary.json"].decode()
+    assert '"tip relief C_a": {\n        "right": 15.0,\n        "left": 11.0' in summary
+
+
+def test_a_span_taken_on_a_modified_flank_is_a_warning_with_what_it_reads():
+    from spur_cad.geometry.inspection import inspection_facts, modification_inspection
+    from spur_cad.pipeline import run_job
+
+    job = parse_job(GEAR + "[gear.modifications]\nprofile_slope_um = 20\n", "f.toml")
+    sheet = inspection_facts(job.gear)
+    facts = modification_inspection(job.gear, job.modifications, sheet)
+    rb = job.gear.base_radius_mm
+    l_form = roll_length_mm(rb, 2 * job.gear.form_radius_mm)
+    l_tip = roll_length_mm(rb, 2 * job.gear.tip_radius_mm)
+    roll = roll_length_mm(rb, 2 * sheet.span_contact_radius_mm)
+    removal_um = -20 * (roll - (l_form + l_tip) / 2) / (l_tip - l_form)  # the material grows toward the tip
+    assert facts.span_removal_um == pytest.approx((removal_um, removal_um))
+    assert facts.span_modified_mm == pytest.approx(sheet.span_measurement_mm - 2 * removal_um / 1000)
+    assert not facts.measured_unmodified
+    report = run_job(job).files["report.html"].decode()
+    assert "warning: the span anvils touch modified flanks" in report

@@ -86,11 +86,12 @@ class FlankModification:
         offset = self.profile_crowning_mm * (2.0 * (roll - middle) / span) ** 2 \
             - self.profile_slope_mm * (roll - middle) / span
         if self.tip_relief_mm:
-            s = np.maximum(roll - self.tip_relief_start_roll_mm, 0.0) / (self.tip_roll_mm - self.tip_relief_start_roll_mm)
+            length = self.tip_roll_mm - self.tip_relief_start_roll_mm
+            s = np.maximum(roll - self.tip_relief_start_roll_mm, 0.0) / length
             offset = offset + self.tip_relief_mm * (s * s if self.tip_relief_parabolic else s)
         if self.root_relief_mm:
-            s = np.maximum(self.root_relief_start_roll_mm - roll, 0.0) / (self.root_relief_start_roll_mm
-                                                                           - self.form_roll_mm)
+            length = self.root_relief_start_roll_mm - self.form_roll_mm
+            s = np.maximum(self.root_relief_start_roll_mm - roll, 0.0) / length
             offset = offset + self.root_relief_mm * (s * s if self.root_relief_parabolic else s)
         return offset
 
@@ -301,7 +302,7 @@ def modified_tooth_space_profile(profile: ToothSpaceProfile, flank: FlankModific
     while radius_minus_tip(lo) > 0.0:
         lo -= 0.05
     t_end = brentq(radius_minus_tip, lo, hi, xtol=1e-14)
-    cuts = [involute.start, *(k / rb for k in flank.profile_kinks_roll_mm()), t_end]
+    cuts = [involute.start, *(k / rb for k in flank.profile_kinks_roll_mm() if k / rb < t_end), t_end]
     segments: list = []
     for seg in profile.segments:
         if seg.label == "fillet":
@@ -309,7 +310,8 @@ def modified_tooth_space_profile(profile: ToothSpaceProfile, flank: FlankModific
             removal = float(involute_offset(t_form))
             normal = tuple(float(v) for v in involute.normals(np.array(t_form)))
             span = seg.end - seg.start
-            segments.append(ModifiedSegment(seg, lambda beta, s=span, r=removal: r * (np.asarray(beta) / s) ** 2, fixed_normal=normal))
+            segments.append(ModifiedSegment(seg, lambda beta, s=span, r=removal: r * (np.asarray(beta) / s) ** 2,
+                                            fixed_normal=normal))
         elif seg.label == "involute":
             for a, b in zip(cuts, cuts[1:]):
                 segments.append(ModifiedSegment(replace(seg, start=a, end=b), involute_offset))
