@@ -40,11 +40,8 @@ from spur_cad.errors import (
     shown,
     shown_path,
 )
-<<<<<<< HEAD
 from spur_cad.geometry.internal import InternalGearSpec
-=======
 from spur_cad.geometry.modifications import SIDES, FlankModifications, flank_modification
->>>>>>> wt-mods
 from spur_cad.geometry.spec import MAX_TEETH, MIN_TEETH, GearSpec
 from spur_cad.keys import check_section, coerce, key, keys_of, section_problems, type_problem
 from spur_cad.post.settings import PostSettings
@@ -692,7 +689,6 @@ def _job_from_data(data: dict, source: str, text: str, strategies: Strategies = 
     except GearSpecError as exc:
         blamed = _blamed_key(exc, 'gear', tables['gear'])
         raise JobFileError(f"{where('gear', blamed)}: invalid gear: {exc}", section="gear", field=blamed) from None
-<<<<<<< HEAD
     if spec.is_internal and any(name.startswith("tools") for name in tables):
         if sections.get("machine", Machine()).axes != 3:
             why = ("the rotary table cannot cut an internal gear (its tool cannot reach inside the ring along the "
@@ -701,9 +697,7 @@ def _job_from_data(data: dict, source: str, text: str, strategies: Strategies = 
             why = "the 3-axis plan does not cut internal gears yet (geometry, inspection, CAD and 2-D export do)"
         raise JobFileError(f"{where('gear', 'internal')}: internal = true: {why}; leave out [tools] for now",
                            section="gear", field="internal")
-=======
     modifications = _modifications(modification_tables, spec, source, text)
->>>>>>> wt-mods
     for check, name in ((gear_section.blank_features().validate, "gear"),
                         (sections.get("stock", StockSpec()).validate, "stock")):
         try:

@@ -350,15 +350,10 @@ def _ring_shape(edges: list[TopoDS_Edge], spec: GearSpec) -> TopoDS_Shape:
 
 
 def build_gear_shape(spec: GearSpec, features: BlankFeatures = BlankFeatures(),
-<<<<<<< HEAD
-                     fit_tolerance_mm: float | None = None) -> tuple[TopoDS_Shape, GearSolidReport]:
-    """The gear as an OCP solid in the machine frame, with a report of the spline fits (an internal gear: a ring
-    whose outside is the rim, rim_outer_diameter_mm).
-=======
                      fit_tolerance_mm: float | None = None,
                      modifications: FlankModifications | None = None) -> tuple[TopoDS_Shape, GearSolidReport]:
-    """The gear as an OCP solid in the machine frame, with a report of the spline fits (the design flanks').
->>>>>>> wt-mods
+    """The gear as an OCP solid in the machine frame, with a report of the spline fits (the design flanks'; an
+    internal gear: a ring whose outside is the rim, rim_outer_diameter_mm).
 
     `fit_tolerance_mm` defaults to 2.5e-6 x module (see default_fit_tolerance_mm). With `modifications` the
     flanks are the modified ones: profile modifications only, the modified outline extruded or swept as the
@@ -369,17 +364,14 @@ def build_gear_shape(spec: GearSpec, features: BlankFeatures = BlankFeatures(),
     tolerance = default_fit_tolerance_mm(spec) if fit_tolerance_mm is None else fit_tolerance_mm
     edges, report = gear_face_edges(spec, tolerance)
     b = spec.face_width_mm
-<<<<<<< HEAD
     if spec.is_internal:
         shape = _ring_shape(edges, spec)
-=======
-    if modifications is not None and not modifications.is_zero:
+    elif modifications is not None and not modifications.is_zero:
         if modifications.has_lead:
             shape = _loft_lead_modified(spec, modifications, tolerance)
         else:
             edges = modified_face_edges(spec, modifications, 0.0, tolerance)
             shape = _sweep_helical(edges, spec) if spec.is_helical else _extrude(edges, b)
->>>>>>> wt-mods
     else:
         shape = _sweep_helical(edges, spec) if spec.is_helical else _extrude(edges, b)
     if features.bore_diameter_mm > 0.0:
