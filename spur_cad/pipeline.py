@@ -375,7 +375,7 @@ def cam_inputs(job: Job) -> CamInputs:
     """The part of a job the CAM stage reads."""
     return CamInputs(job.gear, job.stock, job.tools.roughing, job.tools.finishing, job.roughing, job.finishing,
                      job.machine, job.tools.bottom, top_tool=job.tools.roughing_top, strategies=job.strategies,
-                     profile_tolerance_mm=job.job.profile_tolerance_mm)
+                     profile_tolerance_mm=job.job.profile_tolerance_mm, modifications=job.modifications)
 
 
 def plan_cam(job: Job, checkpoint: Callable[[], None] | None = None) -> CamPlan:
@@ -401,7 +401,7 @@ def simulate_stage(job: Job, plan: CamPlan, progress: Callable[[float], None] | 
         return None
     stations = plan.finishing.result.station_x_mm if plan.finishing is not None else np.zeros(0)
     result = simulate(job.gear, job_stock(job), operations, SimSettings(resolution_mm=job.simulation.resolution_mm),
-                      station_x=stations, progress=progress)
+                      station_x=stations, progress=progress, modifications=job.modifications)
     return dataclasses.replace(result, engagement=roughing_engagement(job, plan))
 
 

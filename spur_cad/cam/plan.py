@@ -49,6 +49,7 @@ from spur_cad.cam.strategies import (
 )
 from spur_cad.cam.tools import Tool, ToolError
 from spur_cad.errors import SpurCadError, StockError, WorkLimitError, shown
+from spur_cad.geometry.modifications import FlankModifications
 from spur_cad.geometry.spec import GearSpec
 
 MAX_CONTACTS_PER_FLANK = 20_000
@@ -140,6 +141,7 @@ class CamInputs:
     top_tool: Tool | None = None  # two-stage roughing offered: a larger tool above roughing_tool ([tools.roughing_top])
     strategies: Strategies = field(default_factory=lambda: dict(REGISTRY))  # where [finishing] strategy is found
     profile_tolerance_mm: float = 0.001  # [job] profile_tolerance_mm: the 3-axis finishing arcs' chordal tolerance
+    modifications: FlankModifications | None = None  # [gear.modifications]: cut by generating finishing
 
 
 def check_cam_inputs(inputs: CamInputs) -> tuple[ToolRecommendations, RoughingLevels | None]:
@@ -548,7 +550,8 @@ def check_finishing_work(spec: GearSpec, tool: Tool, machine: Machine, section: 
 
 def _plan_finishing(inputs: CamInputs, blank: float, check: Callable[[], None]) -> FinishingPlan:
     spec, tool, machine = inputs.spec, inputs.finishing_tool, inputs.machine
-    path, result = plan_finishing(spec, tool, machine, inputs.finishing, blank, inputs.strategies)
+    path, result = plan_finishing(spec, tool, machine, inputs.finishing, blank, inputs.strategies,
+                                  inputs.modifications, inputs.profile_tolerance_mm)
     check_travel(machine, path.x, path.y, path.z, path.a, "finishing")
     own = estimate(path, machine)
     check()
