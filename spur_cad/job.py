@@ -42,6 +42,7 @@ from spur_cad.errors import (
     shown_path,
 )
 from spur_cad.geometry.internal import InternalGearSpec
+from spur_cad.geometry.modifications import SIDES, FlankModifications, flank_modification
 from spur_cad.geometry.spec import MAX_TEETH, MIN_TEETH, GearSpec
 from spur_cad.keys import check_section, coerce, key, keys_of, section_problems, type_problem
 from spur_cad.post.settings import PostSettings
@@ -141,6 +142,61 @@ class GearSection:
         return BlankFeatures(self.bore_diameter_mm, self.keyway_width_mm, self.keyway_depth_mm)
 
 
+def _amount(label: str, meaning: str, signed: bool = False):
+    """A modification amount key (um): 0 = none; beyond 10 % of the module is refused with the gear."""
+    return key(0.0, unit="um", low=-10000.0 if signed else 0.0, high=10000.0, label=label, group="Modifications",
+               meaning=meaning)
+
+
+@dataclass(frozen=True)
+class ModificationsSection:
+    """[gear.modifications] / [gear.modifications.left] / [gear.modifications.right]: flank modifications
+    (micro-geometry, ISO 21771 names; docs/geometry.md), amounts in um removed along the flank normal, lengths in mm.
+    [gear.modifications] sets both flank sides; a .left or .right table overrides the keys it gives for that side.
+    Amounts are at most 10 % of the module; reliefs start on the usable involute (form to tip diameter)."""
+
+    tip_relief_um: float = _amount("TipRelief", "tip relief C_a: removed at the tip diameter")
+    tip_relief_start_diameter_mm: float = key(0.0, unit="mm", low=0.0, high=5000.0, label="TipReliefStartDiameter",
+                                              group="Modifications",
+                                              meaning="diameter d_Ca where the tip relief starts (needed with it)")
+    tip_relief_shape: str = key("linear", choices=("linear", "parabolic"), label="TipReliefShape",
+                                group="Modifications", meaning="tip relief along the roll length: linear or parabolic")
+    root_relief_um: float = _amount("RootRelief", "root relief C_f: removed at the form diameter (start of the "
+                                                  "usable involute)")
+    root_relief_start_diameter_mm: float = key(0.0, unit="mm", low=0.0, high=5000.0, label="RootReliefStartDiameter",
+                                               group="Modifications",
+                                               meaning="diameter d_Cf where the root relief starts, toward the root "
+                                                       "(needed with it)")
+    root_relief_shape: str = key("linear", choices=("linear", "parabolic"), label="RootReliefShape",
+                                 group="Modifications",
+                                 meaning="root relief along the roll length: linear or parabolic")
+    profile_crowning_um: float = _amount("ProfileCrowning", "profile crowning C_alpha: removed at both ends of the "
+                                                            "usable involute, parabolic, none at its middle")
+    profile_slope_um: float = _amount("ProfileSlope", "design profile slope f_Halpha: the material grows by this "
+                                                      "from the form diameter to the tip (signed, none at "
+                                                      "mid-profile)", signed=True)
+    lead_crowning_um: float = _amount("LeadCrowning", "lead crowning C_beta: removed at both faces, parabolic, none "
+                                                      "at mid-face")
+    end_relief_um: float = _amount("EndRelief", "end relief C_I / C_II: removed at the face(s), linear")
+    end_relief_length_mm: float = key(0.0, unit="mm", low=0.0, high=2000.0, label="EndReliefLength",
+                                      group="Modifications",
+                                      meaning="length L_I / L_II of the end relief from the face (needed with it)")
+    end_relief_faces: str = key("both", choices=("both", "front", "back"), label="EndReliefFaces",
+                                group="Modifications",
+                                meaning="faces with end relief: both, front (X = 0) or back (X = b)")
+    helix_slope_um: float = _amount("HelixSlope", "design helix slope f_Hbeta: the material grows by this from the "
+                                                  "front face to the back face (signed, none at mid-face)",
+                                    signed=True)
+
+
+MODIFICATION_SECTIONS: dict[str, type] = {
+    "gear.modifications": ModificationsSection,
+    "gear.modifications.left": ModificationsSection,
+    "gear.modifications.right": ModificationsSection,
+}
+"""The flank modification tables: read with [gear] (not workbench properties yet)."""
+
+
 @dataclass(frozen=True)
 class SimulationSection:
     """[simulation]: verification by simulated cutting (see docs/simulation.md)."""
@@ -208,6 +264,7 @@ class Job:
     export: ExportSection = field(default_factory=ExportSection)
     lathe: LatheSection | None = None  # [lathe] present: the blank's lathe program is written too
     probe: ProbeSection | None = None  # [probe] present: the on-machine probing program is written too
+    modifications: FlankModifications | None = None  # [gear.modifications]: None when it sets no amount
     text: str = field(default="", repr=False, compare=False)  # the file's text, to point at lines
     report_template_text: str | None = field(default=None, repr=False, compare=False)  # [job] report_template's
     rotary_calibration: CalibrationTable | None = field(default=None, repr=False, compare=False)  # [machine]'s file
@@ -569,8 +626,60 @@ def _validate_sections(sections: dict, tables: dict, types: dict, autos: dict[st
             raise JobFileError(f"{where(name, blamed)}: {prefix}{exc}", section=name, field=blamed) from None
 
 
+def _split_modifications(data: object, source: str, text: str) -> tuple[object, dict[str, dict]]:
+    """`data` without [gear.modifications], and {table name: table} of its common, .left and .right tables."""
+    if not isinstance(data, dict) or not isinstance(data.get("gear"), dict) or "modifications" not in data["gear"]:
+        return data, {}
+    gear = dict(data["gear"])
+    common = gear.pop("modifications")
+    name = "gear.modifications"
+    if not isinstance(common, dict):
+        raise JobFileError(f"{_where(source, text, name)}: [{name}] must be a table")
+    common = dict(common)
+    tables = {name: common}
+    for child, value in common.items():
+        if isinstance(value, dict) and child not in SIDES:
+            raise JobFileError(f"{_where(source, text, f'{name}.{child}')}: unknown section "
+                               f"[{shown_path(f'{name}.{child}', MAX_SHOWN_CHARS)}] (known: [{name}.left], "
+                               f"[{name}.right])")
+    for side in SIDES:
+        if side in common:
+            side_table = common.pop(side)
+            if not isinstance(side_table, dict):
+                raise JobFileError(f"{_where(source, text, f'{name}.{side}')}: [{name}.{side}] must be a table")
+            tables[f"{name}.{side}"] = side_table
+    return {**data, "gear": gear}, tables
+
+
+def _modifications(tables: dict[str, dict], spec: GearSpec, source: str, text: str) -> FlankModifications | None:
+    """Both flank sides' modifications from the [gear.modifications] tables (a side's table overrides the keys it
+    gives), checked against the gear; None when no amount is set. Errors name the key's line in the table that
+    gives it."""
+    if not tables:
+        return None
+    common = _load_section(tables["gear.modifications"], "gear.modifications", source, text, MODIFICATION_SECTIONS)
+    sides = {}
+    for side in SIDES:
+        name = f"gear.modifications.{side}"
+        given = tables.get(name, {})
+        own = _load_section(given, name, source, text, MODIFICATION_SECTIONS)
+        values = {k.name: getattr(own if k.name in given else common, k.name) for k in keys_of(ModificationsSection)}
+        try:
+            sides[side] = flank_modification(values, spec.base_radius_mm, spec.form_radius_mm, spec.tip_radius_mm,
+                                             spec.module_mm, spec.face_width_mm)
+        except GearSpecError as exc:
+            table = name if exc.field in given else "gear.modifications"
+            if table not in tables:
+                table = "gear.modifications"
+            raise JobFileError(f"{_where(source, text, table, exc.field)}: [{table}] {exc}", section=table,
+                               field=exc.field) from None
+    modifications = FlankModifications(**sides)
+    return None if modifications.is_zero else modifications
+
+
 def _job_from_data(data: dict, source: str, text: str, strategies: Strategies = REGISTRY) -> Job:
     """Validate parsed job data; `text` (the file's text, or "") only locates keys for messages."""
+    data, modification_tables = _split_modifications(data, source, text)
     tables, autos = _without_auto(_tables(data, source, text), lambda name, key_name: _where(source, text, name,
                                                                                               key_name))
     types = job_sections(strategies)
@@ -590,6 +699,7 @@ def _job_from_data(data: dict, source: str, text: str, strategies: Strategies = 
         raise JobFileError(f"{where('gear', 'internal')}: internal = true: the rotary table cannot cut an internal "
                            "gear (its tool cannot reach inside the ring along the rotary axis); cut it with [machine] "
                            "axes = 3 or leave out [tools]", section="gear", field="internal")
+    modifications = _modifications(modification_tables, spec, source, text)
     for check, name in ((gear_section.blank_features().validate, "gear"),
                         (sections.get("stock", StockSpec()).validate, "stock")):
         try:
@@ -620,7 +730,8 @@ def _job_from_data(data: dict, source: str, text: str, strategies: Strategies = 
                                                   "export", "lathe", "probe") if name in sections}
     finishing = sections["finishing"] if "finishing" in sections else types["finishing"]()  # the registry's default
     return Job(source=source, job=sections.get("job", JobSection()), gear_section=gear_section, gear=spec,
-               tools=tools, finishing=finishing, **optional, text=text, strategies=dict(strategies))
+               tools=tools, finishing=finishing, **optional, text=text, strategies=dict(strategies),
+               modifications=modifications)
 
 
 def _check_probe(spec: GearSpec, sections: dict, tools: ToolsSection, tables: dict,

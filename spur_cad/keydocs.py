@@ -8,7 +8,7 @@ import re
 import sys
 
 from spur_cad.cam.strategies import REGISTRY, Strategies
-from spur_cad.job import job_sections
+from spur_cad.job import MODIFICATION_SECTIONS, job_sections
 from spur_cad.keys import keys_of, toml_literal
 
 _DOC_INTRO = """\
@@ -108,7 +108,11 @@ def _accepted(k) -> str:
 def job_file_reference_markdown(strategies: Strategies = REGISTRY) -> str:
     """docs/job-file.md: the introduction, one table per section from its key declarations (the [finishing]
     keys from the strategies of `strategies`), the notes."""
-    sections = job_sections(strategies)
+    sections = {}
+    for name, cls in job_sections(strategies).items():
+        sections[name] = cls
+        if name == "gear":  # the flank modification tables follow [gear]
+            sections.update(MODIFICATION_SECTIONS)
     parts = [_DOC_INTRO]
     done: set[type] = set()
     for cls in sections.values():
@@ -117,15 +121,16 @@ def job_file_reference_markdown(strategies: Strategies = REGISTRY) -> str:
         done.add(cls)
         names = [n for n, c in sections.items() if c is cls]
         parts.append(f"## {' / '.join(f'[{n}]' for n in names)}\n\n{_section_summary(cls)}\n")
-        if len(names) > 1:
+        if len(names) > 1 and any("{Role}" in k.label for k in keys_of(cls)):
             roles = " or ".join(n.split(".")[-1].capitalize() for n in names)
             parts.append(f"In the workbench property names, `{{Role}}` is {roles}.\n")
         rows = ["| key | type | unit | default | accepted | meaning | workbench property |",
                 "| --- | --- | --- | --- | --- | --- | --- |"]
         for k in keys_of(cls):
             default = "**required**" if k.required else f"`{toml_literal(k.default)}`"
+            holder = "(job file only)" if cls in MODIFICATION_SECTIONS.values() else f"`{k.label}`"
             rows.append(f"| `{k.name}` | {_TYPE_WORDS[k.type]} | {k.unit or '-'} | {default} | {_accepted(k)} | "
-                        f"{_doc_text(k.meaning)} | `{k.label}` |")
+                        f"{_doc_text(k.meaning)} | {holder} |")
         parts.append("\n".join(rows) + "\n")
     parts.append(_DOC_NOTES)
     return "\n".join(parts)

@@ -35,12 +35,32 @@ if TYPE_CHECKING:
     from spur_cad.sim.simulate import SimResult, StockCylinder
 
 
-def profile_csv(samples: ProfileSamples) -> bytes:
-    """Right half of one tooth space, root (x = 0) to tip, header x_mm,y_mm."""
+def profile_csv(samples: ProfileSamples, unmodified: np.ndarray | None = None) -> bytes:
+    """Right half of one tooth space, root (x = 0) to tip, header x_mm,y_mm. A modified gear's samples come with
+    the `unmodified` design points under them: columns unmodified_x_mm, unmodified_y_mm and removal_um (the
+    distance between the two, positive into the tooth)."""
     buffer = io.StringIO()
-    buffer.write("x_mm,y_mm\n")
-    np.savetxt(buffer, samples.points, fmt="%.9f", delimiter=",")
+    if unmodified is None:
+        buffer.write("x_mm,y_mm\n")
+        np.savetxt(buffer, samples.points, fmt="%.9f", delimiter=",")
+        return buffer.getvalue().encode()
+    away = unmodified - samples.points
+    removal_um = 1000.0 * np.sign(np.einsum("ij,ij->i", away, samples.normals)) * np.hypot(*away.T)
+    buffer.write("x_mm,y_mm,unmodified_x_mm,unmodified_y_mm,removal_um\n")
+    np.savetxt(buffer, np.column_stack([samples.points, unmodified, removal_um]), fmt="%.9f", delimiter=",")
     return buffer.getvalue().encode()
+
+
+def job_profile_csv(job: Job, samples: ProfileSamples) -> bytes:
+    """profile.csv of the job: the design samples, or for a modified gear the right flank's modified profile at
+    mid-face (X = b/2) with the unmodified one beside it."""
+    if job.modifications is None:
+        return profile_csv(samples)
+    from spur_cad.geometry.modifications import modified_tooth_space_profile, sample_modified_profile
+
+    modified = modified_tooth_space_profile(job.gear.tooth_space_profile(), job.modifications.right,
+                                            job.gear.face_width_mm / 2.0)
+    return profile_csv(*sample_modified_profile(modified, job.job.profile_tolerance_mm))
 
 
 def run_job(job: Job, progress: Callable[[str, float], None] | None = None,
@@ -103,7 +123,7 @@ def run_job(job: Job, progress: Callable[[str, float], None] | None = None,
                                                           job.report_template_text, template_source))
     result = dataclasses.replace(result, timings_s=dict(seconds))
     files = {
-        "profile.csv": profile_csv(samples),
+        "profile.csv": job_profile_csv(job, samples),
         "profile.png": png,
         **step,
         **program_files,
@@ -363,7 +383,7 @@ def build_cad(job: Job, checkpoint: Callable[[], None] | None = None,
     )
     from spur_cad.cad.step import step_files
 
-    shape, report = build_gear_shape(job.gear, job.gear_section.blank_features())
+    shape, report = build_gear_shape(job.gear, job.gear_section.blank_features(), modifications=job.modifications)
     if checkpoint is not None:
         checkpoint()
     if job.machine.axes == 3:  # the blank lying flat: a disk of the face width, clamped on its bore
@@ -371,7 +391,10 @@ def build_cad(job: Job, checkpoint: Callable[[], None] | None = None,
     else:
         stock = build_stock_shape(job.gear, job.stock)
     files = step_files(shape, stock, timestamp)
-    gear_volume = front_face_area_mm2(shape) * job.gear.face_width_mm  # exact: a section moved along X
+    if job.modifications is not None and job.modifications.has_lead:  # the section varies along X
+        gear_volume = solid_volume_mm3(shape)
+    else:
+        gear_volume = front_face_area_mm2(shape) * job.gear.face_width_mm  # exact: a section moved along X
     facts = CadResult(report, gear_volume, solid_volume_mm3(stock),
                       {name: len(content) for name, content in files.items()})
     return facts, files
@@ -381,7 +404,8 @@ def cam_inputs(job: Job) -> CamInputs:
     """The part of a job the CAM stage reads."""
     return CamInputs(job.gear, job.stock, job.tools.roughing, job.tools.finishing, job.roughing, job.finishing,
                      job.machine, job.tools.bottom, top_tool=job.tools.roughing_top, strategies=job.strategies,
-                     profile_tolerance_mm=job.job.profile_tolerance_mm, three_axis=job.three_axis)
+                     profile_tolerance_mm=job.job.profile_tolerance_mm, three_axis=job.three_axis,
+                     modifications=job.modifications)
 
 
 def plan_cam(job: Job, checkpoint: Callable[[], None] | None = None) -> CamPlan:
@@ -417,7 +441,7 @@ def simulate_stage(job: Job, plan: CamPlan, progress: Callable[[float], None] | 
         return result
     stations = plan.finishing.result.station_x_mm if plan.finishing is not None else np.zeros(0)
     result = simulate(job.gear, job_stock(job), operations, SimSettings(resolution_mm=job.simulation.resolution_mm),
-                      station_x=stations, progress=progress)
+                      station_x=stations, progress=progress, modifications=job.modifications)
     return dataclasses.replace(result, engagement=roughing_engagement(job, plan))
 
 

@@ -15,7 +15,7 @@ if TYPE_CHECKING:  # annotations only: the CAD kernel and the simulator load whe
     from spur_cad.cad.solid import GearSolidReport
     from spur_cad.cam.estimate import Estimate
     from spur_cad.cam.recommend import ToolRecommendations
-    from spur_cad.geometry.inspection import InspectionSheet
+    from spur_cad.geometry.inspection import InspectionSheet, ModificationInspection
     from spur_cad.geometry.spec import GearFacts
     from spur_cad.grade.grading import Grading
     from spur_cad.sim.budget import BudgetTerms, Deflection
@@ -284,3 +284,4 @@ class JobResult:
     setup: SetupFacts | None = None  # the report's set-up sheet (not in summary.json)
     error_budget: ErrorBudgetFacts | None = None  # the expected grade with the machine's errors (None: no simulation)
     correction: dict | None = None  # spur-cad correct's correction.json when the run is a corrected set (the report)
+    modifications: ModificationInspection | None = None  # the flank modifications on the inspection sheet

@@ -15,7 +15,7 @@ from spur_cad.cam.machine import Machine, RoughingParams
 from spur_cad.cam.plan import CamPlan, FinishingPlan, RoughingPlan
 from spur_cad.cam.recommend import ToolRecommendations
 from spur_cad.cam.tools import Tool
-from spur_cad.geometry.inspection import inspection_facts
+from spur_cad.geometry.inspection import inspection_facts, modification_inspection
 from spur_cad.geometry.sampling import ProfileSamples
 from spur_cad.post.program import PostedProgram
 from spur_cad.post.settings import PostSettings
@@ -60,9 +60,12 @@ def build_result(job, samples: ProfileSamples, cad: CadResult, plan: CamPlan, po
     """The run's typed result (`job` is a spur_cad.job.Job); `files` are added by the pipeline."""
     labels = np.array(samples.label_names())
     counts = SegmentCounts(*(int(np.count_nonzero(labels == name)) for name in SEGMENT_NAMES))
+    inspection = inspection_facts(job.gear)
+    modifications = (None if job.modifications is None
+                     else modification_inspection(job.gear, job.modifications, inspection))
     return JobResult(
         version=__version__, job=JobFacts(job.job.name, job.source), gear=job.gear.facts(),
-        inspection=inspection_facts(job.gear),
+        inspection=inspection, modifications=modifications,
         profile=ProfileFacts(job.job.profile_tolerance_mm, len(samples), counts), cad=cad,
         tools=tools_facts(plan, job.machine, plan.roughing.tool if plan.roughing is not None else job.tools.roughing,
                           job.tools.finishing),
@@ -230,6 +233,15 @@ def simulation_facts(result: SimResult | None, resolution_mm: float) -> Simulati
 # --- the one serialisation ------------------------------------------------------------------------------------
 
 
+def _inspection_json(inspection) -> dict:
+    """The inspection sheet's figures; `pins_between` only for an internal gear (an external gear's summary keeps
+    the keys it had, so scripts and golden files that read it are unchanged)."""
+    facts = dataclasses.asdict(inspection)
+    if not facts.get("pins_between"):
+        facts.pop("pins_between", None)
+    return facts
+
+
 def summary_json(result: JobResult) -> dict:
     """summary.json's content: every key as users' scripts read it."""
     tools = result.tools
@@ -237,7 +249,8 @@ def summary_json(result: JobResult) -> dict:
         "spur_cad_version": result.version,
         "job": {"name": result.job.name, "file": result.job.file},
         "gear": dataclasses.asdict(result.gear),
-        "inspection": dataclasses.asdict(result.inspection),
+        "inspection": _inspection_json(result.inspection),
+        **({"modifications": modifications_json(result.modifications)} if result.modifications is not None else {}),
         "profile": {"tolerance_mm": result.profile.tolerance_mm, "points": result.profile.points,
                     "points_per_segment": dataclasses.asdict(result.profile.points_per_segment)},
         "cad": cad_json(result.cad),
@@ -259,6 +272,16 @@ def summary_json(result: JobResult) -> dict:
         summary["lathe"] = dataclasses.asdict(result.lathe)
     summary["timings_s"] = dict(result.timings_s)
     return summary
+
+
+def modifications_json(facts) -> dict:
+    """summary.json's `modifications` (modified gears only): amounts per side in um, the reliefs' start diameters,
+    the removal at the span and pin contacts and the span the modified gear reads."""
+    return {"amounts_um": {name: {"right": right, "left": left} for name, (right, left) in facts.amounts_um.items()},
+            "tip_relief_start_diameters_mm": list(facts.tip_relief_start_diameters_mm),
+            "root_relief_start_diameters_mm": list(facts.root_relief_start_diameters_mm),
+            "span_removal_um": list(facts.span_removal_um), "pin_removal_um": list(facts.pin_removal_um),
+            "measured_unmodified": facts.measured_unmodified, "span_modified_mm": facts.span_modified_mm}
 
 
 def error_budget_json(budget: ErrorBudgetFacts | None) -> dict | None:

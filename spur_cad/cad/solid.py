@@ -32,7 +32,7 @@ from OCP.BRepBuilderAPI import (
 from OCP.BRepCheck import BRepCheck_Analyzer
 from OCP.BRepGProp import BRepGProp
 from OCP.BRepLib import BRepLib
-from OCP.BRepOffsetAPI import BRepOffsetAPI_MakePipeShell
+from OCP.BRepOffsetAPI import BRepOffsetAPI_MakePipeShell, BRepOffsetAPI_ThruSections
 from OCP.BRepPrimAPI import BRepPrimAPI_MakeBox, BRepPrimAPI_MakeCylinder, BRepPrimAPI_MakePrism
 from OCP.GC import GC_MakeArcOfCircle
 from OCP.GCE2d import GCE2d_MakeSegment
@@ -51,6 +51,7 @@ from OCP.TopoDS import TopoDS, TopoDS_Edge, TopoDS_Shape, TopoDS_Wire
 
 from spur_cad.cad.specs import BlankFeatures, StockSpec
 from spur_cad.errors import ArgumentError, require_instance
+from spur_cad.geometry.modifications import SIDES, FlankModifications, modified_tooth_space_profile
 from spur_cad.geometry.profile import Segment
 from spur_cad.geometry.sampling import segment_parameters
 from spur_cad.geometry.spec import GearSpec
@@ -203,6 +204,82 @@ def gear_face_edges(spec: GearSpec, fit_tolerance_mm: float) -> tuple[list[TopoD
     return edges, report
 
 
+def modified_face_edges(spec: GearSpec, modifications: FlankModifications, x_face_mm: float,
+                        fit_tolerance_mm: float) -> list[TopoDS_Edge]:
+    """Edges of the whole transverse outline of a modified gear at face position X, drawn on the plane X = 0 and
+    not turned by the helix: each flank side moved by its modifications there (spur_cad.geometry.modifications;
+    the left side fitted from its own modified profile and mirrored), the involute split at the reliefs' starts."""
+    profile = spec.tooth_space_profile()
+    halves, tip_angles = {}, {}
+    for side in SIDES:
+        modified = modified_tooth_space_profile(profile, modifications.side(side), x_face_mm)
+        halves[side] = [BRepBuilderAPI_MakeEdge(fit_segment(seg, fit_tolerance_mm).curve).Edge()
+                        for seg in modified.segments if seg.label in ("fillet", "involute") and seg.end > seg.start]
+        tip_angles[side] = modified.segment("tip").start
+    mirror = _mirror_y()
+    space_edges = [_transformed_edge(edge, mirror) for edge in reversed(halves["left"])]
+    v = profile.root_arc_half_angle_rad
+    if v > 0.0:
+        space_edges.append(_arc_edge(spec.root_radius_mm, -v, v))
+    space_edges.extend(halves["right"])
+    pitch = 2.0 * math.pi / spec.teeth
+    space_edges.append(_arc_edge(spec.tip_radius_mm, tip_angles["right"], pitch - tip_angles["left"]))
+    edges: list[TopoDS_Edge] = []
+    for k in range(spec.teeth):
+        rotation = _rotation_about_x(-k * pitch)
+        edges.extend(_transformed_edge(edge, rotation) for edge in space_edges)
+    return edges
+
+
+LOFT_SECTIONS_PER_ZONE = 5
+"""Sections per smooth stretch of the face width in a lead-modified loft (spur gears; helical gears add one per
+degree of helix turn)."""
+
+
+def _section_wire(spec: GearSpec, modifications: FlankModifications, x_mm: float,
+                  fit_tolerance_mm: float) -> TopoDS_Wire:
+    """The modified outline at X as a wire in the plane X, turned with the helix."""
+    trsf = _rotation_about_x(spec.section_turn_rad(x_mm))
+    shift = gp_Trsf()
+    shift.SetTranslation(gp_Vec(x_mm, 0.0, 0.0))
+    trsf.Multiply(shift)
+    wire_maker = BRepBuilderAPI_MakeWire()
+    for edge in modified_face_edges(spec, modifications, x_mm, fit_tolerance_mm):
+        wire_maker.Add(_transformed_edge(edge, trsf))
+    if not wire_maker.IsDone():
+        raise RuntimeError("the modified transverse outline did not close into a wire")
+    return wire_maker.Wire()
+
+
+def _loft_lead_modified(spec: GearSpec, modifications: FlankModifications, fit_tolerance_mm: float) -> TopoDS_Shape:
+    """A gear with lead modifications: B-spline surfaces through modified sections along X (OCP's ThruSections),
+    one loft per smooth stretch of the face width (between the end reliefs' starts), fused."""
+    b = spec.face_width_mm
+    kinks = sorted(set(modifications.right.lead_kinks_mm()) | set(modifications.left.lead_kinks_mm()))
+    bounds = [0.0, *kinks, b]
+    shape = None
+    for x0, x1 in zip(bounds, bounds[1:]):
+        turn_deg = math.degrees(abs(spec.section_turn_rad(x1) - spec.section_turn_rad(x0)))
+        count = LOFT_SECTIONS_PER_ZONE + math.ceil(turn_deg)
+        loft = BRepOffsetAPI_ThruSections(True, False, 1e-7)
+        loft.CheckCompatibility(False)
+        for x in np.linspace(x0, x1, count):
+            loft.AddWire(_section_wire(spec, modifications, float(x), fit_tolerance_mm))
+        loft.Build()
+        if not loft.IsDone():
+            raise RuntimeError("the loft through the modified sections failed")
+        shape = loft.Shape() if shape is None else _fuse(shape, loft.Shape())
+    return shape
+
+
+def _fuse(first: TopoDS_Shape, second: TopoDS_Shape) -> TopoDS_Shape:
+    fuse = BRepAlgoAPI_Fuse(first, second)
+    fuse.Build()
+    if not fuse.IsDone():
+        raise RuntimeError("boolean fuse failed")
+    return fuse.Shape()
+
+
 def _extrude(edges: list[TopoDS_Edge], length: float) -> TopoDS_Shape:
     wire_maker = BRepBuilderAPI_MakeWire()
     for edge in edges:
@@ -273,11 +350,14 @@ def _ring_shape(edges: list[TopoDS_Edge], spec: GearSpec) -> TopoDS_Shape:
 
 
 def build_gear_shape(spec: GearSpec, features: BlankFeatures = BlankFeatures(),
-                     fit_tolerance_mm: float | None = None) -> tuple[TopoDS_Shape, GearSolidReport]:
-    """The gear as an OCP solid in the machine frame, with a report of the spline fits (an internal gear: a ring
-    whose outside is the rim, rim_outer_diameter_mm).
+                     fit_tolerance_mm: float | None = None,
+                     modifications: FlankModifications | None = None) -> tuple[TopoDS_Shape, GearSolidReport]:
+    """The gear as an OCP solid in the machine frame, with a report of the spline fits (the design flanks'; an
+    internal gear: a ring whose outside is the rim, rim_outer_diameter_mm).
 
-    `fit_tolerance_mm` defaults to 2.5e-6 x module (see default_fit_tolerance_mm)."""
+    `fit_tolerance_mm` defaults to 2.5e-6 x module (see default_fit_tolerance_mm). With `modifications` the
+    flanks are the modified ones: profile modifications only, the modified outline extruded or swept as the
+    design's; lead modifications, a loft through modified sections (`_loft_lead_modified`)."""
     require_instance(spec, GearSpec, "spec")
     require_instance(features, BlankFeatures, "features")
     features.validate(spec)
@@ -286,6 +366,12 @@ def build_gear_shape(spec: GearSpec, features: BlankFeatures = BlankFeatures(),
     b = spec.face_width_mm
     if spec.is_internal:
         shape = _ring_shape(edges, spec)
+    elif modifications is not None and not modifications.is_zero:
+        if modifications.has_lead:
+            shape = _loft_lead_modified(spec, modifications, tolerance)
+        else:
+            edges = modified_face_edges(spec, modifications, 0.0, tolerance)
+            shape = _sweep_helical(edges, spec) if spec.is_helical else _extrude(edges, b)
     else:
         shape = _sweep_helical(edges, spec) if spec.is_helical else _extrude(edges, b)
     if features.bore_diameter_mm > 0.0:

@@ -12,20 +12,27 @@ from spur_cad.cam.strategies import (
     get_strategy,
     params_from_section,
 )
-from spur_cad.cam.tools import Tool
+from spur_cad.cam.tools import Tool, ToolError
+from spur_cad.geometry.modifications import FlankModifications
 from spur_cad.geometry.spec import GearSpec
 
 
 def plan_finishing(spec: GearSpec, tool: Tool, machine: Machine, section: FinishingParams,
                    blank_radius_mm: float, strategies: Strategies = REGISTRY,
+                   modifications: FlankModifications | None = None, profile_tolerance_mm: float = 0.001,
                    **overrides) -> tuple[Toolpath, FinishingResult]:
     """Toolpath and result of the strategy named by `section.strategy`, with its parameters taken from
     the section (`overrides` replace some, e.g. the reference process's contact spacing), found in
-    `strategies`."""
+    `strategies`. Flank `modifications` are cut by the generating strategy only (others refuse them)."""
     strategy = get_strategy(section.strategy, strategies)
     params = params_from_section(strategy, section, **overrides)
     strategy.check_tool(spec, tool)
-    return strategy.generate(spec, tool, machine, params, blank_radius_mm)
+    if modifications is None:
+        return strategy.generate(spec, tool, machine, params, blank_radius_mm)
+    if strategy.name != "generating":
+        raise ToolError(f"[finishing] strategy = '{strategy.name}' does not cut flank modifications "
+                        "([gear.modifications]); use strategy = 'generating'", field="strategy", section="finishing")
+    return strategy.generate(spec, tool, machine, params, blank_radius_mm, modifications, profile_tolerance_mm)
 
 
 def finishing_toolpath(spec: GearSpec, tool: Tool, machine: Machine, section: FinishingParams,

@@ -50,6 +50,7 @@ from spur_cad.cam.strategies import (
 from spur_cad.cam.three_axis_tabs import ThreeAxisSection
 from spur_cad.cam.tools import Tool, ToolError
 from spur_cad.errors import SpurCadError, StockError, WorkLimitError, shown
+from spur_cad.geometry.modifications import FlankModifications
 from spur_cad.geometry.outline2d import Arc2D
 from spur_cad.geometry.spec import GearSpec
 
@@ -143,6 +144,7 @@ class CamInputs:
     strategies: Strategies = field(default_factory=lambda: dict(REGISTRY))  # where [finishing] strategy is found
     profile_tolerance_mm: float = 0.001  # [job] profile_tolerance_mm: the 3-axis finishing arcs' chordal tolerance
     three_axis: ThreeAxisSection = field(default_factory=ThreeAxisSection)  # [three_axis]: tabs or an onion skin
+    modifications: FlankModifications | None = None  # [gear.modifications]: cut by generating finishing
 
 
 def check_cam_inputs(inputs: CamInputs) -> tuple[ToolRecommendations, RoughingLevels | None]:
@@ -551,7 +553,8 @@ def check_finishing_work(spec: GearSpec, tool: Tool, machine: Machine, section: 
 
 def _plan_finishing(inputs: CamInputs, blank: float, check: Callable[[], None]) -> FinishingPlan:
     spec, tool, machine = inputs.spec, inputs.finishing_tool, inputs.machine
-    path, result = plan_finishing(spec, tool, machine, inputs.finishing, blank, inputs.strategies)
+    path, result = plan_finishing(spec, tool, machine, inputs.finishing, blank, inputs.strategies,
+                                  inputs.modifications, inputs.profile_tolerance_mm)
     check_travel(machine, path.x, path.y, path.z, path.a, "finishing")
     own = estimate(path, machine)
     check()

@@ -10,11 +10,17 @@ from __future__ import annotations
 import dataclasses
 import math
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
+
+import numpy as np
 
 from spur_cad.errors import require_instance
 from spur_cad.geometry.internal import InternalGearSpec
 from spur_cad.geometry.involute import inverse_involute_function, involute_function
 from spur_cad.geometry.spec import GearSpec
+
+if TYPE_CHECKING:
+    from spur_cad.geometry.modifications import FlankModifications
 
 PIN_DIAMETER_STEP_MM = 0.01  # gauge pins are stocked in 0.01 mm steps
 
@@ -268,3 +274,64 @@ def inspection_facts(spec: GearSpec) -> InspectionSheet:
 def inspection_sheet(spec: GearSpec) -> dict[str, float | int | None]:
     """`inspection_facts` as a dict (for scripts: summary.json's `inspection`)."""
     return dataclasses.asdict(inspection_facts(spec))
+
+
+MODIFICATION_NAMES = (  # (FlankModification field, ISO 21771 name as the sheet shows it)
+    ("tip_relief_mm", "tip relief C_a"), ("root_relief_mm", "root relief C_f"),
+    ("profile_crowning_mm", "profile crowning C_alpha"), ("profile_slope_mm", "profile slope f_Halpha"),
+    ("lead_crowning_mm", "lead crowning C_beta"), ("front_end_relief_mm", "end relief C_I (front face)"),
+    ("back_end_relief_mm", "end relief C_II (back face)"), ("helix_slope_mm", "helix slope f_Hbeta"),
+)
+UNMODIFIED_WITHIN_UM = 0.05
+"""A contact whose removal is within this counts as on the unmodified flank."""
+
+
+@dataclass(frozen=True)
+class ModificationInspection:
+    """The flank modifications as the inspection sheet lists them ({ISO name: (right, left) in um}, with the
+    reliefs' start diameters) and the removal where the span anvils and the pins (balls) touch each flank (um,
+    transverse; the anvils and pins of a spur gear rest on the least-removed point along the face, a helical
+    gear's are taken at mid-face); `span_modified_mm`: the span the modified gear reads (None: no span)."""
+
+    amounts_um: dict[str, tuple[float, float]]
+    tip_relief_start_diameters_mm: tuple[float, float]
+    root_relief_start_diameters_mm: tuple[float, float]
+    span_removal_um: tuple[float, float]
+    pin_removal_um: tuple[float, float]
+    span_modified_mm: float | None
+
+    @property
+    def measured_unmodified(self) -> bool:
+        """The span and pin contacts lie where every flank is unmodified (within UNMODIFIED_WITHIN_UM)."""
+        return max(map(abs, (*self.span_removal_um, *self.pin_removal_um))) <= UNMODIFIED_WITHIN_UM
+
+
+def modification_inspection(spec: GearSpec, mods: FlankModifications, sheet: InspectionSheet) -> ModificationInspection:
+    """What the inspection sheet says about `spec`'s flank modifications: their amounts, and whether the span and
+    pin measurements of `sheet` are taken where the flanks are unmodified (else how much they read less)."""
+    sides = (mods.right, mods.left)
+    amounts = {name: tuple(1000.0 * getattr(side, attr) for side in sides) for attr, name in MODIFICATION_NAMES
+               if any(getattr(side, attr) for side in sides)}
+
+    def diameter(roll_mm: float) -> float:
+        return 2.0 * math.hypot(spec.base_radius_mm, roll_mm) if roll_mm else 0.0
+
+    along_face = np.linspace(0.0, spec.face_width_mm, 401)
+
+    def removal_um(contact_radius_mm: float) -> tuple[float, float]:
+        roll = math.sqrt(max(contact_radius_mm**2 - spec.base_radius_mm**2, 0.0))
+        found = []
+        for side in sides:
+            lead = side.lead_offset_mm(spec.face_width_mm / 2.0) if spec.is_helical else side.lead_offset_mm(
+                along_face).min()
+            found.append(1000.0 * float(side.profile_offset_mm(roll) + lead))
+        return found[0], found[1]
+
+    span = removal_um(sheet.span_contact_radius_mm)
+    factor = math.cos(spec.base_helix_angle_rad)  # transverse removal -> the normal-section span
+    span_modified = (None if sheet.span_measurement_mm is None
+                     else sheet.span_measurement_mm - (span[0] + span[1]) / 1000.0 * factor)
+    return ModificationInspection(
+        amounts_um=amounts, tip_relief_start_diameters_mm=tuple(diameter(s.tip_relief_start_roll_mm) for s in sides),
+        root_relief_start_diameters_mm=tuple(diameter(s.root_relief_start_roll_mm) for s in sides),
+        span_removal_um=span, pin_removal_um=removal_um(sheet.pin_contact_radius_mm), span_modified_mm=span_modified)

@@ -28,7 +28,7 @@ from scipy.optimize import brentq
 
 from spur_cad.errors import GearSpecError
 from spur_cad.geometry.involute import inverse_involute_function, involute_function
-from spur_cad.geometry.profile import Involute, ToothSpaceProfile
+from spur_cad.geometry.profile import CircularArc, Involute, ToothSpaceProfile
 from spur_cad.geometry.spec import MIN_TEETH, GearSpec, _range_check
 
 MIN_RIM_MODULES = 2.0
@@ -36,31 +36,15 @@ MIN_RIM_MODULES = 2.0
 
 
 @dataclass(frozen=True)
-class RingArc:
-    """Arc about the gear axis bounding the ring's material from inside (root or tip), polar angles `start` to
-    `end` clockwise. The space (or bore) lies toward the axis: normals point inward, material concave (+R)."""
-
-    label: str
-    radius_mm: float
-    start: float
-    end: float
-
-    def points(self, theta: np.ndarray) -> np.ndarray:
-        theta = np.asarray(theta, dtype=float)
-        return np.stack([self.radius_mm * np.sin(theta), self.radius_mm * np.cos(theta)], axis=-1)
+class RingArc(CircularArc):
+    """profile.CircularArc bounding the ring's material from inside (root or tip), polar angles `start` to `end`
+    clockwise. The space (or bore) lies toward the axis: normals point inward, material concave (+R)."""
 
     def normals(self, theta: np.ndarray) -> np.ndarray:
-        theta = np.asarray(theta, dtype=float)
-        return -np.stack([np.sin(theta), np.cos(theta)], axis=-1)
+        return -super().normals(theta)
 
     def curvature_radii(self, theta: np.ndarray) -> np.ndarray:
-        return np.full(np.shape(theta), self.radius_mm)
-
-    def chord_error_bound(self, a: np.ndarray, b: np.ndarray) -> np.ndarray:
-        return self.radius_mm * (1.0 - np.cos(np.abs(b - a) / 2.0))
-
-    def arc_length_bound(self, a: np.ndarray, b: np.ndarray) -> np.ndarray:
-        return self.radius_mm * np.abs(b - a)
+        return -super().curvature_radii(theta)
 
 
 @dataclass(frozen=True)

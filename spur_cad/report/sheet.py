@@ -346,7 +346,33 @@ def inspection_rows(result: JobResult) -> tuple[Row, ...]:
                 Row(f"at chordal height from the tip circle (measuring radius "
                     f"{number(ins.chordal_measuring_radius_mm, 3)} mm)", number(ins.chordal_height_mm, 4), "mm"),
                 *rows[7:-1]]
+    if result.modifications is not None:
+        rows.extend(modification_rows(result))
     return tuple(rows)
+
+
+def modification_rows(result: JobResult) -> list[Row]:
+    """The flank modifications (right / left flank, ISO 21771 names) and where span and pins touch them."""
+    mods = result.modifications
+
+    def pair(values: tuple[float, float], digits: int) -> str:
+        return f"{number(values[0], digits)} / {number(values[1], digits)}"
+
+    rows = [Row(f"flank modification {name} (right / left)", pair(amounts, 1), MICRO)
+            for name, amounts in mods.amounts_um.items()]
+    for kind, diameters in (("tip", mods.tip_relief_start_diameters_mm), ("root", mods.root_relief_start_diameters_mm)):
+        if any(diameters):
+            rows.append(Row(f"{kind} relief starts at diameter (right / left)", pair(diameters, 3), "mm"))
+    if mods.measured_unmodified:
+        rows.append(Row("span and pins", "measured where the flanks are unmodified (outside every relief)"))
+        return rows
+    rows.append(Row("warning: the span anvils touch modified flanks, removal (right / left)",
+                    pair(mods.span_removal_um, 1), MICRO))
+    if mods.span_modified_mm is not None:
+        rows.append(Row("span measurement the modified gear reads", number(mods.span_modified_mm, 4), "mm"))
+    rows.append(Row("warning: the pins (balls) touch modified flanks, removal (right / left)",
+                    pair(mods.pin_removal_um, 1), MICRO))
+    return rows
 
 
 def expected_tolerance(result: JobResult) -> str | None:

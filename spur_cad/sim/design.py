@@ -126,3 +126,50 @@ def design_grid(spec: GearSpec, spacing_mm: float, x_min: float, x_max: float,
     rows, width = row_positions(x_min, x_max, spacing_mm, extra_rows, spec.face_width_mm)
     return DesignGrid(spec.teeth, points, normals, feature.astype(np.int8), side.astype(np.int8), arc, rows, width,
                       spacing_mm, spec.section_turn_rad(1.0))
+
+
+def space_parameters(profile: ToothSpaceProfile, spacing_mm: float) -> np.ndarray:
+    """Each `sample_space` point's parameter on its segment (same order: right tooth centre -> left)."""
+    params = []
+    for segment in profile.segments:
+        if segment.end <= segment.start:
+            continue
+        values = even_arc_length_parameters(segment, spacing_mm)
+        params.append(values[1:] if params else values)
+    right = np.concatenate(params)
+    return np.concatenate([right[::-1], right[1:]])[:-1]
+
+
+def modification_removal_mm(spec: GearSpec, grid: DesignGrid, mods) -> np.ndarray:
+    """(M, rows) material the flank modifications remove at each design point of `grid` along its normal (mm,
+    positive into the material): involute points by the removal itself, fillet points by the form point's removal
+    faded as (beta / beta_F)^2 along the form normal (as the B-rep), tip-land points near the tooth corner by their
+    depth above the relieved flank, root points not at all. A cut's deviation from the modified design is the
+    deviation from the design plus this."""
+    from spur_cad.geometry.modifications import normal_offset_mm
+
+    profile = spec.tooth_space_profile()
+    involute, fillet = profile.segment("involute"), profile.segment("fillet")
+    rb = spec.base_radius_mm
+    params = space_parameters(profile, grid.spacing_mm)
+    label = np.array(FEATURES)[grid.feature]
+    x = grid.rows_x[None, :]
+    removal = np.zeros((len(grid.points), len(grid.rows_x)))
+    form_normal = involute.normals(np.array(involute.start))
+    tip_point, tip_normal = involute.points(np.array(involute.end)), involute.normals(np.array(involute.end))
+    for side, name in ((RIGHT, "right"), (LEFT, "left")):
+        mirror = np.array([1.0, 1.0]) if side == RIGHT else np.array([-1.0, 1.0])
+        here = grid.side == side
+        flank = (label == "involute") & here
+        removal[flank] = normal_offset_mm(mods, name, rb * params[flank][:, None], x)
+        if fillet is not None and fillet.end > 0.0:
+            near = (label == "fillet") & here
+            form = normal_offset_mm(mods, name, rb * involute.start, x)
+            along = grid.normals[near] @ (form_normal * mirror)
+            removal[near] = form * ((params[near] / fillet.end) ** 2 * along)[:, None]
+        land = (label == "tip") & here
+        edge = tip_point * mirror - normal_offset_mm(mods, name, rb * involute.end, x)[..., None] * tip_normal * mirror
+        reach = ((grid.points[land][:, None, :] - edge) * tip_normal * mirror).sum(axis=-1)
+        removal[land] = np.maximum(reach / (grid.normals[land] @ (tip_normal * mirror))[:, None], 0.0)
+    return removal
+

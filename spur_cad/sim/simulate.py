@@ -19,7 +19,7 @@ import math
 import os
 import time
 from concurrent.futures import ThreadPoolExecutor
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import TYPE_CHECKING, Callable, Sequence
 
 import numpy as np
@@ -28,9 +28,10 @@ from spur_cad.cam.ir import Feature, MoveKind, Toolpath
 from spur_cad.cam.tools import Tool
 from spur_cad.errors import SpurCadError
 from spur_cad.geometry.spec import GearSpec
-from spur_cad.sim.design import DesignGrid, design_grid
+from spur_cad.sim.design import DesignGrid, design_grid, modification_removal_mm
 
 if TYPE_CHECKING:  # numba loads with the kernels, when a simulation runs
+    from spur_cad.geometry.modifications import FlankModifications
     from spur_cad.sim.engagement import Engagement
 
 CHUNK_POINTS = 4
@@ -297,8 +298,10 @@ def section_areas(grid: DesignGrid, h: np.ndarray) -> np.ndarray:
 def simulate(spec: GearSpec, stock: StockCylinder, operations: Sequence[Cut],
              settings: SimSettings = SimSettings(), *, station_x: np.ndarray | None = None,
              rows_x_range: tuple[float, float] | None = None,
-             progress: Callable[[float], None] | None = None, threads: int | None = None) -> SimResult:
-    """Cut the stock with every operation in order and measure the result against the design.
+             progress: Callable[[float], None] | None = None, threads: int | None = None,
+             modifications: FlankModifications | None = None) -> SimResult:
+    """Cut the stock with every operation in order and measure the result against the design (the modified
+    design when `modifications` are given: the deviations then read from the modified flanks).
 
     `station_x`: finishing station positions (rows are added there and halfway between them, where
     the scallop ridges stand). `rows_x_range` limits the rows (default: the stock's X extent). `threads`: see
@@ -314,8 +317,11 @@ def simulate(spec: GearSpec, stock: StockCylinder, operations: Sequence[Cut],
     x_lo, x_hi = rows_x_range if rows_x_range is not None else (stock.x_min, stock.x_max)
     check_design_size(spec, spacing, x_hi - x_lo, len(extra), settings.resolution_mm)
     grid = design_grid(spec, spacing, x_lo, x_hi, extra)
-    return simulate_grid(grid, stock, operations, settings, face_width_mm=spec.face_width_mm, station_x=stations,
-                         progress=progress, started=started, threads=threads)
+    result = simulate_grid(grid, stock, operations, settings, face_width_mm=spec.face_width_mm, station_x=stations,
+                           progress=progress, started=started, threads=threads)
+    if modifications is None:
+        return result
+    return replace(result, deviation=result.deviation + modification_removal_mm(spec, grid, modifications)[None])
 
 
 MAX_DESIGN_VALUES = 60_000_000

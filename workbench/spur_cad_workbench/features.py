@@ -228,7 +228,7 @@ class GearFeature(_Proxy):
 
         try:
             job = job_of(obj)
-            shape, _ = build_gear_shape(job.gear, job.gear_section.blank_features())
+            shape, _ = build_gear_shape(job.gear, job.gear_section.blank_features(), modifications=job.modifications)
         except SpurCadError as exc:
             fail(obj, exc)
             return

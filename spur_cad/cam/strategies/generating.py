@@ -8,7 +8,7 @@ generating_advice.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -32,8 +32,10 @@ from spur_cad.cam.strategies.generating_geometry import (
     land_angles,
     rough_passes_per_space,
 )
+from spur_cad.cam.strategies.generating_modified import modified_passes
 from spur_cad.cam.strategies.generating_plan import GeneratingParams, GeneratingPlan, plan_generating
 from spur_cad.cam.tools import Tool, ToolError
+from spur_cad.geometry.modifications import FlankModifications
 from spur_cad.geometry.profile import rack_corner
 from spur_cad.geometry.spec import GearSpec
 
@@ -126,10 +128,16 @@ class GeneratingStrategy:
         return spec.teeth * MOVES_PER_PASS * plan.passes_per_space
 
     def generate(self, spec: GearSpec, tool: Tool, machine: Machine, params: GeneratingParams,
-                 blank_radius_mm: float) -> tuple[Toolpath, FinishingResult]:
+                 blank_radius_mm: float, modifications: FlankModifications | None = None,
+                 profile_tolerance_mm: float = 0.001) -> tuple[Toolpath, FinishingResult]:
+        """The passes planned for the design, moved onto the modified flanks when `modifications` are given
+        (generating_modified; their offsets along X as lines within `profile_tolerance_mm`)."""
         params.validate()
         machine.validate()
         plan = plan_generating(spec, tool, params, lands=blank_radius_mm > spec.tip_radius_mm + LAND_ALLOWANCE_MM)
+        if modifications is not None:
+            plan = replace(plan, passes=modified_passes(spec, tool, plan.passes, modifications,
+                                                                profile_tolerance_mm))
         toolpath = passes_toolpath(spec, tool, machine, params, plan.passes, blank_radius_mm)
         advice = tool_advice(spec, tool, params, plan, blank_radius_mm)
         if tool.flute_length_mm and tool.flute_length_mm < advice.required_flute_length_mm:
@@ -154,6 +162,12 @@ def passes_toolpath(spec: GearSpec, tool: Tool, machine: Machine, params: Genera
     return builder.build()
 
 
+def _path_offset(p: GeneratingPass, x: float, y: float, z: float) -> tuple[float, float]:
+    """(Y, Z) of the pass line at X moved by its modification offset there (held beyond the path's ends)."""
+    xs = [q[0] for q in p.path]
+    return (y + float(np.interp(x, xs, [q[1] for q in p.path])), z + float(np.interp(x, xs, [q[2] for q in p.path])))
+
+
 def _passes(builder: ToolpathBuilder, spec: GearSpec, tool: Tool, machine: Machine, passes: tuple[GeneratingPass, ...],
             params: GeneratingParams, safe_z: float) -> None:
     """Every space runs the same passes relative to its base angle -k * 360/z (foldable)."""
@@ -173,7 +187,12 @@ def _passes(builder: ToolpathBuilder, spec: GearSpec, tool: Tool, machine: Machi
             rows.append((MoveKind.CLAMP_ROTARY, x0, y0, safe_z, p.a_deg, math.nan, Feature.NONE))
         if machine.clearance_mm > 0.0:
             rows.append((MoveKind.LINEAR, x0, y0, z0 + machine.clearance_mm, p.a_deg, fast, Feature.NONE))
+        if p.path:  # a modified flank: the line moved by the offsets at the breakpoints, in travel order
+            (y0, z0), (y1, z1) = _path_offset(p, x0, y0, z0), _path_offset(p, x1, y1, z1)
         rows.append((MoveKind.LINEAR, x0, y0, z0, p.a_deg, PLUNGE_FEED_FRACTION * feed, Feature.NONE))
+        for xb, dyb, dzb in (p.path if direction > 0 else p.path[::-1]) if len(p.path) > 1 else ():
+            rows.append((MoveKind.LINEAR, xb, p.y_mm + xb * p.dy_per_x + dyb, p.z_mm + xb * p.dz_per_x + dzb,
+                         p.a_deg, feed, p.feature))
         rows.append((MoveKind.LINEAR, x1, y1, z1, p.a_deg, feed, p.feature))
         rows.append((MoveKind.LINEAR, x1, y1, safe_z, p.a_deg, fast, Feature.NONE))
         if clamp:

@@ -147,6 +147,7 @@ class GeneratingPass:
     contact_radius_mm: float
     dy_per_x: float = 0.0  # helical gears: the pass runs along the rack tooth, Y = y_mm + X dy_per_x
     dz_per_x: float = 0.0  # and Z = z_mm + X dz_per_x (y_mm, z_mm at X = 0)
+    path: tuple = ()  # modified flanks: ((X, dY, dZ), ...) added to that line, ascending X, held beyond the ends
 
 
 def flank_rolls(spec: GearSpec, target_mm: float) -> tuple[np.ndarray, float]:

@@ -1,0 +1,138 @@
+"""Generating finishing of modified flanks (issue 31.3, docs/cam.md "Flank modifications"): the planned passes of
+the design moved by the removal spur_cad.geometry.modifications gives, each pass a polyline along X.
+
+- **Flank mode.** A pass at involute roll t keeps its A (clamped, the design's tangent direction) and moves along
+  its flank normal (machine Y: +Y into the tooth on the right flank, -Y on the left) by the removal its straight
+  side must make to touch the modified flank: the design tangent line's support, I(t).n(t) - max_L Q(L).n(t),
+  over dense points Q of the modified involute (exact at the reliefs' kinks, where the modified flank is convex),
+  plus the lead modifications at the face position X. A helical pass touches section X at the effective roll
+  t_e = t - side (dY/dX) X / r_b, so even a profile modification makes its offset vary along X.
+  Spur flank passes take the "raised" tool end (never lower than the planned one): a rack-end corner moved with
+  its flank into the tooth would reach into the fillet, which moves less (found in the simulation: 6 um).
+- **Tip mode.** The modified fillet is the design fillet moved by the form point's removal faded as
+  (beta / beta_F)^2 along the form point's normal (spur_cad.geometry.modifications.modified_tooth_space_profile);
+  each fillet pass moves with its contact point. Root passes are not moved (the root is not modified). Helical
+  gears: only modifications that leave the form point where it is (tip relief, a profile crowning or slope
+  balanced to zero there is not checked for) are cut; others are refused.
+- The offset along X is sampled every `X_SAMPLE_MM` over the face and reduced to the fewest breakpoints whose
+  lines stay within the chordal tolerance ([job] profile_tolerance_mm); outside the face the end values hold.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import replace
+
+import numpy as np
+
+from spur_cad.cam.strategies.generating_geometry import GeneratingPass, flank_poses
+from spur_cad.cam.tools import Tool, ToolError
+from spur_cad.geometry.frames import turn_points
+from spur_cad.geometry.modifications import FlankModifications
+from spur_cad.geometry.spec import GearSpec
+
+X_SAMPLE_MM = 0.02
+"""Face positions the removal is evaluated at before the chordal reduction."""
+_FLANK_SAMPLES = 4001
+
+
+def simplify_polyline(x: np.ndarray, y: np.ndarray, tolerance_mm: float) -> np.ndarray:
+    """Indices of the fewest points (Douglas-Peucker) whose chords stay within `tolerance_mm` of every sample."""
+    keep = {0, len(x) - 1}
+    stack = [(0, len(x) - 1)]
+    while stack:
+        i, j = stack.pop()
+        if j <= i + 1:
+            continue
+        chord = y[i] + (y[j] - y[i]) * (x[i + 1:j] - x[i]) / (x[j] - x[i])
+        error = np.abs(y[i + 1:j] - chord)
+        k = int(np.argmax(error))
+        if error[k] > tolerance_mm:
+            m = i + 1 + k
+            keep.add(m)
+            stack += [(i, m), (m, j)]
+    return np.array(sorted(keep))
+
+
+class FlankSupport:
+    """The removal a straight flank pass at design roll t makes to touch one side's modified flank (no lead)."""
+
+    def __init__(self, spec: GearSpec, mods: FlankModifications, side: str):
+        involute = spec.tooth_space_profile().segment("involute")
+        flank = mods.side(side)
+        self.rb = spec.base_radius_mm
+        t = np.linspace(involute.start, involute.end, _FLANK_SAMPLES)
+        normals = involute.normals(t)
+        self.points = involute.points(t) - flank.profile_offset_mm(self.rb * t)[:, None] * normals
+        self.involute = involute
+
+    def removal_mm(self, rolls: np.ndarray) -> np.ndarray:
+        """I(t).n(t) - max over the modified flank of Q.n(t), for design rolls t (vectorised)."""
+        rolls = np.atleast_1d(np.asarray(rolls, float))
+        normals = self.involute.normals(rolls)
+        design = (self.involute.points(rolls) * normals).sum(axis=1)
+        support = (self.points @ normals.T).max(axis=0)
+        return design - support
+
+
+def _face_samples(spec: GearSpec) -> np.ndarray:
+    b = spec.face_width_mm
+    return np.linspace(0.0, b, max(2, math.ceil(b / X_SAMPLE_MM) + 1))
+
+
+def _path(x: np.ndarray, dy: np.ndarray, dz: np.ndarray, tolerance_mm: float) -> tuple:
+    """((x, dy, dz), ...) breakpoints of the offsets along X within the tolerance (constant: one point)."""
+    if np.ptp(dy) <= tolerance_mm and np.ptp(dz) <= tolerance_mm:
+        mid = len(x) // 2
+        return ((float(x[mid]), float(dy[mid]), float(dz[mid])),)
+    keep = np.union1d(simplify_polyline(x, dy, tolerance_mm), simplify_polyline(x, dz, tolerance_mm))
+    return tuple((float(x[i]), float(dy[i]), float(dz[i])) for i in keep)
+
+
+def _raised_ends(spec: GearSpec, tool: Tool, passes: tuple[GeneratingPass, ...]) -> dict:
+    """{(side, roll): Z} of the spur flank passes with the "raised" end: a rack-end corner moved into the tooth with
+    its flank would reach into the fillet, a raised one stays above the lower neighbour's flat."""
+    rolls = np.array(sorted({p.roll_rad for p in passes if p.mode == "flank"}))
+    if len(rolls) == 0:
+        return {}
+    z = flank_poses(spec, tool, rolls, "raised")[2]
+    return {(side, float(t)): float(zi) for side in (1, -1) for t, zi in zip(rolls, z)}
+
+
+def modified_passes(spec: GearSpec, tool: Tool, passes: tuple[GeneratingPass, ...], mods: FlankModifications,
+                    tolerance_mm: float) -> tuple[GeneratingPass, ...]:
+    """`passes` (one space's, planned for the design) moved onto the modified flanks (see the module docstring)."""
+    profile = spec.tooth_space_profile()
+    fillet = profile.segment("fillet")
+    involute = profile.segment("involute")
+    x = _face_samples(spec)
+    supports = {+1: FlankSupport(spec, mods, "right"), -1: FlankSupport(spec, mods, "left")}
+    sides = {+1: mods.right, -1: mods.left}
+    form_normal = involute.normals(np.array(involute.start))
+    form_removal = {s: float(sides[s].profile_offset_mm(spec.base_radius_mm * involute.start)) for s in sides}
+    if spec.is_helical and any(abs(form_removal[s]) > 1e-9 or sides[s].has_lead for s in sides):
+        raise ToolError("generating finishing of a helical gear cuts only flank modifications that leave the form "
+                        "circle unmoved (tip relief); root relief, profile crowning or slope and lead modifications "
+                        "would move the fillet, which helical tip mode does not follow yet",
+                        section="gear.modifications")
+    raised = {} if spec.is_helical else _raised_ends(spec, tool, passes)
+    out = []
+    for p in passes:
+        side = p.side
+        lead = sides[side].lead_offset_mm(x)
+        if p.mode == "flank":
+            rolls = p.roll_rad - side * p.dy_per_x * x / spec.base_radius_mm
+            removal = supports[side].removal_mm(rolls) + lead
+            dy, dz = side * removal, np.zeros_like(x)
+        elif p.mode == "tip" and not math.isnan(p.beta_rad) and fillet is not None and fillet.end > 0.0:
+            fade = (p.beta_rad / fillet.end) ** 2
+            removal = (form_removal[side] + lead) * fade
+            normal = form_normal * np.array([1.0 if side > 0 else -1.0, 1.0])
+            moved = -removal[:, None] * turn_points(normal[None, :], math.radians(p.a_deg))[0][None, :]
+            dy, dz = moved[:, 0], moved[:, 1]
+        else:
+            out.append(p)
+            continue
+        out.append(replace(p, z_mm=max(p.z_mm, raised.get((p.side, p.roll_rad), p.z_mm)) if p.mode == "flank"
+                           else p.z_mm, path=_path(x, dy, dz, tolerance_mm)))
+    return tuple(out)

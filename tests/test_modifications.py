@@ -1,0 +1,237 @@
+"""Flank modifications (issue 31): the job file's [gear.modifications], the removal they define, profile.csv, and
+the STEP solid sectioned at three X positions against the design involute moved by the modification (computed
+here from the job's numbers, not by spur_cad.geometry.modifications)."""
+
+from __future__ import annotations
+
+import csv
+import io
+import math
+
+import numpy as np
+import pytest
+
+from spur_cad.errors import JobFileError
+from spur_cad.geometry.modifications import normal_offset_mm, roll_length_mm
+from spur_cad.geometry.sampling import sample_profile
+from spur_cad.job import parse_job
+from spur_cad.pipeline import job_profile_csv
+
+GEAR = "[gear]\nteeth = 23\nmodule_mm = 4.0\nface_width_mm = 20\nrack_tip_radius_mm = 1.52\n"
+SPUR = GEAR + ("[gear.modifications]\ntip_relief_um = 15\ntip_relief_start_diameter_mm = 98\n"
+               "lead_crowning_um = 10\n")
+HELICAL = GEAR + "helix_angle_deg = 15\n" + ("[gear.modifications]\ntip_relief_um = 12\n"
+                                           "tip_relief_start_diameter_mm = 97.5\n")
+
+
+def test_an_unmodified_job_has_no_modifications_and_the_old_profile_csv():
+    job = parse_job(GEAR + "[gear.modifications]\ntip_relief_start_diameter_mm = 98\n", "f.toml")
+    assert job.modifications is None
+    text = job_profile_csv(job, sample_profile(job.gear.tooth_space_profile(), 0.001)).decode()
+    assert text.splitlines()[0] == "x_mm,y_mm"
+
+
+def test_side_tables_override_the_common_one():
+    job = parse_job(SPUR + "[gear.modifications.left]\ntip_relief_um = 5\nhelix_slope_um = -4\n", "f.toml")
+    right, left = job.modifications.right, job.modifications.left
+    assert (right.tip_relief_mm, left.tip_relief_mm) == (0.015, 0.005)
+    assert (right.helix_slope_mm, left.helix_slope_mm) == (0.0, -0.004)
+    assert right.lead_crowning_mm == left.lead_crowning_mm == 0.010
+    assert right.tip_relief_start_roll_mm == left.tip_relief_start_roll_mm
+
+
+@pytest.mark.parametrize("extra, line, words", [
+    ("tip_relief_um = 15\n", 6, "[gear.modifications] tip_relief_start_diameter_mm = 0 must lie on the usable "
+                                "involute"),
+    ("tip_relief_um = 401\ntip_relief_start_diameter_mm = 98\n", 7, "tip_relief_um = 401 um is beyond 10 % of the "
+                                                                  "module (400 um)"),
+    ("lead_crowning_um = -1\n", 7, "[gear.modifications] lead_crowning_um must be in [0, 10000] um, got -1"),
+    ("profile_slope_um = nan\n", 7, "profile_slope_um must be a finite number, got nan"),
+    ("tip_relief_um = 10\ntip_relief_start_diameter_mm = 92\nroot_relief_um = 5\nroot_relief_start_diameter_mm = 95\n",
+     10, "overlap: together they are longer than the usable involute"),
+    ("end_relief_um = 5\nend_relief_length_mm = 10.5\n", 8, "end_relief_length_mm = 10.5 must be above 0"),
+    ("tip_relief_shape = \"round\"\n", 7, "tip_relief_shape must be 'linear' or 'parabolic'"),
+    ("tip_relief_um = 5\ntip_relief_start_diameter_mm = 98\n[gear.modifications.right]\n"
+     "tip_relief_start_diameter_mm = 101\n", 10, "[gear.modifications.right] tip_relief_start_diameter_mm = 101 must "
+                                                 "lie on the usable involute, between the form diameter"),
+])
+def test_errors_name_the_key_and_its_line(extra, line, words):
+    with pytest.raises(JobFileError) as info:
+        parse_job(GEAR + "[gear.modifications]\n" + extra, "f.toml")
+    message = str(info.value)
+    assert message.startswith(f"f.toml:{line}: "), message
+    assert words in message, message
+    assert "\n" not in message
+
+
+def test_removal_follows_the_iso_21771_definitions():
+    job = parse_job(GEAR + "[gear.modifications]\ntip_relief_um = 15\ntip_relief_start_diameter_mm = 98\n"
+                           "tip_relief_shape = \"parabolic\"\nlead_crowning_um = 10\nprofile_slope_um = 4\n"
+                           "end_relief_um = 6\nend_relief_length_mm = 2\nend_relief_faces = \"front\"\n", "f.toml")
+    spec, mods = job.gear, job.modifications
+    rb = spec.base_radius_mm
+    l_form, l_tip = roll_length_mm(rb, 2 * spec.form_radius_mm), roll_length_mm(rb, 2 * spec.tip_radius_mm)
+    l_start, l_mid = roll_length_mm(rb, 98.0), (l_form + l_tip) / 2
+
+    def removal_um(roll, x):
+        return 1000 * float(normal_offset_mm(mods, "right", roll, x))
+
+    assert removal_um(l_mid, 10.0) == pytest.approx(0.0, abs=1e-12)  # mid-profile, mid-face: nothing
+    assert removal_um(l_tip, 10.0) - removal_um(l_start, 10.0) == pytest.approx(15.0 - 4 * (l_tip - l_start)
+                                                                                 / (l_tip - l_form))
+    halfway = (l_start + l_tip) / 2
+    slope_there = -4 * (halfway - l_mid) / (l_tip - l_form)
+    assert removal_um(halfway, 10.0) == pytest.approx(15.0 / 4 + slope_there)  # parabolic: a quarter halfway
+    assert removal_um(l_form, 10.0) - removal_um(l_tip, 10.0) == pytest.approx(4.0 - 15.0)  # f_Halpha = 4 um
+    assert removal_um(l_mid, 20.0) == pytest.approx(10.0)  # C_beta at the back face
+    assert removal_um(l_mid, 0.0) == pytest.approx(10.0 + 6.0)  # and the front face's end relief
+    assert removal_um(l_mid, 1.0) == pytest.approx(10.0 * 0.81 + 3.0)
+    grid = normal_offset_mm(mods, "right", np.linspace(l_form, l_tip, 7)[:, None], np.linspace(0, 20, 5)[None, :])
+    assert grid.shape == (7, 5)
+
+
+def test_profile_csv_of_a_modified_gear_has_both_profiles():
+    job = parse_job(SPUR, "f.toml")
+    rows = list(csv.DictReader(io.StringIO(job_profile_csv(job, sample_profile(job.gear.tooth_space_profile(),
+                                                                               0.001)).decode())))
+    assert list(rows[0]) == ["x_mm", "y_mm", "unmodified_x_mm", "unmodified_y_mm", "removal_um"]
+    spec = job.gear
+    rb = spec.base_radius_mm
+    l_start, l_tip = roll_length_mm(rb, 98.0), roll_length_mm(rb, 100.0)
+    checked = 0
+    for row in rows:
+        x, y = float(row["unmodified_x_mm"]), float(row["unmodified_y_mm"])
+        radius = math.hypot(x, y)
+        if spec.form_radius_mm + 0.01 < radius < spec.tip_radius_mm - 1e-6:  # the involute at mid-face: tip relief
+            roll = math.sqrt(radius**2 - rb**2)
+            expected = 15.0 * max(roll - l_start, 0.0) / (l_tip - l_start)
+            assert float(row["removal_um"]) == pytest.approx(expected, abs=1e-6)
+            checked += 1
+    assert checked > 20
+
+
+# --- the solid, read back from its STEP file ------------------------------------------------------------------
+
+
+def _read_step(content: bytes, tmp_path):
+    from OCP.IFSelect import IFSelect_RetDone
+    from OCP.STEPControl import STEPControl_Reader
+
+    path = tmp_path / "gear.step"
+    path.write_bytes(content)
+    reader = STEPControl_Reader()
+    assert reader.ReadFile(str(path)) == IFSelect_RetDone
+    reader.TransferRoots()
+    return reader.OneShape()
+
+
+def _section_points(shape, x: float, per_edge: int = 200) -> np.ndarray:
+    """Points (Y, Z) of the shape's section by the plane X = x, by OCP."""
+    from OCP.BRepAdaptor import BRepAdaptor_Curve
+    from OCP.BRepAlgoAPI import BRepAlgoAPI_Section
+    from OCP.gp import gp_Dir, gp_Pln, gp_Pnt
+    from OCP.TopAbs import TopAbs_EDGE
+    from OCP.TopExp import TopExp_Explorer
+    from OCP.TopoDS import TopoDS
+
+    section = BRepAlgoAPI_Section(shape, gp_Pln(gp_Pnt(x, 0, 0), gp_Dir(1, 0, 0)), False)
+    section.SetRunParallel(True)
+    section.Approximation(False)  # the exact intersection curves, not approximations of them
+    section.Build()
+    assert section.IsDone()
+    points = []
+    explorer = TopExp_Explorer(section.Shape(), TopAbs_EDGE)
+    while explorer.More():
+        curve = BRepAdaptor_Curve(TopoDS.Edge_s(explorer.Current()))
+        for u in np.linspace(curve.FirstParameter(), curve.LastParameter(), per_edge):
+            p = curve.Value(u)
+            points.append((p.Y(), p.Z()))
+        explorer.Next()
+    return np.array(points)
+
+
+def _expected_removal_mm(spec, values: dict, roll, x):
+    """The job's tip relief (linear) and lead crowning at roll length L and face position X, from ISO 21771's
+    definitions and the job's numbers."""
+    rb, b = spec.base_radius_mm, spec.face_width_mm
+    l_start = math.sqrt((values["tip_relief_start_diameter_mm"] / 2) ** 2 - rb**2)
+    l_tip = math.sqrt(spec.tip_radius_mm**2 - rb**2)
+    tip = values["tip_relief_um"] / 1000 * np.maximum(roll - l_start, 0.0) / (l_tip - l_start)
+    return tip + values.get("lead_crowning_um", 0.0) / 1000 * (2 * (x - b / 2) / b) ** 2
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("text, values", [
+    (SPUR, {"tip_relief_um": 15.0, "tip_relief_start_diameter_mm": 98.0, "lead_crowning_um": 10.0}),
+    (HELICAL, {"tip_relief_um": 12.0, "tip_relief_start_diameter_mm": 97.5}),
+], ids=["spur tip relief and lead crowning", "helical tip relief"])
+def test_step_sections_are_the_design_involute_moved_by_the_modification(text, values, tmp_path):
+    """Every section point on the usable involute (all teeth, both flanks) lies at the expected removal below the
+    design involute within 1.5 um, and the section covers the whole involute; at three X positions."""
+    from OCP.BRepCheck import BRepCheck_Analyzer
+
+    from spur_cad.pipeline import build_cad
+
+    job = parse_job(text, "f.toml")
+    spec = job.gear
+    _, files = build_cad(job, timestamp="2026-01-01T00:00:00")
+    shape = _read_step(files["gear.step"], tmp_path)
+    assert BRepCheck_Analyzer(shape).IsValid()
+    rb, pitch = spec.base_radius_mm, 2 * math.pi / spec.teeth
+    theta_b = spec.base_half_space_angle_rad
+    low, high = spec.form_radius_mm + 0.05, spec.tip_radius_mm - 0.02
+    for x in (0.3, spec.face_width_mm / 2, spec.face_width_mm - 0.3):
+        yz = _section_points(shape, x)
+        # Part frame at A = 0 -> the section as at X = 0 (undo the helix turn) -> polar angle from +Z, clockwise.
+        turn = -spec.section_turn_rad(x)
+        y = yz[:, 0] * math.cos(turn) - yz[:, 1] * math.sin(turn)
+        z = yz[:, 0] * math.sin(turn) + yz[:, 1] * math.cos(turn)
+        radius = np.hypot(y, z)
+        angle = np.arctan2(y, z)
+        folded = np.abs((angle + pitch / 2) % pitch - pitch / 2)  # into space 0, the left flank mirrored
+        on_involute = (radius > low) & (radius < high) & (folded < pitch / 2 - 1e-3)
+        r, theta = radius[on_involute], folded[on_involute]
+        # Involutes of one base circle are parallel: a point at polar angle theta lies r_b (theta - theta_inv(r))
+        # into the tooth from the design involute, whose foot point has roll length L + removal.
+        pressure = np.arccos(rb / r)
+        removal = rb * (theta - theta_b - (np.tan(pressure) - pressure))
+        roll = np.sqrt(r**2 - rb**2)
+        expected = np.zeros_like(roll)
+        for _ in range(3):
+            expected = _expected_removal_mm(spec, values, roll + expected, x)
+        assert np.abs(removal - expected).max() < 1.5e-3, (x, np.abs(removal - expected).max())
+        gaps = np.diff(np.sort(roll))
+        assert roll.min() < math.sqrt(low**2 - rb**2) + 0.5 and roll.max() > math.sqrt(high**2 - rb**2) - 0.5
+        assert gaps.max() < 0.3, x  # every flank is there, not only some
+        assert on_involute.sum() > 2 * spec.teeth * 20
+
+
+def test_the_inspection_sheet_lists_the_modifications_and_says_where_span_and_pins_touch():
+    from spur_cad.pipeline import run_job
+
+    result = run_job(parse_job(SPUR + "[gear.modifications.left]\ntip_relief_um = 11\n", "f.toml"))
+    report = result.files["report.html"].decode()
+    assert "flank modification tip relief C_a (right / left)" in report and "15.0 / 11.0" in report
+    assert "lead crowning C_beta" in report
+    assert "measured where the flanks are unmodified" in report
+    summary = result.files["summary.json"].decode()
+    assert '"tip relief C_a": {\n        "right": 15.0,\n        "left": 11.0' in summary
+
+
+def test_a_span_taken_on_a_modified_flank_is_a_warning_with_what_it_reads():
+    from spur_cad.geometry.inspection import inspection_facts, modification_inspection
+    from spur_cad.pipeline import run_job
+
+    job = parse_job(GEAR + "[gear.modifications]\nprofile_slope_um = 20\n", "f.toml")
+    sheet = inspection_facts(job.gear)
+    facts = modification_inspection(job.gear, job.modifications, sheet)
+    rb = job.gear.base_radius_mm
+    l_form = roll_length_mm(rb, 2 * job.gear.form_radius_mm)
+    l_tip = roll_length_mm(rb, 2 * job.gear.tip_radius_mm)
+    roll = roll_length_mm(rb, 2 * sheet.span_contact_radius_mm)
+    removal_um = -20 * (roll - (l_form + l_tip) / 2) / (l_tip - l_form)  # the material grows toward the tip
+    assert facts.span_removal_um == pytest.approx((removal_um, removal_um))
+    assert facts.span_modified_mm == pytest.approx(sheet.span_measurement_mm - 2 * removal_um / 1000)
+    assert not facts.measured_unmodified
+    report = run_job(job).files["report.html"].decode()
+    assert "warning: the span anvils touch modified flanks" in report

@@ -1,0 +1,79 @@
+"""Generating finishing of modified flanks (issue 31.3) and the simulation against the modified design (31.5):
+programs rs274 reads with A clamped in every feed move, the simulated cut within the target of the MODIFIED design
+(so a correctly cut relief is no leftover), and the same cut read against the unmodified design shows the relief."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from spur_cad.job import parse_job
+from spur_cad.pipeline import job_stock, plan_cam
+from spur_cad.sim import Cut, SimSettings, simulate, subset
+
+GEAR = "[gear]\nteeth = 23\nmodule_mm = 4.0\nface_width_mm = 20\nrack_tip_radius_mm = 1.52\n"
+TOOLS = "[tools.finishing]\ndiameter_mm = 'auto'\ncorner_radius_mm = 'auto'\n[tools.roughing]\ndiameter_mm = 'auto'\n"
+SPUR = GEAR + TOOLS + ("[gear.modifications]\ntip_relief_um = 15\ntip_relief_start_diameter_mm = 98\n"
+                       "lead_crowning_um = 10\n")
+HELICAL = GEAR + "helix_angle_deg = 15\n" + TOOLS + ("[gear.modifications]\ntip_relief_um = 12\n"
+                                                   "tip_relief_start_diameter_mm = 97.5\n")
+RES = 0.002
+
+
+@pytest.fixture(scope="module", params=["spur", "helical"])
+def planned(request):
+    job = parse_job({"spur": SPUR, "helical": HELICAL}[request.param], "f.toml")
+    return request.param, job, plan_cam(job)
+
+
+def _simulated(job, plan, modifications):
+    def of(path):
+        return subset(path, np.isin(path.space, [0, 1, 2]))
+
+    result = simulate(job.gear, job_stock(job), [Cut(of(plan.roughing.toolpath), job.tools.roughing),
+                                                 Cut(of(plan.finishing.toolpath), job.tools.finishing)],
+                      SimSettings(resolution_mm=RES), modifications=modifications)
+    return result, result.deviation[1][:, result.gear_rows], np.array(result.grid.feature_names())
+
+
+def test_an_unmodified_job_plans_straight_passes():
+    plan = plan_cam(parse_job(GEAR + TOOLS, "f.toml"))
+    assert all(p.path == () for p in plan.finishing.result.passes)
+
+
+def test_the_cut_lies_on_the_modified_design_and_shows_the_relief_against_the_unmodified(planned):
+    name, job, plan = planned
+    result, middle, names = _simulated(job, plan, job.modifications)
+    target = job.finishing.target_scallop_mm
+    assert -middle.min() <= RES
+    assert middle.max() <= target + RES, f"{name}: leftover {1000 * middle.max():.2f} um"
+    # against the unmodified design the tip relief reads as a gouge of about its amount near the tip
+    from spur_cad.sim.design import modification_removal_mm
+
+    removal = modification_removal_mm(job.gear, result.grid, job.modifications)[:, result.gear_rows]
+    plain = middle - removal
+    flank = names == "right involute"
+    tip_relief_um = 1000 * job.modifications.right.tip_relief_mm
+    assert -1000 * plain[flank].min() == pytest.approx(tip_relief_um + (10.0 if name == "spur" else 0.0), abs=3.0)
+
+
+@pytest.mark.linuxcnc
+def test_rs274_reads_the_modified_finishing_program_with_a_clamped(planned, tmp_path):
+    from spur_cad.post import PostSettings, ProgramInfo, post_program
+    from tests.rs274_helper import run_rs274
+    from tests.test_post import assert_same_moves, canonical_moves
+
+    name, job, plan = planned
+    path = plan.finishing.toolpath
+    program = post_program(path, PostSettings(), ProgramInfo("modified finishing test", ()))
+    target = tmp_path / "finishing.ngc"
+    target.write_text(program.text)
+    ok, canon, messages = run_rs274(target)
+    assert ok, messages
+    moves = canonical_moves(canon)
+    assert_same_moves(moves, path, 4, 4)
+    for (_, before), (rapid, after) in zip(moves, moves[1:]):
+        if not rapid:
+            assert after[3] == before[3]
+    # lead crowning: some feed moves change Y along X within a pass
+    assert name != "spur" or sum(1 for p in plan.finishing.result.passes if len(p.path) > 2) > 10
