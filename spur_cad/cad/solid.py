@@ -40,8 +40,9 @@ from OCP.Geom import Geom_BSplineCurve, Geom_Curve, Geom_CylindricalSurface
 from OCP.Geom2d import Geom2d_Line
 from OCP.GeomAbs import GeomAbs_Plane
 from OCP.GeomAPI import GeomAPI_Interpolate, GeomAPI_ProjectPointOnCurve
-from OCP.gp import gp_Ax1, gp_Ax2, gp_Ax3, gp_Dir, gp_Dir2d, gp_Pnt, gp_Pnt2d, gp_Trsf, gp_Vec
+from OCP.gp import gp_Ax1, gp_Ax2, gp_Ax3, gp_Circ, gp_Dir, gp_Dir2d, gp_Pnt, gp_Pnt2d, gp_Trsf, gp_Vec
 from OCP.GProp import GProp_GProps
+from OCP.ShapeFix import ShapeFix_Face
 from OCP.ShapeUpgrade import ShapeUpgrade_UnifySameDomain
 from OCP.TColgp import TColgp_Array1OfVec, TColgp_HArray1OfPnt
 from OCP.TColStd import TColStd_HArray1OfBoolean
@@ -339,14 +340,23 @@ def _x_cylinder(radius: float, x0: float, x1: float) -> TopoDS_Shape:
 
 
 def _ring_shape(edges: list[TopoDS_Edge], spec: GearSpec) -> TopoDS_Shape:
-    """An internal gear: the rim cylinder (rim_outer_diameter_mm, 0 <= X <= b) less the toothed inner outline
-    extruded 1 mm beyond both faces (no coplanar faces in the boolean cut)."""
-    b = spec.face_width_mm
-    inner = _extrude(edges, b + 2.0)
-    shift = gp_Trsf()
-    shift.SetTranslation(gp_Vec(-1.0, 0.0, 0.0))
-    inner = BRepBuilderAPI_Transform(inner, shift, True).Shape()
-    return _cut(_x_cylinder(spec.rim_outer_diameter_mm / 2.0, 0.0, b), inner)
+    """An internal gear: the transverse face between the rim circle (rim_outer_diameter_mm) and the toothed inner
+    outline, extruded over 0 <= X <= b (a face with a hole: no boolean, which took a minute on a 60-tooth ring)."""
+    circle = gp_Circ(gp_Ax2(gp_Pnt(0.0, 0.0, 0.0), gp_Dir(1.0, 0.0, 0.0)), spec.rim_outer_diameter_mm / 2.0)
+    rim = BRepBuilderAPI_MakeWire(BRepBuilderAPI_MakeEdge(circle).Edge()).Wire()
+    inner = BRepBuilderAPI_MakeWire()
+    for edge in edges:
+        inner.Add(edge)
+    if not inner.IsDone():
+        raise RuntimeError("the ring's toothed outline did not close into a wire")
+    maker = BRepBuilderAPI_MakeFace(rim, True)
+    maker.Add(inner.Wire())
+    if not maker.IsDone():
+        raise RuntimeError("could not make the ring's transverse face")
+    fix = ShapeFix_Face(maker.Face())
+    fix.FixOrientation()  # the hole's wire runs opposite to the rim's, whichever way the outline was traced
+    fix.Perform()
+    return BRepPrimAPI_MakePrism(fix.Face(), gp_Vec(spec.face_width_mm, 0.0, 0.0)).Shape()
 
 
 def build_gear_shape(spec: GearSpec, features: BlankFeatures = BlankFeatures(),
