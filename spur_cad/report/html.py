@@ -80,6 +80,10 @@ def program_notes(result: JobResult) -> tuple[str, ...]:
             notes.append(f"Roughing by flanks: {rough.passes_per_space} passes per space, A turned by +-({turns}) "
                          f"deg to the flank segments, down to {number(rough.lowest_level_height_mm, 3)} mm above "
                          f"the root circle{tips}.")
+        elif result.setup is not None and result.setup.axes == 3:
+            notes.append(f"Roughing on 3 axes: {rough.levels_per_space} levels down to Z "
+                         f"{number(min(rough.level_heights_mm), 3)} mm, each a series of passes offset from the "
+                         "blank inward to the finish stock.")
         else:
             notes.append(f"Roughing: {rough.levels_per_space} levels per space, the lowest "
                          f"{number(rough.lowest_level_height_mm, 3)} mm above the root circle{tips}.")
@@ -140,7 +144,9 @@ def report_context(result: JobResult, images: dict[str, bytes]) -> dict:
         "expected_tolerance": sheet.expected_tolerance(result), "limit_rows": sheet.limit_rows(result),
         "advice_rows": sheet.advice_rows(result), "advice_strategy": result.tools.advice_strategy,
         "program_table": sheet.program_table(result),
-        "finishing_comparison": finishing_comparison(result.finishing) if result.finishing is not None else None,
+        # the comparison strategies are rotary-table strategies: none for a gear lying flat
+        "finishing_comparison": finishing_comparison(result.finishing)
+        if result.finishing is not None and (result.setup is None or result.setup.axes != 3) else None,
         "program_notes": program_notes(result), "simulation_rows": sheet.simulation_rows(result),
         "gouge_within_resolution": (not sim.enabled) or sim.max_gouge_mm <= sim.resolution_mm,
         "simulation_verdict": verdict, "feature_table": sheet.feature_table(result),

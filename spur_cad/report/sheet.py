@@ -209,6 +209,8 @@ def operation_table(result: JobResult) -> Table:
         if name.startswith("roughing"):
             strategy = (f"roughing by flanks, {facts.passes_per_space} passes per space"
                         if facts.passes_per_space is not None else
+                        f"3-axis roughing, {facts.levels_per_space} levels of passes offset from the blank inward"
+                        if setup is not None and setup.axes == 3 else
                         f"z-level roughing, {facts.levels_per_space} levels per space")
             stock = (f"{number(setup.finish_stock_mm, 2)} to {number(setup.flank_allowance_mm, 2)} mm"
                      if setup is not None else "-")
