@@ -8,9 +8,10 @@ the K-chart draws with the tolerance band around it.
 
 The cut modifications: deviation + design is the trace against the unmodified flank (up to a constant), so
 r = -(deviation + design) is the removal as cut; it is fitted by least squares with a constant (the flank's
-position, the tooth's size) and the unit shapes of spur_cad.geometry.modifications: profile traces with profile
-crowning, profile slope and the designed tip and root reliefs over the whole usable involute (form to tip
-circle), helix traces with lead crowning, helix slope and the designed end reliefs over the face width.
+position, the tooth's size) and the unit shapes of spur_cad.geometry.modifications: profile traces with the profile
+slope and the designed crowning and tip and root reliefs over the whole usable involute (form to tip circle), helix
+traces with the helix slope and the designed crowning and end reliefs over the face width (a shape not designed
+is not fitted: the few scallop valleys of a trace do not tell more shapes apart).
 Each fitted coefficient is the amount as cut (C_alpha, f_Halpha, C_a, C_f; C_beta, f_Hbeta, C_I, C_II), the mean
 over the flank's traces of one side.
 """
@@ -79,10 +80,11 @@ def with_design(traces, mods: FlankModifications) -> tuple[Trace, ...]:
 def _profile_shapes(flank: FlankModification) -> list[tuple[str, str, float, object]]:
     """(name, symbol, designed um, unit shape of the roll length) of the profile modifications read from a trace."""
     unit = FlankModification(flank.form_roll_mm, flank.tip_roll_mm, flank.face_width_mm)
-    shapes = [("profile crowning", "C_alpha", flank.profile_crowning_mm,
-               replace(unit, profile_crowning_mm=1.0).profile_offset_mm),
-              ("profile slope", "f_Halpha", flank.profile_slope_mm,
+    shapes = [("profile slope", "f_Halpha", flank.profile_slope_mm,
                replace(unit, profile_slope_mm=1.0).profile_offset_mm)]
+    if flank.profile_crowning_mm:
+        shapes.append(("profile crowning", "C_alpha", flank.profile_crowning_mm,
+                       replace(unit, profile_crowning_mm=1.0).profile_offset_mm))
     if flank.tip_relief_mm:
         shapes.append(("tip relief", "C_a", flank.tip_relief_mm, replace(
             unit, tip_relief_mm=1.0, tip_relief_start_roll_mm=flank.tip_relief_start_roll_mm,
@@ -97,8 +99,10 @@ def _profile_shapes(flank: FlankModification) -> list[tuple[str, str, float, obj
 def _lead_shapes(flank: FlankModification) -> list[tuple[str, str, float, object]]:
     """(name, symbol, designed um, unit shape of the face position) of the lead modifications read from a trace."""
     unit = FlankModification(flank.form_roll_mm, flank.tip_roll_mm, flank.face_width_mm)
-    shapes = [("lead crowning", "C_beta", flank.lead_crowning_mm, replace(unit, lead_crowning_mm=1.0).lead_offset_mm),
-              ("helix slope", "f_Hbeta", flank.helix_slope_mm, replace(unit, helix_slope_mm=1.0).lead_offset_mm)]
+    shapes = [("helix slope", "f_Hbeta", flank.helix_slope_mm, replace(unit, helix_slope_mm=1.0).lead_offset_mm)]
+    if flank.lead_crowning_mm:
+        shapes.append(("lead crowning", "C_beta", flank.lead_crowning_mm,
+                       replace(unit, lead_crowning_mm=1.0).lead_offset_mm))
     if flank.front_end_relief_mm:
         shapes.append(("end relief, front face", "C_I", flank.front_end_relief_mm, replace(
             unit, front_end_relief_mm=1.0,
