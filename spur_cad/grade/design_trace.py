@@ -66,8 +66,8 @@ def design_removal_mm(mods: FlankModifications, side: np.ndarray, roll_mm: np.nd
 
 def with_design(traces, mods: FlankModifications) -> tuple[Trace, ...]:
     """The traces with their design trace (um, -removal): a profile trace's profile modifications, a helix trace's
-    lead modifications. The other direction's modification is a constant along a trace; it stays in the charted
-    trace's level (as a gear measuring machine charts a profile at a face position of a crowned flank)."""
+    lead modifications. The other direction's modification is a constant along a trace and is not charted (a
+    profile trace at the face of a crowned flank is drawn against the involute moved by the crowning there)."""
     found = []
     for trace in traces:
         flank = mods.side(trace.side)
