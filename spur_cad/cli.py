@@ -307,7 +307,7 @@ def _grade(args: argparse.Namespace, received: list[int], loaded: list) -> int:
     job = loaded[0]
     measured = read_measured_file(args.measured)
     if isinstance(measured, MeasuredPoints):
-        grading = grade_measured(job.gear, measured, args.datum or "best-fit")
+        grading = grade_measured(job.gear, measured, args.datum or "best-fit", job.modifications)
     else:
         grading = _grade_probe_log(job, measured, args.datum)
     spec = job.gear
@@ -324,6 +324,8 @@ def _grade(args: argparse.Namespace, received: list[int], loaded: list) -> int:
     for name, value in grading.deviations_um.items():
         grade = grading.classes[name]
         print(f"{name}: {value:.2f} um, class {grade if grade else 'beyond 11'}")
+    for cut in grading.modifications_cut or ():
+        print(f"{cut.side} flank: {cut.sentence}")
     for note in grading.notes:
         print(f"note: {note}")
     overall = grading.overall_class
@@ -393,7 +395,7 @@ def _grade_probe_log(job, log, datum: str | None):
         raise SpurCadError(f"{log.source}: a probe log, but the job has no [probe] section to name its trips (grade "
                            "with the job that wrote the probing program)")
     plan = plan_probe(job.gear, job.stock, job.machine, job.probe)
-    return grade_probe_log(job.gear, plan, log, job.post.rotary_sign)
+    return grade_probe_log(job.gear, plan, log, job.post.rotary_sign, job.modifications)
 
 
 def _main(argv: list[str] | None, received: list[int]) -> int:

@@ -677,6 +677,28 @@ def _modifications(tables: dict[str, dict], spec: GearSpec, source: str, text: s
     return None if modifications.is_zero else modifications
 
 
+def _check_added_material(mods: FlankModifications | None, finish_stock_mm: float, tables: dict[str, dict], source: str,
+                          text: str) -> None:
+    """JobFileError at the slope key when the signed slopes of `mods` (None: no modification, or no finishing) add
+    more material to a flank (negative removal, at the worst roll length and face position) than roughing leaves
+    for finishing ([roughing] finish_stock_mm): the finishing tool would find nothing to cut there."""
+    import numpy as np
+
+    for side in SIDES if mods is not None else ():
+        flank = mods.side(side)
+        rolls = np.linspace(flank.form_roll_mm, flank.tip_roll_mm, 2001)
+        faces = np.linspace(0.0, flank.face_width_mm, 2001)
+        added = -(float(flank.profile_offset_mm(rolls).min()) + float(flank.lead_offset_mm(faces).min()))
+        if added <= finish_stock_mm + 1e-9:  # as much as roughing leaves: the finishing just touches it
+            continue
+        key = "profile_slope_um" if abs(flank.profile_slope_mm) >= abs(flank.helix_slope_mm) else "helix_slope_um"
+        table = f"gear.modifications.{side}" if key in tables.get(f"gear.modifications.{side}", {}) \
+            else "gear.modifications"
+        raise JobFileError(f"{_where(source, text, table, key)}: [{table}] the {side} flank's modifications add "
+                           f"{1000 * added:.1f} um of material (the signed slopes), more than roughing leaves for "
+                           f"finishing ([roughing] finish_stock_mm = {finish_stock_mm:g} mm)", section=table, field=key)
+
+
 def _job_from_data(data: dict, source: str, text: str, strategies: Strategies = REGISTRY) -> Job:
     """Validate parsed job data; `text` (the file's text, or "") only locates keys for messages."""
     data, modification_tables = _split_modifications(data, source, text)
@@ -709,6 +731,8 @@ def _job_from_data(data: dict, source: str, text: str, strategies: Strategies = 
             raise JobFileError(f"{where(name, blamed)}: invalid [{name}]: {exc}", section=name, field=blamed) from None
     _validate_sections(sections, tables, types, autos, spec, strategies, where)
     tools = _tools_section(sections, tables, where)
+    _check_added_material(modifications if tools.finishing is not None else None,
+                          sections.get("roughing", RoughingParams()).finish_stock_mm, modification_tables, source, text)
     _check_roughing_top(tools, where)
     try:
         check_machine_limits(spec, sections.get("stock", StockSpec()), sections.get("machine", Machine()),

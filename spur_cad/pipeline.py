@@ -141,7 +141,7 @@ def grade_stage(job: Job, sim_result: SimResult | None, plan: CamPlan | None = N
         return None
     from spur_cad.grade.simulated import grade_simulation
 
-    return grade_simulation(job.gear, sim_result, three_axis_profile_start_mm(plan))
+    return grade_simulation(job.gear, sim_result, three_axis_profile_start_mm(plan), job.modifications)
 
 
 def three_axis_profile_start_mm(plan: CamPlan | None) -> float | None:

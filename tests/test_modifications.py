@@ -235,3 +235,27 @@ def test_a_span_taken_on_a_modified_flank_is_a_warning_with_what_it_reads():
     assert not facts.measured_unmodified
     report = run_job(job).files["report.html"].decode()
     assert "warning: the span anvils touch modified flanks" in report
+
+
+TOOLS = "[tools.finishing]\ndiameter_mm = 'auto'\ncorner_radius_mm = 'auto'\n[tools.roughing]\ndiameter_mm = 'auto'\n"
+
+
+@pytest.mark.parametrize("mods, line, table, key, added", [
+    ("[gear.modifications]\nprofile_slope_um = -40\nhelix_slope_um = 30\n", 14, "gear.modifications",
+     "profile_slope_um", 35.0),
+    ("[gear.modifications]\nprofile_slope_um = 10\n[gear.modifications.left]\nhelix_slope_um = -52\n", 16,
+     "gear.modifications.left", "helix_slope_um", 31.0),
+])
+def test_slopes_that_add_more_than_the_finish_stock_are_refused_at_the_key(mods, line, table, key, added):
+    """Signed slopes add material on one half of the flank (profile slope -40 um: 20 um at the form circle; helix
+    slope 30 um: 15 um at the front face); more than [roughing] finish_stock_mm is refused, at the slope's line."""
+    text = GEAR + TOOLS + "[roughing]\nfinish_stock_mm = 0.03\n" + mods
+    with pytest.raises(JobFileError) as info:
+        parse_job(text, "f.toml")
+    message = str(info.value)
+    assert message.startswith(f"f.toml:{line}: [{table}] ") and "\n" not in message, message
+    assert f"add {added:.1f} um of material" in message and "finish_stock_mm = 0.03" in message, message
+    assert text.splitlines()[line - 1].startswith(key)
+    # as much as roughing leaves is accepted, and a job without tools is not checked
+    parse_job(text.replace("finish_stock_mm = 0.03", f"finish_stock_mm = {added / 1000:.4f}"), "f.toml")
+    parse_job(GEAR + mods, "f.toml")

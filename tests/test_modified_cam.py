@@ -46,7 +46,9 @@ def test_the_cut_lies_on_the_modified_design_and_shows_the_relief_against_the_un
     result, middle, names = _simulated(job, plan, job.modifications)
     target = job.finishing.target_scallop_mm
     assert -middle.min() <= RES
-    assert middle.max() <= target + RES, f"{name}: leftover {1000 * middle.max():.2f} um"
+    # within the target and the simulation's own error (cusps between clipped poses, at most half its resolution);
+    # the spur relief's start kink and the contacts behind it are cut by their own passes (7 um at 5 um without)
+    assert middle.max() <= target + RES / 2, f"{name}: leftover {1000 * middle.max():.2f} um"
     # against the unmodified design the tip relief reads as a gouge of about its amount near the tip
     from spur_cad.sim.design import modification_removal_mm
 

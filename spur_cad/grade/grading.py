@@ -31,7 +31,9 @@ HELIX_DEVIATIONS = ("f_Hb", "f_fb", "F_b")
 
 @dataclass(frozen=True)
 class Trace:
-    """One measured trace: where (space, side, X for a profile trace), positions (mm) and deviations (um)."""
+    """One measured trace: where (space, side, X for a profile trace), positions (mm) and deviations (um) from the
+    design; a modified gear's traces also carry the design trace (um: the modified design against the unmodified
+    involute or helix, spur_cad.grade.design_trace), which the K-chart draws."""
 
     kind: str  # "profile" or "helix"
     space: int
@@ -40,6 +42,7 @@ class Trace:
     position_mm: np.ndarray
     deviation_um: np.ndarray
     evaluation: tuple[float, float]
+    design_um: np.ndarray | None = None
 
 
 @dataclass(frozen=True)
@@ -93,7 +96,8 @@ class Grading:
     """A gear's ISO 1328-1:2013 grade: worst deviations (um) and where, each one's class (None: beyond 11),
     the gear's class (the worst; None when beyond 11 or nothing graded), the validity of the formulas, and
     the traces (for charts). Simulated grading adds the class-5 tolerances and every space's pitch;
-    measured grading the number of points, the fit and notes."""
+    measured grading the number of points, the fit and notes. A modified gear's grading is against the modified
+    design and says how much of each modification was cut (`modifications_cut`)."""
 
     deviations_um: dict[str, float]
     where: dict[str, Location]
@@ -107,6 +111,7 @@ class Grading:
     points: int | None = None
     fit: MeasuredFit | None = None
     notes: tuple[str, ...] = ()
+    modifications_cut: tuple | None = None  # spur_cad.grade.design_trace.ModificationCut, modified gears only
 
     @property
     def measured(self) -> bool:
@@ -117,17 +122,20 @@ class Grading:
         return any(trace.kind == "profile" for trace in self.traces)
 
     def to_json(self) -> dict:
-        """The JSON form (summary.json `grading`, grade.json): the traces are left out."""
+        """The JSON form (summary.json `grading`, grade.json): the traces are left out; a modified gear's adds
+        `modifications_cut`."""
+        cut = {} if self.modifications_cut is None else {
+            "modifications_cut": [item.to_json() for item in self.modifications_cut]}
         where = {name: place.to_json() for name, place in self.where.items()}
         if self.measured:
             return {"standard": STANDARD, "points": self.points, "notes": list(self.notes),
                     "fit": self.fit.to_json(), "deviations_um": dict(self.deviations_um), "where": where,
-                    "classes": dict(self.classes), "class": self.overall_class, "validity": list(self.validity)}
+                    "classes": dict(self.classes), "class": self.overall_class, "validity": list(self.validity), **cut}
         return {"standard": STANDARD, "deviations_um": dict(self.deviations_um), "where": where,
                 "classes": dict(self.classes), "class": self.overall_class,
                 "class5_tolerances_um": dict(self.class5_tolerances_um),
                 "class5_unrounded_um": dict(self.class5_unrounded_um),
-                "pitch": {side: p.to_json() for side, p in self.pitch.items()}, "validity": list(self.validity)}
+                "pitch": {side: p.to_json() for side, p in self.pitch.items()}, "validity": list(self.validity), **cut}
 
 
 def worst_deviations(measured: list[Trace]) -> tuple[dict[str, float], dict[str, Location]]:

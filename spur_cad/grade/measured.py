@@ -9,7 +9,8 @@ axis), optionally a third column `X_mm`, the axial position (several transverse 
 traces). A header line of names is allowed; `#` starts a comment. Points of several flanks and tooth
 spaces may be mixed: each point belongs to the flank of the design point nearest to it (after the fit).
 A helical gear's section at X is the section at X = 0 turned by spec.section_turn_rad(X); the points are turned
-back by it before they meet the design.
+back by it before they meet the design. A modified gear's points are graded against the modified design (a flank
+point's deviation plus the design's removal at its roll length and X; spur_cad.grade.design_trace).
 """
 
 from __future__ import annotations
@@ -22,6 +23,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from spur_cad.errors import SpurCadError
+from spur_cad.grade.design_trace import against_design, design_removal_mm
 from spur_cad.grade.grading import Grading, MeasuredFit, Trace, add_pitch, classes_of, validity, worst_deviations
 from spur_cad.grade.simulated import helix_range_mm, profile_range_mm
 
@@ -162,17 +164,24 @@ def _deviations(tree, points, normals, y, z, axial, params, turn_rad_per_mm):
     return deviation, nearest
 
 
-def fit(spec, measured: MeasuredPoints, design=None, datum: str = "best-fit"):
+def fit(spec, measured: MeasuredPoints, design=None, datum: str = "best-fit", modifications=None):
     """Rotation (rad) and centre (mm) that bring the points nearest the design (least squares of the normal
-    deviations), and each point's deviation (mm, + material) and nearest design point after the fit.
+    deviations), and each point's deviation (mm, + material) and nearest design point after the fit. With
+    `modifications` the design is the modified one: a flank point's deviation is read from the modified flank.
     `datum` "axis": the file's origin is the gear's datum axis, the centre stays (0, 0) and only the rotation is
     fitted (a turn changes no pitch deviation; a centre fit would take the eccentricity out of F_p).
     `design`: `_design(spec)` when the caller has it already."""
     from scipy.optimize import least_squares
     from scipy.spatial import cKDTree
 
-    points, normals, *_ = design if design is not None else _design(spec)
+    points, normals, _, sides, rolls, _ = design if design is not None else _design(spec)
     tree = cKDTree(points)
+
+    def modified(deviation, nearest, axial):  # the deviation from the modified design (+ the design's removal)
+        if modifications is None:
+            return deviation
+        return deviation + design_removal_mm(modifications, sides[nearest], rolls[nearest], axial)
+
     turn = spec.section_turn_rad(1.0)  # rad per mm of X (0 for a spur gear)
     pitch = 2.0 * math.pi / spec.teeth
     step = max(1, len(measured.plane_x) // FIT_POINTS)  # the fit on an even subset; deviations of every point after
@@ -180,7 +189,7 @@ def fit(spec, measured: MeasuredPoints, design=None, datum: str = "best-fit"):
 
     def residuals(p):
         params = p if datum != "axis" else [p[0], 0.0, 0.0]
-        return _deviations(tree, points, normals, y, z, x, params, turn)[0]
+        return modified(*_deviations(tree, points, normals, y, z, x, params, turn), x)
 
     starts = np.linspace(0.0, pitch, 48, endpoint=False)  # the rotation's basin is narrower than a pitch
     costs = [np.sum(residuals([a, 0.0, 0.0]) ** 2) for a in starts]
@@ -189,7 +198,7 @@ def fit(spec, measured: MeasuredPoints, design=None, datum: str = "best-fit"):
     params = list(best.x) + [0.0, 0.0] if datum == "axis" else list(best.x)
     deviation, nearest = _deviations(tree, points, normals, measured.plane_x, measured.plane_y, measured.axial,
                                      params, turn)
-    return params, deviation, nearest
+    return params, modified(deviation, nearest, measured.axial), nearest
 
 
 REFERENCE_ROLL_TOLERANCE_MM = 0.1
@@ -259,14 +268,16 @@ def graded(spec, found_traces: list[Trace], positions, axial: np.ndarray, fitted
                    traces=tuple(found_traces), points=int(len(axial)), notes=notes, fit=fitted)
 
 
-def grade_measured(spec, measured: MeasuredPoints, datum: str = "best-fit") -> Grading:
+def grade_measured(spec, measured: MeasuredPoints, datum: str = "best-fit", modifications=None) -> Grading:
     """ISO 1328-1 deviations and classes of the measured flanks (worst over the flanks measured). `datum`:
     "best-fit" fits the centre and rotation (the eccentricity leaves F_p), "axis" takes the file's origin as the
-    gear's datum axis and fits the rotation only. A helical gear's sections are turned back by their X first."""
+    gear's datum axis and fits the rotation only. A helical gear's sections are turned back by their X first.
+    `modifications` (the job's FlankModifications): graded against the modified design, with the modifications as
+    cut (spur_cad.grade.design_trace)."""
     if datum not in ("best-fit", "axis"):
         raise SpurCadError(f"datum must be 'best-fit' or 'axis', got {datum!r}")
     design = _design(spec)
-    params, deviation, nearest = fit(spec, measured, design, datum)
+    params, deviation, nearest = fit(spec, measured, design, datum, modifications)
     _, _, space, side, roll, _ = design
     found_traces, positions = flank_traces(spec, measured.axial, deviation, space[nearest], side[nearest],
                                            roll[nearest])
@@ -274,4 +285,4 @@ def grade_measured(spec, measured: MeasuredPoints, datum: str = "best-fit") -> G
     turn = -((params[0] + 0.5 * pitch) % pitch - 0.5 * pitch)  # the scan's turn from the design, within a pitch
     fitted = MeasuredFit(math.degrees(turn), (float(params[1]), float(params[2])),
                          float(np.sqrt(np.mean(deviation ** 2)) * 1000.0), datum)
-    return graded(spec, found_traces, positions, measured.axial, fitted)
+    return against_design(graded(spec, found_traces, positions, measured.axial, fitted), modifications)

@@ -18,6 +18,7 @@ import numpy as np
 
 from spur_cad.errors import shown
 from spur_cad.geometry.frames import machine_to_part
+from spur_cad.grade.design_trace import against_design, design_removal_mm
 from spur_cad.grade.grading import Grading, MeasuredFit
 from spur_cad.grade.measured import (
     MAX_POINTS,
@@ -121,21 +122,24 @@ def probe_deviations(spec, plan, log: ProbeLog, rotary_sign: int = 1) -> np.ndar
     return along - ball
 
 
-def grade_probe_log(spec, plan, log: ProbeLog, rotary_sign: int = 1) -> Grading:
+def grade_probe_log(spec, plan, log: ProbeLog, rotary_sign: int = 1, modifications=None) -> Grading:
     """ISO 1328-1 deviations and classes from a probe log (the module docstring): traces as the measured-points
     grading builds them, from the plan's labels (space, side, roll length, X), with no fit. A log shorter than the
-    plan (the program stopped) is graded on its trips, with a note."""
+    plan (the program stopped) is graded on its trips, with a note. `modifications`: graded against the modified
+    design (each trip's deviation plus the design's removal at its point), with the modifications as cut."""
     deviation = probe_deviations(spec, plan, log, rotary_sign)
     points = plan.points[:len(deviation)]
     roll = np.sqrt(np.maximum(np.array([pt.radius_mm for pt in points]) ** 2 - spec.base_radius_mm ** 2, 0.0))
     axial = np.array([pt.x_mm for pt in points])
-    found, positions = flank_traces(spec, axial, deviation, np.array([pt.space for pt in points]),
-                                    np.array([pt.side for pt in points]), roll)
+    sides = np.array([pt.side for pt in points])
+    if modifications is not None:
+        deviation = deviation + design_removal_mm(modifications, sides, roll, axial)
+    found, positions = flank_traces(spec, axial, deviation, np.array([pt.space for pt in points]), sides, roll)
     notes = () if len(points) == len(plan.points) else (
         f"the probe log holds {len(points)} of the probing program's {len(plan.points)} trips (the program "
         f"stopped early?): graded on those",)
     fitted = MeasuredFit(0.0, (0.0, 0.0), float(np.sqrt(np.mean(deviation ** 2)) * 1000.0), "probe log")
-    return graded(spec, found, positions, axial, fitted, notes)
+    return against_design(graded(spec, found, positions, axial, fitted, notes), modifications)
 
 
 def read_measured_file(path, source: str | None = None):

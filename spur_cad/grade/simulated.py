@@ -14,7 +14,9 @@ space and both flanks:
   the arc e / cos(alpha_t) there; single pitch deviations are differences of neighbouring flanks of
   one side, the total cumulative pitch deviation their spread.
 
-The gear's grade is the worst class over every deviation of every flank.
+The gear's grade is the worst class over every deviation of every flank. A modified gear is graded against its
+modified design (ISO 1328-1 with a design profile and helix: the simulation's deviations read from the modified
+flanks), and the modifications as cut are read from the same traces (spur_cad.grade.design_trace).
 """
 
 from __future__ import annotations
@@ -23,6 +25,8 @@ import math
 
 import numpy as np
 
+from spur_cad.geometry.modifications import FlankModifications
+from spur_cad.grade.design_trace import against_design
 from spur_cad.grade.grading import (
     Grading,
     Trace,
@@ -95,15 +99,19 @@ def flank_positions_um(spec, result, side: str) -> np.ndarray:
     return np.array([result.deviation[k][mask][reference, middle] * 1000.0 / cos_alpha for k in range(grid.teeth)])
 
 
-def grade_simulation(spec, result, profile_start_radius_mm: float | None = None) -> Grading:
+def grade_simulation(spec, result, profile_start_radius_mm: float | None = None,
+                     modifications: FlankModifications | None = None) -> Grading:
     """The gear's ISO 1328-1 grade from the simulated cut: worst deviations over all flanks, their classes, the
     gear's class, the class-5 tolerances, every space's pitch, the validity of the formulas and the traces
-    (profiles evaluated from `profile_start_radius_mm`, default the form circle)."""
+    (profiles evaluated from `profile_start_radius_mm`, default the form circle). A modified gear's `result` reads
+    its deviations from the modified design (simulate's `modifications`); give the same `modifications` here for
+    the design traces and the modifications as cut (spur_cad.grade.design_trace)."""
     measured = traces(spec, result, profile_start_radius_mm)
     worst, where = worst_deviations(measured)
     pitch = {side: add_pitch(worst, where, side, flank_positions_um(spec, result, side)) for side in SIDES}
     classes, overall = classes_of(spec, worst, set(worst))
     tolerances, unrounded = class5(spec)
-    return Grading(deviations_um={name: round(value, 3) for name, value in worst.items()}, where=where,
-                   classes=classes, overall_class=overall, validity=validity(spec), traces=tuple(measured),
-                   class5_tolerances_um=tolerances, class5_unrounded_um=unrounded, pitch=pitch)
+    grading = Grading(deviations_um={name: round(value, 3) for name, value in worst.items()}, where=where,
+                      classes=classes, overall_class=overall, validity=validity(spec), traces=tuple(measured),
+                      class5_tolerances_um=tolerances, class5_unrounded_um=unrounded, pitch=pitch)
+    return against_design(grading, modifications)

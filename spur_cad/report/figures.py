@@ -189,11 +189,11 @@ def k_chart_png(spec: GearSpec, grading: Grading) -> bytes:
 def k_chart_figure(spec: GearSpec, grading: Grading) -> Figure:
     """A gear measuring machine's chart for the tooth space with the largest total profile deviation: its
     right and left profile traces (deviation against roll length, the three face positions) and helix traces,
-    the evaluation ranges, the design (deviation 0: the traces are deviations from the design, which has no
-    profile or helix modification) and the tolerance band of the gear's class around it (the total tolerance
-    F_aT / F_bT, half each side, as measuring machines print it). The class counts a trace's own spread, not its
-    offset: a flank standing off the design as a whole (tooth size, the finish's scallops on one side) pokes out of
-    the band while its spread is in class."""
+    the evaluation ranges, the design (deviation 0; a modified flank's design trace, its profile or lead
+    modification, with the traces drawn against the unmodified involute or helix) and the tolerance band of the
+    gear's class around it (the total tolerance F_aT / F_bT, half each side, as measuring machines print it).
+    The class counts a trace's own spread, not its offset: a flank standing off the design as a whole (tooth size,
+    the finish's scallops on one side) pokes out of the band while its spread is in class."""
     from spur_cad.grade.iso1328 import tolerance_um
 
     traces = grading.traces
@@ -216,10 +216,13 @@ def k_chart_figure(spec: GearSpec, grading: Grading) -> Figure:
             chosen = [t for t in traces if t.kind == kind and t.side == side and t.space == worst]
             for trace, style in zip(chosen, ("-", "--", ":", "-.") * len(chosen)):  # coinciding traces stay visible
                 label = f"X = {trace.x_mm:.2f} mm" if trace.x_mm is not None else "reference circle"
-                ax.plot(trace.position_mm, trace.deviation_um, style, lw=1.1, label=label)
+                design = 0.0 if trace.design_um is None else trace.design_um
+                ax.plot(trace.position_mm, trace.deviation_um + design, style, lw=1.1, label=label)
                 for edge in trace.evaluation:
                     ax.axvline(edge, color="k", lw=0.5, ls=":")
-            if chosen:
+            if chosen and chosen[0].design_um is not None:  # a modified flank: the design trace, the band about it
+                _design_trace(ax, chosen[0], band)
+            elif chosen:
                 ax.axhline(0.0, color="k", lw=0.8, gid="design")
                 for edge in (-0.5 * band, 0.5 * band):
                     ax.axhline(edge, color="tab:red", lw=0.6, ls="--", gid="tolerance band")
@@ -233,6 +236,15 @@ def k_chart_figure(spec: GearSpec, grading: Grading) -> Figure:
             else:
                 ax.text(0.5, 0.5, "not measured", transform=ax.transAxes, ha="center", fontsize=8)
     return fig
+
+
+def _design_trace(ax, trace, band_um: float) -> None:
+    """A modified flank's design trace on a K-chart panel and the tolerance band about it (half each side)."""
+    order = np.argsort(trace.position_mm)
+    position, design = trace.position_mm[order], trace.design_um[order]
+    ax.plot(position, design, "-", color="k", lw=0.8, gid="design", label="design (modified)")
+    for edge in (-0.5 * band_um, 0.5 * band_um):
+        ax.plot(position, design + edge, "--", color="tab:red", lw=0.6, gid="tolerance band")
 
 
 _PASS_COLOURS = {"flank": "tab:blue", "tip": "tab:green", "land": "tab:purple"}

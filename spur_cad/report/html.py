@@ -151,6 +151,7 @@ def report_context(result: JobResult, images: dict[str, bytes]) -> dict:
         "gouge_within_resolution": (not sim.enabled) or sim.max_gouge_mm <= sim.resolution_mm,
         "simulation_verdict": verdict, "feature_table": sheet.feature_table(result),
         "grading_table": sheet.grading_table(result),
+        "modifications_cut_table": sheet.modifications_cut_table(result),
         "correction": result.correction, "correction_table": sheet.correction_table(result.correction),
         "correction_notes": sheet.correction_notes(result.correction),
         "error_budget_text": sheet.error_budget_text(result),

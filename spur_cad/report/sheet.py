@@ -449,6 +449,15 @@ def grading_table(result: JobResult) -> Table:
                   "class", f"budget's share [{MICRO}]"), rows)
 
 
+def modifications_cut_table(result: JobResult) -> Table:
+    """A modified gear's flank modifications as designed and as cut (ISO 21771 amounts read from the simulated
+    flanks, spur_cad.grade.design_trace), one row per modification and flank side; no rows for an unmodified gear."""
+    cuts = () if result.grading is None else result.grading.modifications_cut or ()
+    return Table(("modification (ISO 21771)", "flank", f"designed [{MICRO}]", f"cut [{MICRO}]", "traces"),
+                 tuple((f"{cut.name} {cut.symbol}", cut.side, number(cut.designed_um, 1), number(cut.cut_um, 1),
+                        str(cut.traces)) for cut in cuts))
+
+
 def error_budget_text(result: JobResult) -> str:
     """The report's sentence on the error budget: what it holds and the expected class."""
     budget = result.error_budget

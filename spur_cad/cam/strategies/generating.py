@@ -131,10 +131,15 @@ class GeneratingStrategy:
                  blank_radius_mm: float, modifications: FlankModifications | None = None,
                  profile_tolerance_mm: float = 0.001) -> tuple[Toolpath, FinishingResult]:
         """The passes planned for the design, moved onto the modified flanks when `modifications` are given
-        (generating_modified; their offsets along X as lines within `profile_tolerance_mm`)."""
+        (generating_modified; their offsets along X as lines within `profile_tolerance_mm`), with a flank pass at
+        each relief's start roll (spur gears: the kink cut exactly)."""
         params.validate()
         machine.validate()
-        plan = plan_generating(spec, tool, params, lands=blank_radius_mm > spec.tip_radius_mm + LAND_ALLOWANCE_MM)
+        kinks = () if modifications is None else tuple(sorted({
+            k / spec.base_radius_mm for side in (modifications.right, modifications.left)
+            for k in side.profile_kinks_roll_mm()}))
+        plan = plan_generating(spec, tool, params, lands=blank_radius_mm > spec.tip_radius_mm + LAND_ALLOWANCE_MM,
+                               kink_rolls_rad=kinks)
         if modifications is not None:
             plan = replace(plan, passes=modified_passes(spec, tool, plan.passes, modifications,
                                                                 profile_tolerance_mm))

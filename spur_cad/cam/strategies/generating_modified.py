@@ -7,6 +7,9 @@ the design moved by the removal spur_cad.geometry.modifications gives, each pass
   over dense points Q of the modified involute (exact at the reliefs' kinks, where the modified flank is convex),
   plus the lead modifications at the face position X. A helical pass touches section X at the effective roll
   t_e = t - side (dY/dX) X / r_b, so even a profile modification makes its offset vary along X.
+  Spur flank passes are turned to touch the modified flank at their planned contacts (a relief turns the flank's
+  tangent; a pass keeping the design's roll would touch 0.6 mm higher and leave 7 um at a 5 um target), with two
+  passes at each relief's start (the kink, which the plan gives a pass of its own).
   Spur flank passes take the "raised" tool end (never lower than the planned one): a rack-end corner moved with
   its flank into the tooth would reach into the fillet, which moves less (found in the simulation: 6 um).
 - **Tip mode.** The modified fillet is the design fillet moved by the form point's removal faded as
@@ -27,7 +30,7 @@ import numpy as np
 
 from spur_cad.cam.strategies.generating_geometry import GeneratingPass, flank_poses
 from spur_cad.cam.tools import Tool, ToolError
-from spur_cad.geometry.frames import turn_points
+from spur_cad.geometry.frames import part_to_machine, turn_points
 from spur_cad.geometry.modifications import FlankModifications
 from spur_cad.geometry.spec import GearSpec
 
@@ -54,6 +57,11 @@ def simplify_polyline(x: np.ndarray, y: np.ndarray, tolerance_mm: float) -> np.n
     return np.array(sorted(keep))
 
 
+def _cross(u: np.ndarray, v: np.ndarray) -> float:
+    """The z component of u x v for plane vectors."""
+    return float(u[0] * v[1] - u[1] * v[0])
+
+
 class FlankSupport:
     """The removal a straight flank pass at design roll t makes to touch one side's modified flank (no lead)."""
 
@@ -65,6 +73,29 @@ class FlankSupport:
         normals = involute.normals(t)
         self.points = involute.points(t) - flank.profile_offset_mm(self.rb * t)[:, None] * normals
         self.involute = involute
+        self.flank = flank
+
+    def modified_point(self, roll: float) -> np.ndarray:
+        """The modified flank's point at design roll t (gap frame, right flank)."""
+        return self._modified(np.array([roll]))[0]
+
+    def _modified(self, t: np.ndarray) -> np.ndarray:
+        t = np.asarray(t, float)
+        return self.involute.points(t) - self.flank.profile_offset_mm(self.rb * t)[:, None] * self.involute.normals(t)
+
+    def pass_roll(self, contact_roll: float, ahead: bool = True) -> float:
+        """The design roll whose tangent (a straight pass's direction) is the modified flank's tangent at
+        `contact_roll`: the contact roll plus the modification's turn of the tangent there (one-sided at a kink:
+        `ahead` toward the tip). A tip relief turns it by about r_b C_a' / L, which moves a pass planned for the
+        design's contact by r_b times that along the line of action (0.6 mm on the test gear)."""
+        h = 1e-6
+        t = np.array([contact_roll, contact_roll + h] if ahead else [contact_roll - h, contact_roll])
+        chord = np.diff(self._modified(t), axis=0)[0]
+        tangent = np.diff(self.involute.points(t), axis=0)[0]
+        following = np.diff(self.involute.points(t + h), axis=0)[0]
+        turn_sense = math.copysign(1.0, _cross(tangent, following))
+        angle = math.atan2(_cross(tangent, chord), float(tangent @ chord))
+        return float(contact_roll + turn_sense * angle)
 
     def removal_mm(self, rolls: np.ndarray) -> np.ndarray:
         """I(t).n(t) - max over the modified flank of Q.n(t), for design rolls t (vectorised)."""
@@ -99,6 +130,36 @@ def _raised_ends(spec: GearSpec, tool: Tool, passes: tuple[GeneratingPass, ...])
     return {(side, float(t)): float(zi) for side in (1, -1) for t, zi in zip(rolls, z)}
 
 
+def _touching_modified_contacts(spec: GearSpec, tool: Tool, passes: tuple[GeneratingPass, ...],
+                                mods: FlankModifications, supports: dict) -> tuple[tuple[GeneratingPass, ...], dict]:
+    """Spur flank passes turned so that each touches the modified flank at its planned contact roll (the pass's
+    design roll plus the modification's turn of the tangent there, FlankSupport.pass_roll); at a relief's start
+    (a kink) two passes, the tangents just below and just above it, both touching the kink. Also {(side, roll):
+    how far each pass's tool end must go below its end for the design (mm): as far as its contact lies below the
+    design's contact of that roll (a relief's contacts lie 0.6 mm lower on the test gear; the raised end alone
+    leaves 7 um there)}."""
+    rb = spec.base_radius_mm
+    kinks = {+1: {k / rb for k in mods.right.profile_kinks_roll_mm()},
+             -1: {k / rb for k in mods.left.profile_kinks_roll_mm()}}
+    out, lowered = [], {}
+    for p in passes:
+        if p.mode != "flank":
+            out.append(p)
+            continue
+        at_kink = any(abs(p.roll_rad - k) < 1e-12 for k in kinks[p.side])
+        ahead_first = p.side > 0  # the right flank's passes run tip -> root, the left's root -> tip
+        sides = ((True, False) if ahead_first else (False, True)) if at_kink else (True,)
+        support = supports[p.side]
+        for ahead in sides:
+            t = support.pass_roll(p.roll_rad, ahead)
+            a, y, z = (float(v[0]) for v in flank_poses(spec, tool, np.array([t]), "rack"))
+            contacts = np.array([support.involute.points(np.array(t)), support.modified_point(p.roll_rad)])
+            design_z, contact_z = part_to_machine(contacts, math.degrees(a))[:, 1]
+            lowered[p.side, t] = max(design_z - contact_z, 0.0)
+            out.append(replace(p, roll_rad=t, a_deg=p.side * math.degrees(a), y_mm=p.side * y, z_mm=z))
+    return tuple(out), lowered
+
+
 def modified_passes(spec: GearSpec, tool: Tool, passes: tuple[GeneratingPass, ...], mods: FlankModifications,
                     tolerance_mm: float) -> tuple[GeneratingPass, ...]:
     """`passes` (one space's, planned for the design) moved onto the modified flanks (see the module docstring)."""
@@ -115,6 +176,9 @@ def modified_passes(spec: GearSpec, tool: Tool, passes: tuple[GeneratingPass, ..
                         "circle unmoved (tip relief); root relief, profile crowning or slope and lead modifications "
                         "would move the fillet, which helical tip mode does not follow yet",
                         section="gear.modifications")
+    lowered = {}
+    if not spec.is_helical:
+        passes, lowered = _touching_modified_contacts(spec, tool, passes, mods, supports)
     raised = {} if spec.is_helical else _raised_ends(spec, tool, passes)
     out = []
     for p in passes:
@@ -133,6 +197,7 @@ def modified_passes(spec: GearSpec, tool: Tool, passes: tuple[GeneratingPass, ..
         else:
             out.append(p)
             continue
-        out.append(replace(p, z_mm=max(p.z_mm, raised.get((p.side, p.roll_rad), p.z_mm)) if p.mode == "flank"
-                           else p.z_mm, path=_path(x, dy, dz, tolerance_mm)))
+        z = (max(p.z_mm, raised.get((p.side, p.roll_rad), p.z_mm)) - lowered.get((p.side, p.roll_rad), 0.0)
+             if p.mode == "flank" else p.z_mm)
+        out.append(replace(p, z_mm=z, path=_path(x, dy, dz, tolerance_mm)))
     return tuple(out)

@@ -115,9 +115,10 @@ def _refuse_gouging_passes(spec: GearSpec, tool: Tool, params: GeneratingParams,
 
 
 def plan_generating(spec: GearSpec, tool: Tool, params: GeneratingParams, *, lands: bool = True,
-                    check: bool = True) -> GeneratingPlan:
+                    check: bool = True, kink_rolls_rad: tuple[float, ...] = ()) -> GeneratingPlan:
     """The passes of tooth space 0 (the land beside it when `lands`, both flanks, fillets and root), in
-    cutting order."""
+    cutting order. `kink_rolls_rad`: involute rolls where a modified flank has a kink (a relief's start), each
+    given a flank pass of its own so the kink is cut exactly (spur gears; a helical pass meets a roll at one X)."""
     params.validate()
     check_generating_tool(spec, tool)
     if spec.is_helical:
@@ -130,6 +131,7 @@ def plan_generating(spec: GearSpec, tool: Tool, params: GeneratingParams, *, lan
                              f"{MAX_PASSES_PER_SPACE:,}) for target_scallop_mm = {target:.3g}; raise [finishing] "
                              "target_scallop_mm", field="target_scallop_mm", section="finishing")
     t_rolls, flat_height = flank_rolls(spec, target)
+    t_rolls = np.union1d(t_rolls, [t for t in kink_rolls_rad if t_rolls[0] < t < t_rolls[-1]])
     betas, roots, tip_leftover = tip_rolls(spec, tool, TIP_MODE_SAFETY * target)
     fa, fy, fz = flank_poses(spec, tool, t_rolls, params.flank_tool_end)
     ba, by, bz = fillet_pose(spec, tool, betas)
