@@ -158,6 +158,7 @@ HARD_MODIFICATIONS = ("[gear.modifications]\ntip_relief_um = 12\ntip_relief_star
 HARD_COMMON = {"tip_relief_um": 12.0, "tip_relief_start_diameter_mm": 37.0, "root_relief_um": 8.0,
                "root_relief_start_diameter_mm": 34.5, "root_relief_shape": "parabolic", "profile_crowning_um": 3.0,
                "lead_crowning_um": 6.0, "end_relief_um": 10.0, "end_relief_length_mm": 2.0}
+SIDES_OF_HARD = ("right", "left")
 HARD_SIDES = {"right": HARD_COMMON,
               "left": {**HARD_COMMON, "tip_relief_um": 6.0, "tip_relief_shape": "parabolic", "profile_slope_um": -2.0,
                        "lead_crowning_um": 3.0, "helix_slope_um": 4.0}}
@@ -278,3 +279,91 @@ def test_a_span_taken_on_a_modified_flank_is_a_warning_with_what_it_reads():
     assert not facts.measured_unmodified
     report = run_job(job).files["report.html"].decode()
     assert "warning: the span anvils touch modified flanks" in report
+
+
+def test_a_loft_through_unmodified_sections_has_the_design_volume():
+    """A negligible lead crowning (0.001 um) makes the gear a loft sewn from B-spline shells: valid, and its volume is
+    the design's (transverse area x face width) within 1e-6, spur and helical."""
+    from OCP.BRepCheck import BRepCheck_Analyzer
+
+    from spur_cad.cad.solid import build_gear_shape, front_face_area_mm2, solid_volume_mm3
+
+    for helix_angle_deg in (0, 20):
+        text = _hard_job(helix_angle_deg).split("[gear.modifications]")[0]
+        job = parse_job(text + "[gear.modifications]\nlead_crowning_um = 0.001\n", "f.toml")
+        lofted, _ = build_gear_shape(job.gear, modifications=job.modifications)
+        design, _ = build_gear_shape(job.gear)
+        assert BRepCheck_Analyzer(lofted).IsValid()
+        design_volume = front_face_area_mm2(design) * job.gear.face_width_mm
+        assert solid_volume_mm3(lofted) == pytest.approx(design_volume, rel=1e-6)
+
+
+def test_the_every_modification_gear_loses_at_least_its_flanks_removal():
+    """The 17-tooth gear with every modification: the volume lost is at least the removal integrated over the
+    involute flanks (first order: flank area element L / r_b dL dX; the fillets lose material besides) and at most
+    the largest removal times a generous tooth surface."""
+    from spur_cad.cad.solid import build_gear_shape, front_face_area_mm2, solid_volume_mm3
+
+    job = parse_job(_hard_job(0), "f.toml")
+    spec = job.gear
+    modified, _ = build_gear_shape(spec, modifications=job.modifications)
+    design, _ = build_gear_shape(spec)
+    lost = front_face_area_mm2(design) * spec.face_width_mm - solid_volume_mm3(modified)
+    rb = spec.base_radius_mm
+    roll = np.linspace(math.sqrt(spec.form_radius_mm**2 - rb**2), math.sqrt(spec.tip_radius_mm**2 - rb**2), 801)
+    x = np.linspace(0.0, spec.face_width_mm, 801)
+    flanks, largest = 0.0, 0.0
+    for side in SIDES_OF_HARD:
+        removal = np.array([_expected_removal_mm(spec, HARD_SIDES[side], roll, xi) for xi in x])
+        assert removal[:, 0].min() > 0.0  # at the form circle: the fillet, moved by it, loses material too
+        flanks += spec.teeth * np.trapezoid(np.trapezoid(removal * roll / rb, roll, axis=1), x)
+        largest = max(largest, removal.max())
+    surface = 2 * spec.teeth * spec.face_width_mm * (spec.tip_radius_mm - spec.root_radius_mm) * 2  # generous
+    assert flanks < lost < largest * surface, (flanks, lost, largest * surface)
+
+
+def test_an_absurd_loft_is_refused_before_it_is_built():
+    import time
+
+    from spur_cad.cad.solid import build_gear_shape
+    from spur_cad.errors import WorkLimitError
+
+    job = parse_job("[gear]\nteeth = 17\nmodule_mm = 2.0\nface_width_mm = 300\nhelix_angle_deg = 45\n"
+                    "[gear.modifications]\nlead_crowning_um = 5\n", "f.toml")
+    start = time.monotonic()
+    with pytest.raises(WorkLimitError) as info:
+        build_gear_shape(job.gear, modifications=job.modifications)
+    assert time.monotonic() - start < 10.0
+    message = str(info.value)
+    turn_deg = math.degrees(300 * math.tan(math.radians(45)) / (17 * 2.0 / math.cos(math.radians(45)) / 2))
+    assert "lofted through about" in message and "limit 1e+06" in message, message
+    assert f"{turn_deg:.0f} degrees" in message, message
+
+
+def _orange_columns(png: bytes) -> np.ndarray:
+    """Column indices of the pixels drawn in the modified profile's colour (#ff7f0e)."""
+    from matplotlib.image import imread
+
+    rgb = imread(io.BytesIO(png), format="png")[..., :3]
+    close = np.abs(rgb - np.array([1.0, 0x7F / 255, 0x0E / 255])).max(axis=-1) < 0.08
+    return np.nonzero(close)[1]
+
+
+def test_the_profile_figure_draws_both_modified_flanks_magnified():
+    from spur_cad.geometry.sampling import sample_profile
+    from spur_cad.pipeline import modified_flank_samples
+    from spur_cad.report.plots import removal_magnification, tooth_space_png
+
+    job = parse_job(_hard_job(0), "f.toml")
+    plain = parse_job(_hard_job(0).split("[gear.modifications]")[0], "f.toml")
+    samples = sample_profile(job.gear.tooth_space_profile(), 0.001)
+    assert modified_flank_samples(plain) is None
+    assert len(_orange_columns(tooth_space_png(plain.gear, samples))) == 0
+    columns = _orange_columns(tooth_space_png(job.gear, samples, modified_flank_samples(job)))
+    middle = 0.5 * (columns.min() + columns.max())
+    assert (columns < middle - 50).sum() > 200 and (columns > middle + 50).sum() > 200  # left and right flanks
+    depth = job.gear.tip_radius_mm - job.gear.root_radius_mm
+    for largest_mm in (0.012, 0.0009, 0.3):
+        factor = removal_magnification(job.gear, largest_mm)
+        assert 0.4 * 0.04 * depth < factor * largest_mm <= 0.04 * depth
+        assert f"{factor:.0e}"[0] in "125"
