@@ -63,6 +63,22 @@ def job_profile_csv(job: Job, samples: ProfileSamples) -> bytes:
     return profile_csv(*sample_modified_profile(modified, job.job.profile_tolerance_mm))
 
 
+def modified_flank_samples(job: Job) -> dict | None:
+    """Each flank side's modified profile at mid-face (X = b/2) and the unmodified points under it, for the
+    report's profile figure; None for an unmodified job."""
+    if job.modifications is None:
+        return None
+    from spur_cad.geometry.modifications import SIDES, modified_tooth_space_profile, sample_modified_profile
+
+    flanks = {}
+    for side in SIDES:
+        modified = modified_tooth_space_profile(job.gear.tooth_space_profile(), job.modifications.side(side),
+                                                job.gear.face_width_mm / 2.0)
+        samples, design = sample_modified_profile(modified, job.job.profile_tolerance_mm)
+        flanks[side] = (samples.points, design)
+    return flanks
+
+
 def run_job(job: Job, progress: Callable[[str, float], None] | None = None,
             checkpoint: Callable[[], None] | None = None, restart: RestartPoint | None = None,
             plan: CamPlan | None = None, correction: dict | None = None) -> JobResult:
@@ -96,7 +112,7 @@ def run_job(job: Job, progress: Callable[[str, float], None] | None = None,
 
     samples = timed("profile", None, lambda: sample_profile(job.gear.tooth_space_profile(),
                                                             job.job.profile_tolerance_mm))
-    png = timed("plot", None, lambda: tooth_space_png(job.gear, samples))
+    png = timed("plot", None, lambda: tooth_space_png(job.gear, samples, modified_flank_samples(job)))
     cad, step = timed("cad_and_step", "CAD and STEP", lambda: build_cad(job, checkpoint, timestamp))
     if plan is None:
         plan = timed("cam", "toolpaths", lambda: plan_cam(job, checkpoint))

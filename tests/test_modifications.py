@@ -150,30 +150,73 @@ def _section_points(shape, x: float, per_edge: int = 200) -> np.ndarray:
     return np.array(points)
 
 
+HARD_MODIFICATIONS = ("[gear.modifications]\ntip_relief_um = 12\ntip_relief_start_diameter_mm = 37\n"
+                      "root_relief_um = 8\nroot_relief_start_diameter_mm = 34.5\nroot_relief_shape = \"parabolic\"\n"
+                      "profile_crowning_um = 3\nlead_crowning_um = 6\nend_relief_um = 10\nend_relief_length_mm = 2\n"
+                      "[gear.modifications.left]\ntip_relief_um = 6\ntip_relief_shape = \"parabolic\"\n"
+                      "profile_slope_um = -2\nlead_crowning_um = 3\nhelix_slope_um = 4\n")
+HARD_COMMON = {"tip_relief_um": 12.0, "tip_relief_start_diameter_mm": 37.0, "root_relief_um": 8.0,
+               "root_relief_start_diameter_mm": 34.5, "root_relief_shape": "parabolic", "profile_crowning_um": 3.0,
+               "lead_crowning_um": 6.0, "end_relief_um": 10.0, "end_relief_length_mm": 2.0}
+SIDES_OF_HARD = ("right", "left")
+HARD_SIDES = {"right": HARD_COMMON,
+              "left": {**HARD_COMMON, "tip_relief_um": 6.0, "tip_relief_shape": "parabolic", "profile_slope_um": -2.0,
+                       "lead_crowning_um": 3.0, "helix_slope_um": 4.0}}
+
+
+def _hard_job(helix_angle_deg: float) -> str:
+    """17 teeth with every modification, different on the two sides (the loft that once took minutes)."""
+    return (f"[gear]\nteeth = 17\nmodule_mm = 2.0\nface_width_mm = 16\nhelix_angle_deg = {helix_angle_deg}\n"
+            + HARD_MODIFICATIONS)
+
+
 def _expected_removal_mm(spec, values: dict, roll, x):
-    """The job's tip relief (linear) and lead crowning at roll length L and face position X, from ISO 21771's
-    definitions and the job's numbers."""
+    """One flank side's removal (mm) at roll length L and face position X, from ISO 21771's definitions and the
+    job's numbers (um; absent keys are 0): reliefs linear or parabolic from their start to the tip / form circle,
+    profile crowning and slope about mid-profile, lead crowning and helix slope about mid-face, end reliefs linear
+    over their length at both faces."""
     rb, b = spec.base_radius_mm, spec.face_width_mm
-    l_start = math.sqrt((values["tip_relief_start_diameter_mm"] / 2) ** 2 - rb**2)
-    l_tip = math.sqrt(spec.tip_radius_mm**2 - rb**2)
-    tip = values["tip_relief_um"] / 1000 * np.maximum(roll - l_start, 0.0) / (l_tip - l_start)
-    return tip + values.get("lead_crowning_um", 0.0) / 1000 * (2 * (x - b / 2) / b) ** 2
+    l_form, l_tip = math.sqrt(spec.form_radius_mm**2 - rb**2), math.sqrt(spec.tip_radius_mm**2 - rb**2)
+    l_mid, l_alpha = (l_form + l_tip) / 2, l_tip - l_form
+    um = {key: value / 1000 for key, value in values.items() if key.endswith("_um")}
+    removal = um.get("profile_crowning_um", 0.0) * (2 * (roll - l_mid) / l_alpha) ** 2 \
+        - um.get("profile_slope_um", 0.0) * (roll - l_mid) / l_alpha
+    if "tip_relief_um" in um:
+        l_start = math.sqrt((values["tip_relief_start_diameter_mm"] / 2) ** 2 - rb**2)
+        s = np.maximum(roll - l_start, 0.0) / (l_tip - l_start)
+        removal = removal + um["tip_relief_um"] * (s**2 if values.get("tip_relief_shape") == "parabolic" else s)
+    if "root_relief_um" in um:
+        l_start = math.sqrt((values["root_relief_start_diameter_mm"] / 2) ** 2 - rb**2)
+        s = np.maximum(l_start - roll, 0.0) / (l_start - l_form)
+        removal = removal + um["root_relief_um"] * (s**2 if values.get("root_relief_shape") == "parabolic" else s)
+    removal = removal + um.get("lead_crowning_um", 0.0) * (2 * (x - b / 2) / b) ** 2 \
+        - um.get("helix_slope_um", 0.0) * (x - b / 2) / b
+    if "end_relief_um" in um:
+        length = values["end_relief_length_mm"]
+        removal = removal + um["end_relief_um"] * (max(length - x, 0.0) + max(x - (b - length), 0.0)) / length
+    return removal
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("text, values", [
+@pytest.mark.parametrize("text, sides", [
     (SPUR, {"tip_relief_um": 15.0, "tip_relief_start_diameter_mm": 98.0, "lead_crowning_um": 10.0}),
     (HELICAL, {"tip_relief_um": 12.0, "tip_relief_start_diameter_mm": 97.5}),
-], ids=["spur tip relief and lead crowning", "helical tip relief"])
-def test_step_sections_are_the_design_involute_moved_by_the_modification(text, values, tmp_path):
-    """Every section point on the usable involute (all teeth, both flanks) lies at the expected removal below the
-    design involute within 1.5 um, and the section covers the whole involute; at three X positions."""
+    (_hard_job(0), HARD_SIDES),
+    (_hard_job(20), HARD_SIDES),
+], ids=["spur tip relief and lead crowning", "helical tip relief", "spur every modification, sides differ",
+        "helical every modification, sides differ"])
+def test_step_sections_are_the_design_involute_moved_by_the_modification(text, sides, tmp_path):
+    """Every section point on the usable involute (all teeth, both flanks, each with its side's modifications)
+    lies at the expected removal below the design involute within 1.5 um, and the section covers the whole
+    involute; at three X positions (inside the end reliefs, mid-face)."""
     from OCP.BRepCheck import BRepCheck_Analyzer
 
     from spur_cad.pipeline import build_cad
 
     job = parse_job(text, "f.toml")
     spec = job.gear
+    if "right" not in sides:
+        sides = {"right": sides, "left": sides}
     _, files = build_cad(job, timestamp="2026-01-01T00:00:00")
     shape = _read_step(files["gear.step"], tmp_path)
     assert BRepCheck_Analyzer(shape).IsValid()
@@ -187,23 +230,24 @@ def test_step_sections_are_the_design_involute_moved_by_the_modification(text, v
         y = yz[:, 0] * math.cos(turn) - yz[:, 1] * math.sin(turn)
         z = yz[:, 0] * math.sin(turn) + yz[:, 1] * math.cos(turn)
         radius = np.hypot(y, z)
-        angle = np.arctan2(y, z)
-        folded = np.abs((angle + pitch / 2) % pitch - pitch / 2)  # into space 0, the left flank mirrored
-        on_involute = (radius > low) & (radius < high) & (folded < pitch / 2 - 1e-3)
-        r, theta = radius[on_involute], folded[on_involute]
-        # Involutes of one base circle are parallel: a point at polar angle theta lies r_b (theta - theta_inv(r))
-        # into the tooth from the design involute, whose foot point has roll length L + removal.
-        pressure = np.arccos(rb / r)
-        removal = rb * (theta - theta_b - (np.tan(pressure) - pressure))
-        roll = np.sqrt(r**2 - rb**2)
-        expected = np.zeros_like(roll)
-        for _ in range(3):
-            expected = _expected_removal_mm(spec, values, roll + expected, x)
-        assert np.abs(removal - expected).max() < 1.5e-3, (x, np.abs(removal - expected).max())
-        gaps = np.diff(np.sort(roll))
-        assert roll.min() < math.sqrt(low**2 - rb**2) + 0.5 and roll.max() > math.sqrt(high**2 - rb**2) - 0.5
-        assert gaps.max() < 0.3, x  # every flank is there, not only some
-        assert on_involute.sum() > 2 * spec.teeth * 20
+        signed = (np.arctan2(y, z) + pitch / 2) % pitch - pitch / 2  # into space 0: + its right flank (+Y)
+        folded = np.abs(signed)  # the left flank mirrored onto the right
+        for side, on_side in (("right", signed > 0), ("left", signed < 0)):
+            on_involute = on_side & (radius > low) & (radius < high) & (folded < pitch / 2 - 1e-3)
+            r, theta = radius[on_involute], folded[on_involute]
+            # Involutes of one base circle are parallel: a point at polar angle theta lies r_b (theta - theta_inv(r))
+            # into the tooth from the design involute, whose foot point has roll length L + removal.
+            pressure = np.arccos(rb / r)
+            removal = rb * (theta - theta_b - (np.tan(pressure) - pressure))
+            roll = np.sqrt(r**2 - rb**2)
+            expected = np.zeros_like(roll)
+            for _ in range(3):
+                expected = _expected_removal_mm(spec, sides[side], roll + expected, x)
+            assert np.abs(removal - expected).max() < 1.5e-3, (x, side, np.abs(removal - expected).max())
+            gaps = np.diff(np.sort(roll))
+            assert roll.min() < math.sqrt(low**2 - rb**2) + 0.5 and roll.max() > math.sqrt(high**2 - rb**2) - 0.5
+            assert gaps.max() < 0.3, (x, side)  # every flank is there, not only some
+            assert on_involute.sum() > spec.teeth * 20
 
 
 def test_the_inspection_sheet_lists_the_modifications_and_says_where_span_and_pins_touch():
@@ -259,3 +303,87 @@ def test_slopes_that_add_more_than_the_finish_stock_are_refused_at_the_key(mods,
     # as much as roughing leaves is accepted, and a job without tools is not checked
     parse_job(text.replace("finish_stock_mm = 0.03", f"finish_stock_mm = {added / 1000:.4f}"), "f.toml")
     parse_job(GEAR + mods, "f.toml")
+
+
+def test_a_loft_through_unmodified_sections_has_the_design_volume():
+    """A negligible lead crowning (0.001 um) makes the gear a loft sewn from B-spline shells: valid, and its volume is
+    the design's (transverse area x face width) within 1e-6, spur and helical."""
+    from OCP.BRepCheck import BRepCheck_Analyzer
+
+    from spur_cad.cad.solid import build_gear_shape, front_face_area_mm2, solid_volume_mm3
+
+    for helix_angle_deg in (0, 20):
+        text = _hard_job(helix_angle_deg).split("[gear.modifications]")[0]
+        job = parse_job(text + "[gear.modifications]\nlead_crowning_um = 0.001\n", "f.toml")
+        lofted, _ = build_gear_shape(job.gear, modifications=job.modifications)
+        design, _ = build_gear_shape(job.gear)
+        assert BRepCheck_Analyzer(lofted).IsValid()
+        design_volume = front_face_area_mm2(design) * job.gear.face_width_mm
+        assert solid_volume_mm3(lofted) == pytest.approx(design_volume, rel=1e-6)
+
+
+def test_the_every_modification_gear_loses_at_least_its_flanks_removal():
+    """The 17-tooth gear with every modification: the volume lost is at least the removal integrated over the
+    involute flanks (first order: flank area element L / r_b dL dX; the fillets lose material besides) and at most
+    the largest removal times a generous tooth surface."""
+    from spur_cad.cad.solid import build_gear_shape, front_face_area_mm2, solid_volume_mm3
+
+    job = parse_job(_hard_job(0), "f.toml")
+    spec = job.gear
+    modified, _ = build_gear_shape(spec, modifications=job.modifications)  # about 3 s (docs/benchmarks.md)
+    design, _ = build_gear_shape(spec)
+    lost = front_face_area_mm2(design) * spec.face_width_mm - solid_volume_mm3(modified)
+    rb = spec.base_radius_mm
+    roll = np.linspace(math.sqrt(spec.form_radius_mm**2 - rb**2), math.sqrt(spec.tip_radius_mm**2 - rb**2), 801)
+    x = np.linspace(0.0, spec.face_width_mm, 801)
+    flanks, largest = 0.0, 0.0
+    for side in SIDES_OF_HARD:
+        removal = np.array([_expected_removal_mm(spec, HARD_SIDES[side], roll, xi) for xi in x])
+        assert removal[:, 0].min() > 0.0  # at the form circle: the fillet, moved by it, loses material too
+        flanks += spec.teeth * np.trapezoid(np.trapezoid(removal * roll / rb, roll, axis=1), x)
+        largest = max(largest, removal.max())
+    surface = 2 * spec.teeth * spec.face_width_mm * (spec.tip_radius_mm - spec.root_radius_mm) * 2  # generous
+    assert flanks < lost < largest * surface, (flanks, lost, largest * surface)
+
+
+def test_an_absurd_loft_is_refused_before_it_is_built():
+    from spur_cad.cad.solid import build_gear_shape
+    from spur_cad.errors import WorkLimitError
+
+    job = parse_job("[gear]\nteeth = 17\nmodule_mm = 2.0\nface_width_mm = 300\nhelix_angle_deg = 45\n"
+                    "[gear.modifications]\nlead_crowning_um = 5\n", "f.toml")
+    with pytest.raises(WorkLimitError) as info:
+        build_gear_shape(job.gear, modifications=job.modifications)
+    message = str(info.value)
+    turn_deg = math.degrees(300 * math.tan(math.radians(45)) / (17 * 2.0 / math.cos(math.radians(45)) / 2))
+    assert "lofted through about" in message and "limit 1e+06" in message, message
+    assert f"{turn_deg:.0f} degrees" in message, message
+
+
+def _orange_columns(png: bytes) -> np.ndarray:
+    """Column indices of the pixels drawn in the modified profile's colour (#ff7f0e)."""
+    from matplotlib.image import imread
+
+    rgb = imread(io.BytesIO(png), format="png")[..., :3]
+    close = np.abs(rgb - np.array([1.0, 0x7F / 255, 0x0E / 255])).max(axis=-1) < 0.08
+    return np.nonzero(close)[1]
+
+
+def test_the_profile_figure_draws_both_modified_flanks_magnified():
+    from spur_cad.geometry.sampling import sample_profile
+    from spur_cad.pipeline import modified_flank_samples
+    from spur_cad.report.plots import removal_magnification, tooth_space_png
+
+    job = parse_job(_hard_job(0), "f.toml")
+    plain = parse_job(_hard_job(0).split("[gear.modifications]")[0], "f.toml")
+    samples = sample_profile(job.gear.tooth_space_profile(), 0.001)
+    assert modified_flank_samples(plain) is None
+    assert len(_orange_columns(tooth_space_png(plain.gear, samples))) == 0
+    columns = _orange_columns(tooth_space_png(job.gear, samples, modified_flank_samples(job)))
+    middle = 0.5 * (columns.min() + columns.max())
+    assert (columns < middle - 50).sum() > 200 and (columns > middle + 50).sum() > 200  # left and right flanks
+    depth = job.gear.tip_radius_mm - job.gear.root_radius_mm
+    for largest_mm in (0.012, 0.0009, 0.3):
+        factor = removal_magnification(job.gear, largest_mm)
+        assert 0.4 * 0.04 * depth < factor * largest_mm <= 0.04 * depth
+        assert f"{factor:.0e}"[0] in "125"

@@ -44,10 +44,39 @@ def _png(fig: Figure) -> bytes:
     return buffer.getvalue()
 
 
-def tooth_space_png(spec: GearSpec, samples: ProfileSamples) -> bytes:
-    """The tooth space (right half as sampled, left half mirrored), segments coloured, key circles dashed."""
+MODIFIED_COLOUR = "#ff7f0e"
+MODIFIED_SHARE_OF_DEPTH = 0.04
+"""A modified gear's plotted removal is magnified so that its largest amount shows as about this share of the
+tooth depth (micrometres would not show on a millimetre plot)."""
+
+
+def removal_magnification(spec: GearSpec, largest_removal_mm: float) -> float:
+    """A round factor (1, 2 or 5 x 10^n) showing `largest_removal_mm` as about 4 % of the tooth depth."""
+    wanted = MODIFIED_SHARE_OF_DEPTH * (spec.tip_radius_mm - spec.root_radius_mm) / max(largest_removal_mm, 1e-9)
+    decade = 10.0 ** np.floor(np.log10(wanted))
+    return float(max(step * decade for step in (1.0, 2.0, 5.0) if step * decade <= wanted))
+
+
+def _plot_modified_flanks(ax, spec: GearSpec, flanks: dict) -> None:
+    """The modified flanks (`flanks`: side -> (modified points, unmodified points), right-half gap frame) with their
+    removal magnified; the left side drawn mirrored."""
+    largest = max(float(np.linalg.norm(modified - design, axis=1).max()) for modified, design in flanks.values())
+    factor = removal_magnification(spec, largest)
+    for side, (modified, design) in flanks.items():
+        shown = design + factor * (modified - design)
+        mirror = -1.0 if side == "left" else 1.0
+        ax.plot(mirror * shown[:, 0], shown[:, 1], "--", color=MODIFIED_COLOUR, lw=1.4, zorder=3,
+                label=f"modified at mid-face (removal x {factor:g})" if side == "right" else None)
+
+
+def tooth_space_png(spec: GearSpec, samples: ProfileSamples, modified_flanks: dict | None = None) -> bytes:
+    """The tooth space (right half as sampled, left half mirrored), segments coloured, key circles dashed; with
+    `modified_flanks` (side -> (modified points, unmodified points)) a modified gear's flanks over it, their
+    removal magnified."""
     fig = figure(8.0, 5.5, left=0.08, right=0.86, bottom=0.09, top=0.94)  # room for the circles' names
     ax = fig.add_subplot(1, 1, 1)
+    if modified_flanks:
+        _plot_modified_flanks(ax, spec, modified_flanks)
     for index, label in enumerate(SEGMENT_LABELS):
         mask = samples.labels == index
         if not mask.any():
