@@ -15,8 +15,9 @@ the design moved by the removal spur_cad.geometry.modifications gives, each pass
 - **Tip mode.** The modified fillet is the design fillet moved by the form point's removal faded as
   (beta / beta_F)^2 along the form point's normal (spur_cad.geometry.modifications.modified_tooth_space_profile);
   each fillet pass moves with its contact point. Root passes are not moved (the root is not modified). Helical
-  gears: only modifications that leave the form point where it is (tip relief, a profile crowning or slope
-  balanced to zero there is not checked for) are cut; others are refused.
+  fillet passes touch a different fillet point in each section X (`helical_fillet_parameters`) and move by its
+  faded removal along the form normal turned with the section. Helical gears with lead modifications are refused:
+  their flank passes' end corners, moved sideways by the lead amount, gouge the fillet (5.5 um for 10 um crowning).
 - The offset along X is sampled every `X_SAMPLE_MM` over the face and reduced to the fewest breakpoints whose
   lines stay within the chordal tolerance ([job] profile_tolerance_mm); outside the face the end values hold.
 """
@@ -28,10 +29,13 @@ from dataclasses import replace
 
 import numpy as np
 
+from spur_cad.cam.ir import Feature
 from spur_cad.cam.strategies.generating_geometry import GeneratingPass, flank_poses
+from spur_cad.cam.strategies.generating_helical import CORNER_MATCH_MM
 from spur_cad.cam.tools import Tool, ToolError
-from spur_cad.geometry.frames import part_to_machine, turn_points
+from spur_cad.geometry.frames import part_to_machine
 from spur_cad.geometry.modifications import FlankModifications
+from spur_cad.geometry.profile import rack_corner
 from spur_cad.geometry.spec import GearSpec
 
 X_SAMPLE_MM = 0.02
@@ -160,6 +164,31 @@ def _touching_modified_contacts(spec: GearSpec, tool: Tool, passes: tuple[Genera
     return tuple(out), lowered
 
 
+def helical_fillet_parameters(spec: GearSpec, tool: Tool, p: GeneratingPass, x: np.ndarray,
+                              fillet) -> np.ndarray:
+    """The fillet parameter (the normal-section angle b on the rack round, 0 at the root, clipped to beta_F) that a
+    helical tip-mode pass touches in each section X: the round itself (r_t = rho) touches section X where the
+    fillet's generating roll equals the section's effective roll side (phi + turn(X)); a smaller corner touches
+    only at its own contact angle b, read back from its position (corner centre = round centre + (rho - r_t)
+    (sin b, -cos b); the contacts on the flank line above T lie beyond beta_F)."""
+    rho, r_t = spec.rack_tip_radius_mm, tool.effective_corner_radius_mm
+    if abs(r_t - rho) <= CORNER_MATCH_MM:
+        grid = np.linspace(fillet.start, fillet.end, 2001)
+        rolls = fillet.roll_angle(grid)
+        if not np.all(np.diff(rolls) < 0.0):
+            raise ToolError("generating finishing of a modified helical gear: the fillet's generating roll is not "
+                            "monotonic in the rack round's angle; its tip passes cannot follow the modified fillet",
+                            section="gear.modifications")
+        effective = p.side * (p.roll_rad + np.array([spec.section_turn_rad(xi) for xi in x]))
+        return np.interp(effective, rolls[::-1], grid[::-1])  # beyond the ends: the ends
+    corner = rack_corner(spec)
+    across = (p.side * (p.y_mm + spec.reference_radius_mm * p.roll_rad) * math.cos(spec.helix_angle_rad)
+              - (corner.normal_corner_offset_mm - tool.flat_width_mm / 2.0))
+    up = p.z_mm - (spec.root_radius_mm + rho - r_t)
+    b = math.atan2(across, -up)
+    return np.full(len(x), min(max(b, 0.0), fillet.end))
+
+
 def modified_passes(spec: GearSpec, tool: Tool, passes: tuple[GeneratingPass, ...], mods: FlankModifications,
                     tolerance_mm: float) -> tuple[GeneratingPass, ...]:
     """`passes` (one space's, planned for the design) moved onto the modified flanks (see the module docstring)."""
@@ -171,10 +200,10 @@ def modified_passes(spec: GearSpec, tool: Tool, passes: tuple[GeneratingPass, ..
     sides = {+1: mods.right, -1: mods.left}
     form_normal = involute.normals(np.array(involute.start))
     form_removal = {s: float(sides[s].profile_offset_mm(spec.base_radius_mm * involute.start)) for s in sides}
-    if spec.is_helical and any(abs(form_removal[s]) > 1e-9 or sides[s].has_lead for s in sides):
-        raise ToolError("generating finishing of a helical gear cuts only flank modifications that leave the form "
-                        "circle unmoved (tip relief); root relief, profile crowning or slope and lead modifications "
-                        "would move the fillet, which helical tip mode does not follow yet",
+    if spec.is_helical and mods.has_lead:
+        raise ToolError("generating finishing of a helical gear cuts profile modifications only; lead modifications "
+                        "move the flank passes sideways by up to their amount at the faces, and their end corners, "
+                        "near the root, would gouge the fillet (5.5 um for a 10 um lead crowning)",
                         section="gear.modifications")
     lowered = {}
     if not spec.is_helical:
@@ -188,11 +217,15 @@ def modified_passes(spec: GearSpec, tool: Tool, passes: tuple[GeneratingPass, ..
             rolls = p.roll_rad - side * p.dy_per_x * x / spec.base_radius_mm
             removal = supports[side].removal_mm(rolls) + lead
             dy, dz = side * removal, np.zeros_like(x)
-        elif p.mode == "tip" and not math.isnan(p.beta_rad) and fillet is not None and fillet.end > 0.0:
-            fade = (p.beta_rad / fillet.end) ** 2
-            removal = (form_removal[side] + lead) * fade
+        elif p.mode == "tip" and fillet is not None and fillet.end > 0.0 \
+                and (p.feature != Feature.ROOT if spec.is_helical else not math.isnan(p.beta_rad)):
+            beta = helical_fillet_parameters(spec, tool, p, x, fillet) if spec.is_helical else p.beta_rad
+            removal = (form_removal[side] + lead) * (beta / fillet.end) ** 2
             normal = form_normal * np.array([1.0 if side > 0 else -1.0, 1.0])
-            moved = -removal[:, None] * turn_points(normal[None, :], math.radians(p.a_deg))[0][None, :]
+            # section X lies turned by its turn (0 for a spur gear): the form normal turns with it
+            turns = math.radians(p.a_deg) + np.array([spec.section_turn_rad(xi) for xi in x])
+            moved = -removal[:, None] * np.stack([normal[0] * np.cos(turns) - normal[1] * np.sin(turns),
+                                                  normal[0] * np.sin(turns) + normal[1] * np.cos(turns)], axis=-1)
             dy, dz = moved[:, 0], moved[:, 1]
         else:
             out.append(p)
