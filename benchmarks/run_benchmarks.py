@@ -135,6 +135,7 @@ def main() -> None:
     parser.add_argument("--sim-runs", type=int, default=5)
     parser.add_argument("--run-runs", type=int, default=3, help="spur-cad run end to end, generating and perimeter")
     args = parser.parse_args()
+    from benchmarks.bench_flat import figures as flat_figures
     from benchmarks.bench_generating import REFERENCE_JOB, end_to_end_seconds, figures
     from benchmarks.bench_helical import HELICAL_JOB
     from benchmarks.bench_helical import figures as helical_figures
@@ -156,6 +157,7 @@ def main() -> None:
                "verify": verify_figures(args.run_runs), "verify_large": large_program_figures(args.run_runs),
                "shop_floor": shop_floor_figures(args.run_runs), "roughing": roughing_figures(args.run_runs),
                "roughing_two_stage": two_stage_figures(),
+               "modified_ring_flat": flat_figures(args.cad_runs),
                "fresh_runs": run_figures(args.cad_runs), "workbench_generate": workbench_figures(),
                "run_s": {strategy: end_to_end_seconds(strategy, args.run_runs)
                          for strategy in ("generating", "perimeter")}}
