@@ -51,6 +51,12 @@ NUMBER_DECIMALS = 6
 REVALIDATE_DELAY_MS = 250  # typing: check once the keys pause (a check plans roughing levels: up to 0.5 s)
 
 
+def quantity_unit(field) -> str:
+    """The unit a quantity field is set and read in: the key's own for micrometres (machine accuracy), else its
+    kind's (mm, deg, mm/min)."""
+    return field.unit if field.unit in schema.SET_IN_KEY_UNIT else QUANTITY_UNITS[field.kind]
+
+
 def _policy(name: str):
     """A QSizePolicy.Policy member (scoped name on PySide6, see compat.qt_enum)."""
     return compat.qt_enum(QtGui.QSizePolicy, "Policy", name)
@@ -310,7 +316,7 @@ class JobTaskPanel:
 
     def _quantity_box(self, field, value):
         """FreeCAD's unit-aware spin box (any number: spur_cad's own messages judge it), or None without one."""
-        unit = QUANTITY_UNITS[field.kind]
+        unit = quantity_unit(field)
         widget = compat.quantity_spin_box(FreeCADGui.UiLoader(), unit, -BIG, BIG)
         if widget is None:
             return None
@@ -344,7 +350,7 @@ class JobTaskPanel:
             return exact
         if isinstance(widget, QtGui.QDoubleSpinBox):
             return float(widget.value()) * self._per_unit.get(field.prop, 1.0)
-        return compat.spin_box_value(widget, FreeCAD.Units, QUANTITY_UNITS[field.kind])
+        return compat.spin_box_value(widget, FreeCAD.Units, quantity_unit(field))
 
     def job_values(self) -> dict:
         """The job property values as the panel's widgets hold them."""
@@ -365,7 +371,7 @@ class JobTaskPanel:
             widget.setValue(float(value) / self._per_unit.get(prop, 1.0))
             self._shown[prop] = (widget.text(), float(value))
         else:
-            unit = QUANTITY_UNITS[schema.field_by_prop(prop).kind]
+            unit = quantity_unit(schema.field_by_prop(prop))
             self._show_quantity(widget, float(value), unit)
             self._shown[prop] = (widget.text(), float(value))
         show_start(self.widgets[prop])
