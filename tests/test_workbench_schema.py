@@ -461,6 +461,25 @@ def test_index_move_is_drawn_as_an_arc_around_the_axis(wb):
     assert end_angle == pytest.approx(90.0)  # the part point now under the tool was 90 deg toward +Y
 
 
+def test_a_3_axis_program_is_drawn_lying_flat_with_its_arcs_as_arcs(wb):
+    """Gear axis = machine Z (Z0 the top face, drawn at the part's x = b), machine X, Y = the part's y, z: a
+    clockwise half circle of radius 30 about the axis at Z -4 stays on the circle at x = b - 4, from machine +Y
+    over +X to -Y (the part's +z, +y, -z)."""
+    face_width = 20.0
+    builder = ToolpathBuilder(Operation.FINISHING, 1, 1000.0)
+    builder.move(MoveKind.RAPID, 0.0, 30.0, 5.0, 0.0)
+    builder.move(MoveKind.LINEAR, 0.0, 30.0, -4.0, 0.0, 100.0)
+    builder.arc(True, 0.0, -30.0, -4.0, 0.0, 0.0, 500.0)
+    shown = wb.display.display_flat_path(builder.build(), face_width)
+    on_arc = shown.points[3:]
+    assert np.allclose(np.hypot(on_arc[:, 1], on_arc[:, 2]), 30.0) and np.allclose(on_arc[:, 0], face_width - 4.0)
+    assert len(on_arc) >= 180 / wb.display.MAX_ARC_STEP_DEG
+    assert np.allclose(shown.points[0], [face_width + 5.0, 0.0, 30.0])  # the rapid's start: above the top face
+    assert on_arc[:, 1].min() > -1e-9 and on_arc[:, 1].max() == pytest.approx(30.0)  # clockwise: through +X
+    assert np.allclose(on_arc[-1], [face_width - 4.0, 0.0, -30.0])
+    assert list(shown.rapid[:2]) == [True, True] and not shown.rapid[2:].any()
+
+
 def test_large_programs_show_whole_stations_first_and_last(wb):
     builder = ToolpathBuilder(Operation.FINISHING, 2, 1000.0)
     for station in range(40):

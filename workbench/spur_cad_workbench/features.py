@@ -353,10 +353,11 @@ class JobFeature(_Proxy):
             outputs[f"{title}Time"] = op.seconds / 60.0 if op is not None else 0.0
             outputs[f"{title}TimeWithAcceleration"] = op.seconds_with_acceleration / 60.0 if op is not None else 0.0
             outputs[f"{title}ProgramLines"] = op.program_lines if op is not None else 0
+        flat = job.gear.face_width_mm if job.machine.axes == 3 else None  # drawn lying flat
         for name in schema.TOOL_ROLES:  # the bottom tool's program has no toolpath object (see workbench/README.md)
             target = getattr(obj, f"{name.capitalize()}Toolpath")
             if target is not None:
-                update_toolpath(target, getattr(plan, name))
+                update_toolpath(target, getattr(plan, name), flat)
         write_outputs(obj, outputs)
         for dependant in dependants(obj):
             if getattr(dependant.Proxy, "KIND", "") != "simulation":
@@ -397,17 +398,18 @@ def uses_path_module(obj) -> bool:
     return obj.isDerivedFrom("Path::Feature")
 
 
-def update_toolpath(obj, planned) -> None:
+def update_toolpath(obj, planned, flat_face_width_mm: float | None = None) -> None:
     """Draw a planned operation (spur_cad.cam.plan RoughingPlan / FinishingPlan, or None) into the toolpath
-    object and set its computed properties."""
-    from spur_cad_workbench.display import display_path, gcode_text, polylines
+    object and set its computed properties; `flat_face_width_mm`: the gear's face width for a 3-axis program
+    (drawn with the gear lying flat, display.display_flat_path)."""
+    from spur_cad_workbench.display import display_flat_path, display_path, gcode_text, polylines
 
     path = planned.toolpath if planned is not None else None
     if path is None:
         drawn, moves, outputs = None, 0, {"Moves": 0, "DisplayedMoves": 0, "CuttingLength": 0.0,
                                           "EstimatedTime": 0.0, "ToolNumber": 0, "SpindleSpeed": 0.0}
     else:
-        drawn = display_path(path)
+        drawn = display_path(path) if flat_face_width_mm is None else display_flat_path(path, flat_face_width_mm)
         moves = drawn.moves_shown
         outputs = {"Moves": int(planned.estimate.moves), "DisplayedMoves": int(moves),
                    "CuttingLength": float(planned.estimate.cutting_length_mm),
