@@ -233,22 +233,27 @@ class GearFeature(_Proxy):
             fail(obj, exc)
             return
         spec, sheet = job.gear, inspection_facts(job.gear)
-        write_outputs(obj, {
+        outputs = {
             "ReferenceRadius": spec.reference_radius_mm, "BaseRadius": spec.base_radius_mm,
             "TipRadius": spec.tip_radius_mm, "RootRadius": spec.root_radius_mm, "FormRadius": spec.form_radius_mm,
             "ToothThickness": spec.tooth_thickness_mm, "SpanTeeth": sheet.span_teeth_k,
             "SpanMeasurement": sheet.span_measurement_mm, "PinDiameter": sheet.pin_diameter_mm,
             "DimensionOverPins": sheet.dimension_over_pins_mm, "Undercut": bool(spec.undercut),
             "UndercutDepth": spec.undercut_depth_mm,
-            "MinTeethWithoutUndercut": sheet.min_teeth_without_undercut})
-        write_outputs(obj, precise_outputs(obj))
+            "MinTeethWithoutUndercut": sheet.min_teeth_without_undercut}
+        # a ring has no span (and a helical gear none where the anvils do not fit the face): 0, its text "none"
+        missing = {prop for prop, value in outputs.items() if value is None}
+        write_outputs(obj, {prop: 0 if prop in missing else value for prop, value in outputs.items()})
+        write_outputs(obj, precise_outputs(obj, missing))
         set_shape(obj, part_shape(shape))
         report(obj, None)
 
 
-def precise_outputs(obj) -> dict[str, str]:
-    """The gear's length outputs as text to 0.1 um in the user's unit schema (schema.PRECISE)."""
-    return {f"{field.prop}{schema.PRECISE_SUFFIX}": units.inspection_text(getattr(obj, field.prop).Value, FreeCAD.Units)
+def precise_outputs(obj, missing: set[str] = frozenset()) -> dict[str, str]:
+    """The gear's length outputs as text to 0.1 um in the user's unit schema (schema.PRECISE); "none" for the
+    `missing` ones (the gear has no such value)."""
+    return {f"{field.prop}{schema.PRECISE_SUFFIX}": "none" if field.prop in missing else
+            units.inspection_text(getattr(obj, field.prop).Value, FreeCAD.Units)
             for field in schema.GEAR_OUTPUTS if field.kind == "length"}
 
 

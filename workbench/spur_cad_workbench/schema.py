@@ -92,7 +92,8 @@ ANGLE_PROPERTY_LIMIT_DEG = 360.0  # App::PropertyAngle clamps values to [-360, 3
 class Field:
     """One FreeCAD property holding one job-file key (`section`, `key`), or a computed output (no key).
 
-    `unit` is the job-file unit of the value (the key's); `choices` the drop-down list of a choice.
+    `unit` is the job-file unit of the value (the key's); `choices` the drop-down list of a choice, or the values
+    an int key takes (the panel offers them in a drop-down list; the property stays a PropertyInteger).
     """
 
     prop: str
@@ -138,7 +139,7 @@ def _key_field(section: str, k) -> Field:
     kind = property_kind(k)
     doc = k.meaning if not k.unit or kind in UNIT_CARRYING else f"{k.meaning} ({k.unit})"
     return Field(k.label.format(Role=role), kind, k.group.format(Role=role), section, k.name, doc,
-                 tuple(str(n) for n in k.names) if kind == "choice" else (), k.unit)
+                 tuple(str(n) for n in k.names) if kind in ("choice", "int") else (), k.unit)
 
 
 # The switch that says whether the job file has the [tools.<role>] section at all.
@@ -226,10 +227,12 @@ GEAR_OUTPUTS = (
     _f("RootRadius", "length", COMPUTED, "", "", "root radius r_f"),
     _f("FormRadius", "length", COMPUTED, "", "", "radius where the involute starts (fillet junction)"),
     _f("ToothThickness", "length", COMPUTED, "", "", "design tooth thickness on the reference circle (arc)"),
-    _f("SpanTeeth", "int", INSPECTION, "", "", "teeth spanned k for the span measurement"),
-    _f("SpanMeasurement", "length", INSPECTION, "", "", "span measurement (base tangent length) W_k"),
+    _f("SpanTeeth", "int", INSPECTION, "", "", "teeth spanned k for the span measurement (0: none)"),
+    _f("SpanMeasurement", "length", INSPECTION, "", "", "span measurement (base tangent length) W_k (0: none, an "
+                                                         "internal gear has no span)"),
     _f("PinDiameter", "length", INSPECTION, "", "", "pin (ball) diameter for the dimension over pins"),
-    _f("DimensionOverPins", "length", INSPECTION, "", "", "dimension over two pins M"),
+    _f("DimensionOverPins", "length", INSPECTION, "", "", "dimension over two pins M (an internal gear: between "
+                                                          "two pins)"),
     _f("Undercut", "bool", INSPECTION, "", "", "the rack's tip corner undercuts the involute"),
     _f("UndercutDepth", "length", INSPECTION, "", "", "depth of the undercut (0 without undercut)"),
     _f("MinTeethWithoutUndercut", "int", INSPECTION, "", "", "fewest teeth generated without undercut"),
@@ -409,7 +412,9 @@ _TITLES = {"UseRoughingTool": "Rough with this tool", "UseFinishingTool": "Finis
            "SimulationResolution": "Resolution", "PostDialect": "Dialect", "JobName": "Name",
            "MachineName": "Name", "ThicknessAllowancePercent": "Thickness allowance (%)",
            "ProfileShift": "Profile shift coefficient x", "LeftFlankOwnValues": "Own values for the left flank",
-           "RightFlankOwnValues": "Own values for the right flank"}
+           "RightFlankOwnValues": "Own values for the right flank", "MachineAxes": "Axes (4: rotary table, 3: flat)",
+           "ExportDxf": "Write gear.dxf", "ExportSvg": "Write gear.svg",
+           "ExportOffset": "Offset (wire radius + gap, half kerf)"}
 
 
 def title(field: Field) -> str:
