@@ -329,6 +329,8 @@ def modification_chart_figure(mods: FlankModifications, base_radius_mm: float, w
     droop below the unmodified design at 0): the profile against roll length L (diameter on the top axis), from
     the form to the tip circle, and the lead against the face position X, both flanks (right solid, left
     dashed). `stacked`: profile above lead (a narrow task panel), else side by side."""
+    from matplotlib.ticker import MaxNLocator
+
     right = mods.side("right")
     rolls = np.linspace(right.form_roll_mm, right.tip_roll_mm, 400)
     faces = np.linspace(0.0, right.face_width_mm, 400)
@@ -362,6 +364,7 @@ def modification_chart_figure(mods: FlankModifications, base_radius_mm: float, w
         return np.sqrt(np.maximum((np.asarray(diam, dtype=float) / 2.0) ** 2 - base_radius_mm ** 2, 0.0))
 
     top = profile_ax.secondary_xaxis("top", functions=(diameter, roll))
+    top.xaxis.set_major_locator(MaxNLocator(4 if stacked else 8))  # a narrow chart's diameters never overlap
     top.set_xlabel("diameter [mm]", fontsize=size)
     top.tick_params(labelsize=size)
     profile_ax.set_xlabel("roll length L [mm]" if stacked else "roll length L [mm] (form to tip)", fontsize=size)
