@@ -144,8 +144,8 @@ class GearSection:
 
 def _amount(label: str, meaning: str, signed: bool = False):
     """A modification amount key (um): 0 = none; beyond 10 % of the module is refused with the gear."""
-    return key(0.0, unit="um", low=-10000.0 if signed else 0.0, high=10000.0, label=label, group="Modifications",
-               meaning=meaning)
+    return key(0.0, unit="um", low=-10000.0 if signed else 0.0, high=10000.0, label=label,
+               group="Flank modifications", meaning=meaning)
 
 
 @dataclass(frozen=True)
@@ -157,18 +157,19 @@ class ModificationsSection:
 
     tip_relief_um: float = _amount("TipRelief", "tip relief C_a: removed at the tip diameter")
     tip_relief_start_diameter_mm: float = key(0.0, unit="mm", low=0.0, high=5000.0, label="TipReliefStartDiameter",
-                                              group="Modifications",
+                                              group="Flank modifications",
                                               meaning="diameter d_Ca where the tip relief starts (needed with it)")
     tip_relief_shape: str = key("linear", choices=("linear", "parabolic"), label="TipReliefShape",
-                                group="Modifications", meaning="tip relief along the roll length: linear or parabolic")
+                                group="Flank modifications",
+                                meaning="tip relief along the roll length: linear or parabolic")
     root_relief_um: float = _amount("RootRelief", "root relief C_f: removed at the form diameter (start of the "
                                                   "usable involute)")
     root_relief_start_diameter_mm: float = key(0.0, unit="mm", low=0.0, high=5000.0, label="RootReliefStartDiameter",
-                                               group="Modifications",
+                                               group="Flank modifications",
                                                meaning="diameter d_Cf where the root relief starts, toward the root "
                                                        "(needed with it)")
     root_relief_shape: str = key("linear", choices=("linear", "parabolic"), label="RootReliefShape",
-                                 group="Modifications",
+                                 group="Flank modifications",
                                  meaning="root relief along the roll length: linear or parabolic")
     profile_crowning_um: float = _amount("ProfileCrowning", "profile crowning C_alpha: removed at both ends of the "
                                                             "usable involute, parabolic, none at its middle")
@@ -179,10 +180,10 @@ class ModificationsSection:
                                                       "at mid-face")
     end_relief_um: float = _amount("EndRelief", "end relief C_I / C_II: removed at the face(s), linear")
     end_relief_length_mm: float = key(0.0, unit="mm", low=0.0, high=2000.0, label="EndReliefLength",
-                                      group="Modifications",
+                                      group="Flank modifications",
                                       meaning="length L_I / L_II of the end relief from the face (needed with it)")
     end_relief_faces: str = key("both", choices=("both", "front", "back"), label="EndReliefFaces",
-                                group="Modifications",
+                                group="Flank modifications",
                                 meaning="faces with end relief: both, front (X = 0) or back (X = b)")
     helix_slope_um: float = _amount("HelixSlope", "design helix slope f_Hbeta: the material grows by this from the "
                                                   "front face to the back face (signed, none at mid-face)",
@@ -194,7 +195,7 @@ MODIFICATION_SECTIONS: dict[str, type] = {
     "gear.modifications.left": ModificationsSection,
     "gear.modifications.right": ModificationsSection,
 }
-"""The flank modification tables: read with [gear] (not workbench properties yet)."""
+"""The flank modification tables: read with [gear] (in the workbench, the gear's "Flank modifications" groups)."""
 
 
 @dataclass(frozen=True)
@@ -265,6 +266,9 @@ class Job:
     lathe: LatheSection | None = None  # [lathe] present: the blank's lathe program is written too
     probe: ProbeSection | None = None  # [probe] present: the on-machine probing program is written too
     modifications: FlankModifications | None = None  # [gear.modifications]: None when it sets no amount
+    # {table name: every key's value} of the [gear.modifications] tables the file gives, a side's with the common
+    # table's values where it gives none (the workbench's properties hold them as given)
+    modification_values: dict[str, dict] = field(default_factory=dict, repr=False, compare=False)
     text: str = field(default="", repr=False, compare=False)  # the file's text, to point at lines
     report_template_text: str | None = field(default=None, repr=False, compare=False)  # [job] report_template's
     rotary_calibration: CalibrationTable | None = field(default=None, repr=False, compare=False)  # [machine]'s file
@@ -651,19 +655,23 @@ def _split_modifications(data: object, source: str, text: str) -> tuple[object, 
     return {**data, "gear": gear}, tables
 
 
-def _modifications(tables: dict[str, dict], spec: GearSpec, source: str, text: str) -> FlankModifications | None:
+def _modifications(tables: dict[str, dict], spec: GearSpec, source: str,
+                   text: str) -> tuple[FlankModifications | None, dict[str, dict]]:
     """Both flank sides' modifications from the [gear.modifications] tables (a side's table overrides the keys it
-    gives), checked against the gear; None when no amount is set. Errors name the key's line in the table that
-    gives it."""
+    gives), checked against the gear (None when no amount is set), and {table name: its keys' values} of the tables
+    given (a side's resolved). Errors name the key's line in the table that gives it."""
     if not tables:
-        return None
+        return None, {}
     common = _load_section(tables["gear.modifications"], "gear.modifications", source, text, MODIFICATION_SECTIONS)
+    given_values = {"gear.modifications": dataclasses.asdict(common)}
     sides = {}
     for side in SIDES:
         name = f"gear.modifications.{side}"
         given = tables.get(name, {})
         own = _load_section(given, name, source, text, MODIFICATION_SECTIONS)
         values = {k.name: getattr(own if k.name in given else common, k.name) for k in keys_of(ModificationsSection)}
+        if name in tables:
+            given_values[name] = values
         try:
             sides[side] = flank_modification(values, spec.base_radius_mm, spec.form_radius_mm, spec.tip_radius_mm,
                                              spec.module_mm, spec.face_width_mm)
@@ -674,7 +682,7 @@ def _modifications(tables: dict[str, dict], spec: GearSpec, source: str, text: s
             raise JobFileError(f"{_where(source, text, table, exc.field)}: [{table}] {exc}", section=table,
                                field=exc.field) from None
     modifications = FlankModifications(**sides)
-    return None if modifications.is_zero else modifications
+    return (None if modifications.is_zero else modifications), given_values
 
 
 def _check_added_material(mods: FlankModifications | None, finish_stock_mm: float, tables: dict[str, dict], source: str,
@@ -721,7 +729,7 @@ def _job_from_data(data: dict, source: str, text: str, strategies: Strategies = 
         raise JobFileError(f"{where('gear', 'internal')}: internal = true: the rotary table cannot cut an internal "
                            "gear (its tool cannot reach inside the ring along the rotary axis); cut it with [machine] "
                            "axes = 3 or leave out [tools]", section="gear", field="internal")
-    modifications = _modifications(modification_tables, spec, source, text)
+    modifications, modification_values = _modifications(modification_tables, spec, source, text)
     for check, name in ((gear_section.blank_features().validate, "gear"),
                         (sections.get("stock", StockSpec()).validate, "stock")):
         try:
@@ -755,7 +763,7 @@ def _job_from_data(data: dict, source: str, text: str, strategies: Strategies = 
     finishing = sections["finishing"] if "finishing" in sections else types["finishing"]()  # the registry's default
     return Job(source=source, job=sections.get("job", JobSection()), gear_section=gear_section, gear=spec,
                tools=tools, finishing=finishing, **optional, text=text, strategies=dict(strategies),
-               modifications=modifications)
+               modifications=modifications, modification_values=modification_values)
 
 
 def _check_probe(spec: GearSpec, sections: dict, tools: ToolsSection, tables: dict,

@@ -124,11 +124,17 @@ def job_file_reference_markdown(strategies: Strategies = REGISTRY) -> str:
         if len(names) > 1 and any("{Role}" in k.label for k in keys_of(cls)):
             roles = " or ".join(n.split(".")[-1].capitalize() for n in names)
             parts.append(f"In the workbench property names, `{{Role}}` is {roles}.\n")
+        if cls in MODIFICATION_SECTIONS.values():
+            parts.append("In the workbench these are the gear's properties: [gear.modifications] in the group Flank "
+                         "modifications; a side's table is `LeftFlankOwnValues` / `RightFlankOwnValues` switched on "
+                         "and the `Left...` / `Right...` properties (the whole table: a side switched off takes the "
+                         "common values).\n")
         rows = ["| key | type | unit | default | accepted | meaning | workbench property |",
                 "| --- | --- | --- | --- | --- | --- | --- |"]
         for k in keys_of(cls):
             default = "**required**" if k.required else f"`{toml_literal(k.default)}`"
-            holder = "(job file only)" if cls in MODIFICATION_SECTIONS.values() else f"`{k.label}`"
+            holder = (f"`{k.label}`, `Left{k.label}`, `Right{k.label}`" if cls in MODIFICATION_SECTIONS.values()
+                      else f"`{k.label}`")
             rows.append(f"| `{k.name}` | {_TYPE_WORDS[k.type]} | {k.unit or '-'} | {default} | {_accepted(k)} | "
                         f"{_doc_text(k.meaning)} | {holder} |")
         parts.append("\n".join(rows) + "\n")

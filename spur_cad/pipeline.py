@@ -136,7 +136,8 @@ def run_job(job: Job, progress: Callable[[str, float], None] | None = None,
     template_source = shown_path(job.job.report_template) if job.job.report_template else "report.html.j2"
     report = timed("report", "report", lambda: report_html(result, png, job.gear,
                                                           job.stock.blank_radius_mm(job.gear), plan, sim_result,
-                                                          job.report_template_text, template_source))
+                                                          job.report_template_text, template_source,
+                                                          job.modifications))
     result = dataclasses.replace(result, timings_s=dict(seconds))
     files = {
         "profile.csv": job_profile_csv(job, samples),

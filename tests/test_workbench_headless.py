@@ -214,6 +214,9 @@ job.addProperty("App::PropertyAngle", "AMin", "Machine", "A travel limit, low (d
 job.AMin = -99999.0
 job.FinishingStrategy = ["perimeter"]
 job.removeProperty("BottomRoughingMoves")  # schema 4's bottom-tool results: not in an older document
+job.removeProperty("SpindleRunout")  # schema 4: a um key was a PropertyFloat holding um
+job.addProperty("App::PropertyFloat", "SpindleRunout", "Machine accuracy", "spindle runout (um)")
+job.SpindleRunout = 3.5
 job.SchemaVersion = 1
 RESULT["saved_values"] = properties.read_values(job, schema.JOB_FIELDS)
 doc.saveAs(FILE)
@@ -232,6 +235,7 @@ RESULT["schema_version"] = schema.SCHEMA_VERSION
 RESULT["job_version"] = job.SchemaVersion
 RESULT["migrated_types"] = {p: job.getTypeIdOfProperty(p) for p in ("MaxFeed", "AMin", "FinishingStrategy")}
 RESULT["bottom_results"] = ["BottomRoughingMoves" in job.PropertiesList, job.BottomRoughingMoves]
+RESULT["migrated_runout"] = [job.getTypeIdOfProperty("SpindleRunout"), job.SpindleRunout.UserString]
 RESULT["strategies"] = job.getEnumerationsOfProperty("FinishingStrategy")
 RESULT["restored_values"] = properties.read_values(job, schema.JOB_FIELDS)
 for obj in doc.Objects:
@@ -266,8 +270,8 @@ def test_documents_save_and_reopen_without_pickles(freecadcmd, tmp_path):
     restored = result["restored"]  # the migrated gear is touched (a property was added), nothing is invalid
     assert all("Invalid" not in state and status == "ok" for state, status in restored.values()), restored
     assert _all_up_to_date(result["recomputed"]), result
-    assert result["schema_version"] == 4
-    assert result["migrated"] == {"version": 4, "has": True, "value": 0.0}
+    assert result["schema_version"] == 5
+    assert result["migrated"] == {"version": 5, "has": True, "value": 0.0}
     # schema 3's PropertyLength inputs re-created as PropertyDistance with their value; precise outputs added
     assert result["migrated_module"] == ["App::PropertyDistance", SMALL_GEAR_PROPERTIES["Module"], True]
     assert result["migrated_expressions"] == [["Module", "FaceWidth / 2"]]
@@ -279,12 +283,14 @@ def test_documents_save_and_reopen_without_pickles(freecadcmd, tmp_path):
     assert result["new_types"] == types
     assert result["new_max_feed"][0] == pytest.approx(5000.0 / 60.0) and "mm/s" in result["new_max_feed"][1]
     # schema-1 types re-created with the values they held, the drop-down list brought up to date
-    assert result["job_version"] == 4 and result["migrated_types"] == types
+    assert result["job_version"] == 5 and result["migrated_types"] == types
+    assert result["migrated_runout"] == ["App::PropertyDistance", "3.50 \u00b5m"]  # schema 5: the um in a Quantity
     assert result["bottom_results"] == [True, 0]  # schema 4's results of the bottom tool, added on reopening
     assert result["migrated_groups"] == ["Values: computed", "Values: status"]
     assert result["strategies"] == list(strategy_names())  # the registry's list, brought up to date
     before = result["saved_values"]
     assert before["MaxFeed"] == 4321.5 and before["AMin"] == -360.0  # the angle had clamped
+    assert before["SpindleRunout"] == 3.5 and result["restored_values"]["SpindleRunout"] == 3.5
     assert result["restored_values"] == before and result["reopened_values"] == before
     assert _all_up_to_date(result["second_restore"]), result["second_restore"]
     assert result["moves"][0] > 0 and result["moves"][1] == result["moves"][2] > 0
@@ -489,3 +495,50 @@ def test_the_default_job_starts_from_advised_tools_and_a_time_a_shop_accepts(fre
         expected = planned.estimate.time_with_acceleration_s / 60.0 if planned is not None else 0.0
         assert minutes[title] == pytest.approx(expected, rel=1e-9)
     assert 60.0 < sum(minutes.values()) < 8 * 60.0
+
+
+MODIFIED_SAVE_BODY = """
+import FreeCAD
+from spur_cad_workbench import commands
+doc = FreeCAD.newDocument("Modified")
+gear = commands.make_gear(doc, **PROPS, **MODS)
+plain = commands.make_gear(doc, **PROPS)
+doc.recompute()
+doc.saveAs(FILE)
+"""
+
+MODIFIED_OPEN_BODY = """
+import FreeCAD
+from spur_cad_workbench import properties, schema
+doc = FreeCAD.openDocument(FILE)
+gear, plain = doc.getObject("Gear"), doc.getObject("Gear001")
+values = properties.read_values(gear, schema.GEAR_FIELDS)
+RESULT["values"] = {prop: values[prop] for prop in MODS}
+RESULT["shown"] = [gear.getTypeIdOfProperty("TipRelief"), gear.TipRelief.UserString,
+                   gear.getGroupOfProperty("TipRelief"), gear.getGroupOfProperty("RightTipRelief")]
+mods = properties.job_of(gear).modifications
+RESULT["mm"] = [mods.left.tip_relief_mm, mods.right.tip_relief_mm, mods.right.tip_relief_parabolic]
+RESULT["status"] = [gear.Status, plain.Status]
+RESULT["volumes"] = [gear.Shape.Volume, plain.Shape.Volume, gear.Shape.isValid()]
+"""
+
+
+def test_flank_modifications_are_gear_properties_in_um_saved_and_reopened_in_a_new_process(freecadcmd, tmp_path):
+    """The common table and the right flank's own values as PropertyDistance shown in um, in their groups; saved,
+    reopened by another FreeCAD process with their values, the job's modifications and a solid with less material
+    than the unmodified gear's."""
+    mods = dict(TipRelief=20.0, TipReliefStartDiameter=40.0, RightFlankOwnValues=True, RightTipRelief=30.0,
+                RightTipReliefStartDiameter=40.0, RightTipReliefShape="parabolic")
+    saved = tmp_path / "modified.FCStd"
+    head = f"PROPS = {SMALL_GEAR_PROPERTIES!r}\nMODS = {mods!r}\nFILE = {str(saved)!r}\n"
+    result, proc = run_workbench_code(head + MODIFIED_SAVE_BODY, tmp_path / "save", freecadcmd=freecadcmd)
+    assert result is not None and result.get("ok"), describe(proc, result)
+    result, proc = run_workbench_code(head + MODIFIED_OPEN_BODY, tmp_path / "open", freecadcmd=freecadcmd)
+    assert result is not None and result.get("ok"), describe(proc, result)
+    assert result["values"] == mods
+    assert result["shown"] == ["App::PropertyDistance", "20.00 \u00b5m", "Flank modifications",
+                               "Flank modifications: right flank"]
+    assert result["mm"] == [0.02, 0.03, True]
+    assert result["status"] == ["ok", "ok"]
+    modified, plain, valid = result["volumes"]
+    assert valid and modified < plain - 1e-3, result["volumes"]

@@ -247,3 +247,30 @@ def test_an_object_s_error_is_one_sentence_with_the_field_s_title_and_unit(wb, s
     assert not KEY_NAME.search(text) and "[" + section + "]" not in text and "doc.FCStd" not in text, text
     if key.endswith("_mm") and value == value:  # a length: its unit is said (NaN has none)
         assert " mm" in text, text
+
+
+def test_three_axes_are_checked_as_the_3_axis_plan_checks_them(wb):
+    """axes = 3: the flat end mill's rules (at the finishing tool's kind), not the rotary table's tool limits (a
+    roughing tool wider than the space at the root is fine: it roughs around the gear)."""
+    values = wb.schema.values_from_job(parse_job(small_job_text(), "small.toml"))
+    values["gear"].update(Teeth=23, Module=4.0, FaceWidth=20.0, RackTipRadius=0.8)
+    values["job"].update(MachineAxes=3, FinishingToolKind="bull_nose", FinishingCornerRadius=0.3,
+                         FinishingToolDiameter=2.0, RoughingToolDiameter=6.0)
+    result = wb.validation.validate(values, "flat")
+    assert [(p.prop, p.group) for p in result.problems] == [("FinishingToolKind", "Finishing tool")]
+    assert "flat end mill" in result.problems[0].advice
+    values["job"].update(FinishingToolKind="flat", FinishingCornerRadius=0.0)
+    assert wb.validation.validate(values, "flat").ok
+    values["job"]["MachineAxes"] = 4  # the same 6 mm roughing tool on the rotary table: too wide for the space
+    assert not wb.validation.validate(values, "table").ok
+
+
+def test_the_modification_summary_names_the_amounts_of_each_table(wb):
+    gear = wb.schema.default_values()["gear"]
+    assert wb.summary.modification_summary(gear) == "none"
+    gear.update(TipRelief=15.0, TipReliefStartDiameter=96.0, LeftFlankOwnValues=True, LeftEndRelief=4.0,
+                LeftEndReliefLength=2.0)
+    assert wb.summary.modification_summary(gear) == "tip relief 15 \u00b5m; left flank: end relief 4 \u00b5m"
+    assert wb.summary.group_summary("3-axis", {"MachineAxes": 4}) == ""  # its fields are off
+    assert wb.summary.group_summary("Machine", {"MachineName": "VMC", "MachineAxes": 3}) == "VMC, 3 axes"
+    assert wb.summary.group_summary("3-axis", {"MachineAxes": 3, "HoldingTabs": 3}) == "3 holding tabs"

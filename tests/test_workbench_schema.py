@@ -24,7 +24,16 @@ from spur_cad.cam.roughing import roughing_levels
 from spur_cad.cam.strategies import FinishingParams
 from spur_cad.cam.tools import Tool
 from spur_cad.errors import JobFileError, SpurCadError
-from spur_cad.job import GearSection, Job, JobSection, SimulationSection, job_from_dict, load_job, parse_job
+from spur_cad.job import (
+    MODIFICATION_SECTIONS,
+    GearSection,
+    Job,
+    JobSection,
+    SimulationSection,
+    job_from_dict,
+    load_job,
+    parse_job,
+)
 from spur_cad.post.settings import PostSettings
 from tests.gears import GEAR_CASES
 from tests.textbook import Textbook
@@ -140,8 +149,9 @@ def _section_classes() -> dict[str, type]:
     hints = typing.get_type_hints(Job)
     sections = {("gear" if f.name == "gear_section" else f.name): hints[f.name] for f in dataclasses.fields(Job)
                 if f.name not in ("source", "gear", "tools", "text", "strategies", "report_template_text",
-                                                                               "rotary_calibration")}
+                                  "rotary_calibration", "modifications", "modification_values")}
     sections["tools.roughing"] = sections["tools.finishing"] = sections["tools.bottom"] = Tool
+    sections.update(MODIFICATION_SECTIONS)  # read with [gear]: the Job holds them as FlankModifications
     # an optional section (`lathe: LatheSection | None`) is its dataclass
     return {name: next((a for a in typing.get_args(cls) if a is not type(None)), cls) for name, cls in sections.items()}
 
@@ -163,7 +173,9 @@ def test_properties_carry_the_keys_meaning_group_and_unit(wb):
 
     for f in (f for fs in wb.schema.FIELDS.values() for f in fs if f.key):
         k = next(k for k in keys_of(_section_classes()[f.section]) if k.name == f.key)
-        assert f.doc.startswith(k.meaning) and f.group == k.group.format(Role=f.section[6:].capitalize()), f
+        group = k.group.format(Role=f.section[6:].capitalize())
+        side = f.section.removeprefix("gear.modifications.") if f.section.startswith("gear.modifications.") else ""
+        assert f.doc.startswith(k.meaning) and f.group == (f"{group}: {side} flank" if side else group), f
         assert f.unit == k.unit
 
 
@@ -198,7 +210,7 @@ def test_property_types_follow_the_documented_unit_mapping(wb):
         assert f.kind in allowed, f
         assert f.kind != "length", f  # clamps to >= 0: outputs only
         if f.kind == "distance":
-            assert f.unit == "mm"
+            assert f.unit in ("mm", "um")
         if f.kind == "angle":
             assert f.unit == "deg"
 
@@ -209,8 +221,7 @@ def test_plain_values_convert_freecads_quantities(wb):
             self.Value = value
 
         def getValueAs(self, unit):
-            assert unit == "mm/min"
-            return self.Value * 60.0
+            return self.Value * {"mm/min": 60.0, "um": 1000.0}[unit]
 
     speed, length = wb.schema.field_by_prop("MaxFeed"), wb.schema.field_by_prop("Module")
     assert wb.schema.plain_value(speed, Quantity(5000.0 / 60.0)) == 5000.0
@@ -218,6 +229,66 @@ def test_plain_values_convert_freecads_quantities(wb):
         assert wb.schema.plain_value(speed, Quantity(float(f"{feed / 60.0:.16g}"))) == feed
     assert wb.schema.plain_value(length, Quantity(4.0)) == 4.0
     assert wb.schema.plain_value(speed, 4000.0) == 4000.0  # a PropertyFloat of a schema-1 document
+    relief = wb.schema.field_by_prop("TipRelief")  # um keys: set and read in um, not the Quantity's mm
+    for amount_um in (15.0, 14.6, 2.7, 0.3):
+        assert wb.schema.plain_value(relief, Quantity(amount_um / 1000.0)) == amount_um
+    assert wb.schema.plain_value(relief, 15.0) == 15.0  # a PropertyFloat of a schema-4 document (SpindleRunout)
+
+
+MODIFIED_JOB = """[gear]
+teeth = 23
+module_mm = 4
+face_width_mm = 20
+rack_tip_radius_mm = 1.52
+
+[gear.modifications]
+tip_relief_um = 15
+tip_relief_start_diameter_mm = 96
+lead_crowning_um = 8
+
+[gear.modifications.right]
+tip_relief_um = 20
+tip_relief_shape = "parabolic"
+"""
+
+
+def test_flank_modifications_round_trip_through_the_gears_properties(wb):
+    """The common table, the right flank's override (the left one takes the common values) and the amounts in um;
+    a job file's partial side table reads back as the same modifications."""
+    job = parse_job(MODIFIED_JOB, "mods.toml")
+    values = wb.schema.values_from_job(job)
+    gear = values["gear"]
+    assert (gear["TipRelief"], gear["RightTipRelief"], gear["RightTipReliefStartDiameter"]) == (15.0, 20.0, 96.0)
+    assert (gear["RightFlankOwnValues"], gear["LeftFlankOwnValues"], gear["RightTipReliefShape"]) == \
+        (True, False, "parabolic")
+    assert wb.schema.field_by_prop("RightLeadCrowning").group == "Flank modifications: right flank"
+    data = json.loads(json.dumps(wb.schema.job_data(values)))
+    assert set(data["gear"]["modifications"]) >= {"right"} and "left" not in data["gear"]["modifications"]
+    again = job_from_dict(data, "mods.toml")
+    assert again.modifications == job.modifications
+    assert again.modifications.right.tip_relief_mm == 0.02 and again.modifications.left.tip_relief_mm == 0.015
+    assert again.modifications.right.lead_crowning_mm == 0.008 and again.modifications.right.tip_relief_parabolic
+    gear["LeftFlankOwnValues"], gear["LeftLeadCrowning"] = True, 3.0  # the left flank's own values now
+    changed = job_from_dict(wb.schema.job_data(values), "mods.toml").modifications
+    assert changed.left.lead_crowning_mm == 0.003 and changed.right == job.modifications.right
+
+
+def test_a_gear_without_modification_amounts_writes_no_modification_table(wb):
+    """Start diameters or shapes alone set nothing: the job (and its PlannedValues fingerprint) stays as before."""
+    values = wb.schema.default_values()
+    values["gear"].update(TipReliefStartDiameter=96.0, RightFlankOwnValues=True, RightTipReliefShape="parabolic")
+    assert "modifications" not in wb.schema.job_data(values)["gear"]
+    values["gear"]["RightEndRelief"] = 5.0  # an amount on a side switched on writes the tables
+    assert set(wb.schema.job_data(values)["gear"]["modifications"]) > {"right", "end_relief_um"}
+
+
+def test_a_modification_error_is_filed_under_its_property(wb):
+    """Too long a relief: the command line's message, blamed on the field of the table that gives the key."""
+    values = wb.schema.values_from_job(parse_job(MODIFIED_JOB, "mods.toml"))
+    values["gear"]["RightTipReliefStartDiameter"] = 80.0  # below the form diameter
+    result = wb.validation.validate(values, "mods")
+    assert not result.ok
+    assert result.problems[0].prop == "RightTipReliefStartDiameter", result.problems
 
 
 def test_defaults_are_in_the_choices(wb):
@@ -388,6 +459,25 @@ def test_index_move_is_drawn_as_an_arc_around_the_axis(wb):
     assert len(shown.points) >= 1 + 90 / wb.display.MAX_A_STEP_DEG
     end_angle = math.degrees(math.atan2(shown.points[-1, 1], shown.points[-1, 2]))
     assert end_angle == pytest.approx(90.0)  # the part point now under the tool was 90 deg toward +Y
+
+
+def test_a_3_axis_program_is_drawn_lying_flat_with_its_arcs_as_arcs(wb):
+    """Gear axis = machine Z (Z0 the top face, drawn at the part's x = b), machine X, Y = the part's y, z: a
+    clockwise half circle of radius 30 about the axis at Z -4 stays on the circle at x = b - 4, from machine +Y
+    over +X to -Y (the part's +z, +y, -z)."""
+    face_width = 20.0
+    builder = ToolpathBuilder(Operation.FINISHING, 1, 1000.0)
+    builder.move(MoveKind.RAPID, 0.0, 30.0, 5.0, 0.0)
+    builder.move(MoveKind.LINEAR, 0.0, 30.0, -4.0, 0.0, 100.0)
+    builder.arc(True, 0.0, -30.0, -4.0, 0.0, 0.0, 500.0)
+    shown = wb.display.display_flat_path(builder.build(), face_width)
+    on_arc = shown.points[3:]
+    assert np.allclose(np.hypot(on_arc[:, 1], on_arc[:, 2]), 30.0) and np.allclose(on_arc[:, 0], face_width - 4.0)
+    assert len(on_arc) >= 180 / wb.display.MAX_ARC_STEP_DEG
+    assert np.allclose(shown.points[0], [face_width + 5.0, 0.0, 30.0])  # the rapid's start: above the top face
+    assert on_arc[:, 1].min() > -1e-9 and on_arc[:, 1].max() == pytest.approx(30.0)  # clockwise: through +X
+    assert np.allclose(on_arc[-1], [face_width - 4.0, 0.0, -30.0])
+    assert list(shown.rapid[:2]) == [True, True] and not shown.rapid[2:].any()
 
 
 def test_large_programs_show_whole_stations_first_and_last(wb):

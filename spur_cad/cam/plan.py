@@ -589,6 +589,27 @@ def _comparison_estimate(spec: GearSpec, tool: Tool, machine: Machine, blank: fl
         return None
 
 
+def check_three_axis_inputs(inputs: CamInputs):
+    """Every check of a 3-axis job that needs no toolpath (cheap enough for a GUI to run while the user types):
+    a roughing tool with a finishing one, flat end mills whose side reaches the active profile (check_three_axis),
+    the tabs against the face width. Returns (the tool recommendations, the flat end mill's root analysis)."""
+    from spur_cad.cam.three_axis import check_three_axis
+
+    spec = inputs.spec
+    if inputs.finishing_tool is not None and inputs.roughing_tool is None:
+        raise ToolError("[machine] axes = 3 needs [tools.roughing]: finishing cuts only the finish stock around the "
+                        "outline", field="diameter_mm", section="tools.roughing")
+    root = check_three_axis(spec, inputs.finishing_tool, inputs.roughing_tool)
+    inputs.three_axis.validate(spec.face_width_mm)
+    if spec.is_internal:  # the rotary-table strategies' recommendations do not apply to a ring
+        from spur_cad.cam.three_axis_ring import ring_tool_recommendations
+
+        return ring_tool_recommendations(spec, inputs.machine.clearance_mm), root
+    rec = recommend_tools(spec, inputs.stock.blank_radius_mm(spec), inputs.machine.clearance_mm, inputs.finishing_tool,
+                          inputs.finishing.target_scallop_mm)
+    return rec, root
+
+
 def _plan_three_axis(inputs: CamInputs, tolerance_mm: float) -> CamPlan:
     """The CAM plan of a 3-axis job ([machine] axes = 3): the checks of three_axis.check_three_axis, roughing and
     finishing as spur_cad.cam.three_axis says; no tool recommendations for the rotary-table strategies
@@ -596,7 +617,6 @@ def _plan_three_axis(inputs: CamInputs, tolerance_mm: float) -> CamPlan:
     from spur_cad.cam.roughing import RoughingLevels
     from spur_cad.cam.three_axis import (
         ThreeAxisFinishingFacts,
-        check_three_axis,
         finishing_engagement,
         finishing_loop,
         finishing_toolpath,
@@ -606,15 +626,10 @@ def _plan_three_axis(inputs: CamInputs, tolerance_mm: float) -> CamPlan:
     from spur_cad.cam.three_axis_root import root_thickness
 
     spec, machine, stock = inputs.spec, inputs.machine, inputs.stock
-    if inputs.finishing_tool is not None and inputs.roughing_tool is None:
-        raise ToolError("[machine] axes = 3 needs [tools.roughing]: finishing cuts only the finish stock around the "
-                        "outline", field="diameter_mm", section="tools.roughing")
-    root = check_three_axis(spec, inputs.finishing_tool, inputs.roughing_tool)
-    inputs.three_axis.validate(spec.face_width_mm)
+    rec, root = check_three_axis_inputs(inputs)
     if spec.is_internal:
         return _plan_three_axis_ring(inputs, tolerance_mm, root)
     blank = stock.blank_radius_mm(spec)
-    rec = recommend_tools(spec, blank, machine.clearance_mm, inputs.finishing_tool, inputs.finishing.target_scallop_mm)
     roughing = finishing = None
     if inputs.roughing_tool is not None:
         inputs.roughing.validate()

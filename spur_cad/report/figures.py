@@ -1,5 +1,5 @@
 """The job report's figures (PNG bytes, matplotlib object API): roughing levels, finishing contacts and
-cutter locations, the simulated deviation map, the roughing engagement."""
+cutter locations, the simulated deviation map, the roughing engagement, the flank modification chart."""
 
 from __future__ import annotations
 
@@ -17,6 +17,7 @@ if TYPE_CHECKING:
 
     from spur_cad.cam.flank_roughing import FlankPlan
     from spur_cad.cam.tools import Tool
+    from spur_cad.geometry.modifications import FlankModifications
     from spur_cad.grade.grading import Grading
     from spur_cad.sim.engagement import Engagement
     from spur_cad.sim.simulate import SimResult
@@ -329,3 +330,71 @@ def engagement_png(engagement: Engagement, step_over_fraction: float, max_depth_
     n = int(cutting.sum())
     fig.suptitle(f"roughing engagement measured on the simulated stock ({n} moves removing material)", fontsize=9)
     return _png(fig)
+
+
+MODIFICATION_SIDE_STYLES = {"right": ("tab:blue", "-"), "left": ("tab:orange", "--")}
+
+
+def modification_chart_figure(mods: FlankModifications, base_radius_mm: float, width_in: float = 9.0,
+                              stacked: bool = False) -> Figure:
+    """The design flank modifications as a gear measuring machine charts them (+ material, so reliefs and crowning
+    droop below the unmodified design at 0): the profile against roll length L (diameter on the top axis), from
+    the form to the tip circle, and the lead against the face position X, both flanks (right solid, left
+    dashed). `stacked`: profile above lead (a narrow task panel), else side by side."""
+    from matplotlib.ticker import MaxNLocator
+
+    right = mods.side("right")
+    rolls = np.linspace(right.form_roll_mm, right.tip_roll_mm, 400)
+    faces = np.linspace(0.0, right.face_width_mm, 400)
+    # a breakpoint at every kink (the reliefs' starts), so a linear relief's corner is drawn sharp
+    for side in ("right", "left"):
+        flank = mods.side(side)
+        rolls = np.union1d(rolls, flank.profile_kinks_roll_mm())
+        faces = np.union1d(faces, flank.lead_kinks_mm())
+    if stacked:  # inches: left, right, top (the diameter axis), bottom margins, axes height, gap between the axes
+        left, right, top_in, bottom, axes_h, gap = 0.62, 0.08, 0.42, 0.42, 1.35, 0.78
+        height_in = top_in + 2.0 * axes_h + gap + bottom
+    else:
+        left, right, top_in, bottom, axes_h, gap = 0.85, 0.15, 0.55, 0.5, 2.4, 0.0
+        height_in = top_in + axes_h + bottom
+    fig = figure(width_in, height_in, left=left / width_in, right=1.0 - right / width_in, bottom=bottom / height_in,
+                 top=1.0 - top_in / height_in)
+    fig.subplots_adjust(hspace=gap / axes_h, wspace=0.3)
+    profile_ax, lead_ax = fig.subplots(2, 1) if stacked else fig.subplots(1, 2)
+    size = 7 if stacked else 8
+    for side, (colour, style) in MODIFICATION_SIDE_STYLES.items():
+        flank = mods.side(side)
+        profile_ax.plot(rolls, -1000.0 * flank.profile_offset_mm(rolls), style, color=colour, lw=1.4,
+                        label=f"{side} flank")
+        lead_ax.plot(faces, -1000.0 * flank.lead_offset_mm(faces), style, color=colour, lw=1.4,
+                     label=f"{side} flank")
+
+    def diameter(roll):
+        return 2.0 * np.sqrt(np.asarray(roll, dtype=float) ** 2 + base_radius_mm ** 2)
+
+    def roll(diam):
+        return np.sqrt(np.maximum((np.asarray(diam, dtype=float) / 2.0) ** 2 - base_radius_mm ** 2, 0.0))
+
+    top = profile_ax.secondary_xaxis("top", functions=(diameter, roll))
+    top.xaxis.set_major_locator(MaxNLocator(4 if stacked else 8))  # a narrow chart's diameters never overlap
+    top.set_xlabel("diameter [mm]", fontsize=size)
+    top.tick_params(labelsize=size)
+    profile_ax.set_xlabel("roll length L [mm]" if stacked else "roll length L [mm] (form to tip)", fontsize=size)
+    lead_ax.set_xlabel("face position X [mm]" if stacked else "face position X [mm] (front to back)", fontsize=size)
+    for ax, name in ((profile_ax, "profile"), (lead_ax, "lead")):
+        ax.axhline(0.0, color="k", lw=0.8, gid="design")
+        ax.set_ylabel(f"{name} [\u00b5m]\n(+ material)", fontsize=size)
+        ax.tick_params(labelsize=size)
+        ax.grid(True, lw=0.3)
+        low = min(ax.get_ylim()[0], -1.0)
+        ax.set_ylim(low, max(ax.get_ylim()[1], 0.1 * -low))
+        if not any(getattr(mods.side(side), f"has_{name}") for side in MODIFICATION_SIDE_STYLES):
+            ax.text(0.5, 0.35, f"no {name} modification", transform=ax.transAxes, ha="center", fontsize=size)
+    lead_ax.legend(fontsize=size - 1, loc="lower center")
+    return fig
+
+
+def modification_chart_png(mods: FlankModifications, base_radius_mm: float, width_in: float = 9.0,
+                           stacked: bool = False) -> bytes:
+    """`modification_chart_figure` as PNG bytes."""
+    return _png(modification_chart_figure(mods, base_radius_mm, width_in, stacked))

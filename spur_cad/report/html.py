@@ -157,8 +157,8 @@ def report_context(result: JobResult, images: dict[str, bytes]) -> dict:
         "error_budget_text": sheet.error_budget_text(result),
         "overall_class": (grading.overall_class or "beyond 11") if grading is not None else "",
         "grading_validity": "; ".join(grading.validity) if grading is not None and grading.validity else "",
-        "images": {name: _image_uri(images.get(name)) for name in ("profile", "roughing", "finishing", "deviation",
-                                                                  "engagement", "kchart")},
+        "images": {name: _image_uri(images.get(name)) for name in ("profile", "modifications", "roughing", "finishing",
+                                                                  "deviation", "engagement", "kchart")},
     }
 
 
@@ -166,7 +166,8 @@ def render_report(result: JobResult, images: dict[str, bytes], template_text: st
                   template_source: str = TEMPLATE_NAME) -> bytes:
     """The whole report as UTF-8 HTML bytes, from `template_text` (default: spur_cad's own template). `images`:
     'profile', 'roughing', 'finishing', 'deviation', 'kchart' PNGs. A template that fails while rendering (an
-    unknown name, say) is a ReportTemplateError naming it and its line."""
+    unknown name, say) is a ReportTemplateError naming it and its line. A job with flank modifications adds
+    'modifications' (their chart)."""
     import jinja2
 
     template = compile_template(default_template_text() if template_text is None else template_text,

@@ -10,16 +10,19 @@ from spur_cad.report.html import TEMPLATE_NAME, render_report
 
 if TYPE_CHECKING:
     from spur_cad.cam.plan import CamPlan
+    from spur_cad.geometry.modifications import FlankModifications
     from spur_cad.geometry.spec import GearSpec
     from spur_cad.result import JobResult
     from spur_cad.sim.simulate import SimResult
 
 
 def report_html(result: JobResult, profile_png: bytes, spec: GearSpec, blank_radius_mm: float, plan: CamPlan,
-                sim: SimResult | None, template_text: str | None = None, template_source: str = TEMPLATE_NAME) -> bytes:
+                sim: SimResult | None, template_text: str | None = None, template_source: str = TEMPLATE_NAME,
+                modifications: FlankModifications | None = None) -> bytes:
     """report.html for a job (pure: bytes out): values from the typed result, levels and contact poses from the
-    plan and the deviation map from the simulation (not recomputed); `template_text`: a shop's own template
-    (default spur_cad's), `template_source` names it in messages."""
+    plan and the deviation map from the simulation (not recomputed), the flank modification chart from the
+    design's `modifications`; `template_text`: a shop's own template (default spur_cad's), `template_source`
+    names it in messages."""
     from spur_cad.report.figures import (
         deviation_map_png,
         finishing_png,
@@ -29,6 +32,10 @@ def report_html(result: JobResult, profile_png: bytes, spec: GearSpec, blank_rad
     )
 
     images = {"profile": profile_png}
+    if modifications is not None:
+        from spur_cad.report.figures import modification_chart_png
+
+        images["modifications"] = modification_chart_png(modifications, spec.base_radius_mm)
     if plan.finishing is not None and plan.finishing.result.strategy == "three_axis":
         pass  # [machine] axes = 3: no level or contact figures (the report's text says what was planned)
     elif plan.roughing is not None and plan.roughing.flank is not None:

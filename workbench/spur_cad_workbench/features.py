@@ -233,22 +233,27 @@ class GearFeature(_Proxy):
             fail(obj, exc)
             return
         spec, sheet = job.gear, inspection_facts(job.gear)
-        write_outputs(obj, {
+        outputs = {
             "ReferenceRadius": spec.reference_radius_mm, "BaseRadius": spec.base_radius_mm,
             "TipRadius": spec.tip_radius_mm, "RootRadius": spec.root_radius_mm, "FormRadius": spec.form_radius_mm,
             "ToothThickness": spec.tooth_thickness_mm, "SpanTeeth": sheet.span_teeth_k,
             "SpanMeasurement": sheet.span_measurement_mm, "PinDiameter": sheet.pin_diameter_mm,
             "DimensionOverPins": sheet.dimension_over_pins_mm, "Undercut": bool(spec.undercut),
             "UndercutDepth": spec.undercut_depth_mm,
-            "MinTeethWithoutUndercut": sheet.min_teeth_without_undercut})
-        write_outputs(obj, precise_outputs(obj))
+            "MinTeethWithoutUndercut": sheet.min_teeth_without_undercut}
+        # a ring has no span (and a helical gear none where the anvils do not fit the face): 0, its text "none"
+        missing = {prop for prop, value in outputs.items() if value is None}
+        write_outputs(obj, {prop: 0 if prop in missing else value for prop, value in outputs.items()})
+        write_outputs(obj, precise_outputs(obj, missing))
         set_shape(obj, part_shape(shape))
         report(obj, None)
 
 
-def precise_outputs(obj) -> dict[str, str]:
-    """The gear's length outputs as text to 0.1 um in the user's unit schema (schema.PRECISE)."""
-    return {f"{field.prop}{schema.PRECISE_SUFFIX}": units.inspection_text(getattr(obj, field.prop).Value, FreeCAD.Units)
+def precise_outputs(obj, missing: set[str] = frozenset()) -> dict[str, str]:
+    """The gear's length outputs as text to 0.1 um in the user's unit schema (schema.PRECISE); "none" for the
+    `missing` ones (the gear has no such value)."""
+    return {f"{field.prop}{schema.PRECISE_SUFFIX}": "none" if field.prop in missing else
+            units.inspection_text(getattr(obj, field.prop).Value, FreeCAD.Units)
             for field in schema.GEAR_OUTPUTS if field.kind == "length"}
 
 
@@ -353,10 +358,11 @@ class JobFeature(_Proxy):
             outputs[f"{title}Time"] = op.seconds / 60.0 if op is not None else 0.0
             outputs[f"{title}TimeWithAcceleration"] = op.seconds_with_acceleration / 60.0 if op is not None else 0.0
             outputs[f"{title}ProgramLines"] = op.program_lines if op is not None else 0
+        flat = job.gear.face_width_mm if job.machine.axes == 3 else None  # drawn lying flat
         for name in schema.TOOL_ROLES:  # the bottom tool's program has no toolpath object (see workbench/README.md)
             target = getattr(obj, f"{name.capitalize()}Toolpath")
             if target is not None:
-                update_toolpath(target, getattr(plan, name))
+                update_toolpath(target, getattr(plan, name), flat)
         write_outputs(obj, outputs)
         for dependant in dependants(obj):
             if getattr(dependant.Proxy, "KIND", "") != "simulation":
@@ -397,17 +403,18 @@ def uses_path_module(obj) -> bool:
     return obj.isDerivedFrom("Path::Feature")
 
 
-def update_toolpath(obj, planned) -> None:
+def update_toolpath(obj, planned, flat_face_width_mm: float | None = None) -> None:
     """Draw a planned operation (spur_cad.cam.plan RoughingPlan / FinishingPlan, or None) into the toolpath
-    object and set its computed properties."""
-    from spur_cad_workbench.display import display_path, gcode_text, polylines
+    object and set its computed properties; `flat_face_width_mm`: the gear's face width for a 3-axis program
+    (drawn with the gear lying flat, display.display_flat_path)."""
+    from spur_cad_workbench.display import display_flat_path, display_path, gcode_text, polylines
 
     path = planned.toolpath if planned is not None else None
     if path is None:
         drawn, moves, outputs = None, 0, {"Moves": 0, "DisplayedMoves": 0, "CuttingLength": 0.0,
                                           "EstimatedTime": 0.0, "ToolNumber": 0, "SpindleSpeed": 0.0}
     else:
-        drawn = display_path(path)
+        drawn = display_path(path) if flat_face_width_mm is None else display_flat_path(path, flat_face_width_mm)
         moves = drawn.moves_shown
         outputs = {"Moves": int(planned.estimate.moves), "DisplayedMoves": int(moves),
                    "CuttingLength": float(planned.estimate.cutting_length_mm),

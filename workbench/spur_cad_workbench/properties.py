@@ -14,8 +14,9 @@ PROP_OUTPUT = 8
 
 
 def property_value(field, value):
-    """A job-file value as the property takes it: a speed as a Quantity in its key's unit (mm/min)."""
-    if field.kind == "speed":
+    """A job-file value as the property takes it: a speed or a micrometre length as a Quantity in its key's unit
+    (mm/min, um)."""
+    if field.unit in schema.SET_IN_KEY_UNIT:
         return FreeCAD.Units.Quantity(f"{float(value)!r} {field.unit}")
     return value
 

@@ -17,6 +17,8 @@ group, tooltip = its meaning, and the property type from the key's type, unit an
 |                                       |                             | clamps to [-360, 360])           |
 | float, mm/min                         | App::PropertySpeed          | Quantity in mm/s; set and read   |
 |                                       |                             | in mm/min (15 significant digits)|
+| float, um                             | App::PropertyDistance       | Quantity, set and read in um (15 |
+|                                       |                             | significant digits; shown as um) |
 | float, other units (m/min, 1/min,     | App::PropertyFloat          | number in the key's unit (named  |
 | deg/min, s, %) or none                |                             | in the tooltip)                  |
 | int                                   | App::PropertyInteger        | int                              |
@@ -30,6 +32,13 @@ lengths are PropertyLength.
 
 Cutting speeds (m/min), spindle speeds (1/min) and rotary speeds (deg/min) stay PropertyFloat:
 catalogues quote them in those units, and FreeCAD would show them as mm/s, Hz or deg/s.
+The flank modifications ([gear.modifications], its .left and .right tables) are gear properties: the common
+table in group "Flank modifications", each side's own values (`Left...`, `Right...`) in "Flank modifications:
+left flank" / "...: right flank" behind a switch (LeftFlankOwnValues, RightFlankOwnValues); a side switched on
+writes its whole table (a job file's side table with some keys reads back as the common values overridden by
+them: the same modifications). A job writes the tables only when some amount is set, so a gear without
+modifications gives the job (and PlannedValues) it gave before.
+
 `values_from_job` / `job_data` always hold plain numbers in the job file's units;
 `plain_value` converts what FreeCAD returns (features.py converts when setting).
 
@@ -43,7 +52,8 @@ the inputs; reopening moves them). Version 4: every mm input became PropertyDist
 for keys that are never negative, which stored a typed -3 as 0 without a word); the gear gained its
 length outputs as text to 0.1 um in the user's unit schema ("Values: precise"); the bottom tool's roughing
 program (two-stage roughing) has its own results (BottomRoughingMoves, ...Time, ...TimeWithAcceleration,
-...ProgramLines).
+...ProgramLines). Version 5: the um keys (the flank modifications, the machine's accuracy) became PropertyDistance
+(were PropertyFloat): the property editor shows them with their unit.
 """
 
 from __future__ import annotations
@@ -51,10 +61,10 @@ from __future__ import annotations
 import re
 from dataclasses import dataclass
 
-from spur_cad.job import SECTIONS
+from spur_cad.job import MODIFICATION_SECTIONS, SECTIONS
 from spur_cad.keys import keys_of
 
-SCHEMA_VERSION = 4
+SCHEMA_VERSION = 5
 TOOL_ROLES = ("roughing", "finishing")
 OPERATION_TITLES = {"roughing": "Roughing", "roughing_bottom": "BottomRoughing", "finishing": "Finishing"}
 """The programs a job writes, in cutting order, and the prefix of their result properties on the job."""
@@ -73,6 +83,8 @@ PROPERTY_TYPES = {
     "strings": "App::PropertyStringList",
 }
 UNIT_CARRYING = {"length": "mm", "distance": "mm", "angle": "deg", "speed": "mm/min"}
+SET_IN_KEY_UNIT = ("mm/min", "um")
+"""Key units whose Quantity is set and read in the key's unit (FreeCAD's internal units are mm/s and mm)."""
 ANGLE_PROPERTY_LIMIT_DEG = 360.0  # App::PropertyAngle clamps values to [-360, 360]
 
 
@@ -80,7 +92,8 @@ ANGLE_PROPERTY_LIMIT_DEG = 360.0  # App::PropertyAngle clamps values to [-360, 3
 class Field:
     """One FreeCAD property holding one job-file key (`section`, `key`), or a computed output (no key).
 
-    `unit` is the job-file unit of the value (the key's); `choices` the drop-down list of a choice.
+    `unit` is the job-file unit of the value (the key's); `choices` the drop-down list of a choice, or the values
+    an int key takes (the panel offers them in a drop-down list; the property stays a PropertyInteger).
     """
 
     prop: str
@@ -111,7 +124,7 @@ def property_kind(k) -> str:
         return "choice" if k.names else "string"
     numeric_low = k.low if not isinstance(k.low, str) else None
     numeric_high = k.high if not isinstance(k.high, str) else None
-    if k.unit == "mm":
+    if k.unit in ("mm", "um"):
         return "distance"
     if k.unit == "deg" and numeric_low is not None and numeric_high is not None and \
             -ANGLE_PROPERTY_LIMIT_DEG <= numeric_low and numeric_high <= ANGLE_PROPERTY_LIMIT_DEG:
@@ -126,7 +139,7 @@ def _key_field(section: str, k) -> Field:
     kind = property_kind(k)
     doc = k.meaning if not k.unit or kind in UNIT_CARRYING else f"{k.meaning} ({k.unit})"
     return Field(k.label.format(Role=role), kind, k.group.format(Role=role), section, k.name, doc,
-                 tuple(str(n) for n in k.names) if kind == "choice" else (), k.unit)
+                 tuple(str(n) for n in k.names) if kind in ("choice", "int") else (), k.unit)
 
 
 # The switch that says whether the job file has the [tools.<role>] section at all.
@@ -155,6 +168,30 @@ def section_enabled(job_values: dict[str, object], section: str) -> bool:
 SECTION_OBJECTS = {"gear": "gear", "stock": "stock"}
 
 
+MODIFICATIONS = "gear.modifications"
+MODIFICATION_GROUP = "Flank modifications"
+MODIFICATION_SIDES = ("left", "right")
+MODIFICATION_SWITCHES = {
+    f"{MODIFICATIONS}.{side}": _f(f"{side.capitalize()}FlankOwnValues", "bool", f"{MODIFICATION_GROUP}: {side} flank",
+                                  f"{MODIFICATIONS}.{side}", "",
+                                  f"the {side} flank has values of its own ([{MODIFICATIONS}.{side}]); off: the "
+                                  f"common values")
+    for side in MODIFICATION_SIDES}
+"""The switch that says whether a flank side has its own modification table."""
+
+
+def _modification_fields() -> list[Field]:
+    """The common table's fields (group "Flank modifications"), then each side's switch and fields (its label
+    prefixed Left / Right, in its own group)."""
+    fields = [_key_field(MODIFICATIONS, k) for k in keys_of(MODIFICATION_SECTIONS[MODIFICATIONS])]
+    for section, switch in MODIFICATION_SWITCHES.items():
+        prefix = section.rsplit(".", 1)[1].capitalize()
+        fields.append(switch)
+        fields.extend(Field(prefix + f.prop, f.kind, switch.group, section, f.key, f.doc, f.choices, f.unit)
+                      for f in fields[:len(keys_of(MODIFICATION_SECTIONS[MODIFICATIONS]))])
+    return fields
+
+
 JOB_FILE_ONLY = ("tools.roughing_top",)
 """Sections the panel leaves to the job file: [tools.roughing_top] is the pair of roughing tools the panel holds
 as the roughing and bottom tools (values_from_job turns one into the other)."""
@@ -169,6 +206,8 @@ def _input_fields() -> dict[str, tuple[Field, ...]]:
         if section in SECTION_SWITCHES:
             target.append(SECTION_SWITCHES[section])
         target.extend(_key_field(section, k) for k in keys_of(cls))
+        if section == "gear":
+            target.extend(_modification_fields())
     return {role: tuple(found) for role, found in fields.items()}
 
 
@@ -188,10 +227,12 @@ GEAR_OUTPUTS = (
     _f("RootRadius", "length", COMPUTED, "", "", "root radius r_f"),
     _f("FormRadius", "length", COMPUTED, "", "", "radius where the involute starts (fillet junction)"),
     _f("ToothThickness", "length", COMPUTED, "", "", "design tooth thickness on the reference circle (arc)"),
-    _f("SpanTeeth", "int", INSPECTION, "", "", "teeth spanned k for the span measurement"),
-    _f("SpanMeasurement", "length", INSPECTION, "", "", "span measurement (base tangent length) W_k"),
+    _f("SpanTeeth", "int", INSPECTION, "", "", "teeth spanned k for the span measurement (0: none)"),
+    _f("SpanMeasurement", "length", INSPECTION, "", "", "span measurement (base tangent length) W_k (0: none, an "
+                                                         "internal gear has no span)"),
     _f("PinDiameter", "length", INSPECTION, "", "", "pin (ball) diameter for the dimension over pins"),
-    _f("DimensionOverPins", "length", INSPECTION, "", "", "dimension over two pins M"),
+    _f("DimensionOverPins", "length", INSPECTION, "", "", "dimension over two pins M (an internal gear: between "
+                                                          "two pins)"),
     _f("Undercut", "bool", INSPECTION, "", "", "the rack's tip corner undercuts the involute"),
     _f("UndercutDepth", "length", INSPECTION, "", "", "depth of the undercut (0 without undercut)"),
     _f("MinTeethWithoutUndercut", "int", INSPECTION, "", "", "fewest teeth generated without undercut"),
@@ -247,7 +288,7 @@ def plain_value(field: Field, value):
     """A property's value as plain Python in the job file's unit (Quantity -> float in mm, deg or mm/min)."""
     if not hasattr(value, "Value"):
         return value
-    if field.kind == "speed":
+    if field.unit in SET_IN_KEY_UNIT:
         return float(format(float(value.getValueAs(field.unit)), ".15g"))
     return float(value.Value)
 
@@ -259,7 +300,7 @@ def _section_defaults() -> dict[str, dict[str, object]]:
 
     zero = {float: 0.0, int: 0, str: "", bool: False}
     defaults = {section: {k.name: zero[k.type] if k.required else k.default for k in keys_of(cls)}
-                for section, cls in SECTIONS.items()}
+                for section, cls in {**SECTIONS, **MODIFICATION_SECTIONS}.items()}
     defaults["tools.finishing"]["tool_number"] = DEFAULT_FINISHING_TOOL_NUMBER  # T1 roughing, T2 finishing
     defaults["tools.bottom"]["tool_number"] = DEFAULT_BOTTOM_TOOL_NUMBER  # T3 the bottom roughing tool
     return defaults
@@ -304,9 +345,14 @@ def values_from_job(job) -> dict[str, dict[str, object]]:
                                                                  bottom=job.tools.roughing, roughing_top=None))
     defaults = _section_defaults()
     values: dict[str, dict[str, object]] = {}
+    given = job.modification_values  # {table: values} of the tables the job file gives
     for role, fields in FIELDS.items():
         values[role] = {}
         for field in fields:
+            if field.section.startswith(MODIFICATIONS):
+                table = given.get(field.section, given.get(MODIFICATIONS, defaults[MODIFICATIONS]))
+                values[role][field.prop] = table[field.key] if field.key else field.section in given
+                continue
             section = job.section(field.section)
             if not field.key:
                 values[role][field.prop] = section is not None
@@ -331,11 +377,22 @@ def job_data(values: dict[str, dict[str, object]]) -> dict[str, dict]:
                 continue
             if role == "job" and not section_enabled(values["job"], field.section):
                 continue
+            if field.section.startswith(MODIFICATIONS) and field.section not in modification_tables(values[role]):
+                continue
             target = data
             for part in field.section.split("."):
                 target = target.setdefault(part, {})
             target[field.key] = values[role][field.prop]
     return data
+
+
+def modification_tables(gear_values: dict[str, object]) -> tuple[str, ...]:
+    """The [gear.modifications] tables the gear's values write: none without an amount (the job of a gear without
+    modifications stays as it was), else the common table and the sides switched on."""
+    tables = (MODIFICATIONS, *(section for section, switch in MODIFICATION_SWITCHES.items()
+                               if gear_values[switch.prop]))
+    amounts = [field for field in FIELDS["gear"] if field.section in tables and field.key.endswith("_um")]
+    return tables if any(gear_values[field.prop] for field in amounts) else ()
 
 
 def field_by_prop(prop: str) -> Field:
@@ -354,7 +411,10 @@ _TITLES = {"UseRoughingTool": "Rough with this tool", "UseFinishingTool": "Finis
            "FinishingStepOver": "Step-over", "MaxSpindleRpm": "Max spindle speed", "SimulationEnabled": "Simulate",
            "SimulationResolution": "Resolution", "PostDialect": "Dialect", "JobName": "Name",
            "MachineName": "Name", "ThicknessAllowancePercent": "Thickness allowance (%)",
-           "ProfileShift": "Profile shift coefficient x"}
+           "ProfileShift": "Profile shift coefficient x", "LeftFlankOwnValues": "Own values for the left flank",
+           "RightFlankOwnValues": "Own values for the right flank", "MachineAxes": "Axes (4: rotary table, 3: flat)",
+           "ExportDxf": "Write gear.dxf", "ExportSvg": "Write gear.svg",
+           "ExportOffset": "Offset (wire radius + gap, half kerf)"}
 
 
 def title(field: Field) -> str:

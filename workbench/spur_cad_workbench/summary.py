@@ -158,6 +158,34 @@ def _tool_summary(job: dict, role: str, units) -> str:
     return f"T{job.get(f'{role}ToolNumber', '')} {kind} D {diameter}"
 
 
+def modification_summary(gear: dict[str, object]) -> str:
+    """The gear's flank modification amounts in a few words ('tip relief 15 um, lead crowning 8 um; right flank:
+    tip relief 20 um'); 'none' without an amount. `gear`: the gear's property values."""
+    from spur_cad_workbench.schema import FIELDS, MODIFICATION_SWITCHES, MODIFICATIONS, modification_tables, title
+
+    parts = []
+    for table in modification_tables(gear):
+        amounts = [f"{title(field).lower().removeprefix(table.rsplit('.', 1)[1] + ' ')} {gear[field.prop]:g} \u00b5m"
+                   for field in FIELDS["gear"] if field.section == table and field.key.endswith("_um")
+                   and gear[field.prop]]
+        side = "" if table == MODIFICATIONS else f"{MODIFICATION_SWITCHES[table].group.split(': ')[1]}: "
+        parts.append(side + (", ".join(amounts) or "none"))
+    return "; ".join(parts) or "none"
+
+
+def _three_axis_summary(job: dict[str, object], units=None) -> str:
+    """The folded "3-axis" group: how a through-cut gear is held; nothing on the rotary table (its fields are off)."""
+    from spur_cad_workbench.units import text as length_text
+
+    if int(job.get("MachineAxes", 4)) != 3:
+        return ""
+    if int(job.get("HoldingTabs", 0)):
+        return f"{job['HoldingTabs']} holding tabs"
+    if float(job.get("OnionSkin", 0.0)):
+        return f"onion skin {length_text(float(job['OnionSkin']), 'mm', units)}"
+    return "cut through, no tabs"
+
+
 def group_summary(group: str, job: dict[str, object], units=None) -> str:
     """What a folded group of the job panel holds, in a few words ('T1 flat D 4 mm', 'generating, scallop
     5 um'; lengths in the user's unit schema, `units` = FreeCAD.Units, None for mm); '' for groups without one.
@@ -174,7 +202,9 @@ def group_summary(group: str, job: dict[str, object], units=None) -> str:
         text = (f"{job.get('RoughingStrategy', 'levels')}, flank allowance "
                 f"{length_text(float(job.get('FlankAllowance', 0.0)), 'mm', units)}")
     elif group == "Machine":
-        text = str(job.get("MachineName", ""))
+        text = str(job.get("MachineName", "")) + (", 3 axes" if int(job.get("MachineAxes", 4)) == 3 else "")
+    elif group == "3-axis":
+        text = _three_axis_summary(job, units)
     elif group == "Post":
         text = str(job.get("PostDialect", ""))
     elif group == "Simulation":

@@ -10,6 +10,10 @@ collapsible sections, checked as you type.
 - Summary: validity, the tool limits (cheap, as you type), and the cycle time by both estimators,
   moves and program lines. Those need a plan: they are shown from the job's last recompute while
   the values are the job's, from the panel's own plan after "Plan", and marked outdated otherwise.
+- Flank modifications: the gear's (edited on the gear's properties), charted in their own section
+  (spur_cad.report.figures.modification_chart_figure, stacked for the dock's width); none: no section.
+- Variants: a 3-axis job says so in its title, its "3-axis" fields are on only with 3 axes; an internal gear or a
+  tool the variant refuses gets the command line's message at the top.
 - Errors: every change runs validation.validate (the command line's own checks); the problem is
   shown in its section as what to change, and its field is highlighted. OK with a problem keeps
   the panel open, opens the section, scrolls to the field and focuses it.
@@ -30,6 +34,7 @@ from spur_cad_workbench.summary import (
     group_summary,
     limits_text,
     long_job_advice,
+    modification_summary,
     plan_figures,
     values_signature,
 )
@@ -48,7 +53,20 @@ FIELD_MIN_WIDTH_PX = 112
 PANEL_MIN_WIDTH_PX = 170  # fits a 240 px task dock: its scroll area's 220 px less the task box's margins
 QUANTITY_UNITS = {"length": "mm", "distance": "mm", "angle": "deg", "speed": "mm/min"}
 NUMBER_DECIMALS = 6
+THREE_AXIS_LIMITS = ("3 axes, the gear lying flat: flat end mills; the finishing tool's radius is the root fillet's "
+                     "at least, and its side must reach the active profile (docs/cam.md).")
+MODIFICATIONS_TITLE = "Flank modifications"  # the gear's: a longer title is elided in a narrow dock
+CHART_DPI = 96
+CHART_MIN_WIDTH_IN = 2.5
+"""The modification chart is drawn this wide at least (its tick labels need it) and scaled down to the section's
+width in a narrower dock."""
 REVALIDATE_DELAY_MS = 250  # typing: check once the keys pause (a check plans roughing levels: up to 0.5 s)
+
+
+def quantity_unit(field) -> str:
+    """The unit a quantity field is set and read in: the key's own for micrometres (machine accuracy), else its
+    kind's (mm, deg, mm/min)."""
+    return field.unit if field.unit in schema.SET_IN_KEY_UNIT else QUANTITY_UNITS[field.kind]
 
 
 def _policy(name: str):
@@ -180,7 +198,8 @@ class JobTaskPanel:
         self.job = job_obj
         self.form = QtGui.QWidget()
         self.form.setObjectName("SpurCadJobPanel")
-        title = f"4-axis job: {job_obj.Label}"
+        values = document_values(job_obj)
+        title = f"{values['job']['MachineAxes']}-axis job: {job_obj.Label}"
         bold = QtGui.QFont(self.form.font())
         bold.setBold(True)
         elide = compat.qt_enum(QtCore.Qt, "TextElideMode", "ElideRight")
@@ -202,7 +221,6 @@ class JobTaskPanel:
         layout.addWidget(self._summary_box())
         for extra in ("Gear", "Stock", "Job"):
             layout.addWidget(self._message_label(extra))
-        values = document_values(job_obj)
         self._timer = QtCore.QTimer(self.form)
         self._timer.setSingleShot(True)
         self._timer.timeout.connect(self.revalidate)
@@ -216,6 +234,7 @@ class JobTaskPanel:
                 if field.group == group:
                     self._add_row(section, field, values["job"][field.prop])
             layout.addWidget(section.widget)
+        layout.addWidget(self._modifications_section().widget)
         layout.addStretch(1)
         self.revalidate()
 
@@ -238,6 +257,57 @@ class JobTaskPanel:
                        self.plan_button):
             layout.addWidget(widget)
         return box
+
+    def _modifications_section(self) -> Section:
+        """The gear's flank modifications: a note (what they are, where to edit them) and their chart."""
+        self._chart_key: str | None = None  # the gear values the chart was drawn for
+        self.modifications_note = _wrapped_label(NOTE_STYLE, "modifications:note")
+        self.modifications_chart = QtGui.QLabel()
+        self.modifications_chart.setObjectName("modifications:chart")
+        self.modifications_chart.setSizePolicy(_policy("Ignored"), _policy("Fixed"))  # never widens the panel
+        self.modifications_section = Section(MODIFICATIONS_TITLE, collapsed=True, on_open=self._show_modifications)
+        self.modifications_section.form.addRow(self.modifications_note)
+        self.modifications_section.form.addRow(self.modifications_chart)
+        return self.modifications_section
+
+    def _show_modifications(self) -> None:
+        """Draw the gear's modifications into the open section (again only when the gear's values changed)."""
+        import json
+
+        from spur_cad.errors import SpurCadError
+        from spur_cad.job import job_from_dict
+
+        gear = document_values(self.job)["gear"]
+        key = json.dumps(gear, sort_keys=True, default=repr)
+        if key == self._chart_key or not self.modifications_section.is_open:
+            return
+        self._chart_key = key
+        where = "Edit them on the gear's properties, group Flank modifications."
+        try:
+            job = job_from_dict(schema.job_data({"gear": gear}), self.job.Label)
+        except SpurCadError as exc:
+            job = None
+            self.modifications_note.setText(sentence(exc, self.job.Label, FreeCAD.Units))
+        if job is None or job.modifications is None:
+            if job is not None:
+                self.modifications_note.setText(f"The gear has no flank modifications. {where}")
+            self.modifications_chart.clear()
+            self.modifications_chart.setVisible(False)
+            return
+        from spur_cad.report.figures import modification_chart_figure
+
+        self.modifications_note.setText(f"The gear's: {modification_summary(gear)}. {where}")
+        width_px = max(1, self.modifications_section.body.width() - 12)
+        figure = modification_chart_figure(job.modifications, job.gear.base_radius_mm,
+                                           max(CHART_MIN_WIDTH_IN, width_px / CHART_DPI), stacked=True)
+        pixmap = QtGui.QPixmap()
+        pixmap.loadFromData(_png_bytes(figure, CHART_DPI), "PNG")
+        if pixmap.width() > width_px:
+            pixmap = pixmap.scaledToWidth(width_px, compat.qt_enum(QtCore.Qt, "TransformationMode",
+                                                                   "SmoothTransformation"))
+        self.modifications_chart.setPixmap(pixmap)
+        self.modifications_chart.setFixedHeight(pixmap.height())
+        self.modifications_chart.setVisible(True)
 
     def _message_label(self, group: str) -> QtGui.QLabel:
         label = _wrapped_label(ERROR_STYLE, f"message:{group}")
@@ -279,6 +349,11 @@ class JobTaskPanel:
         elif field.kind == "string":
             widget = QtGui.QLineEdit(str(value))
             widget.textChanged.connect(self._schedule)
+        elif field.kind == "int" and field.choices:  # a few values ([machine] axes: 4 or 3)
+            widget = QtGui.QComboBox()
+            widget.addItems(list(field.choices))
+            widget.setCurrentIndex(max(0, list(field.choices).index(str(value)) if str(value) in field.choices else 0))
+            widget.currentIndexChanged.connect(self._schedule)
         elif field.kind == "int":
             widget = QtGui.QSpinBox()
             widget.setRange(-2**31 + 1, 2**31 - 1)
@@ -310,7 +385,7 @@ class JobTaskPanel:
 
     def _quantity_box(self, field, value):
         """FreeCAD's unit-aware spin box (any number: spur_cad's own messages judge it), or None without one."""
-        unit = QUANTITY_UNITS[field.kind]
+        unit = quantity_unit(field)
         widget = compat.quantity_spin_box(FreeCADGui.UiLoader(), unit, -BIG, BIG)
         if widget is None:
             return None
@@ -335,6 +410,8 @@ class JobTaskPanel:
             return widget.isChecked()
         if field.kind == "choice":
             return widget.currentText()
+        if field.kind == "int" and field.choices:
+            return int(widget.currentText())
         if field.kind == "string":
             return widget.text()
         if field.kind == "int":
@@ -344,7 +421,7 @@ class JobTaskPanel:
             return exact
         if isinstance(widget, QtGui.QDoubleSpinBox):
             return float(widget.value()) * self._per_unit.get(field.prop, 1.0)
-        return compat.spin_box_value(widget, FreeCAD.Units, QUANTITY_UNITS[field.kind])
+        return compat.spin_box_value(widget, FreeCAD.Units, quantity_unit(field))
 
     def job_values(self) -> dict:
         """The job property values as the panel's widgets hold them."""
@@ -365,7 +442,7 @@ class JobTaskPanel:
             widget.setValue(float(value) / self._per_unit.get(prop, 1.0))
             self._shown[prop] = (widget.text(), float(value))
         else:
-            unit = QUANTITY_UNITS[schema.field_by_prop(prop).kind]
+            unit = quantity_unit(schema.field_by_prop(prop))
             self._show_quantity(widget, float(value), unit)
             self._shown[prop] = (widget.text(), float(value))
         show_start(self.widgets[prop])
@@ -396,7 +473,8 @@ class JobTaskPanel:
             label.setVisible(group in advice)
         self._highlight(next((p.prop for p in result.problems if p.prop in self.widgets), None))
         two_stage = bool(values["job"].get("UseBottomTool"))
-        notes = {**recommendation_notes(result.recommendations, two_stage, FreeCAD.Units),
+        flat = int(values["job"]["MachineAxes"]) == 3  # the rotary table's tool limits do not apply
+        notes = {**({} if flat else recommendation_notes(result.recommendations, two_stage, FreeCAD.Units)),
                  **unusual_value_notes(values["job"], FreeCAD.Units)}
         finishing_invalid = any(problem.group == "Finishing tool" for problem in result.problems)
         if finishing_invalid:  # the roughing limit depends on the finishing tool (A_p)
@@ -411,6 +489,15 @@ class JobTaskPanel:
             for field in schema.JOB_FIELDS:
                 if field.section == section and field.key:
                     self.widgets[field.prop].setEnabled(enabled)
+        axes = int(values["job"]["MachineAxes"])
+        for field in schema.JOB_FIELDS:
+            if field.section == "three_axis":  # tabs and onion skin: 3-axis programs only
+                self.widgets[field.prop].setEnabled(axes == 3)
+        modified = bool(schema.modification_tables(values["gear"]))  # a gear without them: no section
+        self.modifications_section.widget.setVisible(modified)
+        self.modifications_section.set_summary(modification_summary(values["gear"]) if modified else "")
+        if modified:
+            self._show_modifications()
         self._show_summary(values, result, with_roughing_limit=not finishing_invalid)
         return result
 
@@ -437,8 +524,9 @@ class JobTaskPanel:
             first = result.problems[0]
             self.summary.setText(f"{len(result.problems)} problem: {first.advice}")
             self.summary.setStyleSheet(ERROR_STYLE)
-        self.summary_limits.setText(limits_text(result.recommendations, with_roughing_limit,
-                                                bool(values["job"].get("UseBottomTool")), FreeCAD.Units))
+        flat = int(values["job"]["MachineAxes"]) == 3
+        self.summary_limits.setText(THREE_AXIS_LIMITS if flat else limits_text(
+            result.recommendations, with_roughing_limit, bool(values["job"].get("UseBottomTool")), FreeCAD.Units))
         figures, source = self._figures(values_signature(values)) if result.ok else (None, "")
         if figures is not None:
             self.summary_figures.setText(f"{figures_text(figures)}\n({source})")
@@ -529,6 +617,18 @@ class JobTaskPanel:
             gui_doc.resetEdit()
         else:
             FreeCADGui.Control.closeDialog()
+
+
+def _png_bytes(figure, dpi: int) -> bytes:
+    """A matplotlib figure as PNG bytes at `dpi` (the screen's: the chart's text at its point size)."""
+    import io
+
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+
+    FigureCanvasAgg(figure)
+    buffer = io.BytesIO()
+    figure.savefig(buffer, format="png", dpi=dpi)
+    return buffer.getvalue()
 
 
 def _scroll_area_of(widget):

@@ -16,7 +16,7 @@ import re
 
 MESSAGE_RESOLUTION_MM = 0.0001  # notes, limits, messages, fields: 0.1 um (a typed 0.0005 mm is not rounded)
 INSPECTION_RESOLUTION_MM = 0.0001  # inspection values: 0.1 um, always 4 decimals in mm
-RESOLUTIONS = {"mm": MESSAGE_RESOLUTION_MM, "deg": 0.0001, "mm/min": 0.1, "mm/s^2": 0.1}
+RESOLUTIONS = {"mm": MESSAGE_RESOLUTION_MM, "um": 0.01, "deg": 0.0001, "mm/min": 0.1, "mm/s^2": 0.1}
 """Smallest step each job-file unit needs to show (in that unit)."""
 FIELD_MIN_DECIMALS = 2  # FreeCAD's default number of decimals: fields look like FreeCAD's own
 _NUMBER = r"-?\d+(?:\.\d+)?(?:[eE][-+]?\d+)?"

@@ -183,7 +183,7 @@ def validate(values: dict[str, dict[str, object]], source: str = "job", units=No
 
     Recommendations never use an invalid tool: with the finishing tool in error they are the gear's alone.
     """
-    from spur_cad.cam.plan import check_cam_inputs
+    from spur_cad.cam.plan import check_cam_inputs, check_three_axis_inputs
     from spur_cad.cam.recommend import recommend_tools
     from spur_cad.cam.strategies import get_strategy
     from spur_cad.job import job_from_dict
@@ -203,8 +203,9 @@ def validate(values: dict[str, dict[str, object]], source: str = "job", units=No
     except SpurCadError as exc:
         return Validation(None, (_problem(exc, source, values, units),),
                           recommend_tools(spec, blank, clearance, strategy=strategy))
+    check = check_three_axis_inputs if job.machine.axes == 3 else check_cam_inputs  # the blank flat, or on the table
     try:
-        rec, _ = check_cam_inputs(cam_inputs(job))
+        rec, _ = check(cam_inputs(job))
     except SpurCadError as exc:
         problem = _problem(exc, source, values, units)
         finishing = None if problem.group == SECTION_GROUPS["tools.finishing"] else job.tools.finishing
