@@ -22,8 +22,6 @@ flanks), and the modifications as cut are read from the same traces (spur_cad.gr
 
 from __future__ import annotations
 
-import math
-
 import numpy as np
 
 from spur_cad.geometry.modifications import FlankModifications
