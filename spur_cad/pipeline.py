@@ -444,15 +444,16 @@ def simulate_stage(job: Job, plan: CamPlan, progress: Callable[[float], None] | 
 
     operations = [Cut(planned.toolpath, planned.tool) for planned in (plan.roughing, plan.roughing_bottom,
                                                                       plan.finishing) if planned is not None]
-    if not job.simulation.enabled or not operations or job.gear.is_internal:  # a ring's cut: not simulated yet
+    if not job.simulation.enabled or not operations:
         return None
-    if job.machine.axes == 3:  # the blank lying flat: swept areas level by level (spur_cad.sim.flat)
+    if job.machine.axes == 3:  # the blank lying flat (a ring's: the rim's disc, its bore): spur_cad.sim.flat
         from spur_cad.sim.flat import simulate_flat
 
         depths = -plan.finishing.toolpath.z[plan.finishing.toolpath.motion_mask] if plan.finishing is not None \
             else np.zeros(0)
         result = simulate_flat(job.gear, job.stock.blank_radius_mm(job.gear), operations,
-                               SimSettings(resolution_mm=job.simulation.resolution_mm), np.unique(depths))
+                               SimSettings(resolution_mm=job.simulation.resolution_mm), np.unique(depths),
+                               job.stock.inner_diameter_mm / 2.0)
         if progress is not None:
             progress(1.0)
         return result

@@ -146,6 +146,8 @@ def test_a_tool_whose_fillet_reaches_the_active_profile_is_refused_in_one_line()
 
 @pytest.mark.slow
 def test_the_ring_example_runs_through_the_pipeline_on_three_axes():
+    """Programs without an A axis, arcs; the cut simulated and graded (an ideal machine: class 1), the root's
+    leftover reported as the flat end mill's reach."""
     from spur_cad.pipeline import run_job
 
     result = run_job(ring_job())
@@ -153,6 +155,11 @@ def test_the_ring_example_runs_through_the_pipeline_on_three_axes():
     assert "G2 " in finishing and "G3 " in finishing and "gear axis = Z" in finishing
     for program in (finishing, roughing):
         assert not [line for line in program.splitlines() if not line.startswith("(") and " A" in line]
+    assert result.simulation.enabled and result.simulation.max_gouge_mm <= GOUGE_MM
+    assert result.grading is not None and result.grading.overall_class == 1
+    assert not [w for w in result.warnings if "not simulated" in w]
+    report = result.files["report.html"].decode()
+    assert "flat end mill cannot reach (the cutter-generated fillet is tighter than its radius)" in report
 
 
 def test_the_ring_root_thickness_is_the_tooth_between_two_spaces():

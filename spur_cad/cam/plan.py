@@ -68,6 +68,10 @@ MAX_COMPARISON_MOVES = 2_000_000
 """Largest toolpath a comparison time is given for (perimeter, reference process's strategy; estimated from
 two stations' worth, PerimeterStrategy.estimate); beyond it the comparison is left out (None)."""
 
+THREE_AXIS_BUDGET_WARNING = ("[machine] axes = 3: the error budget is not applied (its index errors are the rotary "
+                             "table's); the simulation and grade are those of an ideal 3-axis machine")
+"""The warning of every 3-axis plan, an external gear's or a ring's."""
+
 
 @dataclass(frozen=True)
 class RoughingPlan:
@@ -654,15 +658,13 @@ def _plan_three_axis(inputs: CamInputs, tolerance_mm: float) -> CamPlan:
                                         segments, arcs, root_thickness(spec, tool.diameter_mm / 2.0), engagement)
         result = FinishingResult("three_axis", None, None, len(levels), 0.0, np.zeros(0), facts=facts)
         finishing = FinishingPlan(tool, result, path, estimate(path, machine), None, None)
-    warnings = ("[machine] axes = 3: the error budget is not applied (its index errors are the rotary table's); "
-                "the simulation and grade are those of an ideal 3-axis machine",)
-    return CamPlan(rec, roughing, finishing, warnings)
+    return CamPlan(rec, roughing, finishing, (THREE_AXIS_BUDGET_WARNING,))
 
 
 def _plan_three_axis_ring(inputs: CamInputs, tolerance_mm: float, root) -> CamPlan:
     """The 3-axis plan of an internal gear (spur_cad.cam.three_axis_ring): the hole roughed from the centre out
     (from [stock] inner_diameter_mm's bore, or a helix into a solid blank), the toothed inner outline finished;
-    no tool recommendations, no simulation (a warning says so)."""
+    no tool recommendations; simulated and graded as an external gear's 3-axis cut (spur_cad.sim.flat)."""
     from spur_cad.cam.roughing import RoughingLevels
     from spur_cad.cam.three_axis import ThreeAxisFinishingFacts, finishing_engagement
     from spur_cad.cam.three_axis_ring import (
@@ -704,6 +706,4 @@ def _plan_three_axis_ring(inputs: CamInputs, tolerance_mm: float, root) -> CamPl
                                         "cutter")
         result = FinishingResult("three_axis", None, None, len(levels), 0.0, np.zeros(0), facts=facts)
         finishing = FinishingPlan(tool, result, path, estimate(path, machine), None, None)
-    warnings = ("[machine] axes = 3: the ring's cut is not simulated nor graded; the LinuxCNC programs are checked "
-                "by rs274 in the tests",)
-    return CamPlan(rec, roughing, finishing, warnings)
+    return CamPlan(rec, roughing, finishing, (THREE_AXIS_BUDGET_WARNING,))

@@ -6,8 +6,9 @@ measuring machine's profile probe reads them), + for material above the design. 
 space and both flanks:
 
 - profile traces at three face positions (the ends and the middle of the helix evaluation range):
-  deviation against the roll length sqrt(r^2 - r_b^2) of the involute points, evaluated from the form
-  circle to 95 % of the roll length to the tip circle (the standard leaves the tip's last 5 % out);
+  deviation against the roll length sqrt(r^2 - r_b^2) of the involute points (a ring's negative: its traces
+  run root to tip too), evaluated from the form circle to 95 % of the roll length to the tip circle (the
+  standard leaves the tip's last 5 % out);
 - a helix trace on the reference circle's point of the flank, along the face width without, at each
   end, the smaller of 5 % of b and one module;
 - the flank's position on the reference circle at mid face: a normal deviation e moves the flank by
@@ -20,8 +21,6 @@ flanks), and the modifications as cut are read from the same traces (spur_cad.gr
 """
 
 from __future__ import annotations
-
-import math
 
 import numpy as np
 
@@ -47,13 +46,21 @@ def helix_range_mm(face_width_mm: float, module_mm: float) -> tuple[float, float
     return cut, face_width_mm - cut
 
 
+def profile_roll_mm(spec, radius_mm):
+    """The profile trace's position of an involute point at `radius_mm`: its roll length sqrt(r^2 - r_b^2), a
+    ring's negative (ISO 21771 signs an internal gear's radii so), so that every profile trace runs from the root
+    to the tip in increasing position and a slope + means material rising toward the tip, external or internal."""
+    roll = np.sqrt(np.maximum(np.asarray(radius_mm, float) ** 2 - spec.base_radius_mm ** 2, 0.0))
+    return -roll if spec.is_internal else roll
+
+
 def profile_range_mm(spec, start_radius_mm: float | None = None) -> tuple[float, float]:
-    """The profile evaluation range in roll length: form circle (or `start_radius_mm`: where a 3-axis tool leaves
-    the involute, above the rack's form circle) to 95 % of the way to the tip circle."""
-    rb = spec.base_radius_mm
+    """The profile evaluation range in profile_roll_mm: form circle (or `start_radius_mm`: where a 3-axis tool
+    leaves the involute, above the rack's form circle; a ring's: inside its cutter-generated form circle) to 95 %
+    of the way to the tip circle (ISO 1328-1 leaves the tip's last 5 % out, an internal gear's as well: its tip is
+    the circle toward the axis)."""
     start_radius = spec.form_radius_mm if start_radius_mm is None else start_radius_mm
-    start = math.sqrt(max(start_radius ** 2 - rb ** 2, 0.0))
-    tip = math.sqrt(spec.tip_radius_mm ** 2 - rb ** 2)
+    start, tip = float(profile_roll_mm(spec, start_radius)), float(profile_roll_mm(spec, spec.tip_radius_mm))
     return start, start + (1.0 - TIP_EXCLUDED_FRACTION) * (tip - start)
 
 
@@ -75,7 +82,7 @@ def traces(spec, result, profile_start_radius_mm: float | None = None) -> list[T
     for side in SIDES:
         mask = _flank_points(grid, side)
         radius = np.hypot(grid.points[mask, 0], grid.points[mask, 1])
-        roll = np.sqrt(np.maximum(radius ** 2 - spec.base_radius_mm ** 2, 0.0))
+        roll = profile_roll_mm(spec, radius)
         order = np.argsort(roll)
         reference = int(np.argmin(np.abs(radius - spec.reference_radius_mm)))
         for k in range(grid.teeth):

@@ -207,6 +207,7 @@ def k_chart_figure(spec: GearSpec, grading: Grading) -> Figure:
     worst = max(profile, key=spread_in_range).space
     grade = grading.overall_class or 11
     d, b, m = 2.0 * spec.reference_radius_mm, spec.face_width_mm, spec.module_mm
+    profile_label = "roll length [mm] (a ring's negative: root to tip)" if spec.is_internal else "roll length [mm]"
     fig = figure(9.0, 6.5, left=0.08, right=0.98, bottom=0.08, top=0.95)
     fig.subplots_adjust(wspace=0.25, hspace=0.4)
     axes = fig.subplots(2, 2)
@@ -229,7 +230,7 @@ def k_chart_figure(spec: GearSpec, grading: Grading) -> Figure:
                     ax.axhline(edge, color="tab:red", lw=0.6, ls="--", gid="tolerance band")
             ax.set_title(f"space {worst}, {side} flank: {kind} (band: class {grade} "
                          f"{'F_aT' if kind == 'profile' else 'F_bT'} = {band:g} \u00b5m)", fontsize=8)
-            ax.set_xlabel("roll length [mm]" if kind == "profile" else "X (face width) [mm]", fontsize=8)
+            ax.set_xlabel(profile_label if kind == "profile" else "X (face width) [mm]", fontsize=8)
             ax.set_ylabel("deviation [\u00b5m] (+ material)", fontsize=8)
             ax.grid(True, lw=0.3)
             if ax.get_legend_handles_labels()[0]:

@@ -122,6 +122,23 @@ def _image_uri(png: bytes | None) -> str:
     return f"data:image/png;base64,{base64.b64encode(png).decode('ascii')}" if png else ""
 
 
+def _tool_reach_note(result: JobResult) -> str:
+    """A 3-axis finish whose flat end mill cannot follow the generated fillet: the root's leftover is the tool's
+    reach (expected, the design's fillet being tighter than the tool), not a flank error; '' otherwise."""
+    finish = result.finishing
+    facts = finish.strategy_facts if finish is not None and finish.strategy == "three_axis" else None
+    if facts is None or abs(facts.form_diameter_mm - facts.rack_form_diameter_mm) < 1e-6:
+        return ""
+    root = [f.max_leftover_mm for f in result.simulation.per_feature if f.feature.endswith(("fillet", "root"))]
+    generated = f"{facts.generated_by}-generated"
+    return (f" The leftover in the root ({number(1000 * max(root, default=0.0), 1)} {sheet.MICRO} at most) and on "
+            f"the involute between diameters {number(facts.form_diameter_mm, 3)} and "
+            f"{number(facts.rack_form_diameter_mm, 3)} mm is where the D {number(2 * facts.tool_radius_mm, 3)} mm "
+            f"flat end mill cannot reach (the {generated} fillet is tighter than its radius), as planned: expected, "
+            "not a flank error; the involute it cuts is graded from diameter "
+            f"{number(facts.form_diameter_mm, 3)} mm.")
+
+
 def report_context(result: JobResult, images: dict[str, bytes]) -> dict:
     """What the template receives: labelled, formatted values (spur_cad.report.sheet), the images as data URIs,
     and the typed result itself (`result`)."""
@@ -133,7 +150,7 @@ def report_context(result: JobResult, images: dict[str, bytes]) -> dict:
         verdict = (f"Largest gouge {number(1000 * sim.max_gouge_mm, 1)} {sheet.MICRO} "
                    f"({'within' if within else 'beyond'} the resolution). Largest leftover "
                    f"{number(1000 * sim.max_leftover_mm, 1)} {sheet.MICRO} at tooth space {worst.space}, "
-                   f"{worst.feature}, X = {number(worst.x_mm, 3)} mm.")
+                   f"{worst.feature}, X = {number(worst.x_mm, 3)} mm.") + _tool_reach_note(result)
     return {
         "title": f"spur_cad report: {result.job.name}", "job": result.job, "version": result.version,
         "dialect": result.post.dialect, "folded": result.post.folded, "result": result,

@@ -12,6 +12,11 @@ Each design point's blade (along its normal, from gouge_range_mm inside the mate
 where it first enters a swept area, found by sphere tracing on the exact distance to the lines and arcs (steps of
 the distance less the radius, never shorter than MIN_STEP_MM, then bisection to 1 nm): the same blades, deviations
 and SimResult as spur_cad.sim.simulate, so the grading and the report read it unchanged.
+
+A ring (internal gear) is the same grid: its design normals point out of the material into the spaces, toward the
+axis, so a blade reads + leftover and - gouge as an external gear's. Its stock is the rim's disc with the stock's
+bore (air: blades end where they enter it), and what is cut is the hole: the removed volume is the simulated hole's
+area less the bore's, not the blank's disc less the section.
 """
 
 from __future__ import annotations
@@ -179,11 +184,23 @@ def _bisect(points: np.ndarray, normals: np.ndarray, outside: np.ndarray, inside
     return inside
 
 
+def bore_entry_mm(grid: DesignGrid, bore_radius_mm: float) -> np.ndarray:
+    """(M,) where each blade (point + t normal, t > 0) first enters the circle of `bore_radius_mm` about the axis
+    (inf when it passes it): a ring's stock has no material there to cut."""
+    p, n = grid.points, grid.normals
+    pn = np.einsum("ij,ij->i", p, n)
+    discriminant = pn * pn - (np.einsum("ij,ij->i", p, p) - bore_radius_mm ** 2)
+    entry = -pn - np.sqrt(np.maximum(discriminant, 0.0))
+    return np.where((discriminant > 0.0) & (entry > 0.0), entry, np.inf)
+
+
 def simulate_flat(spec: GearSpec, blank_radius_mm: float, operations: Sequence[Cut],
-                  settings: SimSettings | None = None, station_depths_mm: np.ndarray | None = None) -> SimResult:
-    """Cut the flat blank (radius `blank_radius_mm`, the face width thick) with every operation and measure the
-    result against the design: rows over the face width at depths 0..b below the top face (plus the finishing
-    step-downs `station_depths_mm` and the middles between them); `settings` default SimSettings()."""
+                  settings: SimSettings | None = None, station_depths_mm: np.ndarray | None = None,
+                  bore_radius_mm: float = 0.0) -> SimResult:
+    """Cut the flat blank (radius `blank_radius_mm`, the face width thick; a ring's with its bore of
+    `bore_radius_mm`, 0: a solid disc) with every operation and measure the result against the design: rows over
+    the face width at depths 0..b below the top face (plus the finishing step-downs `station_depths_mm` and the
+    middles between them); `settings` default SimSettings()."""
     settings = settings or SimSettings()
     settings.validate()
     radii = [op.tool.diameter_mm / 2.0 for op in operations] or [0.5]
@@ -194,16 +211,22 @@ def simulate_flat(spec: GearSpec, blank_radius_mm: float, operations: Sequence[C
     extra = np.concatenate([stations, 0.5 * (stations[1:] + stations[:-1])]) if len(stations) else np.zeros(0)
     check_design_size(spec, spacing, b, len(extra), settings.resolution_mm)
     grid = design_grid(spec, spacing, 0.0, b, extra)
-    return simulate_flat_grid(grid, blank_radius_mm, operations, settings, b, stations)
+    ring_bore_mm = bore_radius_mm if spec.is_internal else None
+    return simulate_flat_grid(grid, blank_radius_mm, operations, settings, b, stations, ring_bore_mm)
 
 
 def simulate_flat_grid(grid: DesignGrid, blank_radius_mm: float, operations: Sequence[Cut], settings: SimSettings,
-                       face_width_mm: float, stations: np.ndarray | None = None) -> SimResult:
-    """`simulate_flat` on a given design grid (any outline with normals: a plain circle in tests)."""
+                       face_width_mm: float, stations: np.ndarray | None = None,
+                       ring_bore_radius_mm: float | None = None) -> SimResult:
+    """`simulate_flat` on a given design grid (any outline with normals: a plain circle in tests);
+    `ring_bore_radius_mm` None for an external gear's blank, else the grid is a ring's cut from a disc with that
+    bore (0: solid)."""
     started = time.perf_counter()
     stock = StockCylinder(blank_radius_mm, 0.0, face_width_mm)
     t_min = -settings.gouge_range_mm
     initial = initial_blades(grid, stock, settings.leftover_range_mm)
+    if ring_bore_radius_mm:
+        initial = np.minimum(initial, bore_entry_mm(grid, ring_bore_radius_mm)[None, :, None])
     top = initial[:, :, 0]
     by_level: dict[float, np.ndarray] = {}  # Z -> blades cut by that level alone (teeth, M)
     seen: dict[bytes, np.ndarray] = {}  # levels with the same path and tool are cut once
@@ -233,9 +256,13 @@ def simulate_flat_grid(grid: DesignGrid, blank_radius_mm: float, operations: Seq
         reaching = np.flatnonzero(levels_z <= -x + 1e-9)
         if len(reaching):
             h[:, :, row] = cumulative[int(reaching[-1])]
-    removed = float(((math.pi * blank_radius_mm ** 2 - section_areas(grid, h)) * grid.row_width).sum())
+    if ring_bore_radius_mm is None:  # the blank's disc less the section
+        removed_area = math.pi * blank_radius_mm ** 2 - section_areas(grid, h)
+    else:  # a ring: its hole (the section's outline, counterclockwise) less the stock's bore
+        removed_area = section_areas(grid, h) - math.pi * ring_bore_radius_mm ** 2
+    removed = float((removed_area * grid.row_width).sum())
     return SimResult(grid, h, initial, stock, face_width_mm, settings, removed, time.perf_counter() - started,
                      clipped, 0, moves, np.asarray(stations if stations is not None else (), float))
 
 
-__all__ = ["Pieces", "clip_blades", "level_pieces", "simulate_flat", "simulate_flat_grid"]
+__all__ = ["Pieces", "bore_entry_mm", "clip_blades", "level_pieces", "simulate_flat", "simulate_flat_grid"]
