@@ -21,12 +21,17 @@ HELICAL_PROFILE = GEAR + "helix_angle_deg = 15\n" + TOOLS + (
     "[gear.modifications]\nprofile_crowning_um = 6\nprofile_slope_um = 5\nroot_relief_um = 8\n"
     "root_relief_start_diameter_mm = 93\ntip_relief_um = 12\ntip_relief_start_diameter_mm = 97.5\n")
 """Moves the form point (by 16.5 um): the helical tip passes follow the faded fillet (not moved: 12.8 um left)."""
+SPUR_SIDES = GEAR + TOOLS + ("[gear.modifications]\ntip_relief_um = 15\ntip_relief_start_diameter_mm = 98\n"
+                             "[gear.modifications.left]\ntip_relief_um = 20\ntip_relief_shape = \"parabolic\"\n")
+"""Sides modified differently: their turned passes differ, and each flank's raised tool ends must follow its own
+neighbours (taken from both sides' passes together they left 13.7 um on the left flank of the modified example)."""
 RES = 0.002
 
 
-@pytest.fixture(scope="module", params=["spur", "helical", "helical profile"])
+@pytest.fixture(scope="module", params=["spur", "spur sides", "helical", "helical profile"])
 def planned(request):
-    job = parse_job({"spur": SPUR, "helical": HELICAL, "helical profile": HELICAL_PROFILE}[request.param], "f.toml")
+    jobs = {"spur": SPUR, "spur sides": SPUR_SIDES, "helical": HELICAL, "helical profile": HELICAL_PROFILE}
+    job = parse_job(jobs[request.param], "f.toml")
     return request.param, job, plan_cam(job)
 
 

