@@ -729,6 +729,12 @@ def _job_from_data(data: dict, source: str, text: str, strategies: Strategies = 
         raise JobFileError(f"{where('gear', 'internal')}: internal = true: the rotary table cannot cut an internal "
                            "gear (its tool cannot reach inside the ring along the rotary axis); cut it with [machine] "
                            "axes = 3 or leave out [tools]", section="gear", field="internal")
+    if modification_tables and (spec.is_internal or sections.get("machine", Machine()).axes == 3):
+        table = next(iter(modification_tables))
+        what = "an internal gear's ring" if spec.is_internal else "the 3-axis variant ([machine] axes = 3)"
+        raise JobFileError(f"{_where(source, text, table)}: [{table}] flank modifications are cut by generating "
+                           f"finishing on the rotary table only; {what} does not follow them: leave them out",
+                           section=table, field=None)
     modifications, modification_values = _modifications(modification_tables, spec, source, text)
     for check, name in ((gear_section.blank_features().validate, "gear"),
                         (sections.get("stock", StockSpec()).validate, "stock")):

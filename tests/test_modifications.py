@@ -387,3 +387,19 @@ def test_the_profile_figure_draws_both_modified_flanks_magnified():
         factor = removal_magnification(job.gear, largest_mm)
         assert 0.4 * 0.04 * depth < factor * largest_mm <= 0.04 * depth
         assert f"{factor:.0e}"[0] in "125"
+
+
+@pytest.mark.parametrize("example, what", [("flat_gear.toml", "the 3-axis variant"),
+                                           ("ring_gear.toml", "an internal gear's ring")])
+def test_modifications_are_refused_where_the_cut_would_not_follow_them(example, what):
+    """The 3-axis variant and a ring cut the unmodified outline: modifications there are one line at their table."""
+    from pathlib import Path
+
+    text = (Path(__file__).resolve().parent.parent / "resources" / "examples" / example).read_text()
+    text += "\n[gear.modifications]\nlead_crowning_um = 5\n"
+    with pytest.raises(JobFileError) as info:
+        parse_job(text, "f.toml")
+    message = str(info.value)
+    line = text.splitlines().index("[gear.modifications]") + 1
+    assert message.startswith(f"f.toml:{line}: [gear.modifications] ") and "\n" not in message, message
+    assert what in message and "leave them out" in message
