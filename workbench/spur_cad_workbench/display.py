@@ -57,23 +57,26 @@ def shown_moves(path: Toolpath, limit: int = MAX_DISPLAY_MOVES) -> np.ndarray:
     return motion[::stride]
 
 
-def display_path(path: Toolpath, limit: int = MAX_DISPLAY_MOVES, max_a_step_deg: float = MAX_A_STEP_DEG) -> DisplayPath:
-    """The drawn path of `path` in the part frame (see the module docstring)."""
+def _drawn_moves(path: Toolpath, limit: int) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """(the moves drawn, every motion move, each drawn move's start move (0 for the first), joined): a move is drawn
+    from its start pose when that pose was drawn too; otherwise it is a jump."""
     moves = shown_moves(path, limit)
     motion = np.nonzero(path.motion_mask)[0]
-    if len(moves) == 0:
-        return DisplayPath(np.zeros((0, 3)), np.zeros(0, bool), 0, len(motion))
     previous_motion = np.full(len(path), -1)
     previous_motion[motion[1:]] = motion[:-1]
     start = previous_motion[moves]
-    # A move is drawn from its start pose when that pose was drawn too; otherwise it is a jump.
     drawn = np.zeros(len(path), bool)
     drawn[moves] = True
     joined = (start >= 0) & drawn[np.maximum(start, 0)]
-    x0 = np.where(joined, path.x[np.maximum(start, 0)], path.x[moves])
-    y0 = np.where(joined, path.y[np.maximum(start, 0)], path.y[moves])
-    z0 = np.where(joined, path.z[np.maximum(start, 0)], path.z[moves])
-    a0 = np.where(joined, path.a[np.maximum(start, 0)], path.a[moves])
+    return moves, motion, np.maximum(start, 0), joined
+
+
+def display_path(path: Toolpath, limit: int = MAX_DISPLAY_MOVES, max_a_step_deg: float = MAX_A_STEP_DEG) -> DisplayPath:
+    """The drawn path of `path` in the part frame (see the module docstring)."""
+    moves, motion, start, joined = _drawn_moves(path, limit)
+    if len(moves) == 0:
+        return DisplayPath(np.zeros((0, 3)), np.zeros(0, bool), 0, len(motion))
+    x0, y0, z0, a0 = (np.where(joined, c[start], c[moves]) for c in (path.x, path.y, path.z, path.a))
     x1, y1, z1, a1 = path.x[moves], path.y[moves], path.z[moves], path.a[moves]
     steps = np.maximum(1, np.ceil(np.abs(a1 - a0) / max_a_step_deg - 1e-9)).astype(int)
     owner = np.repeat(np.arange(len(moves)), steps)
@@ -95,17 +98,10 @@ def display_path(path: Toolpath, limit: int = MAX_DISPLAY_MOVES, max_a_step_deg:
 def display_flat_path(path: Toolpath, face_width_mm: float, limit: int = MAX_DISPLAY_MOVES,
                       max_arc_step_deg: float = MAX_ARC_STEP_DEG) -> DisplayPath:
     """The drawn path of a 3-axis program in the part frame (see the module docstring)."""
-    moves = shown_moves(path, limit)
-    motion = np.nonzero(path.motion_mask)[0]
+    moves, motion, start, joined = _drawn_moves(path, limit)
     if len(moves) == 0:
         return DisplayPath(np.zeros((0, 3)), np.zeros(0, bool), 0, len(motion))
-    previous_motion = np.full(len(path), -1)
-    previous_motion[motion[1:]] = motion[:-1]
-    start = previous_motion[moves]
-    drawn = np.zeros(len(path), bool)
-    drawn[moves] = True
-    joined = (start >= 0) & drawn[np.maximum(start, 0)]
-    x0, y0, z0 = (np.where(joined, c[np.maximum(start, 0)], c[moves]) for c in (path.x, path.y, path.z))
+    x0, y0, z0 = (np.where(joined, c[start], c[moves]) for c in (path.x, path.y, path.z))
     x1, y1, z1 = path.x[moves], path.y[moves], path.z[moves]
     radius, sweep = (values[moves] for values in arc_sweeps_rad(path))
     arc = joined & (sweep != 0.0)
