@@ -88,8 +88,15 @@ RESULT["scroll_modifications"] = scroll.horizontalScrollBar().maximum()
 scroll.viewport().grab().save(MODIFICATIONS_SHOT)
 RESULT["dock_width"] = dock.width()
 
-# the 3-axis variant from the panel: a bull-nose finishing tool is refused at its field, a flat one plans
+# the 3-axis variant from the panel (an unmodified gear: 3 axes refuse modifications): a bull-nose finishing tool is
+# refused at its field, a flat one plans
 section.set_open(False)
+FreeCADGui.Control.closeDialog()
+settle()
+for prop in ("TipRelief", "LeadCrowning", "RightFlankOwnValues"):
+    setattr(gear, prop, False if prop == "RightFlankOwnValues" else FreeCAD.Units.Quantity("0 um"))
+doc.recompute()
+panel, scroll = open_panel()
 panel.set_value("MachineAxes", 3)
 RESULT["axes3_problem"] = [panel.highlighted, panel.summary.text()]
 RESULT["three_axis_enabled"] = [panel.widgets[p].isEnabled() for p in ("HoldingTabs", "TabWidth", "OnionSkin")]
@@ -131,9 +138,8 @@ RESULT["title_3"] = panel.form.toolTip()
 FreeCADGui.Control.closeDialog()
 settle()
 
-# an internal gear: the gear is fine, the job refuses it with the command line's sentence
-for prop in ("TipRelief", "LeadCrowning", "RightFlankOwnValues"):
-    setattr(gear, prop, False if prop == "RightFlankOwnValues" else FreeCAD.Units.Quantity("0 um"))
+# an internal gear: the gear is fine, the rotary-table job refuses it with the command line's sentence (3 axes cut it)
+job.MachineAxes = 4
 gear.Teeth = 60
 gear.Module = 2.0
 gear.RackTipRadius = 0.4            # as resources/examples/ring_gear.toml: the cutter's tip rounds apart

@@ -29,6 +29,7 @@ from spur_cad.cam.machine import Machine, MachineError, RoughingParams
 from spur_cad.cam.three_axis_root import (
     FlatMillRoot,
     RootThickness,
+    check_ring_root,
     flat_mill_root,
     largest_flat_mill_radius_mm,
 )
@@ -82,8 +83,6 @@ def check_three_axis(spec: GearSpec, finishing_tool: Tool | None, roughing_tool:
     if finishing_tool is None:
         return None
     if spec.is_internal:  # a ring: its spaces open outward (spur_cad.cam.three_axis_ring)
-        from spur_cad.cam.three_axis_ring import check_ring_root
-
         return check_ring_root(spec, finishing_tool)
     root = flat_mill_root(spec, finishing_tool.diameter_mm / 2.0)
     if not root.fits:

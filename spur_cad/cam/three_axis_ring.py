@@ -38,12 +38,9 @@ from spur_cad.cam.three_axis import (
     _started_at_nearest,
 )
 from spur_cad.cam.three_axis_root import (
-    FlatMillRoot,
-    flat_mill_root,
     largest_flat_mill_radius_mm,
-    ring_active_profile_start,
 )
-from spur_cad.cam.tools import Tool, ToolError
+from spur_cad.cam.tools import Tool
 from spur_cad.geometry.outline2d import Arc2D, Segment2D, internal_gear_outline_arcs, offset_outline
 from spur_cad.geometry.sampling import gear_outline
 from spur_cad.geometry.spec import GearSpec
@@ -65,21 +62,6 @@ HELIX_START_ABOVE_MM = 0.1
 """The helix starts this far above the level it goes down from (the top face or the level above, cut)."""
 AIR_BORE_MARGIN_MM = 0.5
 """A blank's bore is plunged into (no helix) only if it is wider than the roughing tool by twice this."""
-
-
-def check_ring_root(spec: GearSpec, finishing_tool: Tool) -> FlatMillRoot:
-    """The root the finishing tool leaves in the ring's spaces; ToolError (one line) when its fillet reaches the
-    active profile, naming the largest tool radius that works and what sets the active profile's start."""
-    root = flat_mill_root(spec, finishing_tool.diameter_mm / 2.0)
-    if not root.fits:
-        largest = largest_flat_mill_radius_mm(spec)
-        _, source = ring_active_profile_start(spec)
-        raise ToolError(f"a D {finishing_tool.diameter_mm:g} mm flat end mill's side leaves the ring's involute at "
-                        f"diameter {2 * root.form_radius_mm:.3f} mm, inside the active profile's start at "
-                        f"{2 * root.active_start_radius_mm:.3f} mm (set by {source}); the largest tool radius that "
-                        f"works is {largest:.3f} mm (D {2 * largest:.2f} mm)", field="diameter_mm",
-                        section="tools.finishing")
-    return root
 
 
 def ring_finishing_loop(spec: GearSpec, tool: Tool, tolerance_mm: float) -> list[Segment2D]:

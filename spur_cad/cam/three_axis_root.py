@@ -15,6 +15,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.spatial import cKDTree
 
+from spur_cad.cam.tools import Tool, ToolError
 from spur_cad.geometry.spec import GearSpec
 
 ROOT_SAMPLE_SPACING_MM = 0.005
@@ -211,3 +212,18 @@ def root_thickness(spec: GearSpec, tool_radius_mm: float) -> RootThickness:
 
     return RootThickness(tool_radius_mm, 2 * form, chord(cut, form), chord(gear, form), 2 * fillet,
                          chord(cut, fillet), chord(gear, fillet))
+
+
+def check_ring_root(spec: GearSpec, finishing_tool: Tool) -> FlatMillRoot:
+    """The root the finishing tool leaves in the ring's spaces; ToolError (one line) when its fillet reaches the
+    active profile, naming the largest tool radius that works and what sets the active profile's start."""
+    root = flat_mill_root(spec, finishing_tool.diameter_mm / 2.0)
+    if not root.fits:
+        largest = largest_flat_mill_radius_mm(spec)
+        _, source = ring_active_profile_start(spec)
+        raise ToolError(f"a D {finishing_tool.diameter_mm:g} mm flat end mill's side leaves the ring's involute at "
+                        f"diameter {2 * root.form_radius_mm:.3f} mm, inside the active profile's start at "
+                        f"{2 * root.active_start_radius_mm:.3f} mm (set by {source}); the largest tool radius that "
+                        f"works is {largest:.3f} mm (D {2 * largest:.2f} mm)", field="diameter_mm",
+                        section="tools.finishing")
+    return root
