@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from tests.freecad_helper import describe
-from tests.workbench_helper import ARTIFACTS, run_workbench_code
+from tests.workbench_helper import ARTIFACTS, GUI_PRELUDE, run_workbench_code
 
 MODIFICATIONS_SHOT = ARTIFACTS / "workbench_panel_modifications.png"
 THREE_AXIS_SHOT = ARTIFACTS / "workbench_panel_three_axis.png"
@@ -19,18 +19,7 @@ GEAR = dict(Teeth=23, Module=4.0, FaceWidth=20.0, RackTipRadius=0.8, TipRelief=1
             LeadCrowning=8.0, RightFlankOwnValues=True, RightTipRelief=20.0, RightTipReliefStartDiameter=96.0,
             RightTipReliefShape="parabolic", RightLeadCrowning=8.0)
 
-BODY = r"""
-import sys, traceback
-import FreeCAD, FreeCADGui
-from PySide import QtCore, QtGui
-
-hooked = []
-sys.excepthook = lambda kind, value, tb: hooked.append("".join(traceback.format_exception(kind, value, tb)))
-main_window = FreeCADGui.getMainWindow()
-
-def settle(times=8):
-    for _ in range(times):
-        QtGui.QApplication.processEvents()
+BODY = GUI_PRELUDE + r"""
 
 FreeCADGui.activateWorkbench("SpurCadWorkbench")
 dock = [d for d in main_window.findChildren(QtGui.QDockWidget) if d.objectName() == "Combo View"][0]
