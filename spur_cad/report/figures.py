@@ -143,9 +143,15 @@ def finishing_png(spec: GearSpec, tool: Tool, y: np.ndarray, z: np.ndarray, a_de
     return _png(fig)
 
 
-def deviation_map_png(result: SimResult) -> bytes:
-    """Deviation over the space outline (arc length) x face width for the tooth space with the largest
-    deviation, and per tooth space the largest gouge and leftover."""
+def row_axis_label(lying_flat: bool) -> tuple[str, str]:
+    """(what a simulated row's position is, its axis label): X along the face width on the rotary table, the depth
+    below the top face for a gear cut lying flat (3 axes)."""
+    return ("depth", "depth below the top face [mm]") if lying_flat else ("X", "X (face width) [mm]")
+
+
+def deviation_map_png(result: SimResult, lying_flat: bool = False) -> bytes:
+    """Deviation over the space outline (arc length) x face width (depth when `lying_flat`) for the tooth space with
+    the largest deviation, and per tooth space the largest gouge and leftover."""
     rows = result.gear_rows
     deviation = result.gear_deviation  # mm, a view (no copy of a big gear's millions of values)
     most, least = deviation.max(axis=(1, 2)) * 1000.0, deviation.min(axis=(1, 2)) * 1000.0  # um, per space
@@ -169,7 +175,7 @@ def deviation_map_png(result: SimResult) -> bytes:
             ax.annotate(names[j], (arc[end], x[-1]), fontsize=7, rotation=90, va="top", ha="right",
                         xytext=(-2, -2), textcoords="offset points")
     ax.set_xlabel("position along the tooth space, right tooth centre -> root -> left tooth centre [mm]")
-    ax.set_ylabel("X (face width) [mm]")
+    ax.set_ylabel(row_axis_label(lying_flat)[1])
     ax.set_title(f"simulated deviation of tooth space {worst} (largest |deviation|); resolution "
                  f"{1000 * result.settings.resolution_mm:g} \u00b5m", fontsize=9)
     spaces = np.arange(deviation.shape[0])
@@ -182,12 +188,12 @@ def deviation_map_png(result: SimResult) -> bytes:
     return _png(fig)
 
 
-def k_chart_png(spec: GearSpec, grading: Grading) -> bytes:
+def k_chart_png(spec: GearSpec, grading: Grading, lying_flat: bool = False) -> bytes:
     """`k_chart_figure` as PNG bytes."""
-    return _png(k_chart_figure(spec, grading))
+    return _png(k_chart_figure(spec, grading, lying_flat))
 
 
-def k_chart_figure(spec: GearSpec, grading: Grading) -> Figure:
+def k_chart_figure(spec: GearSpec, grading: Grading, lying_flat: bool = False) -> Figure:
     """A gear measuring machine's chart for the tooth space with the largest total profile deviation: its
     right and left profile traces (deviation against roll length, the three face positions) and helix traces,
     the evaluation ranges, the design (deviation 0; a modified flank's design trace, its profile or lead
@@ -208,6 +214,7 @@ def k_chart_figure(spec: GearSpec, grading: Grading) -> Figure:
     grade = grading.overall_class or 11
     d, b, m = 2.0 * spec.reference_radius_mm, spec.face_width_mm, spec.module_mm
     profile_label = "roll length [mm] (a ring's negative: root to tip)" if spec.is_internal else "roll length [mm]"
+    row_name, row_label = row_axis_label(lying_flat)
     fig = figure(9.0, 6.5, left=0.08, right=0.98, bottom=0.08, top=0.95)
     fig.subplots_adjust(wspace=0.25, hspace=0.4)
     axes = fig.subplots(2, 2)
@@ -217,7 +224,7 @@ def k_chart_figure(spec: GearSpec, grading: Grading) -> Figure:
             band = tolerance_um("F_aT" if kind == "profile" else "F_bT", grade, d, b, m)  # the gear's class
             chosen = [t for t in traces if t.kind == kind and t.side == side and t.space == worst]
             for trace, style in zip(chosen, ("-", "--", ":", "-.") * len(chosen)):  # coinciding traces stay visible
-                label = f"X = {trace.x_mm:.2f} mm" if trace.x_mm is not None else "reference circle"
+                label = f"{row_name} = {trace.x_mm:.2f} mm" if trace.x_mm is not None else "reference circle"
                 design = 0.0 if trace.design_um is None else trace.design_um
                 ax.plot(trace.position_mm, trace.deviation_um + design, style, lw=1.1, label=label)
                 for edge in trace.evaluation:
@@ -230,7 +237,7 @@ def k_chart_figure(spec: GearSpec, grading: Grading) -> Figure:
                     ax.axhline(edge, color="tab:red", lw=0.6, ls="--", gid="tolerance band")
             ax.set_title(f"space {worst}, {side} flank: {kind} (band: class {grade} "
                          f"{'F_aT' if kind == 'profile' else 'F_bT'} = {band:g} \u00b5m)", fontsize=8)
-            ax.set_xlabel(profile_label if kind == "profile" else "X (face width) [mm]", fontsize=8)
+            ax.set_xlabel(profile_label if kind == "profile" else row_label, fontsize=8)
             ax.set_ylabel("deviation [\u00b5m] (+ material)", fontsize=8)
             ax.grid(True, lw=0.3)
             if ax.get_legend_handles_labels()[0]:

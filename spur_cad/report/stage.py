@@ -55,8 +55,9 @@ def report_html(result: JobResult, profile_png: bytes, spec: GearSpec, blank_rad
         z = np.concatenate([p.z for p in parts])
         a = np.concatenate([p.a for p in parts])
         images["finishing"] = finishing_png(spec, plan.finishing.tool, y, z, a)
+    lying_flat = plan.finishing is not None and plan.finishing.result.strategy == "three_axis"
     if sim is not None:
-        images["deviation"] = deviation_map_png(sim)
+        images["deviation"] = deviation_map_png(sim, lying_flat)
     rough = result.setup
     if sim is not None and sim.engagement is not None and result.tools.roughing is not None \
             and rough.roughing_step_down_mm is not None:
@@ -70,5 +71,5 @@ def report_html(result: JobResult, profile_png: bytes, spec: GearSpec, blank_rad
     if result.grading is not None and result.grading.has_profile_traces:
         from spur_cad.report.figures import k_chart_png
 
-        images["kchart"] = k_chart_png(spec, result.grading)
+        images["kchart"] = k_chart_png(spec, result.grading, lying_flat)
     return render_report(result, images, template_text, template_source)
