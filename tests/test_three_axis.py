@@ -203,6 +203,15 @@ def test_a_three_axis_job_runs_through_the_pipeline_without_a_rotary_axis(tmp_pa
     report = result.files["report.html"].decode()  # the set-up sheet of the blank lying flat, not the rotary table's
     assert "blank thickness (faced to the face width)" in report and "A zero" not in report
     assert result.grading is not None and result.simulation is not None
+    # the limits are the 3-axis variant's: the largest flat finishing end mill is the root analysis's (one 0.02 mm
+    # larger is refused), the flutes reach through the face width; no rotary-table generating tool is offered
+    limits = result.tools.recommendations
+    largest = limits.finishing_flat_end_mill_max_diameter_mm
+    check_three_axis(REFERENCE, flat(largest, 2), None)
+    with pytest.raises(ToolError, match="largest tool radius that works"):
+        check_three_axis(REFERENCE, flat(largest + 0.02, 2), None)
+    assert limits.required_flute_length_mm == pytest.approx(20.5) and limits.finishing_generating_max_diameter_mm == 0
+    assert "largest finishing flat end mill" in report and "by generation" not in report
 
 
 def tooth_chord_from_centres(centres: np.ndarray, radius_mm: float, circle_mm: float, teeth: int) -> float:

@@ -609,9 +609,10 @@ def check_three_axis_inputs(inputs: CamInputs):
         from spur_cad.cam.three_axis_ring import ring_tool_recommendations
 
         return ring_tool_recommendations(spec, inputs.machine.clearance_mm), root
-    rec = recommend_tools(spec, inputs.stock.blank_radius_mm(spec), inputs.machine.clearance_mm, inputs.finishing_tool,
-                          inputs.finishing.target_scallop_mm)
-    return rec, root
+    from spur_cad.cam.three_axis import flat_tool_recommendations
+
+    rotary = recommend_tools(spec, inputs.stock.blank_radius_mm(spec), inputs.machine.clearance_mm)
+    return flat_tool_recommendations(spec, inputs.machine.clearance_mm, rotary.roughing_max_diameter_mm), root
 
 
 def _plan_three_axis(inputs: CamInputs, tolerance_mm: float) -> CamPlan:

@@ -94,6 +94,17 @@ def check_three_axis(spec: GearSpec, finishing_tool: Tool | None, roughing_tool:
     return root
 
 
+def flat_tool_recommendations(spec: GearSpec, clearance_mm: float, roughing_max_diameter_mm: float):
+    """The tool limits of a gear cut lying flat (summary.json's `tools`): the side cuts, so no flat width, corner,
+    plunge allowance or generating tool; the finishing flat end mill up to the root analysis's largest; the flutes
+    through the face width and the break-through."""
+    from spur_cad.cam.recommend import ToolRecommendations
+
+    flute = spec.face_width_mm + BREAK_THROUGH_MM
+    return ToolRecommendations(0.0, 0.0, 0.0, roughing_max_diameter_mm, flute, flute + clearance_mm, 0.0,
+                               2.0 * largest_flat_mill_radius_mm(spec))
+
+
 def _levels(depth_mm: float, step_mm: float) -> list[float]:
     """Z of equal step-downs from 0 to -depth_mm, each at most step_mm."""
     n = max(1, math.ceil(depth_mm / step_mm - 1e-9))

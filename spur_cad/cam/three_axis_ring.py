@@ -36,9 +36,7 @@ from spur_cad.cam.three_axis import (
     _climb,
     _levels,
     _started_at_nearest,
-)
-from spur_cad.cam.three_axis_root import (
-    largest_flat_mill_radius_mm,
+    flat_tool_recommendations,
 )
 from spur_cad.cam.tools import Tool
 from spur_cad.geometry.outline2d import Arc2D, Segment2D, internal_gear_outline_arcs, offset_outline
@@ -214,15 +212,9 @@ def _helix(builder: ToolpathBuilder, radius_mm: float, top_mm: float, z_mm: floa
 
 
 def ring_tool_recommendations(spec: GearSpec, clearance_mm: float):
-    """The tool limits of a ring cut lying flat (summary.json's `tools`): the side cuts, so no flat width, corner
-    or plunge allowance; the finishing flat end mill up to the root analysis's largest; the flutes through the face
-    width and the break-through."""
-    from spur_cad.cam.recommend import ToolRecommendations
-
-    flute = spec.face_width_mm + BREAK_THROUGH_MM
-    largest = largest_flat_mill_radius_mm(spec)
-    return ToolRecommendations(0.0, 0.0, 0.0, 2.0 * spec.tip_radius_mm, flute, flute + clearance_mm, 0.0,
-                               2.0 * largest)
+    """The tool limits of a ring cut lying flat (summary.json's `tools`): flat_tool_recommendations, any roughing
+    end mill that enters the hole (its tip circle)."""
+    return flat_tool_recommendations(spec, clearance_mm, 2.0 * spec.tip_radius_mm)
 
 
 def _circle(builder: ToolpathBuilder, radius_mm: float, here: np.ndarray, z_mm: float, feed: float,

@@ -102,6 +102,13 @@ LIMIT_LABELS = (  # (ToolRecommendations field, label)
     ("required_flute_length_mm", "flute length the tools need (blank to root)"),
     ("required_stick_out_mm", "stick-out the tools need"),
 )
+FLAT_LIMIT_LABELS = (  # a gear cut lying flat (3 axes): the side cuts, no generating tool, corner or flat width
+    ("roughing_max_diameter_mm", "largest roughing end mill (flat)"),
+    ("finishing_flat_end_mill_max_diameter_mm", "largest finishing flat end mill (its side leaves the involute no "
+                                                "higher than the active profile's start)"),
+    ("required_flute_length_mm", "flute length the tools need (the face width and the break-through)"),
+    ("required_stick_out_mm", "stick-out the tools need"),
+)
 TOOL_KINDS = {"flat": "flat end mill", "bull_nose": "bull-nose end mill", "ball": "ball end mill"}
 OPERATION_NAMES = {"roughing": "roughing", "roughing_bottom": "roughing, bottom of the spaces",
                    "finishing": "finishing"}
@@ -122,10 +129,12 @@ def gear_rows(result: JobResult) -> tuple[Row, ...]:
 
 
 def limit_rows(result: JobResult) -> tuple[Row, ...]:
-    """The gear's tool limits, labelled (0 shown as 'none fits')."""
+    """The gear's tool limits, labelled (0 shown as 'none fits'); a gear cut lying flat shows the limits of the
+    3-axis variant (FLAT_LIMIT_LABELS)."""
     rec = result.tools.recommendations
+    labels = FLAT_LIMIT_LABELS if result.setup is not None and result.setup.axes == 3 else LIMIT_LABELS
     return tuple(Row(_limit_label(rec, name, label), number(getattr(rec, name), 3) if getattr(rec, name) > 0.0
-                     else "none fits", "mm" if getattr(rec, name) > 0.0 else "") for name, label in LIMIT_LABELS)
+                     else "none fits", "mm" if getattr(rec, name) > 0.0 else "") for name, label in labels)
 
 
 def _limit_label(rec, name: str, label: str) -> str:
