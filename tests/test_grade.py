@@ -284,3 +284,33 @@ def test_the_k_charts_tolerance_band_is_centred_on_the_design_not_on_the_traces_
         assert edges[0] <= trace.min() and trace.max() <= edges[1]  # ... and inside the band, as it is in class
         low, high = ax.get_ylim()
         assert low <= edges[0] and edges[1] <= high  # the band is in view
+
+
+def test_a_k_chart_keeps_its_scale_on_the_evaluation_range_when_a_trace_spikes_beyond_it():
+    """A ring's fillet or a tip corner beyond the evaluation range (a spike 40 bands high) must not squash the graded
+    part of the trace to a line: the panel is clipped to the range's traces and the band, and says so."""
+    from spur_cad.grade.grading import Grading, Trace
+    from spur_cad.report.figures import k_chart_figure
+
+    spec = parse_job(small_job_text(), "small.toml").gear
+    grade = 8
+    d, b, m = 2.0 * spec.reference_radius_mm, spec.face_width_mm, spec.module_mm
+    half = {kind: 0.5 * tolerance_um(name, grade, d, b, m) for kind, name in (("profile", "F_aT"), ("helix", "F_bT"))}
+    s = np.linspace(0.0, 4.0, 41)
+
+    def deviation(kind: str) -> np.ndarray:
+        values = half[kind] * 0.5 * np.sin(3.0 * s)
+        values[s > 3.7] = 80.0 * half[kind] if kind == "profile" else values[s > 3.7]  # beyond the range (0.5, 3.5)
+        return values
+
+    traces = tuple(Trace(kind, 3, side, 1.0 if kind == "profile" else None, s, deviation(kind), (0.5, 3.5))
+                   for kind in ("profile", "helix") for side in ("right", "left"))
+    fig = k_chart_figure(spec, Grading({}, {}, {}, grade, (), traces))
+    charts = [ax for ax in fig.axes if ax.get_lines()]
+    for ax in charts:
+        kind = "profile" if "profile" in ax.get_title() else "helix"
+        low, high = ax.get_ylim()
+        assert low <= -half[kind] and half[kind] <= high  # the band in view
+        assert high - low < 4.0 * half[kind]  # the graded range fills the panel, the spike is clipped
+        clipped = any("clipped" in text.get_text() for text in ax.texts)
+        assert clipped == (kind == "profile")  # only the panel with a spike says so

@@ -235,6 +235,8 @@ def k_chart_figure(spec: GearSpec, grading: Grading, lying_flat: bool = False) -
                 ax.axhline(0.0, color="k", lw=0.8, gid="design")
                 for edge in (-0.5 * band, 0.5 * band):
                     ax.axhline(edge, color="tab:red", lw=0.6, ls="--", gid="tolerance band")
+            if chosen:
+                _clip_outside_evaluation(ax, chosen, band)
             ax.set_title(f"space {worst}, {side} flank: {kind} (band: class {grade} "
                          f"{'F_aT' if kind == 'profile' else 'F_bT'} = {band:g} \u00b5m)", fontsize=8)
             ax.set_xlabel(profile_label if kind == "profile" else row_label, fontsize=8)
@@ -245,6 +247,27 @@ def k_chart_figure(spec: GearSpec, grading: Grading, lying_flat: bool = False) -
             else:
                 ax.text(0.5, 0.5, "not measured", transform=ax.transAxes, ha="center", fontsize=8)
     return fig
+
+
+def _clip_outside_evaluation(ax, traces, band_um: float) -> None:
+    """Keep a K-chart panel's scale on what is graded: when a trace beyond the evaluation range (a ring's root fillet,
+    a tip corner) reaches more than twice as far as the traces inside it and the band, the panel is clipped to those
+    (20 % margin) and says so."""
+    inside, design = [], []
+    for trace in traces:
+        lo, hi = trace.evaluation
+        shown = trace.deviation_um + (0.0 if trace.design_um is None else trace.design_um)
+        within = (trace.position_mm >= lo) & (trace.position_mm <= hi)
+        inside.append(shown[within])
+        design.append(np.zeros(1) if trace.design_um is None else trace.design_um[within])
+    values = np.concatenate(inside + [d + 0.5 * band_um for d in design] + [d - 0.5 * band_um for d in design])
+    low, high = float(values.min()), float(values.max())
+    pad = 0.2 * max(high - low, 1e-3)
+    shown_low, shown_high = ax.get_ylim()
+    if shown_high - shown_low > 2.0 * (high - low + 2.0 * pad):
+        ax.set_ylim(low - pad, high + pad)
+        ax.text(0.01, 0.02, "clipped: the trace beyond the evaluation range leaves the scale", fontsize=6,
+                transform=ax.transAxes, color="0.3")
 
 
 def _design_trace(ax, trace, band_um: float) -> None:
