@@ -162,3 +162,42 @@ def test_a_finishing_path_5_um_off_the_axis_reads_as_runout(ring_cut):
         assert graded.pitch[side].F_p_um == pytest.approx(2e3 * shift, abs=1.0)
     assert off.max_gouge_mm > 0.5 * shift * math.sin(math.radians(20.0))
     assert graded.overall_class > grade_simulation(job.gear, result, form_radius).overall_class
+
+
+def test_a_measured_ring_grades_a_planted_profile_slope_with_its_sign():
+    """`spur-cad grade`'s grader on a ring: points on every involute of the example ring (another spacing than the
+    grader's, turned and shifted as a scan is), with +8 um of profile slope planted on one right flank (material
+    rising toward the tip, the tip being the circle toward the axis; ISO 21771's signed roll lengths), and one
+    left flank 10 um ahead. The slope reads +8 um, not its mirror, and the pitch 10 um."""
+    from spur_cad.grade.measured import MeasuredPoints, grade_measured
+    from spur_cad.grade.simulated import helix_range_mm, profile_range_mm, profile_roll_mm
+    from spur_cad.sim.design import design_grid
+
+    spec = ring_job().gear
+    grid = design_grid(spec, 0.037, 0.0, 0.0, np.zeros(0))
+    names = np.array(grid.feature_names())
+    roll = profile_roll_mm(spec, np.hypot(grid.points[:, 0], grid.points[:, 1]))
+    start, end = profile_range_mm(spec)
+    lo, hi = helix_range_mm(spec.face_width_mm, spec.module_mm)
+    cos_alpha = spec.base_radius_mm / spec.reference_radius_mm
+    turn, centre = math.radians(2.0), (0.04, -0.02)
+    xs, ys, axial = [], [], []
+    for k in range(spec.teeth):
+        for x in np.linspace(lo, hi, 3):
+            points, normals = grid.row_points(k, x)
+            dev = np.zeros(len(points))
+            if k == 2:
+                right = names == "right involute"
+                dev[right] += 8.0e-3 * (roll[right] - start) / (end - start)
+            if k == 5:
+                dev[names == "left involute"] += 10.0e-3 * cos_alpha
+            on_flank = np.char.endswith(names, "involute")
+            moved = (points + dev[:, None] * normals)[on_flank]
+            xs.append(math.cos(turn) * moved[:, 0] - math.sin(turn) * moved[:, 1] + centre[0])
+            ys.append(math.sin(turn) * moved[:, 0] + math.cos(turn) * moved[:, 1] + centre[1])
+            axial.append(np.full(len(moved), x))
+    grading = grade_measured(spec, MeasuredPoints(np.concatenate(xs), np.concatenate(ys), np.concatenate(axial)))
+    found = grading.deviations_um
+    assert found["f_Ha"] == pytest.approx(8.0, abs=0.5)  # its sign: + is material rising toward the tip
+    assert found["f_pt"] == pytest.approx(10.0, abs=0.5)
+    assert abs(found["f_Hb"]) < 0.5

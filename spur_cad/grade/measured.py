@@ -25,7 +25,7 @@ import numpy as np
 from spur_cad.errors import SpurCadError
 from spur_cad.grade.design_trace import against_design, design_removal_mm
 from spur_cad.grade.grading import Grading, MeasuredFit, Trace, add_pitch, classes_of, validity, worst_deviations
-from spur_cad.grade.simulated import helix_range_mm, profile_range_mm
+from spur_cad.grade.simulated import helix_range_mm, profile_range_mm, profile_roll_mm
 
 MAX_POINTS = 2_000_000
 MAX_MEASURED_BYTES = 128 * 1024 * 1024  # a scan of MAX_POINTS points (about 70 MB of text) fits
@@ -141,13 +141,13 @@ def _design(spec):
     grid = design_grid(spec, DESIGN_SPACING_MM, 0.0, 0.0, np.zeros(0))
     names = grid.feature_names()
     radius = np.hypot(grid.points[:, 0], grid.points[:, 1])
-    on_flank = [name.endswith("involute") or (name.endswith("fillet") and r >= spec.form_radius_mm - 1e-6)
+    on_flank = [name.endswith("involute") or (name.endswith("fillet") and abs(r - spec.form_radius_mm) <= 1e-6)
                 for name, r in zip(names, radius)]
     side = np.array([name.split()[0] if flank else "" for name, flank in zip(names, on_flank)])
     points = np.concatenate([grid.space_points(k) for k in range(grid.teeth)])
     normals = np.concatenate([grid.space_normals(k) for k in range(grid.teeth)])
     space = np.repeat(np.arange(grid.teeth), len(grid.points))
-    roll = np.tile(np.sqrt(np.maximum(radius ** 2 - spec.base_radius_mm ** 2, 0.0)), grid.teeth)
+    roll = np.tile(profile_roll_mm(spec, radius), grid.teeth)  # a ring's negative, as the simulated grading's
     return points, normals, space, np.tile(side, grid.teeth), roll, np.tile(radius, grid.teeth)
 
 
@@ -218,7 +218,7 @@ def flank_traces(spec, axial, deviation, space, side, roll):
     profile_range = profile_range_mm(spec)
     helix_range = helix_range_mm(spec.face_width_mm, spec.module_mm)
     cos_alpha = spec.base_radius_mm / spec.reference_radius_mm
-    reference_roll = math.sqrt(spec.reference_radius_mm ** 2 - spec.base_radius_mm ** 2)
+    reference_roll = float(profile_roll_mm(spec, spec.reference_radius_mm))
     found: list[Trace] = []
     positions: dict[str, dict[int, float]] = {"right": {}, "left": {}}
     for flank_side in ("right", "left"):
