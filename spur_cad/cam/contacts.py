@@ -57,8 +57,6 @@ class TransversePoses:
 
 GOUGE_TOLERANCE_MM = 1e-5
 ROTATION_CANDIDATES = 181
-KINK_ANGLE_RAD = 1e-9
-"""Segments of a flank profile whose normals differ by more than this at their junction meet at a kink."""
 
 
 def tool_signed_distance(points: np.ndarray, tip_y: float, tip_z: float, tool: Tool) -> np.ndarray:
@@ -208,20 +206,19 @@ def modified_space_poses(spec: GearSpec, tool: Tool, scallop_mm: float, modifica
     the two modified flanks' tip edges."""
     design = spec.tooth_space_profile()
     profiles = {side: modified_tooth_space_profile(design, modifications.side(side), x_face_mm) for side in SIDES}
-    right = flank_poses(spec, profiles["right"], tool, scallop_mm, contact_spacing_mm, turn_at_kinks=True)
-    left = flank_poses(spec, profiles["left"], tool, scallop_mm, contact_spacing_mm, turn_at_kinks=True).mirrored()
+    right = flank_poses(spec, profiles["right"], tool, scallop_mm, contact_spacing_mm)
+    left = flank_poses(spec, profiles["left"], tool, scallop_mm, contact_spacing_mm).mirrored()
     return _with_root_and_tip(spec, design, tool, scallop_mm, right, left, profiles["left"], profiles["right"])
 
 
 def flank_poses(spec: GearSpec, profile: ToothSpaceProfile, tool: Tool, scallop_mm: float,
-                contact_spacing_mm: float | None = None, turn_at_kinks: bool = False) -> TransversePoses:
+                contact_spacing_mm: float | None = None) -> TransversePoses:
     """Right-flank poses (tip edge -> root) on the involute and fillet segments of `profile` (the design's, or a
-    modified one whose involute is split at the reliefs' starts). A junction of two segments appears once; with
-    `turn_at_kinks`, where they meet at an angle (a relief's start, the modified fillet's join) it gets a pose
-    with each segment's normal, the corner turning about it (the modified flank is convex there)."""
+    modified one whose involute is split at the reliefs' starts); a junction of two segments appears once (at a
+    linear relief's kink with the upper segment's normal: a pose with each normal there changed the simulated
+    leftover near it by 0.02 um)."""
     r_t = tool.effective_corner_radius_mm
     points, normals = [], []
-    previous_normal = None
     for segment in reversed(profile.segments):  # tip -> root
         if segment.label not in ("involute", "fillet") or segment.end <= segment.start:
             continue
@@ -230,19 +227,12 @@ def flank_poses(spec: GearSpec, profile: ToothSpaceProfile, tool: Tool, scallop_
         else:
             params = even_arc_length_parameters(segment, contact_spacing_mm)
         params = params[::-1]
-        segment_normals = segment.normals(params)
-        if previous_normal is not None and not (turn_at_kinks and _kink(previous_normal, segment_normals[0])):
-            params, segment_normals = params[1:], segment_normals[1:]  # the junction is shared
+        if points:  # the junction is shared with the previous segment
+            params = params[1:]
         points.append(segment.points(params))
-        normals.append(segment_normals)
-        previous_normal = segment_normals[-1]
+        normals.append(segment.normals(params))
     return _corner_poses(np.concatenate(points), np.concatenate(normals), tool,
                          _space_design_points(profile, spec.module_mm))
-
-
-def _kink(normal: np.ndarray, other: np.ndarray) -> bool:
-    """The two unit normals differ by more than KINK_ANGLE_RAD."""
-    return abs(float(normal[0] * other[1] - normal[1] * other[0])) > KINK_ANGLE_RAD
 
 
 def _with_root_and_tip(spec: GearSpec, profile: ToothSpaceProfile, tool: Tool, scallop_mm: float,
