@@ -732,8 +732,9 @@ def _job_from_data(data: dict, source: str, text: str, strategies: Strategies = 
     if modification_tables and (spec.is_internal or sections.get("machine", Machine()).axes == 3):
         table = next(iter(modification_tables))
         what = "an internal gear's ring" if spec.is_internal else "the 3-axis variant ([machine] axes = 3)"
-        raise JobFileError(f"{_where(source, text, table)}: [{table}] flank modifications are cut by generating "
-                           f"finishing on the rotary table only; {what} does not follow them: leave them out",
+        raise JobFileError(f"{_where(source, text, table)}: [{table}] flank modifications are cut by generating or "
+                           f"perimeter finishing on the rotary table only; {what} does not follow them: leave them "
+                           "out",
                            section=table, field=None)
     modifications, modification_values = _modifications(modification_tables, spec, source, text)
     for check, name in ((gear_section.blank_features().validate, "gear"),

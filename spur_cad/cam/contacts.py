@@ -24,6 +24,8 @@ import numpy as np
 
 from spur_cad.cam.tools import Tool, ToolError
 from spur_cad.geometry.frames import turn_point, turn_points
+from spur_cad.geometry.modifications import SIDES, FlankModifications, modified_tooth_space_profile
+from spur_cad.geometry.profile import ToothSpaceProfile
 from spur_cad.geometry.sampling import (
     even_arc_length_parameters,
     full_space_points,
@@ -191,11 +193,34 @@ def space_poses(spec: GearSpec, tool: Tool, scallop_mm: float,
     """All transverse poses of one space. `contact_spacing_mm` (fixed arc-length spacing) reproduces
     the reference process's sampling for comparison; by default the scallop bound decides."""
     profile = spec.tooth_space_profile()
-    r_t, d = tool.effective_corner_radius_mm, tool.flat_width_mm
+    right = flank_poses(spec, profile, tool, scallop_mm, contact_spacing_mm)
+    return _with_root_and_tip(spec, profile, tool, scallop_mm, right, right.mirrored(), profile)
+
+
+def modified_space_poses(spec: GearSpec, tool: Tool, scallop_mm: float, modifications: FlankModifications,
+                         x_face_mm: float, contact_spacing_mm: float | None = None) -> SpacePoses:
+    """The poses of one space touching the flanks modified by `modifications` at face position X: each side's
+    contacts on its modified tooth-space profile (geometry.modifications.modified_tooth_space_profile: the involute
+    moved along its normal by the removal at its roll length and X, the fillet faded as the generating strategy's
+    tip passes cut it), the left side's mirrored. The root arc is unchanged; the tip sweep spans the land between
+    the two modified flanks' tip edges."""
+    design = spec.tooth_space_profile()
+    profiles = {side: modified_tooth_space_profile(design, modifications.side(side), x_face_mm) for side in SIDES}
+    right = flank_poses(spec, profiles["right"], tool, scallop_mm, contact_spacing_mm)
+    left = flank_poses(spec, profiles["left"], tool, scallop_mm, contact_spacing_mm).mirrored()
+    return _with_root_and_tip(spec, design, tool, scallop_mm, right, left, profiles["left"], profiles["right"])
+
+
+def flank_poses(spec: GearSpec, profile: ToothSpaceProfile, tool: Tool, scallop_mm: float,
+                contact_spacing_mm: float | None = None) -> TransversePoses:
+    """Right-flank poses (tip edge -> root) on the involute and fillet segments of `profile` (the design's, or a
+    modified one whose involute is split at the reliefs' starts); a junction of two segments appears once (at a
+    linear relief's kink with the upper segment's normal: a pose with each normal there changed the simulated
+    leftover near it by 0.02 um)."""
+    r_t = tool.effective_corner_radius_mm
     points, normals = [], []
-    for label in ("involute", "fillet"):  # tip -> root
-        segment = profile.segment(label)
-        if segment is None or segment.end <= segment.start:
+    for segment in reversed(profile.segments):  # tip -> root
+        if segment.label not in ("involute", "fillet") or segment.end <= segment.start:
             continue
         if contact_spacing_mm is None:
             params = segment_parameters(segment, scallop_mm, extra_curvature=1.0 / r_t)
@@ -206,19 +231,28 @@ def space_poses(spec: GearSpec, tool: Tool, scallop_mm: float,
             params = params[1:]
         points.append(segment.points(params))
         normals.append(segment.normals(params))
-    right = _corner_poses(np.concatenate(points), np.concatenate(normals), tool, _space_design_points(spec))
+    return _corner_poses(np.concatenate(points), np.concatenate(normals), tool,
+                         _space_design_points(profile, spec.module_mm))
+
+
+def _with_root_and_tip(spec: GearSpec, profile: ToothSpaceProfile, tool: Tool, scallop_mm: float,
+                       right: TransversePoses, left: TransversePoses, left_profile: ToothSpaceProfile,
+                       right_profile: ToothSpaceProfile | None = None) -> SpacePoses:
+    """The space's poses: the flanks' and the flat sweeps of the root arc and of the tip land between this space's
+    left tip edge and the next space's right one (each side's profile gives its tip edge)."""
+    d = tool.flat_width_mm
     v = profile.root_arc_half_angle_rad
     root = _flat_sweep(spec.root_radius_mm, v, -v, -d / 2.0, d / 2.0, scallop_mm)
-    tip_edge = profile.segment("tip").start  # clockwise polar angle of the right flank's tip edge
+    left_edge = left_profile.segment("tip").start  # clockwise polar angle of the flank's tip edge
+    right_edge = (right_profile or left_profile).segment("tip").start
     pitch = 2.0 * math.pi / spec.teeth
-    tip = _flat_sweep(spec.tip_radius_mm, -tip_edge, tip_edge - pitch, -d / 2.0, d / 2.0, scallop_mm)
-    return SpacePoses(right, root, right.mirrored(), tip)
+    tip = _flat_sweep(spec.tip_radius_mm, -left_edge, right_edge - pitch, -d / 2.0, d / 2.0, scallop_mm)
+    return SpacePoses(right, root, left, tip)
 
 
-def _space_design_points(spec: GearSpec) -> np.ndarray:
-    """Dense exact points of tooth space 0 (both halves, tip lands to the tooth centres)."""
-    return full_space_points(sample_profile(spec.tooth_space_profile(), 2e-5 * spec.module_mm))
-
+def _space_design_points(profile: ToothSpaceProfile, module_mm: float) -> np.ndarray:
+    """Dense exact points of a tooth space of `profile` (both halves, tip lands to the tooth centres)."""
+    return full_space_points(sample_profile(profile, 2e-5 * module_mm))
 
 
 def station_step_mm(tool: Tool, target_scallop_mm: float, step_over_mm: float = 0.0) -> float:

@@ -148,7 +148,7 @@ class CamInputs:
     strategies: Strategies = field(default_factory=lambda: dict(REGISTRY))  # where [finishing] strategy is found
     profile_tolerance_mm: float = 0.001  # [job] profile_tolerance_mm: the 3-axis finishing arcs' chordal tolerance
     three_axis: ThreeAxisSection = field(default_factory=ThreeAxisSection)  # [three_axis]: tabs or an onion skin
-    modifications: FlankModifications | None = None  # [gear.modifications]: cut by generating finishing
+    modifications: FlankModifications | None = None  # [gear.modifications]: cut by generating or perimeter finishing
 
 
 def check_cam_inputs(inputs: CamInputs) -> tuple[ToolRecommendations, RoughingLevels | None]:

@@ -14,6 +14,7 @@ from spur_cad.cam.contacts import (
     SpacePoses,
     TransversePoses,
     contact_counts,
+    modified_space_poses,
     space_poses,
     station_positions,
     station_step_mm,
@@ -29,6 +30,7 @@ from spur_cad.cam.strategies.base import (
     finishing_builder,
 )
 from spur_cad.cam.tools import Tool
+from spur_cad.geometry.modifications import SIDES, FlankModifications
 from spur_cad.geometry.spec import GearSpec
 
 
@@ -59,9 +61,18 @@ class PerimeterStrategy(ContactStrategy):
         return stations * spec.teeth * (counts.per_space + 4)
 
     def generate(self, spec: GearSpec, tool: Tool, machine: Machine, params: PerimeterParams,
-                 blank_radius_mm: float) -> tuple[Toolpath, FinishingResult]:
+                 blank_radius_mm: float, modifications: FlankModifications | None = None,
+                 profile_tolerance_mm: float = 0.001) -> tuple[Toolpath, FinishingResult]:
+        """The stations' toolpath; with flank `modifications` each station's contacts lie on the flanks modified
+        at its X (contacts.modified_space_poses; the result's poses are those of the middle station). The
+        profile tolerance is not used: a station's contacts are placed exactly."""
         poses, stations = self._poses_and_stations(spec, tool, params)
-        path = self._stations_path(spec, tool, machine, params, blank_radius_mm, poses, stations)
+        if modifications is None:
+            path = self._stations_path(spec, tool, machine, params, blank_radius_mm, [poses], stations)
+        else:
+            at_station = _modified_poses_of_stations(spec, tool, params, modifications, stations)
+            path = self._stations_path(spec, tool, machine, params, blank_radius_mm, at_station, stations)
+            poses = at_station[len(stations) // 2]
         step = float(stations[1] - stations[0]) if len(stations) > 1 else 0.0
         return path, FinishingResult(self.name, params, poses, len(stations), step, stations)
 
@@ -74,11 +85,11 @@ class PerimeterStrategy(ContactStrategy):
         the full toolpath's estimate but for rounding and the look-ahead's coupling across stations
         (tests/test_work_limits.py compares them)."""
         poses, stations = self._poses_and_stations(spec, tool, params)
-        first = estimate(self._stations_path(spec, tool, machine, params, blank_radius_mm, poses, stations[:1]),
+        first = estimate(self._stations_path(spec, tool, machine, params, blank_radius_mm, [poses], stations[:1]),
                          machine)
         if len(stations) == 1:
             return first
-        two = estimate(self._stations_path(spec, tool, machine, params, blank_radius_mm, poses, stations[:2]),
+        two = estimate(self._stations_path(spec, tool, machine, params, blank_radius_mm, [poses], stations[:2]),
                        machine)
         more = len(stations) - 1
         return Estimate(first.moves + more * (two.moves - first.moves),
@@ -97,11 +108,31 @@ class PerimeterStrategy(ContactStrategy):
 
     @staticmethod
     def _stations_path(spec: GearSpec, tool: Tool, machine: Machine, params: PerimeterParams,
-                       blank_radius_mm: float, poses: SpacePoses, stations: np.ndarray) -> Toolpath:
+                       blank_radius_mm: float, poses: list[SpacePoses], stations: np.ndarray) -> Toolpath:
+        """The toolpath of `stations`: `poses` holds one space's poses for all of them, or one for each."""
         builder = finishing_builder(tool, machine, params)
-        _tile_stations(builder, spec, machine, poses, stations, tool.feed_mm_min(machine),
-                       safe_height_mm(blank_radius_mm, machine))
+        feed, safe_z = tool.feed_mm_min(machine), safe_height_mm(blank_radius_mm, machine)
+        if len(poses) == 1:
+            _tile_stations(builder, spec, machine, poses[0], stations, feed, safe_z)
+        else:
+            for index, station_poses in enumerate(poses):
+                _tile_stations(builder, spec, machine, station_poses, stations[index:index + 1], feed, safe_z, index)
         return apply_inverse_time(builder.build(), machine)
+
+
+def _modified_poses_of_stations(spec: GearSpec, tool: Tool, params: PerimeterParams,
+                                modifications: FlankModifications, stations: np.ndarray) -> list[SpacePoses]:
+    """Each station's poses on the flanks modified at its X; stations whose lead removal is the same on both sides
+    (all of them without lead modifications, mirrored pairs under lead crowning) share theirs."""
+    computed: dict[tuple[float, float], SpacePoses] = {}
+    out = []
+    for x in stations:
+        key = tuple(round(float(modifications.side(side).lead_offset_mm(x)), 12) for side in SIDES)
+        if key not in computed:
+            computed[key] = modified_space_poses(spec, tool, params.target_scallop_mm, modifications, float(x),
+                                                 params.contact_spacing_mm)
+        out.append(computed[key])
+    return out
 
 
 def _space_sequence(poses: SpacePoses, safe_z: float) -> list[tuple]:
@@ -130,8 +161,9 @@ def _space_sequence(poses: SpacePoses, safe_z: float) -> list[tuple]:
 
 
 def _tile_stations(builder: ToolpathBuilder, spec: GearSpec, machine: Machine, poses: SpacePoses,
-                   stations: np.ndarray, feed: float, safe_z: float) -> None:
-    """Every station: once around the gear, space by space; stations tiled with numpy."""
+                   stations: np.ndarray, feed: float, safe_z: float, first_station: int = 0) -> None:
+    """Every station (numbered from `first_station`): once around the gear, space by space; stations tiled with
+    numpy."""
     rows = _space_sequence(poses, safe_z)
     kind = np.array([r[0] for r in rows], dtype=np.int8)
     y = np.array([r[1] for r in rows])
@@ -143,12 +175,12 @@ def _tile_stations(builder: ToolpathBuilder, spec: GearSpec, machine: Machine, p
     per_space, per_station = len(rows), len(rows) * teeth
     n_total = per_station * len(stations)
     space_index = np.tile(np.repeat(np.arange(teeth), per_space), len(stations))
-    station_index = np.repeat(np.arange(len(stations)), per_station)
+    station_index = first_station + np.repeat(np.arange(len(stations)), per_station)
     turns = station_index * teeth if machine.rotary_continuous else np.zeros(n_total, int)
     # Space k is brought up by A = -k * pitch; continuous tables keep turning the same way.
     a = np.tile(a_rel, teeth * len(stations)) - (space_index + turns) * pitch_deg
     feeds = np.where(np.tile(plunge, teeth * len(stations)), PLUNGE_FEED_FRACTION * feed, feed)
     feeds = np.where(np.tile(kind, teeth * len(stations)) == MoveKind.RAPID, np.nan, feeds)
-    builder.extend(np.tile(kind, teeth * len(stations)), stations[station_index],
+    builder.extend(np.tile(kind, teeth * len(stations)), stations[station_index - first_station],
                    np.tile(y, teeth * len(stations)), np.tile(z, teeth * len(stations)), a, feeds, False,
                    space_index, station_index, np.tile(feature, teeth * len(stations)))
