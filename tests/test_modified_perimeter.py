@@ -86,3 +86,23 @@ def test_rs274_reads_the_modified_perimeter_program(cut, tmp_path):
 def test_along_x_still_refuses_modifications():
     with pytest.raises(ToolError, match="along_x' does not cut flank modifications"):
         plan_cam(parse_job(GEAR + TOOLS + "[finishing]\nstrategy = 'along_x'\n" + MODS, "along_x.toml"))
+
+
+def test_the_work_limit_counts_the_modified_contacts_before_building_them():
+    """Reliefs split and curve the flanks, so a modified perimeter finish takes more contacts than the design the
+    work check estimated (1.26 times on this gear): a 220 mm face is 8.8 million moves by the design's count, under
+    the limit, and 11.1 million on the modified flanks, over it. It is refused before its toolpath is built."""
+    from spur_cad.cam.ir import MAX_TOOLPATH_MOVES
+    from spur_cad.cam.plan import params_from_section
+    from spur_cad.cam.strategies.perimeter import PerimeterStrategy
+    from spur_cad.errors import WorkLimitError
+
+    reliefs = MODS.split("lead_crowning_um")[0]  # no lead modification: every station shares its contacts
+    job = parse_job(GEAR.replace("face_width_mm = 4", "face_width_mm = 220") + TOOLS + PERIMETER + reliefs, "w.toml")
+    strategy = PerimeterStrategy()
+    params = params_from_section(strategy, job.finishing)
+    assert strategy.estimate_moves(job.gear, job.tools.finishing, params) < MAX_TOOLPATH_MOVES
+    with pytest.raises(WorkLimitError, match=r"finishing would need about 1\.1e\+07 moves") as refused:
+        strategy.generate(job.gear, job.tools.finishing, job.machine, params, job.stock.blank_radius_mm(job.gear),
+                          job.modifications)
+    assert refused.value.field == "target_scallop_mm"

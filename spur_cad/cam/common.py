@@ -6,8 +6,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from spur_cad.cam.ir import MoveKind, Toolpath, relative_path_lengths
+from spur_cad.cam.ir import MAX_TOOLPATH_MOVES, MoveKind, Toolpath, relative_path_lengths
 from spur_cad.cam.machine import Machine
+from spur_cad.errors import WorkLimitError
 from spur_cad.geometry.sampling import sample_profile
 from spur_cad.geometry.spec import GearSpec
 
@@ -53,3 +54,10 @@ def offset_flank(spec: GearSpec, finish_stock_mm: float) -> tuple[np.ndarray, np
     if len(involute) and involute[0] > 0:
         junction = float(points[involute[0], 1])
     return points, labels, junction
+
+
+def check_moves(operation: str, moves: int, section: str, field: str) -> None:
+    """Refuse (WorkLimitError naming [section] field) an operation whose estimated moves exceed MAX_TOOLPATH_MOVES."""
+    if moves > MAX_TOOLPATH_MOVES:
+        raise WorkLimitError(f"{operation} would need about {moves:.2g} moves (limit {MAX_TOOLPATH_MOVES:.0e}); "
+                             f"raise [{section}] {field}", field=field, section=section)

@@ -13,11 +13,12 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from spur_cad.cad.specs import StockSpec
+from spur_cad.cam.common import check_moves
 from spur_cad.cam.contacts import ContactCounts, contact_counts
 from spur_cad.cam.estimate import Estimate, estimate, move_seconds
 from spur_cad.cam.finishing import plan_finishing
 from spur_cad.cam.flank_roughing import FlankPlan
-from spur_cad.cam.ir import MAX_TOOLPATH_MOVES, Toolpath
+from spur_cad.cam.ir import Toolpath
 from spur_cad.cam.machine import Machine, MachineError, RoughingParams, check_travel
 from spur_cad.cam.machine_limits import check_machine_limits
 from spur_cad.cam.recommend import (
@@ -336,13 +337,6 @@ def plan_cam(inputs: CamInputs, checkpoint: Callable[[], None] | None = None) ->
         finishing = _plan_finishing(inputs, blank, check)
         warnings.extend(finishing.toolpath.warnings)
     return CamPlan(rec, roughing, finishing, tuple(warnings), bottom, two_stage, declined)
-
-
-def check_moves(operation: str, moves: int, section: str, field: str) -> None:
-    """Refuse (WorkLimitError naming [section] field) an operation whose estimated moves exceed MAX_TOOLPATH_MOVES."""
-    if moves > MAX_TOOLPATH_MOVES:
-        raise WorkLimitError(f"{operation} would need about {moves:.2g} moves (limit {MAX_TOOLPATH_MOVES:.0e}); "
-                             f"raise [{section}] {field}", field=field, section=section)
 
 
 def _levels_where(levels: RoughingLevels, keep: np.ndarray) -> RoughingLevels:
