@@ -9,7 +9,7 @@ import time
 import numpy as np
 import pytest
 
-from spur_cad.cam.plan import MAX_TOOLPATH_MOVES
+from spur_cad.cam.ir import MAX_TOOLPATH_MOVES
 from spur_cad.errors import SpurCadError, WorkLimitError
 from spur_cad.geometry.sampling import sample_profile
 from spur_cad.job import load_job
