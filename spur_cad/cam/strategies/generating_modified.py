@@ -16,8 +16,15 @@ the design moved by the removal spur_cad.geometry.modifications gives, each pass
   (beta / beta_F)^2 along the form point's normal (spur_cad.geometry.modifications.modified_tooth_space_profile);
   each fillet pass moves with its contact point. Root passes are not moved (the root is not modified). Helical
   fillet passes touch a different fillet point in each section X (`helical_fillet_parameters`) and move by its
-  faded removal along the form normal turned with the section. Helical gears with lead modifications are refused:
-  their flank passes' end corners, moved sideways by the lead amount, gouge the fillet (5.5 um for 10 um crowning).
+  faded removal along the form normal turned with the section. The lead modifications at X are part of the form
+  point's removal there (the design's fillet moves with them, as the B-rep's sections do).
+- **Helical flank passes' ends** are raised per section X (`_helical_raised_ends`): a pass seen below the form
+  circle in some section has its corner on the rack's round over the fillet, and moved sideways with the lead it
+  gouged the fillet (5.5 um for 10 um crowning); raised so that its straight side starts neither below the spur
+  raised end at the section's effective roll nor below the form point, it leaves the fillet to the tip passes.
+- **Helical sideways offsets** are reduced by the swept tool's growth with the path's slope (`_envelope_growth_mm`),
+  and their dY chords lie at most CHORD_GOUGE_SHARE of the tolerance deeper than the samples (a crowning's chords
+  all lie deeper).
 - The offset along X is sampled every `X_SAMPLE_MM` over the face and reduced to the fewest breakpoints whose
   lines stay within the chordal tolerance ([job] profile_tolerance_mm); outside the face the end values hold.
 """
