@@ -1,6 +1,7 @@
 """Generating finishing of modified flanks (issue 31.3) and the simulation against the modified design (31.5):
 programs rs274 reads with A clamped in every feed move, the simulated cut within the target of the MODIFIED design
-(so a correctly cut relief is no leftover), and the same cut read against the unmodified design shows the relief."""
+(so a correctly cut relief is no leftover; helical gears, lead modifications too, gouge it nowhere by more than 1 um),
+and the same cut read against the unmodified design shows the relief."""
 
 from __future__ import annotations
 
@@ -25,12 +26,21 @@ SPUR_SIDES = GEAR + TOOLS + ("[gear.modifications]\ntip_relief_um = 15\ntip_reli
                              "[gear.modifications.left]\ntip_relief_um = 20\ntip_relief_shape = \"parabolic\"\n")
 """Sides modified differently: their turned passes differ, and each flank's raised tool ends must follow its own
 neighbours (taken from both sides' passes together they left 13.7 um on the left flank of the modified example)."""
+HELICAL_LEAD = GEAR + "helix_angle_deg = 15\n" + TOOLS + "[gear.modifications]\nlead_crowning_um = 10\n"
+"""Lead crowning on a helical gear: the flank passes' ends are raised per section X (unraised, their corners moved
+sideways with the flank gouged the fillet by 5.5 um)."""
+HELICAL_END = GEAR + "helix_angle_deg = 15\n" + TOOLS + ("[gear.modifications]\nend_relief_um = 10\n"
+                                                        "end_relief_length_mm = 3\n")
 RES = 0.002
+GOUGE_MM = 0.001
+"""Helical lead modifications: the cut reaches at most this far into the modified design anywhere (fillet too)."""
 
 
-@pytest.fixture(scope="module", params=["spur", "spur sides", "helical", "helical profile"])
+@pytest.fixture(scope="module", params=["spur", "spur sides", "helical", "helical profile", "helical lead",
+                                        "helical end relief"])
 def planned(request):
-    jobs = {"spur": SPUR, "spur sides": SPUR_SIDES, "helical": HELICAL, "helical profile": HELICAL_PROFILE}
+    jobs = {"spur": SPUR, "spur sides": SPUR_SIDES, "helical": HELICAL, "helical profile": HELICAL_PROFILE,
+            "helical lead": HELICAL_LEAD, "helical end relief": HELICAL_END}
     job = parse_job(jobs[request.param], "f.toml")
     return request.param, job, plan_cam(job)
 
@@ -50,13 +60,6 @@ def test_an_unmodified_job_plans_straight_passes():
     assert all(p.path == () for p in plan.finishing.result.passes)
 
 
-def test_a_helical_gear_with_lead_modifications_is_refused():
-    from spur_cad.cam.tools import ToolError
-
-    with pytest.raises(ToolError, match="lead modifications"):
-        plan_cam(parse_job(HELICAL + "lead_crowning_um = 10\n", "f.toml"))
-
-
 def test_the_cut_lies_on_the_modified_design_and_shows_the_relief_against_the_unmodified(planned):
     name, job, plan = planned
     result, middle, names = _simulated(job, plan, job.modifications)
@@ -65,6 +68,10 @@ def test_the_cut_lies_on_the_modified_design_and_shows_the_relief_against_the_un
     # within the target and the simulation's own error (cusps between clipped poses, at most half its resolution);
     # the spur relief's start kink and the contacts behind it are cut by their own passes (7 um at 5 um without)
     assert middle.max() <= target + RES / 2, f"{name}: leftover {1000 * middle.max():.2f} um"
+    if name.startswith("helical"):  # the raised ends keep the flank passes' corners off the fillet
+        for feature in ("right fillet", "left fillet", "right involute", "left involute"):
+            deepest = -middle[names == feature].min()
+            assert deepest <= GOUGE_MM, f"{name}: {feature} gouged {1000 * deepest:.2f} um"
     # against the unmodified design the tip relief reads as a gouge of about its amount near the tip
     if name == "helical profile":
         return
@@ -74,7 +81,8 @@ def test_the_cut_lies_on_the_modified_design_and_shows_the_relief_against_the_un
     plain = middle - removal
     flank = names == "right involute"
     tip_relief_um = 1000 * job.modifications.right.tip_relief_mm
-    assert -1000 * plain[flank].min() == pytest.approx(tip_relief_um + (10.0 if name == "spur" else 0.0), abs=3.0)
+    at_faces_um = 1000 * job.modifications.right.lead_offset_mm([0.0, job.gear.face_width_mm]).max()
+    assert -1000 * plain[flank].min() == pytest.approx(tip_relief_um + at_faces_um, abs=3.0)
 
 
 @pytest.mark.linuxcnc
@@ -96,4 +104,4 @@ def test_rs274_reads_the_modified_finishing_program_with_a_clamped(planned, tmp_
         if not rapid:
             assert after[3] == before[3]
     # lead crowning: some feed moves change Y along X within a pass
-    assert name != "spur" or sum(1 for p in plan.finishing.result.passes if len(p.path) > 2) > 10
+    assert name not in ("spur", "helical lead") or sum(1 for p in plan.finishing.result.passes if len(p.path) > 2) > 10

@@ -16,8 +16,15 @@ the design moved by the removal spur_cad.geometry.modifications gives, each pass
   (beta / beta_F)^2 along the form point's normal (spur_cad.geometry.modifications.modified_tooth_space_profile);
   each fillet pass moves with its contact point. Root passes are not moved (the root is not modified). Helical
   fillet passes touch a different fillet point in each section X (`helical_fillet_parameters`) and move by its
-  faded removal along the form normal turned with the section. Helical gears with lead modifications are refused:
-  their flank passes' end corners, moved sideways by the lead amount, gouge the fillet (5.5 um for 10 um crowning).
+  faded removal along the form normal turned with the section. The lead modifications at X are part of the form
+  point's removal there (the design's fillet moves with them, as the B-rep's sections do).
+- **Helical flank passes' ends** are raised per section X (`_helical_raised_ends`): a pass seen below the form
+  circle in some section has its corner on the rack's round over the fillet, and moved sideways with the lead it
+  gouged the fillet (5.5 um for 10 um crowning); raised so that its straight side starts neither below the spur
+  raised end at the section's effective roll nor below the form point, it leaves the fillet to the tip passes.
+- **Helical sideways offsets** are reduced by the swept tool's growth with the path's slope (`_envelope_growth_mm`),
+  and their dY chords lie at most CHORD_GOUGE_SHARE of the tolerance deeper than the samples (a crowning's chords
+  all lie deeper).
 - The offset along X is sampled every `X_SAMPLE_MM` over the face and reduced to the fewest breakpoints whose
   lines stay within the chordal tolerance ([job] profile_tolerance_mm); outside the face the end values hold.
 """
@@ -30,7 +37,7 @@ from dataclasses import replace
 import numpy as np
 
 from spur_cad.cam.ir import Feature
-from spur_cad.cam.strategies.generating_geometry import GeneratingPass, flank_poses
+from spur_cad.cam.strategies.generating_geometry import RAISED_END_MARGIN_MM, GeneratingPass, flank_poses
 from spur_cad.cam.strategies.generating_helical import CORNER_MATCH_MM
 from spur_cad.cam.tools import Tool, ToolError
 from spur_cad.geometry.frames import part_to_machine
@@ -41,10 +48,15 @@ from spur_cad.geometry.spec import GearSpec
 X_SAMPLE_MM = 0.02
 """Face positions the removal is evaluated at before the chordal reduction."""
 _FLANK_SAMPLES = 4001
+CHORD_GOUGE_SHARE = 0.2
+"""Helical passes: the share of [job] profile_tolerance_mm their dY chords may reach deeper than the sampled
+offsets (a lead crowning's chords all lie deeper: 0.85 um of a 1 um tolerance in the simulation)."""
 
 
-def simplify_polyline(x: np.ndarray, y: np.ndarray, tolerance_mm: float) -> np.ndarray:
-    """Indices of the fewest points (Douglas-Peucker) whose chords stay within `tolerance_mm` of every sample."""
+def simplify_polyline(x: np.ndarray, y: np.ndarray, tolerance_mm: float, above_mm: float | None = None) -> np.ndarray:
+    """Indices of the fewest points (Douglas-Peucker) whose chords stay within `tolerance_mm` of every sample (and
+    at most `above_mm` above them, when given: a one-sided bound for offsets whose + direction is into the tooth)."""
+    above = tolerance_mm if above_mm is None else above_mm
     keep = {0, len(x) - 1}
     stack = [(0, len(x) - 1)]
     while stack:
@@ -52,7 +64,7 @@ def simplify_polyline(x: np.ndarray, y: np.ndarray, tolerance_mm: float) -> np.n
         if j <= i + 1:
             continue
         chord = y[i] + (y[j] - y[i]) * (x[i + 1:j] - x[i]) / (x[j] - x[i])
-        error = np.abs(y[i + 1:j] - chord)
+        error = np.maximum(y[i + 1:j] - chord, (chord - y[i + 1:j]) * (tolerance_mm / above))
         k = int(np.argmax(error))
         if error[k] > tolerance_mm:
             m = i + 1 + k
@@ -115,12 +127,15 @@ def _face_samples(spec: GearSpec) -> np.ndarray:
     return np.linspace(0.0, b, max(2, math.ceil(b / X_SAMPLE_MM) + 1))
 
 
-def _path(x: np.ndarray, dy: np.ndarray, dz: np.ndarray, tolerance_mm: float) -> tuple:
-    """((x, dy, dz), ...) breakpoints of the offsets along X within the tolerance (constant: one point)."""
+def _path(x: np.ndarray, dy: np.ndarray, dz: np.ndarray, tolerance_mm: float, into_tooth: int = 0) -> tuple:
+    """((x, dy, dz), ...) breakpoints of the offsets along X within the tolerance (constant: one point); with
+    `into_tooth` (the sign of Y into the material) the chords of dY reach at most CHORD_GOUGE_SHARE of it deeper."""
     if np.ptp(dy) <= tolerance_mm and np.ptp(dz) <= tolerance_mm:
         mid = len(x) // 2
         return ((float(x[mid]), float(dy[mid]), float(dz[mid])),)
-    keep = np.union1d(simplify_polyline(x, dy, tolerance_mm), simplify_polyline(x, dz, tolerance_mm))
+    lateral = (simplify_polyline(x, into_tooth * dy, tolerance_mm, CHORD_GOUGE_SHARE * tolerance_mm) if into_tooth
+               else simplify_polyline(x, dy, tolerance_mm))
+    keep = np.union1d(lateral, simplify_polyline(x, dz, tolerance_mm))
     return tuple((float(x[i]), float(dy[i]), float(dz[i])) for i in keep)
 
 
@@ -133,6 +148,38 @@ def _raised_ends(spec: GearSpec, tool: Tool, passes: tuple[GeneratingPass, ...])
         if len(rolls):
             z = flank_poses(spec, tool, rolls, "raised")[2]
             ends.update({(side, float(t)): float(zi) for t, zi in zip(rolls, z)})
+    return ends
+
+
+def _envelope_growth_mm(tool: Tool, planned_slope: float, slope: np.ndarray) -> np.ndarray:
+    """How much farther sideways a tool swept along a path of slope dY/dX = `slope` reaches than along the planned
+    one: the swept cylinder's side lies R sqrt(1 + k^2) from its axis in a section X, so a lead modification's slope
+    (crowning: 4 C_beta / b at the faces) changes the reach of a helical pass by R k dk / sqrt(1 + k^2) (0.85 um for
+    10 um crowning on the test gear's 3.5 mm tool)."""
+    radius = tool.diameter_mm / 2.0
+    return radius * (np.sqrt(1.0 + slope ** 2) - math.sqrt(1.0 + planned_slope ** 2))
+
+
+def _helical_raised_ends(spec: GearSpec, tool: Tool, passes: tuple[GeneratingPass, ...], x: np.ndarray) -> dict:
+    """{(side, roll): tool end Z at each face position `x`} of helical flank passes, raised per section: section X
+    sees the pass at effective roll t_e (the spur pass there, contact at Z = r_b), so its end is the spur raised end
+    at t_e (straight side from RAISED_END_MARGIN_MM below the crossing with the lower neighbour's flat, rolls evenly
+    spaced by delta) and its straight side never starts below the form point, at Z = r_b cos(t_F - t_e) + r_b t_F
+    sin(t_F - t_e) in that pass's frame (below it the corner would follow the rack's round over the fillet, which the
+    tip passes cut and which moves less than the flank); never lower than the planned line."""
+    rb, r_t = spec.base_radius_mm, tool.effective_corner_radius_mm
+    t_form = spec.tooth_space_profile().segment("involute").start
+    ends = {}
+    for side in (1, -1):
+        flank = [p for p in passes if p.mode == "flank" and p.side == side]
+        if len(flank) < 2:
+            continue
+        delta = float(np.median(np.abs(np.diff([p.roll_rad for p in flank]))))
+        for p in flank:
+            t_e = p.roll_rad - side * p.dy_per_x * x / rb
+            need = rb * (t_e * math.cos(delta) - (t_e - delta)) / math.sin(delta) - RAISED_END_MARGIN_MM
+            form = rb * np.cos(t_form - t_e) + rb * t_form * np.sin(t_form - t_e)
+            ends[side, p.roll_rad] = np.maximum.reduce([p.z_mm + x * p.dz_per_x, need - r_t, form - r_t])
     return ends
 
 
@@ -226,15 +273,11 @@ def modified_passes(spec: GearSpec, tool: Tool, passes: tuple[GeneratingPass, ..
     sides = {+1: mods.right, -1: mods.left}
     form_normal = involute.normals(np.array(involute.start))
     form_removal = {s: float(sides[s].profile_offset_mm(spec.base_radius_mm * involute.start)) for s in sides}
-    if spec.is_helical and mods.has_lead:
-        raise ToolError("generating finishing of a helical gear cuts profile modifications only; lead modifications "
-                        "move the flank passes sideways by up to their amount at the faces, and their end corners, "
-                        "near the root, would gouge the fillet (5.5 um for a 10 um lead crowning)",
-                        section="gear.modifications")
     lowered = {}
     if not spec.is_helical:
         passes, lowered = _touching_modified_contacts(spec, tool, passes, mods, supports)
     raised = {} if spec.is_helical else _raised_ends(spec, tool, passes)
+    helical_ends = _helical_raised_ends(spec, tool, passes, x) if spec.is_helical else {}
     out = []
     for p in passes:
         side = p.side
@@ -242,7 +285,11 @@ def modified_passes(spec: GearSpec, tool: Tool, passes: tuple[GeneratingPass, ..
         if p.mode == "flank":
             rolls = p.roll_rad - side * p.dy_per_x * x / spec.base_radius_mm
             removal = supports[side].removal_mm(rolls) + lead
+            if spec.is_helical:
+                removal = removal - _envelope_growth_mm(tool, p.dy_per_x, p.dy_per_x + side * np.gradient(removal, x))
             dy, dz = side * removal, np.zeros_like(x)
+            if (side, p.roll_rad) in helical_ends:
+                dz = helical_ends[side, p.roll_rad] - (p.z_mm + x * p.dz_per_x)
         elif p.mode == "tip" and fillet is not None and fillet.end > 0.0 \
                 and (p.feature != Feature.ROOT if spec.is_helical else not math.isnan(p.beta_rad)):
             beta = helical_fillet_parameters(spec, tool, p, x, fillet) if spec.is_helical else p.beta_rad
@@ -253,10 +300,12 @@ def modified_passes(spec: GearSpec, tool: Tool, passes: tuple[GeneratingPass, ..
             moved = -removal[:, None] * np.stack([normal[0] * np.cos(turns) - normal[1] * np.sin(turns),
                                                   normal[0] * np.sin(turns) + normal[1] * np.cos(turns)], axis=-1)
             dy, dz = moved[:, 0], moved[:, 1]
+            if spec.is_helical:
+                dy = dy - side * _envelope_growth_mm(tool, p.dy_per_x, p.dy_per_x + np.gradient(dy, x))
         else:
             out.append(p)
             continue
         z = (max(p.z_mm, raised.get((p.side, p.roll_rad), p.z_mm)) - lowered.get((p.side, p.roll_rad), 0.0)
              if p.mode == "flank" else p.z_mm)
-        out.append(replace(p, z_mm=z, path=_path(x, dy, dz, tolerance_mm)))
+        out.append(replace(p, z_mm=z, path=_path(x, dy, dz, tolerance_mm, side if spec.is_helical else 0)))
     return tuple(out)
