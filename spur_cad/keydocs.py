@@ -127,8 +127,9 @@ def job_file_reference_markdown(strategies: Strategies = REGISTRY) -> str:
         if cls in MODIFICATION_SECTIONS.values():
             parts.append("In the workbench these are the gear's properties: [gear.modifications] in the group Flank "
                          "modifications; a side's table is `LeftFlankOwnValues` / `RightFlankOwnValues` switched on "
-                         "and the `Left...` / `Right...` properties (the whole table: a side switched off takes the "
-                         "common values).\n")
+                         "and the `Left...` / `Right...` properties (switched on, they start from the common values; "
+                         "the side's table writes only the keys that differ from them and inherits the rest, key by "
+                         "key as here; switched off: the common values).\n")
         rows = ["| key | type | unit | default | accepted | meaning | workbench property |",
                 "| --- | --- | --- | --- | --- | --- | --- |"]
         for k in keys_of(cls):

@@ -542,3 +542,56 @@ def test_flank_modifications_are_gear_properties_in_um_saved_and_reopened_in_a_n
     assert result["status"] == ["ok", "ok"]
     modified, plain, valid = result["volumes"]
     assert valid and modified < plain - 1e-3, result["volumes"]
+
+
+SIDES_SAVE_BODY = """
+import FreeCAD
+from spur_cad_workbench import commands, properties, schema
+doc = FreeCAD.newDocument("Sides")
+gear = commands.make_gear(doc, **PROPS, **COMMON)
+gear.LeftFlankOwnValues = True                    # the user switches a side on and changes one amount
+properties.write_values(gear, {"LeftTipRelief": 25.0})
+gear.RightFlankOwnValues = True                   # and the other side's crowning off
+properties.write_values(gear, {"RightLeadCrowning": 0.0})
+doc.recompute()
+RESULT["status"] = gear.Status
+doc.saveAs(FILE)
+"""
+
+SIDES_OPEN_BODY = """
+import FreeCAD
+from spur_cad_workbench import properties, schema
+doc = FreeCAD.openDocument(FILE)
+gear = doc.getObject("Gear")
+values = properties.read_values(gear, schema.GEAR_FIELDS)
+RESULT["sides"] = {prop: values[prop] for prop in ("LeftTipRelief", "LeftTipReliefStartDiameter", "LeftLeadCrowning",
+                                                   "RightTipRelief", "RightLeadCrowning")}
+RESULT["tables"] = schema.job_data(properties.document_values(gear))["gear"]["modifications"]
+mods = properties.job_of(gear).modifications
+RESULT["mm"] = {side: [getattr(mods, side).tip_relief_mm, getattr(mods, side).tip_relief_start_roll_mm,
+                       getattr(mods, side).lead_crowning_mm] for side in ("left", "right")}
+"""
+
+
+def test_a_flank_side_switched_on_writes_only_what_differs_from_the_common_values(freecadcmd, tmp_path):
+    """A side switched on starts from the common values: changing one amount gives its table that one key and the
+    side keeps the common relief start and crowning; saved and reopened in a new process (reading the switch must
+    not copy the common values over the side's own)."""
+    common = dict(TipRelief=15.0, TipReliefStartDiameter=40.0, LeadCrowning=8.0)
+    saved = tmp_path / "sides.FCStd"
+    head = f"PROPS = {SMALL_GEAR_PROPERTIES!r}\nCOMMON = {common!r}\nFILE = {str(saved)!r}\n"
+    result, proc = run_workbench_code(head + SIDES_SAVE_BODY, tmp_path / "save", freecadcmd=freecadcmd)
+    assert result is not None and result.get("ok"), describe(proc, result)
+    assert result["status"] == "ok"
+    result, proc = run_workbench_code(head + SIDES_OPEN_BODY, tmp_path / "open", freecadcmd=freecadcmd)
+    assert result is not None and result.get("ok"), describe(proc, result)
+    assert result["sides"] == dict(LeftTipRelief=25.0, LeftTipReliefStartDiameter=40.0, LeftLeadCrowning=8.0,
+                                   RightTipRelief=15.0, RightLeadCrowning=0.0)
+    tables = result["tables"]
+    assert tables["left"] == {"tip_relief_um": 25.0} and tables["right"] == {"lead_crowning_um": 0.0}
+    assert (tables["tip_relief_um"], tables["tip_relief_start_diameter_mm"], tables["lead_crowning_um"]) == \
+        (15.0, 40.0, 8.0)
+    (left_tip, left_start, left_crowning), (right_tip, right_start, right_crowning) = \
+        result["mm"]["left"], result["mm"]["right"]
+    assert (left_tip, left_crowning) == (0.025, 0.008) and (right_tip, right_crowning) == (0.015, 0.0)
+    assert left_start == right_start > 0.0  # the left's relief starts at the common diameter

@@ -20,23 +20,25 @@ be known to a fraction of a micrometre, since the measured mean less it is the t
 
 
 def finishing_cut(spec, path, tool, stock, x_range_mm: tuple[float, float], stations=None,
-                  resolution_mm: float = IDEAL_RESOLUTION_MM):
+                  resolution_mm: float = IDEAL_RESOLUTION_MM, modifications=None):
     """The finishing toolpath alone cut into the stock cylinder over `x_range_mm` (spur_cad.sim.simulate): the
-    flanks are the finishing's, whatever roughing left."""
+    flanks are the finishing's, whatever roughing left; deviations from the modified design with `modifications`."""
     from spur_cad.sim.simulate import Cut, SimSettings, simulate
 
     return simulate(spec, stock, [Cut(path, tool)], SimSettings(resolution_mm=resolution_mm),
-                    station_x=stations, rows_x_range=x_range_mm)
+                    station_x=stations, rows_x_range=x_range_mm, modifications=modifications)
 
 
 def ideal_flanks(job, plan) -> IdealFlanks:
     """What the job's finishing leaves on an ideal machine over the face, per side against roll length (the mean
-    over spaces and rows at each design point)."""
+    over spaces and rows at each design point), from the modified design when the job has modifications: the
+    scallops alone, as identify reads the measured points."""
     from spur_cad.pipeline import job_stock
 
     spec = job.gear
     result = finishing_cut(spec, plan.finishing.toolpath, plan.finishing.tool, job_stock(job),
-                           (0.0, spec.face_width_mm), plan.finishing.result.station_x_mm)
+                           (0.0, spec.face_width_mm), plan.finishing.result.station_x_mm,
+                           modifications=job.modifications)
     grid = result.grid
     names = grid.feature_names()
     mean = result.gear_deviation.mean(axis=(0, 2))
@@ -257,23 +259,38 @@ PROBE_SEES_NO_INDEX = ("the index errors are not corrected: a probe log is measu
 
 
 def _identify_probe_log(job, log, ideal: IdealFlanks) -> Identified:
-    """identify_probed on a probe log's deviations from the job's probing plan (its [probe] section)."""
+    """identify_probed on a probe log's deviations from the job's probing plan (its [probe] section), read from the
+    modified design when the job has modifications."""
     from spur_cad.cam.probing import plan_probe
     from spur_cad.correct.identify import identify_probed
     from spur_cad.errors import SpurCadError
-    from spur_cad.grade.probe_log import probe_deviations
+    from spur_cad.grade.probe_log import labelled_deviations
 
     spec = job.gear
     if job.probe is None:
         raise SpurCadError(f"{log.source}: a probe log, but the job has no [probe] section to name its trips "
                            "(correct with the job that wrote the probing program)")
     plan = plan_probe(spec, job.stock, job.machine, job.probe)
-    deviation = probe_deviations(spec, plan, log, job.post.rotary_sign)
-    points = plan.points[:len(deviation)]
-    radius = np.array([pt.radius_mm for pt in points])
-    return identify_probed(spec, np.array([pt.space for pt in points]), np.array([pt.side for pt in points]),
-                           np.sqrt(np.maximum(radius ** 2 - spec.base_radius_mm ** 2, 0.0)),
-                           np.array([pt.x_mm for pt in points]), deviation, ideal)
+    trips = labelled_deviations(spec, plan, log, job.post.rotary_sign, job.modifications)
+    return identify_probed(spec, trips.space, trips.side, trips.roll_mm, trips.x_mm, trips.deviation_mm, ideal)
+
+
+def corrected_plan_of(job, identified: Identified):
+    """(the corrected job, its plan with the corrections, why the slopes are not corrected or None): the job re-planned
+    with the finishing tool as it cuts (its modifications kept: the finishing still cuts the modified flanks), the
+    generating flank passes moved for the slopes, and each space's A words of every operation turned by its index
+    correction."""
+    from spur_cad.pipeline import plan_cam
+
+    fixed = corrected_job(job, identified)
+    fixed_plan = plan_cam(fixed)
+    finishing, slopes_not_corrected = slope_corrected_finishing(fixed, fixed_plan.finishing, identified)
+    fixed_plan = dataclasses.replace(fixed_plan, finishing=finishing)
+    correction = index_correction_deg(identified)
+    turned = {name: dataclasses.replace(planned, toolpath=turned_by_space(planned.toolpath, correction))
+              for name in ("roughing", "roughing_bottom", "finishing")
+              if (planned := getattr(fixed_plan, name)) is not None}
+    return fixed, dataclasses.replace(fixed_plan, **turned), slopes_not_corrected
 
 
 def correct_job(job, measured, measured_source: str):
@@ -295,23 +312,17 @@ def correct_job(job, measured, measured_source: str):
         raise SpurCadError("the job has no [tools.finishing]: there is no finishing program to correct")
     plan = plan_cam(job)
     try:
-        identified = identify(spec, measured, ideal_flanks(job, plan)) if isinstance(measured, MeasuredPoints) \
+        identified = identify(spec, measured, ideal_flanks(job, plan), job.modifications) \
+            if isinstance(measured, MeasuredPoints) \
             else _identify_probe_log(job, measured, ideal_flanks(job, plan))
     except ValueError as exc:
         raise SpurCadError(f"{measured_source}: {exc}") from None
-    fixed = corrected_job(job, identified)
-    fixed_plan = plan_cam(fixed)
-    finishing, slopes_not_corrected = slope_corrected_finishing(fixed, fixed_plan.finishing, identified)
-    fixed_plan = dataclasses.replace(fixed_plan, finishing=finishing)
+    fixed, corrected_plan, slopes_not_corrected = corrected_plan_of(job, identified)
     correction = index_correction_deg(identified)
-    turned = {name: dataclasses.replace(planned, toolpath=turned_by_space(planned.toolpath, correction))
-              for name in ("roughing", "roughing_bottom", "finishing")
-              if (planned := getattr(fixed_plan, name)) is not None}
     notes = (f"corrected from {measured_source}: finishing tool programmed as D "
              f"{fixed.tools.finishing.diameter_mm:.4f} mm (size error {identified.size_um:+.2f} um), A of each space "
              "turned by its index correction" + ("" if slopes_not_corrected else ", flank passes moved for the "
                                                   "profile and helix slopes") + " (correction.json)",)
-    corrected_plan = dataclasses.replace(fixed_plan, **turned)
     _, files = build_programs(fixed, corrected_plan, notes)
     summary = correction_summary(spec, identified, job.tools.finishing, fixed.tools.finishing, correction,
                                  measured_source, slopes_not_corrected)

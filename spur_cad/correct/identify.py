@@ -117,14 +117,17 @@ def space_numbering_offset(angle_rad: float, teeth: int) -> int:
     return int(round((angle_rad - ((angle_rad + 0.5 * pitch) % pitch - 0.5 * pitch)) / pitch))
 
 
-def identify(spec, measured: MeasuredPoints, ideal: IdealFlanks | None = None) -> Identified:
+def identify(spec, measured: MeasuredPoints, ideal: IdealFlanks | None = None, modifications=None) -> Identified:
     """Fit the scan (spur_cad.grade.measured.fit), take each involute point's deviation minus the ideal cut's in the
     profile evaluation range, and separate size and index per space (see the module docstring). Uncertainties:
     the flank means' noise is read from the scatter over the spaces of each space's size (the sum of its two
-    flanks, constant in the model); an index error's is that over the lever's 2 r_b, the size's over sqrt(z)."""
+    flanks, constant in the model); an index error's is that over the lever's 2 r_b, the size's over sqrt(z).
+    `modifications` (the job's FlankModifications): the points are read from the modified design, as the grader reads
+    them (spur_cad.grade.measured.fit), so that a designed relief, crowning or slope is no machine error; `ideal`
+    must then be read from it too (spur_cad.correct.correct.ideal_flanks)."""
     design = _design(spec)
     points, normals, space, side, roll, _ = design
-    params, deviation, nearest = fit(spec, measured, design)
+    params, deviation, nearest = fit(spec, measured, design, modifications=modifications)
     offset = space_numbering_offset(float(params[0]), spec.teeth)
     machine_space = (space[nearest] - offset) % spec.teeth
     lever = points[nearest, 0] * normals[nearest, 1] - points[nearest, 1] * normals[nearest, 0]

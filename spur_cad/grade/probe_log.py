@@ -122,11 +122,21 @@ def probe_deviations(spec, plan, log: ProbeLog, rotary_sign: int = 1) -> np.ndar
     return along - ball
 
 
-def grade_probe_log(spec, plan, log: ProbeLog, rotary_sign: int = 1, modifications=None) -> Grading:
-    """ISO 1328-1 deviations and classes from a probe log (the module docstring): traces as the measured-points
-    grading builds them, from the plan's labels (space, side, roll length, X), with no fit. A log shorter than the
-    plan (the program stopped) is graded on its trips, with a note. `modifications`: graded against the modified
-    design (each trip's deviation plus the design's removal at its point), with the modifications as cut."""
+@dataclass(frozen=True)
+class LabelledDeviations:
+    """A probe log's trips as points of the plan: each one's space, flank side, roll length (mm) and X (mm), and its
+    normal deviation (mm, + material) from the design, the modified design when the job has modifications."""
+
+    space: np.ndarray
+    side: np.ndarray
+    roll_mm: np.ndarray
+    x_mm: np.ndarray
+    deviation_mm: np.ndarray
+
+
+def labelled_deviations(spec, plan, log: ProbeLog, rotary_sign: int = 1, modifications=None) -> LabelledDeviations:
+    """probe_deviations labelled by the plan's points; with `modifications`, each trip's deviation plus the design's
+    removal at its point (read from the modified flank: a designed relief is no deviation)."""
     deviation = probe_deviations(spec, plan, log, rotary_sign)
     points = plan.points[:len(deviation)]
     roll = np.sqrt(np.maximum(np.array([pt.radius_mm for pt in points]) ** 2 - spec.base_radius_mm ** 2, 0.0))
@@ -134,12 +144,21 @@ def grade_probe_log(spec, plan, log: ProbeLog, rotary_sign: int = 1, modificatio
     sides = np.array([pt.side for pt in points])
     if modifications is not None:
         deviation = deviation + design_removal_mm(modifications, sides, roll, axial)
-    found, positions = flank_traces(spec, axial, deviation, np.array([pt.space for pt in points]), sides, roll)
-    notes = () if len(points) == len(plan.points) else (
-        f"the probe log holds {len(points)} of the probing program's {len(plan.points)} trips (the program "
+    return LabelledDeviations(np.array([pt.space for pt in points]), sides, roll, axial, deviation)
+
+
+def grade_probe_log(spec, plan, log: ProbeLog, rotary_sign: int = 1, modifications=None) -> Grading:
+    """ISO 1328-1 deviations and classes from a probe log (the module docstring): traces as the measured-points
+    grading builds them, from the plan's labels (space, side, roll length, X), with no fit. A log shorter than the
+    plan (the program stopped) is graded on its trips, with a note. `modifications`: graded against the modified
+    design (labelled_deviations), with the modifications as cut."""
+    trips = labelled_deviations(spec, plan, log, rotary_sign, modifications)
+    found, positions = flank_traces(spec, trips.x_mm, trips.deviation_mm, trips.space, trips.side, trips.roll_mm)
+    notes = () if len(trips.space) == len(plan.points) else (
+        f"the probe log holds {len(trips.space)} of the probing program's {len(plan.points)} trips (the program "
         f"stopped early?): graded on those",)
-    fitted = MeasuredFit(0.0, (0.0, 0.0), float(np.sqrt(np.mean(deviation ** 2)) * 1000.0), "probe log")
-    return against_design(graded(spec, found, positions, axial, fitted, notes), modifications)
+    fitted = MeasuredFit(0.0, (0.0, 0.0), float(np.sqrt(np.mean(trips.deviation_mm ** 2)) * 1000.0), "probe log")
+    return against_design(graded(spec, found, positions, trips.x_mm, fitted, notes), modifications)
 
 
 def read_measured_file(path, source: str | None = None):

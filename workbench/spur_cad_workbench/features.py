@@ -25,7 +25,16 @@ import io
 import FreeCAD
 
 from spur_cad_workbench import compat, schema, units
-from spur_cad_workbench.properties import add_bookkeeping, add_fields, document_values, job_of, source_of, write_outputs
+from spur_cad_workbench.properties import (
+    add_bookkeeping,
+    add_fields,
+    document_values,
+    job_of,
+    read_values,
+    source_of,
+    write_outputs,
+    write_values,
+)
 from spur_cad_workbench.resources import icon_path
 
 GEAR_COLOUR = (0.55, 0.62, 0.72)
@@ -208,6 +217,10 @@ class _Proxy(compat.StatelessProxy):
                                          f" ({', '.join(changed) or 'no property changed'})\n")
 
 
+SIDE_SWITCH_SECTIONS = {switch.prop: section for section, switch in schema.MODIFICATION_SWITCHES.items()}
+"""{LeftFlankOwnValues: 'gear.modifications.left', ...}: the switch property of each side's table."""
+
+
 class GearFeature(_Proxy):
     """The gear: ISO 21771 inputs, computed radii and inspection values, the exact solid."""
 
@@ -220,6 +233,15 @@ class GearFeature(_Proxy):
         add_fields(obj, self.FIELDS, values)
         add_fields(obj, self.OUTPUTS, outputs=True)
         add_bookkeeping(obj)
+
+    def onChanged(self, obj, prop):
+        """A flank side's switch turned on (by the user, not a document being read): the side's properties start
+        from the common modification values, so that changing one of them gives the side table that one key."""
+        section = SIDE_SWITCH_SECTIONS.get(prop)
+        if section is None or not getattr(obj, prop) or "Restore" in obj.State:
+            return
+        if all(field.prop in obj.PropertiesList for field in self.FIELDS):  # not while __init__ adds them
+            write_values(obj, schema.side_start_values(read_values(obj, self.FIELDS), section))
 
     def execute(self, obj):
         from spur_cad.cad.solid import build_gear_shape

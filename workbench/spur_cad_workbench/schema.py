@@ -34,9 +34,10 @@ Cutting speeds (m/min), spindle speeds (1/min) and rotary speeds (deg/min) stay 
 catalogues quote them in those units, and FreeCAD would show them as mm/s, Hz or deg/s.
 The flank modifications ([gear.modifications], its .left and .right tables) are gear properties: the common
 table in group "Flank modifications", each side's own values (`Left...`, `Right...`) in "Flank modifications:
-left flank" / "...: right flank" behind a switch (LeftFlankOwnValues, RightFlankOwnValues); a side switched on
-writes its whole table (a job file's side table with some keys reads back as the common values overridden by
-them: the same modifications). A job writes the tables only when some amount is set, so a gear without
+left flank" / "...: right flank" behind a switch (LeftFlankOwnValues, RightFlankOwnValues). A side switched on
+starts from the common values (the gear's onChanged copies them) and its table writes only the keys whose value
+differs from the common one: the rest it inherits, key by key as a job file's side table does (which reads back as
+the common values overridden by its keys). A job writes the tables only when some amount is set, so a gear without
 modifications gives the job (and PlannedValues) it gave before.
 
 `values_from_job` / `job_data` always hold plain numbers in the job file's units;
@@ -377,7 +378,8 @@ def job_data(values: dict[str, dict[str, object]]) -> dict[str, dict]:
                 continue
             if role == "job" and not section_enabled(values["job"], field.section):
                 continue
-            if field.section.startswith(MODIFICATIONS) and field.section not in modification_tables(values[role]):
+            if field.section.startswith(MODIFICATIONS) and (field.section not in modification_tables(values[role])
+                                                            or field.prop in inherited_side_props(values[role])):
                 continue
             target = data
             for part in field.section.split("."):
@@ -393,6 +395,27 @@ def modification_tables(gear_values: dict[str, object]) -> tuple[str, ...]:
                                if gear_values[switch.prop]))
     amounts = [field for field in FIELDS["gear"] if field.section in tables and field.key.endswith("_um")]
     return tables if any(gear_values[field.prop] for field in amounts) else ()
+
+
+def common_prop(side_field: Field) -> str:
+    """The common [gear.modifications] property a side's field overrides (LeftTipRelief: TipRelief)."""
+    return side_field.prop.removeprefix(side_field.section.rsplit(".", 1)[1].capitalize())
+
+
+def inherited_side_props(gear_values: dict[str, object]) -> set[str]:
+    """The side properties whose value is the common one: their side table leaves them out and inherits them, as a
+    job file's side table does (it overrides key by key), so that a side switched on with one amount changed writes
+    that one key."""
+    return {field.prop for field in FIELDS["gear"]
+            if field.key and field.section in MODIFICATION_SWITCHES
+            and gear_values[field.prop] == gear_values[common_prop(field)]}
+
+
+def side_start_values(gear_values: dict[str, object], section: str) -> dict[str, object]:
+    """{side property: the common value} of a side's table (`section`: 'gear.modifications.left'): what a side
+    switched on starts from (the common modifications; the user then changes what differs)."""
+    return {field.prop: gear_values[common_prop(field)] for field in FIELDS["gear"]
+            if field.key and field.section == section}
 
 
 def field_by_prop(prop: str) -> Field:
