@@ -74,20 +74,27 @@ def test_the_measured_engagement_is_within_the_job_s_limits_and_the_feed_keeps_t
     ).mean_removal_rate_mm3_min
 
 
-def test_the_passes_cross_the_air_beyond_the_stock_at_the_largest_feed_and_cut_only_at_their_own(reference):
-    """Every pass leaves the largest feed before the tool can meet the stock: the legs at the machine's largest feed
-    along X remove nothing in the section model (tip lands included), and they are a real share of the passes."""
+def test_the_passes_turn_just_beyond_the_stock_and_cut_only_along_x(reference):
+    """Every pass runs between the stock's ends plus the tool radius and ENTRY_GAP_MM (the tool's edge that far from
+    the stock, not the machine's clearance: no air legs to accelerate through), and everything but the passes (the
+    links, the returns along a cleared column beside the holding stub) is at the largest feed and removes nothing
+    in the section model (tip lands included)."""
+    from spur_cad.cam.roughing import ENTRY_GAP_MM
+
     job, plan = reference
     path = plan.roughing.toolpath
     e = roughing_engagement(job, plan)
+    radius = job.tools.roughing.diameter_mm / 2.0
+    front = -(job.stock.front_margin_mm + radius + ENTRY_GAP_MM)
     start = path.start_poses()
-    along_x = (path.kind == MoveKind.LINEAR) & (path.x != start[:, 0]) & (path.y == start[:, 1]) & (
-        path.z == start[:, 2])
-    air = along_x & (path.feed == job.machine.max_feed_mm_min) & (path.feature == Feature.NONE)
-    rows = np.isin(e.index, np.flatnonzero(air))
-    assert rows.sum() >= np.count_nonzero(along_x & (path.feature != Feature.NONE))  # at least one per pass
-    assert e.removed_mm3[rows].max() == 0.0
-    cutting = along_x & (path.feature != Feature.NONE)
+    cutting = path.feature != Feature.NONE
+    along_x = (path.kind == MoveKind.LINEAR) & (path.x != start[:, 0]) & (path.y == start[:, 1])
+    assert np.all(along_x[cutting])
+    assert np.isclose(np.minimum(path.x, start[:, 0])[cutting].min(), front)  # the pass's end at the front
+    links = (path.kind == MoveKind.LINEAR) & ~cutting
+    assert np.all(path.x[links] >= front - 1e-9)  # no leg in the air beyond that
+    assert np.all(path.feed[links] == job.machine.max_feed_mm_min)
+    assert e.removed_mm3[np.isin(e.index, np.flatnonzero(links))].max() == 0.0
     assert np.all(path.feed[cutting] < job.machine.max_feed_mm_min)
 
 
