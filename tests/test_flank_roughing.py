@@ -15,6 +15,7 @@ from spur_cad.cam.flank_roughing import UNCUT_MM2, FlankLimits, chip_thinning_fa
 from spur_cad.cam.ir import Feature, MoveKind
 from spur_cad.cam.machine import Machine, RoughingParams
 from spur_cad.cam.roughing import flank_plan_for, roughing_levels
+from spur_cad.cam.tools import Tool
 from spur_cad.job import parse_job
 from spur_cad.pipeline import job_stock, plan_cam, roughing_engagement
 from spur_cad.sim import Cut, SimSettings, simulate
@@ -220,3 +221,31 @@ def test_the_summary_the_report_and_the_program_name_the_strategy(reference):
     assert f"roughing by flanks, {len(flank.passes)} passes per space" in report and "z-level roughing" not in report
     program = result.files["roughing.ngc"].decode()
     assert f"(strategy: by flanks, {len(flank.passes)} passes per space" in program
+
+
+def test_one_small_tool_gets_a_larger_top_tool_suggested_when_it_pays_and_the_estimator_confirms_it(reference):
+    """z120 m1 roughed by flanks with one D 0.569 mm tool: the plan suggests a larger top tool, and planning the job
+    with that tool as [tools.roughing_top] gives two-stage roughing with the suggested time, quicker than the tool
+    alone by the suggested saving; the reference job (its D 3.5 mm tool) gets no suggestion."""
+    import dataclasses
+
+    from spur_cad.cad.specs import StockSpec
+    from spur_cad.cam.plan import TWO_STAGE_PAYS_FRACTION, CamInputs, plan_cam
+    from spur_cad.cam.strategies import FinishingParams
+    from spur_cad.geometry import GearSpec
+
+    spec = GearSpec(teeth=120, module_mm=1.0, pressure_angle_deg=20.0, rack_tip_radius_mm=0.25, face_width_mm=6.0)
+    tool = Tool(diameter_mm=0.569, kind="flat", flutes=3)
+    params = RoughingParams(flank_allowance_mm=0.075, finish_stock_mm=0.005, strategy="flank")
+    inputs = CamInputs(spec, StockSpec(radial_allowance_mm=0.5), tool, None, params, FinishingParams(), Machine())
+    alone = plan_cam(inputs)
+    suggested = alone.two_stage_suggested
+    assert suggested is not None and suggested.roughing_tool.diameter_mm > tool.diameter_mm
+    assert suggested.bottom_tool_alone_time_s == alone.roughing.estimate.time_with_acceleration_s
+    assert suggested.two_stage_time_s <= TWO_STAGE_PAYS_FRACTION * suggested.bottom_tool_alone_time_s
+    staged = plan_cam(dataclasses.replace(inputs, top_tool=suggested.roughing_tool))
+    assert staged.two_stage is not None and staged.two_stage_suggested is None
+    total = (staged.roughing.estimate.time_with_acceleration_s +
+             staged.roughing_bottom.estimate.time_with_acceleration_s)
+    assert math.isclose(total, suggested.two_stage_time_s, rel_tol=1e-9)
+    assert reference[1].two_stage_suggested is None
