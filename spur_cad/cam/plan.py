@@ -35,6 +35,7 @@ from spur_cad.cam.roughing import (
     check_helical_roughing_machine,
     estimated_roughing_moves,
     flank_plan_for,
+    lowest_roughing_level,
     roughing_levels,
     roughing_toolpath,
     tip_heights_mm,
@@ -361,21 +362,22 @@ def suggested_top_tool(inputs: CamInputs, roughing: RoughingPlan, blank: float) 
     top = dataclasses.replace(tool, diameter_mm=diameter, kind="flat", corner_radius_mm=0.0, flute_length_mm=flutes,
                               tool_number=tool.tool_number + 1)
     staged = dataclasses.replace(inputs, roughing_tool=top, bottom_tool=tool, top_tool=None)
-    try:
-        upper_levels = roughing_levels(spec, top, inputs.roughing, blank)
-        upper = _plan_roughing(staged, upper_levels, blank)
-        bottom_levels = roughing_levels(spec, tool, inputs.roughing, blank)
-        flank = flank_plan_for(spec, tool, inputs.roughing, blank, bottom_levels, tips=False,
-                               first=(upper.flank, top))
-        if not flank.passes or flank.uncut_mm2 > UNCUT_MM2 or upper.flank.uncut_mm2 > UNCUT_MM2:
+    limit_s = TWO_STAGE_PAYS_FRACTION * _seconds(roughing)
+    try:  # the upper program first: when it alone takes too long, the lower one is not planned
+        upper = _plan_roughing(staged, lowest_roughing_level(spec, top, inputs.roughing, blank), blank)
+        if upper.flank.uncut_mm2 > UNCUT_MM2 or _seconds(upper) > limit_s:
             return None
-        lower = _plan_roughing(staged, bottom_levels, blank, tool, tips=False, flank=flank)
+        flank = flank_plan_for(spec, tool, inputs.roughing, blank, roughing.levels, tips=False,
+                               first=(upper.flank, top))
+        if not flank.passes or flank.uncut_mm2 > UNCUT_MM2:
+            return None
+        lower = _plan_roughing(staged, roughing.levels, blank, tool, tips=False, flank=flank)
     except SpurCadError:  # the larger tool fits no level, or its plan is refused: nothing to suggest
         return None
-    staged_s, alone_s = _seconds(upper) + _seconds(lower), _seconds(roughing)
-    if staged_s > TWO_STAGE_PAYS_FRACTION * alone_s:
+    staged_s = _seconds(upper) + _seconds(lower)
+    if staged_s > limit_s:
         return None
-    return TwoStage(upper.lowest_level_above_root_mm, "reach", staged_s, alone_s, top)
+    return TwoStage(upper.lowest_level_above_root_mm, "reach", staged_s, _seconds(roughing), top)
 
 
 def check_moves(operation: str, moves: int, section: str, field: str) -> None:

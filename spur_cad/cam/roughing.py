@@ -174,6 +174,15 @@ def _next_level(flank: _OffsetFlank, h: float, max_depth: float, budget: float, 
     return lo
 
 
+def lowest_roughing_level(spec: GearSpec, tool: Tool, params: RoughingParams,
+                          blank_radius_mm: float) -> RoughingLevels:
+    """The lowest of roughing_levels alone (all the flank strategy reads of them), without the levels above."""
+    points, _, junction = offset_flank(spec, params.finish_stock_mm)
+    flank = _OffsetFlank(points, junction, abs(spec.section_turn_rad(1.0)) * tool.diameter_mm / 2.0)
+    lowest = _lowest_level(flank, tool, transverse_radius_mm(spec, tool, blank_radius_mm))
+    return RoughingLevels(np.array([lowest]), np.array([flank.reach_width(lowest)]), junction)
+
+
 def roughing_levels(spec: GearSpec, tool: Tool, params: RoughingParams, blank_radius_mm: float) -> RoughingLevels:
     """Levels as described in the module docstring (pure function)."""
     points, _, junction = offset_flank(spec, params.finish_stock_mm)
