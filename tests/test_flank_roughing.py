@@ -22,7 +22,7 @@ from spur_cad.sim import Cut, SimSettings, simulate
 from spur_cad.sim.engagement import MeasuredCut, engagement_warnings
 from spur_cad.sim.section_engagement import measure_section_engagement
 from spur_cad.sim.simulate import shifted
-from spur_cad.summary import engagement_limits
+from spur_cad.summary import engagement_limits, roughing_facts, roughing_json
 from tests.gears import CAM_GEARS, REFERENCE_JOB, spec_of, tools_for
 
 
@@ -248,4 +248,9 @@ def test_one_small_tool_gets_a_larger_top_tool_suggested_when_it_pays_and_the_es
     total = (staged.roughing.estimate.time_with_acceleration_s +
              staged.roughing_bottom.estimate.time_with_acceleration_s)
     assert math.isclose(total, suggested.two_stage_time_s, rel_tol=1e-9)
+    # summary.json says it under roughing, the saving in seconds; nothing when there is nothing to suggest
+    facts = roughing_json(roughing_facts(alone, Machine()), measured=False)["two_stage_suggested"]
+    assert facts["top_tool_diameter_mm"] == suggested.roughing_tool.diameter_mm
+    assert facts["time_saved_s"] == pytest.approx(alone.roughing.estimate.time_with_acceleration_s - total)
     assert reference[1].two_stage_suggested is None
+    assert "two_stage_suggested" not in roughing_json(roughing_facts(reference[1], Machine()), measured=False)

@@ -366,14 +366,15 @@ def follow_lead(path: Toolpath, spec: GearSpec, machine: Machine) -> Toolpath:
 
 
 def _tip_offsets_mm(spec: GearSpec, tool: Tool, params: RoughingParams) -> np.ndarray:
-    """Y of the flank strategy's tip passes (the tooth's axis up): the tool's centre from one tip edge of the land
-    (grown by the finish stock) to the other, so that its side reaches a tool radius beyond, where the flank runs
-    leave what stands above the tip circle. The passes are at most the slot depth deep (tip_heights_mm), so each
-    may be engaged across the whole diameter: they step by TIP_STEP_FRACTION x D."""
+    """Y of the flank strategy's tip passes (the tooth's axis up): the tool's sides from one tip edge of the land
+    (grown by the finish stock) to the other (one pass on the axis when the tool is wider than the land). What
+    stands above the tip circle beyond the tip edges is the flank runs' (their completeness check and clean-up
+    columns stop at the land's columns, land_half_width_mm). The passes are at most the slot depth deep
+    (tip_heights_mm), so each may be engaged across the whole diameter: they step by TIP_STEP_FRACTION x D."""
     tip_edge = offset_flank(spec, params.finish_stock_mm)[0][-1]
     half_pitch = math.pi / spec.teeth
     edge = tip_edge[0] * math.cos(half_pitch) - tip_edge[1] * math.sin(half_pitch)  # the edge in the tooth's frame
-    return _pass_offsets(abs(edge), TIP_STEP_FRACTION * tool.diameter_mm)
+    return _pass_offsets(max(abs(edge) - tool.diameter_mm / 2.0, 0.0), TIP_STEP_FRACTION * tool.diameter_mm)
 
 
 TIP_STEP_FRACTION = 0.9
