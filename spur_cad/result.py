@@ -134,6 +134,16 @@ class DeclinedTwoStageFacts:
 
 
 @dataclass(frozen=True)
+class SuggestedTopToolFacts:
+    """Roughing by flanks with one tool: a larger top tool the job does not give would save time (cam.plan
+    suggested_top_tool)."""
+
+    top_tool_diameter_mm: float
+    two_stage_time_s: float
+    roughing_tool_alone_time_s: float
+
+
+@dataclass(frozen=True)
 class RoughingFacts:
     """One roughing operation: its levels and its estimate (and two-stage roughing's bottom operation)."""
 
@@ -153,6 +163,7 @@ class RoughingFacts:
     passes_per_space: int | None = None
     flank_turns_deg: tuple[float, ...] = ()
     two_stage_declined: DeclinedTwoStageFacts | None = None
+    two_stage_suggested: SuggestedTopToolFacts | None = None
 
 
 @dataclass(frozen=True)

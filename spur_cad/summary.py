@@ -35,6 +35,7 @@ from spur_cad.result import (
     SegmentCounts,
     SetupFacts,
     SimulationFacts,
+    SuggestedTopToolFacts,
     ToolFacts,
     ToolsFacts,
     TwoStageFacts,
@@ -186,6 +187,10 @@ def roughing_facts(plan: CamPlan, machine: Machine, simulation: SimResult | None
     if declined is not None:
         facts = dataclasses.replace(facts, two_stage_declined=DeclinedTwoStageFacts(
             tool_facts(declined.roughing_tool, machine), declined.two_stage_time_s, declined.bottom_tool_alone_time_s))
+    suggested = plan.two_stage_suggested
+    if suggested is not None:
+        facts = dataclasses.replace(facts, two_stage_suggested=SuggestedTopToolFacts(
+            suggested.roughing_tool.diameter_mm, suggested.two_stage_time_s, suggested.bottom_tool_alone_time_s))
     if plan.roughing_bottom is None:
         return facts
     stage, bottom = plan.two_stage, plan.roughing_bottom
@@ -357,6 +362,12 @@ def roughing_json(roughing: RoughingFacts, measured: bool = True) -> dict:
             "roughing_tool": tool_json(declined.roughing_tool, with_number=True),
             "two_stage_time_s": declined.two_stage_time_s,
             "bottom_tool_alone_time_s": declined.bottom_tool_alone_time_s}
+    suggested = roughing.two_stage_suggested
+    if suggested is not None:
+        facts["two_stage_suggested"] = {
+            "top_tool_diameter_mm": suggested.top_tool_diameter_mm, "two_stage_time_s": suggested.two_stage_time_s,
+            "roughing_tool_alone_time_s": suggested.roughing_tool_alone_time_s,
+            "time_saved_s": suggested.roughing_tool_alone_time_s - suggested.two_stage_time_s}
     return facts
 
 

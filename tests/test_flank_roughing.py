@@ -15,13 +15,14 @@ from spur_cad.cam.flank_roughing import UNCUT_MM2, FlankLimits, chip_thinning_fa
 from spur_cad.cam.ir import Feature, MoveKind
 from spur_cad.cam.machine import Machine, RoughingParams
 from spur_cad.cam.roughing import flank_plan_for, roughing_levels
+from spur_cad.cam.tools import Tool
 from spur_cad.job import parse_job
 from spur_cad.pipeline import job_stock, plan_cam, roughing_engagement
 from spur_cad.sim import Cut, SimSettings, simulate
 from spur_cad.sim.engagement import MeasuredCut, engagement_warnings
 from spur_cad.sim.section_engagement import measure_section_engagement
 from spur_cad.sim.simulate import shifted
-from spur_cad.summary import engagement_limits
+from spur_cad.summary import engagement_limits, roughing_facts, roughing_json
 from tests.gears import CAM_GEARS, REFERENCE_JOB, spec_of, tools_for
 
 
@@ -74,20 +75,27 @@ def test_the_measured_engagement_is_within_the_job_s_limits_and_the_feed_keeps_t
     ).mean_removal_rate_mm3_min
 
 
-def test_the_passes_cross_the_air_beyond_the_stock_at_the_largest_feed_and_cut_only_at_their_own(reference):
-    """Every pass leaves the largest feed before the tool can meet the stock: the legs at the machine's largest feed
-    along X remove nothing in the section model (tip lands included), and they are a real share of the passes."""
+def test_the_passes_turn_just_beyond_the_stock_and_cut_only_along_x(reference):
+    """Every pass runs between the stock's ends plus the tool radius and ENTRY_GAP_MM (the tool's edge that far from
+    the stock, not the machine's clearance: no air legs to accelerate through), and everything but the passes (the
+    links, the returns along a cleared column beside the holding stub) is at the largest feed and removes nothing
+    in the section model (tip lands included)."""
+    from spur_cad.cam.roughing import ENTRY_GAP_MM
+
     job, plan = reference
     path = plan.roughing.toolpath
     e = roughing_engagement(job, plan)
+    radius = job.tools.roughing.diameter_mm / 2.0
+    front = -(job.stock.front_margin_mm + radius + ENTRY_GAP_MM)
     start = path.start_poses()
-    along_x = (path.kind == MoveKind.LINEAR) & (path.x != start[:, 0]) & (path.y == start[:, 1]) & (
-        path.z == start[:, 2])
-    air = along_x & (path.feed == job.machine.max_feed_mm_min) & (path.feature == Feature.NONE)
-    rows = np.isin(e.index, np.flatnonzero(air))
-    assert rows.sum() >= np.count_nonzero(along_x & (path.feature != Feature.NONE))  # at least one per pass
-    assert e.removed_mm3[rows].max() == 0.0
-    cutting = along_x & (path.feature != Feature.NONE)
+    cutting = path.feature != Feature.NONE
+    along_x = (path.kind == MoveKind.LINEAR) & (path.x != start[:, 0]) & (path.y == start[:, 1])
+    assert np.all(along_x[cutting])
+    assert np.isclose(np.minimum(path.x, start[:, 0])[cutting].min(), front)  # the pass's end at the front
+    links = (path.kind == MoveKind.LINEAR) & ~cutting
+    assert np.all(path.x[links] >= front - 1e-9)  # no leg in the air beyond that
+    assert np.all(path.feed[links] == job.machine.max_feed_mm_min)
+    assert e.removed_mm3[np.isin(e.index, np.flatnonzero(links))].max() == 0.0
     assert np.all(path.feed[cutting] < job.machine.max_feed_mm_min)
 
 
@@ -213,3 +221,36 @@ def test_the_summary_the_report_and_the_program_name_the_strategy(reference):
     assert f"roughing by flanks, {len(flank.passes)} passes per space" in report and "z-level roughing" not in report
     program = result.files["roughing.ngc"].decode()
     assert f"(strategy: by flanks, {len(flank.passes)} passes per space" in program
+
+
+def test_one_small_tool_gets_a_larger_top_tool_suggested_when_it_pays_and_the_estimator_confirms_it(reference):
+    """z120 m1 roughed by flanks with one D 0.569 mm tool: the plan suggests a larger top tool, and planning the job
+    with that tool as [tools.roughing_top] gives two-stage roughing with the suggested time, quicker than the tool
+    alone by the suggested saving; the reference job (its D 3.5 mm tool) gets no suggestion."""
+    import dataclasses
+
+    from spur_cad.cad.specs import StockSpec
+    from spur_cad.cam.plan import TWO_STAGE_PAYS_FRACTION, CamInputs, plan_cam
+    from spur_cad.cam.strategies import FinishingParams
+    from spur_cad.geometry import GearSpec
+
+    spec = GearSpec(teeth=120, module_mm=1.0, pressure_angle_deg=20.0, rack_tip_radius_mm=0.25, face_width_mm=6.0)
+    tool = Tool(diameter_mm=0.569, kind="flat", flutes=3)
+    params = RoughingParams(flank_allowance_mm=0.075, finish_stock_mm=0.005, strategy="flank")
+    inputs = CamInputs(spec, StockSpec(radial_allowance_mm=0.5), tool, None, params, FinishingParams(), Machine())
+    alone = plan_cam(inputs)
+    suggested = alone.two_stage_suggested
+    assert suggested is not None and suggested.roughing_tool.diameter_mm > tool.diameter_mm
+    assert suggested.bottom_tool_alone_time_s == alone.roughing.estimate.time_with_acceleration_s
+    assert suggested.two_stage_time_s <= TWO_STAGE_PAYS_FRACTION * suggested.bottom_tool_alone_time_s
+    staged = plan_cam(dataclasses.replace(inputs, top_tool=suggested.roughing_tool))
+    assert staged.two_stage is not None and staged.two_stage_suggested is None
+    total = (staged.roughing.estimate.time_with_acceleration_s +
+             staged.roughing_bottom.estimate.time_with_acceleration_s)
+    assert math.isclose(total, suggested.two_stage_time_s, rel_tol=1e-9)
+    # summary.json says it under roughing, the saving in seconds; nothing when there is nothing to suggest
+    facts = roughing_json(roughing_facts(alone, Machine()), measured=False)["two_stage_suggested"]
+    assert facts["top_tool_diameter_mm"] == suggested.roughing_tool.diameter_mm
+    assert facts["time_saved_s"] == pytest.approx(alone.roughing.estimate.time_with_acceleration_s - total)
+    assert reference[1].two_stage_suggested is None
+    assert "two_stage_suggested" not in roughing_json(roughing_facts(reference[1], Machine()), measured=False)

@@ -17,7 +17,7 @@ from spur_cad.cam.common import check_moves
 from spur_cad.cam.contacts import ContactCounts, contact_counts
 from spur_cad.cam.estimate import Estimate, estimate, move_seconds
 from spur_cad.cam.finishing import plan_finishing
-from spur_cad.cam.flank_roughing import FlankPlan
+from spur_cad.cam.flank_roughing import UNCUT_MM2, FlankPlan
 from spur_cad.cam.ir import Toolpath
 from spur_cad.cam.machine import Machine, MachineError, RoughingParams, check_travel
 from spur_cad.cam.machine_limits import check_machine_limits
@@ -36,6 +36,7 @@ from spur_cad.cam.roughing import (
     check_helical_roughing_machine,
     estimated_roughing_moves,
     flank_plan_for,
+    lowest_roughing_level,
     roughing_levels,
     roughing_toolpath,
     tip_heights_mm,
@@ -131,6 +132,9 @@ class CamPlan:
     # two-stage roughing the job's tools allow but not used: the bottom tool alone is quicker (roughing is then that
     # tool's single program)
     two_stage_declined: TwoStage | None = None
+    # roughing by flanks with one tool: two-stage roughing with a larger top tool the job does not give, when it would
+    # save at least 1 - TWO_STAGE_PAYS_FRACTION of the time (its roughing_tool: the larger tool; suggested_top_tool)
+    two_stage_suggested: TwoStage | None = None
 
 
 @dataclass(frozen=True)
@@ -323,7 +327,7 @@ def plan_cam(inputs: CamInputs, checkpoint: Callable[[], None] | None = None) ->
     warnings.extend(small_tool_warnings(rec, inputs.machine.smallest_end_mill_mm, strategy.name,
                                         strategy.largest_tool(rec),
                                         inputs.finishing_tool.kind if inputs.finishing_tool is not None else None))
-    bottom = two_stage = declined = None
+    bottom = two_stage = declined = suggested = None
     if levels is not None and (inputs.bottom_tool is not None or inputs.top_tool is not None):
         check()
         roughing, bottom, two_stage, declined, notes = _plan_tool_pair(inputs, levels, blank)
@@ -332,11 +336,49 @@ def plan_cam(inputs: CamInputs, checkpoint: Callable[[], None] | None = None) ->
         check()
         roughing = _plan_roughing(inputs, levels, blank)
         warnings.extend(roughing.toolpath.warnings)
+        check()
+        suggested = suggested_top_tool(inputs, roughing, blank)
     if inputs.finishing_tool is not None:
         check()
         finishing = _plan_finishing(inputs, blank, check)
         warnings.extend(finishing.toolpath.warnings)
-    return CamPlan(rec, roughing, finishing, tuple(warnings), bottom, two_stage, declined)
+    return CamPlan(rec, roughing, finishing, tuple(warnings), bottom, two_stage, declined, suggested)
+
+
+def suggested_top_tool(inputs: CamInputs, roughing: RoughingPlan, blank: float) -> TwoStage | None:
+    """Roughing by flanks with the job's one tool: two-stage roughing by flanks with a larger top tool above it, when
+    it takes at most TWO_STAGE_PAYS_FRACTION of `roughing`'s time (both estimated with accelerations); else None.
+    One size is planned (each costs a flank plan of both tools): the largest whole-millimetre flat end mill no wider
+    than the space at the reference circle (suggested_two_stage's range), with the job tool's cutting data and
+    flutes 3 D long (or the job tool's length). Not for helical gears (a plan of theirs takes seconds) nor by
+    levels (the workbench's suggested_two_stage)."""
+    spec, tool = inputs.spec, inputs.roughing_tool
+    if inputs.roughing.strategy != "flank" or spec.is_helical or roughing.flank is None:
+        return None
+    widest_mm = 2.0 * space_half_width_mm(flank_polyline(spec), spec.reference_radius_mm)
+    diameter = float(np.floor(widest_mm / TOP_TOOL_STEP_MM + 1e-9) * TOP_TOOL_STEP_MM)
+    if diameter <= tool.diameter_mm + 1e-9:
+        return None
+    flutes = max(tool.flute_length_mm, 3.0 * diameter) if tool.flute_length_mm > 0.0 else 0.0
+    top = dataclasses.replace(tool, diameter_mm=diameter, kind="flat", corner_radius_mm=0.0, flute_length_mm=flutes,
+                              tool_number=tool.tool_number + 1)
+    staged = dataclasses.replace(inputs, roughing_tool=top, bottom_tool=tool, top_tool=None)
+    limit_s = TWO_STAGE_PAYS_FRACTION * _seconds(roughing)
+    try:  # the upper program first: when it alone takes too long, the lower one is not planned
+        upper = _plan_roughing(staged, lowest_roughing_level(spec, top, inputs.roughing, blank), blank)
+        if upper.flank.uncut_mm2 > UNCUT_MM2 or _seconds(upper) > limit_s:
+            return None
+        flank = flank_plan_for(spec, tool, inputs.roughing, blank, roughing.levels, tips=False,
+                               first=(upper.flank, top))
+        if not flank.passes or flank.uncut_mm2 > UNCUT_MM2:
+            return None
+        lower = _plan_roughing(staged, roughing.levels, blank, tool, tips=False, flank=flank)
+    except SpurCadError:  # the larger tool fits no level, or its plan is refused: nothing to suggest
+        return None
+    staged_s = _seconds(upper) + _seconds(lower)
+    if staged_s > limit_s:
+        return None
+    return TwoStage(upper.lowest_level_above_root_mm, "reach", staged_s, _seconds(roughing), top)
 
 
 def _levels_where(levels: RoughingLevels, keep: np.ndarray) -> RoughingLevels:

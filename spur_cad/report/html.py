@@ -113,6 +113,13 @@ def program_notes(result: JobResult) -> tuple[str, ...]:
                          f"{duration(declined.two_stage_time_s - declined.bottom_tool_alone_time_s)} more than the "
                          f"smaller tool alone ({duration(declined.bottom_tool_alone_time_s)}): roughing uses the "
                          "smaller tool alone, the quicker of the two.")
+        suggested = rough.two_stage_suggested
+        if suggested is not None:
+            notes.append(f"A D {number(suggested.top_tool_diameter_mm, 3)} mm top tool would save "
+                         f"{duration(suggested.roughing_tool_alone_time_s - suggested.two_stage_time_s)} of roughing "
+                         f"({duration(suggested.roughing_tool_alone_time_s)} -> "
+                         f"{duration(suggested.two_stage_time_s)}): name it [tools.roughing_top] (two-stage "
+                         "roughing by flanks, the same cutting data).")
     if finish is not None:
         notes.append(finish.report_text)
     return tuple(notes)
