@@ -248,7 +248,7 @@ def test_the_bottom_allowance_is_the_finishing_strategys_rule():
     # the report's limits table says which rule applies
     from spur_cad.report.sheet import limit_rows
 
-    result = SimpleNamespace(tools=SimpleNamespace(recommendations=generating))
+    result = SimpleNamespace(tools=SimpleNamespace(recommendations=generating), setup=None)  # no set-up: on the table
     rows = {row.label: row.value for row in limit_rows(result)}
     assert rows["material roughing may leave above the root: as much as the finishing tool takes off in one generating "
                 "pass (1.000 mm: 0.5 x D 2 mm, a slot's depth)"] == "1.000"
