@@ -144,6 +144,16 @@ class SuggestedTopToolFacts:
 
 
 @dataclass(frozen=True)
+class FlankSuggestionFacts:
+    """Roughing by levels: roughing by flanks with the same tool and cutting data would save time (cam.plan
+    suggested_flank_roughing)."""
+
+    flank_time_s: float
+    levels_time_s: float
+    passes_per_space: int
+
+
+@dataclass(frozen=True)
 class RoughingFacts:
     """One roughing operation: its levels and its estimate (and two-stage roughing's bottom operation)."""
 
@@ -164,6 +174,7 @@ class RoughingFacts:
     flank_turns_deg: tuple[float, ...] = ()
     two_stage_declined: DeclinedTwoStageFacts | None = None
     two_stage_suggested: SuggestedTopToolFacts | None = None
+    flank_suggested: FlankSuggestionFacts | None = None
 
 
 @dataclass(frozen=True)

@@ -25,6 +25,7 @@ from spur_cad.result import (
     ErrorBudgetFacts,
     FeatureDeviation,
     FinishingFacts,
+    FlankSuggestionFacts,
     JobFacts,
     JobResult,
     LatheFacts,
@@ -191,6 +192,10 @@ def roughing_facts(plan: CamPlan, machine: Machine, simulation: SimResult | None
     if suggested is not None:
         facts = dataclasses.replace(facts, two_stage_suggested=SuggestedTopToolFacts(
             suggested.roughing_tool.diameter_mm, suggested.two_stage_time_s, suggested.bottom_tool_alone_time_s))
+    by_flanks = plan.flank_suggested
+    if by_flanks is not None:
+        facts = dataclasses.replace(facts, flank_suggested=FlankSuggestionFacts(
+            by_flanks.flank_time_s, by_flanks.levels_time_s, by_flanks.passes_per_space))
     if plan.roughing_bottom is None:
         return facts
     stage, bottom = plan.two_stage, plan.roughing_bottom
@@ -368,6 +373,12 @@ def roughing_json(roughing: RoughingFacts, measured: bool = True) -> dict:
             "top_tool_diameter_mm": suggested.top_tool_diameter_mm, "two_stage_time_s": suggested.two_stage_time_s,
             "roughing_tool_alone_time_s": suggested.roughing_tool_alone_time_s,
             "time_saved_s": suggested.roughing_tool_alone_time_s - suggested.two_stage_time_s}
+    by_flanks = roughing.flank_suggested
+    if by_flanks is not None:
+        facts["flank_suggested"] = {
+            "flank_time_s": by_flanks.flank_time_s, "levels_time_s": by_flanks.levels_time_s,
+            "passes_per_space": by_flanks.passes_per_space,
+            "time_saved_s": by_flanks.levels_time_s - by_flanks.flank_time_s}
     return facts
 
 

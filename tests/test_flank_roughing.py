@@ -46,6 +46,13 @@ def test_the_reference_gear_roughs_in_at_most_50_minutes_with_its_own_tool_and_c
     levels_min = levels.roughing.estimate.time_with_acceleration_s / 60.0
     assert flank_min <= 50.0, flank_min
     assert levels_min / flank_min >= 2.8, (levels_min, flank_min)
+    # the job as shipped (by levels) is told what roughing by flanks would take: the time of the job planned so
+    assert levels.flank_suggested is not None and plan.flank_suggested is None
+    assert levels.flank_suggested.flank_time_s == plan.roughing.estimate.time_with_acceleration_s
+    assert levels.flank_suggested.levels_time_s == levels.roughing.estimate.time_with_acceleration_s
+    assert levels.flank_suggested.passes_per_space == len(plan.roughing.flank.passes)
+    facts = roughing_json(roughing_facts(levels, Machine()), measured=False)["flank_suggested"]
+    assert facts["time_saved_s"] == pytest.approx(60.0 * (levels_min - flank_min))
 
 
 def test_the_measured_engagement_is_within_the_job_s_limits_and_the_feed_keeps_the_chip(reference):

@@ -14,6 +14,9 @@ finish by generation, which never plunges, so tools.plunge_allowance_mm is 0.5 x
 (CHANGED_ON_PURPOSE); their tools, programs and everything else are unchanged. Issue 30 added one key to the
 recorded summaries, `error_budget` after `grading` (the expected grade with the machine's error budget, from the
 [machine] accuracy keys' defaults): `grading` stays the ideal machine's, unchanged, and no other key changed.
+Issue 29's suggestions added `roughing.flank_suggested` to the reference gear's (it roughs by levels; what roughing
+by flanks with the same tool would take: the job planned with [roughing] strategy = "flank"); the helical gear gets
+none (not suggested for helical gears), and nothing else changed.
 
 Their STEP files and programs are byte-identical to that run's (SHA-256 below), but for the header's time
 (set to a fixed value before hashing; SOURCE_DATE_EPOCH sets it, tested below) and, in job.step, the order

@@ -47,4 +47,5 @@ def generating_pass_allowance(diameter_mm: float, largest: bool = False) -> Bott
     allowance = LAND_PASS_DEPTH_FRACTION * diameter_mm
     diameter = "the largest generating tool's D" if largest else "D"
     return BottomAllowance(allowance, f"the finishing tool takes off in one generating pass ({allowance:.3f} mm: "
-                                      f"{LAND_PASS_DEPTH_FRACTION:g} x {diameter} {diameter_mm:.4g} mm, a slot's depth)")
+                                      f"{LAND_PASS_DEPTH_FRACTION:g} x {diameter} {diameter_mm:.4g} mm, "
+                                      "a slot's depth)")

@@ -104,6 +104,16 @@ class FinishingPlan:
 
 
 @dataclass(frozen=True)
+class FlankSuggestion:
+    """Roughing by flanks instead of the job's levels, with the same tool and cutting data (times with the machine's
+    accelerations)."""
+
+    flank_time_s: float
+    levels_time_s: float
+    passes_per_space: int
+
+
+@dataclass(frozen=True)
 class TwoStage:
     """Two-stage roughing: where the bottom tool takes over and what it saves against that tool alone (times with
     the machine's accelerations)."""
@@ -135,6 +145,9 @@ class CamPlan:
     # roughing by flanks with one tool: two-stage roughing with a larger top tool the job does not give, when it would
     # save at least 1 - TWO_STAGE_PAYS_FRACTION of the time (its roughing_tool: the larger tool; suggested_top_tool)
     two_stage_suggested: TwoStage | None = None
+    # roughing by levels (a job file's default): roughing by flanks with the same tool and cutting data, when it would
+    # save at least 1 - TWO_STAGE_PAYS_FRACTION of the time (suggested_flank_roughing)
+    flank_suggested: FlankSuggestion | None = None
 
 
 @dataclass(frozen=True)
@@ -327,7 +340,7 @@ def plan_cam(inputs: CamInputs, checkpoint: Callable[[], None] | None = None) ->
     warnings.extend(small_tool_warnings(rec, inputs.machine.smallest_end_mill_mm, strategy.name,
                                         strategy.largest_tool(rec),
                                         inputs.finishing_tool.kind if inputs.finishing_tool is not None else None))
-    bottom = two_stage = declined = suggested = None
+    bottom = two_stage = declined = suggested = by_flanks = None
     if levels is not None and (inputs.bottom_tool is not None or inputs.top_tool is not None):
         check()
         roughing, bottom, two_stage, declined, notes = _plan_tool_pair(inputs, levels, blank)
@@ -338,11 +351,32 @@ def plan_cam(inputs: CamInputs, checkpoint: Callable[[], None] | None = None) ->
         warnings.extend(roughing.toolpath.warnings)
         check()
         suggested = suggested_top_tool(inputs, roughing, blank)
+        check()
+        by_flanks = suggested_flank_roughing(inputs, roughing, blank)
     if inputs.finishing_tool is not None:
         check()
         finishing = _plan_finishing(inputs, blank, check)
         warnings.extend(finishing.toolpath.warnings)
-    return CamPlan(rec, roughing, finishing, tuple(warnings), bottom, two_stage, declined, suggested)
+    return CamPlan(rec, roughing, finishing, tuple(warnings), bottom, two_stage, declined, suggested, by_flanks)
+
+
+def suggested_flank_roughing(inputs: CamInputs, roughing: RoughingPlan, blank: float) -> FlankSuggestion | None:
+    """Roughing by levels with one tool (a job file's default strategy): roughing by flanks with the same tool,
+    cutting data and allowances, when it takes at most TWO_STAGE_PAYS_FRACTION of `roughing`'s time and leaves
+    nothing uncut; else None. Not for helical gears (a flank plan of theirs takes seconds)."""
+    if inputs.roughing.strategy != "levels" or inputs.spec.is_helical:
+        return None
+    flank_inputs = dataclasses.replace(inputs, roughing=dataclasses.replace(inputs.roughing, strategy="flank"))
+    try:  # bounded as the job's own roughing would be
+        moves, driver = estimated_roughing_moves(inputs.spec, roughing.tool, flank_inputs.roughing, blank)
+        check_moves("roughing by flanks", moves, "roughing", driver)
+        flank = _plan_roughing(flank_inputs, roughing.levels, blank)
+    except SpurCadError:  # the flank strategy cannot rough this space with this tool: nothing to suggest
+        return None
+    if flank.flank is None or flank.flank.uncut_mm2 > UNCUT_MM2 \
+            or _seconds(flank) > TWO_STAGE_PAYS_FRACTION * _seconds(roughing):
+        return None
+    return FlankSuggestion(_seconds(flank), _seconds(roughing), len(flank.flank.passes))
 
 
 def suggested_top_tool(inputs: CamInputs, roughing: RoughingPlan, blank: float) -> TwoStage | None:

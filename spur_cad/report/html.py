@@ -120,6 +120,13 @@ def program_notes(result: JobResult) -> tuple[str, ...]:
                          f"({duration(suggested.roughing_tool_alone_time_s)} -> "
                          f"{duration(suggested.two_stage_time_s)}): name it [tools.roughing_top] (two-stage "
                          "roughing by flanks, the same cutting data).")
+        by_flanks = rough.flank_suggested
+        if by_flanks is not None:
+            notes.append(f"Roughing by flanks ([roughing] strategy = \"flank\", the same tool and cutting data, "
+                         f"{by_flanks.passes_per_space} passes per space) would take "
+                         f"{duration(by_flanks.flank_time_s)} instead of {duration(by_flanks.levels_time_s)} "
+                         "by levels, "
+                         f"{duration(by_flanks.levels_time_s - by_flanks.flank_time_s)} less.")
     if finish is not None:
         notes.append(finish.report_text)
     return tuple(notes)
