@@ -33,3 +33,17 @@ def test_the_flat_example_plans_what_the_readme_quotes():
     assert facts.step_downs == 11 and facts.arcs_per_loop == 1013
     assert round(facts.form_diameter_mm, 3) == 86.614 and round(facts.active_start_diameter_mm, 3) == 86.828
     assert round(facts.root_fillet_radius_mm, 3) == 1.151
+
+
+@pytest.mark.slow
+def test_the_modified_example_cuts_and_grades_what_the_readme_quotes():
+    """README: against the modified design the cut gouges at most 0.2 um and leaves at most 5.6 um, and the grading
+    reads the tip reliefs and the crowning within 0.4 um of designed, the profile slopes within 1.2 um."""
+    from spur_cad.pipeline import run_job
+
+    result = run_job(load_job(EXAMPLES / "modified_gear.toml"))
+    simulation = result.simulation
+    assert simulation.max_gouge_mm <= 0.0002 and simulation.max_leftover_mm <= 0.0056
+    for cut in result.grading.modifications_cut:
+        allowed = 1.2 if cut.symbol in ("f_Halpha", "f_Hbeta") else 0.4
+        assert abs(cut.cut_um - cut.designed_um) <= allowed, (cut.side, cut.symbol, cut.cut_um)
