@@ -19,7 +19,7 @@ from spur_cad.sim.flat import simulate_flat, simulate_flat_grid
 from spur_cad.sim.simulate import Cut, SimSettings
 from tests.test_three_axis import GOUGE_MM, SCALLOP_TARGET_MM, exact_outline
 from tests.test_three_axis_ring import ring_job
-from tests.test_three_axis_sim import circle_grid, flat, walked_centres
+from tests.test_three_axis_sim import circle_grid, deepest_row_deviations, flat, walked_centres
 
 SETTINGS = SimSettings(resolution_mm=0.005)
 
@@ -65,14 +65,8 @@ def deepest_row_check(result, finishing: Cut, labels: tuple[str, ...]):
     chosen = np.zeros(len(names), bool)
     for label in labels:
         chosen |= np.char.endswith(names, label)
-    tree = cKDTree(walked_centres(finishing.path))
-    simulated, independent = [], []
-    for k in range(grid.teeth):
-        clearance, _ = tree.query(grid.space_points(k)[chosen])
-        independent.append(clearance - finishing.tool.diameter_mm / 2.0)
-        simulated.append(result.deviation[k, chosen, -1])
-    radius = np.tile(np.hypot(*grid.points[chosen].T), grid.teeth)
-    return np.concatenate(simulated), np.concatenate(independent), radius
+    simulated, independent = deepest_row_deviations(result, finishing, chosen)
+    return simulated, independent, np.tile(np.hypot(*grid.points[chosen].T), grid.teeth)
 
 
 def test_the_ring_cut_is_within_the_scallop_target_inside_the_form_circle_the_tool_leaves(ring_cut):

@@ -95,23 +95,28 @@ def reference_plan():
     return root, blank, Cut(rough, roughing), Cut(finish, finishing), -np.array(levels)
 
 
+def deepest_row_deviations(result, finishing: Cut, chosen: np.ndarray):
+    """(simulated deviation, independent deviation) of the deepest row's design points `chosen` (a mask over one
+    space's points) in every space: the independent one is the design point's clearance from the walked tool centre
+    less the tool radius."""
+    tree = cKDTree(walked_centres(finishing.path))
+    simulated, independent = [], []
+    for k in range(result.grid.teeth):
+        clearance, _ = tree.query(result.grid.space_points(k)[chosen])
+        independent.append(clearance - finishing.tool.diameter_mm / 2.0)
+        simulated.append(result.deviation[k, chosen, -1])
+    return np.concatenate(simulated), np.concatenate(independent)
+
+
 def involute_check(result, finishing: Cut, lowest_radius_mm: float):
-    """(simulated deviation, independent deviation) of the deepest row's involute points above `lowest_radius_mm`
-    and 0.05 mm below the tip (at the tip's corner a gouge read along the normal is deeper than the distance into
-    the tool): the independent one is the design point's clearance from the walked tool centre less the tool
-    radius."""
+    """deepest_row_deviations of the involute points above `lowest_radius_mm` and 0.05 mm below the tip (at the
+    tip's corner a gouge read along the normal is deeper than the distance into the tool)."""
     grid = result.grid
     names = np.array(grid.feature_names())
     radius = np.hypot(*grid.points.T)
     involute = np.char.endswith(names.astype(str), "involute") & (radius >= lowest_radius_mm) \
         & (radius <= REFERENCE.tip_radius_mm - 0.05)
-    tree = cKDTree(walked_centres(finishing.path))
-    simulated, independent = [], []
-    for k in range(grid.teeth):
-        clearance, _ = tree.query(grid.space_points(k)[involute])
-        independent.append(clearance - finishing.tool.diameter_mm / 2.0)
-        simulated.append(result.deviation[k, involute, -1])
-    return np.concatenate(simulated), np.concatenate(independent)
+    return deepest_row_deviations(result, finishing, involute)
 
 
 def test_the_reference_gear_cut_lying_flat_measures_as_the_exact_outline_says(reference_plan):

@@ -290,25 +290,20 @@ def _flat_setup_rows(setup, gear) -> tuple[Row, ...]:
     """The set-up of the 3-axis variant ([machine] axes = 3): the blank lying flat, Z0 on its top face; a ring
     (its root outside its tip) clamped on its rim."""
     if gear.root_radius_mm > gear.tip_radius_mm:
-        return (
-            Row("machine", setup.machine_name),
-            Row("blank diameter (the rim's outside, not cut)", number(setup.blank_diameter_mm, 3), "mm"),
-            Row("blank thickness (faced to the face width)", number(gear.face_width_mm, 3), "mm"),
-            Row("work offset", f"{setup.work_offset}: X = 0 and Y = 0 on the ring's axis (the rim's centre), Z = 0 "
-                               "on the blank's top face"),
-            Row("tooth space 0", "its axis points to +Y"),
-            Row("gear axis", "machine Z: the ring clamped flat on its rim (outside the tip circle), relieved 0.5 mm "
-                             "under the hole (the programs mill the hole away through the face width)"),
-        )
+        blank, centre = "blank diameter (the rim's outside, not cut)", "the ring's axis (the rim's centre)"
+        axis = ("machine Z: the ring clamped flat on its rim (outside the tip circle), relieved 0.5 mm under the "
+                "hole (the programs mill the hole away through the face width)")
+    else:
+        blank, centre = "blank diameter", "the gear axis (the bore's centre)"
+        axis = ("machine Z: the blank clamped flat on its bore or a fixture, relieved 0.5 mm under the outline (the "
+                "programs cut through unless [three_axis] leaves tabs or a skin)")
     return (
         Row("machine", setup.machine_name),
-        Row("blank diameter", number(setup.blank_diameter_mm, 3), "mm"),
+        Row(blank, number(setup.blank_diameter_mm, 3), "mm"),
         Row("blank thickness (faced to the face width)", number(gear.face_width_mm, 3), "mm"),
-        Row("work offset", f"{setup.work_offset}: X = 0 and Y = 0 on the gear axis (the bore's centre), Z = 0 on "
-                           "the blank's top face"),
+        Row("work offset", f"{setup.work_offset}: X = 0 and Y = 0 on {centre}, Z = 0 on the blank's top face"),
         Row("tooth space 0", "its axis points to +Y"),
-        Row("gear axis", "machine Z: the blank clamped flat on its bore or a fixture, relieved 0.5 mm under the "
-                         "outline (the programs cut through unless [three_axis] leaves tabs or a skin)"),
+        Row("gear axis", axis),
     )
 
 
