@@ -564,3 +564,34 @@ def test_rs274_runs_the_smaller_corner_finishing_program(small_corner, tmp_path)
     ok, canon, messages = run_rs274(target)
     assert ok, messages
     assert_same_moves(canonical_moves(canon), path, 4, 4)
+
+
+@pytest.mark.parametrize("name, corner_fraction", [("reference_15_right", 1.0), ("z31_30_left_shifted", 0.5),
+                                                   ("z12_20_undercut", 0.3), ("z40_25pa_10", 1.0)])
+def test_the_work_bound_counts_the_passes_the_plan_places(name, corner_fraction):
+    """The move check counts a helical gear's passes without placing them (planned_passes_per_space): the count
+    is the plan's, with and without land passes, for corners of rho and smaller."""
+    from spur_cad.cam.strategies.generating_plan import GeneratingParams, plan_generating, planned_passes_per_space
+    from spur_cad.geometry.profile import rack_corner
+
+    job = _other_gear_job(name)
+    r_t = corner_fraction * job.gear.rack_tip_radius_mm
+    tool = dataclasses.replace(job.tools.finishing, corner_radius_mm=r_t,
+                               diameter_mm=1.8 * rack_corner(job.gear).normal_corner_offset_mm + 2.0 * r_t)
+    params = GeneratingParams(target_scallop_mm=job.finishing.target_scallop_mm)
+    for lands in (True, False):
+        planned = plan_generating(job.gear, tool, params, lands=lands)
+        assert planned_passes_per_space(job.gear, tool, params, lands=lands) == planned.passes_per_space
+        assert planned.land_passes_per_space > 0 or not lands
+
+
+def test_a_helical_job_places_its_flank_passes_once(monkeypatch):
+    """Planning the helical example places its flank passes (a bisection per pass) once, for the toolpath; the
+    work bound before it counts them (it placed them a second time before)."""
+    from spur_cad.cam.strategies import generating_helical
+
+    calls = []
+    placed = generating_helical._flank_passes
+    monkeypatch.setattr(generating_helical, "_flank_passes", lambda *args: calls.append(1) or placed(*args))
+    plan_cam(_job())
+    assert len(calls) == 1

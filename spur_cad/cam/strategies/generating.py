@@ -33,7 +33,12 @@ from spur_cad.cam.strategies.generating_geometry import (
     rough_passes_per_space,
 )
 from spur_cad.cam.strategies.generating_modified import modified_passes
-from spur_cad.cam.strategies.generating_plan import GeneratingParams, GeneratingPlan, plan_generating
+from spur_cad.cam.strategies.generating_plan import (
+    GeneratingParams,
+    GeneratingPlan,
+    plan_generating,
+    planned_passes_per_space,
+)
 from spur_cad.cam.tools import Tool, ToolError
 from spur_cad.geometry.modifications import FlankModifications
 from spur_cad.geometry.profile import rack_corner
@@ -124,8 +129,7 @@ class GeneratingStrategy:
     def estimate_moves(self, spec: GearSpec, tool: Tool, params: GeneratingParams) -> int:
         """Counted with the land passes (an upper bound when the blank is turned to the tip diameter), without
         the clamp rows (which are no motion)."""
-        plan = plan_generating(spec, tool, params, check=False)
-        return spec.teeth * MOVES_PER_PASS * plan.passes_per_space
+        return spec.teeth * MOVES_PER_PASS * planned_passes_per_space(spec, tool, params)
 
     def generate(self, spec: GearSpec, tool: Tool, machine: Machine, params: GeneratingParams,
                  blank_radius_mm: float, modifications: FlankModifications | None = None,

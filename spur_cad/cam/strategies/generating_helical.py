@@ -265,18 +265,24 @@ def _first_tip_step(spec: GearSpec, goal: float) -> float:
     return min(steps)
 
 
-def _flank_passes(spec: GearSpec, tool: Tool, target_mm: float, points: np.ndarray) -> list[tuple]:
-    """(mode, feature, roll, a rad, y0, z0, dy/dx, dz/dx, side) of both flanks' passes (right tip -> root, left
-    root -> tip)."""
+def _flank_rolls(spec: GearSpec, target_mm: float) -> tuple[tuple[int, Feature, np.ndarray], ...]:
+    """(side, feature, rolls) of both flanks' passes: right tip -> root, left root -> tip, evenly spaced over the
+    rolls any section sees."""
     involute = spec.tooth_space_profile().segment("involute")
     lo, hi = face_turn_range(spec)
     step = flank_roll_step(spec, target_mm)
+    return ((1, Feature.RIGHT_FLANK, _even(involute.start - hi, involute.end - lo, step)[::-1]),
+            (-1, Feature.LEFT_FLANK, _even(involute.start + lo, involute.end + hi, step)))
+
+
+def _flank_passes(spec: GearSpec, tool: Tool, target_mm: float, points: np.ndarray) -> list[tuple]:
+    """(mode, feature, roll, a rad, y0, z0, dy/dx, dz/dx, side) of both flanks' passes (right tip -> root, left
+    root -> tip)."""
     rb, alpha_t = spec.base_radius_mm, spec.pressure_angle_rad
-    theta_b = involute.base_angle_rad
+    theta_b = spec.tooth_space_profile().segment("involute").base_angle_rad
     radius = tool.diameter_mm / 2.0
     out = []
-    for side, feature, rolls in ((1, Feature.RIGHT_FLANK, _even(involute.start - hi, involute.end - lo, step)[::-1]),
-                                 (-1, Feature.LEFT_FLANK, _even(involute.start + lo, involute.end + hi, step))):
+    for side, feature, rolls in _flank_rolls(spec, target_mm):
         gamma = side * alpha_t
         sy, sz = pass_slopes(spec, gamma)
         for t in rolls:
@@ -468,6 +474,15 @@ def helical_passes(spec: GearSpec, tool: Tool, target_mm: float, blank_radius_mm
     return passes
 
 
+def helical_pass_count(spec: GearSpec, tool: Tool, target_mm: float, lands: bool) -> int:
+    """How many passes helical_passes plans for tooth space 0, counted without placing the flank passes' ends (a
+    bisection each) or checking them against the rack: what the work bound needs before anything is built."""
+    check_helical_generating_tool(spec, tool)
+    flank = sum(len(rolls) for _, _, rolls in _flank_rolls(spec, target_mm))
+    land = len(_land_passes(spec, tool, target_mm)) if lands else 0
+    return len(_tip_passes(spec, tool, target_mm)) + flank + land
+
+
 __all__ = ["check_helical_generating_tool", "face_turn_range", "flank_roll_step", "helical_passes",
-           "contact_roll_rad", "corner_contacts", "helical_passes_estimate", "pass_slopes",
+           "contact_roll_rad", "corner_contacts", "helical_pass_count", "helical_passes_estimate", "pass_slopes",
            "rack_clearance_mm", "rack_tooth_signed_distance_mm", "tip_roll_step", "tool_hull_points"]

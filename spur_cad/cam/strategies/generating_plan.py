@@ -38,6 +38,7 @@ from spur_cad.cam.strategies.generating_helical import (
     CORNER_MATCH_MM,
     face_turn_range,
     flank_roll_step,
+    helical_pass_count,
     helical_passes,
     helical_passes_estimate,
 )
@@ -175,14 +176,30 @@ def plan_generating(spec: GearSpec, tool: Tool, params: GeneratingParams, *, lan
                           flat_height, max(tip_leftover, land_leftover))
 
 
-def _plan_helical(spec: GearSpec, tool: Tool, params: GeneratingParams, lands: bool) -> GeneratingPlan:
-    """The helical gear's passes (spur_cad.cam.strategies.generating_helical) as a plan."""
-    target = params.target_scallop_mm
+def planned_passes_per_space(spec: GearSpec, tool: Tool, params: GeneratingParams, *, lands: bool = True) -> int:
+    """plan_generating(...).passes_per_space (without kink passes), refused as it would be; a helical gear's
+    passes are counted, not placed (their ends take a bisection each), so the work bound does not plan them twice."""
+    if not spec.is_helical:
+        return plan_generating(spec, tool, params, lands=lands, check=False).passes_per_space
+    params.validate()
+    check_generating_tool(spec, tool)
+    _check_helical_work(spec, tool, params.target_scallop_mm)
+    return helical_pass_count(spec, tool, params.target_scallop_mm, lands)
+
+
+def _check_helical_work(spec: GearSpec, tool: Tool, target: float) -> None:
+    """WorkLimitError when the closed-form count of a helical gear's passes exceeds MAX_PASSES_PER_SPACE."""
     rough = helical_passes_estimate(spec, target, tool)
     if rough > MAX_PASSES_PER_SPACE:
         raise WorkLimitError(f"generating finishing would need about {rough:.3g} passes per tooth space (limit "
                              f"{MAX_PASSES_PER_SPACE:,}) for target_scallop_mm = {target:.3g}; raise [finishing] "
                              "target_scallop_mm", field="target_scallop_mm", section="finishing")
+
+
+def _plan_helical(spec: GearSpec, tool: Tool, params: GeneratingParams, lands: bool) -> GeneratingPlan:
+    """The helical gear's passes (spur_cad.cam.strategies.generating_helical) as a plan."""
+    target = params.target_scallop_mm
+    _check_helical_work(spec, tool, target)
     lo, hi = face_turn_range(spec)
     rows = helical_passes(spec, tool, target, spec.tip_radius_mm + tool.diameter_mm, lands)
     rb = spec.base_radius_mm
