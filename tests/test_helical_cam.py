@@ -595,3 +595,56 @@ def test_a_helical_job_places_its_flank_passes_once(monkeypatch):
     monkeypatch.setattr(generating_helical, "_flank_passes", lambda *args: calls.append(1) or placed(*args))
     plan_cam(_job())
     assert len(calls) == 1
+
+
+@pytest.mark.parametrize("name", ["reference_15_right", "z31_30_left_shifted", "z12_20_undercut"])
+def test_the_pruned_searches_give_the_bits_of_searches_over_every_point(name):
+    """The flank passes' lowest ends drop hull points that can no longer decide a bisection step, and the tip
+    spacing's check drops fillet points already reached: both against the plain searches over every point
+    (written here): the ends within the bisections' own resolution, the check exactly."""
+    from spur_cad.cam.strategies import generating_helical as gh
+    from spur_cad.cam.tools import Tool
+    from spur_cad.geometry.profile import rack_corner
+    from spur_cad.geometry.sampling import sample_profile
+    from tests.test_helical import spec_of
+
+    spec = spec_of(name)
+    tool = Tool(diameter_mm=1.8 * rack_corner(spec).normal_corner_offset_mm + 2.0 * spec.rack_tip_radius_mm,
+                kind="bull_nose", corner_radius_mm=spec.rack_tip_radius_mm)
+    points = gh.tool_hull_points(tool, spec.tip_radius_mm - spec.root_radius_mm + 2.0 * tool.diameter_mm)
+    involute = spec.tooth_space_profile().segment("involute")
+    for side in (1, -1):
+        gamma = side * spec.pressure_angle_rad
+        sy, _ = gh.pass_slopes(spec, gamma)
+        for t in np.linspace(involute.start, involute.end, 5):
+            a = side * (involute.base_angle_rad + t)
+            y0 = -side * (spec.base_radius_mm * t + tool.diameter_mm / 2.0 * math.sqrt(1.0 + sy * sy))
+            pruned = gh._lowest_end(spec, points, a, a - gamma, y0, side, tool)
+            low, high = pruned - 1.0, pruned + 1.0  # the plain bisection, from a bracket of its own
+
+            def fits(z0, y0=y0, a=a, gamma=gamma):
+                return (gh.rack_clearance_mm(spec, points + np.array([0.0, y0, z0]), a, a - gamma)
+                        <= gh.CLEARANCE_TOLERANCE_MM)
+
+            assert fits(high) and not fits(low)
+            for _ in range(60):
+                mid = 0.5 * (low + high)
+                low, high = (low, mid) if fits(mid) else (mid, high)
+            assert abs(high - pruned) <= 1e-12, (high, pruned)  # both bisections end within 1e-13 mm
+    samples = sample_profile(spec.tooth_space_profile(), 1e-3 * spec.module_mm)
+    keep = np.isin(samples.label_names(), ["fillet", "root"])
+    fillet = samples.points[keep][:: max(1, int(keep.sum()) // 120)]
+    outline = gh._rack_tip_boundary(spec)
+    rolls = np.linspace(-0.3, 0.3, 25)
+    nearest = np.full(len(fillet), np.inf)
+    for phi in rolls:  # every point against every outline, as dense polylines' vertex-free segment distances
+        c, s = math.cos(-phi), math.sin(-phi)
+        moved = outline - np.array([spec.reference_radius_mm * phi, 0.0])
+        part = np.stack([moved[:, 0] * c - moved[:, 1] * s, moved[:, 0] * s + moved[:, 1] * c], axis=-1)
+        for p0, p1 in zip(part[:-1], part[1:]):
+            edge = p1 - p0
+            u = np.clip(((fillet - p0) @ edge) / (edge @ edge), 0.0, 1.0)
+            nearest = np.minimum(nearest, np.hypot(*(fillet - p0 - u[:, None] * edge).T))
+    worst = float(nearest.max())
+    assert gh._tip_rolls_within(spec, rolls, fillet, outline, worst * (1.0 + 1e-9))
+    assert not gh._tip_rolls_within(spec, rolls, fillet, outline, worst * (1.0 - 1e-9))

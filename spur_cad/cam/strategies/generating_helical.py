@@ -117,13 +117,18 @@ def tool_hull_points(tool: Tool, height_mm: float, around: int = 180, corner: in
 def rack_clearance_mm(spec: GearSpec, points: np.ndarray, a_rad: float, phi: float) -> float:
     """Largest signed distance of machine points (N, 3: X, Y, Z at A = a_rad) from the rack tooth at roll
     phi (<= 0: all inside the rack, which never enters the gear)."""
+    return float(rack_distances_mm(spec, points, a_rad, phi).max())
+
+
+def rack_distances_mm(spec: GearSpec, points: np.ndarray, a_rad: float, phi: float) -> np.ndarray:
+    """Signed distance of each machine point (N, 3: X, Y, Z at A = a_rad) from the rack tooth at roll phi."""
     turn = phi - a_rad  # the same part point with A = phi
     c, s = math.cos(turn), math.sin(turn)
     x, y, z = points[:, 0], points[:, 1] * c - points[:, 2] * s, points[:, 1] * s + points[:, 2] * c
     tan_h = spec.hand_sign * math.tan(spec.helix_angle_rad)
     axis_y = -spec.reference_radius_mm * phi - tan_h * x
     n = (y - axis_y) * math.cos(spec.helix_angle_rad)
-    return float(rack_tooth_signed_distance_mm(spec, n, z).max())
+    return rack_tooth_signed_distance_mm(spec, n, z)
 
 
 def check_helical_generating_tool(spec: GearSpec, tool: Tool) -> None:
@@ -179,20 +184,25 @@ def _rack_tip_boundary(spec: GearSpec, samples: int = 400) -> np.ndarray:
     return np.concatenate([line, round_])
 
 
-def _tip_leftover_mm(spec: GearSpec, rolls: np.ndarray, points: np.ndarray, outline: np.ndarray) -> float:
-    """Largest distance of fillet/root points from the nearest of the rack outlines at `rolls` (transverse)."""
-    best = np.full(len(points), np.inf)
+def _tip_rolls_within(spec: GearSpec, rolls: np.ndarray, points: np.ndarray, outline: np.ndarray,
+                      goal_mm: float) -> bool:
+    """Whether every fillet/root point lies within goal_mm of the nearest of the rack outlines at `rolls`
+    (transverse). A point once within is done (its nearest distance can only shrink), so each roll measures only
+    the points not reached yet."""
+    open_ = points
     r = spec.reference_radius_mm
     for phi in rolls:
         c, s = math.cos(-phi), math.sin(-phi)
         moved = outline - np.array([r * phi, 0.0])
         part = np.stack([moved[:, 0] * c - moved[:, 1] * s, moved[:, 0] * s + moved[:, 1] * c], axis=-1)
         a, edge = part[:-1], np.diff(part, axis=0)  # distance to the outline's segments, not its vertices
-        rel = points[:, None, :] - a[None, :, :]
+        rel = open_[:, None, :] - a[None, :, :]
         u = np.clip((rel * edge[None]).sum(axis=-1) / np.maximum((edge * edge).sum(axis=-1), 1e-300), 0.0, 1.0)
         d = np.hypot(*(rel - u[..., None] * edge[None]).transpose(2, 0, 1)).min(axis=1)
-        best = np.minimum(best, d)
-    return float(best.max())
+        open_ = open_[d > goal_mm]
+        if not len(open_):
+            return True
+    return False
 
 
 def tip_roll_step(spec: GearSpec, target_mm: float) -> float:
@@ -222,8 +232,8 @@ def tip_roll_step(spec: GearSpec, target_mm: float) -> float:
         rolls = np.arange(lo, hi + step, step)
         if len(rolls) > MAX_TIP_ROLLS:
             break
-        if all(_tip_leftover_mm(spec, rolls + phase * step, points, outline) <= goal for phase in (0.0, 0.25, 0.5,
-                                                                                                 0.75)):
+        if all(_tip_rolls_within(spec, rolls + phase * step, points, outline, goal) for phase in (0.0, 0.25, 0.5,
+                                                                                                0.75)):
             return step
         step *= 0.9
     raise WorkLimitError(f"generating finishing: no roll spacing above {step:.3g} rad keeps the fillet within "
@@ -324,9 +334,15 @@ def _lowest_end(spec: GearSpec, points: np.ndarray, a: float, phi: float, y0: fl
                         field="diameter_mm", section="tools.finishing")
     while fits(low):
         low -= span
+    active = points  # the hull points that may still decide a step
     for _ in range(48):
         mid = 0.5 * (low + high)
-        low, high = (low, mid) if fits(mid) else (mid, high)
+        distance = rack_distances_mm(spec, active + np.array([0.0, y0, mid]), a, phi)
+        low, high = (low, mid) if distance.max(initial=-math.inf) <= CLEARANCE_TOLERANCE_MM else (mid, high)
+        # Moving the tool by dz moves a point's signed distance by at most |dz| (a distance is 1-Lipschitz; twice
+        # that, and 1 nm, for safety): a point below the tolerance by more than that over the bracket left never
+        # decides a step again, so dropping it leaves every step, and the result, as they were.
+        active = active[distance + 2.0 * (high - low) + 1e-6 >= CLEARANCE_TOLERANCE_MM]
     return high
 
 
@@ -485,4 +501,5 @@ def helical_pass_count(spec: GearSpec, tool: Tool, target_mm: float, lands: bool
 
 __all__ = ["check_helical_generating_tool", "face_turn_range", "flank_roll_step", "helical_passes",
            "contact_roll_rad", "corner_contacts", "helical_pass_count", "helical_passes_estimate", "pass_slopes",
-           "rack_clearance_mm", "rack_tooth_signed_distance_mm", "tip_roll_step", "tool_hull_points"]
+           "rack_clearance_mm", "rack_distances_mm", "rack_tooth_signed_distance_mm", "tip_roll_step",
+           "tool_hull_points"]
