@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import csv
+import gc
 import json
 import math
 import os
@@ -161,6 +162,21 @@ def test_bad_job_gives_one_clear_line_and_writes_nothing(tmp_path, case):
     assert expected in result.stderr
     assert "Traceback" not in result.stderr and len(result.stderr.strip().splitlines()) == 1
     assert not out.exists()
+
+
+@pytest.mark.parametrize("enabled", [True, False])
+def test_a_run_gives_the_cycle_collector_back_as_it_found_it(tmp_path, enabled):
+    """The CLI pauses Python's cyclic garbage collector for a run (docs/benchmarks.md); called in-process, as
+    scripts may, it leaves the collector as it was, also when the run stops at bad input."""
+    bad = tmp_path / "bad.toml"
+    bad.write_text(BAD_JOBS["unknown key"][0])
+    was = gc.isenabled()
+    try:
+        gc.enable() if enabled else gc.disable()
+        assert main(["run", str(bad), "--out", str(tmp_path / "o")]) == 2
+        assert gc.isenabled() is enabled
+    finally:
+        gc.enable() if was else gc.disable()
 
 
 @pytest.mark.parametrize("epoch", ["yesterday", "-5", "1e9", "99999999999999"])
