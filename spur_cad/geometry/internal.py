@@ -24,11 +24,11 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.optimize import brentq
 
 from spur_cad.errors import GearSpecError
 from spur_cad.geometry.involute import inverse_involute_function, involute_function
 from spur_cad.geometry.profile import CircularArc, Involute, ToothSpaceProfile
+from spur_cad.geometry.roots import brentq
 from spur_cad.geometry.spec import MIN_TEETH, GearSpec, _range_check
 
 MIN_RIM_MODULES = 2.0

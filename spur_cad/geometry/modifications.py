@@ -27,10 +27,10 @@ import math
 from dataclasses import dataclass, replace
 
 import numpy as np
-from scipy.optimize import brentq
 
 from spur_cad.errors import GearSpecError
 from spur_cad.geometry.profile import CircularArc, Segment, ToothSpaceProfile
+from spur_cad.geometry.roots import brentq
 from spur_cad.geometry.sampling import ProfileSamples, sample_profile, segment_parameters
 
 SIDES = ("right", "left")

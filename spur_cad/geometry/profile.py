@@ -26,10 +26,10 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
 import numpy as np
-from scipy.optimize import brentq, minimize_scalar
 
 from spur_cad.errors import GearSpecError
 from spur_cad.geometry.involute import involute_function
+from spur_cad.geometry.roots import brentq, minimize_bounded
 
 if TYPE_CHECKING:  # annotations only: spec.py builds profiles with this module (no import loop)
     from spur_cad.geometry.spec import GearSpec
@@ -495,8 +495,7 @@ def _undercut_junction(fillet: Fillet, rb: float, theta_b: float,
         candidates = grid[: i + 2][finite]
         best = candidates[int(np.argmin([neg_depth(b) for b in candidates]))]
         step = grid[1] - grid[0]
-        res = minimize_scalar(neg_depth, bounds=(max(best - step, candidates[0]), min(best + step, beta_j)),
-                              method="bounded", options={"xatol": 1e-12})
+        res = minimize_bounded(neg_depth, max(best - step, candidates[0]), min(best + step, beta_j), xatol=1e-12)
         depth = max(0.0, -float(res.fun), -neg_depth(best))
     return beta_j, t_j, depth
 

@@ -5,7 +5,8 @@ and helical generating passes."""
 from __future__ import annotations
 
 import numpy as np
-from scipy.optimize import brentq
+
+from spur_cad.geometry.roots import brentq
 
 
 def flat_deviation_mm(base_radius_mm: float, t_i: float, t: np.ndarray | float) -> np.ndarray | float:

@@ -95,7 +95,6 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.optimize import brentq
 
 from spur_cad.cam.contacts import tool_signed_distance
 from spur_cad.cam.ir import Feature
@@ -104,6 +103,7 @@ from spur_cad.cam.strategies.generating_helical import check_helical_generating_
 from spur_cad.cam.tools import Tool, ToolError
 from spur_cad.geometry.frames import turn_points
 from spur_cad.geometry.profile import rack_corner
+from spur_cad.geometry.roots import brentq
 from spur_cad.geometry.sampling import full_space_points, sample_profile
 from spur_cad.geometry.spec import GearSpec
 
