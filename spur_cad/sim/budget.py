@@ -143,7 +143,9 @@ def apply_budget(grid, deviation: np.ndarray, budget: ErrorBudget) -> tuple[np.n
     lever_mm = p[:, 0] * n[:, 1] - p[:, 1] * n[:, 0]  # p x n: the normal motion per radian of turn (r_b on flanks)
     change = -(total * ARCSEC_RAD)[:, None] * lever_mm[None, :] + shifts["total"] / 1000.0
     moved = np.array(deviation, dtype=float, copy=True)
-    moved[:, mask, :] += change[:, :, None]
+    flank = np.flatnonzero(mask)
+    for space in range(len(moved)):  # a space at a time: no temporary the size of the whole gear's deviations
+        moved[space, flank, :] += change[space, :, None]
     terms = BudgetTerms(source, RANDOM_SEED, tuple(round(float(a), 6) for a in a_deg),
                         tuple(round(float(e), 3) for e in systematic), tuple(round(float(e), 3) for e in random),
                         tuple(round(float(e), 3) for e in total), {k: round(v, 3) for k, v in shifts.items()})
