@@ -68,9 +68,19 @@ def big_gear_job(teeth: int, module_mm: float, face_width_mm: float, rack_tip_ra
 BIG_GEARS = {"z120_m1_b10": (120, 1.0, 10.0, 0.25, 0.3), "z200_m3_b30": (200, 3.0, 30.0, 0.6, 0.5)}
 
 
+def compile_bytecode() -> None:
+    """spur_cad's modules compiled to bytecode (__pycache__), as pip does when it installs a wheel: a machine
+    that sets PYTHONDONTWRITEBYTECODE (as this one's CI does) would otherwise compile every module in every
+    measured run (0.1 s)."""
+    import compileall
+
+    compileall.compile_dir(str(ROOT / "spur_cad"), quiet=1)
+
+
 def figures(runs: int) -> dict:
     """Medians of `runs` fresh runs: the bare import floor, the reference job (simulation on and off), the
     helical example and the two big gears of issue 27."""
+    compile_bytecode()
     with tempfile.TemporaryDirectory(prefix="spur_cad_bench_run_") as tmp:
         folder = Path(tmp)
         no_simulation = folder / "reference_no_simulation.toml"
