@@ -35,6 +35,12 @@ def figure_for_extent(width_in: float, x_range: float, y_range: float, margins_i
                   top=1.0 - top / height_in)
 
 
+def set_title(ax, text: str, fontsize: float) -> None:
+    """The axes' title at matplotlib's default place above the plot, fixed there: left automatic, every draw
+    measures the y axis's tick labels again to dodge a top axis or offset text that these plots do not have."""
+    ax.set_title(text, fontsize=fontsize, y=1.0)
+
+
 def _png(fig: Figure) -> bytes:
     """The figure as PNG bytes at 120 dpi (zlib level 1: the plots' flat colours compress nearly as well, in a
     fraction of the default level's time)."""
@@ -108,7 +114,7 @@ def tooth_space_png(spec: GearSpec, samples: ProfileSamples, modified_flanks: di
     title = (f"z={spec.teeth}  m={spec.module_mm:g}  alpha={spec.pressure_angle_deg:g} deg  "
              f"x={spec.profile_shift_coefficient:g}"
              f"  rho={spec.rack_tip_radius_mm:g} mm" + ("  UNDERCUT" if profile.undercut else ""))
-    ax.set_title(title, fontsize=9)
+    set_title(ax, title, 9)
     ax.legend(loc="lower center", fontsize=8, ncols=4)  # below the root: the tip circle stays visible
     ax.grid(True, lw=0.3)
     return _png(fig)
