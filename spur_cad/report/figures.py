@@ -3,6 +3,7 @@ cutter locations, the simulated deviation map, the roughing engagement, the flan
 
 from __future__ import annotations
 
+import itertools
 import math
 from typing import TYPE_CHECKING
 
@@ -235,8 +236,8 @@ def k_chart_figure(spec: GearSpec, grading: Grading, lying_flat: bool = False) -
                 label = f"{row_name} = {trace.x_mm:.2f} mm" if trace.x_mm is not None else "reference circle"
                 design = 0.0 if trace.design_um is None else trace.design_um
                 ax.plot(trace.position_mm, trace.deviation_um + design, style, lw=1.1, label=label)
-                for edge in trace.evaluation:
-                    ax.axvline(edge, color="k", lw=0.5, ls=":")
+            for edge in sorted({edge for trace in chosen for edge in trace.evaluation}):  # each range edge once
+                ax.axvline(edge, color="k", lw=0.5, ls=":")
             if chosen and chosen[0].design_um is not None:  # a modified flank: the design trace, the band about it
                 _design_trace(ax, chosen[0], band)
             elif chosen:
@@ -321,11 +322,13 @@ def passes_png(spec: GearSpec, tool: Tool, passes: tuple, blank_radius_mm: float
     ax.plot(outline[:, 0], outline[:, 1], "-", color="k", lw=1.2, label="design")
     ax.plot(neighbour[:, 0], neighbour[:, 1], "-", color="0.4", lw=0.8)
     ax.plot(blank_radius_mm * np.sin(span), blank_radius_mm * np.cos(span), ":", color="0.5", lw=1, label="blank")
+    gap = np.full((1, 2), np.nan)  # a line broken between tools: one line per run of passes of a kind, in order
     labelled = set()
-    for p, shape in zip(passes, shapes):
-        label = None if p.mode in labelled else f"{p.mode} passes"
-        labelled.add(p.mode)
-        ax.plot(shape[:, 0], shape[:, 1], "-", color=_PASS_COLOURS.get(p.mode, "0.6"), lw=0.4, label=label)
+    for mode, run in itertools.groupby(zip(passes, shapes), key=lambda pass_shape: pass_shape[0].mode):
+        joined = np.concatenate([part for _, shape in run for part in (shape, gap)])
+        label = None if mode in labelled else f"{mode} passes"
+        labelled.add(mode)
+        ax.plot(joined[:, 0], joined[:, 1], "-", color=_PASS_COLOURS.get(mode, "0.6"), lw=0.4, label=label)
     ax.plot(contacts[:, 0], contacts[:, 1], ".", ms=4, color="tab:red", label="contacts")
     ax.set_aspect("equal")
     ax.set_xlabel("part Y [mm] (space 0, A = 0)")
