@@ -236,8 +236,8 @@ def k_chart_figure(spec: GearSpec, grading: Grading, lying_flat: bool = False) -
                 label = f"{row_name} = {trace.x_mm:.2f} mm" if trace.x_mm is not None else "reference circle"
                 design = 0.0 if trace.design_um is None else trace.design_um
                 ax.plot(trace.position_mm, trace.deviation_um + design, style, lw=1.1, label=label)
-            for edge in sorted({edge for trace in chosen for edge in trace.evaluation}):  # each range edge once
-                ax.axvline(edge, color="k", lw=0.5, ls=":")
+                for edge in trace.evaluation:
+                    ax.axvline(edge, color="k", lw=0.5, ls=":")
             if chosen and chosen[0].design_um is not None:  # a modified flank: the design trace, the band about it
                 _design_trace(ax, chosen[0], band)
             elif chosen:
