@@ -58,8 +58,10 @@ def roughing_levels_png(spec: GearSpec, heights_mm: np.ndarray, half_widths_mm: 
     both ends of the lowest level."""
     fig, ax = _space_axes(spec, blank_radius_mm)
     radius = tool.diameter_mm / 2.0
-    for i, (h, w) in enumerate(zip(heights_mm, half_widths_mm)):
-        ax.plot([-w, w], [h, h], "-", color="tab:orange", lw=1.2, label="levels (tool edge reach)" if i == 0 else None)
+    gap = np.full(len(heights_mm), np.nan)  # one line broken between the levels, not a line per level
+    ax.plot(np.column_stack([-half_widths_mm, half_widths_mm, gap]).ravel(),
+            np.column_stack([heights_mm, heights_mm, gap]).ravel(), "-", color="tab:orange", lw=1.2,
+            label="levels (tool edge reach)")
     h, w = heights_mm[-1], half_widths_mm[-1]
     for centre in (-(w - radius), w - radius):
         ax.add_patch(_rectangle(centre - radius, h, tool.diameter_mm, 2.5 * tool.diameter_mm))
