@@ -75,14 +75,19 @@ def roughing_flank_png(spec: GearSpec, plan: FlankPlan, tool: Tool, blank_radius
     fig, ax = _space_axes(spec, blank_radius_mm)
     radius = tool.diameter_mm / 2.0
     colours = ("tab:blue", "tab:orange", "tab:green", "tab:red", "tab:purple", "tab:brown", "tab:pink", "tab:olive")
-    for p in plan.passes:
-        corners = np.array([[p.y_mm - radius, p.z_mm], [p.y_mm + radius, p.z_mm],
-                            [p.y_mm + radius, p.z_mm + p.axial_depth_mm], [p.y_mm - radius, p.z_mm + p.axial_depth_mm],
-                            [p.y_mm - radius, p.z_mm]])
-        turn = math.radians(p.turn_deg)  # the machine frame turned back into the space's: R(-turn)
-        c, s = math.cos(turn), math.sin(turn)
-        ax.plot(c * corners[:, 0] + s * corners[:, 1], -s * corners[:, 0] + c * corners[:, 1], "-", lw=0.7,
-                color=colours[p.run % len(colours)])
+    gap = np.full((1, 2), np.nan)  # a line broken between tools: one line per run, not one per pass
+    for run, passes in itertools.groupby(plan.passes, key=lambda p: p.run):
+        drawn = []
+        for p in passes:
+            corners = np.array([[p.y_mm - radius, p.z_mm], [p.y_mm + radius, p.z_mm],
+                                [p.y_mm + radius, p.z_mm + p.axial_depth_mm],
+                                [p.y_mm - radius, p.z_mm + p.axial_depth_mm], [p.y_mm - radius, p.z_mm]])
+            turn = math.radians(p.turn_deg)  # the machine frame turned back into the space's: R(-turn)
+            c, s = math.cos(turn), math.sin(turn)
+            drawn += [np.column_stack([c * corners[:, 0] + s * corners[:, 1], -s * corners[:, 0] + c * corners[:, 1]]),
+                      gap]
+        joined = np.concatenate(drawn)
+        ax.plot(joined[:, 0], joined[:, 1], "-", lw=0.7, color=colours[run % len(colours)])
     turns = ", ".join(f"{abs(s.turn_deg):.1f}" for s in plan.segments)
     return _space_png(fig, ax, spec, blank_radius_mm,
                       f"roughing by flanks: {len(plan.passes)} passes per space, A turned +-({turns}) deg, flat end "
@@ -132,8 +137,9 @@ def finishing_png(spec: GearSpec, tool: Tool, y: np.ndarray, z: np.ndarray, a_de
     ax.plot(outline[:, 0], outline[:, 1], "-", color="k", lw=1.2, label="design")
     ax.plot(tips[:, 0], tips[:, 1], ".", ms=2, color="tab:blue", label="cutter locations (tip centre)")
     ax.plot(contacts[:, 0], contacts[:, 1], ".", ms=3, color="tab:red", label="contact points")
-    for shape in shapes:
-        ax.plot(shape[:, 0], shape[:, 1], "-", color="0.6", lw=0.5)
+    if shapes:  # one line broken between the tools, not a line per tool
+        joined = np.concatenate([part for shape in shapes for part in (shape, np.full((1, 2), np.nan))])
+        ax.plot(joined[:, 0], joined[:, 1], "-", color="0.6", lw=0.5)
     ax.set_aspect("equal")
     ax.set_xlabel("part Y [mm] (space 0, A = 0)")
     ax.set_ylabel("part Z [mm]")
