@@ -3,6 +3,7 @@ cutter locations, the simulated deviation map, the roughing engagement, the flan
 
 from __future__ import annotations
 
+import itertools
 import math
 from typing import TYPE_CHECKING
 
@@ -10,7 +11,7 @@ import numpy as np
 
 from spur_cad.geometry.sampling import full_space_points, sample_profile
 from spur_cad.geometry.spec import GearSpec
-from spur_cad.report.plots import _png, figure, figure_for_extent
+from spur_cad.report.plots import _png, figure, figure_for_extent, set_title
 
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
@@ -45,7 +46,7 @@ def _space_png(fig, ax, spec: GearSpec, blank_radius_mm: float, title: str) -> b
     ax.set_xlabel("Y [mm] (space axis up)")
     ax.set_ylabel("Z [mm]")
     ax.set_ylim(spec.root_radius_mm - 0.5, blank_radius_mm + 1.0)
-    ax.set_title(title, fontsize=9)
+    set_title(ax, title, 9)
     ax.legend(fontsize=8, loc="lower right")
     ax.grid(True, lw=0.3)
     return _png(fig)
@@ -57,8 +58,10 @@ def roughing_levels_png(spec: GearSpec, heights_mm: np.ndarray, half_widths_mm: 
     both ends of the lowest level."""
     fig, ax = _space_axes(spec, blank_radius_mm)
     radius = tool.diameter_mm / 2.0
-    for i, (h, w) in enumerate(zip(heights_mm, half_widths_mm)):
-        ax.plot([-w, w], [h, h], "-", color="tab:orange", lw=1.2, label="levels (tool edge reach)" if i == 0 else None)
+    gap = np.full(len(heights_mm), np.nan)  # one line broken between the levels, not a line per level
+    ax.plot(np.column_stack([-half_widths_mm, half_widths_mm, gap]).ravel(),
+            np.column_stack([heights_mm, heights_mm, gap]).ravel(), "-", color="tab:orange", lw=1.2,
+            label="levels (tool edge reach)")
     h, w = heights_mm[-1], half_widths_mm[-1]
     for centre in (-(w - radius), w - radius):
         ax.add_patch(_rectangle(centre - radius, h, tool.diameter_mm, 2.5 * tool.diameter_mm))
@@ -72,14 +75,19 @@ def roughing_flank_png(spec: GearSpec, plan: FlankPlan, tool: Tool, blank_radius
     fig, ax = _space_axes(spec, blank_radius_mm)
     radius = tool.diameter_mm / 2.0
     colours = ("tab:blue", "tab:orange", "tab:green", "tab:red", "tab:purple", "tab:brown", "tab:pink", "tab:olive")
-    for p in plan.passes:
-        corners = np.array([[p.y_mm - radius, p.z_mm], [p.y_mm + radius, p.z_mm],
-                            [p.y_mm + radius, p.z_mm + p.axial_depth_mm], [p.y_mm - radius, p.z_mm + p.axial_depth_mm],
-                            [p.y_mm - radius, p.z_mm]])
-        turn = math.radians(p.turn_deg)  # the machine frame turned back into the space's: R(-turn)
-        c, s = math.cos(turn), math.sin(turn)
-        ax.plot(c * corners[:, 0] + s * corners[:, 1], -s * corners[:, 0] + c * corners[:, 1], "-", lw=0.7,
-                color=colours[p.run % len(colours)])
+    gap = np.full((1, 2), np.nan)  # a line broken between tools: one line per run, not one per pass
+    for run, passes in itertools.groupby(plan.passes, key=lambda p: p.run):
+        drawn = []
+        for p in passes:
+            corners = np.array([[p.y_mm - radius, p.z_mm], [p.y_mm + radius, p.z_mm],
+                                [p.y_mm + radius, p.z_mm + p.axial_depth_mm],
+                                [p.y_mm - radius, p.z_mm + p.axial_depth_mm], [p.y_mm - radius, p.z_mm]])
+            turn = math.radians(p.turn_deg)  # the machine frame turned back into the space's: R(-turn)
+            c, s = math.cos(turn), math.sin(turn)
+            drawn += [np.column_stack([c * corners[:, 0] + s * corners[:, 1], -s * corners[:, 0] + c * corners[:, 1]]),
+                      gap]
+        joined = np.concatenate(drawn)
+        ax.plot(joined[:, 0], joined[:, 1], "-", lw=0.7, color=colours[run % len(colours)])
     turns = ", ".join(f"{abs(s.turn_deg):.1f}" for s in plan.segments)
     return _space_png(fig, ax, spec, blank_radius_mm,
                       f"roughing by flanks: {len(plan.passes)} passes per space, A turned +-({turns}) deg, flat end "
@@ -129,15 +137,16 @@ def finishing_png(spec: GearSpec, tool: Tool, y: np.ndarray, z: np.ndarray, a_de
     ax.plot(outline[:, 0], outline[:, 1], "-", color="k", lw=1.2, label="design")
     ax.plot(tips[:, 0], tips[:, 1], ".", ms=2, color="tab:blue", label="cutter locations (tip centre)")
     ax.plot(contacts[:, 0], contacts[:, 1], ".", ms=3, color="tab:red", label="contact points")
-    for shape in shapes:
-        ax.plot(shape[:, 0], shape[:, 1], "-", color="0.6", lw=0.5)
+    if shapes:  # one line broken between the tools, not a line per tool
+        joined = np.concatenate([part for shape in shapes for part in (shape, np.full((1, 2), np.nan))])
+        ax.plot(joined[:, 0], joined[:, 1], "-", color="0.6", lw=0.5)
     ax.set_aspect("equal")
     ax.set_xlabel("part Y [mm] (space 0, A = 0)")
     ax.set_ylabel("part Z [mm]")
     ax.set_xlim(x_low, x_high)
     ax.set_ylim(y_low, y_high)
-    ax.set_title(f"finishing: {len(y)} poses per space, {tool.kind} D {tool.diameter_mm:g} mm r {r_t:g} mm "
-                 f"(every {every}th tool drawn)", fontsize=9)
+    set_title(ax, f"finishing: {len(y)} poses per space, {tool.kind} D {tool.diameter_mm:g} mm r {r_t:g} mm "
+              f"(every {every}th tool drawn)", 9)
     ax.legend(fontsize=8, loc="lower right")
     ax.grid(True, lw=0.3)
     return _png(fig)
@@ -176,16 +185,24 @@ def deviation_map_png(result: SimResult, lying_flat: bool = False) -> bytes:
                         xytext=(-2, -2), textcoords="offset points")
     ax.set_xlabel("position along the tooth space, right tooth centre -> root -> left tooth centre [mm]")
     ax.set_ylabel(row_axis_label(lying_flat)[1])
-    ax.set_title(f"simulated deviation of tooth space {worst} (largest |deviation|); resolution "
-                 f"{1000 * result.settings.resolution_mm:g} \u00b5m", fontsize=9)
+    set_title(ax, f"simulated deviation of tooth space {worst} (largest |deviation|); resolution "
+              f"{1000 * result.settings.resolution_mm:g} \u00b5m", 9)
     spaces = np.arange(deviation.shape[0])
-    bars.bar(spaces - 0.2, np.maximum(most, 0.0), width=0.4, color="tab:red", label="max leftover")
-    bars.bar(spaces + 0.2, np.maximum(-least, 0.0), width=0.4, color="tab:blue", label="max gouge")
+    _bars(bars, spaces - 0.4, np.maximum(most, 0.0), 0.4, "tab:red", "max leftover")
+    _bars(bars, spaces, np.maximum(-least, 0.0), 0.4, "tab:blue", "max gouge")
     bars.set_xlabel("tooth space")
     bars.set_ylabel("[\u00b5m]")
     bars.legend(fontsize=8, loc="lower right", bbox_to_anchor=(1.0, 1.0), ncols=2, frameon=False)  # above the bars
     bars.grid(True, lw=0.3, axis="y")
     return _png(fig)
+
+
+def _bars(ax, left: np.ndarray, heights: np.ndarray, width: float, colour: str, label: str) -> None:
+    """Bars from `left` (ascending, apart by more than `width`) up from 0 drawn as one filled step outline (zero
+    between the bars): it looks as `ax.bar` does, without an artist per bar to make and draw."""
+    edges = np.column_stack([left, left + width]).ravel()
+    values = np.column_stack([heights, np.zeros_like(heights)]).ravel()[:-1]
+    ax.stairs(values, edges, fill=True, color=colour, label=label)
 
 
 def k_chart_png(spec: GearSpec, grading: Grading, lying_flat: bool = False) -> bytes:
@@ -237,8 +254,8 @@ def k_chart_figure(spec: GearSpec, grading: Grading, lying_flat: bool = False) -
                     ax.axhline(edge, color="tab:red", lw=0.6, ls="--", gid="tolerance band")
             if chosen:
                 _clip_outside_evaluation(ax, chosen, band)
-            ax.set_title(f"space {worst}, {side} flank: {kind} (band: class {grade} "
-                         f"{'F_aT' if kind == 'profile' else 'F_bT'} = {band:g} \u00b5m)", fontsize=8)
+            set_title(ax, f"space {worst}, {side} flank: {kind} (band: class {grade} "
+                      f"{'F_aT' if kind == 'profile' else 'F_bT'} = {band:g} \u00b5m)", 8)
             ax.set_xlabel(profile_label if kind == "profile" else row_label, fontsize=8)
             ax.set_ylabel("deviation [\u00b5m] (+ material)", fontsize=8)
             ax.grid(True, lw=0.3)
@@ -313,11 +330,13 @@ def passes_png(spec: GearSpec, tool: Tool, passes: tuple, blank_radius_mm: float
     ax.plot(outline[:, 0], outline[:, 1], "-", color="k", lw=1.2, label="design")
     ax.plot(neighbour[:, 0], neighbour[:, 1], "-", color="0.4", lw=0.8)
     ax.plot(blank_radius_mm * np.sin(span), blank_radius_mm * np.cos(span), ":", color="0.5", lw=1, label="blank")
+    gap = np.full((1, 2), np.nan)  # a line broken between tools: one line per run of passes of a kind, in order
     labelled = set()
-    for p, shape in zip(passes, shapes):
-        label = None if p.mode in labelled else f"{p.mode} passes"
-        labelled.add(p.mode)
-        ax.plot(shape[:, 0], shape[:, 1], "-", color=_PASS_COLOURS.get(p.mode, "0.6"), lw=0.4, label=label)
+    for mode, run in itertools.groupby(zip(passes, shapes), key=lambda pass_shape: pass_shape[0].mode):
+        joined = np.concatenate([part for _, shape in run for part in (shape, gap)])
+        label = None if mode in labelled else f"{mode} passes"
+        labelled.add(mode)
+        ax.plot(joined[:, 0], joined[:, 1], "-", color=_PASS_COLOURS.get(mode, "0.6"), lw=0.4, label=label)
     ax.plot(contacts[:, 0], contacts[:, 1], ".", ms=4, color="tab:red", label="contacts")
     ax.set_aspect("equal")
     ax.set_xlabel("part Y [mm] (space 0, A = 0)")
@@ -325,8 +344,8 @@ def passes_png(spec: GearSpec, tool: Tool, passes: tuple, blank_radius_mm: float
     ax.set_xlim(x_low, x_high)
     ax.set_ylim(y_low, y_high)
     counts = {mode: sum(1 for p in passes if p.mode == mode) for mode in _PASS_COLOURS}
-    ax.set_title(f"finishing passes of one tooth space: {len(passes)} ({counts['flank']} flank, {counts['tip']} fillet "
-                 f"and root, {counts['land']} land), {tool.kind} D {tool.diameter_mm:g} mm r {r_t:g} mm", fontsize=9)
+    set_title(ax, f"finishing passes of one tooth space: {len(passes)} ({counts['flank']} flank, {counts['tip']} "
+              f"fillet and root, {counts['land']} land), {tool.kind} D {tool.diameter_mm:g} mm r {r_t:g} mm", 9)
     ax.legend(fontsize=8, loc="best")
     ax.grid(True, lw=0.3)
     return _png(fig)
@@ -347,8 +366,11 @@ def engagement_png(engagement: Engagement, step_over_fraction: float, max_depth_
         ax = fig.add_subplot(1, 2, col + 1)
         top = max(1.0, float(value[cutting].max(initial=0.0)), limit)
         bins = (np.arange(math.ceil(top / 0.025) + 2) - 0.5) * 0.025  # bins centred on 0, 0.025, ..., 1 D
-        ax.hist([value[cutting & (operation == name)] for name in names], bins=bins, stacked=True,
-                label=names, color=["tab:blue", "tab:orange"][:len(names)])
+        stacked = np.zeros(len(bins) - 1)
+        for name, colour in zip(names, ("tab:blue", "tab:orange")):  # one filled outline per operation, stacked
+            counts = np.histogram(value[cutting & (operation == name)], bins)[0]
+            ax.stairs(stacked + counts, bins, baseline=stacked, fill=True, color=colour, label=name)
+            stacked = stacked + counts
         ax.axvline(limit, color="tab:red", lw=1.0, ls="--", label="limit")
         if col == 1 and slot_depth_fraction is not None:
             ax.axvline(slot_depth_fraction, color="0.4", lw=1.0, ls=":", label="wider only up to here")
