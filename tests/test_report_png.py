@@ -1,5 +1,5 @@
-"""The report figures' PNG writer (spur_cad.report.plots.png_bytes): what Pillow reads back is the drawn image, pixel
-for pixel, at the figures' resolution."""
+"""The report figures' PNGs (spur_cad.report.plots.png_bytes, the canvas's pixels saved by Pillow): what Pillow reads
+back is the drawn image, pixel for pixel, at the figures' resolution."""
 
 from __future__ import annotations
 

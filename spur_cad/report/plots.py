@@ -2,8 +2,7 @@
 
 from __future__ import annotations
 
-import struct
-import zlib
+import io
 
 import numpy as np
 from matplotlib.backends.backend_agg import FigureCanvasAgg
@@ -56,20 +55,14 @@ def _png(fig: Figure) -> bytes:
 
 
 def png_bytes(rgb: np.ndarray, dpi: float) -> bytes:
-    """An opaque image (height x width x 3, uint8) as PNG: rows unfiltered, zlib level 3. A plot's flat colours
-    compress about as well so (a little smaller than Pillow's level 1), and Pillow's per-row choice of filter cost
-    more than the compression (matplotlib's savefig spent about 15 ms a figure in it)."""
-    height, width, _ = rgb.shape
-    rows = np.zeros((height, 1 + 3 * width), np.uint8)  # each row: its filter type (0, none), then its pixels
-    rows[:, 1:] = rgb.reshape(height, 3 * width)
-    per_metre = round(dpi / 0.0254)
+    """An opaque image (height x width x 3, uint8) as PNG by Pillow at zlib level 1: three channels, not
+    savefig's four (a plot has no transparency), which Pillow filters and compresses in 35 ms instead of 42 for a
+    large figure."""
+    from PIL import Image
 
-    def chunk(kind: bytes, data: bytes) -> bytes:
-        return struct.pack(">I", len(data)) + kind + data + struct.pack(">I", zlib.crc32(kind + data))
-
-    return (b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", struct.pack(">IIBBBBB", width, height, 8, 2, 0, 0, 0))
-            + chunk(b"pHYs", struct.pack(">IIB", per_metre, per_metre, 1))
-            + chunk(b"IDAT", zlib.compress(rows.tobytes(), 3)) + chunk(b"IEND", b""))
+    buffer = io.BytesIO()
+    Image.fromarray(np.ascontiguousarray(rgb), "RGB").save(buffer, "PNG", compress_level=1, dpi=(dpi, dpi))
+    return buffer.getvalue()
 
 
 MODIFIED_COLOUR = "#ff7f0e"
