@@ -71,3 +71,56 @@ def test_the_rotary_axis_limits_a_pure_a_move():
     result = estimate(path_of((0.0, 0.0, 10.0, 90.0)), MACHINE)
     assert result.time_s == pytest.approx(1.5)  # 90 deg at 60 deg/s
     assert result.time_with_acceleration_s == pytest.approx(trapezoid(90.0, 60.0, 1500.0))
+
+
+def _sequential_plan(lengths, nominal, accel, junction, stops):
+    """The look-ahead plan as a controller makes it: a backward pass, then a forward pass, move by move."""
+    n = len(lengths)
+    entry, exit_ = [0.0] * n, [0.0] * n
+    following = 0.0
+    for i in range(n - 1, -1, -1):
+        limit = 0.0 if (i == n - 1 or stops[i]) else min(junction[i], following)
+        exit_[i] = min(limit, nominal[i])
+        entry[i] = min(nominal[i], math.sqrt(exit_[i] ** 2 + 2.0 * accel[i] * lengths[i]))
+        following = entry[i]
+    previous = 0.0
+    for i in range(n):
+        entry[i] = min(entry[i], 0.0 if (i == 0 or stops[i - 1]) else previous)
+        exit_[i] = min(exit_[i], math.sqrt(entry[i] ** 2 + 2.0 * accel[i] * lengths[i]))
+        previous = exit_[i]
+    return entry, exit_
+
+
+def _sequential_seconds(lengths, nominal, accel, entry, exit_):
+    seconds = []
+    for length, vmax, a, v0, v1 in zip(lengths, nominal, accel, entry, exit_):
+        up, down = (vmax**2 - v0**2) / (2 * a), (vmax**2 - v1**2) / (2 * a)
+        if up + down <= length:
+            seconds.append((vmax - v0) / a + (vmax - v1) / a + (length - up - down) / vmax)
+        else:
+            peak = math.sqrt((2 * a * length + v0**2 + v1**2) / 2)
+            seconds.append((peak - v0) / a + (peak - v1) / a)
+    return seconds
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_the_scanned_plan_is_the_backward_and_forward_passes(seed):
+    """plan_velocities scans the passes' min-plus recurrences by doubling (no numba): on random moves (short and long,
+    stops between some, corners of every sharpness and straight junctions without a limit) it gives the speeds of
+    the two passes run move by move, and trapezoid_seconds their times, to rounding."""
+    import numpy as np
+
+    from spur_cad.cam.estimate import plan_velocities, trapezoid_seconds
+
+    rng = np.random.default_rng(seed)
+    n = int(rng.integers(1, 3000))
+    lengths = rng.exponential(1.0, n) * rng.choice([0.001, 0.1, 5.0, 200.0], n)
+    nominal, accel = rng.uniform(0.5, 300.0, n), rng.uniform(50.0, 5000.0, n)
+    junction = np.where(rng.random(n) < 0.3, np.inf, rng.uniform(0.0, 200.0, n))
+    stops = rng.random(n) < [0.0, 0.002, 0.05, 0.5, 0.9, 1.0][seed]
+    entry, exit_ = plan_velocities(lengths, nominal, accel, junction, stops)
+    want_entry, want_exit = _sequential_plan(lengths, nominal, accel, junction, stops)
+    np.testing.assert_allclose(entry, want_entry, rtol=1e-12, atol=1e-9)
+    np.testing.assert_allclose(exit_, want_exit, rtol=1e-12, atol=1e-9)
+    np.testing.assert_allclose(trapezoid_seconds(lengths, nominal, accel, entry, exit_),
+                               _sequential_seconds(lengths, nominal, accel, want_entry, want_exit), rtol=1e-9)

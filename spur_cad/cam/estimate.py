@@ -17,8 +17,6 @@ and the control's own block look-ahead depth are not modelled (docs/cam.md).
 
 from __future__ import annotations
 
-import functools
-import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -78,51 +76,63 @@ def estimate(path: Toolpath, machine: Machine) -> Estimate:
                     float(with_acceleration.sum()))
 
 
-def _plan_velocities(lengths, nominal, accel, junction, stops):  # pragma: no cover - numba
-    """Look-ahead velocity planning over a move sequence: the largest entry/exit speeds that respect each
-    move's nominal speed and acceleration and each junction's speed limit (backward, then forward pass)."""
+def _min_plus_scan(own: np.ndarray, gain: np.ndarray) -> np.ndarray:
+    """y_i = min(own_i, y_(i-1) + gain_i) for every i, gain_i = inf restarting at y_i = own_i (gain_0 must be).
+
+    Each step is the map y -> min(own, y + gain); two maps compose to one, (own_1, gain_1) then (own_2, gain_2)
+    being (min(own_2, own_1 + gain_2), gain_1 + gain_2), so a prefix scan by doubling gives every y_i in as many
+    passes as the longest chain between restarts has binary digits. Gains are summed within the chain only, so
+    the figures keep their own precision however long the path."""
+    own, gain = own.copy(), gain.copy()
+    step = 1
+    while step < len(own) and np.isfinite(gain[step:]).any():
+        own[step:] = np.minimum(own[step:], own[:-step] + gain[step:])
+        gain[step:] = gain[:-step] + gain[step:]
+        step *= 2
+    return own
+
+
+def plan_velocities(lengths: np.ndarray, nominal: np.ndarray, accel: np.ndarray, junction: np.ndarray,
+                    stops: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Look-ahead velocity planning over a move sequence: the largest entry/exit speeds that respect each move's
+    nominal speed and acceleration and each junction's speed limit, as a backward then a forward pass over the
+    moves gives them (a stop after move i where stops[i], and after the last).
+
+    In squared speeds each pass is a min-plus recurrence, entry_i = min(c_i, entry_(i+1) + 2 a_i L_i) backward and
+    exit_i = min(k_i, exit_(i-1) + 2 a_i L_i) forward, restarted at every stop (_min_plus_scan)."""
     n = len(lengths)
-    entry = np.zeros(n)
-    exit_ = np.zeros(n)
-    following = 0.0
-    for i in range(n - 1, -1, -1):
-        limit = 0.0 if (i == n - 1 or stops[i]) else min(junction[i], following)
-        exit_[i] = min(limit, nominal[i])
-        entry[i] = min(nominal[i], math.sqrt(exit_[i] ** 2 + 2.0 * accel[i] * lengths[i]))
-        following = entry[i]
-    previous = 0.0
-    for i in range(n):
-        start = 0.0 if (i == 0 or stops[i - 1]) else previous
-        entry[i] = min(entry[i], start)
-        exit_[i] = min(exit_[i], math.sqrt(entry[i] ** 2 + 2.0 * accel[i] * lengths[i]))
-        previous = exit_[i]
-    return entry, exit_
+    if n == 0:
+        return np.zeros(0), np.zeros(0)
+    gain = 2.0 * accel * lengths  # v^2 gained (or lost) over a move at full acceleration
+    top = nominal * nominal
+    linked = ~np.asarray(stops, bool)
+    linked[-1] = False  # move i runs on into move i + 1 without a stop
+    with np.errstate(over="ignore"):
+        corner = np.where(linked, np.minimum(junction * junction, top), 0.0)  # exit^2 before looking further ahead
+    # backward: entry_i = min(top_i, corner_i + gain_i, entry_(i+1) + gain_i) where linked, min(top_i, gain_i) not
+    own = np.minimum(top, corner + gain)
+    entry2 = _min_plus_scan(own[::-1], np.where(linked, gain, np.inf)[::-1])[::-1]
+    exit2 = np.where(linked, np.minimum(corner, np.append(entry2[1:], 0.0)), 0.0)
+    # forward: a chain starts at rest; exit_i = min(exit2_i, entry_i' + gain_i), entry_i' = min(entry2_i, exit_(i-1))
+    follows = np.concatenate([[False], linked[:-1]])  # move i runs on from move i - 1
+    first = np.where(follows, np.minimum(exit2, entry2 + gain), np.minimum(exit2, gain))
+    exit_final = _min_plus_scan(first, np.where(follows, gain, np.inf))
+    entry_final = np.where(follows, np.minimum(entry2, np.concatenate([[0.0], exit_final[:-1]])), 0.0)
+    return np.sqrt(entry_final), np.sqrt(exit_final)
 
 
-def _trapezoid_seconds(lengths, nominal, accel, entry, exit_):  # pragma: no cover - numba
-    """Time of each move under a trapezoidal speed profile from `entry` to `exit_`, cruising at most at `nominal`."""
-    seconds = np.zeros(len(lengths))
-    for i in range(len(lengths)):
-        length, v0, v1, vmax, a = lengths[i], entry[i], exit_[i], nominal[i], accel[i]
-        if length <= 0.0:
-            continue
-        accelerating = (vmax * vmax - v0 * v0) / (2.0 * a)
-        braking = (vmax * vmax - v1 * v1) / (2.0 * a)
-        if accelerating + braking <= length:
-            seconds[i] = (vmax - v0) / a + (vmax - v1) / a + (length - accelerating - braking) / vmax
-        else:
-            peak = math.sqrt((2.0 * a * length + v0 * v0 + v1 * v1) / 2.0)
-            seconds[i] = (peak - v0) / a + (peak - v1) / a
-    return seconds
-
-
-@functools.cache
-def _compiled_planners():
-    """The velocity planner and the trapezoid timer compiled by numba, once per process (numba is imported
-    only when a toolpath is estimated; cache=True keeps the machine code on disk for the next process)."""
-    from numba import njit
-
-    return njit(cache=True)(_plan_velocities), njit(cache=True)(_trapezoid_seconds)
+def trapezoid_seconds(lengths: np.ndarray, nominal: np.ndarray, accel: np.ndarray, entry: np.ndarray,
+                      exit_: np.ndarray) -> np.ndarray:
+    """Time of each move under a trapezoidal speed profile from `entry` to `exit_`, cruising at most at `nominal`
+    (0 for a move of no length)."""
+    with np.errstate(divide="ignore", invalid="ignore"):
+        accelerating = (nominal * nominal - entry * entry) / (2.0 * accel)
+        braking = (nominal * nominal - exit_ * exit_) / (2.0 * accel)
+        cruising = (nominal - entry) / accel + (nominal - exit_) / accel + (lengths - accelerating - braking) / nominal
+        peak = np.sqrt((2.0 * accel * lengths + entry * entry + exit_ * exit_) / 2.0)
+        peaking = (peak - entry) / accel + (peak - exit_) / accel
+        seconds = np.where(accelerating + braking <= lengths, cruising, peaking)
+    return np.where(lengths > 0.0, seconds, 0.0)
 
 
 def acceleration_aware_seconds(path: Toolpath, machine: Machine, feed_bound_seconds: np.ndarray) -> np.ndarray:
@@ -134,7 +144,6 @@ def acceleration_aware_seconds(path: Toolpath, machine: Machine, feed_bound_seco
     tolerance limits it (centripetal acceleration on the largest arc within the tolerance: the "junction
     deviation" rule of look-ahead planners); markers (clamp codes) and the ends are exact stops.
     """
-    plan, profile = _compiled_planners()
     start = path.start_poses()
     delta = path.poses() - start
     lengths = np.linalg.norm(delta, axis=1)
@@ -160,6 +169,7 @@ def acceleration_aware_seconds(path: Toolpath, machine: Machine, feed_bound_seco
         keep = np.zeros(len(path), bool)
         keep[idx] = True
         # Junction limits between consecutive motion rows; a stop wherever the next row is not motion.
-        entry, exit_ = plan(lengths[idx], nominal[idx], accel[idx], junction[idx], stops[idx])
-        seconds[idx] = np.maximum(profile(lengths[idx], nominal[idx], accel[idx], entry, exit_), machine.block_time_s)
+        entry, exit_ = plan_velocities(lengths[idx], nominal[idx], accel[idx], junction[idx], stops[idx])
+        seconds[idx] = np.maximum(trapezoid_seconds(lengths[idx], nominal[idx], accel[idx], entry, exit_),
+                                  machine.block_time_s)
     return seconds
