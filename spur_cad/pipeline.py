@@ -115,7 +115,7 @@ def run_job(job: Job, progress: Callable[[str, float], None] | None = None,
         seconds[name] = time.perf_counter() - start
         return value
 
-    with CadWorker(job, timestamp) if cad_in_worker else contextlib.nullcontext() as worker:
+    with CadWorker(job, timestamp, checkpoint) if cad_in_worker else contextlib.nullcontext() as worker:
         samples = timed("profile", None, lambda: sample_profile(job.gear.tooth_space_profile(),
                                                                 job.job.profile_tolerance_mm))
         png = timed("plot", None, lambda: tooth_space_png(job.gear, samples, modified_flank_samples(job)))
@@ -131,7 +131,7 @@ def run_job(job: Job, progress: Callable[[str, float], None] | None = None,
         grading = timed("grading", None, lambda: grade_stage(job, sim_result, plan))
         budget = timed("error_budget", None, lambda: budget_stage(job, plan, sim_result, grading))
         if worker is not None:  # its bar shown while the run waits for it, its time the worker's own
-            cad, step, seconds["cad_and_step"] = timed("cad_wait", "CAD and STEP", lambda: worker.result(checkpoint))
+            cad, step, seconds["cad_and_step"] = timed("cad_wait", "CAD and STEP", worker.result)
         result = build_result(job, samples, cad, plan, job.post, programs, sim_result, grading, seconds, budget)
         result = dataclasses.replace(result, correction=correction)
         template_source = shown_path(job.job.report_template) if job.job.report_template else "report.html.j2"

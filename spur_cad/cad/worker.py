@@ -38,10 +38,14 @@ READ_BYTES = 1 << 20
 
 
 class CadWorker:
-    """`build_cad(job, None, timestamp)` started in a worker process; `result(checkpoint)` waits for it, `stop()`
-    ends it (also as a context manager's exit, so no worker outlives the run that started it)."""
+    """`build_cad(job, None, timestamp)` started in a worker process; `result()` waits for it (calling `checkpoint()`
+    meanwhile), `stop()` ends it. As a context manager its exit stops it, so that no worker outlives the run that
+    started it; when the run failed with an Exception, the worker's own error is raised instead if it has one (the
+    CAD stage came before the others in a run, so its error is the one a user saw)."""
 
-    def __init__(self, job: Job, timestamp: str | None) -> None:
+    def __init__(self, job: Job, timestamp: str | None, checkpoint: Callable[[], None] | None = None) -> None:
+        self._checkpoint = checkpoint
+        self._read = False  # the worker's outcome has been read (result() was called to its end)
         self._process = subprocess.Popen([sys.executable, "-m", "spur_cad.cad.worker"], stdin=subprocess.PIPE,
                                          stdout=subprocess.PIPE, start_new_session=True)
         try:
@@ -54,9 +58,10 @@ class CadWorker:
     def pid(self) -> int:
         return self._process.pid
 
-    def result(self, checkpoint: Callable[[], None] | None = None) -> tuple[CadResult, dict[str, bytes], float]:
+    def result(self) -> tuple[CadResult, dict[str, bytes], float]:
         """(CAD facts, STEP files, the worker's own seconds for them); calls `checkpoint()` every POLL_S while
         waiting; raises the worker's exception again."""
+        checkpoint = self._checkpoint
         chunks = []
         stdout = self._process.stdout
         with selectors.DefaultSelector() as selector:
@@ -69,6 +74,7 @@ class CadWorker:
                     if not chunk:  # end-of-file: the worker has ended
                         break
                     chunks.append(chunk)
+        self._read = True
         code = self._process.wait()
         if code != 0 or not chunks:  # killed, out of memory, or no Python to start
             if checkpoint is not None:
@@ -98,8 +104,12 @@ class CadWorker:
     def __enter__(self) -> CadWorker:
         return self
 
-    def __exit__(self, *exc_info) -> None:
-        self.stop()
+    def __exit__(self, exc_type, exc, traceback_) -> None:
+        try:
+            if isinstance(exc, Exception) and not self._read:
+                self.result()  # raises the CAD stage's error, if any, in place of the run's
+        finally:
+            self.stop()
 
 
 def _serve(source: BinaryIO, sink: BinaryIO) -> None:
