@@ -6,8 +6,8 @@ The worker is a fresh interpreter, `python -m spur_cad.cad.worker` (not a fork: 
 threads exist can deadlock; not multiprocessing's 'spawn', which runs the caller's main script again in the
 worker). It reads the pickled job from its stdin and writes the pickled outcome to its stdout. It runs in a
 session of its own, so a Ctrl-C at the terminal reaches the main process only, which decides: it stops the
-worker at its next checkpoint. The worker also ends itself when the main process ends without stopping it
-(SIGKILL): its stdin then reaches end-of-file. An error in the worker comes back as the same exception (pickled,
+worker at its next checkpoint. The worker also ends when the main process ends without stopping it (SIGKILL):
+the kernel kills it (Linux's parent-death signal), and elsewhere it ends when its stdin reaches end-of-file. An error in the worker comes back as the same exception (pickled,
 with the worker's traceback as a note) and is raised again in the main process.
 
 The FreeCAD workbench builds the CAD in its own process: OCCT is loaded there already, and FreeCAD's
@@ -16,9 +16,11 @@ executable is not a Python interpreter a worker could be started with (`run_job(
 
 from __future__ import annotations
 
+import ctypes
 import os
 import pickle
 import selectors
+import signal
 import subprocess
 import sys
 import threading
@@ -35,6 +37,7 @@ POLL_S = 0.05
 STOP_WAIT_S = 2.0
 """How long a stopped worker is given to end after SIGTERM before SIGKILL."""
 READ_BYTES = 1 << 20
+PR_SET_PDEATHSIG = 1  # linux/prctl.h
 
 
 class CadWorker:
@@ -46,8 +49,8 @@ class CadWorker:
     def __init__(self, job: Job, timestamp: str | None, checkpoint: Callable[[], None] | None = None) -> None:
         self._checkpoint = checkpoint
         self._read = False  # the worker's outcome has been read (result() was called to its end)
-        self._process = subprocess.Popen([sys.executable, "-m", "spur_cad.cad.worker"], stdin=subprocess.PIPE,
-                                         stdout=subprocess.PIPE, start_new_session=True)
+        self._process = subprocess.Popen([sys.executable, "-m", "spur_cad.cad.worker", str(os.getpid())],
+                                         stdin=subprocess.PIPE, stdout=subprocess.PIPE, start_new_session=True)
         try:
             self._process.stdin.write(pickle.dumps((job, timestamp), protocol=pickle.HIGHEST_PROTOCOL))
             self._process.stdin.flush()  # stdin stays open: the worker's lifeline
@@ -139,6 +142,18 @@ def _exit_at_end_of_file(source: BinaryIO) -> None:
     os._exit(1)
 
 
+def _end_with_parent(parent_pid: int) -> None:
+    """On Linux, have the kernel SIGKILL this process when its parent ends (prctl PR_SET_PDEATHSIG): at once, where
+    the lifeline thread waits for the GIL, which OCP's long calls and its import hold. Ends now if the parent has
+    ended already."""
+    try:
+        ctypes.CDLL(None).prctl(PR_SET_PDEATHSIG, signal.SIGKILL, 0, 0, 0)
+    except (OSError, AttributeError):  # not Linux: the lifeline alone
+        pass
+    if os.getppid() != parent_pid:
+        os._exit(1)
+
+
 def _transferable(exc: Exception) -> Exception:
     """`exc` with the worker's traceback as a note when it survives pickling, else a RuntimeError naming it."""
     exc.add_note("in the CAD worker process:\n" + "".join(traceback.format_exception(exc)).rstrip())
@@ -150,6 +165,7 @@ def _transferable(exc: Exception) -> Exception:
 
 
 if __name__ == "__main__":
+    _end_with_parent(int(sys.argv[1]))
     results = os.fdopen(os.dup(sys.stdout.fileno()), "wb")
     os.dup2(sys.stderr.fileno(), sys.stdout.fileno())  # whatever a library prints goes to stderr, not the result
     _serve(sys.stdin.buffer, results)
