@@ -222,7 +222,7 @@ def _run(args: argparse.Namespace, received: list[int], loaded: list) -> tuple[l
             bars(stage, fraction)
 
     try:
-        result = run_job(loaded[0], progress, checkpoint, restart, cad_in_worker=True)  # spur_cad.cad.worker
+        result = run_job(loaded[0], progress, checkpoint, restart, cad_in_worker=True)  # spur_cad.cad_worker
     finally:
         if bars is not None:
             bars.close()

@@ -18,8 +18,8 @@ from typing import TYPE_CHECKING, Callable
 
 import numpy as np
 
-from spur_cad.cad.stage import build_cad
-from spur_cad.cad.worker import CadWorker
+from spur_cad.cad_stage import build_cad
+from spur_cad.cad_worker import CadWorker
 from spur_cad.cam.plan import CamInputs, CamPlan
 from spur_cad.cam.plan import plan_cam as plan_cam_inputs
 from spur_cad.errors import shown_path
@@ -91,7 +91,7 @@ def run_job(job: Job, progress: Callable[[str, float], None] | None = None,
     stage (the CLI stops there when a signal has arrived, never inside a library). `restart` adds a program
     restarting an operation there (restart_program). spur-cad correct gives its corrected `plan` (else the job's is
     planned) and its `correction` (correction.json), which the report shows. `cad_in_worker` builds the CAD stage in
-    a second process (spur_cad.cad.worker) while this one does the rest, which then never imports OCP: the command
+    a second process (spur_cad.cad_worker) while this one does the rest, which then never imports OCP: the command
     line's choice; in FreeCAD (OCCT loaded, no Python executable to start) the CAD is built here."""
     from spur_cad.report.plots import tooth_space_png
     from spur_cad.report.stage import report_html

@@ -1,4 +1,4 @@
-"""The CAD stage in a worker process (spur_cad.cad.worker, issue 27), as `spur-cad run` runs it: the main process
+"""The CAD stage in a worker process (spur_cad.cad_worker, issue 27), as `spur-cad run` runs it: the main process
 never imports OCP, the STEP files are the in-process ones, a CAD error is the same exception with the same one
 line, and a signal during the CAD stage stops the worker and leaves the folder's old set."""
 
@@ -15,7 +15,7 @@ from pathlib import Path
 
 import pytest
 
-from spur_cad.cad.worker import CadWorker
+from spur_cad.cad_worker import CadWorker
 from spur_cad.errors import WorkLimitError
 from spur_cad.job import load_job, parse_job
 from tests.test_summary_golden import _entities_without_numbers

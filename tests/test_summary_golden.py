@@ -104,7 +104,7 @@ def test_the_comparison_sees_a_changed_key_order_value_and_type():
 @pytest.mark.parametrize(("example", "cad_in_worker"), [("reference_gear", False), ("helical_gear", False),
                                                           ("reference_gear", True)])
 def test_the_summary_and_the_files_of_the_examples_are_unchanged(example, cad_in_worker, monkeypatch):
-    """Also with the CAD stage in a worker process, as the command line runs it (spur_cad.cad.worker)."""
+    """Also with the CAD stage in a worker process, as the command line runs it (spur_cad.cad_worker)."""
     monkeypatch.chdir(ROOT)  # the summary shows the job file as given, relative to the working folder
     job = load_job(Path("resources") / "examples" / f"{example}.toml")
     files = run_job(job, cad_in_worker=cad_in_worker).files

@@ -1,6 +1,6 @@
 """The CAD stage of a run: the gear solid, its stock and their STEP files, with the facts the summary reports.
 
-Its own module (the kernel imported inside `build_cad`) so that `spur_cad.cad.worker` can run it in a second
+Its own module (the kernel imported inside `build_cad`) so that `spur_cad.cad_worker` can run it in a second
 process importing little else; `spur_cad.pipeline.build_cad` is this function.
 """
 

@@ -2,13 +2,14 @@
 files here while its own process plans, posts, simulates and reports, so a run takes about the longer of the
 two instead of their sum on a machine of two cores, and the main process never imports OCP (about 280 MB).
 
-The worker is a fresh interpreter, `python -m spur_cad.cad.worker` (not a fork: a fork after numpy's or numba's
+The worker is a fresh interpreter, `python -m spur_cad.cad_worker` (not a fork: a fork after numpy's or numba's
 threads exist can deadlock; not multiprocessing's 'spawn', which runs the caller's main script again in the
 worker). It reads the pickled job from its stdin and writes the pickled outcome to its stdout. It runs in a
 session of its own, so a Ctrl-C at the terminal reaches the main process only, which decides: it stops the
 worker at its next checkpoint. The worker also ends when the main process ends without stopping it (SIGKILL):
-the kernel kills it (Linux's parent-death signal), and elsewhere it ends when its stdin reaches end-of-file. An error in the worker comes back as the same exception (pickled,
-with the worker's traceback as a note) and is raised again in the main process.
+the kernel kills it (Linux's parent-death signal), and elsewhere it ends when its stdin reaches end-of-file.
+An error in the worker comes back as the same exception (pickled, with the worker's traceback as a note) and
+is raised again in the main process.
 
 The FreeCAD workbench builds the CAD in its own process: OCCT is loaded there already, and FreeCAD's
 executable is not a Python interpreter a worker could be started with (`run_job(cad_in_worker=False)`).
@@ -49,7 +50,7 @@ class CadWorker:
     def __init__(self, job: Job, timestamp: str | None, checkpoint: Callable[[], None] | None = None) -> None:
         self._checkpoint = checkpoint
         self._read = False  # the worker's outcome has been read (result() was called to its end)
-        self._process = subprocess.Popen([sys.executable, "-m", "spur_cad.cad.worker", str(os.getpid())],
+        self._process = subprocess.Popen([sys.executable, "-m", "spur_cad.cad_worker", str(os.getpid())],
                                          stdin=subprocess.PIPE, stdout=subprocess.PIPE, start_new_session=True)
         try:
             self._process.stdin.write(pickle.dumps((job, timestamp), protocol=pickle.HIGHEST_PROTOCOL))
@@ -121,7 +122,7 @@ def _serve(source: BinaryIO, sink: BinaryIO) -> None:
     job, timestamp = pickle.load(source)
     threading.Thread(target=_exit_at_end_of_file, args=(source,), daemon=True).start()
     try:
-        from spur_cad.cad.stage import build_cad
+        from spur_cad.cad_stage import build_cad
 
         start = time.perf_counter()
         value = build_cad(job, None, timestamp)
