@@ -45,7 +45,6 @@ sampler.start()
 _, status, usage = os.wait4(child.pid, 0)
 done.set()
 sampler.join()
-peaks_kb[child.pid] = max(peaks_kb.get(child.pid, 0), usage.ru_maxrss)
 with open(sys.argv[1], "w") as report:
     report.write(f"{usage.ru_maxrss * 1024} {os.waitstatus_to_exitcode(status)} {sum(peaks_kb.values()) * 1024}")
 sys.exit(0)
@@ -64,7 +63,8 @@ def run_measured_tree(args: list[str], timeout_s: float,
                       preexec_fn=None) -> tuple[subprocess.CompletedProcess, int, int, float]:
     """run_measured's (result, peak bytes of the largest process, ..., wall seconds) with, third, the sum of the
     peaks of every process of the command (the command and the processes it started, e.g. `spur-cad run`'s CAD
-    worker: each one's VmHWM sampled every 10 ms until it ends; the command's own from ru_maxrss)."""
+    worker: each one's VmHWM sampled every 10 ms until it ends; not ru_maxrss, which is the largest of a process
+    and the children it waited for)."""
     with tempfile.NamedTemporaryFile("r", suffix=".peak") as report:
         start = time.perf_counter()
         launcher = subprocess.Popen([sys.executable, "-c", _LAUNCHER, report.name, *args], stdout=subprocess.PIPE,
