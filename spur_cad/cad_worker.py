@@ -42,20 +42,28 @@ PR_SET_PDEATHSIG = 1  # linux/prctl.h
 
 
 class CadWorker:
-    """`build_cad(job, None, timestamp)` started in a worker process; `result()` waits for it (calling `checkpoint()`
-    meanwhile), `stop()` ends it. As a context manager its exit stops it, so that no worker outlives the run that
-    started it; when the run failed with an Exception, the worker's own error is raised instead if it has one (the
-    CAD stage came before the others in a run, so its error is the one a user saw)."""
+    """A worker process started early, then given `build_cad(job, None, timestamp)` by `submit`; `result()` waits
+    for it (calling `checkpoint()` meanwhile), `stop()` ends it. As a context manager its exit stops it, so that
+    no worker outlives the run that started it; when the run failed with an Exception after `submit`, the worker's
+    own error is raised instead if it has one (the CAD stage came before the others in a run, so its error is the
+    one a user saw)."""
 
-    def __init__(self, job: Job, timestamp: str | None, checkpoint: Callable[[], None] | None = None) -> None:
+    def __init__(self, checkpoint: Callable[[], None] | None = None) -> None:
+        """Start the worker: it loads the kernel (OCP, about 1 s with Python's start) while the caller reads the
+        job, which `submit` then gives it."""
         self._checkpoint = checkpoint
+        self._submitted = False
         self._read = False  # the worker's outcome has been read (result() was called to its end)
         self._process = subprocess.Popen([sys.executable, "-m", "spur_cad.cad_worker", str(os.getpid())],
                                          stdin=subprocess.PIPE, stdout=subprocess.PIPE, start_new_session=True)
+
+    def submit(self, job: Job, timestamp: str | None) -> None:
+        """Have the worker build `job`'s CAD stage, with `timestamp` as the STEP headers' time."""
+        self._submitted = True
         try:
             self._process.stdin.write(pickle.dumps((job, timestamp), protocol=pickle.HIGHEST_PROTOCOL))
             self._process.stdin.flush()  # stdin stays open: the worker's lifeline
-        except BrokenPipeError:  # the worker could not start; result() says so
+        except BrokenPipeError:  # the worker has ended; result() says so
             pass
 
     @property
@@ -110,20 +118,26 @@ class CadWorker:
 
     def __exit__(self, exc_type, exc, traceback_) -> None:
         try:
-            if isinstance(exc, Exception) and not self._read:
+            if isinstance(exc, Exception) and self._submitted and not self._read:
                 self.result()  # raises the CAD stage's error, if any, in place of the run's
         finally:
             self.stop()
 
 
 def _serve(source: BinaryIO, sink: BinaryIO) -> None:
-    """The worker process: read (job, timestamp) from `source`, build, write ("done", (facts, files), seconds)
-    or ("error", exception, None) to `sink`, end. Ends at once when `source` reaches end-of-file before."""
-    job, timestamp = pickle.load(source)
+    """The worker process: load the kernel, read (job, timestamp) from `source`, build, write ("done", (facts,
+    files), seconds) or ("error", exception, None) to `sink`, end. Ends at once when `source` reaches end-of-file
+    before."""
+    import spur_cad.cad.solid  # noqa: F401 - the kernel, loaded while the main process reads the job
+    import spur_cad.cad.step  # noqa: F401
+    from spur_cad.cad_stage import build_cad
+
+    try:
+        job, timestamp = pickle.load(source)
+    except EOFError:  # stopped before a job came
+        os._exit(0)
     threading.Thread(target=_exit_at_end_of_file, args=(source,), daemon=True).start()
     try:
-        from spur_cad.cad_stage import build_cad
-
         start = time.perf_counter()
         value = build_cad(job, None, timestamp)
         message = ("done", value, time.perf_counter() - start)

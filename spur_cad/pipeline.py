@@ -19,7 +19,6 @@ from typing import TYPE_CHECKING, Callable
 import numpy as np
 
 from spur_cad.cad_stage import build_cad
-from spur_cad.cad_worker import CadWorker
 from spur_cad.cam.plan import CamInputs, CamPlan
 from spur_cad.cam.plan import plan_cam as plan_cam_inputs
 from spur_cad.errors import shown_path
@@ -31,6 +30,7 @@ from spur_cad.summary import build_result, summary_json
 from spur_cad.version import __version__
 
 if TYPE_CHECKING:
+    from spur_cad.cad_worker import CadWorker
     from spur_cad.cam.restart import RestartPoint
     from spur_cad.grade.grading import Grading
     from spur_cad.post.program import PostedProgram
@@ -84,15 +84,17 @@ def modified_flank_samples(job: Job) -> dict | None:
 
 def run_job(job: Job, progress: Callable[[str, float], None] | None = None,
             checkpoint: Callable[[], None] | None = None, restart: RestartPoint | None = None,
-            plan: CamPlan | None = None, correction: dict | None = None, cad_in_worker: bool = False) -> JobResult:
+            plan: CamPlan | None = None, correction: dict | None = None,
+            cad_worker: CadWorker | None = None) -> JobResult:
     """Compute every output of the job in memory (no file I/O): the typed result with its output set in
     `files` ({name: bytes}, for spur_cad.outputs.write_output_set). `progress(stage, fraction)` is told how
     far each long stage is (the CLI draws progress bars with it); `checkpoint()` is called before every
     stage (the CLI stops there when a signal has arrived, never inside a library). `restart` adds a program
     restarting an operation there (restart_program). spur-cad correct gives its corrected `plan` (else the job's is
-    planned) and its `correction` (correction.json), which the report shows. `cad_in_worker` builds the CAD stage in
-    a second process (spur_cad.cad_worker) while this one does the rest, which then never imports OCP: the command
-    line's choice; in FreeCAD (OCCT loaded, no Python executable to start) the CAD is built here."""
+    planned) and its `correction` (correction.json), which the report shows. `cad_worker` (a started
+    spur_cad.cad_worker.CadWorker, which run_job stops before it returns) builds the CAD stage in a second process
+    while this one does the rest, which then never imports OCP: the command line's choice; without it (FreeCAD:
+    OCCT loaded, no Python executable to start; spur-cad correct) the CAD is built here."""
     from spur_cad.report.plots import tooth_space_png
     from spur_cad.report.stage import report_html
 
@@ -115,7 +117,9 @@ def run_job(job: Job, progress: Callable[[str, float], None] | None = None,
         seconds[name] = time.perf_counter() - start
         return value
 
-    with CadWorker(job, timestamp, checkpoint) if cad_in_worker else contextlib.nullcontext() as worker:
+    if cad_worker is not None:
+        cad_worker.submit(job, timestamp)
+    with cad_worker if cad_worker is not None else contextlib.nullcontext() as worker:
         samples = timed("profile", None, lambda: sample_profile(job.gear.tooth_space_profile(),
                                                                 job.job.profile_tolerance_mm))
         png = timed("plot", None, lambda: tooth_space_png(job.gear, samples, modified_flank_samples(job)))

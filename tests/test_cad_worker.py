@@ -24,6 +24,9 @@ ROOT = Path(__file__).resolve().parents[1]
 EPOCH = "1700000000"
 ABSURD_LOFT = ("[gear]\nteeth = 17\nmodule_mm = 2.0\nface_width_mm = 300\nhelix_angle_deg = 45\n"
                "[gear.modifications]\nlead_crowning_um = 5\n")  # refused by the CAD stage before it builds
+CAD_STAGE_S = 1.5
+"""A signal this long after the worker started comes while the run builds its CAD (the worker's own start and
+OCP's import take about 1 s, the CAD stage 1.5 s)."""
 KILLED_WORKER_ENDS_S = 1.0
 """A worker whose run was killed ends within this (between two of OCP's calls, when its lifeline thread runs)."""
 CLI_IN_PROCESS = """
@@ -100,11 +103,19 @@ def test_a_cad_error_in_the_worker_is_the_same_exception_with_the_same_message()
     job = parse_job(ABSURD_LOFT, "f.toml")
     with pytest.raises(WorkLimitError) as here:
         build_cad(job)
-    with CadWorker(job, None) as worker, pytest.raises(WorkLimitError) as there:
+    with CadWorker() as worker, pytest.raises(WorkLimitError) as there:
+        worker.submit(job, None)
         worker.result()
     assert str(there.value) == str(here.value)
     assert "lofted through about" in str(there.value)
     assert any("in the CAD worker process" in note for note in there.value.__notes__)
+    assert not _running(worker.pid)
+
+
+def test_a_worker_stopped_before_a_job_came_ends():
+    """As when the job file is refused: the worker, started first, ends with the run."""
+    worker = CadWorker()
+    worker.stop()
     assert not _running(worker.pid)
 
 
@@ -128,7 +139,7 @@ def _interrupted_during_cad(job: Path, out: Path, send) -> tuple[subprocess.Pope
     while not (workers := _children(run.pid)):
         assert run.poll() is None and time.monotonic() < deadline, "no CAD worker started"
         time.sleep(0.01)
-    time.sleep(0.3)  # the worker is importing or building: well inside the CAD stage
+    time.sleep(CAD_STAGE_S)  # the worker starts with the run: it is now building
     assert _running(workers[0])
     send(run)
     return run, workers[0]

@@ -30,6 +30,7 @@ from pathlib import Path
 
 import pytest
 
+from spur_cad.cad_worker import CadWorker
 from spur_cad.job import load_job
 from spur_cad.pipeline import run_job
 
@@ -107,7 +108,7 @@ def test_the_summary_and_the_files_of_the_examples_are_unchanged(example, cad_in
     """Also with the CAD stage in a worker process, as the command line runs it (spur_cad.cad_worker)."""
     monkeypatch.chdir(ROOT)  # the summary shows the job file as given, relative to the working folder
     job = load_job(Path("resources") / "examples" / f"{example}.toml")
-    files = run_job(job, cad_in_worker=cad_in_worker).files
+    files = run_job(job, cad_worker=CadWorker() if cad_in_worker else None).files
     expected = json.loads((GOLDEN / f"{example}_summary.json").read_text())
     for (section, key), value in CHANGED_ON_PURPOSE[example].items():
         assert expected[section][key] != value  # still a change against the recorded run
