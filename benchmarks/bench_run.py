@@ -13,7 +13,7 @@ import sys
 import tempfile
 from pathlib import Path
 
-from benchmarks.peak_memory import run_measured
+from benchmarks.peak_memory import run_measured, run_measured_tree
 
 ROOT = Path(__file__).resolve().parents[1]
 EXAMPLES = ROOT / "resources" / "examples"
@@ -24,16 +24,30 @@ def _cli() -> list[str]:
     return [str(exe)] if exe.exists() else [sys.executable, "-m", "spur_cad.cli"]
 
 
-def _median_run(command: list[str], runs: int) -> dict:
-    walls, peaks = [], []
+def _median_run(command: list[str], runs: int, summary: Path | None = None) -> dict:
+    """Medians of `runs` runs: wall seconds, the peak of the largest process and the sum of every process's peak
+    (`spur-cad run` builds its CAD in a worker process), and with the run's `summary` (its summary.json) the
+    stages' own seconds: the main process's stages summed (its critical path, waiting for the CAD included) and
+    the CAD worker's."""
+    walls, peaks, sums, main_stages, cad = [], [], [], [], []
     for _ in range(runs):
-        result, peak, wall = run_measured(command, 600)
+        result, peak, peak_sum, wall = run_measured_tree(command, 600)
         if result.returncode != 0:
             raise RuntimeError(f"{command} failed: {result.stderr[-500:]}")
         walls.append(wall)
         peaks.append(peak)
-    return {"wall_s": statistics.median(walls), "peak_mb": statistics.median(peaks) / 1e6,
-            "walls_s": [round(w, 2) for w in walls]}
+        sums.append(peak_sum)
+        if summary is not None:
+            timings = json.loads(summary.read_text())["timings_s"]
+            in_worker = "cad_wait" in timings  # cad_and_step is then the worker's, beside the main stages
+            main_stages.append(sum(v for k, v in timings.items() if not (in_worker and k == "cad_and_step")))
+            cad.append(timings["cad_and_step"])
+    figures = {"wall_s": statistics.median(walls), "peak_mb": statistics.median(peaks) / 1e6,
+               "peak_sum_mb": statistics.median(sums) / 1e6, "walls_s": [round(w, 2) for w in walls]}
+    if summary is not None:
+        figures.update(main_stages_s=round(statistics.median(main_stages), 3), cad_and_step_s=round(
+            statistics.median(cad), 3))
+    return figures
 
 
 def _without_simulation(text: str) -> str:
@@ -77,7 +91,7 @@ def compile_bytecode() -> None:
     compileall.compile_dir(str(ROOT / "spur_cad"), quiet=1)
 
 
-def figures(runs: int) -> dict:
+def figures(runs: int, only: set[str] | None = None) -> dict:
     """Medians of `runs` fresh runs: the bare import floor, the reference job (simulation on and off), the
     helical example and the two big gears of issue 27."""
     compile_bytecode()
@@ -92,10 +106,14 @@ def figures(runs: int) -> dict:
             jobs[name].write_text(big_gear_job(*values))
         out = {"import_ocp_numpy": _median_run([sys.executable, "-c", "import OCP, numpy"], runs)}
         for name, job in jobs.items():
+            if only is not None and name not in only:
+                continue
             target = folder / f"out_{name}"
-            out[name] = _median_run([*_cli(), "run", str(job), "--out", str(target), "--quiet"], runs)
+            out[name] = _median_run([*_cli(), "run", str(job), "--out", str(target), "--quiet"], runs,
+                                    target / "summary.json")
             shutil.rmtree(target, ignore_errors=True)
-    out["reference_in_one_process"] = second_run_figures(runs)
+    if only is None or "reference_in_one_process" in only:
+        out["reference_in_one_process"] = second_run_figures(runs)
     return out
 
 
@@ -131,7 +149,10 @@ def second_run_figures(runs: int) -> dict:
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__)
     parser.add_argument("--runs", type=int, default=5)
-    print(json.dumps(figures(parser.parse_args().runs), indent=2))
+    parser.add_argument("--only", help="comma-separated figures to measure (e.g. reference,reference_no_simulation; "
+                                       "the floor is always measured)")
+    args = parser.parse_args()
+    print(json.dumps(figures(args.runs, set(args.only.split(",")) if args.only else None), indent=2))
 
 
 if __name__ == "__main__":

@@ -16,18 +16,55 @@ import tempfile
 import time
 
 _LAUNCHER = """
-import os, subprocess, sys
+import glob, os, subprocess, sys, threading
 child = subprocess.Popen(sys.argv[2:])
+peaks_kb, done = {}, threading.Event()
+
+def tree(pid):
+    found = [pid]
+    for path in glob.glob(f"/proc/{pid}/task/*/children"):
+        try:
+            with open(path) as listing:
+                found += [p for c in listing.read().split() for p in tree(int(c))]
+        except OSError:
+            pass
+    return found
+
+def sample():
+    while not done.wait(0.01):
+        for pid in tree(child.pid):
+            try:
+                with open(f"/proc/{pid}/status") as status:
+                    kb = next(int(line.split()[1]) for line in status if line.startswith("VmHWM:"))
+            except (OSError, StopIteration):
+                continue
+            peaks_kb[pid] = max(peaks_kb.get(pid, 0), kb)
+
+sampler = threading.Thread(target=sample, daemon=True)
+sampler.start()
 _, status, usage = os.wait4(child.pid, 0)
+done.set()
+sampler.join()
 with open(sys.argv[1], "w") as report:
-    report.write(f"{usage.ru_maxrss * 1024} {os.waitstatus_to_exitcode(status)}")
+    report.write(f"{usage.ru_maxrss * 1024} {os.waitstatus_to_exitcode(status)} {sum(peaks_kb.values()) * 1024}")
 sys.exit(0)
 """
 
 
 def run_measured(args: list[str], timeout_s: float, preexec_fn=None) -> tuple[subprocess.CompletedProcess, int, float]:
     """(the command's result with its text output, its peak resident bytes, wall seconds); raises
-    subprocess.TimeoutExpired when it runs past `timeout_s`."""
+    subprocess.TimeoutExpired when it runs past `timeout_s`. The peak is the largest of the command's processes
+    (Linux's ru_maxrss of a child); run_measured_tree also gives the sum over its processes."""
+    result, peak, _, seconds = run_measured_tree(args, timeout_s, preexec_fn)
+    return result, peak, seconds
+
+
+def run_measured_tree(args: list[str], timeout_s: float,
+                      preexec_fn=None) -> tuple[subprocess.CompletedProcess, int, int, float]:
+    """run_measured's (result, peak bytes of the largest process, ..., wall seconds) with, third, the sum of the
+    peaks of every process of the command (the command and the processes it started, e.g. `spur-cad run`'s CAD
+    worker: each one's VmHWM sampled every 10 ms until it ends; not ru_maxrss, which is the largest of a process
+    and the children it waited for)."""
     with tempfile.NamedTemporaryFile("r", suffix=".peak") as report:
         start = time.perf_counter()
         launcher = subprocess.Popen([sys.executable, "-c", _LAUNCHER, report.name, *args], stdout=subprocess.PIPE,
@@ -40,8 +77,8 @@ def run_measured(args: list[str], timeout_s: float, preexec_fn=None) -> tuple[su
             launcher.communicate()
             raise
         seconds = time.perf_counter() - start
-        peak, code = (int(value) for value in report.read().split())
-    return subprocess.CompletedProcess(args, code, out, err), peak, seconds
+        peak, code, peak_sum = (int(value) for value in report.read().split())
+    return subprocess.CompletedProcess(args, code, out, err), peak, peak_sum, seconds
 
 
 def fresh_python_floor_bytes() -> int:
@@ -50,6 +87,7 @@ def fresh_python_floor_bytes() -> int:
 
 
 if __name__ == "__main__":  # pragma: no cover
-    result, peak_bytes, wall = run_measured(sys.argv[1:], 3600)
-    print(f"exit {result.returncode}, {wall:.2f} s, peak {peak_bytes / 1e6:.0f} MB", file=sys.stderr)
+    result, peak_bytes, sum_bytes, wall = run_measured_tree(sys.argv[1:], 3600)
+    print(f"exit {result.returncode}, {wall:.2f} s, peak {peak_bytes / 1e6:.0f} MB (all its processes: "
+          f"{sum_bytes / 1e6:.0f} MB)", file=sys.stderr)
     sys.exit(result.returncode)

@@ -204,6 +204,7 @@ def _checkpoint(received: list[int]) -> None:
 def _run(args: argparse.Namespace, received: list[int], loaded: list) -> tuple[list, tuple[str, ...]]:
     """Load, compute and write the job's output set; the job goes into `loaded` (for locating errors). Returns
     the paths written and the run's warnings (summary.json's)."""
+    from spur_cad.cad_worker import CadWorker
     from spur_cad.cam.restart import parse_restart
     from spur_cad.job import load_job  # heavy imports after the signal handling is in place
     from spur_cad.outputs import check_output_folder
@@ -215,19 +216,20 @@ def _run(args: argparse.Namespace, received: list[int], loaded: list) -> tuple[l
     checkpoint()
     restart = parse_restart(args.restart) if args.restart is not None else None
     out_dir = check_output_folder(args.out)  # before any computation
-    loaded.append(load_job(args.job))
-    bars = ProgressBars(sys.stderr) if not args.quiet and sys.stderr.isatty() else None
+    with CadWorker(checkpoint) as cad_worker:  # the CAD stage's process, loading OCP while this one reads the job
+        loaded.append(load_job(args.job))
+        bars = ProgressBars(sys.stderr) if not args.quiet and sys.stderr.isatty() else None
 
-    def progress(stage: str, fraction: float) -> None:
-        checkpoint()
-        if bars is not None:
-            bars(stage, fraction)
+        def progress(stage: str, fraction: float) -> None:
+            checkpoint()
+            if bars is not None:
+                bars(stage, fraction)
 
-    try:
-        result = run_job(loaded[0], progress, checkpoint, restart)
-    finally:
-        if bars is not None:
-            bars.close()
+        try:
+            result = run_job(loaded[0], progress, checkpoint, restart, cad_worker=cad_worker)
+        finally:
+            if bars is not None:
+                bars.close()
     checkpoint()
     paths = _write(out_dir, result.files, received)
     checkpoint()  # a signal while the set was switched: it is this run's set, and the message says so

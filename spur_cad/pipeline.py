@@ -8,6 +8,7 @@ the same job. The stages: profile -> CAD -> CAM plan (spur_cad.cam.plan) -> post
 
 from __future__ import annotations
 
+import contextlib
 import dataclasses
 import io
 import json
@@ -17,17 +18,19 @@ from typing import TYPE_CHECKING, Callable
 
 import numpy as np
 
+from spur_cad.cad_stage import build_cad
 from spur_cad.cam.plan import CamInputs, CamPlan
 from spur_cad.cam.plan import plan_cam as plan_cam_inputs
 from spur_cad.errors import shown_path
 from spur_cad.geometry.sampling import ProfileSamples, sample_profile
 from spur_cad.inputs import step_timestamp
 from spur_cad.job import Job
-from spur_cad.result import CadResult, JobResult
+from spur_cad.result import JobResult
 from spur_cad.summary import build_result, summary_json
 from spur_cad.version import __version__
 
 if TYPE_CHECKING:
+    from spur_cad.cad_worker import CadWorker
     from spur_cad.cam.restart import RestartPoint
     from spur_cad.grade.grading import Grading
     from spur_cad.post.program import PostedProgram
@@ -81,13 +84,17 @@ def modified_flank_samples(job: Job) -> dict | None:
 
 def run_job(job: Job, progress: Callable[[str, float], None] | None = None,
             checkpoint: Callable[[], None] | None = None, restart: RestartPoint | None = None,
-            plan: CamPlan | None = None, correction: dict | None = None) -> JobResult:
+            plan: CamPlan | None = None, correction: dict | None = None,
+            cad_worker: CadWorker | None = None) -> JobResult:
     """Compute every output of the job in memory (no file I/O): the typed result with its output set in
     `files` ({name: bytes}, for spur_cad.outputs.write_output_set). `progress(stage, fraction)` is told how
     far each long stage is (the CLI draws progress bars with it); `checkpoint()` is called before every
     stage (the CLI stops there when a signal has arrived, never inside a library). `restart` adds a program
     restarting an operation there (restart_program). spur-cad correct gives its corrected `plan` (else the job's is
-    planned) and its `correction` (correction.json), which the report shows."""
+    planned) and its `correction` (correction.json), which the report shows. `cad_worker` (a started
+    spur_cad.cad_worker.CadWorker, which run_job stops before it returns) builds the CAD stage in a second process
+    while this one does the rest, which then never imports OCP: the command line's choice; without it (FreeCAD:
+    OCCT loaded, no Python executable to start; spur-cad correct) the CAD is built here."""
     from spur_cad.report.plots import tooth_space_png
     from spur_cad.report.stage import report_html
 
@@ -110,45 +117,59 @@ def run_job(job: Job, progress: Callable[[str, float], None] | None = None,
         seconds[name] = time.perf_counter() - start
         return value
 
-    samples = timed("profile", None, lambda: sample_profile(job.gear.tooth_space_profile(),
-                                                            job.job.profile_tolerance_mm))
-    png = timed("plot", None, lambda: tooth_space_png(job.gear, samples, modified_flank_samples(job)))
-    cad, step = timed("cad_and_step", "CAD and STEP", lambda: build_cad(job, checkpoint, timestamp))
-    if plan is None:
-        plan = timed("cam", "toolpaths", lambda: plan_cam(job, checkpoint))
-    programs, program_files = timed("post", None, lambda: build_programs(job, plan))
+    if cad_worker is not None:
+        cad_worker.submit(job, timestamp)
+    with cad_worker if cad_worker is not None else contextlib.nullcontext() as worker:
+        samples = timed("profile", None, lambda: sample_profile(job.gear.tooth_space_profile(),
+                                                                job.job.profile_tolerance_mm))
+        png = timed("plot", None, lambda: tooth_space_png(job.gear, samples, modified_flank_samples(job)))
+        if worker is None:
+            cad, step = timed("cad_and_step", "CAD and STEP", lambda: build_cad(job, checkpoint, timestamp))
+        if plan is None:
+            plan = timed("cam", "toolpaths", lambda: plan_cam(job, checkpoint))
+        programs, program_files = timed("post", None, lambda: build_programs(job, plan))
+        program_files.update(other_programs(job, plan, restart, timed))
+        drawings = timed("export", None, lambda: export_files(job)) if job.export.dxf or job.export.svg else {}
+        sim_result = timed("simulation", "simulation",
+                           lambda: simulate_stage(job, plan, lambda fraction: tell("simulation", fraction)))
+        grading = timed("grading", None, lambda: grade_stage(job, sim_result, plan))
+        budget = timed("error_budget", None, lambda: budget_stage(job, plan, sim_result, grading))
+        if worker is not None:  # its bar shown while the run waits for it, its time the worker's own
+            cad, step, seconds["cad_and_step"] = timed("cad_wait", "CAD and STEP", worker.result)
+        result = build_result(job, samples, cad, plan, job.post, programs, sim_result, grading, seconds, budget)
+        result = dataclasses.replace(result, correction=correction)
+        template_source = shown_path(job.job.report_template) if job.job.report_template else "report.html.j2"
+        report = timed("report", "report", lambda: report_html(result, png, job.gear,
+                                                              job.stock.blank_radius_mm(job.gear), plan, sim_result,
+                                                              job.report_template_text, template_source,
+                                                              job.modifications))
+        result = dataclasses.replace(result, timings_s=dict(seconds))
+        files = {
+            "profile.csv": job_profile_csv(job, samples),
+            "profile.png": png,
+            **step,
+            **program_files,
+            **drawings,
+            "report.html": report,
+            "summary.json": (json.dumps(summary_json(result), indent=2, sort_keys=False) + "\n").encode(),
+        }
+        return dataclasses.replace(result, files=files)
+
+
+def other_programs(job: Job, plan: CamPlan, restart: RestartPoint | None, timed: Callable) -> dict[str, bytes]:
+    """The restart, lathe and probing programs the run asks for ({name: text}); `timed(name, stage, compute)` is
+    run_job's timer (the restart program is not timed)."""
+    files = {}
     if restart is not None:
         name, text = restart_program(job, plan, restart)
-        program_files[name] = text
+        files[name] = text
     if job.lathe is not None:
         name, text = timed("lathe", None, lambda: lathe_program(job))
-        program_files[name] = text
+        files[name] = text
     if job.probe is not None:
         name, text = timed("probe", None, lambda: probe_program(job))
-        program_files[name] = text
-    drawings = timed("export", None, lambda: export_files(job)) if job.export.dxf or job.export.svg else {}
-    sim_result = timed("simulation", "simulation",
-                       lambda: simulate_stage(job, plan, lambda fraction: tell("simulation", fraction)))
-    grading = timed("grading", None, lambda: grade_stage(job, sim_result, plan))
-    budget = timed("error_budget", None, lambda: budget_stage(job, plan, sim_result, grading))
-    result = build_result(job, samples, cad, plan, job.post, programs, sim_result, grading, seconds, budget)
-    result = dataclasses.replace(result, correction=correction)
-    template_source = shown_path(job.job.report_template) if job.job.report_template else "report.html.j2"
-    report = timed("report", "report", lambda: report_html(result, png, job.gear,
-                                                          job.stock.blank_radius_mm(job.gear), plan, sim_result,
-                                                          job.report_template_text, template_source,
-                                                          job.modifications))
-    result = dataclasses.replace(result, timings_s=dict(seconds))
-    files = {
-        "profile.csv": job_profile_csv(job, samples),
-        "profile.png": png,
-        **step,
-        **program_files,
-        **drawings,
-        "report.html": report,
-        "summary.json": (json.dumps(summary_json(result), indent=2, sort_keys=False) + "\n").encode(),
-    }
-    return dataclasses.replace(result, files=files)
+        files[name] = text
+    return files
 
 
 def grade_stage(job: Job, sim_result: SimResult | None, plan: CamPlan | None = None) -> Grading | None:
@@ -385,36 +406,6 @@ def _three_axis_comments(job: Job, plan: CamPlan, operation: str) -> tuple[str, 
         "frame: gear axis = Z, X0 Y0 on it, Z0 on the blank's top face, blank clamped flat; tool tip centre "
         "programmed",
     )
-
-
-def build_cad(job: Job, checkpoint: Callable[[], None] | None = None,
-              timestamp: str | None = None) -> tuple[CadResult, dict[str, bytes]]:
-    """Gear solid, stock and STEP files; returns (CAD facts, files). `checkpoint()` between the steps;
-    `timestamp` is the STEP headers' time (step_timestamp)."""
-    from spur_cad.cad.solid import (
-        build_flat_stock_shape,
-        build_gear_shape,
-        build_stock_shape,
-        front_face_area_mm2,
-        solid_volume_mm3,
-    )
-    from spur_cad.cad.step import step_files
-
-    shape, report = build_gear_shape(job.gear, job.gear_section.blank_features(), modifications=job.modifications)
-    if checkpoint is not None:
-        checkpoint()
-    if job.machine.axes == 3:  # the blank lying flat: a disk of the face width, clamped on its bore
-        stock = build_flat_stock_shape(job.gear, job.stock, job.gear_section.blank_features())
-    else:
-        stock = build_stock_shape(job.gear, job.stock)
-    files = step_files(shape, stock, timestamp)
-    if job.modifications is not None and job.modifications.has_lead:  # the section varies along X
-        gear_volume = solid_volume_mm3(shape)
-    else:
-        gear_volume = front_face_area_mm2(shape) * job.gear.face_width_mm  # exact: a section moved along X
-    facts = CadResult(report, gear_volume, solid_volume_mm3(stock),
-                      {name: len(content) for name, content in files.items()})
-    return facts, files
 
 
 def cam_inputs(job: Job) -> CamInputs:

@@ -12,7 +12,7 @@ from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
 if TYPE_CHECKING:  # annotations only: the CAD kernel and the simulator load when a job uses them
-    from spur_cad.cad.solid import GearSolidReport
+    from spur_cad.cad.specs import GearSolidReport
     from spur_cad.cam.estimate import Estimate
     from spur_cad.cam.recommend import ToolRecommendations
     from spur_cad.geometry.inspection import InspectionSheet, ModificationInspection

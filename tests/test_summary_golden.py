@@ -33,6 +33,7 @@ from pathlib import Path
 
 import pytest
 
+from spur_cad.cad_worker import CadWorker
 from spur_cad.job import load_job
 from spur_cad.pipeline import run_job
 
@@ -104,11 +105,13 @@ def test_the_comparison_sees_a_changed_key_order_value_and_type():
     assert differences(golden, {"a": 1.0, "b": {"c": [1]}, "timings_s": timings})  # length
 
 
-@pytest.mark.parametrize("example", ["reference_gear", "helical_gear"])
-def test_the_summary_and_the_files_of_the_examples_are_unchanged(example, monkeypatch):
+@pytest.mark.parametrize(("example", "cad_in_worker"), [("reference_gear", False), ("helical_gear", False),
+                                                          ("reference_gear", True)])
+def test_the_summary_and_the_files_of_the_examples_are_unchanged(example, cad_in_worker, monkeypatch):
+    """Also with the CAD stage in a worker process, as the command line runs it (spur_cad.cad_worker)."""
     monkeypatch.chdir(ROOT)  # the summary shows the job file as given, relative to the working folder
     job = load_job(Path("resources") / "examples" / f"{example}.toml")
-    files = run_job(job).files
+    files = run_job(job, cad_worker=CadWorker() if cad_in_worker else None).files
     expected = json.loads((GOLDEN / f"{example}_summary.json").read_text())
     for (section, key), value in CHANGED_ON_PURPOSE[example].items():
         assert expected[section][key] != value  # still a change against the recorded run

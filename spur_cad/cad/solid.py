@@ -52,7 +52,7 @@ from OCP.TopAbs import TopAbs_FACE, TopAbs_SHELL
 from OCP.TopExp import TopExp_Explorer
 from OCP.TopoDS import TopoDS, TopoDS_Edge, TopoDS_Shape, TopoDS_Solid, TopoDS_Wire
 
-from spur_cad.cad.specs import BlankFeatures, StockSpec
+from spur_cad.cad.specs import BlankFeatures, GearSolidReport, StockSpec
 from spur_cad.errors import ArgumentError, WorkLimitError, require_instance
 from spur_cad.geometry.modifications import SIDES, FlankModifications, modified_tooth_space_profile
 from spur_cad.geometry.profile import Segment
@@ -172,18 +172,6 @@ def _rotation_about_x(angle_rad: float) -> gp_Trsf:
 
 def _transformed_edge(edge: TopoDS_Edge, trsf: gp_Trsf) -> TopoDS_Edge:
     return TopoDS.Edge_s(BRepBuilderAPI_Transform(edge, trsf, True).Shape())
-
-
-@dataclass(frozen=True)
-class GearSolidReport:
-    """Facts about a built solid that the summary and tests use."""
-
-    fit_tolerance_mm: float
-    fillet_max_deviation_mm: float
-    involute_max_deviation_mm: float
-    fillet_poles: int
-    involute_poles: int
-    edges_per_space: int
 
 
 def gear_face_edges(spec: GearSpec, fit_tolerance_mm: float) -> tuple[list[TopoDS_Edge], GearSolidReport]:

@@ -14,6 +14,19 @@ from spur_cad.keys import check_section, key
 
 
 @dataclass(frozen=True)
+class GearSolidReport:
+    """Facts about a built solid that the summary and tests use (here, without the kernel, so that a CadResult
+    built in a worker process unpickles without importing OCP)."""
+
+    fit_tolerance_mm: float
+    fillet_max_deviation_mm: float
+    involute_max_deviation_mm: float
+    fillet_poles: int
+    involute_poles: int
+    edges_per_space: int
+
+
+@dataclass(frozen=True)
 class BlankFeatures:
     """Optional bore (through, on the gear axis) and keyway (on the bore's +Z side, under tooth space 0).
 
