@@ -25,8 +25,13 @@ EPOCH = "1700000000"
 ABSURD_LOFT = ("[gear]\nteeth = 17\nmodule_mm = 2.0\nface_width_mm = 300\nhelix_angle_deg = 45\n"
                "[gear.modifications]\nlead_crowning_um = 5\n")  # refused by the CAD stage before it builds
 CAD_STAGE_S = 1.5
-"""A signal this long after the worker started comes while the run builds its CAD (the worker's own start and
-OCP's import take about 1 s, the CAD stage 1.5 s)."""
+"""A signal this long after the worker started comes while it builds the CAD of LONG_CAD_JOB (the worker's own
+start and OCP's import take about 1 s, that gear's CAD stage about 3 s; the reference gear's takes 0.4 s, too short
+to be sure of)."""
+LONG_CAD_JOB = ("[job]\nname = \"z200 m3\"\n[gear]\nteeth = 200\nmodule_mm = 3.0\nrack_tip_radius_mm = 0.6\n"
+                "face_width_mm = 30.0\n[stock]\nradial_allowance_mm = 0.5\n[tools.roughing]\ndiameter_mm = 3.0\n"
+                "[tools.finishing]\nkind = \"bull_nose\"\ndiameter_mm = 2.4\ncorner_radius_mm = 0.6\n"
+                "[simulation]\nenabled = false\n")
 KILLED_WORKER_ENDS_S = 1.0
 """A worker whose run was killed ends within this (between two of OCP's calls, when its lifeline thread runs)."""
 CLI_IN_PROCESS = """
@@ -130,9 +135,11 @@ def test_the_cli_shows_the_workers_error_as_one_line(tmp_path):
     assert len(done.stderr.splitlines()) == 1, done.stderr
 
 
-def _interrupted_during_cad(job: Path, out: Path, send) -> tuple[subprocess.Popen, int]:
-    """Start `spur-cad run` in a session of its own, wait until its CAD worker runs, then `send(process)`;
-    returns the process and its worker's pid."""
+def _interrupted_during_cad(folder: Path, out: Path, send) -> tuple[subprocess.Popen, int]:
+    """Start `spur-cad run` of LONG_CAD_JOB (written into `folder`) in a session of its own, wait until its CAD
+    worker runs, then `send(process)`; returns the process and its worker's pid."""
+    job = folder / "long_cad.toml"
+    job.write_text(LONG_CAD_JOB)
     run = subprocess.Popen([sys.executable, "-m", "spur_cad.cli", "run", str(job), "--out", str(out), "--quiet"],
                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, start_new_session=True)
     deadline = time.monotonic() + 60
@@ -148,14 +155,14 @@ def _interrupted_during_cad(job: Path, out: Path, send) -> tuple[subprocess.Pope
 @pytest.mark.slow
 @pytest.mark.parametrize("kind", ["SIGINT to the group", "SIGTERM"])
 def test_a_signal_during_the_cad_stage_stops_the_worker_and_keeps_the_old_set(kind, worker_run, tmp_path):
-    job, old, _ = worker_run
+    _, old, _ = worker_run  # the set an interrupted run must leave as it was (any complete set will do)
     out = tmp_path / "out"
     shutil.copytree(old, out)
     before = {p.name: p.read_bytes() for p in out.iterdir()}
     if kind == "SIGTERM":
-        run, worker = _interrupted_during_cad(job, out, lambda process: process.send_signal(signal.SIGTERM))
+        run, worker = _interrupted_during_cad(tmp_path, out, lambda process: process.send_signal(signal.SIGTERM))
     else:  # as a Ctrl-C at the terminal: every process of the foreground group
-        run, worker = _interrupted_during_cad(job, out, lambda process: os.killpg(process.pid, signal.SIGINT))
+        run, worker = _interrupted_during_cad(tmp_path, out, lambda process: os.killpg(process.pid, signal.SIGINT))
     code = run.wait(timeout=60)
     stderr = run.stderr.read()
     assert code == (143 if kind == "SIGTERM" else 130), stderr
@@ -165,10 +172,9 @@ def test_a_signal_during_the_cad_stage_stops_the_worker_and_keeps_the_old_set(ki
 
 
 @pytest.mark.slow
-def test_a_worker_whose_run_is_killed_ends_itself(worker_run, tmp_path):
-    """At once, not when it has built the CAD and finds nobody to give it to (about 2 s on)."""
-    job, _, _ = worker_run
-    run, worker = _interrupted_during_cad(job, tmp_path / "out", lambda process: process.kill())
+def test_a_worker_whose_run_is_killed_ends_itself(tmp_path):
+    """At once, not when it has built the CAD and finds nobody to give it to (about 3 s on)."""
+    run, worker = _interrupted_during_cad(tmp_path, tmp_path / "out", lambda process: process.kill())
     run.wait(timeout=60)
     deadline = time.monotonic() + KILLED_WORKER_ENDS_S
     while _running(worker) and time.monotonic() < deadline:
