@@ -18,6 +18,7 @@ executable is not a Python interpreter a worker could be started with (`run_job(
 from __future__ import annotations
 
 import ctypes
+import gc
 import os
 import pickle
 import selectors
@@ -180,6 +181,7 @@ def _transferable(exc: Exception) -> Exception:
 
 
 if __name__ == "__main__":
+    gc.disable()  # one build and os._exit: the collector would only traverse OCP's import again and again
     _end_with_parent(int(sys.argv[1]))
     results = os.fdopen(os.dup(sys.stdout.fileno()), "wb")
     os.dup2(sys.stderr.fileno(), sys.stdout.fileno())  # whatever a library prints goes to stderr, not the result
