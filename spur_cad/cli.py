@@ -204,19 +204,22 @@ def _checkpoint(received: list[int]) -> None:
 def _run(args: argparse.Namespace, received: list[int], loaded: list) -> tuple[list, tuple[str, ...]]:
     """Load, compute and write the job's output set; the job goes into `loaded` (for locating errors). Returns
     the paths written and the run's warnings (summary.json's)."""
-    from spur_cad.cad_worker import CadWorker
-    from spur_cad.cam.restart import parse_restart
-    from spur_cad.job import load_job  # heavy imports after the signal handling is in place
-    from spur_cad.outputs import check_output_folder
-    from spur_cad.pipeline import run_job
+    from spur_cad.cad_worker import CadWorker  # the standard library only
 
     def checkpoint() -> None:
         _checkpoint(received)
 
     checkpoint()
-    restart = parse_restart(args.restart) if args.restart is not None else None
-    out_dir = check_output_folder(args.out)  # before any computation
-    with CadWorker(checkpoint) as cad_worker:  # the CAD stage's process, loading OCP while this one reads the job
+    # The CAD stage's process, started first: it loads OCP while this one imports the rest and reads the job (a
+    # refused --restart, --out or job file stops it with the run).
+    with CadWorker(checkpoint) as cad_worker:
+        from spur_cad.cam.restart import parse_restart
+        from spur_cad.job import load_job  # heavy imports after the signal handling is in place
+        from spur_cad.outputs import check_output_folder
+        from spur_cad.pipeline import run_job
+
+        restart = parse_restart(args.restart) if args.restart is not None else None
+        out_dir = check_output_folder(args.out)  # before any computation
         loaded.append(load_job(args.job))
         bars = ProgressBars(sys.stderr) if not args.quiet and sys.stderr.isatty() else None
 

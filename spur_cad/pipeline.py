@@ -95,8 +95,9 @@ def run_job(job: Job, progress: Callable[[str, float], None] | None = None,
     spur_cad.cad_worker.CadWorker, which run_job stops before it returns) builds the CAD stage in a second process
     while this one does the rest, which then never imports OCP: the command line's choice; without it (FreeCAD:
     OCCT loaded, no Python executable to start; spur-cad correct) the CAD is built here."""
+    from spur_cad.report.html import render_report
     from spur_cad.report.plots import tooth_space_png
-    from spur_cad.report.stage import report_html
+    from spur_cad.report.stage import report_images
 
     def tell(stage: str, fraction: float) -> None:
         if progress is not None:
@@ -134,15 +135,19 @@ def run_job(job: Job, progress: Callable[[str, float], None] | None = None,
                            lambda: simulate_stage(job, plan, lambda fraction: tell("simulation", fraction)))
         grading = timed("grading", None, lambda: grade_stage(job, sim_result, plan))
         budget = timed("error_budget", None, lambda: budget_stage(job, plan, sim_result, grading))
+        # The report's figures read no CAD facts: drawn before the run waits for its worker (a result without them)
+        result = build_result(job, samples, None, plan, job.post, programs, sim_result, grading, seconds, budget)
+        images = timed("report", "report", lambda: report_images(result, png, job.gear,
+                                                                job.stock.blank_radius_mm(job.gear), plan,
+                                                                sim_result, job.modifications))
         if worker is not None:  # its bar shown while the run waits for it, its time the worker's own
             cad, step, seconds["cad_and_step"] = timed("cad_wait", "CAD and STEP", worker.result)
-        result = build_result(job, samples, cad, plan, job.post, programs, sim_result, grading, seconds, budget)
-        result = dataclasses.replace(result, correction=correction)
+        result = dataclasses.replace(result, cad=cad, correction=correction)
         template_source = shown_path(job.job.report_template) if job.job.report_template else "report.html.j2"
-        report = timed("report", "report", lambda: report_html(result, png, job.gear,
-                                                              job.stock.blank_radius_mm(job.gear), plan, sim_result,
-                                                              job.report_template_text, template_source,
-                                                              job.modifications))
+        figures_s = seconds["report"]
+        report = timed("report", None, lambda: render_report(result, images, job.report_template_text,
+                                                             template_source))
+        seconds["report"] += figures_s  # figures and page: the report stage
         result = dataclasses.replace(result, timings_s=dict(seconds))
         files = {
             "profile.csv": job_profile_csv(job, samples),

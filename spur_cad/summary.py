@@ -56,10 +56,12 @@ __all__ = ["CadResult", "build_result", "simulation_facts", "summary_json"]
 # --- the typed parts, from the stages -----------------------------------------------------------------------
 
 
-def build_result(job, samples: ProfileSamples, cad: CadResult, plan: CamPlan, post: PostSettings,
+def build_result(job, samples: ProfileSamples, cad: CadResult | None, plan: CamPlan, post: PostSettings,
                  programs: dict[str, PostedProgram], simulation: SimResult | None, grading: Grading | None,
                  seconds: dict[str, float], error_budget: ErrorBudgetFacts | None = None) -> JobResult:
-    """The run's typed result (`job` is a spur_cad.job.Job); `files` are added by the pipeline."""
+    """The run's typed result (`job` is a spur_cad.job.Job); `files` are added by the pipeline. `cad` None: the
+    CAD stage still building in its worker (the pipeline draws the report's figures meanwhile and adds it before
+    anything reads it)."""
     labels = np.array(samples.label_names())
     counts = SegmentCounts(*(int(np.count_nonzero(labels == name)) for name in SEGMENT_NAMES))
     inspection = inspection_facts(job.gear)

@@ -23,6 +23,14 @@ def report_html(result: JobResult, profile_png: bytes, spec: GearSpec, blank_rad
     plan and the deviation map from the simulation (not recomputed), the flank modification chart from the
     design's `modifications`; `template_text`: a shop's own template (default spur_cad's), `template_source`
     names it in messages."""
+    images = report_images(result, profile_png, spec, blank_radius_mm, plan, sim, modifications)
+    return render_report(result, images, template_text, template_source)
+
+
+def report_images(result: JobResult, profile_png: bytes, spec: GearSpec, blank_radius_mm: float, plan: CamPlan,
+                  sim: SimResult | None, modifications: FlankModifications | None = None) -> dict[str, bytes]:
+    """The report's figures ({name: PNG bytes}, report_html's): they read the result's set-up, tools and grading
+    but not its CAD facts, so the command line draws them while its CAD worker builds."""
     from spur_cad.report.figures import (
         deviation_map_png,
         finishing_png,
@@ -72,4 +80,4 @@ def report_html(result: JobResult, profile_png: bytes, spec: GearSpec, blank_rad
         from spur_cad.report.figures import k_chart_png
 
         images["kchart"] = k_chart_png(spec, result.grading, lying_flat)
-    return render_report(result, images, template_text, template_source)
+    return images
