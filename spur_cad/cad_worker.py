@@ -12,7 +12,7 @@ An error in the worker comes back as the same exception (pickled, with the worke
 is raised again in the main process.
 
 The FreeCAD workbench builds the CAD in its own process: OCCT is loaded there already, and FreeCAD's
-executable is not a Python interpreter a worker could be started with (`run_job(cad_in_worker=False)`).
+executable is not a Python interpreter a worker could be started with (`run_job` without a `cad_worker`).
 """
 
 from __future__ import annotations
@@ -60,9 +60,12 @@ class CadWorker:
 
     def submit(self, job: Job, timestamp: str | None) -> None:
         """Have the worker build `job`'s CAD stage, with `timestamp` as the STEP headers' time."""
+        # pickled before it counts as submitted: a job that cannot be pickled raises here, and the exit stops the
+        # worker instead of waiting for a result that will never come
+        message = pickle.dumps((job, timestamp), protocol=pickle.HIGHEST_PROTOCOL)
         self._submitted = True
         try:
-            self._process.stdin.write(pickle.dumps((job, timestamp), protocol=pickle.HIGHEST_PROTOCOL))
+            self._process.stdin.write(message)
             self._process.stdin.flush()  # stdin stays open: the worker's lifeline
         except BrokenPipeError:  # the worker has ended; result() says so
             pass

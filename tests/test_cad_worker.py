@@ -117,6 +117,16 @@ def test_a_cad_error_in_the_worker_is_the_same_exception_with_the_same_message()
     assert not _running(worker.pid)
 
 
+def test_a_job_that_cannot_be_pickled_stops_the_worker_without_waiting():
+    """submit raises before anything is sent; the context's exit stops the worker at once (it waited for ever for a
+    result the worker, still waiting for its job, would never send)."""
+    started = time.monotonic()
+    with pytest.raises(Exception), CadWorker() as worker:  # noqa: B017 - whatever pickle raises for a lambda
+        worker.submit(lambda: 0, None)
+    assert time.monotonic() - started < 5.0
+    assert not _running(worker.pid)
+
+
 def test_a_worker_stopped_before_a_job_came_ends():
     """As when the job file is refused: the worker, started first, ends with the run."""
     worker = CadWorker()

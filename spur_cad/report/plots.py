@@ -61,7 +61,7 @@ def png_bytes(rgb: np.ndarray, dpi: float) -> bytes:
     from PIL import Image
 
     buffer = io.BytesIO()
-    Image.fromarray(np.ascontiguousarray(rgb), "RGB").save(buffer, "PNG", compress_level=1, dpi=(dpi, dpi))
+    Image.fromarray(np.ascontiguousarray(rgb, dtype=np.uint8)).save(buffer, "PNG", compress_level=1, dpi=(dpi, dpi))
     return buffer.getvalue()
 
 
