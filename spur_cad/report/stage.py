@@ -1,12 +1,11 @@
-"""The report from typed inputs: figures from the CAM plan and the simulation, values from the summary."""
+"""The report's figures from typed inputs: from the CAM plan, the simulation and the graded result (the page itself is
+spur_cad.report.html.render_report's)."""
 
 from __future__ import annotations
 
 from typing import TYPE_CHECKING
 
 import numpy as np
-
-from spur_cad.report.html import TEMPLATE_NAME, render_report
 
 if TYPE_CHECKING:
     from spur_cad.cam.plan import CamPlan
@@ -16,21 +15,12 @@ if TYPE_CHECKING:
     from spur_cad.sim.simulate import SimResult
 
 
-def report_html(result: JobResult, profile_png: bytes, spec: GearSpec, blank_radius_mm: float, plan: CamPlan,
-                sim: SimResult | None, template_text: str | None = None, template_source: str = TEMPLATE_NAME,
-                modifications: FlankModifications | None = None) -> bytes:
-    """report.html for a job (pure: bytes out): values from the typed result, levels and contact poses from the
-    plan and the deviation map from the simulation (not recomputed), the flank modification chart from the
-    design's `modifications`; `template_text`: a shop's own template (default spur_cad's), `template_source`
-    names it in messages."""
-    images = report_images(result, profile_png, spec, blank_radius_mm, plan, sim, modifications)
-    return render_report(result, images, template_text, template_source)
-
-
 def report_images(result: JobResult, profile_png: bytes, spec: GearSpec, blank_radius_mm: float, plan: CamPlan,
                   sim: SimResult | None, modifications: FlankModifications | None = None) -> dict[str, bytes]:
-    """The report's figures ({name: PNG bytes}, report_html's): they read the result's set-up, tools and grading
-    but not its CAD facts, so the command line draws them while its CAD worker builds."""
+    """The report's figures ({name: PNG bytes} for spur_cad.report.html.render_report; pure): levels and contact
+    poses from the plan, the deviation map from the simulation (not recomputed), the flank modification chart from
+    the design's `modifications`, the K-chart from the result's grading. They read the result's set-up, tools and
+    grading but not its CAD facts, so a run draws them while its CAD worker builds."""
     from spur_cad.report.figures import (
         deviation_map_png,
         finishing_png,
