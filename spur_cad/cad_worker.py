@@ -21,7 +21,6 @@ import ctypes
 import gc
 import os
 import pickle
-import selectors
 import signal
 import subprocess
 import sys
@@ -57,6 +56,12 @@ class CadWorker:
         self._read = False  # the worker's outcome has been read (result() was called to its end)
         self._process = subprocess.Popen([sys.executable, "-m", "spur_cad.cad_worker", str(os.getpid())],
                                          stdin=subprocess.PIPE, stdout=subprocess.PIPE, start_new_session=True)
+        # The outcome is read as it comes, not when the run asks for it: a worker whose STEP files fill the pipe
+        # would otherwise stay alive, holding OCP's 300 MB, until the main process has simulated and reported
+        self._chunks: list[bytes] = []
+        self._ended = threading.Event()  # end-of-file on the worker's stdout
+        self._reader = threading.Thread(target=self._drain, daemon=True)
+        self._reader.start()
 
     def submit(self, job: Job, timestamp: str | None) -> None:
         """Have the worker build `job`'s CAD stage, with `timestamp` as the STEP headers' time."""
@@ -78,19 +83,13 @@ class CadWorker:
         """(CAD facts, STEP files, the worker's own seconds for them); calls `checkpoint()` every POLL_S while
         waiting; raises the worker's exception again."""
         checkpoint = self._checkpoint
-        chunks = []
-        stdout = self._process.stdout
-        with selectors.DefaultSelector() as selector:
-            selector.register(stdout, selectors.EVENT_READ)
-            while True:
-                if checkpoint is not None:
-                    checkpoint()
-                if selector.select(POLL_S):
-                    chunk = os.read(stdout.fileno(), READ_BYTES)
-                    if not chunk:  # end-of-file: the worker has ended
-                        break
-                    chunks.append(chunk)
+        while True:
+            if checkpoint is not None:
+                checkpoint()
+            if self._ended.wait(POLL_S):  # end-of-file: the worker has ended
+                break
         self._read = True
+        chunks = self._chunks
         code = self._process.wait()
         if code != 0 or not chunks:  # killed, out of memory, or no Python to start
             if checkpoint is not None:
@@ -102,6 +101,17 @@ class CadWorker:
         facts, files = value
         return facts, files, seconds
 
+    def _drain(self) -> None:
+        """The reader thread: the worker's stdout to its end, kept in memory (the facts and the STEP files)."""
+        descriptor = self._process.stdout.fileno()
+        try:
+            while chunk := os.read(descriptor, READ_BYTES):
+                self._chunks.append(chunk)
+        except OSError:  # closed under it: stop() has ended the worker
+            pass
+        finally:
+            self._ended.set()
+
     def stop(self) -> None:
         """End the worker if it still runs (SIGTERM, then SIGKILL after STOP_WAIT_S) and close its pipes."""
         if self._process.poll() is None:
@@ -111,6 +121,7 @@ class CadWorker:
             except subprocess.TimeoutExpired:
                 self._process.kill()
                 self._process.wait()
+        self._reader.join(STOP_WAIT_S)  # the worker has ended: its stdout reaches end-of-file
         for stream in (self._process.stdin, self._process.stdout):
             try:
                 stream.close()

@@ -117,6 +117,23 @@ def test_a_cad_error_in_the_worker_is_the_same_exception_with_the_same_message()
     assert not _running(worker.pid)
 
 
+def test_the_worker_ends_once_its_outcome_is_sent_before_the_run_reads_it():
+    """Its STEP files (about 0.9 MB for the reference gear) overflow a pipe's buffer (64 kB): the outcome is read
+    as it comes, so the worker ends, and gives back OCP's 300 MB, while the run still simulates and reports; the
+    run then finds the outcome whole."""
+    job = load_job(ROOT / "resources" / "examples" / "reference_gear.toml")
+    with CadWorker() as worker:
+        worker.submit(job, None)
+        deadline = time.monotonic() + 60.0
+        while _running(worker.pid) and time.monotonic() < deadline:
+            time.sleep(0.05)
+        assert not _running(worker.pid), "the worker still runs: its outcome waits in a full pipe"
+        facts, files, seconds = worker.result()
+    assert sum(len(data) for data in files.values()) > 1 << 16
+    assert set(files) == {"gear.step", "stock.step", "job.step"} and seconds > 0.0
+    assert facts.gear_volume_mm3 > 0.0 and facts.step_bytes == {name: len(data) for name, data in files.items()}
+
+
 def test_a_job_that_cannot_be_pickled_stops_the_worker_without_waiting():
     """submit raises before anything is sent; the context's exit stops the worker at once (it waited for ever for a
     result the worker, still waiting for its job, would never send)."""
