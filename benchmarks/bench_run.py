@@ -25,25 +25,25 @@ def _cli() -> list[str]:
 
 
 def _median_run(command: list[str], runs: int, summary: Path | None = None) -> dict:
-    """Medians of `runs` runs: wall seconds, the peak of the largest process and the sum of every process's peak
-    (`spur-cad run` builds its CAD in a worker process), and with the run's `summary` (its summary.json) the
-    stages' own seconds: the main process's stages summed (its critical path, waiting for the CAD included) and
-    the CAD worker's."""
-    walls, peaks, sums, main_stages, cad = [], [], [], [], []
+    """Medians of `runs` runs: wall seconds, the peak of the largest process and of its processes together
+    (`spur-cad run` builds its CAD in a worker process; peak_memory.run_measured_tree), and with the run's
+    `summary` (its summary.json) the stages' own seconds: the main process's stages summed (its critical path,
+    waiting for the CAD included) and the CAD worker's."""
+    walls, peaks, together, main_stages, cad = [], [], [], [], []
     for _ in range(runs):
-        result, peak, peak_sum, wall = run_measured_tree(command, 600)
+        result, peak, peak_together, wall = run_measured_tree(command, 600)
         if result.returncode != 0:
             raise RuntimeError(f"{command} failed: {result.stderr[-500:]}")
         walls.append(wall)
         peaks.append(peak)
-        sums.append(peak_sum)
+        together.append(peak_together)
         if summary is not None:
             timings = json.loads(summary.read_text())["timings_s"]
             in_worker = "cad_wait" in timings  # cad_and_step is then the worker's, beside the main stages
             main_stages.append(sum(v for k, v in timings.items() if not (in_worker and k == "cad_and_step")))
             cad.append(timings["cad_and_step"])
     figures = {"wall_s": statistics.median(walls), "peak_mb": statistics.median(peaks) / 1e6,
-               "peak_sum_mb": statistics.median(sums) / 1e6, "walls_s": [round(w, 2) for w in walls]}
+               "peak_together_mb": statistics.median(together) / 1e6, "walls_s": [round(w, 2) for w in walls]}
     if summary is not None:
         figures.update(main_stages_s=round(statistics.median(main_stages), 3), cad_and_step_s=round(
             statistics.median(cad), 3))

@@ -18,7 +18,7 @@ import time
 _LAUNCHER = """
 import glob, os, subprocess, sys, threading
 child = subprocess.Popen(sys.argv[2:])
-peaks_kb, done = {}, threading.Event()
+peaks_kb, together_kb, done = {}, [0], threading.Event()
 
 def tree(pid):
     found = [pid]
@@ -32,6 +32,7 @@ def tree(pid):
 
 def sample():
     while not done.wait(0.01):
+        alive_kb = 0
         for pid in tree(child.pid):
             try:
                 with open(f"/proc/{pid}/status") as status:
@@ -39,6 +40,8 @@ def sample():
             except (OSError, StopIteration):
                 continue
             peaks_kb[pid] = max(peaks_kb.get(pid, 0), kb)
+            alive_kb += kb
+        together_kb[0] = max(together_kb[0], alive_kb)
 
 sampler = threading.Thread(target=sample, daemon=True)
 sampler.start()
@@ -46,7 +49,7 @@ _, status, usage = os.wait4(child.pid, 0)
 done.set()
 sampler.join()
 with open(sys.argv[1], "w") as report:
-    report.write(f"{usage.ru_maxrss * 1024} {os.waitstatus_to_exitcode(status)} {sum(peaks_kb.values()) * 1024}")
+    report.write(f"{usage.ru_maxrss * 1024} {os.waitstatus_to_exitcode(status)} {together_kb[0] * 1024}")
 sys.exit(0)
 """
 
@@ -54,17 +57,18 @@ sys.exit(0)
 def run_measured(args: list[str], timeout_s: float, preexec_fn=None) -> tuple[subprocess.CompletedProcess, int, float]:
     """(the command's result with its text output, its peak resident bytes, wall seconds); raises
     subprocess.TimeoutExpired when it runs past `timeout_s`. The peak is the largest of the command's processes
-    (Linux's ru_maxrss of a child); run_measured_tree also gives the sum over its processes."""
+    (Linux's ru_maxrss of a child); run_measured_tree also gives its processes' memory at one time."""
     result, peak, _, seconds = run_measured_tree(args, timeout_s, preexec_fn)
     return result, peak, seconds
 
 
 def run_measured_tree(args: list[str], timeout_s: float,
                       preexec_fn=None) -> tuple[subprocess.CompletedProcess, int, int, float]:
-    """run_measured's (result, peak bytes of the largest process, ..., wall seconds) with, third, the sum of the
-    peaks of every process of the command (the command and the processes it started, e.g. `spur-cad run`'s CAD
-    worker: each one's VmHWM sampled every 10 ms until it ends; not ru_maxrss, which is the largest of a process
-    and the children it waited for)."""
+    """run_measured's (result, peak bytes of the largest process, ..., wall seconds) with, third, the peak of the
+    command's processes together (the command and the processes it started, e.g. `spur-cad run`'s CAD worker):
+    sampled every 10 ms, the largest sum over the processes alive at one sample of each one's peak so far (VmHWM,
+    at least its resident memory then; not ru_maxrss, which is the largest of a process and the children it waited
+    for). A process that has ended no longer counts: two processes that never run at once are not summed."""
     with tempfile.NamedTemporaryFile("r", suffix=".peak") as report:
         start = time.perf_counter()
         launcher = subprocess.Popen([sys.executable, "-c", _LAUNCHER, report.name, *args], stdout=subprocess.PIPE,
@@ -77,8 +81,8 @@ def run_measured_tree(args: list[str], timeout_s: float,
             launcher.communicate()
             raise
         seconds = time.perf_counter() - start
-        peak, code, peak_sum = (int(value) for value in report.read().split())
-    return subprocess.CompletedProcess(args, code, out, err), peak, peak_sum, seconds
+        peak, code, together = (int(value) for value in report.read().split())
+    return subprocess.CompletedProcess(args, code, out, err), peak, together, seconds
 
 
 def fresh_python_floor_bytes() -> int:
@@ -87,7 +91,7 @@ def fresh_python_floor_bytes() -> int:
 
 
 if __name__ == "__main__":  # pragma: no cover
-    result, peak_bytes, sum_bytes, wall = run_measured_tree(sys.argv[1:], 3600)
-    print(f"exit {result.returncode}, {wall:.2f} s, peak {peak_bytes / 1e6:.0f} MB (all its processes: "
-          f"{sum_bytes / 1e6:.0f} MB)", file=sys.stderr)
+    result, peak_bytes, together_bytes, wall = run_measured_tree(sys.argv[1:], 3600)
+    print(f"exit {result.returncode}, {wall:.2f} s, peak {peak_bytes / 1e6:.0f} MB (its processes together: "
+          f"{together_bytes / 1e6:.0f} MB)", file=sys.stderr)
     sys.exit(result.returncode)

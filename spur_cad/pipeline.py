@@ -97,7 +97,7 @@ def run_job(job: Job, progress: Callable[[str, float], None] | None = None,
     OCCT loaded, no Python executable to start; spur-cad correct) the CAD is built here."""
     from spur_cad.report.html import render_report
     from spur_cad.report.plots import tooth_space_png
-    from spur_cad.report.stage import report_images
+    from spur_cad.report.stage import plan_images, simulation_images
 
     def tell(stage: str, fraction: float) -> None:
         if progress is not None:
@@ -131,20 +131,25 @@ def run_job(job: Job, progress: Callable[[str, float], None] | None = None,
         programs, program_files = timed("post", None, lambda: build_programs(job, plan))
         program_files.update(other_programs(job, plan, restart, timed))
         drawings = timed("export", None, lambda: export_files(job)) if job.export.dxf or job.export.svg else {}
+        # The figures from the plan are drawn while the CAD worker builds; a run that simulates then waits for the
+        # worker before it loads the simulation's kernels (numba), so that OCP (in the worker) and numba are never
+        # resident at once: the run's memory is the larger of the two processes', not their sum
+        images = timed("plan_figures", None, lambda: plan_images(png, job.gear, job.stock.blank_radius_mm(job.gear),
+                                                                 plan, job.modifications))
+        if worker is not None and job.simulation.enabled:
+            cad, step, seconds["cad_and_step"] = timed("cad_wait", "CAD and STEP", worker.result)
         sim_result = timed("simulation", "simulation",
                            lambda: simulate_stage(job, plan, lambda fraction: tell("simulation", fraction)))
         grading = timed("grading", None, lambda: grade_stage(job, sim_result, plan))
         budget = timed("error_budget", None, lambda: budget_stage(job, plan, sim_result, grading))
-        # The report's figures read no CAD facts: drawn before the run waits for its worker (a result without them)
+        # The simulation's figures read no CAD facts either: drawn from a result without them
         result = build_result(job, samples, None, plan, job.post, programs, sim_result, grading, seconds, budget)
-        images = timed("report", "report", lambda: report_images(result, png, job.gear,
-                                                                job.stock.blank_radius_mm(job.gear), plan,
-                                                                sim_result, job.modifications))
-        if worker is not None:  # its bar shown while the run waits for it, its time the worker's own
-            cad, step, seconds["cad_and_step"] = timed("cad_wait", "CAD and STEP", worker.result)
+        images.update(timed("report", "report", lambda: simulation_images(result, job.gear, plan, sim_result)))
+        if worker is not None and not job.simulation.enabled:  # its bar shown while the run waits for it, its time
+            cad, step, seconds["cad_and_step"] = timed("cad_wait", "CAD and STEP", worker.result)  # the worker's own
         result = dataclasses.replace(result, cad=cad, correction=correction)
         template_source = shown_path(job.job.report_template) if job.job.report_template else "report.html.j2"
-        figures_s = seconds["report"]
+        figures_s = seconds["report"] + seconds.pop("plan_figures")
         report = timed("report", None, lambda: render_report(result, images, job.report_template_text,
                                                              template_source))
         seconds["report"] += figures_s  # figures and page: the report stage

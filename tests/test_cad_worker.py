@@ -42,6 +42,35 @@ print(json.dumps({"code": code, "kernel": sorted(m for m in sys.modules if m.spl
 """
 
 
+CLI_SPYING_ON_NUMBA = """
+import json, os, sys
+from pathlib import Path
+
+def running_children():
+    found = []
+    for entry in os.listdir("/proc"):
+        try:
+            fields = Path(f"/proc/{entry}/stat").read_text().rsplit(")", 1)[1].split()
+        except (OSError, IndexError):
+            continue
+        if fields[1] == str(os.getpid()) and fields[0] != "Z":
+            found.append(int(entry))
+    return found
+
+class NumbaSpy:  # a finder that finds nothing: it notes who runs when numba is first imported
+    children = None
+    def find_spec(self, name, path=None, target=None):
+        if name == "numba" and NumbaSpy.children is None:
+            NumbaSpy.children = running_children()
+        return None
+
+sys.meta_path.insert(0, NumbaSpy())
+from spur_cad.cli import main
+code = main(sys.argv[1:])
+print(json.dumps({"code": code, "children_at_numba": NumbaSpy.children}))
+"""
+
+
 def _job_without_simulation(folder: Path) -> Path:
     text = (ROOT / "resources" / "examples" / "reference_gear.toml").read_text()
     path = folder / "reference_no_simulation.toml"
@@ -132,6 +161,22 @@ def test_the_worker_ends_once_its_outcome_is_sent_before_the_run_reads_it():
     assert sum(len(data) for data in files.values()) > 1 << 16
     assert set(files) == {"gear.step", "stock.step", "job.step"} and seconds > 0.0
     assert facts.gear_volume_mm3 > 0.0 and facts.step_bytes == {name: len(data) for name, data in files.items()}
+
+
+def test_a_run_that_simulates_loads_numba_only_after_the_worker_has_ended(tmp_path):
+    """OCP (in the worker, about 300 MB) and numba (the simulation's, about 130 MB) are never resident at once: the
+    run waits for its worker before it simulates. The helical example at 0.05 mm: its CAD ends about 0.5 s after
+    its main process is ready to simulate, so a run that did not wait would load numba with the worker running."""
+    job = tmp_path / "helical.toml"
+    job.write_text((ROOT / "resources" / "examples" / "helical_gear.toml").read_text()
+                   + "\n[simulation]\nresolution_mm = 0.05\n")
+    done = subprocess.run([sys.executable, "-c", CLI_SPYING_ON_NUMBA, "run", str(job), "--out", str(tmp_path / "out"),
+                           "--quiet"], capture_output=True, text=True, timeout=300, cwd=ROOT)
+    assert done.returncode == 0 and done.stderr == "", done.stderr
+    outcome = json.loads(done.stdout.splitlines()[-1])
+    assert outcome["code"] == 0
+    assert outcome["children_at_numba"] == [], "numba was loaded while the CAD worker ran"
+    assert (tmp_path / "out" / "gear.step").is_file() and (tmp_path / "out" / "report.html").is_file()
 
 
 def test_a_job_that_cannot_be_pickled_stops_the_worker_without_waiting():

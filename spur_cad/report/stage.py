@@ -15,19 +15,12 @@ if TYPE_CHECKING:
     from spur_cad.sim.simulate import SimResult
 
 
-def report_images(result: JobResult, profile_png: bytes, spec: GearSpec, blank_radius_mm: float, plan: CamPlan,
-                  sim: SimResult | None, modifications: FlankModifications | None = None) -> dict[str, bytes]:
-    """The report's figures ({name: PNG bytes} for spur_cad.report.html.render_report; pure): levels and contact
-    poses from the plan, the deviation map from the simulation (not recomputed), the flank modification chart from
-    the design's `modifications`, the K-chart from the result's grading. They read the result's set-up, tools and
-    grading but not its CAD facts, so a run draws them while its CAD worker builds."""
-    from spur_cad.report.figures import (
-        deviation_map_png,
-        finishing_png,
-        passes_png,
-        roughing_flank_png,
-        roughing_levels_png,
-    )
+def plan_images(profile_png: bytes, spec: GearSpec, blank_radius_mm: float, plan: CamPlan,
+                modifications: FlankModifications | None = None) -> dict[str, bytes]:
+    """The report's figures that need no simulation ({name: PNG bytes} for spur_cad.report.html.render_report;
+    pure): the tooth space's profile, the flank modification chart from the design's `modifications`, and the
+    roughing levels and finishing contact poses from the plan. A run draws them while its CAD worker builds."""
+    from spur_cad.report.figures import finishing_png, passes_png, roughing_flank_png, roughing_levels_png
 
     images = {"profile": profile_png}
     if modifications is not None:
@@ -35,16 +28,14 @@ def report_images(result: JobResult, profile_png: bytes, spec: GearSpec, blank_r
 
         images["modifications"] = modification_chart_png(modifications, spec.base_radius_mm)
     if plan.finishing is not None and plan.finishing.result.strategy == "three_axis":
-        pass  # [machine] axes = 3: no level or contact figures (the report's text says what was planned)
-    elif plan.roughing is not None and plan.roughing.flank is not None:
+        return images  # [machine] axes = 3: no level or contact figures (the report's text says what was planned)
+    if plan.roughing is not None and plan.roughing.flank is not None:
         images["roughing"] = roughing_flank_png(spec, plan.roughing.flank, plan.roughing.tool, blank_radius_mm)
     elif plan.roughing is not None:
         levels = plan.roughing.levels
         images["roughing"] = roughing_levels_png(spec, levels.heights_mm, levels.half_widths_mm, plan.roughing.tool,
                                                  blank_radius_mm)
-    if plan.finishing is not None and plan.finishing.result.strategy == "three_axis":
-        pass
-    elif plan.finishing is not None and plan.finishing.result.passes:
+    if plan.finishing is not None and plan.finishing.result.passes:
         images["finishing"] = passes_png(spec, plan.finishing.tool, plan.finishing.result.passes, blank_radius_mm)
     elif plan.finishing is not None:
         poses = plan.finishing.result.poses
@@ -53,12 +44,21 @@ def report_images(result: JobResult, profile_png: bytes, spec: GearSpec, blank_r
         z = np.concatenate([p.z for p in parts])
         a = np.concatenate([p.a for p in parts])
         images["finishing"] = finishing_png(spec, plan.finishing.tool, y, z, a)
+    return images
+
+
+def simulation_images(result: JobResult, spec: GearSpec, plan: CamPlan, sim: SimResult | None) -> dict[str, bytes]:
+    """The report's figures from the simulation and the graded result ({name: PNG bytes}; pure; none without a
+    simulation): the deviation map (from the simulation, not recomputed), the roughing engagement and the K-chart.
+    They read the result's set-up, tools and grading but not its CAD facts."""
+    if sim is None:
+        return {}
+    from spur_cad.report.figures import deviation_map_png
+
     lying_flat = plan.finishing is not None and plan.finishing.result.strategy == "three_axis"
-    if sim is not None:
-        images["deviation"] = deviation_map_png(sim, lying_flat)
+    images = {"deviation": deviation_map_png(sim, lying_flat)}
     rough = result.setup
-    if sim is not None and sim.engagement is not None and result.tools.roughing is not None \
-            and rough.roughing_step_down_mm is not None:
+    if sim.engagement is not None and result.tools.roughing is not None and rough.roughing_step_down_mm is not None:
         from spur_cad.report.figures import engagement_png
 
         diameter = result.tools.roughing.diameter_mm
