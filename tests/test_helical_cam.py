@@ -648,3 +648,39 @@ def test_the_pruned_searches_give_the_bits_of_searches_over_every_point(name):
     worst = float(nearest.max())
     assert gh._tip_rolls_within(spec, rolls, fillet, outline, worst * (1.0 + 1e-9))
     assert not gh._tip_rolls_within(spec, rolls, fillet, outline, worst * (1.0 - 1e-9))
+
+
+def test_a_chunk_group_that_misses_the_tool_has_no_chunk_that_meets_it():
+    """The helical kernel tests a circle around 8 consecutive chunks before their own circles (CHUNK_GROUP): every
+    chunk's circle must lie in its group's, and whenever the group misses the tool's section (_circle_misses, with
+    the design's spread), each of its chunks must miss it too, so that passing over the group changes no blade.
+    Random chunks along a curve and random tool sections, turned designs and spreads."""
+    from spur_cad.sim.kernel import _circle_misses, chunk_groups
+
+    rng = np.random.default_rng(27)
+    missing_groups = meeting_chunks = 0
+    for _ in range(200):
+        n = int(rng.integers(1, 60))
+        along = np.cumsum(rng.uniform(0.05, 0.6, n))
+        centres = np.stack([along * np.cos(along / 9.0) + 30.0, along * np.sin(along / 9.0)], axis=-1)
+        radii = rng.uniform(0.05, 0.8, n)
+        start, centre, radius = chunk_groups(centres, radii)
+        assert start[0] == 0 and start[-1] == n and np.all(np.diff(start) > 0)
+        for g in range(len(radius)):
+            members = np.arange(start[g], start[g + 1])
+            assert np.all(np.hypot(*(centres[members] - centre[g]).T) + radii[members] <= radius[g])
+        for _ in range(20):
+            turn = rng.uniform(-np.pi, np.pi)
+            c, s = np.cos(turn), np.sin(turn)
+            y, z = rng.uniform(-40.0, 40.0), rng.uniform(-40.0, 40.0)
+            half_flat, corner = rng.uniform(0.0, 2.0), rng.uniform(0.0, 1.5)
+            spread = rng.choice([0.0, rng.uniform(0.0, 0.02)])
+            for g in range(len(radius)):
+                if not _circle_misses(c, s, centre[g, 0], centre[g, 1], radius[g], y, z, half_flat, corner, spread):
+                    continue
+                missing_groups += 1
+                meeting_chunks += sum(not _circle_misses(c, s, centres[ci, 0], centres[ci, 1], radii[ci], y, z,
+                                                         half_flat, corner, spread)
+                                      for ci in range(start[g], start[g + 1]))
+    assert missing_groups > 1000
+    assert meeting_chunks == 0

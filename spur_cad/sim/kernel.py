@@ -23,11 +23,14 @@ from numba import njit
 INF = np.inf
 _NEWTON_STEPS = 60
 _F_TOLERANCE = 1e-10
+CHUNK_GROUP = 8
+"""Chunks per group circle, tested before its chunks (helical kernel)."""
 
 
 @njit(cache=True, inline="always")
-def _gap_and_slope(t, dx, ay, az, ny, nz, half_flat, rt):
-    """G(t) = distance from the blade point to the tool's core minus r_t (<= 0 inside the tool), and dG/dt."""
+def _gap_parts(t, dx, ay, az, ny, nz, half_flat, rt):
+    """(u, s, e, v, dist) of the blade point at t: its offset across the tool u, distance from the axis s,
+    radial and axial distances to the core e and v, and its distance to the core."""
     u = ay + t * ny
     dz = az + t * nz
     s = math.sqrt(dx * dx + u * u)
@@ -37,7 +40,23 @@ def _gap_and_slope(t, dx, ay, az, ny, nz, half_flat, rt):
     v = rt - dz
     if v < 0.0:
         v = 0.0
-    dist = math.sqrt(e * e + v * v)
+    return u, s, e, v, math.sqrt(e * e + v * v)
+
+
+@njit(cache=True, inline="always")
+def _gap(t, dx, ay, az, ny, nz, half_flat, rt):
+    """G(t) = distance from the blade point to the tool's core minus r_t (<= 0 inside the tool); the blades a
+    tool misses need no slope."""
+    dist = _gap_parts(t, dx, ay, az, ny, nz, half_flat, rt)[4]
+    if dist <= 1e-300:
+        return -rt
+    return dist - rt
+
+
+@njit(cache=True, inline="always")
+def _gap_and_slope(t, dx, ay, az, ny, nz, half_flat, rt):
+    """G(t) as _gap gives it, and dG/dt."""
+    u, s, e, v, dist = _gap_parts(t, dx, ay, az, ny, nz, half_flat, rt)
     if dist <= 1e-300:
         return -rt, 0.0
     ds = u * ny / s if s > 1e-300 else 0.0
@@ -80,10 +99,13 @@ def first_entry(dx, ay, az, ny, nz, lo, hi, radius, half_flat, rt):
         return INF
     if lo > hi:
         return INF
-    f, slope = _gap_and_slope(lo, dx, ay, az, ny, nz, half_flat, rt)
+    f = _gap(lo, dx, ay, az, ny, nz, half_flat, rt)
     if f <= 0.0:
         return lo
-    if f > hi - lo or slope >= 0.0:
+    if f > hi - lo:
+        return INF
+    f, slope = _gap_and_slope(lo, dx, ay, az, ny, nz, half_flat, rt)  # the same G(lo), now with its slope
+    if slope >= 0.0:
         return INF
     fh, slope_h = _gap_and_slope(hi, dx, ay, az, ny, nz, half_flat, rt)
     if fh > 0.0 and (slope_h <= 0.0 or f + fh > hi - lo):  # |slope| <= 1: min G >= (G(lo) + G(hi) - (hi - lo)) / 2
@@ -123,6 +145,15 @@ def _chunk_gap(c, s, py, pz, y, z, half_flat, rt):
     out = math.sqrt(max(ddy, 0.0) ** 2 + max(ddz, 0.0) ** 2)
     inside = min(max(ddy, ddz), 0.0)
     return out + inside - rt
+
+
+@njit(cache=True, inline="always")
+def _circle_misses(c, s, py, pz, circle_radius, y, z, half_flat, rt, spread):
+    """A circle of design points (centre (py, pz), turned by (cos, sin) = (c, s)) lies clear of the tool's section at
+    (y, z) even when the design turns by +- spread about the axis (a helical design over the tool's width): its
+    centre's distance to the section exceeds its radius plus how far spread moves its farthest point."""
+    reach = circle_radius + spread * (math.hypot(py, pz) + circle_radius)
+    return _chunk_gap(c, s, py, pz, y, z, half_flat, rt) > reach
 
 
 @njit(cache=True)
@@ -248,11 +279,11 @@ def _blade_entry(dx, theta, px, pz_, nx, nz_, y, z, lo, hi, radius, half_flat, r
 @njit(cache=True)
 def _clip_twisted_pose(x, y, z, a, x_end, h, h_top, points, normals, chunk_start, chunk_centre, chunk_radius,
                        rows, t_min, radius, half_flat, rt, reach, blade_len, pitch, teeth, twist, dx_step, row_first,
-                       row_stop, samples, row_cos, row_sin):
+                       row_stop, samples, row_cos, row_sin, group_start, group_centre, group_radius):
     """Clip the blades of a helical design by the tool at (x, y, z, a) or, with x_end > x, by the tool
     following the lead from x to x_end (entries sampled every dx_step over the tool's width); only the rows
     row_first <= r < row_stop. `samples`, `row_cos` and `row_sin` are work space (as long as clip_poses_twisted
-    makes them)."""
+    makes them). `group_*` are chunk_groups' circles around consecutive chunks, tested before their chunks."""
     if z > reach:
         return 0
     spread = abs(twist) * radius
@@ -267,7 +298,6 @@ def _clip_twisted_pose(x, y, z, a, x_end, h, h_top, points, normals, chunk_start
     if sweep:
         n_samples = 2 * int(math.ceil(radius / dx_step)) + 1  # odd: dx = 0 is a sample
     cuts = 0
-    n_chunks = len(chunk_radius)
     for k in range(first, last + 1):
         sector = k % teeth
         theta0 = c0 + k * pitch
@@ -278,70 +308,104 @@ def _clip_twisted_pose(x, y, z, a, x_end, h, h_top, points, normals, chunk_start
                 theta = theta0 + twist * (rows[r] - x)
                 row_cos[r - r_lo] = math.cos(theta)
                 row_sin[r - r_lo] = math.sin(theta)
-        for ci in range(n_chunks):
-            py = chunk_centre[ci, 0]
-            pz = chunk_centre[ci, 1]
-            if _chunk_gap(c, s, py, pz, y, z, half_flat, rt) > chunk_radius[ci] + spread * math.hypot(py, pz):
-                continue
-            if not sweep:
-                for r in range(r_lo, r_hi):
-                    dx = rows[r] - x
-                    rc = row_cos[r - r_lo]  # as _blade_entry turns the blade, with the row's cos and sin
-                    rs = row_sin[r - r_lo]
-                    # The tool's slice at dx lies in the box |u - y| <= sqrt(R^2 - dx^2), w >= z + its lowest point
-                    # (the corner's bottom there): a chunk whose circle misses the box has no blade to clip here.
-                    corner_dx = max(abs(dx) - half_flat, 0.0)
-                    bottom = rt - math.sqrt(max(rt * rt - corner_dx * corner_dx, 0.0))
-                    box_half_width = math.sqrt(max(radius * radius - dx * dx, 0.0))
-                    if _chunk_gap(rc, rs, py, pz, y, z + bottom, box_half_width, 0.0) > chunk_radius[ci]:
-                        continue
-                    for j in range(chunk_start[ci], chunk_start[ci + 1]):
-                        current = h[sector, j, r]
-                        ay, az, ny, nz = _turned_blade(rc, rs, points[j, 0], points[j, 1], normals[j, 0],
-                                                       normals[j, 1], y, z)
-                        entry = first_entry(dx, ay, az, ny, nz, t_min, min(h_top[sector, j], current), radius,
-                                            half_flat, rt)
-                        if entry < current:
-                            h[sector, j, r] = entry
-                            cuts += 1
-                continue
-            for j in range(chunk_start[ci], chunk_start[ci + 1]):
-                px = points[j, 0]
-                pz_ = points[j, 1]
-                nx = normals[j, 0]
-                nz_ = normals[j, 1]
-                top = h_top[sector, j]
-                hrow = h[sector, j]
-                deepest = INF
-                for i in range(n_samples):
-                    dx = -radius + 2.0 * radius * i / (n_samples - 1)
-                    samples[i] = _blade_entry(dx, theta0 + twist * dx, px, pz_, nx, nz_, y, z, t_min, top, radius,
-                                              half_flat, rt)
-                    if samples[i] < deepest:
-                        deepest = samples[i]
-                if deepest == INF:
+        for gi in range(len(group_radius)):
+            if _circle_misses(c, s, group_centre[gi, 0], group_centre[gi, 1], group_radius[gi], y, z, half_flat, rt,
+                              spread):
+                continue  # then every chunk of the group misses too (chunk_groups)
+            for ci in range(group_start[gi], group_start[gi + 1]):
+                py = chunk_centre[ci, 0]
+                pz = chunk_centre[ci, 1]
+                if _circle_misses(c, s, py, pz, chunk_radius[ci], y, z, half_flat, rt, spread):
                     continue
-                for r in range(r_lo, r_hi):
-                    lo_dx = max(rows[r] - x_end, -radius)  # the slices this row sees during the move
-                    hi_dx = min(rows[r] - x, radius)
-                    if lo_dx <= -radius and hi_dx >= radius:
-                        entry = deepest
-                    else:
-                        entry = INF
-                        i_lo = int(math.ceil((lo_dx + radius) / (2.0 * radius) * (n_samples - 1) - 1e-9))
-                        i_hi = int(math.floor((hi_dx + radius) / (2.0 * radius) * (n_samples - 1) + 1e-9))
-                        for i in range(max(i_lo, 0), min(i_hi, n_samples - 1) + 1):
-                            if samples[i] < entry:
-                                entry = samples[i]
-                        for dx in (lo_dx, hi_dx):  # the move's own end poses, exactly
-                            e = _blade_entry(dx, theta0 + twist * dx, px, pz_, nx, nz_, y, z, t_min, top, radius,
-                                             half_flat, rt)
-                            if e < entry:
-                                entry = e
-                    if entry < hrow[r]:
-                        hrow[r] = entry
-                        cuts += 1
+                if not sweep:
+                    for r in range(r_lo, r_hi):
+                        dx = rows[r] - x
+                        rc = row_cos[r - r_lo]  # as _blade_entry turns the blade, with the row's cos and sin
+                        rs = row_sin[r - r_lo]
+                        # The tool's slice at dx lies in the box |u - y| <= sqrt(R^2 - dx^2), w >= z + its lowest
+                        # point (the corner's bottom there): a chunk whose circle misses the box has no blade to
+                        # clip here.
+                        corner_dx = max(abs(dx) - half_flat, 0.0)
+                        bottom = rt - math.sqrt(max(rt * rt - corner_dx * corner_dx, 0.0))
+                        box_half_width = math.sqrt(max(radius * radius - dx * dx, 0.0))
+                        if _chunk_gap(rc, rs, py, pz, y, z + bottom, box_half_width, 0.0) > chunk_radius[ci]:
+                            continue
+                        for j in range(chunk_start[ci], chunk_start[ci + 1]):
+                            current = h[sector, j, r]
+                            ay, az, ny, nz = _turned_blade(rc, rs, points[j, 0], points[j, 1], normals[j, 0],
+                                                           normals[j, 1], y, z)
+                            entry = first_entry(dx, ay, az, ny, nz, t_min, min(h_top[sector, j], current), radius,
+                                                half_flat, rt)
+                            if entry < current:
+                                h[sector, j, r] = entry
+                                cuts += 1
+                    continue
+                for j in range(chunk_start[ci], chunk_start[ci + 1]):
+                    px = points[j, 0]
+                    pz_ = points[j, 1]
+                    nx = normals[j, 0]
+                    nz_ = normals[j, 1]
+                    top = h_top[sector, j]
+                    hrow = h[sector, j]
+                    deepest = INF
+                    for i in range(n_samples):
+                        dx = -radius + 2.0 * radius * i / (n_samples - 1)
+                        samples[i] = _blade_entry(dx, theta0 + twist * dx, px, pz_, nx, nz_, y, z, t_min, top,
+                                                  radius, half_flat, rt)
+                        if samples[i] < deepest:
+                            deepest = samples[i]
+                    if deepest == INF:
+                        continue
+                    for r in range(r_lo, r_hi):
+                        lo_dx = max(rows[r] - x_end, -radius)  # the slices this row sees during the move
+                        hi_dx = min(rows[r] - x, radius)
+                        if lo_dx <= -radius and hi_dx >= radius:
+                            entry = deepest
+                        else:
+                            entry = INF
+                            i_lo = int(math.ceil((lo_dx + radius) / (2.0 * radius) * (n_samples - 1) - 1e-9))
+                            i_hi = int(math.floor((hi_dx + radius) / (2.0 * radius) * (n_samples - 1) + 1e-9))
+                            for i in range(max(i_lo, 0), min(i_hi, n_samples - 1) + 1):
+                                if samples[i] < entry:
+                                    entry = samples[i]
+                            for dx in (lo_dx, hi_dx):  # the move's own end poses, exactly
+                                e = _blade_entry(dx, theta0 + twist * dx, px, pz_, nx, nz_, y, z, t_min, top,
+                                                 radius, half_flat, rt)
+                                if e < entry:
+                                    entry = e
+                        if entry < hrow[r]:
+                            hrow[r] = entry
+                            cuts += 1
     return cuts
+
+
+@njit(cache=True)
+def chunk_groups(chunk_centre, chunk_radius):
+    """Circles around CHUNK_GROUP consecutive chunks, each holding its chunks' circles: (first chunk of each group
+    and one past the last, centres, radii). The chunk test is 1-Lipschitz in the centre, so a group failing it
+    with its own radius (and its spread at its farthest point from the axis) has no chunk that passes."""
+    n_chunks = len(chunk_radius)
+    n_groups = (n_chunks + CHUNK_GROUP - 1) // CHUNK_GROUP
+    start = np.empty(n_groups + 1, np.int64)
+    centre = np.empty((n_groups, 2))
+    radius = np.empty(n_groups)
+    for g in range(n_groups):
+        lo = g * CHUNK_GROUP
+        hi = min(lo + CHUNK_GROUP, n_chunks)
+        start[g] = lo
+        y_lo = min(chunk_centre[lo:hi, 0] - chunk_radius[lo:hi])
+        y_hi = max(chunk_centre[lo:hi, 0] + chunk_radius[lo:hi])
+        z_lo = min(chunk_centre[lo:hi, 1] - chunk_radius[lo:hi])
+        z_hi = max(chunk_centre[lo:hi, 1] + chunk_radius[lo:hi])
+        centre[g, 0] = 0.5 * (y_lo + y_hi)
+        centre[g, 1] = 0.5 * (z_lo + z_hi)
+        reach = 0.0
+        for ci in range(lo, hi):
+            reach = max(reach, math.hypot(chunk_centre[ci, 0] - centre[g, 0], chunk_centre[ci, 1] - centre[g, 1])
+                        + chunk_radius[ci])
+        radius[g] = reach * (1.0 + 1e-12) + 1e-9
+    start[n_groups] = n_chunks
+    return start, centre, radius
 
 
 @njit(cache=True, nogil=True)
@@ -355,9 +419,10 @@ def clip_poses_twisted(poses, x_end, h, h_top, points, normals, chunk_start, chu
     samples = np.empty(2 * int(math.ceil(radius / dx_step)) + 1 if dx_step > 0.0 else 1)
     row_cos = np.empty(len(rows))
     row_sin = np.empty(len(rows))
+    group_start, group_centre, group_radius = chunk_groups(chunk_centre, chunk_radius)
     for i in range(poses.shape[0]):
         cuts += _clip_twisted_pose(poses[i, 0], poses[i, 1], poses[i, 2], poses[i, 3], x_end[i], h, h_top, points,
                                    normals, chunk_start, chunk_centre, chunk_radius, rows, t_min, radius, half_flat, rt,
                                    reach, blade_len, pitch, teeth, twist, dx_step, row_first, row_stop, samples,
-                                   row_cos, row_sin)
+                                   row_cos, row_sin, group_start, group_centre, group_radius)
     return cuts
