@@ -14,6 +14,7 @@ See docs/simulation.md for the choice of representation. Each move is linear in 
 
 from __future__ import annotations
 
+import contextlib
 import functools
 import math
 import os
@@ -357,8 +358,6 @@ def simulate_grid(grid: DesignGrid, stock: StockCylinder, operations: Sequence[C
                   threads: int | None = None) -> SimResult:
     """`simulate` on a given design grid (any outline with normals, e.g. a plain cylinder in tests). A helical
     design is clipped on `threads` threads (default: simulation_threads()), with the same result for any number."""
-    from spur_cad.sim.kernel import clip_poses, clip_poses_twisted
-
     settings.validate()
     started = time.perf_counter() if started is None else started
     res = settings.resolution_mm
@@ -387,23 +386,13 @@ def simulate_grid(grid: DesignGrid, stock: StockCylinder, operations: Sequence[C
             batches.append((poses[lo:lo + POSE_BATCH], x_end[lo:lo + POSE_BATCH], radius, half_flat, rt, dx_step))
     total = sum(len(b[0]) for b in batches)
     done = 0
-    for poses, x_end, radius, half_flat, rt, dx_step in batches:
-        h_top = np.ascontiguousarray(h.max(axis=2))
-        # Blades only shorten, so each batch's chunk circles need hold them from t_min to their longest h only.
-        chunk_start, chunk_centre, chunk_radius = _chunks(grid, t_min, np.maximum(h_top.max(axis=0), t_min))
-        if twist:
-            clip = functools.partial(clip_poses_twisted, np.ascontiguousarray(poses), np.ascontiguousarray(x_end), h,
-                                     h_top, grid.points, grid.normals, chunk_start, chunk_centre, chunk_radius,
-                                     grid.rows_x, t_min, radius, half_flat, rt, reach, blade_len, grid.pitch_rad,
-                                     grid.teeth, twist, dx_step)
-            _on_row_blocks(clip, len(grid.rows_x), threads or simulation_threads())
-        else:
-            clip_poses(np.ascontiguousarray(poses), np.ascontiguousarray(x_end), h, h_top, grid.points, grid.normals,
-                       chunk_start, chunk_centre, chunk_radius, grid.rows_x, t_min, t_max, radius, half_flat, rt, reach,
-                       blade_len, grid.pitch_rad, grid.teeth)
-        done += len(poses)
-        if progress is not None:
-            progress(done / max(total, 1))
+    n_threads = min(threads or simulation_threads(), len(grid.rows_x)) if twist else 1
+    with ThreadPoolExecutor(max_workers=n_threads) if n_threads > 1 else contextlib.nullcontext() as pool:
+        for poses, x_end, radius, half_flat, rt, dx_step in batches:
+            done += _clip_batch(grid, h, poses, x_end, radius, half_flat, rt, dx_step, t_min, t_max, reach, blade_len,
+                                n_threads, pool)
+            if progress is not None:
+                progress(done / max(total, 1))
     # Rows stand for slabs of the stock; the stock's length outside the rows' span is not counted.
     stock_area = math.pi * stock.radius_mm**2
     removed = float(((stock_area - section_areas(grid, h)) * grid.row_width).sum())
@@ -411,23 +400,47 @@ def simulate_grid(grid: DesignGrid, stock: StockCylinder, operations: Sequence[C
                      total, sweeps, moves, np.asarray(station_x if station_x is not None else (), float))
 
 
+def _clip_batch(grid: DesignGrid, h: np.ndarray, poses: np.ndarray, x_end: np.ndarray, radius: float,
+                half_flat: float, rt: float, dx_step: float, t_min: float, t_max: float, reach: float,
+                blade_len: float, threads: int, pool: ThreadPoolExecutor | None) -> int:
+    """Clip h by one batch of poses (simulate_grid's loop); a helical design on `threads` threads of `pool`.
+    Returns the batch's number of poses."""
+    from spur_cad.sim.kernel import clip_poses, clip_poses_twisted
+
+
+    h_top = np.ascontiguousarray(h.max(axis=2))
+    # Blades only shorten, so each batch's chunk circles need hold them from t_min to their longest h only.
+    chunk_start, chunk_centre, chunk_radius = _chunks(grid, t_min, np.maximum(h_top.max(axis=0), t_min))
+    if grid.twist_rad_per_mm:
+        clip = functools.partial(clip_poses_twisted, np.ascontiguousarray(poses), np.ascontiguousarray(x_end), h,
+                                 h_top, grid.points, grid.normals, chunk_start, chunk_centre, chunk_radius,
+                                 grid.rows_x, t_min, radius, half_flat, rt, reach, blade_len, grid.pitch_rad,
+                                 grid.teeth, grid.twist_rad_per_mm, dx_step)
+        _on_row_blocks(clip, len(grid.rows_x), threads, pool)
+    else:
+        clip_poses(np.ascontiguousarray(poses), np.ascontiguousarray(x_end), h, h_top, grid.points, grid.normals,
+                   chunk_start, chunk_centre, chunk_radius, grid.rows_x, t_min, t_max, radius, half_flat, rt, reach,
+                   blade_len, grid.pitch_rad, grid.teeth)
+    return len(poses)
+
+
 def simulation_threads() -> int:
     """Threads the kernels run on: the processors this process may use, at most MAX_THREADS."""
     return max(1, min(len(os.sched_getaffinity(0)), MAX_THREADS))
 
 
-def _on_row_blocks(clip: Callable[[int, int], object], rows: int, threads: int) -> None:
-    """Run clip(first_row, stop_row) on disjoint blocks of rows, one per thread (the kernel releases the GIL).
-    Rows are independent (each blade's h is clipped by a minimum, searched from the same bounds whatever the
-    other rows hold), so the result is bit for bit that of one call on all rows."""
-    threads = min(threads, rows)
-    if threads <= 1:
+def _on_row_blocks(clip: Callable[[int, int], object], rows: int, threads: int,
+                   pool: ThreadPoolExecutor | None) -> None:
+    """Run clip(first_row, stop_row) on disjoint blocks of rows, one per thread of `pool` (the kernel releases the
+    GIL; one pool for a whole simulation: starting threads per batch cost 0.1 s on the helical example). Rows are
+    independent (each blade's h is clipped by a minimum, searched from the same bounds whatever the other rows
+    hold), so the result is bit for bit that of one call on all rows."""
+    if threads <= 1 or pool is None:
         clip(0, rows)
         return
     edges = np.linspace(0, rows, threads + 1).round().astype(int)
-    with ThreadPoolExecutor(max_workers=threads) as pool:
-        for future in [pool.submit(clip, int(lo), int(hi)) for lo, hi in zip(edges[:-1], edges[1:])]:
-            future.result()
+    for future in [pool.submit(clip, int(lo), int(hi)) for lo, hi in zip(edges[:-1], edges[1:])]:
+        future.result()
 
 
 def shifted(path: Toolpath, mask: np.ndarray, dy: np.ndarray | float = 0.0, dz: np.ndarray | float = 0.0) -> Toolpath:
