@@ -49,7 +49,8 @@ _, status, usage = os.wait4(child.pid, 0)
 done.set()
 sampler.join()
 with open(sys.argv[1], "w") as report:
-    report.write(f"{usage.ru_maxrss * 1024} {os.waitstatus_to_exitcode(status)} {together_kb[0] * 1024}")
+    together = max(together_kb[0], usage.ru_maxrss)  # a peak after the last sample: at least the largest process's
+    report.write(f"{usage.ru_maxrss * 1024} {os.waitstatus_to_exitcode(status)} {together * 1024}")
 sys.exit(0)
 """
 

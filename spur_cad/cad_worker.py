@@ -122,7 +122,10 @@ class CadWorker:
                 self._process.kill()
                 self._process.wait()
         self._reader.join(STOP_WAIT_S)  # the worker has ended: its stdout reaches end-of-file
-        for stream in (self._process.stdin, self._process.stdout):
+        streams = [self._process.stdin]
+        if not self._reader.is_alive():  # never closed under a thread still reading it (its number could be reused)
+            streams.append(self._process.stdout)
+        for stream in streams:
             try:
                 stream.close()
             except BrokenPipeError:  # closing flushes nothing: everything was flushed at the start

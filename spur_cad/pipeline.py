@@ -131,12 +131,13 @@ def run_job(job: Job, progress: Callable[[str, float], None] | None = None,
         programs, program_files = timed("post", None, lambda: build_programs(job, plan))
         program_files.update(other_programs(job, plan, restart, timed))
         drawings = timed("export", None, lambda: export_files(job)) if job.export.dxf or job.export.svg else {}
-        # The figures from the plan are drawn while the CAD worker builds; a run that simulates then waits for the
-        # worker before it loads the simulation's kernels (numba), so that OCP (in the worker) and numba are never
-        # resident at once: the run's memory is the larger of the two processes', not their sum
+        # The figures from the plan are drawn while the CAD worker builds; a run whose simulation loads numba then
+        # waits for the worker first, so that OCP (in the worker) and numba are never resident at once: the run's
+        # memory is the larger of the two processes', not their sum
         images = timed("plan_figures", None, lambda: plan_images(png, job.gear, job.stock.blank_radius_mm(job.gear),
                                                                  plan, job.modifications))
-        if worker is not None and job.simulation.enabled:
+        waits_before_simulating = worker is not None and simulates_with_kernels(job, plan)
+        if waits_before_simulating:
             cad, step, seconds["cad_and_step"] = timed("cad_wait", "CAD and STEP", worker.result)
         sim_result = timed("simulation", "simulation",
                            lambda: simulate_stage(job, plan, lambda fraction: tell("simulation", fraction)))
@@ -145,8 +146,8 @@ def run_job(job: Job, progress: Callable[[str, float], None] | None = None,
         # The simulation's figures read no CAD facts either: drawn from a result without them
         result = build_result(job, samples, None, plan, job.post, programs, sim_result, grading, seconds, budget)
         images.update(timed("report", "report", lambda: simulation_images(result, job.gear, plan, sim_result)))
-        if worker is not None and not job.simulation.enabled:  # its bar shown while the run waits for it, its time
-            cad, step, seconds["cad_and_step"] = timed("cad_wait", "CAD and STEP", worker.result)  # the worker's own
+        if worker is not None and not waits_before_simulating:  # its bar shown while the run waits for it, its
+            cad, step, seconds["cad_and_step"] = timed("cad_wait", "CAD and STEP", worker.result)  # time its own
         result = dataclasses.replace(result, cad=cad, correction=correction)
         template_source = shown_path(job.job.report_template) if job.job.report_template else "report.html.j2"
         figures_s = seconds["report"] + seconds.pop("plan_figures")
@@ -437,6 +438,13 @@ def job_stock(job: Job) -> StockCylinder:
 
     spec, stock = job.gear, job.stock
     return StockCylinder(stock.blank_radius_mm(spec), *stock.blank_x_range_mm(spec))
+
+
+def simulates_with_kernels(job: Job, plan: CamPlan) -> bool:
+    """Whether simulate_stage runs the 4-axis simulation, whose kernels load numba (a job lying flat is simulated
+    by spur_cad.sim.flat, in numpy)."""
+    cuts = any(planned is not None for planned in (plan.roughing, plan.roughing_bottom, plan.finishing))
+    return job.simulation.enabled and cuts and job.machine.axes != 3
 
 
 def simulate_stage(job: Job, plan: CamPlan, progress: Callable[[float], None] | None = None) -> SimResult | None:

@@ -283,29 +283,37 @@ def test_import_spur_cad_does_not_load_cadquery():
 
 def test_job_step_writes_the_parts_colour_styles_in_the_parts_order_whatever_order_occt_adds_them(tmp_path):
     """OCCT adds the two parts' colour styles last, in an order keyed by the shapes' addresses (it changed from
-    run to run): job.step puts them in the parts' order, so that two runs write the same bytes. Here the styles
-    are put in the other order on purpose before the file is written: the same bytes come out, gear's style first,
-    every reference within the file."""
+    run to run): job.step puts them in the parts' order, so that two runs write the same bytes. Here the stock's
+    style (11 entities, with its translucency) is planted before the gear's (9) on purpose, whatever order OCCT
+    chose, so both moves are made (each block over the other): the same bytes come out, the gear's colour first."""
     import re
 
     from OCP.IFSelect import IFSelect_RetDone
 
-    from spur_cad.cad.step import _assembly_writer, _styles_in_part_order, style_blocks
+    from spur_cad.cad.step import (
+        GEAR_COLOUR,
+        STOCK_COLOUR,
+        _assembly_writer,
+        _styles_in_part_order,
+        style_blocks,
+        swap_style_blocks,
+    )
 
     spec = spec_of("reference_z23_m4")
     gear, stock = spur_cad.make_gear(spec).val().wrapped, spur_cad.make_stock(spec).val().wrapped
     written = step_files(gear, stock, "2023-11-14T22:13:20")["job.step"]
     writer = _assembly_writer(gear, stock, "2023-11-14T22:13:20")
     model = writer.ChangeWriter().Model()
+    if [part for part, _, _ in style_blocks(model)] == [1, 0]:
+        swap_style_blocks(model, *style_blocks(model))
     blocks = style_blocks(model)
-    assert sorted(part for part, _, _ in blocks) == [0, 1]
-    (_, first_start, _), (_, second_start, second_size) = blocks
-    model.ChangeOrder(second_start, first_start, second_size)  # the order OCCT did not choose this time
-    assert [part for part, _, _ in style_blocks(model)] == [blocks[1][0], blocks[0][0]]
-    _styles_in_part_order(model)
+    assert [(part, size) for part, _, size in blocks] == [(0, 9), (1, 11)]
+    swap_style_blocks(model, *blocks)  # the stock's 11 entities moved before the gear's 9
+    assert [(part, size) for part, _, size in style_blocks(model)] == [(1, 11), (0, 9)]
+    _styles_in_part_order(model)  # and the gear's 9 back before the stock's 11
+    assert [part for part, _, _ in style_blocks(model)] == [0, 1]
     assert writer.Write(str(tmp_path / "job.step")) == IFSelect_RetDone
     assert (tmp_path / "job.step").read_bytes() == written
-    styled = re.findall(rb"STYLED_ITEM\('color',\(#\d+\),(#\d+)\)", written)
-    assert len(styled) == 2 and b"MANIFOLD_SOLID_BREP" in re.search(rb"\n" + styled[0] + rb" = ([^;]+);",
-                                                                     written).group(1)
-    assert [part for part, _, _ in style_blocks(model)] == [0, 1]
+    colours = [tuple(round(float(v), 6) for v in match) for match in
+               re.findall(rb"COLOUR_RGB\('[^']*',([0-9.eE+-]+),([0-9.eE+-]+),([0-9.eE+-]+)\)", written)]
+    assert colours == [GEAR_COLOUR[:3], STOCK_COLOUR[:3]]

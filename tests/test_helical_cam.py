@@ -652,10 +652,11 @@ def test_the_pruned_searches_give_the_bits_of_searches_over_every_point(name):
 
 def test_a_chunk_group_that_misses_the_tool_has_no_chunk_that_meets_it():
     """The helical kernel tests a circle around 8 consecutive chunks before their own circles (CHUNK_GROUP): every
-    chunk's circle must lie in its group's, and whenever the group misses the tool's section (_circle_misses, with
-    the design's spread), each of its chunks must miss it too, so that passing over the group changes no blade.
-    Random chunks along a curve and random tool sections, turned designs and spreads."""
-    from spur_cad.sim.kernel import _circle_misses, chunk_groups
+    chunk's circle must lie in its group's, and whenever the group misses the tool's section (its distance beyond
+    group_reach, the design's spread included), each of its chunks must miss it too (beyond chunk_reach), so that
+    passing over the group changes no blade. Random chunks along a curve and random tool sections, turned designs
+    and spreads."""
+    from spur_cad.sim.kernel import _chunk_gap, chunk_groups, chunk_reach, group_reach
 
     rng = np.random.default_rng(27)
     missing_groups = meeting_chunks = 0
@@ -669,18 +670,21 @@ def test_a_chunk_group_that_misses_the_tool_has_no_chunk_that_meets_it():
         for g in range(len(radius)):
             members = np.arange(start[g], start[g + 1])
             assert np.all(np.hypot(*(centres[members] - centre[g]).T) + radii[members] <= radius[g])
-        for _ in range(20):
+        for _ in range(40):
             turn = rng.uniform(-np.pi, np.pi)
             c, s = np.cos(turn), np.sin(turn)
-            y, z = rng.uniform(-40.0, 40.0), rng.uniform(-40.0, 40.0)
+            near = centre[rng.integers(len(radius))]  # a section near one group: gaps about its reach
+            y = c * near[0] - s * near[1] + rng.uniform(-4.0, 4.0)
+            z = s * near[0] + c * near[1] + rng.uniform(-4.0, 4.0)
             half_flat, corner = rng.uniform(0.0, 2.0), rng.uniform(0.0, 1.5)
-            spread = rng.choice([0.0, rng.uniform(0.0, 0.02)])
+            spread = rng.choice([0.0, rng.uniform(0.0, 0.1)])
             for g in range(len(radius)):
-                if not _circle_misses(c, s, centre[g, 0], centre[g, 1], radius[g], y, z, half_flat, corner, spread):
+                gy, gz = centre[g]
+                if _chunk_gap(c, s, gy, gz, y, z, half_flat, corner) <= group_reach(gy, gz, radius[g], spread):
                     continue
                 missing_groups += 1
-                meeting_chunks += sum(not _circle_misses(c, s, centres[ci, 0], centres[ci, 1], radii[ci], y, z,
-                                                         half_flat, corner, spread)
+                meeting_chunks += sum(_chunk_gap(c, s, *centres[ci], y, z, half_flat, corner)
+                                      <= chunk_reach(*centres[ci], radii[ci], spread)
                                       for ci in range(start[g], start[g + 1]))
     assert missing_groups > 1000
     assert meeting_chunks == 0

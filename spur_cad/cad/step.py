@@ -153,20 +153,30 @@ def style_blocks(model) -> list[tuple[int, int, int]]:
     blocks = []
     for start, end in zip(starts, [*(start - 1 for start in starts[1:]), last]):
         entities = [model.Value(i) for i in range(start, end + 1)]
-        colour = next(entity for entity in entities if isinstance(entity, StepVisual_ColourRgb))
-        rgb = tuple(round(value, 6) for value in (colour.Red(), colour.Green(), colour.Blue()))
+        colour = next((entity for entity in entities if isinstance(entity, StepVisual_ColourRgb)), None)
+        rgb = None if colour is None else tuple(round(value, 6) for value in (colour.Red(), colour.Green(),
+                                                                              colour.Blue()))
         blocks.append((part_of_colour.get(rgb, len(part_of_colour)), start, end - start + 1))
     return blocks
+
+
+def swap_style_blocks(model, first: tuple[int, int, int], second: tuple[int, int, int]) -> None:
+    """Move the `second` of two adjacent style blocks (style_blocks' (part, first entity, entities)) before the
+    `first`, one entity at a time: OCCT's ChangeOrder moves a block forward only over at least as many entities
+    as it holds, and the two blocks differ in size (the stock's translucency adds two entities)."""
+    _, first_start, _ = first
+    _, second_start, second_size = second
+    for k in range(second_size):
+        model.ChangeOrder(second_start + k, first_start + k, 1)
 
 
 def _styles_in_part_order(model) -> None:
     """Put the parts' two colour styles in the parts' order, gear then stock: OCCT adds them in an order that
     changes from run to run (its map of styles is keyed by the shapes' addresses), and two runs must write the
-    same bytes."""
+    same bytes. Styles not recognised as the two parts' are left as OCCT wrote them."""
     blocks = style_blocks(model)
-    if len(blocks) == 2 and blocks[0][0] > blocks[1][0]:
-        (_, first_start, _), (_, second_start, second_size) = blocks
-        model.ChangeOrder(second_start, first_start, second_size)  # the second block moved before the first
+    if [part for part, _, _ in blocks] == [1, 0]:
+        swap_style_blocks(model, *blocks)
 
 
 def _assembly_writer(gear: TopoDS_Shape, stock: TopoDS_Shape, timestamp: str | None):

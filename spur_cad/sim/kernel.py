@@ -148,12 +148,18 @@ def _chunk_gap(c, s, py, pz, y, z, half_flat, rt):
 
 
 @njit(cache=True, inline="always")
-def _circle_misses(c, s, py, pz, circle_radius, y, z, half_flat, rt, spread):
-    """A circle of design points (centre (py, pz), turned by (cos, sin) = (c, s)) lies clear of the tool's section at
-    (y, z) even when the design turns by +- spread about the axis (a helical design over the tool's width): its
-    centre's distance to the section exceeds its radius plus how far spread moves its farthest point."""
-    reach = circle_radius + spread * (math.hypot(py, pz) + circle_radius)
-    return _chunk_gap(c, s, py, pz, y, z, half_flat, rt) > reach
+def chunk_reach(py, pz, chunk_radius, spread):
+    """How far from a chunk's centre (py, pz) its blades can be when the design turns by +- spread about the axis
+    (a helical design over the tool's width): its radius, plus how far the turn moves its centre (a turned disc
+    is a disc of the same radius)."""
+    return chunk_radius + spread * math.hypot(py, pz)
+
+
+@njit(cache=True, inline="always")
+def group_reach(gy, gz, group_radius, spread):
+    """chunk_reach for a group circle, enough for every chunk in it: a chunk's centre c lies within the group's
+    radius R of the group's centre C, so the turn moves it by at most spread (|C| + R)."""
+    return group_radius + spread * (math.hypot(gy, gz) + group_radius)
 
 
 @njit(cache=True)
@@ -309,13 +315,14 @@ def _clip_twisted_pose(x, y, z, a, x_end, h, h_top, points, normals, chunk_start
                 row_cos[r - r_lo] = math.cos(theta)
                 row_sin[r - r_lo] = math.sin(theta)
         for gi in range(len(group_radius)):
-            if _circle_misses(c, s, group_centre[gi, 0], group_centre[gi, 1], group_radius[gi], y, z, half_flat, rt,
-                              spread):
+            gy = group_centre[gi, 0]
+            gz = group_centre[gi, 1]
+            if _chunk_gap(c, s, gy, gz, y, z, half_flat, rt) > group_reach(gy, gz, group_radius[gi], spread):
                 continue  # then every chunk of the group misses too (chunk_groups)
             for ci in range(group_start[gi], group_start[gi + 1]):
                 py = chunk_centre[ci, 0]
                 pz = chunk_centre[ci, 1]
-                if _circle_misses(c, s, py, pz, chunk_radius[ci], y, z, half_flat, rt, spread):
+                if _chunk_gap(c, s, py, pz, y, z, half_flat, rt) > chunk_reach(py, pz, chunk_radius[ci], spread):
                     continue
                 if not sweep:
                     for r in range(r_lo, r_hi):
@@ -382,8 +389,8 @@ def _clip_twisted_pose(x, y, z, a, x_end, h, h_top, points, normals, chunk_start
 @njit(cache=True)
 def chunk_groups(chunk_centre, chunk_radius):
     """Circles around CHUNK_GROUP consecutive chunks, each holding its chunks' circles: (first chunk of each group
-    and one past the last, centres, radii). The chunk test is 1-Lipschitz in the centre, so a group failing it
-    with its own radius (and its spread at its farthest point from the axis) has no chunk that passes."""
+    and one past the last, centres, radii). The distance to the tool's section (_chunk_gap) is 1-Lipschitz in the
+    centre, so a group whose distance exceeds its group_reach has no chunk within its chunk_reach."""
     n_chunks = len(chunk_radius)
     n_groups = (n_chunks + CHUNK_GROUP - 1) // CHUNK_GROUP
     start = np.empty(n_groups + 1, np.int64)

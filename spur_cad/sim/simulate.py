@@ -407,7 +407,6 @@ def _clip_batch(grid: DesignGrid, h: np.ndarray, poses: np.ndarray, x_end: np.nd
     Returns the batch's number of poses."""
     from spur_cad.sim.kernel import clip_poses, clip_poses_twisted
 
-
     h_top = np.ascontiguousarray(h.max(axis=2))
     # Blades only shorten, so each batch's chunk circles need hold them from t_min to their longest h only.
     chunk_start, chunk_centre, chunk_radius = _chunks(grid, t_min, np.maximum(h_top.max(axis=0), t_min))
