@@ -285,10 +285,11 @@ def _blade_entry(dx, theta, px, pz_, nx, nz_, y, z, lo, hi, radius, half_flat, r
 @njit(cache=True)
 def _clip_twisted_pose(x, y, z, a, x_end, h, h_top, points, normals, chunk_start, chunk_centre, chunk_radius,
                        rows, t_min, radius, half_flat, rt, reach, blade_len, pitch, teeth, twist, dx_step, row_first,
-                       row_stop, samples, row_cos, row_sin, group_start, group_centre, group_radius):
+                       row_stop, samples, row_cos, row_sin, row_bottom, row_half_width, group_start, group_centre,
+                       group_radius):
     """Clip the blades of a helical design by the tool at (x, y, z, a) or, with x_end > x, by the tool
     following the lead from x to x_end (entries sampled every dx_step over the tool's width); only the rows
-    row_first <= r < row_stop. `samples`, `row_cos` and `row_sin` are work space (as long as clip_poses_twisted
+    row_first <= r < row_stop. `samples` and the `row_*` arrays are work space (as long as clip_poses_twisted
     makes them). `group_*` are chunk_groups' circles around consecutive chunks, tested before their chunks."""
     if z > reach:
         return 0
@@ -304,6 +305,14 @@ def _clip_twisted_pose(x, y, z, a, x_end, h, h_top, points, normals, chunk_start
     if sweep:
         n_samples = 2 * int(math.ceil(radius / dx_step)) + 1  # odd: dx = 0 is a sample
     cuts = 0
+    if not sweep:
+        # The tool's slice at row r (dx = rows[r] - x) lies in the box |u - y| <= sqrt(R^2 - dx^2), w >= z + its
+        # lowest point (the corner's bottom there): computed once per pose, not per tooth space and chunk
+        for r in range(r_lo, r_hi):
+            dx = rows[r] - x
+            corner_dx = max(abs(dx) - half_flat, 0.0)
+            row_bottom[r - r_lo] = rt - math.sqrt(max(rt * rt - corner_dx * corner_dx, 0.0))
+            row_half_width[r - r_lo] = math.sqrt(max(radius * radius - dx * dx, 0.0))
     for k in range(first, last + 1):
         sector = k % teeth
         theta0 = c0 + k * pitch
@@ -329,13 +338,9 @@ def _clip_twisted_pose(x, y, z, a, x_end, h, h_top, points, normals, chunk_start
                         dx = rows[r] - x
                         rc = row_cos[r - r_lo]  # as _blade_entry turns the blade, with the row's cos and sin
                         rs = row_sin[r - r_lo]
-                        # The tool's slice at dx lies in the box |u - y| <= sqrt(R^2 - dx^2), w >= z + its lowest
-                        # point (the corner's bottom there): a chunk whose circle misses the box has no blade to
-                        # clip here.
-                        corner_dx = max(abs(dx) - half_flat, 0.0)
-                        bottom = rt - math.sqrt(max(rt * rt - corner_dx * corner_dx, 0.0))
-                        box_half_width = math.sqrt(max(radius * radius - dx * dx, 0.0))
-                        if _chunk_gap(rc, rs, py, pz, y, z + bottom, box_half_width, 0.0) > chunk_radius[ci]:
+                        # a chunk whose circle misses the box holding the tool's slice has no blade to clip here
+                        if _chunk_gap(rc, rs, py, pz, y, z + row_bottom[r - r_lo], row_half_width[r - r_lo],
+                                      0.0) > chunk_radius[ci]:
                             continue
                         for j in range(chunk_start[ci], chunk_start[ci + 1]):
                             current = h[sector, j, r]
@@ -426,10 +431,13 @@ def clip_poses_twisted(poses, x_end, h, h_top, points, normals, chunk_start, chu
     samples = np.empty(2 * int(math.ceil(radius / dx_step)) + 1 if dx_step > 0.0 else 1)
     row_cos = np.empty(len(rows))
     row_sin = np.empty(len(rows))
+    row_bottom = np.empty(len(rows))
+    row_half_width = np.empty(len(rows))
     group_start, group_centre, group_radius = chunk_groups(chunk_centre, chunk_radius)
     for i in range(poses.shape[0]):
         cuts += _clip_twisted_pose(poses[i, 0], poses[i, 1], poses[i, 2], poses[i, 3], x_end[i], h, h_top, points,
                                    normals, chunk_start, chunk_centre, chunk_radius, rows, t_min, radius, half_flat, rt,
                                    reach, blade_len, pitch, teeth, twist, dx_step, row_first, row_stop, samples,
-                                   row_cos, row_sin, group_start, group_centre, group_radius)
+                                   row_cos, row_sin, row_bottom, row_half_width, group_start, group_centre,
+                                   group_radius)
     return cuts
