@@ -25,7 +25,7 @@ from spur_cad.errors import shown_path
 from spur_cad.geometry.sampling import ProfileSamples, sample_profile
 from spur_cad.inputs import step_timestamp
 from spur_cad.job import Job
-from spur_cad.result import JobResult
+from spur_cad.result import CadResult, JobResult
 from spur_cad.summary import build_result, summary_json
 from spur_cad.version import __version__
 
@@ -138,7 +138,7 @@ def run_job(job: Job, progress: Callable[[str, float], None] | None = None,
                                                                  plan, job.modifications))
         waits_before_simulating = worker is not None and simulates_with_kernels(job, plan)
         if waits_before_simulating:
-            cad, step, seconds["cad_and_step"] = timed("cad_wait", "CAD and STEP", worker.result)
+            cad, step = cad_from_worker(worker, timed, seconds)
         sim_result = timed("simulation", "simulation",
                            lambda: simulate_stage(job, plan, lambda fraction: tell("simulation", fraction)))
         grading = timed("grading", None, lambda: grade_stage(job, sim_result, plan))
@@ -146,8 +146,8 @@ def run_job(job: Job, progress: Callable[[str, float], None] | None = None,
         # The simulation's figures read no CAD facts either: drawn from a result without them
         result = build_result(job, samples, None, plan, job.post, programs, sim_result, grading, seconds, budget)
         images.update(timed("report", "report", lambda: simulation_images(result, job.gear, plan, sim_result)))
-        if worker is not None and not waits_before_simulating:  # its bar shown while the run waits for it, its
-            cad, step, seconds["cad_and_step"] = timed("cad_wait", "CAD and STEP", worker.result)  # time its own
+        if worker is not None and not waits_before_simulating:
+            cad, step = cad_from_worker(worker, timed, seconds)
         result = dataclasses.replace(result, cad=cad, correction=correction)
         template_source = shown_path(job.job.report_template) if job.job.report_template else "report.html.j2"
         figures_s = seconds["report"] + seconds.pop("plan_figures")
@@ -165,6 +165,14 @@ def run_job(job: Job, progress: Callable[[str, float], None] | None = None,
             "summary.json": (json.dumps(summary_json(result), indent=2, sort_keys=False) + "\n").encode(),
         }
         return dataclasses.replace(result, files=files)
+
+
+def cad_from_worker(worker: CadWorker, timed: Callable, seconds: dict[str, float]) -> tuple[CadResult,
+                                                                                             dict[str, bytes]]:
+    """Wait for run_job's CAD worker, timed as 'cad_wait' with the CAD stage's bar shown meanwhile; the stage's own
+    time ('cad_and_step' in `seconds`) is the worker's."""
+    cad, step, seconds["cad_and_step"] = timed("cad_wait", "CAD and STEP", worker.result)
+    return cad, step
 
 
 def other_programs(job: Job, plan: CamPlan, restart: RestartPoint | None, timed: Callable) -> dict[str, bytes]:
