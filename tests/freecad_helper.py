@@ -7,18 +7,37 @@ the main window exists and then stays open, also after an exception. So the code
 wrapped: it writes a JSON result file (`{"ok": true, ...}` or `{"ok": false, "error": ...}`)
 and, in the GUI, closes the main window in a `finally`. As root the GUI needs
 QTWEBENGINE_DISABLE_SANDBOX=1 (else Chromium's zygote aborts and freecad exits 1).
+
+Every run writes FreeCAD's log (`--log-file=FILE`, after the script: 0.20's executables take no
+option before it) and fails, whatever the test body found, when the log holds a traceback, an error,
+a warning or a Qt warning that the test did not name as expected (`log_allowed`). FreeCAD routes Qt's
+messages into its console: 0.20 as "Log:" lines, 1.0 and 1.1 as "Wrn:" lines (observed in all three).
 """
 
 from __future__ import annotations
 
 import json
 import os
+import re
 import signal
 import subprocess
 from pathlib import Path
 
 GUI_TIMEOUT_S = 180.0
 CMD_TIMEOUT_S = 120.0
+LOG_NAME = "freecad.log"
+
+# A log entry starts with its level; lines that do not (a traceback's, a banner's) continue the entry before.
+_LOG_ENTRY = re.compile(r"^\ufeff?(Msg|Log|Wrn|Err): ", re.MULTILINE)
+# A message of Qt itself: "QPainter::begin: ...", "QXcbConnection: ...", "QStandardPaths: ...".
+_QT_MESSAGE = re.compile(r"^Q[A-Z][A-Za-z0-9]*(::[A-Za-z0-9_~]+)*: ")
+# Lines FreeCAD writes in these environments whatever the workbench does, each with where it comes from.
+ENVIRONMENT_LOG_LINES = (
+    # 0.20 on Debian 12: FreeCAD's own Addon Manager, at start-up (Debian packages no python3-pyside2.qtwebengine).
+    re.compile(r"^Wrn: Addon Manager Warning: Could not import QtWebEngineWidgets"),
+    # 0.20 under Xvfb, which has no window manager: Qt focusing the main window as it hides at the end.
+    re.compile(r"^Log: QXcbConnection: XCB error: 8 \(BadMatch\).*major code: 42 \(SetInputFocus\)"),
+)
 
 # Runs first inside FreeCAD: make the venv importable, run the test code, record the outcome.
 _PRELUDE = r'''
@@ -69,6 +88,9 @@ def _environment(work: Path, site_packages: str | None) -> dict[str, str]:
     home = work / "home"
     home.mkdir(exist_ok=True)
     env["HOME"] = str(home)
+    runtime = work / "runtime"  # Qt warns "XDG_RUNTIME_DIR not set" without one (1.0 as a warning in the log)
+    runtime.mkdir(mode=0o700, exist_ok=True)
+    env["XDG_RUNTIME_DIR"] = str(runtime)
     if site_packages:
         env["SPUR_CAD_SITE_PACKAGES"] = site_packages
     if os.geteuid() == 0:
@@ -91,12 +113,37 @@ def run_in_session(cmd: list[str], env: dict[str, str], cwd: Path,
     return subprocess.CompletedProcess(cmd, proc.returncode, out, err)
 
 
+def log_entries(text: str) -> list[str]:
+    """The entries of a FreeCAD log file: each starts with its level ("Err: ...") and holds its continuation lines."""
+    starts = [match.start() for match in _LOG_ENTRY.finditer(text)]
+    return [text[start:end].strip("\ufeff\n") for start, end in zip(starts, starts[1:] + [len(text)])]
+
+
+def log_problems(text: str, allowed: tuple[str, ...] = ()) -> list[str]:
+    """The entries of a FreeCAD log that fail a run: errors, warnings, tracebacks and Qt's messages, except
+    those matching a regular expression in `allowed` (searched) or ENVIRONMENT_LOG_LINES (matched)."""
+    problems = []
+    for entry in log_entries(text):
+        level, message = entry[:3], entry[5:]
+        bad = (level in ("Err", "Wrn") or "Traceback (most recent call last)" in entry
+               or _QT_MESSAGE.match(message) is not None)
+        if not bad or any(pattern.match(entry) for pattern in ENVIRONMENT_LOG_LINES):
+            continue
+        if not any(re.search(pattern, entry) for pattern in allowed):
+            problems.append(entry)
+    return problems
+
+
 def run_freecad_code(body: str, work: Path, *, freecadcmd: str | None = None,
                      gui: tuple[str, str] | None = None, site_packages: str | None = None,
-                     timeout_s: float | None = None) -> tuple[dict | None, subprocess.CompletedProcess]:
+                     timeout_s: float | None = None,
+                     log_allowed: tuple[str, ...] = ()) -> tuple[dict | None, subprocess.CompletedProcess]:
     """Run `body` in FreeCAD; return (RESULT dict or None if none was written, process).
 
-    `body` fills the dict `RESULT`; an exception sets RESULT["ok"] = False and "error".
+    `body` fills the dict `RESULT`; an exception sets RESULT["ok"] = False and "error". So does an entry of
+    FreeCAD's log that `log_problems` finds (a traceback, error, warning or Qt message) unless one of the
+    regular expressions `log_allowed` matches it: what a test provokes on purpose, such as an input error's
+    one line. The log's text is RESULT["log"].
     Give `freecadcmd=path` for the console, or `gui=(xvfb_run, freecad)` for the GUI.
     """
     work.mkdir(parents=True, exist_ok=True)
@@ -109,19 +156,31 @@ def run_freecad_code(body: str, work: Path, *, freecadcmd: str | None = None,
     body_file.write_text(body)
     env["SPUR_CAD_BODY"] = str(body_file)
     env["SPUR_CAD_RESULT"] = str(result_file)
+    log_file = work / LOG_NAME
+    log_file.unlink(missing_ok=True)
+    log_option = f"--log-file={log_file}"
     if gui:
         xvfb_run, freecad = gui
-        cmd = [xvfb_run, "-a", "-s", "-screen 0 1280x1024x24", freecad, str(script)]
+        cmd = [xvfb_run, "-a", "-s", "-screen 0 1280x1024x24", freecad, str(script), log_option]
         timeout_s = timeout_s or GUI_TIMEOUT_S
     else:
-        cmd = [freecadcmd, str(script)]
+        cmd = [freecadcmd, str(script), log_option]
         timeout_s = timeout_s or CMD_TIMEOUT_S
     proc = run_in_session(cmd, env, work, timeout_s)
     result = json.loads(result_file.read_text()) if result_file.exists() else None
+    log = log_file.read_text(errors="replace") if log_file.exists() else ""
+    if result is not None:
+        result["log"] = log
+        problems = log_problems(log, log_allowed) if log else [f"FreeCAD wrote no log file {log_file}"]
+        if problems and result.get("ok"):
+            result["ok"] = False
+            result["error"] = "FreeCAD's log holds:\n" + "\n".join(problems)
     return result, proc
 
 
 def describe(proc: subprocess.CompletedProcess, result: dict | None) -> str:
     """Failure text: exit status, result and the tail of FreeCAD's output."""
+    if result is not None:
+        result = {key: value for key, value in result.items() if key != "log"}
     return (f"exit status {proc.returncode}; result {result!r}\n"
             f"--- stdout (tail)\n{proc.stdout[-3000:]}\n--- stderr (tail)\n{proc.stderr[-3000:]}")

@@ -17,6 +17,7 @@ import pytest
 from tests.freecad_helper import describe
 from tests.workbench_helper import (
     ARTIFACTS,
+    GUI_PRELUDE,
     SMALL_GEAR_PROPERTIES,
     SMALL_STOCK_PROPERTIES,
     run_workbench_code,
@@ -28,24 +29,9 @@ VIEW_SHOT = ARTIFACTS / "workbench_simulation_view.png"
 DOCK_WIDTH_PX = 240  # narrower than FreeCAD's default combo view dock (264 px): issue 28 measured 240 px
 LONG_LABEL = "gear job for the customer's gearbox spare part 12345, second batch"
 
-BODY = r"""
-import sys, traceback
-import FreeCAD, FreeCADGui
-from PySide import QtCore, QtGui
-
-hooked = []
-sys.excepthook = lambda kind, value, tb: hooked.append("".join(traceback.format_exception(kind, value, tb)))
-main_window = FreeCADGui.getMainWindow()
-
-def settle(times=8):
-    for _ in range(times):
-        QtGui.QApplication.processEvents()
-
+BODY = GUI_PRELUDE + r"""
 FreeCADGui.activateWorkbench("SpurCadWorkbench")
-dock = [d for d in main_window.findChildren(QtGui.QDockWidget) if d.objectName() == "Combo View"][0]
-main_window.resizeDocks([dock], [DOCK_WIDTH], QtCore.Qt.Horizontal)
 settle()
-RESULT["dock_width"] = dock.width()
 
 from spur_cad_workbench import commands
 doc = FreeCAD.newDocument("Panel")
@@ -63,6 +49,8 @@ RESULT["roughing_strategy"] = job.RoughingStrategy
 
 FreeCADGui.ActiveDocument.setEdit(job.Name)
 settle()
+dock = set_task_dock_width(DOCK_WIDTH)   # once the panel is open: 1.1's overlay dock shows with its task
+RESULT["dock_width"] = dock.width()
 panel = job.ViewObject.Proxy.panel
 scroll = panel.form.parentWidget()
 while scroll is not None and not isinstance(scroll, QtGui.QScrollArea):
@@ -208,9 +196,9 @@ sim = commands.simulate(job, resolution_mm=0.02)
 settle()
 RESULT["sim"] = [sim.Job.Name, sim.Status, sim.PlanSource, sim.ColourScale.Value, max(abs(d) for d in sim.Deviations),
                  sim.MaxGougeMicrons, sim.MaxLeftoverMicrons, sim.Legend, sim.TypeId]
-from spur_cad_workbench.colourbar import find_colour_bar
+from spur_cad_workbench.colourbar import find_colour_bar, scene_graph
 view = FreeCADGui.ActiveDocument.ActiveView
-RESULT["colour_bar"] = find_colour_bar(view.getSceneGraph()) is not None
+RESULT["colour_bar"] = find_colour_bar(scene_graph(view)) is not None
 reds = sum(1 for c in sim.Color if c[0] > 0.99)
 sim.ColourScale = sim.ColourScale.Value / 4.0
 RESULT["rescaled"] = [reds, sum(1 for c in sim.Color if c[0] > 0.99), sim.Legend]
@@ -246,14 +234,14 @@ RESULT["fixed_gear"] = [list(gear.State), gear.Status, job.RoughingToolpath.Stat
 job.TargetScallop = 0.02   # the simulated values again: the simulation is current again
 doc.recompute()
 RESULT["sim_current_again"] = [sim.Status, sim.ViewObject.DisplayMode,
-                               find_colour_bar(view.getSceneGraph()) is not None]
+                               find_colour_bar(scene_graph(view)) is not None]
 
 # the property editor lists the inputs first (FreeCAD sorts groups by name; computed ones are "Values: ...").
 # FreeCAD's property view ignores the selection while hidden: close any task dialog and show the Model tab.
 if FreeCADGui.Control.activeDialog():
     FreeCADGui.Control.closeDialog()
 settle()
-for tabs in dock.findChildren(QtGui.QTabWidget):
+for tabs in model_dock().findChildren(QtGui.QTabWidget):   # 0.20: the Combo View's "Model" tab (1.x: a dock)
     tabs.setCurrentIndex(0)
 FreeCADGui.Selection.clearSelection()
 groups = {}

@@ -22,8 +22,6 @@ GEAR = dict(Teeth=23, Module=4.0, FaceWidth=20.0, RackTipRadius=0.8, TipRelief=1
 BODY = GUI_PRELUDE + r"""
 
 FreeCADGui.activateWorkbench("SpurCadWorkbench")
-dock = [d for d in main_window.findChildren(QtGui.QDockWidget) if d.objectName() == "Combo View"][0]
-main_window.resizeDocks([dock], [DOCK_WIDTH], QtCore.Qt.Horizontal)
 settle()
 
 from spur_cad_workbench import commands
@@ -35,8 +33,10 @@ doc.recompute()
 RESULT["statuses"] = [gear.Status, job.Status]
 
 def open_panel():
+    global dock
     FreeCADGui.ActiveDocument.setEdit(job.Name)
     settle()
+    dock = set_task_dock_width(DOCK_WIDTH)   # once the panel is open: 1.1's overlay dock shows with its task
     panel = job.ViewObject.Proxy.panel
     scroll = panel.form.parentWidget()
     while not isinstance(scroll, QtGui.QScrollArea):

@@ -70,9 +70,43 @@ report = main_window.findChild(QtGui.QTextEdit, "Report view")
 def settle(times=8):
     for _ in range(times):
         QtGui.QApplication.processEvents()
+
+def dock_holding(class_name):
+    # the dock widget around FreeCAD's widget of C++ class `class_name`, found by what it holds, not by its title
+    for widget in main_window.findChildren(QtGui.QWidget):
+        if widget.metaObject().className() == class_name:
+            while widget is not None and not isinstance(widget, QtGui.QDockWidget):
+                widget = widget.parentWidget()
+            return widget
+    return None
+
+def task_dock():
+    # the task view's dock: 0.20 a tab of "Combo View", 1.0 a dock "Tasks" beside "Model", 1.1 a dock "Tasks" in the
+    # right-hand overlay (observed in each)
+    return dock_holding("Gui::TaskView::TaskView")
+
+def model_dock():
+    # the model tree's dock (Gui::DockWnd::ComboView): "Combo View" in 0.20 (its first tab), "Model" in 1.0 and 1.1
+    return dock_holding("Gui::DockWnd::ComboView")
+
+def set_task_dock_width(width):
+    # a dock in the main window's dock areas is resized by the main window (0.20, 1.0); 1.1's overlay
+    # (Gui::OverlayTabWidget, outside the dock areas, 388 px wide by default) by resizing the overlay itself
+    dock = task_dock()
+    overlay = dock.parentWidget()
+    while overlay is not None and overlay.metaObject().className() != "Gui::OverlayTabWidget":
+        overlay = overlay.parentWidget()
+    if overlay is not None:
+        overlay.resize(width, overlay.height())
+    else:
+        main_window.resizeDocks([dock], [width], QtCore.Qt.Horizontal)
+    settle()
+    return dock
 """
 """The start of a test body run in FreeCAD's GUI: uncaught exceptions collected in `hooked` (a test asserts it
-stays empty), the main window and its report view, and `settle()` (let Qt process pending events)."""
+stays empty), the main window and its report view, `settle()` (let Qt process pending events), and the docks
+found by what they hold (`task_dock()`, `model_dock()`, `set_task_dock_width(px)`), whose titles and places differ
+between FreeCAD 0.20, 1.0 and 1.1."""
 
 
 def small_job_text(teeth: int = 12, finishing_diameter: float = 1.5) -> str:

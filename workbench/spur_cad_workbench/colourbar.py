@@ -4,6 +4,11 @@ A vertical bar at the view's left edge from blue (gouge of the full scale) throu
 design) to red (leftover of the full scale), labelled in micrometres. It is one node under the
 view's scene graph named COLOUR_BAR_NAME, with its own orthographic camera, drawn after the
 scene (SoAnnotation) so the part never hides it; showing it again replaces the old one.
+
+The view's scene graph is reached only through `scene_graph`, which imports pivy first: `getSceneGraph`
+returns a SWIG-wrapped Coin node, and before pivy's `coin` module is loaded FreeCAD 1.0 raises "No SWIG
+wrapped library loaded" and 1.1 "SWIG: Cannot find type information for requested type: SoSeparator *"
+(observed; 0.20 happened to have pivy loaded already).
 """
 
 from __future__ import annotations
@@ -75,6 +80,13 @@ def colour_bar_node(scale_mm: float, aspect: float):
     return root
 
 
+def scene_graph(view):
+    """The root Coin node of a 3D view (`view.getSceneGraph()`), with pivy imported first (see above)."""
+    from pivy import coin  # noqa: F401  (loads the SWIG type information getSceneGraph's result needs)
+
+    return view.getSceneGraph()
+
+
 def find_colour_bar(scene):
     """The colour bar node under `scene` (a Coin group), or None."""
     for index in range(scene.getNumChildren()):
@@ -94,7 +106,7 @@ def show_colour_bar(scale_mm: float, document) -> None:
         return
     remove_colour_bar(document)
     width, height = view.getSize()
-    view.getSceneGraph().addChild(colour_bar_node(scale_mm, width / max(height, 1)))
+    scene_graph(view).addChild(colour_bar_node(scale_mm, width / max(height, 1)))
 
 
 def remove_colour_bar(document) -> None:
@@ -102,7 +114,7 @@ def remove_colour_bar(document) -> None:
     from spur_cad_workbench.views import view_3d
 
     view = view_3d(document)
-    scene = view.getSceneGraph() if view is not None else None
+    scene = scene_graph(view) if view is not None else None
     old = find_colour_bar(scene) if scene is not None else None
     if old is not None:
         scene.removeChild(old)

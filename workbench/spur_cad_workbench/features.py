@@ -172,11 +172,16 @@ ICON_SIZE_PX = 64
 def error_icon(path: str):
     """The icon at `path` with a red "!" badge in its lower left corner: a spur_cad object whose last recompute
     failed (FreeCAD's own error mark needs an exception from `execute`, which 0.20 reports with a traceback)."""
-    from PySide import QtCore, QtGui
+    from PySide import QtCore, QtGui, QtSvg
 
-    pixmap = QtGui.QIcon(path).pixmap(ICON_SIZE_PX, ICON_SIZE_PX)
+    # The SVG is drawn by QtSvg itself, as FreeCAD's BitmapFactory draws icons: QIcon(path) needs Qt's SVG
+    # image-format plugin, which Debian testing's FreeCAD 1.1 (Qt 6) does not install; its pixmap is then null
+    # and a painter on it fails ("QPainter::begin: Paint device returned engine == 0", observed).
+    pixmap = QtGui.QPixmap(ICON_SIZE_PX, ICON_SIZE_PX)
+    pixmap.fill(QtGui.QColor(0, 0, 0, 0))
     badge = ICON_SIZE_PX // 2
     painter = QtGui.QPainter(pixmap)
+    QtSvg.QSvgRenderer(path).render(painter, QtCore.QRectF(0, 0, ICON_SIZE_PX, ICON_SIZE_PX))
     painter.setRenderHint(compat.qt_enum(QtGui.QPainter, "RenderHint", "Antialiasing"))
     painter.setPen(compat.qt_enum(QtCore.Qt, "PenStyle", "NoPen"))
     painter.setBrush(QtGui.QColor(ERROR_BADGE_COLOUR))
