@@ -1,11 +1,15 @@
 """`spur-cad install-freecad [--uninstall]`: the link in FreeCAD's user Mod folder, the recorded
 environment, errors, the user data folder of each FreeCAD version (1.1's versioned ones,
 FREECAD_USER_DATA), Addon Manager copies, and a real FreeCAD that then loads the workbench with
-spur_cad and cadquery. The wheel route is tests/test_wheel_install.py."""
+spur_cad and OCP; the workbench's Init.py without a record (an Addon Manager install) taking spur_cad from
+the addon's own folder. The wheel route is tests/test_wheel_install.py, the Addon Manager's
+tests/test_addon_manager.py."""
 
 from __future__ import annotations
 
 import json
+import subprocess
+import sys
 import sysconfig
 from pathlib import Path
 
@@ -210,8 +214,8 @@ IMPORT_BODY = """
 import sys, FreeCAD
 RESULT["user_data"] = FreeCAD.getUserAppDataDir()
 try:
-    import numpy, cadquery, spur_cad, spur_cad_workbench.features
-    RESULT.update(imported=True, numpy=numpy.__file__, cadquery=cadquery.__file__,
+    import numpy, OCP, spur_cad, spur_cad_workbench.features
+    RESULT.update(imported=True, numpy=numpy.__file__, ocp=OCP.__file__,
                   spur_cad=spur_cad.__file__, workbench=spur_cad_workbench.features.__file__)
 except ImportError as exc:
     RESULT.update(imported=False, error=str(exc))
@@ -220,7 +224,7 @@ except ImportError as exc:
 
 @pytest.mark.freecad
 def test_freecad_loads_the_installed_workbench_and_forgets_it_after_uninstall(freecadcmd, tmp_path, monkeypatch):
-    """FreeCAD (HOME = the run's home, no other path set up) imports spur_cad, cadquery and the workbench."""
+    """FreeCAD (HOME = the run's home, no other path set up) imports spur_cad, OCP and the workbench."""
     home = tmp_path / "home"  # the HOME run_freecad_code gives FreeCAD
     home.mkdir()
     monkeypatch.setenv("HOME", str(home))
@@ -232,7 +236,7 @@ def test_freecad_loads_the_installed_workbench_and_forgets_it_after_uninstall(fr
     assert Path(result["user_data"]) == _data(home)  # our rule for the user folder is FreeCAD's
     assert result["imported"], describe(proc, result)
     venv = Path(sysconfig.get_paths()["purelib"])
-    assert Path(result["numpy"]).is_relative_to(venv) and Path(result["cadquery"]).is_relative_to(venv)
+    assert Path(result["numpy"]).is_relative_to(venv) and Path(result["ocp"]).is_relative_to(venv)
     assert Path(result["spur_cad"]).resolve() == (ROOT / "spur_cad" / "__init__.py")
     assert "spur_cad:" not in proc.stdout + proc.stderr  # no warning from Init.py
     assert main(["install-freecad", "--uninstall"]) == 0
@@ -275,3 +279,77 @@ def test_a_record_naming_other_folders_removes_none_of_them(home, tmp_path):
     record.write_text(json.dumps(data))
     assert main(["install-freecad", "--uninstall"]) == 0
     assert all(v.is_dir() for v in victims)
+
+
+# --- the workbench's Init.py (spur_cad_workbench.environment.activate) in a Python that has no spur_cad ---
+
+_ACTIVATE = """
+import importlib.util, json, sys
+sys.path[:0] = ARGS["first"]
+sys.path.insert(0, ARGS["workbench"])  # as FreeCAD puts the addon's <subdirectory> on sys.path
+from spur_cad_workbench import environment
+before = list(sys.path)
+logged = []
+problems = environment.activate(ARGS["user"], **({"addon_folder": __import__("pathlib").Path(ARGS["addon"])}
+                                                 if ARGS["addon"] else {}), log=logged.append)
+spec = importlib.util.find_spec("spur_cad")
+print(json.dumps(dict(problems=problems, added=[p for p in sys.path if p not in before], last=sys.path[-1],
+                      first=sys.path[0], origin=spec.origin if spec else None, logged=logged)))
+"""
+
+
+def _activate(user: Path, addon: Path | None = None, first: tuple[Path, ...] = ()) -> dict:
+    """Run activate() in a fresh `python -I -S` (no site-packages: spur_cad is not importable there unless `first`
+    holds one) with the checkout's workbench folder on sys.path, as FreeCAD has it."""
+    args = dict(user=str(user), addon=str(addon) if addon else "", first=[str(f) for f in first],
+                workbench=str(ROOT / "workbench"))
+    proc = subprocess.run([sys.executable, "-I", "-S", "-c", f"ARGS = {args!r}\n" + _ACTIVATE],
+                          capture_output=True, text=True, timeout=60)
+    assert proc.returncode == 0, proc.stderr
+    return json.loads(proc.stdout)
+
+
+def _fake_spur_cad(folder: Path) -> Path:
+    (folder / "spur_cad").mkdir(parents=True)
+    (folder / "spur_cad" / "__init__.py").write_text("")
+    return folder
+
+
+def test_without_a_record_the_addon_folder_provides_spur_cad(tmp_path):
+    """No spur_cad_environment.json (the Addon Manager installed the workbench): the folder above the workbench,
+    which holds the spur_cad package in a clone of the repository, is appended to sys.path, and said in the log."""
+    user = tmp_path / "user"
+    user.mkdir()
+    found = _activate(user)  # the default: the addon folder of this workbench, here the checkout
+    assert found["problems"] == [] and found["added"] == [str(ROOT)] and found["last"] == str(ROOT)
+    assert Path(found["origin"]) == ROOT / "spur_cad" / "__init__.py"
+    assert len(found["logged"]) == 1 and str(ROOT) in found["logged"][0]
+    addon = _fake_spur_cad(tmp_path / "Mod" / "spur_cad")
+    found = _activate(user, addon)
+    assert found["added"] == [str(addon)] and Path(found["origin"]) == addon / "spur_cad" / "__init__.py"
+
+
+def test_without_a_record_an_importable_spur_cad_is_kept(tmp_path):
+    """A spur_cad already importable (installed into FreeCAD's Python, or earlier on sys.path) stays the one
+    imported: the addon's folder is not added. A folder without the package is not added either."""
+    user = tmp_path / "user"
+    user.mkdir()
+    other = _fake_spur_cad(tmp_path / "elsewhere")
+    found = _activate(user, _fake_spur_cad(tmp_path / "addon"), first=(other,))
+    assert found["added"] == [] and Path(found["origin"]) == other / "spur_cad" / "__init__.py"
+    assert found["logged"] == []
+    (tmp_path / "empty").mkdir()
+    found = _activate(user, tmp_path / "empty")
+    assert found["added"] == [] and found["origin"] is None and found["problems"] == []
+
+
+def test_a_record_wins_over_the_addon_folder(tmp_path):
+    """With the record `install-freecad` writes, its site-packages go first and the addon folder is not added,
+    even where the workbench is an Addon Manager copy holding spur_cad."""
+    user, env = tmp_path / "user", _fake_spur_cad(tmp_path / "env")
+    user.mkdir()
+    record = {"site_packages": [str(env)], "python_version": f"{sys.version_info[0]}.{sys.version_info[1]}"}
+    (user / "spur_cad_environment.json").write_text(json.dumps(record))
+    found = _activate(user, _fake_spur_cad(tmp_path / "addon"))
+    assert found["problems"] == [] and found["added"] == [str(env)] and found["first"] == str(env)
+    assert Path(found["origin"]) == env / "spur_cad" / "__init__.py"

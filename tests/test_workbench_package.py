@@ -209,17 +209,70 @@ def test_the_version_rules_as_modelled_exclude_a_bare_patch_maximum():
         manager_version("latest")
 
 
+ADDON_MANAGER_DATA = ROOT / "tests" / "data" / "addon_manager"  # the lists, with their sources (README.md there)
+# The one OCP distribution package.xml asks for (the workbench needs OCP, no front-end): CadQuery 2.8's own.
+OCP_DISTRIBUTION = "cadquery-ocp"
+# spur_cad's requirements package.xml may leave out or make optional, each with why: on no allow-list.
+NOT_ALLOWED = {"jinja2": "optional: report.html's engine; a report export without it says what to install",
+               "tqdm": "left out: only the command line's progress bars, which work without it"}
+
+
+def allow_list(path) -> set[str]:
+    """A list of allowed packages as the Addon Manager reads one: a name per line, lines starting with "#" left
+    out, compared lower-cased (AddonInstaller._load_local_allowed_packages_list, _handle_disallowed_python)."""
+    return {line.strip().lower() for line in path.read_text().splitlines() if line.strip() and line[0] != "#"}
+
+
+def _python_depends(package) -> tuple[list[str], list[str]]:
+    """(required, optional) python dependencies, in the file's order."""
+    depends = [d for d in package.findall(".//p:depend", NS) if d.get("type") == "python"]
+    required = [d.text.strip() for d in depends if d.get("optional", "false").lower() != "true"]
+    optional = [d.text.strip() for d in depends if d.get("optional", "false").lower() == "true"]
+    return required, optional
+
+
 def test_dependencies_are_well_typed_and_match_pyproject(package, pyproject):
-    """Every <depend> has a type FreeCAD knows (another is a parse error there); the python ones are
-    pyproject's requirements under their pip names (what the Addon Manager hands to pip), lower-case as the
-    Addon Manager compares them with its allow-list."""
+    """Every <depend> has a type FreeCAD knows (another is a parse error there). The python ones are what the
+    Addon Manager hands to pip, one name each: pyproject's requirements under their pip names, lower-case as
+    it compares them with its allow-list, those on no allow-list optional or left out for the reason NOT_ALLOWED
+    gives, and the OCP that pyproject leaves to an extra (OCP_DISTRIBUTION, of pyproject's extra `cadquery`)."""
     depends = package.findall(".//p:depend", NS)
     assert all(d.get("type", "automatic") in DEPENDENCY_TYPES for d in depends)
     assert all(d.get("optional", "false") in ("true", "True", "false", "False") for d in depends)
-    python = [d.text.strip() for d in depends if d.get("type") == "python"]
-    required = [re.split(r"[<>=!~ \[;]", spec, maxsplit=1)[0] for spec in pyproject["dependencies"]]
-    assert len(python) == len(set(python)) and set(python) == {name.lower() for name in required}
+    required, optional = _python_depends(package)
+    python = required + optional
+    assert len(python) == len(set(python))
     assert all(re.fullmatch(r"[a-z0-9]([a-z0-9._-]*[a-z0-9])?", name) for name in python)
+    wanted = {re.split(r"[<>=!~ \[;]", spec, maxsplit=1)[0].lower() for spec in pyproject["dependencies"]}
+    assert set(required) == (wanted - set(NOT_ALLOWED)) | {OCP_DISTRIBUTION}
+    assert set(optional) <= set(NOT_ALLOWED) and set(optional) <= wanted
+    assert set(NOT_ALLOWED) <= wanted  # the reasons above are about spur_cad's own requirements
+
+
+@pytest.mark.parametrize("python", ["3.11", "3.12", "3.13", "3.14"])
+def test_required_dependencies_are_allowed_and_pinned(package, python):
+    """Each required python dependency is on FreeCAD/Addons' list of reviewed packages for that Python and pinned
+    by its constraints file (the Addon Manager installs it with those constraints); the optional ones are on no
+    list. FreeCAD's Python 3.11 (official 1.0 and 1.1 builds) to 3.14 (Debian testing's 1.1)."""
+    folder = ADDON_MANAGER_DATA / "Addons" / "Data" / "Python" / python
+    allowed = allow_list(folder / "Allowed-Packages")
+    pinned = {re.split(r"[=<>!~ ;]", line, maxsplit=1)[0].lower().replace("_", "-")
+              for line in (folder / "constraints.txt").read_text().splitlines() if line.strip()}
+    required, optional = _python_depends(package)
+    assert [name for name in required if name not in allowed] == []
+    assert [name for name in required if name not in pinned] == []
+    assert [name for name in optional if name in allowed] == []
+
+
+def test_what_the_addon_manager_downloads_today_lacks_only_the_ocp(package):
+    """The allow-list the Addon Manager itself reads (FreeCAD/FreeCAD-addons' ALLOWED_PYTHON_PACKAGES.txt,
+    downloaded, else its own copy) has every required dependency but cadquery-ocp: the one package a catalogue
+    install would drop (docs/install.md says what unblocks it). Its `ocp` is another project ("Open
+    Collaboration Platform" on PyPI), not OpenCascade's."""
+    required, _ = _python_depends(package)
+    for path in (ADDON_MANAGER_DATA / "FreeCAD-addons" / "ALLOWED_PYTHON_PACKAGES.txt",
+                 ADDON_MANAGER_DATA / "AddonManager" / "ALLOWED_PYTHON_PACKAGES.txt"):
+        assert [name for name in required if name not in allow_list(path)] == [OCP_DISTRIBUTION], path
 
 
 def test_python_minimum_matches_pyproject(package, pyproject):
@@ -260,7 +313,7 @@ RESULT["variants"] = {{p: FreeCAD.Metadata(p).Content["workbench"][0].supportsCu
     assert result["classname"] == "SpurCadWorkbench" and result["subdirectory"] == "./workbench"
     assert result["supported"] is True and result["licence"] == "Apache-2.0"
     assert (result["low"], result["high"]) == ("0.20.0", "1.1.99")
-    assert {"numpy", "scipy", "matplotlib", "cadquery", "build123d"} <= set(result["depends"])
+    assert {"numpy", "scipy", "matplotlib", "cadquery-ocp", "numba", "jinja2"} <= set(result["depends"])
     running = tuple(result["running"])
     predicted = {path: core_supports(running, low, high) for path, (low, high) in variants.items()}
     assert result["variants"] == predicted, running
@@ -273,9 +326,15 @@ FAULTS = [  # (what is planted in a copy of package.xml, old text, new text, the
     ("freecadmin 0.21.0", "<freecadmin>0.20.0", "<freecadmin>0.21.0", "range"),
     ("no freecadmax", "<freecadmax>1.1.99</freecadmax>", "", "range"),
     ("pythonmin 3.10", "<pythonmin>3.11.0", "<pythonmin>3.10.0", "python"),
-    ("unknown dependency type", 'type="python">tqdm', 'type="pip">tqdm', "depends"),
-    ("missing dependency", '<depend type="python">tqdm</depend>', "", "depends"),
-    ("import name for a pip name", ">build123d<", ">OCP<", "depends"),
+    ("unknown dependency type", 'type="python">numba', 'type="pip">numba', "depends"),
+    ("missing dependency", '<depend type="python">numba</depend>', "", "depends"),
+    ("import name for a pip name", ">cadquery-ocp<", ">OCP<", "depends"),
+    ("jinja2 required", '<depend type="python" optional="true">jinja2', '<depend type="python">jinja2', "depends"),
+    ("tqdm required", "</package>", '<depend type="python">tqdm</depend></package>', "depends"),
+    ("cadquery for OCP", ">cadquery-ocp<", ">cadquery<", "depends"),
+    ("OCP without VTK (on no list)", ">cadquery-ocp<", ">cadquery-ocp-novtk<", "allowed"),
+    ("jinja2 required (on no list)", '<depend type="python" optional="true">jinja2', '<depend type="python">jinja2',
+     "allowed"),
     ("url without branch", "<icon>", '<url type="repository">https://git.host.org/spur_cad</url><icon>', "fields"),
     ("placeholder url", "<icon>", '<url type="repository" branch="main">https://example.invalid/spur_cad</url><icon>',
      "fields"),
@@ -287,6 +346,7 @@ FAULTS = [  # (what is planted in a copy of package.xml, old text, new text, the
 CHECKS = {
     "range": lambda package, pyproject: test_freecad_range_is_0_20_to_1_1_for_freecad_and_the_addon_manager(package),
     "python": test_python_minimum_matches_pyproject,
+    "allowed": lambda package, pyproject: test_required_dependencies_are_allowed_and_pinned(package, "3.11"),
     "depends": test_dependencies_are_well_typed_and_match_pyproject,
     "fields": lambda package, pyproject: test_required_fields_are_present(package),
     "namespace": lambda package, pyproject: test_every_element_is_in_the_package_namespace(package),

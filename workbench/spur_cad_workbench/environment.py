@@ -1,20 +1,32 @@
-"""Make spur_cad (and cadquery) importable inside FreeCAD from the environment recorded at installation.
+"""Make spur_cad and its dependencies importable inside FreeCAD, by either of the two ways it gets there.
 
-`spur-cad install-freecad` writes `spur_cad_environment.json` into FreeCAD's user data folder:
-the site-packages folders of the Python environment it ran in. FreeCAD runs the workbench's
-Init.py at start-up, which calls `activate`; the folders go to the front of sys.path (so that
-environment's numpy wins over the system one) with their .pth files processed (editable installs).
-Plain Python: no FreeCAD import, so the installer and the tests share it.
+- `spur-cad install-freecad` (pip users) writes `spur_cad_environment.json` into FreeCAD's user data
+  folder: the site-packages folders of the Python environment it ran in. `activate` puts them at the
+  front of sys.path (so that environment's numpy wins over the system one) with their .pth files
+  processed (editable installs).
+- The Addon Manager clones the whole repository into `Mod/spur_cad/`, so the `spur_cad` package sits in
+  the addon's own folder (`Mod/spur_cad/spur_cad/`), and pip-installs package.xml's Python dependencies
+  into `AdditionalPythonPackages/py3XY` (0.20: `AdditionalPythonPackages`) of the user data folder, which
+  FreeCAD appends to sys.path before it runs any Init.py. With no record, `activate` appends the addon's
+  folder to sys.path, and only when no `spur_cad` is importable already.
+
+FreeCAD runs the workbench's Init.py at start-up, which calls `activate`. Plain Python: no FreeCAD import,
+so the installer and the tests share it.
 """
 
 from __future__ import annotations
 
+import importlib.util
 import json
 import site
 import sys
+from collections.abc import Callable
 from pathlib import Path
 
 RECORD_NAME = "spur_cad_environment.json"
+# The addon's folder: <addon>/workbench/spur_cad_workbench/environment.py (as FreeCAD found it: a link to a
+# checkout stays the link, which holds the same files).
+ADDON_FOLDER = Path(__file__).absolute().parents[2]
 
 
 def record_path(user_app_data_dir: str | Path) -> Path:
@@ -46,10 +58,29 @@ def _prefer_environment_portions(folders: list[str]) -> None:
                 search.insert(0, candidate)
 
 
-def activate(user_app_data_dir: str | Path) -> list[str]:
-    """Put the recorded site-packages folders at the front of sys.path; returns problems (empty: fine)."""
+def use_addon_folder(addon_folder: Path) -> bool:
+    """Append `addon_folder` to sys.path when it holds the spur_cad package and no spur_cad is importable
+    yet (an Addon Manager copy or a clone of the repository); returns whether it was appended. Appended,
+    not put in front: the repository's other top-level folders (tests, docs, ...) shadow nothing."""
+    if importlib.util.find_spec("spur_cad") is not None:
+        return False
+    if not (addon_folder / "spur_cad" / "__init__.py").is_file():
+        return False
+    sys.path.append(str(addon_folder))
+    importlib.invalidate_caches()
+    return True
+
+
+def activate(user_app_data_dir: str | Path, addon_folder: Path | None = None,
+             log: Callable[[str], None] | None = None) -> list[str]:
+    """Make spur_cad importable: the recorded site-packages folders at the front of sys.path, or without a
+    record the addon's own folder (`ADDON_FOLDER` unless given) at its end; returns problems (empty: fine).
+    `log` receives what was done, for FreeCAD's log."""
     record = read_record(record_path(user_app_data_dir))
     if record is None:
+        folder = ADDON_FOLDER if addon_folder is None else addon_folder
+        if use_addon_folder(folder) and log is not None:
+            log(f"no {RECORD_NAME}; spur_cad imported from the addon's folder {folder}")
         return []
     problems = []
     wanted = record.get("python_version", "")
