@@ -16,9 +16,13 @@ venv: $(STAMP)
 $(PYTHON):
 	python3 -m venv $(VENV)
 
-# (Re)install the project and its test extras when pyproject.toml is newer than the stamp.
+# The flavour a checkout installs: CadQuery 2.8 and build123d 0.12 (both on OCP 7.9), and the test tools.
+# `make venv EXTRAS=build123d,test` makes the build123d 0.13 flavour (OCP 8.0) instead.
+EXTRAS      ?= cadquery,build123d,test
+
+# (Re)install the project and its extras when pyproject.toml is newer than the stamp.
 $(STAMP): pyproject.toml | $(PYTHON)
-	$(VENV)/bin/pip install -e '.[test]'
+	$(VENV)/bin/pip install -e '.[$(EXTRAS)]'
 	touch $(STAMP)
 
 demo: venv

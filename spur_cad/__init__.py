@@ -1,19 +1,22 @@
 """spur_cad: CAD/CAM for spur gears cut with end mills on a 4-axis machining centre.
 
-The engine is layered (geometry -> cad -> cam -> post -> sim -> report/cli). Importing this
-package loads nothing heavy: the CAD entry points below import CadQuery on first use.
+The engine is layered (geometry -> cad -> cam -> post -> sim -> report/cli) and needs OCP, not a front-end.
+Importing this package loads nothing heavy: the CAD entry points below import OCP (and CadQuery or build123d,
+for their own functions) on first use.
 
     import spur_cad
     spec = spur_cad.GearSpec(teeth=23, module_mm=4.0, rack_tip_radius_mm=0.8, face_width_mm=20.0)
-    gear = spur_cad.make_gear(spec)            # cadquery.Workplane, machine frame (axis X)
+    shape = spur_cad.gear_shape(spec)                    # OCP TopoDS_Shape, machine frame (axis X)
+    gear = spur_cad.make_gear(spec)                      # cadquery.Workplane (spur_cad[cadquery])
     stock = spur_cad.make_stock(spec)
-    solid = spur_cad.to_build123d(gear)        # build123d.Solid wrapping the same OCP shape
+    solid = spur_cad.to_build123d(spec, frame="part")    # build123d.Solid, axis Z, centre at the origin
 """
 
 from spur_cad.errors import GearSpecError, JobFileError, SpurCadError, StockError
 from spur_cad.version import __version__
 
-_CAD_ENTRY_POINTS = {"make_gear", "make_stock", "to_build123d", "BlankFeatures", "StockSpec"}
+_CAD_ENTRY_POINTS = {"gear_shape", "stock_shape", "make_gear", "make_stock", "to_build123d", "BlankFeatures",
+                     "StockSpec"}
 
 __all__ = ["GearSpec", "GearSpecError", "JobFileError", "SpurCadError", "StockError", "__version__",
            *sorted(_CAD_ENTRY_POINTS)]

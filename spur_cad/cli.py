@@ -109,21 +109,32 @@ def _parser() -> argparse.ArgumentParser:
 
 class ProgressBars:
     """A `run_job` progress callback: one tqdm bar per long stage on `stream` (used when stderr is a
-    terminal and --quiet is not given, so that logs and pipes get only the one-line messages)."""
+    terminal and --quiet is not given, so that logs and pipes get only the one-line messages).
+
+    tqdm is optional (FreeCAD's Addon Manager cannot install it): without it each stage gets one plain
+    line when it ends."""
 
     def __init__(self, stream) -> None:
         self._stream = stream
         self._bars: dict = {}
+        try:
+            from tqdm import tqdm
+        except ImportError:
+            tqdm = None
+        self._tqdm = tqdm
 
     def __call__(self, stage: str, fraction: float) -> None:
-        from tqdm import tqdm
-
+        if self._tqdm is None:
+            if fraction >= 1.0 and stage not in self._bars:
+                self._bars[stage] = None
+                print(f"{stage:>13}: done", file=self._stream, flush=True)
+            return
         bar = self._bars.get(stage)
         if bar is None:
             size = shutil.get_terminal_size()  # 80 x 24 when the terminal does not say (tqdm would draw nothing)
-            bar = self._bars[stage] = tqdm(total=100, desc=f"{stage:>13}", file=self._stream, leave=True,
-                                           ncols=min(100, size.columns), nrows=max(size.lines, 10),
-                                           bar_format="{desc}: {percentage:3.0f}%|{bar:30}| {elapsed}")
+            bar = self._bars[stage] = self._tqdm(total=100, desc=f"{stage:>13}", file=self._stream, leave=True,
+                                                 ncols=min(100, size.columns), nrows=max(size.lines, 10),
+                                                 bar_format="{desc}: {percentage:3.0f}%|{bar:30}| {elapsed}")
         bar.n = min(100, round(100.0 * fraction))
         bar.refresh()
         if fraction >= 1.0:
@@ -131,7 +142,8 @@ class ProgressBars:
 
     def close(self) -> None:
         for bar in self._bars.values():
-            bar.close()
+            if bar is not None:
+                bar.close()
 
 
 def _install_freecad(uninstall: bool) -> int:

@@ -95,9 +95,13 @@ def run_job(job: Job, progress: Callable[[str, float], None] | None = None,
     spur_cad.cad_worker.CadWorker, which run_job stops before it returns) builds the CAD stage in a second process
     while this one does the rest, which then never imports OCP: the command line's choice; without it (FreeCAD:
     OCCT loaded, no Python executable to start; spur-cad correct) the CAD is built here."""
+    from spur_cad.dependencies import require_jinja2, require_ocp
     from spur_cad.report.html import render_report
     from spur_cad.report.plots import tooth_space_png
     from spur_cad.report.stage import plan_images, simulation_images
+
+    require_ocp()  # before any work: a missing package is one line, not a failure in the CAD stage
+    require_jinja2()
 
     def tell(stage: str, fraction: float) -> None:
         if progress is not None:

@@ -38,7 +38,9 @@ def test_gear_spec_refuses_what_is_not_a_meaningful_number(kwargs, field):
     (lambda: spur_cad.make_stock(reference_spec(), {"radial_allowance_mm": 1.0}), "stock"),
     (lambda: inspection_sheet(None), "spec"),
     (lambda: spur_cad.make_gear(reference_spec(), spur_cad.BlankFeatures(bore_diameter_mm="30")), "bore_diameter_mm"),
-    (lambda: spur_cad.to_build123d(None), "workplane_or_shape"),
+    (lambda: spur_cad.to_build123d(None), "source"),
+    (lambda: spur_cad.gear_shape(reference_spec(), frame="world"), "frame"),
+    (lambda: spur_cad.to_build123d(reference_spec(), frame=None), "frame"),
     (lambda: sample_profile(None), "profile"),
     (lambda: sample_profile(reference_spec().tooth_space_profile(), "0.001"), "tolerance_mm"),
 ])

@@ -17,6 +17,7 @@ projection on dense exact points) is within the fit tolerance.
 from __future__ import annotations
 
 import math
+import sys
 from dataclasses import dataclass
 
 import numpy as np
@@ -50,6 +51,7 @@ from OCP.TColgp import TColgp_Array1OfVec, TColgp_HArray1OfPnt
 from OCP.TColStd import TColStd_HArray1OfBoolean, TColStd_HArray1OfReal
 from OCP.TopAbs import TopAbs_FACE, TopAbs_SHELL
 from OCP.TopExp import TopExp_Explorer
+from OCP.TopLoc import TopLoc_Location
 from OCP.TopoDS import TopoDS, TopoDS_Edge, TopoDS_Shape, TopoDS_Solid, TopoDS_Wire
 
 from spur_cad.cad.specs import BlankFeatures, GearSolidReport, StockSpec
@@ -528,36 +530,102 @@ def build_flat_stock_shape(spec: GearSpec, stock: StockSpec, features: BlankFeat
     return shape
 
 
-def make_gear(spec: GearSpec, features: BlankFeatures = BlankFeatures(),
-              fit_tolerance_mm: float | None = None):
-    """The gear solid as a CadQuery Workplane (machine frame: axis X, front face at X = 0). CadQuery is
-    imported here, for the scripts that want it: the pipeline works on OCP shapes (its import is costly)."""
-    import cadquery as cq
+FRAMES = ("machine", "part")
+"""Where a front-end's gear or stock lies. "machine": the machine frame of docs/architecture.md (axis X, front
+face at X = 0, what the toolpaths and STEP files use). "part": the part's own frame, as CadQuery and build123d
+users place parts: axis Z, the gear's centre (mid-face, on the axis) at the origin; machine X, Y, Z become part
+Z, X, Y (a proper rotation, so a helix keeps its hand), so tooth space 0 is symmetric about +Y."""
 
+
+def part_frame_transform(face_width_mm: float) -> gp_Trsf:
+    """The rigid motion taking the machine frame to the part frame (see FRAMES): (x, y, z) -> (y, z, x - b/2)."""
+    trsf = gp_Trsf()
+    trsf.SetValues(0.0, 1.0, 0.0, 0.0,
+                   0.0, 0.0, 1.0, 0.0,
+                   1.0, 0.0, 0.0, -face_width_mm / 2.0)
+    return trsf
+
+
+def in_frame(shape: TopoDS_Shape, spec: GearSpec, frame: str) -> TopoDS_Shape:
+    """`shape` (built in the machine frame) located in `frame`: the same geometry, moved, not re-modelled."""
+    if frame not in FRAMES:
+        raise ArgumentError(f"frame must be one of {', '.join(FRAMES)}, got {frame!r}")
+    if frame == "machine":
+        return shape
+    return shape.Moved(TopLoc_Location(part_frame_transform(spec.face_width_mm)))
+
+
+def gear_shape(spec: GearSpec, features: BlankFeatures = BlankFeatures(), fit_tolerance_mm: float | None = None,
+               frame: str = "machine") -> TopoDS_Shape:
+    """The gear solid as an OCP shape in `frame` (see FRAMES): needs OCP only, neither CadQuery nor build123d."""
+    require_instance(spec, GearSpec, "spec")
+    require_instance(frame, str, "frame")
+    in_frame(TopoDS_Shape(), spec, frame)  # an unknown frame is refused before the solid is built
     shape, _ = build_gear_shape(spec, features, fit_tolerance_mm)
-    return cq.Workplane("YZ").add(cq.Solid(shape))
+    return in_frame(shape, spec, frame)
 
 
-def make_stock(spec: GearSpec, stock: StockSpec = StockSpec()):
-    """The stock (blank cylinder, optional holding stub) as a CadQuery Workplane."""
+def stock_shape(spec: GearSpec, stock: StockSpec = StockSpec(), frame: str = "machine") -> TopoDS_Shape:
+    """The stock as an OCP shape in `frame` (see FRAMES)."""
+    require_instance(spec, GearSpec, "spec")
+    require_instance(frame, str, "frame")
+    in_frame(TopoDS_Shape(), spec, frame)
+    return in_frame(build_stock_shape(spec, stock), spec, frame)
+
+
+def make_gear(spec: GearSpec, features: BlankFeatures = BlankFeatures(),
+              fit_tolerance_mm: float | None = None, frame: str = "machine"):
+    """The gear solid as a CadQuery Workplane in `frame` (default the machine frame: axis X, front face at X = 0).
+    CadQuery is imported here, for the scripts that want it (spur_cad[cadquery]): the pipeline works on OCP shapes."""
     import cadquery as cq
 
-    return cq.Workplane("YZ").add(cq.Solid(build_stock_shape(spec, stock)))
+    shape = gear_shape(spec, features, fit_tolerance_mm, frame)
+    return cq.Workplane("YZ" if frame == "machine" else "XY").add(cq.Solid(shape))
 
 
-def to_build123d(workplane_or_shape):
-    """Wrap the same OCP shape as a build123d Solid (no copy, no re-modelling)."""
+def make_stock(spec: GearSpec, stock: StockSpec = StockSpec(), frame: str = "machine"):
+    """The stock (blank cylinder, optional holding stub) as a CadQuery Workplane in `frame`."""
+    import cadquery as cq
+
+    shape = stock_shape(spec, stock, frame)
+    return cq.Workplane("YZ" if frame == "machine" else "XY").add(cq.Solid(shape))
+
+
+def _wrapped_shape(source) -> TopoDS_Shape | None:
+    """The OCP shape inside a CadQuery Workplane or Shape, a build123d Shape, or an OCP shape (None otherwise).
+    A front-end's object can exist only once its module is imported, so each is looked up in sys.modules and
+    neither front-end is imported (or needs to be installed) here."""
+    if isinstance(source, TopoDS_Shape):
+        return source
+    cq = sys.modules.get("cadquery")
+    if cq is not None and isinstance(source, cq.Workplane):
+        held = [value for value in source.vals() if isinstance(value, cq.Shape)]
+        return held[0].wrapped if held else TopoDS_Shape()
+    if cq is not None and isinstance(source, cq.Shape):
+        return source.wrapped
+    bd = sys.modules.get("build123d")
+    if bd is not None and isinstance(source, bd.Shape):
+        return source.wrapped if source.wrapped is not None else TopoDS_Shape()
+    return None
+
+
+def to_build123d(source, features: BlankFeatures = BlankFeatures(), *, frame: str = "machine"):
+    """A build123d Solid. From a GearSpec: the gear itself, built in `frame` ("machine" or "part", see FRAMES),
+    with no CadQuery involved (spur_cad[build123d]). From a CadQuery Workplane or Shape, or an OCP shape: the same
+    OCP shape wrapped (no copy, no re-modelling; `frame` must then be left "machine", and `features` unused).
+    What it returns composes in a BuildPart like any build123d Solid (add, subtract, locate)."""
     import build123d
-    import cadquery as cq
 
-    require_instance(workplane_or_shape, (cq.Workplane, cq.Shape, TopoDS_Shape), "workplane_or_shape")
-    shape = workplane_or_shape
-    if isinstance(shape, cq.Workplane):
-        shape = shape.val()
-    if isinstance(shape, cq.Shape):
-        shape = shape.wrapped
-    if not isinstance(shape, TopoDS_Shape) or shape.IsNull():
-        raise ArgumentError("workplane_or_shape holds no solid")
+    if isinstance(source, GearSpec):
+        return build123d.Solid(gear_shape(source, features, frame=frame))
+    shape = _wrapped_shape(source)
+    if shape is None:
+        raise ArgumentError(f"source must be a GearSpec, a CadQuery Workplane or Shape, or an OCP shape, "
+                            f"got {type(source).__name__}")
+    if frame != "machine":
+        raise ArgumentError("frame applies to a GearSpec; a shape given is wrapped where it lies")
+    if shape.IsNull():
+        raise ArgumentError("source holds no solid")
     return build123d.Solid(shape)
 
 

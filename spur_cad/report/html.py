@@ -12,6 +12,7 @@ from importlib import resources
 from typing import TYPE_CHECKING
 
 from spur_cad.cam.plan import REFERENCE_CONTACT_SPACING_MM, REFERENCE_STATION_STEP_MM
+from spur_cad.dependencies import require_jinja2
 from spur_cad.errors import SpurCadError, one_line
 from spur_cad.report import sheet
 from spur_cad.report.sheet import Table, duration, number
@@ -33,7 +34,8 @@ def default_template_text() -> str:
 
 def compile_template(text: str, source: str = TEMPLATE_NAME):
     """The template compiled in Jinja2's sandbox (autoescaped, undefined names are errors); a syntax error is a
-    ReportTemplateError naming `source` and the template's line."""
+    ReportTemplateError naming `source` and the template's line. Without Jinja2 installed: what to install."""
+    require_jinja2()
     import jinja2
     from jinja2.sandbox import ImmutableSandboxedEnvironment
 
