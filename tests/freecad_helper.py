@@ -180,7 +180,9 @@ def run_freecad_code(body: str, work: Path, *, freecadcmd: str | None = None,
 
 def describe(proc: subprocess.CompletedProcess, result: dict | None) -> str:
     """Failure text: exit status, result and the tail of FreeCAD's output."""
+    error = ""
     if result is not None:
-        result = {key: value for key, value in result.items() if key != "log"}
-    return (f"exit status {proc.returncode}; result {result!r}\n"
+        error = f"error: {result.get('error')}\n" if result.get("error") else ""
+        result = {key: value for key, value in result.items() if key not in ("log", "error")}
+    return (f"{error}exit status {proc.returncode}; result {result!r}\n"
             f"--- stdout (tail)\n{proc.stdout[-3000:]}\n--- stderr (tail)\n{proc.stderr[-3000:]}")

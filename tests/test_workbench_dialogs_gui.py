@@ -206,7 +206,10 @@ def test_restart_dialog_and_long_work_in_the_gui(freecad_gui, tmp_path):
                       "FaceWidth": 6.0, "BoreDiameter": 10.0},
              "stock": SMALL_STOCK_PROPERTIES, "job": SMALL_JOB_PROPERTIES}
     body = f"PROPS = {props!r}\nOUT = {str(out)!r}\nTEETH = {TEETH}\nSHOT = {str(DIALOG_SHOT)!r}\n" + BODY
-    result, proc = run_workbench_code(body, tmp_path / "fc", gui=freecad_gui, timeout_s=400)
+    # the reference lines printed to compare colours, and the verification that fails on purpose (an error)
+    expected_log = (r"^Wrn: reference warning line$", r"^Err: reference error line$",
+                    r"^Err: Verify program: space 0: leftover [^\n]*(\nspace \d+: leftover [^\n]*)*\nFAIL: [^\n]*$")
+    result, proc = run_workbench_code(body, tmp_path / "fc", gui=freecad_gui, timeout_s=400, log_allowed=expected_log)
     (tmp_path / "result.json").write_text(json.dumps(result, indent=1))
     assert result is not None and result.get("ok"), describe(proc, result)
     assert result["hooked"] == []
