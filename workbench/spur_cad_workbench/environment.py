@@ -7,8 +7,10 @@
 - The Addon Manager clones the whole repository into `Mod/spur_cad/`, so the `spur_cad` package sits in
   the addon's own folder (`Mod/spur_cad/spur_cad/`), and pip-installs package.xml's Python dependencies
   into `AdditionalPythonPackages/py3XY` (0.20: `AdditionalPythonPackages`) of the user data folder, which
-  FreeCAD appends to sys.path before it runs any Init.py. With no record, `activate` appends the addon's
-  folder to sys.path, and only when no `spur_cad` is importable already.
+  FreeCAD appends to sys.path before it runs any Init.py. FreeCAD 0.20 to 1.1 also put every `Mod/<addon>`
+  folder itself at the front of sys.path (src/App/FreeCADInit.py), which makes that spur_cad importable
+  already; with no record `activate` appends the addon's folder only where spur_cad is not importable
+  (a FreeCAD that stops doing so, or a workbench folder put on sys.path by hand).
 
 FreeCAD runs the workbench's Init.py at start-up, which calls `activate`. Plain Python: no FreeCAD import,
 so the installer and the tests share it.
