@@ -1,5 +1,7 @@
 """pytest plumbing for the external tools: FreeCAD (`freecad` marker), LinuxCNC `rs274`
-(`linuxcnc` marker), headless Chromium and poppler's pdfinfo / pdftotext (`browser` marker).
+(`linuxcnc` marker), headless Chromium and poppler's pdfinfo / pdftotext (`browser` marker), and the CadQuery
+front-end (`cadquery` marker: the engine needs OCP only; the build123d 0.13 flavour, which cannot hold CadQuery 2.8,
+runs with `-m "not cadquery"`).
 
 A marked test whose tool is missing is skipped locally, but fails when the environment
 variable CI is "true": CI installs the tools (.ci/run), so a missing tool there is a bug.
@@ -14,6 +16,7 @@ from pathlib import Path
 
 import pytest
 
+from spur_cad.dependencies import is_installed
 from tests.rs274_helper import rs274_path
 
 FREECADCMD_NAMES = ("freecadcmd", "FreeCADCmd", "freecadcmd-python3")
@@ -79,6 +82,8 @@ def pytest_runtest_setup(item: pytest.Item) -> None:
         require_tool(rs274_path(), "LinuxCNC", "rs274")
     if item.get_closest_marker("browser"):
         require_tool(browser_paths(), "Chromium and poppler", "chromium, pdfinfo or pdftotext")
+    if item.get_closest_marker("cadquery"):
+        require_tool(is_installed("cadquery") or None, "CadQuery", "the cadquery package (spur_cad[cadquery])")
 
 
 @pytest.fixture(scope="session")

@@ -16,6 +16,7 @@ import time
 from dataclasses import dataclass
 
 import numpy as np
+from OCP.TopoDS import TopoDS_Shape
 
 from spur_cad.cam.ir import MoveKind, Toolpath
 from spur_cad.cam.tools import Tool
@@ -40,43 +41,75 @@ class CrossCheck:
         return self.occ_seconds / self.fast_seconds
 
 
-def tool_solid(tool: Tool, height: float):
-    """The tool as a CadQuery solid of revolution about +Z, tip centre at the origin (exact corner arcs)."""
-    import cadquery as cq
+def _profile_face(points_and_arcs: list, plane_point) -> TopoDS_Shape:
+    """A planar face bounded by a closed chain of segments and three-point arcs: each item is an end point, or
+    (mid point, end point) for an arc, in 2-D profile coordinates mapped to 3-D by `plane_point`."""
+    from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeEdge, BRepBuilderAPI_MakeFace, BRepBuilderAPI_MakeWire
+    from OCP.GC import GC_MakeArcOfCircle, GC_MakeSegment
 
+    wire = BRepBuilderAPI_MakeWire()
+    start = points_and_arcs[0]
+    current = start
+    for item in [*points_and_arcs[1:], start]:
+        if isinstance(item[0], tuple):
+            mid, end = item
+            curve = GC_MakeArcOfCircle(plane_point(*current), plane_point(*mid), plane_point(*end)).Value()
+        else:
+            end = item
+            curve = GC_MakeSegment(plane_point(*current), plane_point(*end)).Value()
+        wire.Add(BRepBuilderAPI_MakeEdge(curve).Edge())
+        current = end
+    return BRepBuilderAPI_MakeFace(wire.Wire(), True).Face()
+
+
+def _tool_outline(tool: Tool, height: float, side: float) -> list:
+    """The tool's half section on one side (`side` +1 or -1) from the tip: flat, corner arc, side to `height`."""
     radius, rt = tool.diameter_mm / 2.0, tool.effective_corner_radius_mm
     half_flat = radius - rt
-    wp = cq.Workplane("XZ").moveTo(0.0, 0.0)
+    chain: list = []
     if half_flat > 0.0:
-        wp = wp.lineTo(half_flat, 0.0)
+        chain.append((side * half_flat, 0.0))
     if rt > 0.0:
-        mid = (half_flat + rt * math.sin(math.pi / 4), rt - rt * math.cos(math.pi / 4))
-        wp = wp.threePointArc(mid, (radius, rt))
-    wp = wp.lineTo(radius, height).lineTo(0.0, height).close()
-    return wp.revolve(360.0, (0, 0, 0), (0, 1, 0)).val()
+        mid = (side * (half_flat + rt * math.sin(math.pi / 4)), rt - rt * math.cos(math.pi / 4))
+        chain.append((mid, (side * radius, rt)))
+    chain.append((side * radius, height))
+    return chain
 
 
-def _silhouette_prism(tool: Tool, height: float, length: float):
+def tool_solid(tool: Tool, height: float) -> TopoDS_Shape:
+    """The tool as an OCP solid of revolution about +Z, tip centre at the origin (exact corner arcs)."""
+    from OCP.BRepPrimAPI import BRepPrimAPI_MakeRevol
+    from OCP.gp import gp_Ax1, gp_Dir, gp_Pnt
+
+    chain = [(0.0, 0.0), *_tool_outline(tool, height, 1.0), (0.0, height)]
+    face = _profile_face(chain, lambda u, v: gp_Pnt(u, 0.0, v))  # the XZ plane
+    return BRepPrimAPI_MakeRevol(face, gp_Ax1(gp_Pnt(0, 0, 0), gp_Dir(0, 0, 1)), 2.0 * math.pi).Shape()
+
+
+def _silhouette_prism(tool: Tool, height: float, length: float) -> TopoDS_Shape:
     """The tool's section through its axis in the YZ plane (X = 0), extruded by `length` along +X."""
-    import cadquery as cq
+    from OCP.BRepPrimAPI import BRepPrimAPI_MakePrism
+    from OCP.gp import gp_Pnt, gp_Vec
 
     radius, rt = tool.diameter_mm / 2.0, tool.effective_corner_radius_mm
     half_flat = radius - rt
-    wp = cq.Workplane("YZ").moveTo(-radius, height).lineTo(-radius, rt)
+    chain: list = [(-radius, height), (-radius, rt)]  # down the left side, across the tip, up the right side
     if rt > 0.0:
-        wp = wp.threePointArc((-half_flat - rt * math.sin(math.pi / 4), rt - rt * math.cos(math.pi / 4)),
-                              (-half_flat, 0.0))
-    if half_flat > 0.0:
-        wp = wp.lineTo(half_flat, 0.0)
-    if rt > 0.0:
-        wp = wp.threePointArc((half_flat + rt * math.sin(math.pi / 4), rt - rt * math.cos(math.pi / 4)), (radius, rt))
-    wp = wp.lineTo(radius, height).close()
-    return wp.extrude(length).val()
+        chain.append(((-half_flat - rt * math.sin(math.pi / 4), rt - rt * math.cos(math.pi / 4)), (-half_flat, 0.0)))
+    chain.extend(_tool_outline(tool, height, 1.0))
+    face = _profile_face(chain, lambda u, v: gp_Pnt(0.0, u, v))  # the YZ plane
+    return BRepPrimAPI_MakePrism(face, gp_Vec(length, 0.0, 0.0)).Shape()
 
 
-def _place(shape, x: float, y: float, z: float, a_deg: float):
+def _place(shape: TopoDS_Shape, x: float, y: float, z: float, a_deg: float) -> TopoDS_Shape:
     """Machine pose -> part frame: move the tool tip to (x, y, z), then turn the part back by -A about X."""
-    return shape.translate((x, y, z)).rotate((0, 0, 0), (1, 0, 0), -a_deg)
+    from OCP.gp import gp_Ax1, gp_Dir, gp_Pnt, gp_Trsf, gp_Vec
+    from OCP.TopLoc import TopLoc_Location
+
+    move, turn = gp_Trsf(), gp_Trsf()
+    move.SetTranslation(gp_Vec(x, y, z))
+    turn.SetRotation(gp_Ax1(gp_Pnt(0, 0, 0), gp_Dir(1, 0, 0)), math.radians(-a_deg))
+    return shape.Moved(TopLoc_Location(turn.Multiplied(move)))
 
 
 def swept_solids(path: Toolpath, tool: Tool, stock: StockCylinder, resolution_mm: float, height: float,
@@ -146,7 +179,10 @@ def cross_check(spec: GearSpec, stock: StockCylinder, path: Toolpath, tool: Tool
                 max_blades: int = 400, seed: int = 0) -> CrossCheck:
     """Remove `path` from the stock both ways and compare the blades it cut (a random sample of at most
     `max_blades`, plus as many uncut blades near them, which must stay uncut in both)."""
-    import cadquery as cq
+    from OCP.BRepAlgoAPI import BRepAlgoAPI_Cut
+    from OCP.BRepPrimAPI import BRepPrimAPI_MakeCylinder
+    from OCP.gp import gp_Ax2, gp_Dir, gp_Pnt
+    from OCP.TopTools import TopTools_ListOfShape
 
     start = time.perf_counter()
     fast: SimResult = simulate(spec, stock, [Cut(path, tool)], settings, station_x=station_x,
@@ -155,9 +191,19 @@ def cross_check(spec: GearSpec, stock: StockCylinder, path: Toolpath, tool: Tool
     start = time.perf_counter()
     height = stock.radius_mm + 2.0 * tool.diameter_mm
     solids = swept_solids(path, tool, stock, settings.resolution_mm, height, refine)
-    blank = cq.Solid.makeCylinder(stock.radius_mm, stock.x_max - stock.x_min, cq.Vector(stock.x_min, 0, 0),
-                                  cq.Vector(1, 0, 0))
-    result = blank.cut(*solids)
+    blank = BRepPrimAPI_MakeCylinder(gp_Ax2(gp_Pnt(stock.x_min, 0, 0), gp_Dir(1, 0, 0)), stock.radius_mm,
+                                     stock.x_max - stock.x_min).Shape()
+    arguments, tools = TopTools_ListOfShape(), TopTools_ListOfShape()
+    arguments.Append(blank)
+    for solid in solids:
+        tools.Append(solid)
+    removal = BRepAlgoAPI_Cut()
+    removal.SetArguments(arguments)
+    removal.SetTools(tools)
+    removal.Build()
+    if not removal.IsDone():
+        raise RuntimeError("OCP could not remove the tool solids from the stock")
+    result = removal.Shape()
     occ_seconds = time.perf_counter() - start
     cut = np.argwhere(fast.deviation < fast.initial - 1e-9)
     uncut = np.argwhere((fast.deviation >= fast.initial - 1e-9) & (fast.initial < settings.leftover_range_mm - 1e-9))
@@ -173,7 +219,7 @@ def cross_check(spec: GearSpec, stock: StockCylinder, path: Toolpath, tool: Tool
         p, n = points[j], normals[j]
         origins.append((grid.rows_x[r], p[0], p[1]))
         directions.append((0.0, n[0], n[1]))
-    occ_h = probe_blades(result.wrapped, np.array(origins), np.array(directions), -settings.gouge_range_mm,
+    occ_h = probe_blades(result, np.array(origins), np.array(directions), -settings.gouge_range_mm,
                          settings.leftover_range_mm)
     occ_h = np.minimum(occ_h, fast.initial[tuple(chosen.T)])
     fast_h = fast.deviation[tuple(chosen.T)]
