@@ -23,7 +23,7 @@ local folder is read), the allow-list step left out: the Addon Manager 2026.7.22
 packages (the route docs/install.md describes), and which packages the shipped lists would drop is checked in
 tests/test_workbench_package.py. The optional jinja2 is not ticked. The addon is a copy of the checkout's
 tracked files. Then freecadcmd, with nothing else set up, makes a gear, its stock and a job with the workbench.
-Downloads about 330 MB from PyPI on Debian 12 (its FreeCAD's Python has numpy, scipy, matplotlib, pillow);
+Downloads about 380 MB from PyPI on Debian 12 (its FreeCAD's Python has numpy, scipy, matplotlib, pillow);
 about a minute and a half here.
 """
 
@@ -78,7 +78,10 @@ from Addon import Addon, MissingDependencies
 from addonmanager_dependency_installer import DependencyInstaller
 
 # the Addon Manager's preferences: the Python that runs pip, and where the constraints are (a local folder)
-FreeCAD.ParamGet("User parameter:BaseApp/Preferences/PythonConsole").SetString("ExternalPythonExecutable", PIP_PYTHON)
+# (1.x: PathToPythonExecutable, read by freecad.utils.get_python_exe; the Addon Manager's own fallback for
+# older FreeCADs reads ExternalPythonExecutable)
+for _name in ("PathToPythonExecutable", "ExternalPythonExecutable"):
+    FreeCAD.ParamGet("User parameter:BaseApp/Preferences/PythonConsole").SetString(_name, PIP_PYTHON)
 fci.Preferences().set("pip_constraints_path", CONSTRAINTS_BASE)
 addon = Addon("spur_cad", "https://git.invalid/spur_cad", Addon.Status.NOT_INSTALLED, "main")
 addon.load_metadata_file(PACKAGE_XML)
