@@ -33,7 +33,7 @@ def section_points(shape, origin: tuple[float, float, float], normal: tuple[floa
     points = []
     explorer = TopExp_Explorer(section.Shape(), TopAbs_EDGE)
     while explorer.More():
-        curve = BRepAdaptor_Curve(TopoDS.Edge_s(explorer.Current()))
+        curve = BRepAdaptor_Curve(TopoDS.Edge(explorer.Current()))
         for u in np.linspace(curve.FirstParameter(), curve.LastParameter(), per_edge):
             p = curve.Value(u)
             points.append((p.X(), p.Y(), p.Z()))

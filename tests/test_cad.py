@@ -3,6 +3,7 @@ mid-face section, span measurement between two tangent planes, STEP round trip, 
 
 from __future__ import annotations
 
+import io
 import math
 
 import numpy as np
@@ -109,7 +110,7 @@ def _section_points(shape, x: float, per_edge: int = 400) -> np.ndarray:
     points = []
     explorer = TopExp_Explorer(section.Shape(), TopAbs_EDGE)
     while explorer.More():
-        curve = BRepAdaptor_Curve(TopoDS.Edge_s(explorer.Current()))
+        curve = BRepAdaptor_Curve(TopoDS.Edge(explorer.Current()))
         for u in np.linspace(curve.FirstParameter(), curve.LastParameter(), per_edge):
             p = curve.Value(u)
             assert abs(p.X() - x) < 1e-7
@@ -136,7 +137,7 @@ def test_mid_face_section_matches_exact_profile_within_1um(name):
     edges = []
     explorer = TopExp_Explorer(section, TopAbs_EDGE)
     while explorer.More():
-        edge = TopoDS.Edge_s(explorer.Current())
+        edge = TopoDS.Edge(explorer.Current())
         curve = BRep_Tool.Curve_s(edge, 0.0, 0.0)
         first, last = BRep_Tool.Range_s(edge)
         box = _box(edge)
@@ -166,7 +167,7 @@ def _face_nearest(shape, point: gp_Pnt):
     explorer, best = TopExp_Explorer(shape, TopAbs_FACE), (math.inf, None)
     vertex = BRepBuilderAPI_MakeVertex(point).Vertex()
     while explorer.More():
-        face = TopoDS.Face_s(explorer.Current())
+        face = TopoDS.Face(explorer.Current())
         d = BRepExtrema_DistShapeShape(vertex, face).Value()
         if d < best[0]:
             best = (d, face)
@@ -332,3 +333,21 @@ def test_job_step_writes_the_parts_colour_styles_in_the_parts_order_whatever_ord
     colours = [tuple(round(float(v), 6) for v in match) for match in
                re.findall(rb"COLOUR_RGB\('[^']*',([0-9.eE+-]+),([0-9.eE+-]+),([0-9.eE+-]+)\)", written)]
     assert colours == [GEAR_COLOUR[:3], STOCK_COLOUR[:3]]
+
+
+def test_brep_text_reads_back_as_the_same_solid_in_the_format_freecad_020_reads():
+    """The workbench hands solids to FreeCAD as BREP text (OCP's writer, no front-end): read back by OCP's reader
+    it is the same solid, and it is written in format version 3, the newest OCCT 7.6 (FreeCAD 0.20) reads."""
+    from OCP.BRep import BRep_Builder
+    from OCP.BRepTools import BRepTools
+    from OCP.TopoDS import TopoDS_Shape
+
+    from spur_cad.cad.brep import brep_text
+
+    shape = spur_cad.gear_shape(spec_of("shifted_z12"))
+    text = brep_text(shape)
+    assert text.splitlines()[1].startswith("CASCADE Topology V3")
+    read = TopoDS_Shape()
+    BRepTools.Read_s(read, io.BytesIO(text.encode("ascii")), BRep_Builder())
+    assert BRepCheck_Analyzer(read).IsValid()
+    assert solid_volume_mm3(read) == pytest.approx(solid_volume_mm3(shape), rel=1e-12)

@@ -210,7 +210,7 @@ def test_ring_solid_is_valid_exact_and_survives_step(tmp_path):
     points = []
     explorer = TopExp_Explorer(section.Shape(), TopAbs_EDGE)
     while explorer.More():
-        curve = BRepAdaptor_Curve(TopoDS.Edge_s(explorer.Current()))
+        curve = BRepAdaptor_Curve(TopoDS.Edge(explorer.Current()))
         for u in np.linspace(curve.FirstParameter(), curve.LastParameter(), 25):
             p = curve.Value(u)
             points.append((p.Y(), p.Z()))

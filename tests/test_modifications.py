@@ -142,7 +142,7 @@ def _section_points(shape, x: float, per_edge: int = 200) -> np.ndarray:
     points = []
     explorer = TopExp_Explorer(section.Shape(), TopAbs_EDGE)
     while explorer.More():
-        curve = BRepAdaptor_Curve(TopoDS.Edge_s(explorer.Current()))
+        curve = BRepAdaptor_Curve(TopoDS.Edge(explorer.Current()))
         for u in np.linspace(curve.FirstParameter(), curve.LastParameter(), per_edge):
             p = curve.Value(u)
             points.append((p.Y(), p.Z()))

@@ -38,7 +38,6 @@ from OCP.BRepLib import BRepLib
 from OCP.BRepOffsetAPI import BRepOffsetAPI_MakePipeShell, BRepOffsetAPI_ThruSections
 from OCP.BRepPrimAPI import BRepPrimAPI_MakeBox, BRepPrimAPI_MakeCylinder, BRepPrimAPI_MakePrism
 from OCP.GC import GC_MakeArcOfCircle
-from OCP.GCE2d import GCE2d_MakeSegment
 from OCP.Geom import Geom_BSplineCurve, Geom_Curve, Geom_CylindricalSurface
 from OCP.Geom2d import Geom2d_Line
 from OCP.GeomAbs import GeomAbs_Plane
@@ -47,13 +46,12 @@ from OCP.gp import gp_Ax1, gp_Ax2, gp_Ax3, gp_Circ, gp_Dir, gp_Dir2d, gp_Pnt, gp
 from OCP.GProp import GProp_GProps
 from OCP.ShapeFix import ShapeFix_Face
 from OCP.ShapeUpgrade import ShapeUpgrade_UnifySameDomain
-from OCP.TColgp import TColgp_Array1OfVec, TColgp_HArray1OfPnt
-from OCP.TColStd import TColStd_HArray1OfBoolean, TColStd_HArray1OfReal
 from OCP.TopAbs import TopAbs_FACE, TopAbs_SHELL
 from OCP.TopExp import TopExp_Explorer
 from OCP.TopLoc import TopLoc_Location
 from OCP.TopoDS import TopoDS, TopoDS_Edge, TopoDS_Shape, TopoDS_Solid, TopoDS_Wire
 
+from spur_cad.cad.ocp_compat import Array1OfVec, HArray1OfBoolean, HArray1OfPnt, HArray1OfReal, MakeSegment2d
 from spur_cad.cad.specs import BlankFeatures, GearSolidReport, StockSpec
 from spur_cad.errors import ArgumentError, WorkLimitError, require_instance
 from spur_cad.geometry.modifications import SIDES, FlankModifications, modified_tooth_space_profile
@@ -84,9 +82,9 @@ def _interpolate(points: np.ndarray, tangents: np.ndarray,
     """OCP interpolation through `points` with the given unit tangents at every point; on the given increasing
     `parameters` (they fix the knots), else on OCP's chord-length ones."""
     n = len(points)
-    poles = TColgp_HArray1OfPnt(1, n)
-    vectors = TColgp_Array1OfVec(1, n)
-    flags = TColStd_HArray1OfBoolean(1, n)
+    poles = HArray1OfPnt(1, n)
+    vectors = Array1OfVec(1, n)
+    flags = HArray1OfBoolean(1, n)
     for i, ((x, y), (tx, ty)) in enumerate(zip(points, tangents), start=1):
         poles.SetValue(i, _machine_point(x, y))
         vectors.SetValue(i, gp_Vec(0.0, float(tx), float(ty)))
@@ -94,7 +92,7 @@ def _interpolate(points: np.ndarray, tangents: np.ndarray,
     if parameters is None:
         interpolation = GeomAPI_Interpolate(poles, False, 1e-9)
     else:
-        knots = TColStd_HArray1OfReal(1, n)
+        knots = HArray1OfReal(1, n)
         for i, value in enumerate(parameters, start=1):
             knots.SetValue(i, float(value))
         interpolation = GeomAPI_Interpolate(poles, knots, False, 1e-9)
@@ -173,7 +171,7 @@ def _rotation_about_x(angle_rad: float) -> gp_Trsf:
 
 
 def _transformed_edge(edge: TopoDS_Edge, trsf: gp_Trsf) -> TopoDS_Edge:
-    return TopoDS.Edge_s(BRepBuilderAPI_Transform(edge, trsf, True).Shape())
+    return TopoDS.Edge(BRepBuilderAPI_Transform(edge, trsf, True).Shape())
 
 
 def gear_face_edges(spec: GearSpec, fit_tolerance_mm: float) -> tuple[list[TopoDS_Edge], GearSolidReport]:
@@ -375,7 +373,7 @@ def _loft_lead_modified(spec: GearSpec, modifications: FlankModifications, fit_t
     solid = TopoDS_Solid()
     builder = BRep_Builder()
     builder.MakeSolid(solid)
-    builder.Add(solid, TopoDS.Shell_s(shells.Current()))
+    builder.Add(solid, TopoDS.Shell(shells.Current()))
     shells.Next()
     if shells.More():
         raise RuntimeError("sewing the lofted flanks gave more than one shell")
@@ -422,7 +420,7 @@ def _helix_along_x(lead_mm: float, length_mm: float, radius_mm: float, left_hand
     surface = Geom_CylindricalSurface(gp_Ax3(gp_Pnt(0.0, 0.0, 0.0), gp_Dir(1.0, 0.0, 0.0)), radius_mm)
     line = Geom2d_Line(gp_Pnt2d(0.0, 0.0), gp_Dir2d(-2.0 * math.pi if left_hand else 2.0 * math.pi, lead_mm))
     turns = length_mm / lead_mm
-    segment = GCE2d_MakeSegment(line.Value(0.0),
+    segment = MakeSegment2d(line.Value(0.0),
                                 line.Value(turns * math.sqrt((2.0 * math.pi) ** 2 + lead_mm ** 2))).Value()
     wire = BRepBuilderAPI_MakeWire(BRepBuilderAPI_MakeEdge(segment, surface).Edge()).Wire()
     BRepLib.BuildCurves3d_s(wire, 1e-6, MaxSegment=2000)
@@ -651,7 +649,7 @@ def front_face_area_mm2(shape: TopoDS_Shape) -> float:
     explorer = TopExp_Explorer(shape, TopAbs_FACE)
     areas = []
     while explorer.More():
-        face = TopoDS.Face_s(explorer.Current())
+        face = TopoDS.Face(explorer.Current())
         surface = BRepAdaptor_Surface(face)
         if surface.GetType() == GeomAbs_Plane:
             plane = surface.Plane()

@@ -18,6 +18,7 @@ from dataclasses import dataclass
 import numpy as np
 from OCP.TopoDS import TopoDS_Shape
 
+from spur_cad.cad.ocp_compat import ListOfShape
 from spur_cad.cam.ir import MoveKind, Toolpath
 from spur_cad.cam.tools import Tool
 from spur_cad.geometry.spec import GearSpec
@@ -182,7 +183,6 @@ def cross_check(spec: GearSpec, stock: StockCylinder, path: Toolpath, tool: Tool
     from OCP.BRepAlgoAPI import BRepAlgoAPI_Cut
     from OCP.BRepPrimAPI import BRepPrimAPI_MakeCylinder
     from OCP.gp import gp_Ax2, gp_Dir, gp_Pnt
-    from OCP.TopTools import TopTools_ListOfShape
 
     start = time.perf_counter()
     fast: SimResult = simulate(spec, stock, [Cut(path, tool)], settings, station_x=station_x,
@@ -193,7 +193,7 @@ def cross_check(spec: GearSpec, stock: StockCylinder, path: Toolpath, tool: Tool
     solids = swept_solids(path, tool, stock, settings.resolution_mm, height, refine)
     blank = BRepPrimAPI_MakeCylinder(gp_Ax2(gp_Pnt(stock.x_min, 0, 0), gp_Dir(1, 0, 0)), stock.radius_mm,
                                      stock.x_max - stock.x_min).Shape()
-    arguments, tools = TopTools_ListOfShape(), TopTools_ListOfShape()
+    arguments, tools = ListOfShape(), ListOfShape()
     arguments.Append(blank)
     for solid in solids:
         tools.Append(solid)

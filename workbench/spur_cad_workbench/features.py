@@ -20,8 +20,6 @@ throwException reports it), and a user's typing error is no program error. So Fr
 
 from __future__ import annotations
 
-import io
-
 import FreeCAD
 
 from spur_cad_workbench import compat, schema, units
@@ -147,14 +145,13 @@ def _colour(view, colour) -> None:
 
 
 def part_shape(ocp_shape):
-    """An OCP shape (CadQuery's kernel) as a FreeCAD Part.Shape, via BREP text."""
-    import cadquery as cq
+    """An OCP shape as a FreeCAD Part.Shape, via BREP text written by OCP itself (no CadQuery or build123d)."""
     import Part
 
-    buffer = io.BytesIO()
-    cq.Shape.cast(ocp_shape).exportBrep(buffer)
+    from spur_cad.cad.brep import brep_text
+
     shape = Part.Shape()
-    shape.importBrepFromString(buffer.getvalue().decode("ascii"))
+    shape.importBrepFromString(brep_text(ocp_shape))
     return shape
 
 
