@@ -25,6 +25,7 @@ from tests.workbench_helper import (
     ROOT,
     SMALL_JOB_PROPERTIES,
     SMALL_STOCK_PROPERTIES,
+    VERIFY_FAIL_LOG,
     _without_date_comments,
     run_workbench_code,
     small_job_text,
@@ -207,8 +208,7 @@ def test_restart_dialog_and_long_work_in_the_gui(freecad_gui, tmp_path):
              "stock": SMALL_STOCK_PROPERTIES, "job": SMALL_JOB_PROPERTIES}
     body = f"PROPS = {props!r}\nOUT = {str(out)!r}\nTEETH = {TEETH}\nSHOT = {str(DIALOG_SHOT)!r}\n" + BODY
     # the reference lines printed to compare colours, and the verification that fails on purpose (an error)
-    expected_log = (r"^Wrn: reference warning line$", r"^Err: reference error line$",
-                    r"^Err: Verify program: space 0: leftover [^\n]*(\nspace \d+: leftover [^\n]*)*\nFAIL: [^\n]*$")
+    expected_log = (r"^Wrn: reference warning line$", r"^Err: reference error line$", VERIFY_FAIL_LOG)
     result, proc = run_workbench_code(body, tmp_path / "fc", gui=freecad_gui, timeout_s=400, log_allowed=expected_log)
     (tmp_path / "result.json").write_text(json.dumps(result, indent=1))
     assert result is not None and result.get("ok"), describe(proc, result)

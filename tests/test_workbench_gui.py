@@ -20,6 +20,7 @@ from tests.workbench_helper import (
     SMALL_GEAR_PROPERTIES,
     SMALL_JOB_PROPERTIES,
     SMALL_STOCK_PROPERTIES,
+    VERIFY_FAIL_LOG,
     run_workbench_code,
     small_job_text,
 )
@@ -224,7 +225,9 @@ def test_workbench_commands_panel_and_screenshot_in_the_gui(freecad_gui, tmp_pat
     props = {"gear": SMALL_GEAR_PROPERTIES, "stock": SMALL_STOCK_PROPERTIES, "job": SMALL_JOB_PROPERTIES}
     body = (f"PROPS = {props!r}\nOUT = {str(tmp_path / 'exported')!r}\nJOB_FILE = {str(job_file)!r}\n"
             f"SCREENSHOT = {str(SCREENSHOT)!r}\n" + GUI_BODY)
-    result, proc = run_workbench_code(body, tmp_path / "fc", gui=freecad_gui, timeout_s=300)
+    # roughing alone verified (FAIL, an error) and an export with a bad value, both on purpose
+    expected_log = (VERIFY_FAIL_LOG, r"^Err: Export: Finishing tool: diameter at most [^\n]*$")
+    result, proc = run_workbench_code(body, tmp_path / "fc", gui=freecad_gui, timeout_s=300, log_allowed=expected_log)
     assert result is not None and result.get("ok"), describe(proc, result)
 
     # no Python exception anywhere, nor an error line in the report view

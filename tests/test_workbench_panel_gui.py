@@ -281,7 +281,9 @@ def panel_result(freecad_gui, tmp_path_factory):
             f"PANEL_SHOT = {str(PANEL_SHOT)!r}\nPANEL_ERROR_SHOT = {str(PANEL_ERROR_SHOT)!r}\n"
             f"VIEW_SHOT = {str(VIEW_SHOT)!r}\n" + BODY)
     work = tmp_path_factory.mktemp("panel")
-    result, proc = run_workbench_code(body, work, gui=freecad_gui, timeout_s=420)
+    # the invalid gear made on purpose: one line
+    expected_log = (r"^Err: Gear: Teeth must be in 5\.\.1000, got 3\.$",)
+    result, proc = run_workbench_code(body, work, gui=freecad_gui, timeout_s=420, log_allowed=expected_log)
     assert result is not None and result.get("ok"), describe(proc, result)
     assert result["hooked"] == [], result["hooked"]
     return result

@@ -160,7 +160,12 @@ def units_result(freecad_gui, tmp_path_factory):
     props = {"gear": SMALL_GEAR_PROPERTIES, "stock": SMALL_STOCK_PROPERTIES}
     body = f"PROPS = {props!r}\nIMPERIAL_SHOT = {str(IMPERIAL_SHOT)!r}\n" + BODY
     work = tmp_path_factory.mktemp("units")
-    result, proc = run_workbench_code(body, work, gui=freecad_gui, timeout_s=420)
+    # the bad gear inputs typed on purpose: one line each
+    expected_log = (r"^Err: Gear: Module must be in \[0\.05 mm, 100 mm\], got -3 mm\.$",
+                    r"^Err: Gear: Teeth must be in 5\.\.1000, got 2\.$",
+                    r"^Err: Gear: Profile shift coefficient x: the tooth is pointed: [^\n]*$",
+                    r"^Err: Gear: Profile shift coefficient x must be a finite number, got nan\.$")
+    result, proc = run_workbench_code(body, work, gui=freecad_gui, timeout_s=420, log_allowed=expected_log)
     assert result is not None and result.get("ok"), describe(proc, result)
     assert result["hooked"] == [], result["hooked"]
     return result

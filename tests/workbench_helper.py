@@ -57,6 +57,10 @@ SMALL_JOB_PROPERTIES = dict(JobName="small quick gear", ProfileTolerance=0.002, 
                             FinishingCornerRadius=0.5, TargetScallop=0.05, FinishingStepOver=1.5)
 
 
+# FreeCAD's log entry of a verification that fails (an error, as the report view shows it): one line per tooth space
+# that is off, then the verdict. For tests that make one fail on purpose (run_freecad_code's log_allowed).
+VERIFY_FAIL_LOG = r"^Err: Verify program: space 0: [^\n]*(\nspace \d+: [^\n]*)*\nFAIL: [^\n]*$"
+
 GUI_PRELUDE = r"""
 import os, sys, time, traceback
 import FreeCAD, FreeCADGui
