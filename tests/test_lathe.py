@@ -2,7 +2,7 @@
 lathe mode.
 
 Independent references: LinuxCNC's own interpreter rs274 (its canonical calls, X as a radius under G7), the
-project's reader for the other dialects, and the CadQuery stock solid (spur_cad.cad.solid.make_stock) the
+project's reader for the other dialects, and the stock solid (spur_cad.cad.solid.stock_shape) the
 turned outline is compared with. The outline is computed here from the moves alone: the smallest diameter a
 cutting point reaches over each Z (the insert a point, the blade the interval [z - width, z])."""
 
@@ -11,13 +11,15 @@ from __future__ import annotations
 import dataclasses
 import math
 
-import cadquery as cq
 import numpy as np
 import pytest
 from OCP.Bnd import Bnd_Box
+from OCP.BRepAlgoAPI import BRepAlgoAPI_Common
 from OCP.BRepBndLib import BRepBndLib
+from OCP.BRepPrimAPI import BRepPrimAPI_MakeBox
+from OCP.gp import gp_Pnt
 
-from spur_cad.cad.solid import make_stock
+from spur_cad.cad.solid import stock_shape
 from spur_cad.cam.turning import MAX_PASSES, LatheError, LatheSection, check_lathe_blank, plan_lathe
 from spur_cad.job import load_job
 from spur_cad.post.lathe import lathe_extension, post_lathe
@@ -122,17 +124,18 @@ def _segment_min(x0, z0, x1, z1, w, zs):
 
 def _bbox(shape) -> tuple[float, ...]:
     box = Bnd_Box()
-    BRepBndLib.AddOptimal_s(shape.wrapped, box, False, False)
+    BRepBndLib.AddOptimal_s(shape, box, False, False)
     return box.Get()
 
 
 def stock_diameters(spec, stock, x_mill: np.ndarray) -> tuple[np.ndarray, float]:
-    """The stock solid's diameter at milling X positions (thin sections of the CadQuery solid) and its far X."""
-    solid = make_stock(spec, stock).val()
+    """The stock solid's diameter at milling X positions (thin sections of the OCP solid) and its far X."""
+    solid = stock_shape(spec, stock)
     far = _bbox(solid)[3]
     diameters = []
     for x in x_mill:
-        section = solid.intersect(cq.Solid.makeBox(0.01, 1000.0, 1000.0, pnt=cq.Vector(x - 0.005, -500.0, -500.0)))
+        section = BRepAlgoAPI_Common(solid, BRepPrimAPI_MakeBox(gp_Pnt(x - 0.005, -500.0, -500.0), 0.01, 1000.0,
+                                                                1000.0).Shape()).Shape()
         box = _bbox(section)
         diameters.append(box[4] - box[1])
     return np.array(diameters), far
