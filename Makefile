@@ -7,6 +7,8 @@ STAMP       := $(VENV)/.installed
 PYTEST_ARGS ?=
 
 FAST_TIER   := not slow and not freecad and not linuxcnc and not browser
+# The markers `make test` selects; CI's FreeCAD 1.0 / 1.1 tiers add the FreeCAD tests (.ci/tier)
+MARKS       ?= $(FAST_TIER)
 
 .PHONY: venv demo test test-all lint bench clean
 
@@ -32,7 +34,7 @@ lint: venv
 	$(VENV)/bin/ruff check .
 
 test: lint
-	$(PYTHON) -m pytest -q -m "$(FAST_TIER)" $(PYTEST_ARGS)
+	$(PYTHON) -m pytest -q -m "$(MARKS)" $(PYTEST_ARGS)
 
 test-all: lint
 	$(PYTHON) -m pytest -q $(PYTEST_ARGS)
