@@ -143,7 +143,7 @@ def run_freecad_code(body: str, work: Path, *, freecadcmd: str | None = None,
     `body` fills the dict `RESULT`; an exception sets RESULT["ok"] = False and "error". So does an entry of
     FreeCAD's log that `log_problems` finds (a traceback, error, warning or Qt message) unless one of the
     regular expressions `log_allowed` matches it: what a test provokes on purpose, such as an input error's
-    one line. The log's text is RESULT["log"].
+    one line. The log's text is RESULT["freecad_log"].
     Give `freecadcmd=path` for the console, or `gui=(xvfb_run, freecad)` for the GUI.
     """
     work.mkdir(parents=True, exist_ok=True)
@@ -170,7 +170,7 @@ def run_freecad_code(body: str, work: Path, *, freecadcmd: str | None = None,
     result = json.loads(result_file.read_text()) if result_file.exists() else None
     log = log_file.read_text(errors="replace") if log_file.exists() else ""
     if result is not None:
-        result["log"] = log
+        result["freecad_log"] = log
         problems = log_problems(log, log_allowed) if log else [f"FreeCAD wrote no log file {log_file}"]
         if problems and result.get("ok"):
             result["ok"] = False
@@ -183,6 +183,6 @@ def describe(proc: subprocess.CompletedProcess, result: dict | None) -> str:
     error = ""
     if result is not None:
         error = f"error: {result.get('error')}\n" if result.get("error") else ""
-        result = {key: value for key, value in result.items() if key not in ("log", "error")}
+        result = {key: value for key, value in result.items() if key not in ("freecad_log", "error")}
     return (f"{error}exit status {proc.returncode}; result {result!r}\n"
             f"--- stdout (tail)\n{proc.stdout[-3000:]}\n--- stderr (tail)\n{proc.stderr[-3000:]}")

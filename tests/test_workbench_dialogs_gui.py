@@ -41,7 +41,7 @@ def report_colour(needle):
     colour, block = None, report.document().begin()
     while block.isValid():
         if needle in block.text():
-            formats = block.layout().additionalFormats()
+            formats = block.layout().formats()   # Qt 5.6+; additionalFormats is gone in Qt 6
             colour = formats[0].format.foreground().color().name() if formats else "none"
         block = block.next()
     return colour

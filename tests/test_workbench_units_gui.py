@@ -77,7 +77,9 @@ RESULT["fixed"] = [gear.Status, stock.Status, job.Status, badge_red(gear)]
 
 # the imperial schema: the gear's precise outputs and the job's panel
 names = FreeCAD.Units.listSchemas()
-FreeCAD.Units.setSchema([i for i, name in enumerate(names) if name.startswith("Imperial decimal")][0])
+# listed by description in 0.20 and 1.0 ("Imperial decimal (in, lb)"), by name in 1.1 ("ImperialDecimal")
+imperial = [i for i, name in enumerate(names) if name.startswith(("Imperial decimal", "ImperialDecimal"))]
+FreeCAD.Units.setSchema(imperial[0])
 gear.touch()
 doc.recompute()
 RESULT["precise_imperial"] = {p: [getattr(gear, p + "Precise"), getattr(gear, p).Value]
