@@ -53,7 +53,7 @@ def outside(panel, scroll, widgets):
         if left < 0 or left + widget.width() > viewport.width():
             problems.append([widget.objectName(), left, widget.width(), viewport.width()])
         if isinstance(widget, QtGui.QLabel) and widget.text():
-            longest = max(widget.fontMetrics().boundingRect(word).width() for word in widget.text().split())
+            longest = max(widget.fontMetrics().horizontalAdvance(word) for word in widget.text().split())
             if longest > widget.width() or widget.heightForWidth(widget.width()) > widget.height():
                 problems.append([widget.objectName(), "text", widget.text(), widget.width(), widget.height()])
         if isinstance(widget, QtGui.QAbstractSpinBox) and \
