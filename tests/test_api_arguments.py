@@ -32,12 +32,12 @@ def test_gear_spec_refuses_what_is_not_a_meaningful_number(kwargs, field):
 
 
 @pytest.mark.parametrize("call, argument", [
-    (lambda: spur_cad.make_gear(None), "spec"),
-    (lambda: spur_cad.make_stock("x"), "spec"),
-    (lambda: spur_cad.make_gear(reference_spec(), "bore"), "features"),
-    (lambda: spur_cad.make_stock(reference_spec(), {"radial_allowance_mm": 1.0}), "stock"),
+    (lambda: spur_cad.gear_shape(None), "spec"),
+    (lambda: spur_cad.stock_shape("x"), "spec"),
+    (lambda: spur_cad.gear_shape(reference_spec(), "bore"), "features"),
+    (lambda: spur_cad.stock_shape(reference_spec(), {"radial_allowance_mm": 1.0}), "stock"),
     (lambda: inspection_sheet(None), "spec"),
-    (lambda: spur_cad.make_gear(reference_spec(), spur_cad.BlankFeatures(bore_diameter_mm="30")), "bore_diameter_mm"),
+    (lambda: spur_cad.gear_shape(reference_spec(), spur_cad.BlankFeatures(bore_diameter_mm="30")), "bore_diameter_mm"),
     (lambda: spur_cad.to_build123d(None), "source"),
     (lambda: spur_cad.gear_shape(reference_spec(), frame="world"), "frame"),
     (lambda: spur_cad.to_build123d(reference_spec(), frame=None), "frame"),
@@ -51,8 +51,14 @@ def test_public_functions_name_the_bad_argument(call, argument):
     assert argument in str(info.value)
 
 
-def test_to_build123d_refuses_an_empty_workplane():
+@pytest.mark.cadquery
+def test_the_cadquery_front_end_names_the_bad_argument_and_refuses_an_empty_workplane():
+    for call, argument in ((lambda: spur_cad.make_gear(None), "spec"), (lambda: spur_cad.make_stock("x"), "spec"),
+                           (lambda: spur_cad.make_gear(reference_spec(), frame="world"), "frame")):
+        with pytest.raises(ArgumentError, match=argument):
+            call()
     import cadquery as cq
 
     with pytest.raises(ArgumentError, match="no solid"):
         spur_cad.to_build123d(cq.Workplane("XY"))
+

@@ -9,11 +9,9 @@ import math
 import numpy as np
 import pytest
 import shapely
-from OCP.Bnd import Bnd_Box
 from OCP.BRep import BRep_Tool
 from OCP.BRepAdaptor import BRepAdaptor_Curve
 from OCP.BRepAlgoAPI import BRepAlgoAPI_Section
-from OCP.BRepBndLib import BRepBndLib
 from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeFace, BRepBuilderAPI_MakeVertex
 from OCP.BRepCheck import BRepCheck_Analyzer
 from OCP.BRepClass3d import BRepClass3d_SolidClassifier
@@ -33,6 +31,7 @@ from spur_cad.geometry import gear_outline, sample_profile
 from spur_cad.geometry.inspection import recommended_span_teeth, span_measurement
 from spur_cad.geometry.sampling import polygon_area
 from tests.gears import spec_of
+from tests.ocp_helper import exact_bounds
 
 CAD_CASES = ["reference_z23_m4", "undercut_z8", "shifted_z12", "small_module_z30", "pa25_sharp_rack_z17",
              "big_shift_corner_above_rolling_line_z30"]
@@ -41,10 +40,8 @@ CAD_CASES = ["reference_z23_m4", "undercut_z8", "shifted_z12", "small_module_z30
 def _box(shape):
     """The exact bounding box (OCP's optimal box on the geometry, not on a triangulation): an object with
     xmin ... zmax, as CadQuery's BoundingBox has."""
-    box = Bnd_Box()
-    BRepBndLib.AddOptimal_s(shape, box, False, False)
     names = ("xmin", "ymin", "zmin", "xmax", "ymax", "zmax")
-    return type("Box", (), dict(zip(names, box.Get())))
+    return type("Box", (), dict(zip(names, exact_bounds(shape))))
 
 
 def _count(shape, kind) -> int:

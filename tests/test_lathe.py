@@ -13,9 +13,7 @@ import math
 
 import numpy as np
 import pytest
-from OCP.Bnd import Bnd_Box
 from OCP.BRepAlgoAPI import BRepAlgoAPI_Common
-from OCP.BRepBndLib import BRepBndLib
 from OCP.BRepPrimAPI import BRepPrimAPI_MakeBox
 from OCP.gp import gp_Pnt
 
@@ -24,6 +22,7 @@ from spur_cad.cam.turning import MAX_PASSES, LatheError, LatheSection, check_lat
 from spur_cad.job import load_job
 from spur_cad.post.lathe import lathe_extension, post_lathe
 from spur_cad.verify.reader import ProgramReadError, read_program
+from tests.ocp_helper import exact_bounds
 from tests.rs274_helper import canon_args, run_rs274
 
 REFERENCE = "resources/examples/reference_gear.toml"
@@ -123,9 +122,7 @@ def _segment_min(x0, z0, x1, z1, w, zs):
 
 
 def _bbox(shape) -> tuple[float, ...]:
-    box = Bnd_Box()
-    BRepBndLib.AddOptimal_s(shape, box, False, False)
-    return box.Get()
+    return exact_bounds(shape)
 
 
 def stock_diameters(spec, stock, x_mill: np.ndarray) -> tuple[np.ndarray, float]:

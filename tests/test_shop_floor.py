@@ -11,14 +11,13 @@ import dataclasses
 import re
 
 import pytest
-from OCP.Bnd import Bnd_Box
-from OCP.BRepBndLib import BRepBndLib
 
 from spur_cad.cad.solid import solid_volume_mm3, stock_shape
 from spur_cad.cli import main
 from spur_cad.errors import JobFileError, SpurCadError
 from spur_cad.job import load_job, parse_job
 from spur_cad.pipeline import build_programs, plan_cam
+from tests.ocp_helper import exact_bounds
 from tests.rs274_helper import run_rs274
 from tests.workbench_helper import small_job_text
 
@@ -42,9 +41,7 @@ def test_the_blank_weight_and_overhang_are_those_of_the_stock_solid(reference_te
     stock = stock_shape(job.gear, job.stock)
     volume_dm3 = solid_volume_mm3(stock) * 1e-6
     weight = volume_dm3 * job.stock.density_kg_dm3
-    bounds = Bnd_Box()
-    BRepBndLib.AddOptimal_s(stock, bounds, False, False)
-    x_min, _, z_min, x_max, _, z_max = bounds.Get()
+    x_min, _, z_min, x_max, _, z_max = exact_bounds(stock)
     overhang = job.stock.stub_length_mm and (x_max - job.stock.stub_length_mm) - x_min
     # just under and just over each limit: the limit holds at the solid's own figures
     for key, value in (("max_part_weight_kg", weight), ("max_overhang_mm", overhang),

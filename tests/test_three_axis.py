@@ -160,22 +160,15 @@ def test_helical_gears_are_refused_at_the_axes_key():
 
 def step_volume_and_box(path) -> tuple[float, tuple[float, ...]]:
     """The volume and bounding box (x0, y0, z0, x1, y1, z1) of the solid a STEP file holds, read by OCCT."""
-    from OCP.Bnd import Bnd_Box
-    from OCP.BRepBndLib import BRepBndLib
     from OCP.BRepGProp import BRepGProp
     from OCP.GProp import GProp_GProps
-    from OCP.STEPControl import STEPControl_Reader
 
-    reader = STEPControl_Reader()
-    assert reader.ReadFile(str(path)) == 1  # IFSelect_RetDone
-    reader.TransferRoots()
-    shape = reader.OneShape()
+    from tests.ocp_helper import exact_bounds, read_step
+
+    shape = read_step(path)
     props = GProp_GProps()
     BRepGProp.VolumeProperties_s(shape, props)
-    box = Bnd_Box()
-    box.SetGap(0.0)
-    BRepBndLib.AddOptimal_s(shape, box, False, False)
-    return props.Mass(), box.Get()
+    return props.Mass(), exact_bounds(shape)
 
 
 def test_a_three_axis_job_runs_through_the_pipeline_without_a_rotary_axis(tmp_path):
