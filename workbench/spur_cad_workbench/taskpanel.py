@@ -330,12 +330,9 @@ class JobTaskPanel:
         self.labels[field.prop], self.notes[field.prop] = label, note
         section.form.addRow(label, widget)
         self.widgets.add(field.prop)
-        # From here on the widget is looked up afresh (see FieldWidgets): on FreeCAD 1.1 (PySide6) the wrapper made
-        # before addRow was seen invalid at its signal ("RuntimeError: Signal source has been deleted").
-        widget = section.body.findChild(QtGui.QWidget, field.prop)  # the section is not in the form yet
         show_start(widget)
         finished = getattr(widget, "editingFinished", None)
-        if finished is not None:
+        if finished is not None:  # looked up afresh: see FieldWidgets
             finished.connect(lambda prop=field.prop: show_start(self.widgets[prop]))
         section.form.addRow(note)
 
