@@ -90,10 +90,10 @@ def test_the_gear_composes_in_a_build_part():
     bore_mm = 10.0
     gear = spur_cad.to_build123d(spec, frame="part")
     with build123d.BuildPart() as part:
-        build123d.add(gear) if not hasattr(build123d, "insert") else build123d.insert(gear)
+        build123d.insert(gear)
         build123d.Cylinder(bore_mm, spec.face_width_mm, mode=build123d.Mode.SUBTRACT)
         with build123d.Locations((200.0, 0.0, 0.0)):
-            build123d.add(gear) if not hasattr(build123d, "insert") else build123d.insert(gear)
+            build123d.insert(gear)
     bore_mm3 = math.pi * bore_mm**2 * spec.face_width_mm
     assert part.part.is_valid
     assert part.part.volume == pytest.approx(2.0 * gear.volume - bore_mm3, rel=1e-6)
