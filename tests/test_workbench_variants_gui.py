@@ -80,7 +80,7 @@ RESULT["dock_width"] = dock.width()
 # the 3-axis variant from the panel (an unmodified gear: 3 axes refuse modifications): a bull-nose finishing tool is
 # refused at its field, a flat one plans
 section.set_open(False)
-panel.reject()   # Cancel, as a designer closes it (1.1 keeps the job in edit after a bare closeDialog)
+FreeCADGui.Control.closeDialog()
 settle()
 for prop in ("TipRelief", "LeadCrowning", "RightFlankOwnValues"):
     setattr(gear, prop, False if prop == "RightFlankOwnValues" else FreeCAD.Units.Quantity("0 um"))
@@ -124,7 +124,7 @@ RESULT["drawn_flat"] = [min(p["X"] for p in points), max(p["X"] for p in points)
                         min((p["Y"] ** 2 + p["Z"] ** 2) ** 0.5 for p in points), gear.RootRadius.Value]
 panel, scroll = open_panel()
 RESULT["title_3"] = panel.form.toolTip()
-panel.reject()   # Cancel, as a designer closes it (1.1 keeps the job in edit after a bare closeDialog)
+FreeCADGui.Control.closeDialog()
 settle()
 
 # an internal gear: the gear is fine, the rotary-table job refuses it with the command line's sentence (3 axes cut it)
@@ -142,7 +142,7 @@ RESULT["ring"] = [gear.SpanMeasurementPrecise, gear.SpanMeasurement.Value, gear.
                   gear.TipRadius.Value < gear.RootRadius.Value, gear.Shape.isValid(), gear.Shape.BoundBox.YMax]
 panel, scroll = open_panel()
 RESULT["internal_panel"] = [panel.messages["Gear"].text(), panel.messages["Gear"].isVisible(), panel.result.ok]
-panel.reject()   # Cancel, as a designer closes it (1.1 keeps the job in edit after a bare closeDialog)
+FreeCADGui.Control.closeDialog()
 settle()
 RESULT["hooked"] = hooked
 """
