@@ -75,23 +75,27 @@ def settle(times=8):
     for _ in range(times):
         QtGui.QApplication.processEvents()
 
-def dock_holding(class_name):
-    # the dock widget around FreeCAD's widget of C++ class `class_name`, found by what it holds, not by its title
-    for widget in main_window.findChildren(QtGui.QWidget):
-        if widget.metaObject().className() == class_name:
-            while widget is not None and not isinstance(widget, QtGui.QDockWidget):
-                widget = widget.parentWidget()
-            return widget
+def dock_showing(class_name):
+    # the dock widget whose content is FreeCAD's widget of C++ class `class_name`, found by what it shows, not by its
+    # title. Only the docks are looked at: wrapping every widget of the main window (findChildren(QWidget)) also wraps
+    # the panel's FreeCAD-made fields, and such stale wrappers came back for the fields of a panel opened later.
+    for dock in main_window.findChildren(QtGui.QDockWidget):
+        if dock.widget() is not None and dock.widget().metaObject().className() == class_name:
+            return dock
     return None
 
 def task_dock():
-    # the task view's dock: 0.20 a tab of "Combo View", 1.0 a dock "Tasks" beside "Model", 1.1 a dock "Tasks" in the
-    # right-hand overlay (observed in each)
-    return dock_holding("Gui::TaskView::TaskView")
+    # the task view's dock: 0.20 a tab ("combiTab") of the "Combo View" dock, 1.0 a dock "Tasks" beside "Model", 1.1 a
+    # dock "Tasks" in the right-hand overlay (observed in each)
+    dock = dock_showing("Gui::TaskView::TaskView")
+    if dock is None:
+        dock = model_dock()
+        assert dock.widget().findChild(QtGui.QTabWidget, "combiTab") is not None, "no task view found"
+    return dock
 
 def model_dock():
     # the model tree's dock (Gui::DockWnd::ComboView): "Combo View" in 0.20 (its first tab), "Model" in 1.0 and 1.1
-    return dock_holding("Gui::DockWnd::ComboView")
+    return dock_showing("Gui::DockWnd::ComboView")
 
 def set_task_dock_width(width):
     # a dock in the main window's dock areas is resized by the main window (0.20, 1.0); 1.1's overlay
