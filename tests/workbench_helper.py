@@ -99,13 +99,14 @@ def model_dock():
 
 def set_task_dock_width(width):
     # a dock in the main window's dock areas is resized by the main window (0.20, 1.0); 1.1's overlay
-    # (Gui::OverlayTabWidget, outside the dock areas, 388 px wide by default) by resizing the overlay itself
+    # (Gui::OverlayTabWidget, outside the dock areas, 388 px wide by default) by fixing the overlay's own width (FreeCAD
+    # puts its width back when the panel changes; Qt keeps a widget's geometry within its fixed width)
     dock = task_dock()
     overlay = dock.parentWidget()
     while overlay is not None and overlay.metaObject().className() != "Gui::OverlayTabWidget":
         overlay = overlay.parentWidget()
     if overlay is not None:
-        overlay.resize(width, overlay.height())
+        overlay.setFixedWidth(width)
     else:
         main_window.resizeDocks([dock], [width], QtCore.Qt.Horizontal)
     settle()
