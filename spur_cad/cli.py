@@ -21,6 +21,7 @@ import signal
 import sys
 import threading
 import warnings
+from pathlib import Path
 from typing import NoReturn
 
 from spur_cad.errors import SpurCadError, escaped, one_line
@@ -101,6 +102,10 @@ def _parser() -> argparse.ArgumentParser:
     correct.add_argument("--out", required=True, help="folder for the corrected programs and correction.json")
     correct.add_argument("--quiet", action="store_true", help="print nothing but errors")
     correct.add_argument("--debug", action="store_true", help="show tracebacks of internal errors")
+    for command in (run, verify, grade, correct):
+        command.add_argument("--side-files", action="append", default=[], metavar="DIR",
+                             help="a folder the files the job names (report_template, rotary_calibration_file) may "
+                                  "also be read from, besides the job file's own folder (may be given again)")
     freecad = sub.add_parser("install-freecad", help="make the FreeCAD workbench and this spur_cad available "
                                                      "to your FreeCAD (undo with --uninstall)")
     freecad.add_argument("--uninstall", action="store_true", help="remove what install-freecad added")
@@ -207,6 +212,16 @@ def entry() -> NoReturn:
     os._exit(code)
 
 
+def _side_folders(names: list[str]) -> tuple[Path, ...]:
+    """The --side-files folders, each an existing folder (else one line, before the job is read)."""
+    from spur_cad.errors import shown_path
+
+    for name in names:
+        if not os.path.isdir(name):
+            raise SpurCadError(f"--side-files {shown_path(name)}: not a folder")
+    return tuple(Path(name) for name in names)
+
+
 def _checkpoint(received: list[int]) -> None:
     """Stop here (one line, 130 / 143) when a signal has arrived since the run began."""
     if received:
@@ -232,7 +247,7 @@ def _run(args: argparse.Namespace, received: list[int], loaded: list) -> tuple[l
 
         restart = parse_restart(args.restart) if args.restart is not None else None
         out_dir = check_output_folder(args.out)  # before any computation
-        loaded.append(load_job(args.job))
+        loaded.append(load_job(args.job, side_folders=_side_folders(args.side_files)))
         bars = ProgressBars(sys.stderr) if not args.quiet and sys.stderr.isatty() else None
 
         def progress(stage: str, fraction: float) -> None:
@@ -277,7 +292,7 @@ def _verify(args: argparse.Namespace, received: list[int], loaded: list) -> int:
 
     _checkpoint(received)
     out_dir = check_output_folder(args.out) if args.out else None
-    loaded.append(load_job(args.job))
+    loaded.append(load_job(args.job, side_folders=_side_folders(args.side_files)))
     job = loaded[0]
     options = VerifyOptions(args.point, args.gouge_tolerance_mm, args.leftover_tolerance_mm, tuple(args.point_tools),
                             args.a_offset_deg)
@@ -322,7 +337,7 @@ def _grade(args: argparse.Namespace, received: list[int], loaded: list) -> int:
 
     _checkpoint(received)
     out_dir = check_output_folder(args.out) if args.out else None
-    loaded.append(load_job(args.job))
+    loaded.append(load_job(args.job, side_folders=_side_folders(args.side_files)))
     job = loaded[0]
     measured = read_measured_file(args.measured)
     if isinstance(measured, MeasuredPoints):
@@ -377,7 +392,7 @@ def _correct(args: argparse.Namespace, received: list[int], loaded: list) -> int
 
     _checkpoint(received)
     out_dir = check_output_folder(args.out)
-    loaded.append(load_job(args.job))
+    loaded.append(load_job(args.job, side_folders=_side_folders(args.side_files)))
     measured = read_measured_file(args.measured)  # a scan's CSV, or the job's probe log
     _checkpoint(received)
     identified, files = correct_job(loaded[0], measured, shown_path(args.measured))

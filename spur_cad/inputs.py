@@ -8,7 +8,8 @@ import datetime
 import os
 import re
 import stat
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
+from pathlib import Path
 from typing import BinaryIO
 
 from spur_cad.errors import SpurCadError, shown, shown_path
@@ -54,6 +55,33 @@ def read_regular_file(path: str | os.PathLike, what: str, max_bytes: int,
     if len(data) > max_bytes:  # it grew while being read
         raise error(f"{shown_path(path)}: the {what} has more than {max_bytes:,} bytes; at most {max_bytes:,} are read")
     return data
+
+
+def side_file_path(name: str, folders: Sequence[str | os.PathLike], what: str,
+                   error: type[SpurCadError] = SpurCadError) -> Path:
+    """Where a file a job names beside itself ([job] report_template, [machine] rotary_calibration_file, ...) is
+    read: `name`, relative, looked up in each of `folders` in turn (the job file's folder first, then those the
+    user named: `--side-files`, the workbench's document folder), the first where it exists. Links and `..` are
+    followed, and the file they reach must lie inside one of `folders` (each with its own links resolved): an
+    absolute name, or one that leads out of them, is refused with one line whatever the file holds, so that a
+    job file from elsewhere cannot make a run read (and put into its report) any other file on the machine."""
+    shown_name = shown(name)
+    if not name or os.path.isabs(name):
+        raise error(f"{shown_name} is {'an absolute path' if name else 'empty'}: a {what} is named relative to "
+                    "the job file's folder, and must lie in it (or in a folder given with --side-files)")
+    try:
+        roots = [Path(folder).resolve() for folder in folders]
+        candidates = [(root / name).resolve() for root in roots]
+    except (OSError, RuntimeError, ValueError) as exc:  # a loop of links, a name too long
+        raise error(f"{shown_name}: cannot find the {what}: {getattr(exc, 'strerror', None) or exc}") from None
+    for candidate in candidates:
+        if not any(candidate.is_relative_to(root) for root in roots):
+            allowed = " or ".join(shown_path(root) for root in roots)
+            raise error(f"{shown_name} leads outside the job file's folder (to {shown_path(candidate)}): a {what} "
+                        f"must lie in {allowed}; name another folder with --side-files")
+        if os.path.lexists(candidate):
+            return candidate
+    return candidates[0]
 
 
 def step_timestamp(environment: Mapping[str, str]) -> str | None:

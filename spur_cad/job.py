@@ -17,7 +17,7 @@ import dataclasses
 import difflib
 import re
 import tomllib
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -56,8 +56,9 @@ class JobSection:
     profile_tolerance_mm: float = key(0.001, unit="mm", low=0.0001, high=0.1, label="ProfileTolerance", group="Job",
                                       meaning="chordal tolerance of sampled profiles (profile.csv)")
     report_template: str = key("", label="ReportTemplate", group="Job",
-                               meaning="report.html's Jinja2 template, a file relative to the job file (empty: "
-                                       "spur_cad's own, spur_cad/report/templates/report.html.j2: copy it to start)")
+                               meaning="report.html's Jinja2 template, a file relative to the job file, in its "
+                                       "folder or a --side-files folder (empty: spur_cad's own, "
+                                       "spur_cad/report/templates/report.html.j2: copy it to start)")
     material: str = key(DEFAULT_MATERIAL, choices=tuple(MATERIALS), label="Material", group="Job",
                         meaning="the gear's material: its specific cutting force (Kienzle k_c1.1, m_c; "
                                 "spur_cad/cam/materials.py) sets the finishing tool's deflection in the error budget")
@@ -822,20 +823,21 @@ def _check_export(spec: GearSpec, gear_section: GearSection, export: ExportSecti
 
 
 MAX_TEMPLATE_BYTES = 256 * 1024
-"""Largest report template read (spur_cad's own is about 7 kB)."""
+"""Largest report template read (spur_cad's own is about 9 kB)."""
 
 
-def with_report_template(job: Job, folder: Path) -> Job:
-    """The job with its [job] report_template read (relative to `folder`, the job file's) and compiled: a missing
-    or unreadable file, one that is not a regular file or larger than MAX_TEMPLATE_BYTES, or a template syntax
-    error is one JobFileError at the key's line."""
+def with_report_template(job: Job, folder: Path, side_folders: Sequence[Path] = ()) -> Job:
+    """The job with its [job] report_template read (found as `_named_file` finds it) and compiled: a name that
+    leads outside the allowed folders, a missing or unreadable file, one that is not a regular file or larger
+    than MAX_TEMPLATE_BYTES, or a template syntax error is one JobFileError at the key's line."""
     from spur_cad.report.html import compile_template
 
     def compiled(text: str, source: str) -> str:
         compile_template(text, source)  # a syntax error is refused now, before any work
         return text
 
-    text = _named_file(job, folder, "job", "report_template", "report template", MAX_TEMPLATE_BYTES, compiled)
+    text = _named_file(job, folder, side_folders, "job", "report_template", "report template", MAX_TEMPLATE_BYTES,
+                       compiled)
     return job if text is None else dataclasses.replace(job, report_template_text=text)
 
 
@@ -843,28 +845,32 @@ MAX_CALIBRATION_BYTES = 1024 * 1024
 """Largest rotary calibration table read (a table of every 0.1 deg is about 60 kB)."""
 
 
-def with_rotary_calibration(job: Job, folder: Path) -> Job:
-    """The job with its [machine] rotary_calibration_file read (relative to `folder`, the job file's): a missing
-    file, one that is not a regular file, larger than MAX_CALIBRATION_BYTES, not UTF-8 or with a line that is
-    not 'A_deg error_arcsec' is one JobFileError at the key's line."""
-    table = _named_file(job, folder, "machine", "rotary_calibration_file", "calibration table", MAX_CALIBRATION_BYTES,
-                        parse_calibration_table)
+def with_rotary_calibration(job: Job, folder: Path, side_folders: Sequence[Path] = ()) -> Job:
+    """The job with its [machine] rotary_calibration_file read (found as `_named_file` finds it): a name that
+    leads outside the allowed folders, a missing file, one that is not a regular file, larger than
+    MAX_CALIBRATION_BYTES, not UTF-8 or with a line that is not 'A_deg error_arcsec' is one JobFileError at the
+    key's line."""
+    table = _named_file(job, folder, side_folders, "machine", "rotary_calibration_file", "calibration table",
+                        MAX_CALIBRATION_BYTES, parse_calibration_table)
     return job if table is None else dataclasses.replace(job, rotary_calibration=table)
 
 
-def _named_file(job: Job, folder: Path, section: str, field_name: str, what: str, max_bytes: int, read):
-    """`read(text, shown path)` of the UTF-8 file [section] field_name names, relative to `folder`; None when the
-    key is empty. Every failure (the file, its encoding, what `read` raises: ValueError or a SpurCadError) is one
-    JobFileError at the key's line."""
-    from spur_cad.inputs import read_regular_file
+def _named_file(job: Job, folder: Path, side_folders: Sequence[Path], section: str, field_name: str, what: str,
+                max_bytes: int, read):
+    """`read(text, shown path)` of the UTF-8 file [section] field_name names; None when the key is empty. The
+    name is relative and the file must lie in `folder` (the job file's) or one of `side_folders` (the user's
+    --side-files), links and `..` resolved: spur_cad.inputs.side_file_path. Every failure (where the name leads,
+    the file, its encoding, what `read` raises: ValueError or a SpurCadError) is one JobFileError at the key's
+    line."""
+    from spur_cad.inputs import read_regular_file, side_file_path
     from spur_cad.report.html import ReportTemplateError
 
     name = getattr(job.section(section), field_name)
     if not name:
         return None
-    path = folder / name
     where = f"{_where(job.source, job.text, section, field_name)}: [{section}] {field_name}"
     try:
+        path = side_file_path(name, (folder, *side_folders), what, JobFileError)
         return read(read_regular_file(path, what, max_bytes, JobFileError).decode("utf-8"), shown_path(path))
     except UnicodeDecodeError:
         raise JobFileError(f"{where}: {shown_path(path)} is not UTF-8 text", section=section,
@@ -873,16 +879,17 @@ def _named_file(job: Job, folder: Path, section: str, field_name: str, what: str
         raise JobFileError(f"{where}: {exc}", section=section, field=field_name) from None
 
 
-def with_files(job: Job, folder: Path) -> Job:
-    """The job with the files it names read from `folder` (the job file's): the report template and the rotary
-    calibration table."""
-    return with_rotary_calibration(with_report_template(job, folder), folder)
+def with_files(job: Job, folder: Path, side_folders: Sequence[Path] = ()) -> Job:
+    """The job with the files it names read: the report template and the rotary calibration table, each found
+    in `folder` (the job file's, or in the workbench the saved document's) or in one of `side_folders` (folders
+    the user named), never outside them."""
+    return with_rotary_calibration(with_report_template(job, folder, side_folders), folder, side_folders)
 
 
-def load_job(path: str | Path, strategies: Strategies = REGISTRY) -> Job:
+def load_job(path: str | Path, strategies: Strategies = REGISTRY, side_folders: Sequence[Path] = ()) -> Job:
     """Read and validate a job file from disk (a regular file of at most MAX_JOB_FILE_BYTES: a FIFO or a device
     is refused before it is read); the files it names ([job] report_template, [machine] rotary_calibration_file) are
-    read from the job file's folder."""
+    read from the job file's folder or one of `side_folders` (`--side-files`), never from elsewhere."""
     from spur_cad.inputs import read_regular_file
 
     source = shown_path(path)  # messages name the file with its control characters escaped
@@ -893,4 +900,4 @@ def load_job(path: str | Path, strategies: Strategies = REGISTRY) -> Job:
         raise JobFileError(f"{source}: the job file is not UTF-8 text") from None
     if "\x00" in text:
         raise JobFileError(f"{source}: the job file contains NUL characters (not a text file)")
-    return with_files(parse_job(text, source, strategies), Path(path).parent)
+    return with_files(parse_job(text, source, strategies), Path(path).parent, side_folders)

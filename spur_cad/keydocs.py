@@ -26,6 +26,13 @@ Every number must be finite (`nan` and `inf` are rejected) and inside its range:
 includes both ends, `(a, b]` excludes a; `a..b` is a range of whole numbers. An integer is
 accepted where a number is expected; `true`/`false` only where a flag is. The last column names
 the FreeCAD workbench's property holding the key (see [workbench.md](workbench.md)).
+
+Side files: a file the job names (`[job] report_template`, `[machine] rotary_calibration_file`) is named
+relative to the job file and must lie in the job file's folder or below it, or in a folder named with
+`spur-cad run --side-files DIR` (also `verify`, `grade`, `correct`; DIR is searched after the job's folder). An
+absolute name, or a `..` or a symbolic link that leads out of these folders, is refused with one line, whatever
+the file holds. In the workbench the saved document's folder takes the job file's place. A report template
+renders within bounds (time, size of the page and of its values, loops, recursion): [report.md](report.md).
 """
 
 _DOC_NOTES = """\

@@ -97,8 +97,9 @@ class Machine:
                                                      "to 10); a seeded draw per space in +- half of it")
     rotary_calibration_file: str = key("", label="RotaryCalibrationFile", group="Machine accuracy",
                                        meaning="error budget: the rotary table's measured error, a file relative to "
-                                               "the job file of lines 'A_deg error_arcsec' as compensation tables "
-                                               "hold it (empty: the accuracy's sine)")
+                                               "the job file (in its folder or a --side-files folder) of lines "
+                                               "'A_deg error_arcsec' as compensation tables hold it (empty: the "
+                                               "accuracy's sine)")
     spindle_runout_um: float = key(2.0, unit="um", low=0.0, high=100.0, label="SpindleRunout",
                                    group="Machine accuracy",
                                    meaning="error budget: the spindle's runout, total indicated (datasheets: 1 to 3)")

@@ -18,6 +18,7 @@ from spur_cad.report import sheet
 from spur_cad.report.sheet import Table, duration, number
 
 if TYPE_CHECKING:
+    from spur_cad.report.template_bounds import TemplateLimits
     from spur_cad.result import FinishingFacts, JobResult
 
 TEMPLATE_NAME = "report.html.j2"
@@ -32,19 +33,25 @@ def default_template_text() -> str:
     return resources.files("spur_cad.report").joinpath("templates", TEMPLATE_NAME).read_text(encoding="utf-8")
 
 
-def compile_template(text: str, source: str = TEMPLATE_NAME):
-    """The template compiled in Jinja2's sandbox (autoescaped, undefined names are errors); a syntax error is a
-    ReportTemplateError naming `source` and the template's line. Without Jinja2 installed: what to install."""
+def compile_template(text: str, source: str = TEMPLATE_NAME, limits: TemplateLimits | None = None):
+    """The template compiled in Jinja2's sandbox, bounded (spur_cad.report.template_bounds: autoescaped, undefined
+    names are errors, its loops, calls, values and output counted when it renders); a syntax error (or a template
+    nested too deeply to compile) is a ReportTemplateError naming `source` and the template's line. Without Jinja2
+    installed: what to install."""
     require_jinja2()
     import jinja2
-    from jinja2.sandbox import ImmutableSandboxedEnvironment
 
-    environment = ImmutableSandboxedEnvironment(autoescape=True, undefined=jinja2.StrictUndefined,
-                                                keep_trailing_newline=True)
+    from spur_cad.report.template_bounds import BoundedSandbox, TemplateLimits
+
+    environment = BoundedSandbox(limits or TemplateLimits())
     try:
-        return environment.from_string(text)
+        return environment.bounded_template(text)
     except jinja2.TemplateSyntaxError as exc:
         raise ReportTemplateError(one_line(f"{source}:{exc.lineno}: not a valid report template: {exc.message}"),
+                                  field="report_template", section="job") from None
+    except (RecursionError, MemoryError, SyntaxError, ValueError, OverflowError) as exc:
+        # nested past what Jinja2's parser or Python's compiler takes, or a number literal of thousands of digits
+        raise ReportTemplateError(one_line(f"{source}: not a valid report template: {type(exc).__name__}: {exc}"),
                                   field="report_template", section="job") from None
 
 
@@ -196,21 +203,31 @@ def report_context(result: JobResult, images: dict[str, bytes]) -> dict:
 
 
 def render_report(result: JobResult, images: dict[str, bytes], template_text: str | None = None,
-                  template_source: str = TEMPLATE_NAME) -> bytes:
+                  template_source: str = TEMPLATE_NAME, limits: TemplateLimits | None = None) -> bytes:
     """The whole report as UTF-8 HTML bytes, from `template_text` (default: spur_cad's own template). `images`:
     'profile', 'roughing', 'finishing', 'deviation', 'kchart' PNGs. A template that fails while rendering (an
-    unknown name, say) is a ReportTemplateError naming it and its line. A job with flank modifications adds
-    'modifications' (their chart)."""
+    unknown name, a division by zero) or passes one of its `limits` (TemplateLimits: time, size of the page and of
+    its values, loops, recursion) is a ReportTemplateError naming it and its line. A job with flank modifications
+    adds 'modifications' (their chart)."""
     import jinja2
 
     template = compile_template(default_template_text() if template_text is None else template_text,
-                                template_source)
+                                template_source, limits)
     try:
-        text = template.render(report_context(result, images))
-    except (jinja2.TemplateError, TypeError, ValueError, AttributeError, KeyError) as exc:
+        text = template.environment.bounded_render(template, report_context(result, images))
+    except (jinja2.TemplateError, TypeError, ValueError, AttributeError, LookupError, ArithmeticError,
+            RecursionError, MemoryError) as exc:
+        from spur_cad.report.template_bounds import TemplateBoundError
+
         line = _template_line(exc)
-        raise ReportTemplateError(one_line(f"{template_source}{f':{line}' if line else ''}: the report template "
-                                           f"failed: {exc}"), field="report_template", section="job") from None
+        if isinstance(exc, TemplateBoundError):
+            reason = f"passed its bounds (docs/report.md): {exc}"
+        else:
+            named = isinstance(exc, (RecursionError, MemoryError, ArithmeticError))  # their text alone says little
+            reason = f"failed: {type(exc).__name__ + ': ' if named else ''}{exc}"
+        raise ReportTemplateError(one_line(f"[job] report_template: {template_source}{f':{line}' if line else ''}: "
+                                           f"the report template {reason}"), field="report_template",
+                                  section="job") from None
     return text.encode("utf-8")
 
 
