@@ -1,10 +1,10 @@
 """FreeCAD 0.20 / 1.0 / 1.1 differences the workbench meets, each behind one small function.
 
-Only Debian's FreeCAD 0.20.2 (Qt 5, PySide2 5.15) runs on the project's machines; FreeCAD 1.0 and
-1.1 were checked by reading their source (docs/freecad-compat.md lists every file, tag and pull
-request). Each function takes the FreeCAD / Qt object or module it works on as an argument and
-imports nothing at import time, so every branch is tested without FreeCAD
-(tests/test_workbench_compat.py) and the 0.20 branches also inside freecadcmd and the GUI.
+Observed in Debian 12's FreeCAD 0.20.2 (Qt 5, PySide2 5.15), Debian 13's 1.0.0 (Qt 5, PySide2 5.15) and Debian
+testing's 1.1.3 (Qt 6, PySide6 6.11); first written from their sources (docs/freecad-compat.md lists every file,
+tag and pull request, and what the running versions showed). Each function takes the FreeCAD / Qt object or module
+it works on as an argument and imports nothing at import time, so every branch is tested without FreeCAD
+(tests/test_workbench_compat.py) and each FreeCAD's branches inside its freecadcmd and GUI.
 
 What differs (more in docs/freecad-compat.md):
 - the CAM workbench's Python module: `Path` is a C++ module in 0.20 and a Python package over the C++
@@ -12,8 +12,8 @@ What differs (more in docs/freecad-compat.md):
 - Qt 5 / Qt 6 through FreeCAD's `PySide` wrapper: PySide6's enums are Python enums, so
   `int(QDialogButtonBox.Ok | QDialogButtonBox.Cancel)` raises TypeError; `exec_` is deprecated;
   the wrapper has `PySide.QtWidgets` only in 1.x (both re-export the widgets from `PySide.QtGui`);
-- Gui::QuantitySpinBox has a per-widget `decimals` property in 1.x only (0.20 shows a Quantity with the
-  precision of its own `Format`);
+- Gui::QuantitySpinBox: 1.x's sources have a per-widget `decimals`, but no running version declares it as a Qt
+  property (observed); all three show a Quantity with the precision of its own `Format`;
 - ViewProviderGeometryObject's `ShapeColor` property became `ShapeAppearance` (a material list) in 1.0;
 - Control.showDialog returns None in 0.20 and a TaskDialog wrapper in 1.x;
 - a proxy's state is restored through `__setstate__` in 0.20 and `loads` in 1.x (StatelessProxy).
