@@ -225,7 +225,8 @@ def test_exec_dialog(dialog_class, called):
 
 # --- Gui::QuantitySpinBox -------------------------------------------------------------------------------
 
-# Gui::QuantitySpinBox Qt properties: 0.20 as its metaObject lists them in the GUI; 1.x: src/Gui/QuantitySpinBox.h.
+# Gui::QuantitySpinBox Qt properties: 0.20 as its metaObject lists them in the GUI; 1.x: src/Gui/QuantitySpinBox.h
+# (the running 1.0.0 and 1.1.3 declare no `decimals` property: the 1.x fake keeps the branch for a FreeCAD that does).
 SPIN_BOX_PROPERTIES_020 = ("unit", "minimum", "maximum", "singleStep", "rawValue", "value", "binding", "expression")
 SPIN_BOX_PROPERTIES_1X = ("unit", "minimum", "maximum", "singleStep", "rawValue", "decimals", "value", "binding",
                           "expression", "autoNormalize")
