@@ -76,13 +76,18 @@ def test_the_part_frame_is_the_machine_frame_turned_without_a_mirror():
     assert len(points) > 20
     for point in points:
         assert min((point - other).length for other in targets) < 1e-6
-    # and the same points are metal in both: a ring of points round the pitch circle at five heights
+    # and the same points are metal in both: points round the pitch circle near both faces, a quarter pitch off
+    # the tooth centre lines (metal at one end, air at the other as the helix turns)
     radius = spec.reference_radius_mm
-    for height in (-5.5, -2.0, 0.0, 3.0, 5.5):
-        for k in range(40):
-            angle = 2.0 * math.pi * k / 40
+    seen = set()
+    for height in (-5.5, 5.5):
+        for k in range(0, 17, 2):
+            angle = 2.0 * math.pi * (k + 0.25) / 17
             point = (radius * math.cos(angle), radius * math.sin(angle), height)
-            assert _inside(part, point) == _inside(moved, point), point
+            inside = _inside(part, point)
+            assert inside == _inside(moved, point), point
+            seen.add(inside)
+    assert seen == {True, False}  # both metal and air were compared
 
 
 def test_the_gear_composes_in_a_build_part():
