@@ -188,7 +188,7 @@ HOSTILE_TEMPLATES = {  # name: (template, what the line must say)
     "center-huge": ("{{ 'x'|center(9999999999) }}", "numbers given to filters"),
     "join-wide": ("{% set a = ['x' * 100000] * 40 %}{{ a|join('y' * 100000) }}", "join filter"),
     "replace-empty": ("{{ ('x' * 100000)|replace('', 'y' * 1000) }}", "replace filter"),
-    "sum-lists": ("{{ [[1] * 1000] * 1000|sum(start=[]) }}", "adds numbers only"),
+    "sum-lists": ("{% set rows = [[1] * 1000] * 1000 %}{{ rows|sum(start=[]) }}", "adds numbers only"),
     "to-bytes": ("{{ (1).to_bytes(1000000000, 'big') }}", "unsafe"),
     "ljust": ("{{ 'x'.ljust(10**9) }}", "unsafe"),
     "lipsum": ("{{ lipsum(100000) }}", "'lipsum' is undefined"),
