@@ -161,10 +161,15 @@ def export_job(job_obj, out_dir: str) -> list[str]:
     from spur_cad.outputs import write_output_set
     from spur_cad.pipeline import run_job
 
-    # A relative ReportTemplate or RotaryCalibrationFile is found beside the saved document (else in the current
-    # folder), as a job file's beside the job file.
+    # A relative ReportTemplate or RotaryCalibrationFile is found beside the saved document, as a job file's beside
+    # the job file; an unsaved document has no folder, so it may name none.
     document = job_obj.Document.FileName
-    job = with_files(job_of(job_obj), Path(document).parent if document else Path.cwd())
+    job = job_of(job_obj)
+    if document:
+        job = with_files(job, Path(document).parent)
+    elif job.job.report_template or job.machine.rotary_calibration_file:
+        raise SpurCadError("the job names a ReportTemplate or RotaryCalibrationFile, which is found beside the "
+                           "document: save the document first (in the folder those files are in)")
     with WorkProgress("Export", EXPORT_STAGES) as work:
         files = run_job(job, progress=work.advance, checkpoint=work.events).files
     out = Path(out_dir)
