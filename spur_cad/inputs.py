@@ -18,10 +18,12 @@ _KINDS = ((stat.S_ISDIR, "a folder"), (stat.S_ISFIFO, "a FIFO (named pipe)"), (s
           (stat.S_ISBLK, "a device"), (stat.S_ISSOCK, "a socket"))
 
 
-def open_regular_file(path: str | os.PathLike, what: str, error: type[SpurCadError] = SpurCadError) -> BinaryIO:
+def open_regular_file(path: str | os.PathLike, what: str, error: type[SpurCadError] = SpurCadError,
+                      name: str | None = None) -> BinaryIO:
     """`path` opened for binary reading if it is a regular file (a link to one is fine); else `error` with
-    one line: '<path>: <what> not found' / 'is a FIFO (named pipe), not a regular file' / 'cannot read ...'."""
-    name = shown_path(path)
+    one line: '<name>: <what> not found' / 'is a FIFO (named pipe), not a regular file' / 'cannot read ...'.
+    `name`: how messages name the file (default: `path`, shown)."""
+    name = shown_path(path) if name is None else name
     try:
         # O_NONBLOCK: opening a FIFO does not wait for a writer; the kind is then checked on what was opened
         fd = os.open(path, os.O_RDONLY | os.O_NONBLOCK | os.O_NOCTTY | os.O_CLOEXEC)
@@ -42,18 +44,20 @@ def open_regular_file(path: str | os.PathLike, what: str, error: type[SpurCadErr
 
 
 def read_regular_file(path: str | os.PathLike, what: str, max_bytes: int,
-                      error: type[SpurCadError] = SpurCadError) -> bytes:
-    """The bytes of a regular file of at most `max_bytes` (refused with its size beyond, before reading)."""
-    with open_regular_file(path, what, error) as handle:
+                      error: type[SpurCadError] = SpurCadError, name: str | None = None) -> bytes:
+    """The bytes of a regular file of at most `max_bytes` (refused with its size beyond, before reading).
+    `name`: how messages name the file (default: `path`, shown)."""
+    name = shown_path(path) if name is None else name
+    with open_regular_file(path, what, error, name) as handle:
         size = os.fstat(handle.fileno()).st_size
         if size > max_bytes:
-            raise error(f"{shown_path(path)}: the {what} has {size:,} bytes; at most {max_bytes:,} are read")
+            raise error(f"{name}: the {what} has {size:,} bytes; at most {max_bytes:,} are read")
         try:
             data = handle.read(max_bytes + 1)
         except OSError as exc:
-            raise error(f"{shown_path(path)}: cannot read the {what}: {exc.strerror or exc}") from None
+            raise error(f"{name}: cannot read the {what}: {exc.strerror or exc}") from None
     if len(data) > max_bytes:  # it grew while being read
-        raise error(f"{shown_path(path)}: the {what} has more than {max_bytes:,} bytes; at most {max_bytes:,} are read")
+        raise error(f"{name}: the {what} has more than {max_bytes:,} bytes; at most {max_bytes:,} are read")
     return data
 
 

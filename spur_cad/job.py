@@ -833,7 +833,7 @@ def with_report_template(job: Job, folder: Path, side_folders: Sequence[Path] = 
     from spur_cad.report.html import compile_template
 
     def compiled(text: str, source: str) -> str:
-        compile_template(text, source)  # a syntax error is refused now, before any work
+        compile_template(text, shown_path(job.job.report_template))  # a syntax error is refused now, before any work
         return text
 
     text = _named_file(job, folder, side_folders, "job", "report_template", "report template", MAX_TEMPLATE_BYTES,
@@ -871,9 +871,10 @@ def _named_file(job: Job, folder: Path, side_folders: Sequence[Path], section: s
     where = f"{_where(job.source, job.text, section, field_name)}: [{section}] {field_name}"
     try:
         path = side_file_path(name, (folder, *side_folders), what, JobFileError)
-        return read(read_regular_file(path, what, max_bytes, JobFileError).decode("utf-8"), shown_path(path))
+        data = read_regular_file(path, what, max_bytes, JobFileError, shown_path(name))  # as the job names it
+        return read(data.decode("utf-8"), shown_path(path))
     except UnicodeDecodeError:
-        raise JobFileError(f"{where}: {shown_path(path)} is not UTF-8 text", section=section,
+        raise JobFileError(f"{where}: {shown_path(name)} is not UTF-8 text", section=section,
                            field=field_name) from None
     except (JobFileError, ReportTemplateError, ValueError) as exc:
         raise JobFileError(f"{where}: {exc}", section=section, field=field_name) from None

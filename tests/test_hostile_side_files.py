@@ -345,3 +345,152 @@ def test_a_measured_file_as_a_link_or_fifo_is_refused_without_waiting(small_job,
     os.mkfifo(fifo)
     result = spur_cad("grade", small_job, fifo)
     assert result.returncode == 2 and "FIFO" in result.stderr and len(result.stderr.splitlines()) == 1
+
+
+# --- the reviewer's cases (issue 49, second round) -----------------------------------------------------------
+
+_X1000 = ",".join(["x"] * 1000)
+_BIG = "{% set x = 'y' * 4000000 %}"
+
+REVIEWED_TEMPLATES = {  # name: (template, what the line must say); before the fix each ran out of memory or time
+    "percent-mapping-repeated": (_BIG + "{{ ('%(a)s' * 1000) % {'a': x} }}", "%-format whose result"),
+    "format-filter-repeated": (_BIG + "{{ ('%(a)s' * 1000)|format(a=x)|length }}", "%-format whose result"),
+    "percent-positional": (_BIG + "{{ ('%s' * 3) % (x, x, x) }}", "larger than"),
+    "batch-fill": (_BIG + "{% for b in [1]|batch(100000, x) %}{{ b|string|length }}{% endfor %}",
+                   "fill value repeated 100,000 times"),
+    "batch-fill-sort": (_BIG + "{% for b in [1]|batch(30000, x) %}{{ b|sort|length }}{% endfor %}",
+                        "fill value repeated"),
+    "batch-max-slow": (_BIG + "{% for b in [x]|batch(3000, x) %}{{ b|max|length }}{% endfor %}", "larger than"),
+    "slice-fill": (_BIG + "{% for b in [1]|slice(30000, x) %}{{ b|string|length }}{% endfor %}",
+                   "fill value repeated"),
+    "cycler-items": (_BIG + "{% set c = cycler(" + _X1000 + ") %}{{ c.items|string }}", "a call's arguments"),
+    "macro-varargs": (_BIG + "{% macro m() %}{{ varargs|string }}{% endmacro %}{{ m(" + _X1000 + ") }}",
+                      "a call's arguments"),
+    "filter-input-shared": (_BIG + "{% set b = (x, x) %}{{ [b, b, b]|string|length }}", "larger than"),
+    "int-base16-modulo": ("{% set n = ('f' * 2000000)|int(base=16) %}{% set m = ('e' * 1000000)|int(base=16) %}"
+                          "{{ (n % m) > 0 }}", "the int filter was given text of 2,000,000 characters"),
+    "int-base16-digits": ("{{ ('f' * 4000)|int(base=16) }}", "more than 4,300 digits"),
+    "floordiv-operand": ("{% set n = ('f' * 4000)|int(base=16, default=0) %}{{ n // 7 }}", "4,300 digits"),
+    "power-3-14000": ("{{ 3 ** 14000 }}", "a power with more than 4,300 digits"),
+    "power-10-4300": ("{{ 10 ** 4300 }}", "more than 4,300 digits"),
+}
+
+
+@pytest.mark.parametrize("name", list(REVIEWED_TEMPLATES))
+def test_a_reviewed_hostile_template_is_refused_at_once(small_result, name):
+    """Before the fix: `%` and `|format` with a mapping key repeated 1000 times, batch and slice filled with
+    references to one 4 M string, cycler and macro arguments of 1000 references to it, each printed, sorted or
+    compared: MemoryError after 8 to 15 s at 3.4 GB, or 11 s of comparisons; huge base-16 ints in `%`: 37 s;
+    `3 ** 14000` (6,680 digits) passed. Now each is refused within a second, before the large operation."""
+    template, says = REVIEWED_TEMPLATES[name]
+    start = time.monotonic()
+    with pytest.raises(ReportTemplateError) as refused:
+        render_report(small_result, {}, template, "hostile.j2")
+    message = str(refused.value)
+    assert "\n" not in message and len(message) < ONE_LINE, message
+    assert message.startswith("[job] report_template: hostile.j2:1: the report template passed its bounds"), message
+    assert says in message, message
+    assert time.monotonic() - start < 5.0
+
+
+@pytest.mark.parametrize("template, page", [
+    ("{{ '%s-%05.2f'|format('a', 2.5) }} {{ '%(a)s%(a)s' % {'a': 'xy'} }} {{ '%d%%' % 7 }}", "a-02.50 xyxy 7%"),
+    ("{% for b in [1, 2, 3]|batch(2, 0) %}{{ b }}{% endfor %}{% for s in [1, 2, 3]|slice(2, 0) %}{{ s }}"
+     "{% endfor %}", "[1, 2][3, 0][1, 2][3, 0]"),
+    ("{{ (2 ** 14000)|string|length }} {{ ('ff' * 100)|int(base=16) % 7 }} {{ (7 ** 1500) // 7 ** 1499 }}",
+     "4215 3 7"),
+    ("{% set c = cycler('a', 'b') %}{{ c.next() }}{{ c.items|length }}", "a2"),
+])
+def test_a_reviewed_template_within_its_bounds_renders(small_result, template, page):
+    assert render_report(small_result, {}, template, "shop.j2").decode() == page
+
+
+def test_a_template_nested_too_deeply_names_the_template_line(small_job, tmp_path):
+    """Before the fix: 'IndentationError: too many levels of indentation (<template>, line 208)', a line of the
+    Python Jinja2 generates. Now the template's own line and what is wrong."""
+    (tmp_path / "t.j2").write_text("\n" * 4 + "{% for i in [1] %}" * 120 + "x" + "{% endfor %}" * 120)
+    job = tmp_path / "job.toml"
+    job.write_text(_job_text(small_job, "job", 'report_template = "t.j2"'))
+    line = refused_at_key(spur_cad("run", job, "--out", tmp_path / "out", "--quiet"), job, "report_template",
+                          tmp_path / "out", "report_template: t.j2:5: not a valid report template: the template "
+                                            "nests too deeply")
+    assert "<template>" not in line and "IndentationError" not in line
+
+
+def test_a_template_is_named_as_the_job_names_it(small_job, tmp_path):
+    """Before the fix a syntax error named the template by its resolved absolute path (a link's target, too)."""
+    folder = tmp_path / "job"
+    (folder / "templates").mkdir(parents=True)
+    (folder / "templates" / "real.j2").write_text("{% for %}")
+    (folder / "sheet.j2").symlink_to("templates/real.j2")
+    job = folder / "job.toml"
+    job.write_text(_job_text(small_job, "job", 'report_template = "sheet.j2"'))
+    line = refused_at_key(spur_cad("run", job, "--out", tmp_path / "out", "--quiet"), job, "report_template",
+                          tmp_path / "out", "[job] report_template: sheet.j2:1: not a valid report template")
+    assert str(folder) not in line.split(":", 3)[3] and "real.j2" not in line, line
+    (folder / "templates" / "real.j2").write_bytes(b"\xff\xfe")
+    line = refused_at_key(spur_cad("run", job, "--out", tmp_path / "o2", "--quiet"), job, "report_template",
+                          tmp_path / "o2", "report_template: sheet.j2 is not UTF-8 text")
+
+
+def test_a_memory_error_while_rendering_says_which_bound(small_result):
+    """Before the fix a MemoryError read 'failed: MemoryError: ' (its text is empty). Provoked here with limits
+    above what the machine's 1 GiB address space allows."""
+    code = ("import resource, sys\nfrom spur_cad.report.html import ReportTemplateError, render_report\n"
+            "from spur_cad.report.template_bounds import TemplateLimits\n")
+    template = "{% set x = 'y' * 2000000000 %}{{ x|length }}"
+    script = (code + "import pickle\nresult = pickle.loads(sys.stdin.buffer.read())\n"
+              "resource.setrlimit(resource.RLIMIT_AS, (2 * 1024**3, 2 * 1024**3))\n"
+              f"try:\n    render_report(result, {{}}, {template!r}, 'big.j2', TemplateLimits(value_size=10**12, "
+              "made_size=10**13))\nexcept ReportTemplateError as exc:\n    print(exc)\n")
+    import pickle
+
+    ran = subprocess.run([sys.executable, "-c", script], input=pickle.dumps(small_result), capture_output=True,
+                         timeout=TIME_LIMIT_S)
+    message = ran.stdout.decode().strip()
+    assert message.startswith("[job] report_template: big.j2:1: the report template failed: it ran out of memory"), \
+        (message, ran.stderr[-2000:])
+    assert "a value is bounded at 1,000,000,000,000 characters" in message
+
+
+UNSAVED_EXPORT = """
+from pathlib import Path
+import os, FreeCAD
+from spur_cad.errors import SpurCadError
+from spur_cad_workbench import commands
+os.chdir(CWD)                                  # a folder holding t.j2, as $HOME might
+doc = FreeCAD.newDocument("Unsaved")
+gear = commands.make_gear(doc, **PROPS["gear"])
+stock = commands.make_stock(gear, **PROPS["stock"])
+job = commands.make_job(gear, stock, **PROPS["job"])
+job.ReportTemplate = "t.j2"
+doc.recompute()
+try:
+    commands.export_job(job, OUT)
+    RESULT["refused"] = ""
+except SpurCadError as exc:
+    RESULT["refused"] = str(exc)
+RESULT["written"] = sorted(os.listdir(OUT)) if os.path.isdir(OUT) else []
+"""
+
+
+@pytest.mark.freecad
+def test_the_workbench_finds_no_side_file_for_an_unsaved_document(freecadcmd, tmp_path):
+    """Before the fix an unsaved document's ReportTemplate was found in FreeCAD's current folder (often $HOME
+    or /): the export read and rendered it. Now it is refused with one line saying to save the document."""
+    from tests.workbench_helper import (
+        SMALL_GEAR_PROPERTIES,
+        SMALL_JOB_PROPERTIES,
+        SMALL_STOCK_PROPERTIES,
+        run_workbench_code,
+    )
+
+    cwd, out = tmp_path / "home", tmp_path / "out"
+    cwd.mkdir()
+    (cwd / "t.j2").write_text(SECRET)
+    props = {"gear": SMALL_GEAR_PROPERTIES, "stock": SMALL_STOCK_PROPERTIES, "job": SMALL_JOB_PROPERTIES}
+    body = f"PROPS = {props!r}\nOUT = {str(out)!r}\nCWD = {str(cwd)!r}\n" + UNSAVED_EXPORT
+    result, proc = run_workbench_code(body, tmp_path / "fc", freecadcmd=freecadcmd)
+    assert result is not None and result.get("ok"), (proc.stdout[-2000:], proc.stderr[-2000:], result)
+    assert "save the document first" in result["refused"], result
+    assert "\n" not in result["refused"] and result["written"] == [], result

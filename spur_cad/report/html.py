@@ -41,7 +41,7 @@ def compile_template(text: str, source: str = TEMPLATE_NAME, limits: TemplateLim
     require_jinja2()
     import jinja2
 
-    from spur_cad.report.template_bounds import BoundedSandbox, TemplateLimits
+    from spur_cad.report.template_bounds import BoundedSandbox, TemplateLimits, TemplateTooDeepError
 
     environment = BoundedSandbox(limits or TemplateLimits())
     try:
@@ -49,8 +49,10 @@ def compile_template(text: str, source: str = TEMPLATE_NAME, limits: TemplateLim
     except jinja2.TemplateSyntaxError as exc:
         raise ReportTemplateError(one_line(f"{source}:{exc.lineno}: not a valid report template: {exc.message}"),
                                   field="report_template", section="job") from None
-    except (RecursionError, MemoryError, SyntaxError, ValueError, OverflowError) as exc:
-        # nested past what Jinja2's parser or Python's compiler takes, or a number literal of thousands of digits
+    except TemplateTooDeepError as exc:  # nested past what Jinja2's parser or Python's compiler takes
+        raise ReportTemplateError(one_line(f"{source}{f':{exc.line}' if exc.line else ''}: not a valid report "
+                                           f"template: {exc}"), field="report_template", section="job") from None
+    except (SyntaxError, ValueError, OverflowError) as exc:  # e.g. a number literal of thousands of digits
         raise ReportTemplateError(one_line(f"{source}: not a valid report template: {type(exc).__name__}: {exc}"),
                                   field="report_template", section="job") from None
 
@@ -222,6 +224,9 @@ def render_report(result: JobResult, images: dict[str, bytes], template_text: st
         line = _template_line(exc)
         if isinstance(exc, TemplateBoundError):
             reason = f"passed its bounds (docs/report.md): {exc}"
+        elif isinstance(exc, MemoryError):  # no bound should let it happen; its own text is empty
+            reason = ("failed: it ran out of memory (MemoryError) making a value; a value is bounded at "
+                      f"{template.environment.limits.value_size:,} characters or elements (docs/report.md)")
         else:
             named = isinstance(exc, (RecursionError, MemoryError, ArithmeticError))  # their text alone says little
             reason = f"failed: {type(exc).__name__ + ': ' if named else ''}{exc}"

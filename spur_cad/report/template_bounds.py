@@ -29,6 +29,7 @@ from __future__ import annotations
 
 import functools
 import inspect
+import math
 import re
 import time
 from collections.abc import Callable, Iterable, Iterator, Mapping
@@ -42,6 +43,7 @@ from jinja2.runtime import markup_join, str_join
 from jinja2.sandbox import MAX_RANGE, ImmutableSandboxedEnvironment
 from jinja2.utils import Cycler, Joiner, pass_eval_context
 from jinja2.visitor import NodeTransformer
+from markupsafe import Markup
 
 
 @dataclass(frozen=True)
@@ -64,11 +66,21 @@ class TemplateLimits:
     call_depth: int = 50
     """Nesting of macro, caller and loop calls (recursion)."""
     int_digits: int = 4300
-    """Decimal digits of a whole number made by an operator (Python's own limit for converting one to text)."""
+    """Decimal digits of a whole number made by an operator or a filter, and of the operands of `%`, `//` and `/`
+    (Python's own limit for converting one to text)."""
 
 
 class TemplateBoundError(jinja2.TemplateRuntimeError):
     """A template passed one of its TemplateLimits (Jinja2 adds the template's line to the traceback)."""
+
+
+class TemplateTooDeepError(ValueError):
+    """A template nested more deeply than Jinja2's parser or Python's compiler takes (blocks, loops, conditions
+    or brackets inside one another); `line` is the template's line where it is known."""
+
+    def __init__(self, line: int | None) -> None:
+        super().__init__("the template nests too deeply (loops, blocks, conditions or brackets inside one another)")
+        self.line = line
 
 
 SAFE_METHODS = frozenset({
@@ -90,6 +102,19 @@ not needed for a sheet (random)."""
 _WIDE_FORMAT = re.compile(r"%(\([^)]*\))?[-#0 +]*(\*|[0-9]{4,}|\.\*|\.[0-9]{4,})")
 """A printf-style conversion with a `*` or a width or precision of 4 digits or more."""
 
+_CONVERSION = re.compile(r"%(?:\(([^)]*)\))?[-#0 +]*([0-9]*)(?:\.([0-9]*))?[hlL]?(.)", re.DOTALL)
+"""One printf-style conversion: its mapping key, width, precision and type (`%%` has type '%')."""
+
+_NUMBER_TEXT = 330
+"""At most the characters a float prints as with %f, %e or %g before its precision (1e308 has 309 digits)."""
+
+_LOG10_2 = math.log10(2)
+
+
+def whole_number_digits(number: int) -> int:
+    """At most the decimal digits of `number` (from its bits, without converting it)."""
+    return int(abs(number).bit_length() * _LOG10_2) + 1
+
 
 def _scalar_size(item: Any) -> int | None:
     """The printed size of text and numbers (None for anything else): whole numbers by their bits, not by
@@ -99,7 +124,7 @@ def _scalar_size(item: Any) -> int | None:
     if item is None or isinstance(item, bool):
         return 5
     if isinstance(item, int):
-        return item.bit_length() // 3 + 1
+        return whole_number_digits(item) + 1
     if isinstance(item, (float, complex)):
         return 24
     return None
@@ -132,9 +157,29 @@ class BoundedSandbox(ImmutableSandboxedEnvironment):
 
     def bounded_template(self, text: str) -> jinja2.Template:
         """`text` parsed, its loops, literals and concatenations wrapped (_Counted), compiled."""
-        tree = self.parse(text)
-        tree = _Counted(self).visit(tree)
-        return self.from_string(tree)
+        try:
+            tree = _Counted(self).visit(self.parse(text))
+        except (RecursionError, MemoryError):  # Jinja2's parser nests a call for each level
+            raise TemplateTooDeepError(None) from None
+        try:
+            return self.from_string(tree)
+        except (RecursionError, MemoryError):  # Jinja2's code generator, or Python's parser
+            raise TemplateTooDeepError(None) from None
+        except SyntaxError as exc:  # 'too many levels of indentation', 'too many statically nested blocks'
+            raise TemplateTooDeepError(self._template_line(tree, exc.lineno)) from None
+
+    def _template_line(self, tree: nodes.Template, code_line: int | None) -> int | None:
+        """The template's line that the generated Python's `code_line` was made from (Jinja2's debug_info)."""
+        if code_line is None:
+            return None
+        try:
+            source = self.compile(tree, raw=True)
+        except (RecursionError, MemoryError):
+            return None
+        found = re.search(r"^debug_info = '([0-9=&]*)'", source, re.MULTILINE)
+        pairs = [tuple(map(int, pair.split("="))) for pair in found.group(1).split("&") if pair] if found else []
+        lines = [template_line for template_line, line in pairs if line <= code_line]
+        return lines[-1] if lines else None
 
     # --- rendering -------------------------------------------------------------------------------------------
 
@@ -199,15 +244,30 @@ class BoundedSandbox(ImmutableSandboxedEnvironment):
             self._opaque_sizes[key] = (item, len(repr(item)))  # the object is kept: its id stays its own
         return self._opaque_sizes[key][1]
 
-    def _checked(self, value: Any, what: str = "a value") -> Any:
-        """`value` when its size is within the value limit and the budget of values made; counts it as made."""
-        if self._deadline is None:  # compiling: constants are bounded by the template's own size
-            return value
+    def _within(self, value: Any, what: str) -> int:
+        """`value`'s size, checked against the value limit (0 while compiling: constants are bounded by the
+        template's own size). For what an operation is given (loop items, call arguments, attribute values,
+        filter inputs), before the operation works on it."""
+        if self._deadline is None:
+            return 0
         self._check_time()
         size = self.size_of(value)
         if size > self.limits.value_size:
             raise TemplateBoundError(f"{what} larger than {self.limits.value_size:,} characters or elements")
-        self._made += size
+        return size
+
+    def _check_digits(self, number: Any, what: str) -> None:
+        """A whole number of at most limits.int_digits digits."""
+        if isinstance(number, int) and not isinstance(number, bool) \
+                and whole_number_digits(number) > self.limits.int_digits:
+            raise TemplateBoundError(f"{what} has more than {self.limits.int_digits:,} digits")
+
+    def _checked(self, value: Any, what: str = "a value") -> Any:
+        """`value` when its size is within the value limit and the budget of values made; counts it as made."""
+        if self._deadline is None:  # compiling: constants are bounded by the template's own size
+            return value
+        self._check_digits(value, what)
+        self._made += self._within(value, what)
         if self._made > self.limits.made_size:
             raise TemplateBoundError(f"the template made more than {self.limits.made_size:,} characters or "
                                      "elements of values in all")
@@ -240,7 +300,7 @@ class BoundedSandbox(ImmutableSandboxedEnvironment):
             if self._passes > self.limits.loop_passes:
                 raise TemplateBoundError(f"the template's loops made more than {self.limits.loop_passes:,} "
                                          "passes in all")
-            self._check_time()
+            self._within(item, "a loop's item")
             yield item
 
     def literal(self, value: Any) -> Any:
@@ -255,6 +315,21 @@ class BoundedSandbox(ImmutableSandboxedEnvironment):
 
     # --- the sandbox's hooks ---------------------------------------------------------------------------------
 
+    def getattr(self, obj: Any, attribute: str) -> Any:
+        """`obj.attribute` as the sandbox gives it, text and containers checked against the value limit."""
+        return self._attribute_value(super().getattr(obj, attribute), attribute)
+
+    def getitem(self, obj: Any, argument: Any) -> Any:
+        """`obj[argument]` as the sandbox gives it, text and containers checked against the value limit."""
+        return self._attribute_value(super().getitem(obj, argument), argument)
+
+    def _attribute_value(self, value: Any, name: Any) -> Any:
+        """`value` (an attribute's or an item's) when it is not text or a container larger than the value limit
+        (other objects are measured when they are printed or given to a filter)."""
+        if isinstance(value, (str, bytes, list, tuple, dict, set, frozenset)):
+            self._within(value, f"the value of {str(name)[:40]!r}")
+        return value
+
     def is_safe_attribute(self, obj: Any, attr: str, value: Any) -> bool:
         """The sandbox's rule, and on text, numbers, containers and numpy values only the SAFE_METHODS."""
         if not super().is_safe_attribute(obj, attr, value):
@@ -267,22 +342,31 @@ class BoundedSandbox(ImmutableSandboxedEnvironment):
         return None
 
     def call_binop(self, context: jinja2.runtime.Context, operator_name: str, left: Any, right: Any) -> Any:
-        """An operator whose result's size is estimated first where it can be large (`*`, `**`, `%`)."""
+        """An operator whose result's size is estimated first where it can be large (`*`, `**`, `%`), and whose
+        whole-number operands have at most limits.int_digits digits where its time grows faster than their size
+        (`%`, `//`, `/`)."""
         self._check_time()
         if operator_name == "*":
             self._check_product(left, right)
-        elif operator_name == "**" and isinstance(left, int) and isinstance(right, int) and right > 0 \
-                and abs(left) > 1 and right * (abs(left).bit_length() - 1) > 3.33 * self.limits.int_digits:
-            raise TemplateBoundError(f"a power with more than {self.limits.int_digits:,} digits")
+        elif operator_name == "**":
+            self._check_power(left, right)
         elif operator_name == "%" and isinstance(left, str):
-            check_format(left)
+            self.check_printf(left, right)
+        if operator_name in ("%", "//", "/"):
+            self._check_digits(left, f"the left operand of {operator_name}")
+            self._check_digits(right, f"the right operand of {operator_name}")
         return self._checked(super().call_binop(context, operator_name, left, right), "an operator's result")
+
+    def _check_power(self, base: Any, exponent: Any) -> None:
+        """`base ** exponent` of whole numbers: at most limits.int_digits digits (exponent * log10 |base|)."""
+        if isinstance(base, int) and isinstance(exponent, int) and exponent > 0 and abs(base) > 1 \
+                and exponent * math.log10(abs(base)) > self.limits.int_digits:
+            raise TemplateBoundError(f"a power with more than {self.limits.int_digits:,} digits")
 
     def _check_product(self, left: Any, right: Any) -> None:
         """`left * right`: a repeated sequence or a product of whole numbers within its limit."""
         if isinstance(left, int) and isinstance(right, int):
-            digits = (abs(left).bit_length() + abs(right).bit_length()) // 3
-            if digits > self.limits.int_digits:
+            if (abs(left).bit_length() + abs(right).bit_length()) * _LOG10_2 > self.limits.int_digits:
                 raise TemplateBoundError(f"a product with more than {self.limits.int_digits:,} digits")
             return
         count, sequence = (left, right) if isinstance(left, int) else (right, left)
@@ -293,8 +377,11 @@ class BoundedSandbox(ImmutableSandboxedEnvironment):
 
     def call(__self, __context: jinja2.runtime.Context, __obj: Any, *args: Any,  # noqa: N805 - Jinja2's own
              **kwargs: Any) -> Any:
-        """A call from the template: nested at most limits.call_depth deep, its result checked."""
+        """A call from the template: its arguments within the value limit, nested at most limits.call_depth
+        deep, its result checked."""
         __self._check_time()
+        if getattr(__obj, "__func__", None) not in _SELF_CHECKED:  # those check what they are given themselves
+            __self._within((args, kwargs), "a call's arguments")
         if __self._depth >= __self.limits.call_depth:
             raise TemplateBoundError(f"calls nested more than {__self.limits.call_depth} deep (a recursive macro?)")
         __self._depth += 1
@@ -307,26 +394,58 @@ class BoundedSandbox(ImmutableSandboxedEnvironment):
         return __self._checked(result, "a call's result")
 
     def _bounded_filter(self, name: str, function: Callable) -> Callable:
-        """`function` (a Jinja2 filter) with its whole-number arguments at most limits.range_items, its own
-        guard (FILTER_GUARDS) and its result checked."""
+        """`function` (a Jinja2 filter) with its input and arguments within the value limit, its whole-number
+        arguments at most limits.range_items, its own guard (FILTER_GUARDS) and its result checked (a whole
+        number: at most limits.int_digits digits)."""
         signature = inspect.signature(function)
         guard = FILTER_GUARDS.get(name)
         passes = getattr(function, "jinja_pass_arg", None) is not None
+        # an async variant (slice, ...) is marked pass_eval_context, but its signature is the plain function's
+        signed = not passes or next(iter(signature.parameters), "") in ("eval_ctx", "context", "environment")
 
         @functools.wraps(function)  # keeps Jinja2's pass_eval_context / pass_environment marks
         def bounded(*args: Any, **kwargs: Any) -> Any:
-            options = list(args[2 if passes else 1:]) + list(kwargs.values())
+            given = args[1 if passes else 0:]
+            self._within((given, kwargs), f"the {name} filter's input and arguments")
+            options = list(given[1:]) + list(kwargs.values())
             for option in options:
                 if isinstance(option, int) and not isinstance(option, bool) \
                         and abs(option) > self.limits.range_items:
                     raise TemplateBoundError(f"the {name} filter was given {option:,}; numbers given to filters "
                                              f"are at most {self.limits.range_items:,}")
             if guard is not None:
-                guard(self, signature.bind(*args, **kwargs).arguments)
+                guard(self, signature.bind(*(args if signed else args[1:]), **kwargs).arguments)
             result = function(*args, **kwargs)
             return result if isinstance(result, Iterator) else self._checked(result, f"the {name} filter's result")
 
         return bounded
+
+
+    def check_printf(self, text: str, values: Any) -> None:
+        """`text % values` (the `%` operator, the format filter) without `*` or wide conversions, its result's
+        size estimated before it is made: the text plus, for each conversion, its argument's size (an argument
+        named by a mapping key counted at each of its conversions), its width and precision; %r and %a as ten
+        characters an element (escapes), arguments of Markup text six (HTML escapes)."""
+        check_format(text)
+        positional = values if isinstance(values, tuple) else (values,)
+        escape = 6 if isinstance(text, Markup) else 1
+        size, index = len(text), 0
+        for match in _CONVERSION.finditer(text):
+            key, width, precision, kind = match.groups()
+            if kind == "%":
+                continue
+            if key is not None:
+                value = values.get(key) if isinstance(values, Mapping) else None
+            else:
+                value = positional[index] if index < len(positional) else None
+                index += 1
+            content = self.size_of(value) * (10 if kind in "ra" else 1) * escape
+            if _numeric(value):
+                content += _NUMBER_TEXT
+            size += max(int(width or 0), content + int(precision or 0))
+            if size > self.limits.value_size:
+                raise TemplateBoundError(f"a %-format whose result would be larger than "
+                                         f"{self.limits.value_size:,} characters")
 
 
 _SELF_CHECKED = (BoundedSandbox.loop_passes, BoundedSandbox.literal, BoundedSandbox.joined)
@@ -353,7 +472,23 @@ def _guard_replace(env: BoundedSandbox, arguments: dict) -> None:
 
 
 def _guard_format(env: BoundedSandbox, arguments: dict) -> None:
-    check_format(str(arguments.get("value", "")))
+    env.check_printf(str(arguments.get("value", "")), arguments.get("kwargs") or tuple(arguments.get("args", ())))
+
+
+def _guard_int(env: BoundedSandbox, arguments: dict) -> None:
+    value = arguments.get("value")
+    if isinstance(value, str) and len(value) > 4 * env.limits.int_digits:  # the result is checked after
+        raise TemplateBoundError(f"the int filter was given text of {len(value):,} characters; a whole number has "
+                                 f"at most {env.limits.int_digits:,} digits")
+
+
+def _guard_fill(env: BoundedSandbox, arguments: dict) -> None:
+    """batch and slice: the fill value, repeated up to `linecount` times in a batch, once in each of `slices`."""
+    count = arguments.get("linecount", arguments.get("slices", 0))
+    fill = arguments.get("fill_with")
+    if fill is not None and isinstance(count, int) and count * env.size_of(fill) > env.limits.value_size:
+        raise TemplateBoundError(f"the fill value repeated {count:,} times, larger than "
+                                 f"{env.limits.value_size:,} characters or elements")
 
 
 def _guard_sum(env: BoundedSandbox, arguments: dict) -> None:
@@ -362,7 +497,8 @@ def _guard_sum(env: BoundedSandbox, arguments: dict) -> None:
 
 
 FILTER_GUARDS: dict[str, Callable[[BoundedSandbox, dict], None]] = {
-    "join": _guard_join, "replace": _guard_replace, "format": _guard_format, "sum": _guard_sum}
+    "join": _guard_join, "replace": _guard_replace, "format": _guard_format, "sum": _guard_sum, "int": _guard_int,
+    "batch": _guard_fill, "slice": _guard_fill}
 """Checks made before a filter whose output can be much larger than its input, or slower than linear."""
 
 
