@@ -161,7 +161,11 @@ def run_freecad_code(body: str, work: Path, *, freecadcmd: str | None = None,
     log_option = f"--log-file={log_file}"
     if gui:
         xvfb_run, freecad = gui
-        cmd = [xvfb_run, "-a", "-s", "-screen 0 1280x1024x24", freecad, str(script), log_option]
+        # -a: the first free display from 99 up, judged by the lock files in /tmp. CI runs a chroot's tier beside the
+        # host's tests: each chroot has its own /tmp but X's abstract sockets are shared, so each starts its search
+        # at its own display (SPUR_CAD_XVFB_SERVERNUM, set by .ci/run) and the two never meet.
+        first_display = os.environ.get("SPUR_CAD_XVFB_SERVERNUM", "99")
+        cmd = [xvfb_run, "-a", "-n", first_display, "-s", "-screen 0 1280x1024x24", freecad, str(script), log_option]
         timeout_s = timeout_s or GUI_TIMEOUT_S
     else:
         cmd = [freecadcmd, str(script), log_option]
