@@ -1,4 +1,4 @@
-"""The Python examples of README.md and docs/cad.md that show the CAD front-ends run as written, each in a fresh
+"""The Python examples of docs/usage.md and docs/cad.md that show the CAD front-ends run as written, each in a fresh
 namespace, and what they print or build is checked against the same independent reference as tests/test_cad.py
 (the exact outline's area times the face width)."""
 
@@ -29,9 +29,9 @@ def exact_volume_mm3(spec, bore_mm: float = 0.0) -> float:
 
 
 def test_the_readme_build123d_example_builds_a_gear_with_its_bore(capsys):
-    (block,) = python_blocks("README.md", "bd.BuildPart")
+    (block,) = python_blocks("docs/usage.md", "bd.BuildPart")
     namespace: dict = {}
-    exec(compile(block, "README.md", "exec"), namespace)
+    exec(compile(block, "docs/usage.md", "exec"), namespace)
     volume = float(capsys.readouterr().out.strip())
     # build123d's volume uses OCP's default integration, off by about 1e-4 relative on swept B-spline faces
     # (docs/cad.md); the bore is 12 % of the gear, so a bore left out is far outside
@@ -39,7 +39,7 @@ def test_the_readme_build123d_example_builds_a_gear_with_its_bore(capsys):
 
 
 @pytest.mark.cadquery
-@pytest.mark.parametrize("document", ["README.md", "docs/cad.md"])
+@pytest.mark.parametrize("document", ["docs/usage.md", "docs/cad.md"])
 def test_the_solid_examples_run_and_agree_with_the_exact_outline(document):
     import build123d
 

@@ -1,4 +1,4 @@
-"""resources/examples/: every job file loads as `spur-cad run` loads it, and the figures README.md quotes from
+"""resources/examples/: every job file loads as `spur-cad run` loads it, and the figures docs/usage.md quotes from
 the 3-axis and the flank modification examples are what they plan."""
 
 from __future__ import annotations
@@ -37,7 +37,7 @@ def test_the_flat_example_plans_what_the_readme_quotes():
 
 @pytest.mark.slow
 def test_the_modified_example_cuts_and_grades_what_the_readme_quotes():
-    """README: against the modified design the cut gouges at most 0.2 um and leaves at most 5.6 um, and the grading
+    """usage.md: against the modified design the cut gouges at most 0.2 um and leaves at most 5.6 um, and the grading
     reads the tip reliefs and the crowning within 0.4 um of designed, the profile slopes within 1.2 um."""
     from spur_cad.pipeline import run_job
 
