@@ -5,6 +5,7 @@ from __future__ import annotations
 import re
 from dataclasses import dataclass
 
+from spur_cad.cam.setups import MachineSetup, setup_for_axes
 from spur_cad.errors import SpurCadError, shown
 from spur_cad.keys import check_section, key
 
@@ -120,6 +121,11 @@ class Machine:
                                          "generating clamps for every pass when both codes are given)")
     rotary_unclamp_code: str = key("", label="RotaryUnclampCode", group="Machine",
                                    meaning="M code unclamping A (needed by [roughing] clamp_rotary)")
+
+    @property
+    def setup(self) -> MachineSetup:
+        """The set-up `axes` chooses (spur_cad.cam.setups): code asks it, never `axes`."""
+        return setup_for_axes(self.axes)
 
     def validate(self) -> None:
         check_section(self, "machine", MachineError)

@@ -27,6 +27,7 @@ import numpy as np
 
 from spur_cad.errors import GearSpecError
 from spur_cad.geometry.involute import inverse_involute_function, involute_function
+from spur_cad.geometry.kinds import INTERNAL_SPUR, GearKind
 from spur_cad.geometry.profile import CircularArc, Involute, ToothSpaceProfile
 from spur_cad.geometry.roots import brentq
 from spur_cad.geometry.spec import MIN_TEETH, GearSpec, _range_check
@@ -257,7 +258,12 @@ class InternalGearSpec(GearSpec):
                 f"({MIN_RIM_MODULES * self.module_mm:g} mm) needed", field="rim_outer_diameter_mm")
 
     @property
+    def kind(self) -> GearKind:
+        return INTERNAL_SPUR
+
+    @property
     def is_internal(self) -> bool:
+        """For scripts; spur_cad's own code asks `kind`."""
         return True
 
     def shaper_cutter(self) -> ShaperCutter:

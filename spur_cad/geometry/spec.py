@@ -14,6 +14,7 @@ from typing import TYPE_CHECKING
 
 from spur_cad.errors import GearSpecError
 from spur_cad.geometry.involute import involute_function
+from spur_cad.geometry.kinds import EXTERNAL_HELICAL, EXTERNAL_SPUR, GearKind
 
 if TYPE_CHECKING:  # pragma: no cover
     from spur_cad.geometry.profile import ToothSpaceProfile
@@ -86,6 +87,7 @@ class GearFacts:
 
     @property
     def is_helical(self) -> bool:
+        """For scripts reading summary facts; spur_cad's own code asks GearSpec.kind."""
         return bool(self.helix_angle_deg)
 
 
@@ -184,12 +186,19 @@ class GearSpec:
         return math.radians(self.helix_angle_deg)
 
     @property
+    def kind(self) -> GearKind:
+        """What kind of gear this is (spur_cad.geometry.kinds): code asks the kind, not the flags below."""
+        return EXTERNAL_SPUR if self.helix_angle_deg == 0.0 else EXTERNAL_HELICAL
+
+    @property
     def is_helical(self) -> bool:
+        """For scripts; spur_cad's own code asks `kind` (tests/test_kinds.py)."""
         return self.helix_angle_deg != 0.0
 
     @property
     def is_internal(self) -> bool:
-        """False: an external gear (spur_cad.geometry.internal.InternalGearSpec says True)."""
+        """False: an external gear (spur_cad.geometry.internal.InternalGearSpec says True). For scripts; spur_cad's
+        own code asks `kind`."""
         return False
 
     @property
@@ -220,16 +229,12 @@ class GearSpec:
     @property
     def lead_mm(self) -> float:
         """p_z = 2 pi r / tan(beta), the axial advance of one turn of a helix on the reference cylinder (inf: spur)."""
-        if not self.is_helical:
-            return math.inf
-        return 2.0 * math.pi * self.reference_radius_mm / math.tan(self.helix_angle_rad)
+        return self.kind.lead_mm(self)
 
     def section_turn_rad(self, x_mm: float) -> float:
         """Angle by which the transverse section at axial position X is turned about the axis, in the positive
         A sense (right hand: +X tan(beta) / r; left hand: the other way; 0 for a spur gear)."""
-        if not self.is_helical:
-            return 0.0
-        return self.hand_sign * x_mm * math.tan(self.helix_angle_rad) / self.reference_radius_mm
+        return self.kind.section_turn_rad(self, x_mm)
 
     @property
     def tip_radius_mm(self) -> float:

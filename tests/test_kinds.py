@@ -1,0 +1,196 @@
+"""Gear kinds and machine set-ups as types (issue 45): the flags are read only where the kinds and set-ups are
+defined, and the kinds' and set-ups' declared capabilities agree with independent facts."""
+
+from __future__ import annotations
+
+import ast
+import math
+from pathlib import Path
+
+import pytest
+
+from spur_cad.cam.machine import Machine
+from spur_cad.cam.setups import LYING_FLAT, ROTARY_TABLE, SETUPS, MachineSetup, setup_for_axes
+from spur_cad.geometry.internal import InternalGearSpec
+from spur_cad.geometry.kinds import EXTERNAL_HELICAL, EXTERNAL_SPUR, INTERNAL_SPUR, KINDS, GearKind
+from spur_cad.geometry.spec import GearSpec
+
+RING = dict(teeth=60, module_mm=2.0, addendum_coefficient=0.9, rack_tip_radius_mm=0.4, shaper_cutter_teeth=20,
+            rim_outer_diameter_mm=140.0, face_width_mm=10.0)  # tests/test_internal_gear.py's ring
+ROOT = Path(__file__).resolve().parents[1]
+KIND_MODULES = frozenset({"spur_cad/geometry/kinds.py", "spur_cad/geometry/spec.py", "spur_cad/geometry/internal.py"})
+SETUP_MODULES = frozenset({"spur_cad/cam/setups.py", "spur_cad/cam/machine.py"})
+KIND_FLAGS = frozenset({"is_helical", "is_internal"})
+ORDERING = (ast.Eq, ast.NotEq, ast.Lt, ast.LtE, ast.Gt, ast.GtE)
+
+
+def _mentions(node: ast.AST, names: set[str]) -> bool:
+    """Whether an expression reads a name or attribute in `names`, or indexes by such a string ("MachineAxes")."""
+    for sub in ast.walk(node):
+        if isinstance(sub, ast.Name) and sub.id in names or isinstance(sub, ast.Attribute) and sub.attr in names:
+            return True
+        if isinstance(sub, ast.Constant) and isinstance(sub.value, str) and sub.value in names:
+            return True
+    return False
+
+
+def _is_zero(node: ast.AST) -> bool:
+    return isinstance(node, ast.Constant) and isinstance(node.value, (int, float)) and node.value == 0
+
+
+def flag_reads(source: str) -> list[tuple[int, str, str]]:
+    """(line, family, what) of every flag read in a module's source: attribute reads of is_helical / is_internal,
+    a helix angle compared with 0 or taken as a truth value (family "kind"); a comparison of `axes` or of the
+    workbench's MachineAxes (family "setup")."""
+    found = []
+    for node in ast.walk(ast.parse(source)):
+        if isinstance(node, ast.Attribute) and node.attr in KIND_FLAGS and isinstance(node.ctx, ast.Load):
+            found.append((node.lineno, "kind", node.attr))
+        elif isinstance(node, ast.Compare) and all(isinstance(op, ORDERING) for op in node.ops):
+            operands = [node.left, *node.comparators]
+            if any(_mentions(o, {"helix_angle_deg"}) for o in operands) and any(_is_zero(o) for o in operands):
+                found.append((node.lineno, "kind", "helix_angle_deg compared with 0"))
+            if any(_mentions(o, {"axes", "MachineAxes"}) for o in operands):
+                found.append((node.lineno, "setup", "axes compared"))
+        elif isinstance(node, (ast.If, ast.IfExp, ast.While)) and _mentions_directly(node.test, "helix_angle_deg"):
+            found.append((node.lineno, "kind", "helix_angle_deg as a truth value"))
+        elif (isinstance(node, ast.Call) and isinstance(node.func, ast.Name) and node.func.id == "bool"
+              and node.args and _mentions_directly(node.args[0], "helix_angle_deg")):
+            found.append((node.lineno, "kind", "bool(helix_angle_deg)"))
+    return found
+
+
+def _mentions_directly(node: ast.AST, name: str) -> bool:
+    """The expression is (a negation of) the name or attribute itself."""
+    while isinstance(node, ast.UnaryOp) and isinstance(node.op, ast.Not):
+        node = node.operand
+    return isinstance(node, ast.Name) and node.id == name or isinstance(node, ast.Attribute) and node.attr == name
+
+
+def _package_sources():
+    for folder in ("spur_cad", "workbench"):
+        for path in sorted((ROOT / folder).rglob("*.py")):
+            yield path.relative_to(ROOT).as_posix(), path.read_text(encoding="utf-8")
+
+
+@pytest.mark.xfail(strict=True, reason="issue 45: the readers are converted in the next steps")
+def test_flags_are_read_only_where_kinds_and_setups_are_defined():
+    """Acceptance of issue 45: code asks spec.kind and machine.setup; the flags stay in at most three modules each."""
+    assert len(KIND_MODULES) <= 3 and len(SETUP_MODULES) <= 3
+    stray = [f"{name}:{line}: {what}" for name, source in _package_sources()
+             for line, family, what in flag_reads(source)
+             if name not in (KIND_MODULES if family == "kind" else SETUP_MODULES)]
+    assert not stray, "flags read outside the kind and set-up modules:\n" + "\n".join(stray)
+
+
+@pytest.mark.parametrize("snippet, expected", [
+    ("if spec.is_helical:\n    pass\n", [(1, "kind", "is_helical")]),
+    ("x = a if job.gear.is_internal else b\n", [(1, "kind", "is_internal")]),
+    ("if spec.helix_angle_deg != 0.0:\n    pass\n", [(1, "kind", "helix_angle_deg compared with 0")]),
+    ("if 0 < spec.helix_angle_deg:\n    pass\n", [(1, "kind", "helix_angle_deg compared with 0")]),
+    ("if not spec.helix_angle_deg:\n    pass\n", [(1, "kind", "helix_angle_deg as a truth value")]),
+    ("flat = job.machine.axes == 3\n", [(1, "setup", "axes compared")]),
+    ("flat = int(values['job']['MachineAxes']) != 4\n", [(1, "setup", "axes compared")]),
+    ("ok = letter in self.axes\n", []),  # a string of axis letters (verify/reader.py), not the set-up
+    ("turn = spec.section_turn_rad(1.0)\nflat = machine.setup.rotary_axis\n", []),
+])
+def test_flag_reads_finds_each_form(snippet, expected):
+    """The checker itself: each form of a flag read is found, the kind's and set-up's questions are not."""
+    assert flag_reads(snippet) == expected
+
+
+# --- the kinds' capabilities against independent facts ------------------------------------------------------
+def test_each_spec_names_its_kind():
+    assert GearSpec(teeth=20, module_mm=2.0).kind is EXTERNAL_SPUR
+    assert GearSpec(teeth=20, module_mm=2.0, helix_angle_deg=15.0).kind is EXTERNAL_HELICAL
+    ring = InternalGearSpec(**RING)
+    assert ring.kind is INTERNAL_SPUR
+    assert KINDS == {k.name: k for k in (EXTERNAL_SPUR, EXTERNAL_HELICAL, INTERNAL_SPUR)}
+
+
+@pytest.mark.parametrize("hand, sign", [("right", 1), ("left", -1)])
+def test_helical_section_turns_by_x_tan_beta_over_r(hand, sign):
+    """A helix on the reference cylinder r = z m_n / (2 cos beta) advances r d(theta) = dX tan(beta) (unrolled, the
+    helix is a line at beta to the axis); a right hand turns positive A with +X (docs/architecture.md, Frames).
+    The lead written out as ISO 21771 gives it: p_z = pi z m_n / sin(beta)."""
+    z, m_n, beta_deg = 23, 1.5, 17.0
+    spec = GearSpec(teeth=z, module_mm=m_n, helix_angle_deg=beta_deg, hand=hand, face_width_mm=20.0)
+    beta = math.radians(beta_deg)
+    r = z * m_n / (2.0 * math.cos(beta))
+    for x in (0.0, 3.0, 12.5, -4.0):
+        assert spec.kind.section_turn_rad(spec, x) == pytest.approx(sign * x * math.tan(beta) / r, rel=1e-12, abs=0)
+        assert spec.section_turn_rad(x) == spec.kind.section_turn_rad(spec, x)
+    lead = math.pi * z * m_n / math.sin(beta)
+    assert spec.kind.lead_mm(spec) == pytest.approx(lead, rel=1e-12)
+    assert abs(spec.section_turn_rad(lead)) == pytest.approx(2.0 * math.pi, rel=1e-12)  # one lead: one turn
+
+
+def test_prismatic_kinds_keep_their_section():
+    spur = GearSpec(teeth=17, module_mm=3.0, face_width_mm=30.0)
+    ring = InternalGearSpec(**RING)
+    for spec in (spur, ring):
+        assert spec.kind.prismatic and spec.kind.solid == "extrude" and spec.kind.measured_in == "transverse"
+        assert all(spec.section_turn_rad(x) == 0.0 for x in (0.0, 7.0, spec.face_width_mm))
+        assert spec.lead_mm == math.inf and spec.kind.cut_straight
+    assert EXTERNAL_HELICAL.solid == "sweep" and EXTERNAL_HELICAL.measured_in == "normal"
+    assert not EXTERNAL_HELICAL.cut_straight
+
+
+def test_roll_sign_follows_the_teeth():
+    """A ring's involute runs with negative roll parameters (geometry/internal.py: u = -t, root to tip |u|
+    decreasing); an external gear's with positive ones."""
+    ring = InternalGearSpec(**RING)
+    spur = GearSpec(teeth=17, module_mm=3.0)
+    for spec in (ring, spur):
+        involute = next(s for s in spec.tooth_space_profile().segments if s.label == "involute")
+        assert math.copysign(1.0, involute.end) == spec.kind.roll_sign
+        assert math.copysign(1.0, involute.start) == spec.kind.roll_sign or involute.start == 0.0
+
+
+class _Strategy:
+    def __init__(self, helical: bool) -> None:
+        self.helical = helical
+
+
+def test_helical_kind_needs_a_helical_strategy():
+    assert EXTERNAL_HELICAL.accepts_strategy(_Strategy(True))
+    assert not EXTERNAL_HELICAL.accepts_strategy(_Strategy(False))
+    assert all(kind.accepts_strategy(_Strategy(False)) for kind in (EXTERNAL_SPUR, INTERNAL_SPUR))
+
+
+@pytest.mark.parametrize("changes", [{"solid": "loft"}, {"measured_in": "axial"}, {"solid": "sweep"},
+                                     {"measured_in": "normal"}])
+def test_a_kind_with_inconsistent_capabilities_is_refused(changes):
+    fields = dict(name="x", prismatic=True, teeth_inward=False, solid="extrude", measured_in="transverse") | changes
+    with pytest.raises(ValueError, match="gear kind 'x'"):
+        GearKind(**fields)
+
+
+# --- the set-ups ------------------------------------------------------------------------------------------------
+def test_machine_axes_choose_the_setup():
+    assert Machine().setup is ROTARY_TABLE and Machine(axes=3).setup is LYING_FLAT
+    assert setup_for_axes(4) is ROTARY_TABLE and SETUPS == {4: ROTARY_TABLE, 3: LYING_FLAT}
+    assert ROTARY_TABLE.rotary_axis and not LYING_FLAT.rotary_axis
+    assert LYING_FLAT.reads_section("three_axis") and not ROTARY_TABLE.reads_section("three_axis")
+
+
+@pytest.mark.parametrize("setup, kind, cuts", [
+    (ROTARY_TABLE, EXTERNAL_SPUR, True), (ROTARY_TABLE, EXTERNAL_HELICAL, True), (ROTARY_TABLE, INTERNAL_SPUR, False),
+    (LYING_FLAT, EXTERNAL_SPUR, True), (LYING_FLAT, EXTERNAL_HELICAL, False), (LYING_FLAT, INTERNAL_SPUR, True),
+])
+def test_which_setup_cuts_which_kind(setup, kind, cuts):
+    """The rotary table's tool cannot reach inside a ring along the axis; lying flat, the end mill's side cuts
+    straight teeth only (docs/cam.md)."""
+    assert setup.cuts(kind) is cuts
+
+
+def test_lying_flat_cuts_with_flat_end_mills_only():
+    assert LYING_FLAT.accepts_tool_kind("flat") and not LYING_FLAT.accepts_tool_kind("ball")
+    assert all(ROTARY_TABLE.accepts_tool_kind(kind) for kind in ("flat", "bull_nose", "ball"))
+
+
+def test_a_setup_with_inconsistent_capabilities_is_refused():
+    with pytest.raises(ValueError, match="rotary axis"):
+        MachineSetup("x", axes=3, rotary_axis=True, cuts_helical=True, cuts_teeth_inward=False,
+                     follows_modifications=True, tool_kinds=(), finishing_needs_roughing=False, sections=(),
+                     z_origin="the rotary axis")
