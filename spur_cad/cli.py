@@ -282,10 +282,10 @@ def _write(out_dir, files: dict[str, bytes], received: list[int]) -> list:
 def _verify(args: argparse.Namespace, received: list[int], loaded: list) -> int:
     """`spur-cad verify`: read the programs, simulate, print the verdict, write the set; 0 pass, 1 fail."""
 
+    from spur_cad.dialects import DIALECTS
     from spur_cad.errors import shown, shown_path
     from spur_cad.job import load_job
     from spur_cad.outputs import check_output_folder
-    from spur_cad.post.dialects import DIALECTS
     from spur_cad.verify.reader import open_program_file, read_program_file
     from spur_cad.verify.rs274 import read_canonical, rs274_verdict
     from spur_cad.verify.verify import VerifyOptions, result_files, verify_moves

@@ -1,4 +1,4 @@
-"""The dialect table (spur_cad.post.dialects) is the one place that knows controllers (issue 26, point 3).
+"""The dialect table (spur_cad.dialects) is the one place that knows controllers (issue 26, point 3).
 
 The milling post, the lathe post, the program reader and the CLI read the table's attributes and never
 compare a dialect's name (checked on their source); a dialect defined here, and nowhere else, is written
@@ -13,13 +13,14 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from spur_cad import keys
 from spur_cad.cam.finishing import finishing_toolpath
 from spur_cad.cam.machine import Machine
 from spur_cad.cam.strategies import FinishingParams
-from spur_cad.cam.turning import LATHE_DIALECTS, LatheError, LatheSection, plan_lathe
+from spur_cad.cam.turning import LatheError, LatheSection, plan_lathe
+from spur_cad.dialects import DIALECTS, FANUC, Dialect, Rotary, dialect, lathe_names
 from spur_cad.job import load_job
 from spur_cad.post import PostError, PostSettings, ProgramInfo, post_program
-from spur_cad.post.dialects import DIALECTS, FANUC, Dialect, Rotary, dialect, lathe_names
 from spur_cad.post.lathe import lathe_dialect, lathe_extension, post_lathe
 from spur_cad.verify.reader import ProgramReadError, read_program
 from tests.gears import spec_of, tools_for
@@ -84,13 +85,13 @@ def test_the_checker_finds_name_comparisons():
 def test_posts_reader_and_cli_name_no_dialect(path):
     """No dialect name as a literal in the code of the modules that read the table (prose aside)."""
     tree = ast.parse((ROOT / path).read_text(), path)
-    assert name_literals(tree) == [], f"{path} names dialects: the table (spur_cad/post/dialects.py) should know"
+    assert name_literals(tree) == [], f"{path} names dialects: the table (spur_cad/dialects.py) should know"
 
 
 def test_nothing_in_spur_cad_compares_a_dialect_name():
     """Anywhere in the package but the table, a dialect name is at most a default or a choice, never compared."""
     for path in sorted((ROOT / "spur_cad").rglob("*.py")):
-        if path.name == "dialects.py" and path.parent.name == "post":
+        if path == ROOT / "spur_cad" / "dialects.py":
             continue
         found = name_comparisons(ast.parse(path.read_text(), str(path)))
         assert found == [], f"{path.relative_to(ROOT)} compares dialect names: {found}"
@@ -108,14 +109,14 @@ def _spur_cad_imports(path: Path) -> set[str]:
 
 
 def test_the_table_and_the_settings_do_not_import_each_other():
-    assert _spur_cad_imports(ROOT / "spur_cad/post/dialects.py") == {"spur_cad.errors"}
+    assert _spur_cad_imports(ROOT / "spur_cad/dialects.py") == {"spur_cad.errors"}
     assert _spur_cad_imports(ROOT / "spur_cad/errors.py") == set()
     settings = ast.parse((ROOT / "spur_cad/post/settings.py").read_text())
-    assert any(isinstance(node, ast.ImportFrom) and node.module == "spur_cad.post.dialects" for node in settings.body)
+    assert any(isinstance(node, ast.ImportFrom) and node.module == "spur_cad.dialects" for node in settings.body)
 
 
 def test_the_table_is_consistent():
-    assert set(LATHE_DIALECTS) == set(lathe_names())  # [lathe]'s choices (cam cannot import the table)
+    assert keys.key_of(LatheSection, "dialect").names == lathe_names() == ("linuxcnc", "fanuc", "siemens")
     for d in DIALECTS.values():
         assert d.comments.style in d.comments.reads and d.subprograms.structure in ("o_words", "labels", "numbered")
         assert (d.probing is not None) == (d.name in ("linuxcnc", "fanuc", "haas"))  # probe.<ext> (docs/probing.md)
@@ -168,7 +169,7 @@ def test_a_new_dialect_is_nowhere_registered(finishing):
         read_program(text, "acme")
     with pytest.raises(PostError, match="dialect = 'acme' is not known"):
         post_program(finishing, PostSettings(dialect="acme"), INFO)
-    with pytest.raises(LatheError, match=r"dialect = 'acme' is not known \(known: siemens, fanuc, linuxcnc\)"):
+    with pytest.raises(LatheError, match=r"dialect = 'acme' is not known \(known: linuxcnc, fanuc, siemens\)"):
         lathe_extension("acme")
     assert "acme" not in DIALECTS and isinstance(ACME, Dialect)
 

@@ -19,6 +19,7 @@ from OCP.gp import gp_Pnt
 
 from spur_cad.cad.solid import stock_shape
 from spur_cad.cam.turning import MAX_PASSES, LatheError, LatheSection, check_lathe_blank, plan_lathe
+from spur_cad.dialects import lathe_names
 from spur_cad.job import load_job
 from spur_cad.post.lathe import lathe_extension, post_lathe
 from spur_cad.verify.reader import ProgramReadError, read_program
@@ -26,7 +27,7 @@ from tests.ocp_helper import exact_bounds
 from tests.rs274_helper import canon_args, run_rs274
 
 REFERENCE = "resources/examples/reference_gear.toml"
-DIALECTS = ("siemens", "fanuc", "linuxcnc")
+DIALECTS = lathe_names()  # every dialect with lathe words
 TOL = 1.5e-3  # the programs round to 0.001 mm
 
 

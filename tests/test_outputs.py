@@ -163,12 +163,11 @@ def test_every_name_a_run_writes_is_in_the_vocabulary():
     (each dialect's extension, the lathe's, the restart programs' labels); a name outside it would make
     write_output_set refuse our own set."""
     from spur_cad.cam.restart import parse_restart
+    from spur_cad.dialects import DIALECTS
     from spur_cad.outputs import is_output_name
-    from spur_cad.post import dialect
-    from spur_cad.post.lathe import LATHE_EXTENSIONS
-    from spur_cad.post.settings import dialect_names
 
-    extensions = {dialect(name).extension for name in dialect_names()} | set(LATHE_EXTENSIONS.values())
+    extensions = {d.extension for d in DIALECTS.values()}  # every program's: milling, lathe and probing
+    assert extensions == {"ngc", "nc", "mpf", "min"}
     for extension in extensions:
         for stem in ("roughing", "roughing_bottom", "finishing", "blank", "probe"):
             assert is_output_name(f"{stem}.{extension}"), (stem, extension)

@@ -10,9 +10,9 @@ import numpy as np
 import pytest
 
 from spur_cad.cam.ir import MoveKind, Operation, ToolpathBuilder, arc_sweeps_rad
+from spur_cad.dialects import DIALECTS
 from spur_cad.errors import PostError
 from spur_cad.post import ProgramInfo, post_program
-from spur_cad.post.dialects import DIALECTS
 from spur_cad.post.settings import PostSettings
 from spur_cad.verify.reader import ProgramReadError, read_program
 from tests.rs274_helper import canon_args, run_rs274

@@ -14,9 +14,9 @@ import pytest
 
 from spur_cad.cam.ir import Feature, MoveKind, Operation, ToolpathBuilder
 from spur_cad.cam.machine import Machine, MachineError
+from spur_cad.dialects import DIALECTS
 from spur_cad.errors import SpurCadError
 from spur_cad.post import PostSettings, ProgramInfo, dialect, post_program
-from spur_cad.post.dialects import DIALECTS
 from spur_cad.post.settings import PostError
 from tests.gcode_reader import read_program
 from tests.rs274_helper import canon_args, run_rs274

@@ -222,7 +222,7 @@ def test_bad_probe_settings_are_one_line_naming_file_line_and_key(change, messag
 
 
 def test_without_probe_no_program_and_the_probe_words_never_come_from_user_text():
-    from spur_cad.post.program import inert_comment_text
+    from spur_cad.post.header import inert_comment_text
 
     assert _job(probe="").probe is None
     for text in ("PROBEOPEN /etc/passwd", "probeclose", "LOGCLOSE"):

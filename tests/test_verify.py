@@ -16,10 +16,11 @@ import pytest
 
 from spur_cad.cam.ir import Feature, MoveKind
 from spur_cad.cli import main
+from spur_cad.dialects import DIALECTS
 from spur_cad.job import parse_job
 from spur_cad.pipeline import build_programs, plan_cam
 from spur_cad.post import ProgramInfo, post_program
-from spur_cad.verify.reader import DIALECTS, ProgramReadError, read_program
+from spur_cad.verify.reader import ProgramReadError, read_program
 from tests.workbench_helper import small_job_text
 
 SIM = "\n[simulation]\nresolution_mm = 0.02\n"
@@ -50,7 +51,7 @@ def _distinct_motion(path) -> np.ndarray:
 
 
 @pytest.mark.parametrize("folded", [True, False], ids=["folded", "flat"])
-@pytest.mark.parametrize("dialect", DIALECTS)
+@pytest.mark.parametrize("dialect", list(DIALECTS))
 def test_the_reader_reproduces_the_toolpath_the_post_wrote(small, dialect, folded):
     job, plan = small
     for name, data in _programs(job, plan, dialect, folded).items():
@@ -112,7 +113,7 @@ def test_spur_cads_own_programs_verify_clean(small, tmp_path, dialect, capsys):
 
 @pytest.mark.slow
 @pytest.mark.parametrize("folded", [True, False], ids=["folded", "flat"])
-@pytest.mark.parametrize("dialect", DIALECTS)
+@pytest.mark.parametrize("dialect", list(DIALECTS))
 def test_spur_cads_own_programs_verify_clean_in_every_dialect(small, tmp_path, dialect, folded):
     job, plan = small
     code, result = _verify(tmp_path, _job_text(), _programs(job, plan, dialect, folded), "--dialect", dialect)

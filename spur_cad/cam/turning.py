@@ -29,12 +29,10 @@ from dataclasses import dataclass
 import numpy as np
 
 from spur_cad.cad.specs import StockSpec
+from spur_cad.dialects import WORK_OFFSETS, dialects_meaning, lathe_names
 from spur_cad.errors import SpurCadError, require_instance
 from spur_cad.geometry.spec import GearSpec
 from spur_cad.keys import check_section, key
-
-LATHE_DIALECTS = ("siemens", "fanuc", "linuxcnc")
-WORK_OFFSETS = ("G54", "G55", "G56", "G57", "G58", "G59")
 
 MAX_PASSES = 10_000
 """Largest number of passes and plunges one lathe program may have (far more than any blank needs)."""
@@ -65,8 +63,8 @@ class LatheError(SpurCadError, ValueError):
 class LatheSection:
     """[lathe]: the blank's lathe program from bar stock (docs/lathe.md); X as diameter, Z0 on the front face."""
 
-    dialect: str = key("siemens", label="LatheDialect", group="Lathe", choices=LATHE_DIALECTS,
-                       meaning="the lathe's control: siemens (840D), fanuc (lathe, G-code system A) or linuxcnc")
+    dialect: str = key("siemens", label="LatheDialect", group="Lathe", choices=lathe_names(),
+                       meaning=f"the lathe's control: {dialects_meaning(lathe_names())}; see docs/lathe.md")
     bar_diameter_mm: float = key(0.0, unit="mm", low=0.0, high=2000.0, label="LatheBarDiameter", group="Lathe",
                                  meaning="diameter of the bar stock, 0: the blank diameter + 2 mm rounded up to "
                                          "a whole 5 mm")

@@ -1,6 +1,6 @@
 """G-code posts: toolpath IR in, program text out (no file I/O of its own)."""
 
-from spur_cad.post.dialects import DIALECTS, Dialect, dialect
+from spur_cad.dialects import DIALECTS, Dialect, dialect
 from spur_cad.post.program import PostedProgram, ProgramInfo, post_program
 from spur_cad.post.settings import PostError, PostSettings
 

@@ -12,31 +12,31 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 
-from spur_cad.cam.turning import LATHE_DIALECTS, LatheError, LathePlan, LatheSection
+from spur_cad.cam.turning import LatheError, LathePlan, LatheSection
+from spur_cad.dialects import DIALECTS, Dialect, Dialects, lathe_names
 from spur_cad.errors import require_instance, shown
-from spur_cad.post.dialects import DIALECTS, Dialect
-from spur_cad.post.program import MAX_COORDINATE_MM, comment_line, program_title
+from spur_cad.post.header import comment_line, program_head, setup_blocks
+from spur_cad.post.program import MAX_COORDINATE_MM
 
-LATHE_EXTENSIONS = {name: DIALECTS[name].extension for name in LATHE_DIALECTS}
-"""The lathe program's extension per [lathe] dialect, from the dialect table (siemens mpf, fanuc nc, linuxcnc ngc)."""
 COORDINATE_DECIMALS = 3  # X (diameter) and Z: 1 um
 FEED_DECIMALS = 3  # mm/rev
 
 
-def lathe_dialect(dialect: str | Dialect) -> Dialect:
-    """The table's dialect called `dialect` when it has lathe words, or a LatheError listing [lathe]'s dialects;
-    a `Dialect` with lathe words is returned as it is (a controller not in the table, e.g. one being added)."""
-    found = dialect if isinstance(dialect, Dialect) else DIALECTS.get(dialect) if isinstance(dialect, str) else None
+def lathe_dialect(dialect: str | Dialect, dialects: Dialects = DIALECTS) -> Dialect:
+    """The dialect called `dialect` in `dialects` when it has lathe words, or a LatheError listing the registry's
+    lathe dialects; a `Dialect` with lathe words is returned as it is (a controller in no registry, e.g. one being
+    added)."""
+    found = dialect if isinstance(dialect, Dialect) else dialects.get(dialect) if isinstance(dialect, str) else None
     if found is None or found.lathe is None:
         name = dialect.name if isinstance(dialect, Dialect) else dialect
-        raise LatheError(f"[lathe] dialect = {shown(name)} is not known (known: {', '.join(LATHE_DIALECTS)})",
+        raise LatheError(f"[lathe] dialect = {shown(name)} is not known (known: {', '.join(lathe_names(dialects))})",
                          field="dialect")
     return found
 
 
-def lathe_extension(dialect: str | Dialect) -> str:
-    """The program file's extension for a lathe dialect: siemens mpf, fanuc nc, linuxcnc ngc."""
-    return lathe_dialect(dialect).extension
+def lathe_extension(dialect: str | Dialect, dialects: Dialects = DIALECTS) -> str:
+    """The program file's extension for a lathe dialect (siemens mpf, fanuc nc, linuxcnc ngc)."""
+    return lathe_dialect(dialect, dialects).extension
 
 
 def _number(value: float, decimals: int) -> str:
@@ -64,20 +64,12 @@ class _Program:
     def header(self, plan: LathePlan, title: str, comments: Sequence[str]) -> None:
         lathe, g, d, words = self.lathe, plan.geometry, self.d, self.words
         rpm = str(int(round(lathe.max_spindle_rpm)))
-        if d.percent_delimited:
-            self.lines.append("%")
-        if d.program_start:
-            self.lines.append(d.program_start.format(number=lathe.program_number, title=program_title(d, title)))
-        if "{title}" not in d.program_start:
-            self.lines.append(self.comment(title))
-        self.lines += [self.comment(text) for text in (*comments, *_setup_comments(plan, lathe))]
-        if words.workpiece:
-            self.lines.append(words.workpiece.format(
-                top=_number(plan.face_stock_mm, COORDINATE_DECIMALS),
-                far=_number(g.end_z - lathe.parting_blade_width_mm, COORDINATE_DECIMALS),
-                end=_number(g.end_z, COORDINATE_DECIMALS), diameter=_number(g.bar_diameter, COORDINATE_DECIMALS)))
-        self.lines += [*words.setup, d.work_offsets.word.format(code=lathe.work_offset,
-                                                                 number=int(lathe.work_offset[1:]) - 53)]
+        self.lines += program_head(d, lathe.program_number, title, (*comments, *_setup_comments(plan, lathe)))
+        workpiece = words.workpiece.format(
+            top=_number(plan.face_stock_mm, COORDINATE_DECIMALS),
+            far=_number(g.end_z - lathe.parting_blade_width_mm, COORDINATE_DECIMALS),
+            end=_number(g.end_z, COORDINATE_DECIMALS), diameter=_number(g.bar_diameter, COORDINATE_DECIMALS))
+        self.lines += setup_blocks(d, words.setup, lathe.work_offset, workpiece)
         if words.spindle_limit:
             self.lines.append(words.spindle_limit.format(rpm=rpm))
 
@@ -128,9 +120,10 @@ def _check_plan(plan: LathePlan) -> None:
 
 
 def post_lathe(plan: LathePlan, lathe: LatheSection, title: str, comments: Sequence[str] = (),
-               dialect: Dialect | None = None) -> str:
-    """The text of the lathe program for `plan` (spur_cad.cam.turning.plan_lathe) in [lathe] dialect, or in
-    `dialect` when given (a controller with lathe words that is not in the table; lathe.dialect is then not used).
+               dialect: Dialect | None = None, dialects: Dialects = DIALECTS) -> str:
+    """The text of the lathe program for `plan` (spur_cad.cam.turning.plan_lathe) in [lathe] dialect (of the
+    registry `dialects`), or in `dialect` when given (a controller with lathe words in no registry; lathe.dialect
+    is then not used).
 
     `title` (e.g. the job's name) and `comments` are user text: each becomes one inert comment line.
     """
@@ -140,7 +133,7 @@ def post_lathe(plan: LathePlan, lathe: LatheSection, title: str, comments: Seque
     if dialect is not None:
         require_instance(dialect, Dialect, "dialect")
     lathe.validate()
-    d = lathe_dialect(lathe.dialect if dialect is None else dialect)
+    d = lathe_dialect(lathe.dialect if dialect is None else dialect, dialects)
     _check_plan(plan)
     if not plan.moves:
         raise LatheError("the lathe plan has no moves")

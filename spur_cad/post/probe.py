@@ -1,6 +1,6 @@
 """The on-machine probing program as text (issue 30): a ProbePlan in, probe.<ext> out (no file I/O).
 
-Written for the dialects with probing words (spur_cad.post.dialects.ProbingWords): LinuxCNC (G38.2, the
+Written for the dialects with probing words (spur_cad.dialects.ProbingWords): LinuxCNC (G38.2, the
 trips logged by PROBEOPEN / PROBECLOSE) and Fanuc and Haas (G31, the skip position written by DPRNT between
 POPEN and PCLOS); others are refused with a message naming [post] dialect. docs/probing.md lists every block.
 The ball's centre is programmed (the probe's length offset reaches it), never with radius compensation; rapids
@@ -11,9 +11,9 @@ appears inside one bounded inert comment.
 from __future__ import annotations
 
 from spur_cad.cam.probing import ProbeError, ProbePlan
+from spur_cad.dialects import DIALECTS, Dialect, Dialects, probing_names
 from spur_cad.errors import require_instance, shown
-from spur_cad.post.dialects import DIALECTS, Dialect
-from spur_cad.post.program import comment_line, program_title
+from spur_cad.post.header import comment_line, program_head, setup_blocks
 from spur_cad.post.settings import PostSettings
 
 NO_TRIP_TOLERANCE_MM = 0.001
@@ -28,18 +28,13 @@ BLIND_SPOTS = (
 """The header's statement of what on-machine probing cannot see (docs/probing.md)."""
 
 
-def probing_dialects() -> tuple[str, ...]:
-    """The names of the dialects with probing words, in the table's order."""
-    return tuple(d.name for d in DIALECTS.values() if d.probing is not None)
-
-
-def probing_dialect(name: str | Dialect) -> Dialect:
-    """The dialect with probing words called `name`, or a ProbeError naming [post] dialect."""
-    d = name if isinstance(name, Dialect) else DIALECTS.get(name)
+def probing_dialect(name: str | Dialect, dialects: Dialects = DIALECTS) -> Dialect:
+    """The dialect with probing words called `name` in `dialects`, or a ProbeError naming [post] dialect."""
+    d = name if isinstance(name, Dialect) else dialects.get(name)
     if d is None or d.probing is None:
         shown_name = name.name if isinstance(name, Dialect) else name
         raise ProbeError(f"[post] dialect = {shown(shown_name)} has no probing program (probe.<ext> is written "
-                         f"for {', '.join(probing_dialects())}); leave [probe] out or choose one of them",
+                         f"for {', '.join(probing_names(dialects))}); leave [probe] out or choose one of them",
                          field="dialect", section="post")
     return d
 
@@ -102,17 +97,9 @@ class _Writer:
 
     def start(self, title: str, gear_comment: str) -> None:
         d, probe, settings = self.d, self.plan.section, self.settings
-        if d.percent_delimited:
-            self.lines.append("%")
-        if d.program_start:
-            self.lines.append(d.program_start.format(number=probe.program_number, title=program_title(d, title)))
-        if "{title}" not in d.program_start:
-            self.comment(title)
-        for text in _header_comments(self.plan, d, gear_comment):
-            self.comment(text)
-        offset = d.work_offsets.word.format(code=settings.work_offset, number=int(settings.work_offset[1:]) - 53)
-        self.lines += [d.setup, offset, d.spindle_off, *(block.format(tool=probe.tool_number)
-                                                         for block in d.tool_change)]
+        self.lines += program_head(d, probe.program_number, title, _header_comments(self.plan, d, gear_comment))
+        self.lines += [*setup_blocks(d, (d.setup,), settings.work_offset), d.spindle_off,
+                       *(block.format(tool=probe.tool_number) for block in d.tool_change)]
         if probe.probe_on_code:
             self.lines.append(probe.probe_on_code)
         self.lines += [f"G0 {self.clear_z}", d.probing.log_open]
@@ -148,15 +135,17 @@ class _Writer:
             self.lines.append("%")
 
 
-def post_probe(plan: ProbePlan, settings: PostSettings, title: str, gear_comment: str) -> str:
-    """The text of the probing program for `plan` (spur_cad.cam.probing.plan_probe) in [post] dialect.
+def post_probe(plan: ProbePlan, settings: PostSettings, title: str, gear_comment: str,
+               dialects: Dialects = DIALECTS) -> str:
+    """The text of the probing program for `plan` (spur_cad.cam.probing.plan_probe) in [post] dialect (of the
+    registry `dialects`).
 
     `title` (e.g. with the job's name) is user text: it becomes one inert comment. A is written with
     [post] rotary_sign, and in [0, 360) when rotary_mode is "wrapped".
     """
     require_instance(plan, ProbePlan, "plan")
     require_instance(settings, PostSettings, "settings")
-    d = probing_dialect(settings.dialect)
+    d = probing_dialect(settings.dialect, dialects)
     writer = _Writer(d, settings, plan)
     writer.start(title, gear_comment)
     space = None

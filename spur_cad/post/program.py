@@ -14,55 +14,21 @@ from __future__ import annotations
 
 import functools
 import math
-import re
 from dataclasses import dataclass
 
 import numpy as np
 
 from spur_cad.cam.ir import MoveKind, Toolpath
 from spur_cad.cam.machine import check_rotary_code
+from spur_cad.dialects import Dialect, FoldStyle
+from spur_cad.dialects import dialect as dialect_named
 from spur_cad.errors import PostError, require_instance, shown
-from spur_cad.post.dialects import Dialect
-from spur_cad.post.dialects import dialect as dialect_named
+from spur_cad.post.header import program_head, setup_blocks
 from spur_cad.post.settings import PostSettings
 
 MAX_COORDINATE_MM = 100_000.0
 """Largest |X|, |Y|, |Z| a program may command (100 m: beyond any machining centre, far inside every
 control's number format); larger or non-finite values are refused."""
-
-_ACTIVE_COMMENT = re.compile(r"(msg|debug|print|log\w*|probe\w*|abort|py\w*)\s*,|(probeopen|probeclose|logclose)\b",
-                             re.IGNORECASE)
-"""Comment words a LinuxCNC interpreter acts on (messages, log files, probe files, aborts, Python); PROBEOPEN takes
-its file name after a space, PROBECLOSE and LOGCLOSE take nothing."""
-
-_COMMENT_TRANSLATION = str.maketrans({"(": "[", ")": "]", ";": ",", "%": "?"})
-
-
-def inert_comment_text(text: str, max_length: int) -> str:
-    """User text made safe inside one comment of any dialect: printable ASCII only (white space and line
-    breaks become one space, anything else non-printable or non-ASCII becomes '?'), no comment delimiter,
-    no '%' (the end of a Fanuc tape), never a comment the control acts on (LinuxCNC's MSG, LOGOPEN,
-    ABORT, PY, ...: an '_' goes in front), at most `max_length` characters ('...' marks a cut)."""
-    text = re.sub(r"\s+", " ", text)
-    text = "".join(c if " " <= c <= "~" else "?" for c in text).translate(_COMMENT_TRANSLATION).strip()
-    if _ACTIVE_COMMENT.match(text):  # LinuxCNC acts on (MSG,...), (LOGOPEN,...), (ABORT,...), (PY,...), ...
-        text = "_" + text
-    return text if len(text) <= max_length else text[:max_length - 3] + "..."
-
-
-def comment_line(d: Dialect, text: str) -> str:
-    """User text as one inert comment line of dialect `d` (its syntax and case, cut to its line limit)."""
-    text = inert_comment_text(text, d.max_line_length - 4)
-    if d.comments.uppercase:
-        text = text.upper()
-    return f"({text})" if d.comments.style == "paren" else f"; {text}"
-
-
-def program_title(d: Dialect, title: str) -> str:
-    """The title inside dialect `d`'s program-start block (room left for the O number and the parentheses)."""
-    text = inert_comment_text(title, d.max_line_length - 16)
-    return text.upper() if d.comments.uppercase else text
-
 
 @dataclass(frozen=True)
 class ProgramInfo:
@@ -280,10 +246,6 @@ class _Writer:
         self.d, self.settings, self.info, self.c = d, settings, info, c
         self.tool, self.rpm = tool, rpm
 
-    def comment(self, text: str) -> str:
-        """One inert comment line (see inert_comment_text)."""
-        return comment_line(self.d, text)
-
     def run_key(self, run: _Run) -> bytes:
         """Everything a run's folded text depends on, as bytes: equal keys give equal subprogram text."""
         c, sl = self.c, slice(run.start, run.stop)
@@ -411,12 +373,8 @@ class _Writer:
         d, s, info = self.d, self.settings, self.info
         subs = d.subprograms
         sub_ids = self._sub_ids(len(sub_bodies))
-        head: list[str] = ["%"] if d.percent_delimited else []
-        if d.program_start:
-            head.append(d.program_start.format(number=s.program_number, title=self._title()))
-        titled = (info.comments if d.program_start and "{title}" in d.program_start else (info.title, *info.comments))
-        head += [self.comment(line) for line in titled]
-        definitions = [] if subs.after_end or subs.fold_style == "repeat" else \
+        head = program_head(d, s.program_number, info.title, info.comments)
+        definitions = [] if subs.after_end or subs.fold_style == FoldStyle.REPEATED_SECTION else \
             self._definitions(sub_bodies, sub_ids)
         main = self._start_blocks() + self._main_body(body, sub_bodies, sub_ids)
         if s.coolant:
@@ -427,7 +385,7 @@ class _Writer:
             tail.append("%")
         lines = head + definitions + main + tail
         if s.line_numbers:
-            lines = self._numbered(lines, min(sub_ids) - 1 if subs.fold_style == "local_sub" and sub_ids
+            lines = self._numbered(lines, min(sub_ids) - 1 if subs.fold_style == FoldStyle.LOCAL_LABEL and sub_ids
                                    else s.max_line_number)
         too_long = [n for n, line in enumerate(lines, start=1) if len(line) > d.max_line_length]
         if too_long:
@@ -439,24 +397,23 @@ class _Writer:
         """Blank description, setup, work offset, tool, spindle, coolant, and a restart's move to the clearance
         height (up or down, Z alone, before moving across)."""
         d, s, info = self.d, self.settings, self.info
-        offset = d.work_offsets.word.format(code=s.work_offset, number=int(s.work_offset[1:]) - 53)
-        lines = [*self._workpiece(), d.setup, offset, *[t.format(tool=self.tool) for t in d.tool_change],
-                 d.spindle_on.format(rpm=self.rpm)]
+        lines = [*setup_blocks(d, (d.setup,), s.work_offset, self._workpiece()),
+                 *[t.format(tool=self.tool) for t in d.tool_change], d.spindle_on.format(rpm=self.rpm)]
         if s.coolant:
             lines.append(d.coolant_on)
         if info.approach_z_mm is not None:
             lines.append("G0 Z" + _number(int(round(info.approach_z_mm * 10 ** d.linear_decimals)), d.linear_decimals))
         return lines
 
-    def _workpiece(self) -> list[str]:
-        """The dialect's blank description for the control's simulation (Siemens WORKPIECE), if it has one."""
+    def _workpiece(self) -> str:
+        """The dialect's blank description for the control's simulation (Siemens WORKPIECE), "" for none."""
         box = self.info.blank_box_mm
         if not self.d.workpiece or box is None:
-            return []
+            return ""
         names = ("x_min", "y_min", "z_min", "x_max", "y_max", "z_max")
         units = 10 ** self.d.linear_decimals
-        return [self.d.workpiece.format(**{n: _number(int(round(v * units)), self.d.linear_decimals)
-                                           for n, v in zip(names, box)})]
+        return self.d.workpiece.format(**{n: _number(int(round(v * units)), self.d.linear_decimals)
+                                          for n, v in zip(names, box)})
 
     def _definitions(self, sub_bodies: list[list[str]], sub_ids: list[int]) -> list[str]:
         """Every subprogram, framed by the dialect's start and end blocks."""
@@ -477,7 +434,7 @@ class _Writer:
                 main += item
                 continue
             index, run = item
-            if subs.fold_style == "repeat" and index not in written:  # first use: the section itself, labelled
+            if subs.fold_style == FoldStyle.REPEATED_SECTION and index not in written:  # first use: the section itself
                 written.add(index)
                 main += [subs.call[0].format(x=_number(run.x_base or 0, lin_dec), a=_number(run.a_base, rot_dec)),
                          subs.start.format(sub=sub_ids[index]), *sub_bodies[index],
@@ -487,13 +444,9 @@ class _Writer:
                 main += [line.format(sub=sub_ids[index], x=x, a=_number(run.a_base, rot_dec)) for line in subs.call]
         return main
 
-    def _title(self) -> str:
-        """The title inside the program-start block (room left for the O number and the parentheses)."""
-        return program_title(self.d, self.info.title)
-
     def _sub_ids(self, count: int) -> list[int]:
         """Subprogram numbers: after the program number; Haas labels (N numbers) at the top of the range."""
-        if self.d.subprograms.fold_style == "local_sub":
+        if self.d.subprograms.fold_style == FoldStyle.LOCAL_LABEL:
             top = self.settings.max_line_number
             return [top - count + 1 + i for i in range(count)]
         first = self.settings.program_number + 1

@@ -4,20 +4,11 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+from spur_cad.dialects import WORK_OFFSETS, dialect_names, dialects_meaning
 from spur_cad.errors import PostError, shown
 from spur_cad.keys import check_section, key
-from spur_cad.post.dialects import DIALECTS
 
 __all__ = ["WORK_OFFSETS", "PostError", "PostSettings", "dialect_names"]
-
-
-def dialect_names() -> tuple[str, ...]:
-    """The dialects' names, from the table in spur_cad.post.dialects: adding a dialect there is all it takes."""
-    return tuple(DIALECTS)
-
-
-WORK_OFFSETS = ("G54", "G55", "G56", "G57", "G58", "G59")
-"""The work offsets a program may select."""
 
 
 @dataclass(frozen=True)
@@ -31,8 +22,7 @@ class PostSettings:
     """
 
     dialect: str = key("linuxcnc", label="PostDialect", group="Post", names_from=dialect_names,
-                       meaning="G-code dialect: linuxcnc (.ngc), fanuc (.nc), haas (.nc), siemens (.mpf, 840D), "
-                               "okuma (.min, OSP); see docs/post.md")
+                       meaning=f"G-code dialect: {dialects_meaning()}; see docs/post.md")
     line_numbers: bool = key(False, label="LineNumbers", group="Post", meaning="write N block numbers")
     line_number_step: int = key(1, low=1, high="max_line_number", label="LineNumberStep", group="Post",
                                 meaning="increment of the N words")

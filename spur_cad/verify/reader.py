@@ -42,14 +42,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from spur_cad.dialects import DIALECTS, Dialect, Dialects, lathe_names
 from spur_cad.errors import SpurCadError, shown, shown_path
-from spur_cad.post.dialects import DIALECTS as DIALECT_TABLE
-from spur_cad.post.dialects import Dialect, lathe_names
 
-DIALECTS = tuple(DIALECT_TABLE)
-"""The names the reader takes (the dialect table's; a `Dialect` not in it may be given too)."""
-LATHE_DIALECTS = lathe_names()
-"""The names the reader takes in lathe mode: the table's dialects with lathe words."""
 # The largest program read, and what reading it may do. Together they bound a verification to about a minute
 # and half a gigabyte whatever the program holds (docs/verification.md, "Limits").
 MAX_PROGRAM_BYTES = 64 * 1024 * 1024  # refused at once beyond this, naming the size
@@ -161,7 +156,7 @@ _ORDER = {"T": 0, "S": 0, "G": 1, "F": 2, "M": 3}  # T and S before M, G before 
 
 @dataclass(frozen=True, slots=True)
 class _Syntax:
-    """What reading every line needs from the dialect table (spur_cad.post.dialects), in flat fields."""
+    """What reading every line needs from the dialect table (spur_cad.dialects), in flat fields."""
 
     paren: bool  # ( ... ) is a comment
     semicolon: bool  # ; starts a comment to the end of the line
@@ -831,28 +826,28 @@ def _may_be_control(text: str, structure: str) -> bool:
     return text[0] in "O#C" or "P" in text  # numbered: O, #n =, CALL (Okuma), G65 P, M98 P, M97 P
 
 
-def _dialect(dialect: str | Dialect, lathe: bool) -> Dialect:
-    """The table's dialect called `dialect` (a Dialect is taken as it is: a controller not in the table); in
-    lathe mode one with lathe words."""
+def _dialect(dialect: str | Dialect, lathe: bool, dialects: Dialects) -> Dialect:
+    """The dialect called `dialect` in the registry `dialects` (a Dialect is taken as it is: a controller in no
+    registry); in lathe mode one with lathe words."""
     if isinstance(dialect, Dialect):
         found = dialect
-    elif dialect not in DIALECTS:
-        raise ProgramReadError(f"unknown dialect {shown(dialect)} (known: {', '.join(DIALECTS)})")
+    elif not isinstance(dialect, str) or dialect not in dialects:
+        raise ProgramReadError(f"unknown dialect {shown(dialect)} (known: {', '.join(dialects)})")
     else:
-        found = DIALECT_TABLE[dialect]
+        found = dialects[dialect]
     if lathe and found.lathe is None:
-        raise ProgramReadError(f"no lathe dialect {shown(found.name)} (known: {', '.join(LATHE_DIALECTS)})")
+        raise ProgramReadError(f"no lathe dialect {shown(found.name)} (known: {', '.join(lathe_names(dialects))})")
     return found
 
 
 def read_program(text: str, dialect: str | Dialect, source: str = "program", checkpoint=None,
-                 lathe: bool = False) -> ProgramMoves:
-    """The moves of a program's text in `dialect` (one of DIALECTS, or a Dialect of spur_cad.post.dialects: a
-    controller not in the table); raises ProgramReadError naming `source`'s line. `checkpoint()` is called every
-    CHECK_EVERY_BLOCKS lines read (the CLI stops there when a signal arrived). `lathe`: a lathe program
-    (LATHE_DIALECTS, or a Dialect with lathe words; the module docstring says what is read): x is the diameter
-    as written, y = a = 0, feed in mm/rev as written. Lines end with LF (or CR LF)."""
-    d = _dialect(dialect, lathe)
+                 lathe: bool = False, dialects: Dialects = DIALECTS) -> ProgramMoves:
+    """The moves of a program's text in `dialect` (a name in the registry `dialects`, or a Dialect of
+    spur_cad.dialects: a controller in no registry); raises ProgramReadError naming `source`'s line.
+    `checkpoint()` is called every CHECK_EVERY_BLOCKS lines read (the CLI stops there when a signal arrived).
+    `lathe`: a lathe program (a dialect with lathe words; the module docstring says what is read): x is the
+    diameter as written, y = a = 0, feed in mm/rev as written. Lines end with LF (or CR LF)."""
+    d = _dialect(dialect, lathe, dialects)
     data = text.encode("utf-8", "surrogatepass")
     if len(data) > MAX_PROGRAM_BYTES:
         raise ProgramReadError(f"{source}: the program has {len(data):,} bytes; verify reads at most "
@@ -876,10 +871,10 @@ def open_program_file(path: str | os.PathLike, source: str | None = None):
 
 
 def read_program_file(path: str | os.PathLike, dialect: str | Dialect, source: str | None = None, checkpoint=None,
-                      lathe: bool = False) -> ProgramMoves:
+                      lathe: bool = False, dialects: Dialects = DIALECTS) -> ProgramMoves:
     """`read_program` of a file, read as a stream: a regular file of at most MAX_PROGRAM_BYTES (a FIFO, a device
     or a larger file is refused before reading); memory holds a line at a time besides the moves."""
-    d = _dialect(dialect, lathe)
+    d = _dialect(dialect, lathe, dialects)
     source = source if source is not None else shown_path(path)
     with open_program_file(path, source) as handle:
         return _Reader(handle, d, source, checkpoint, lathe).run()

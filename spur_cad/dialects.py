@@ -1,17 +1,43 @@
-"""Controller dialects as data: one `Dialect` per controller, the one table that the milling post
-(program.py), the lathe post (lathe.py), the program reader (spur_cad.verify.reader) and the CLI read.
+"""Controller dialects as data: one `Dialect` per controller, and registries of them (`Dialects`, a read-only
+mapping name -> Dialect; `DIALECTS` is the default one). Everything that names or lists controllers derives
+from a registry: the job file's `[post] dialect` and `[lathe] dialect` choices and their documentation, the
+milling, lathe and probing posts (spur_cad.post), the output folder's vocabulary of program file names
+(spur_cad.outputs), the program reader of `spur-cad verify` and the CLI. Functions take `dialects=` to use
+another registry (e.g. one with a controller defined in a test: `registry(*DIALECTS.values(), MACH3)`).
 
-No other module compares a dialect's name (tests/test_dialect_table.py checks it): each reads the
-attributes here. What each dialect relies on is listed in docs/post.md, which also walks through adding
-one. Only LinuxCNC is checked by an interpreter here (rs274); the others follow their programming
-manuals and are pinned by golden tests.
+No other module compares a dialect's name (tests/test_dialect_table.py checks it): each reads the attributes
+here. What each dialect relies on is listed in docs/post.md, which also walks through adding one. Only
+LinuxCNC is checked by an interpreter here (rs274); the others follow their programming manuals and are
+pinned by golden tests. Data only, in the lowest layer (imports spur_cad.errors alone), so that the output
+vocabulary and the CAM's [lathe] section can derive from it.
 """
 
 from __future__ import annotations
 
+import enum
+from collections.abc import Mapping
 from dataclasses import dataclass, replace
+from types import MappingProxyType
 
 from spur_cad.errors import PostError, shown
+
+WORK_OFFSETS = ("G54", "G55", "G56", "G57", "G58", "G59")
+"""The work offsets a program may select ([post] and [lathe] work_offset); a dialect says how it writes them."""
+
+
+class FoldStyle(enum.Enum):
+    """How the post writes a tooth space's pattern once and has it run once per space ([post] folded)."""
+
+    NUMBERED_SUBPROGRAM = "numbered subprogram"
+    """A subprogram of its own number after the program's (o1001, O1001), before or after the main program,
+    run by the dialect's call blocks: LinuxCNC `o<n> call`, Fanuc `G65 P`, Okuma `CALL O`, an `M98 P` after
+    parameter assignments."""
+    LOCAL_LABEL = "local label"
+    """A local subprogram in the same file, labelled by a block number at the top of the numbers' range
+    (`N<label>` ... `M99` after the end), run by the call blocks (Haas `M97 P<label>`)."""
+    REPEATED_SECTION = "repeated section"
+    """The section itself, labelled, written in place at its first use and repeated there after (Siemens
+    `REPEAT <start> <end> P=1`)."""
 
 
 @dataclass(frozen=True)
@@ -34,7 +60,7 @@ class Subprograms:
     """How the post writes a space pattern once and calls it per space (folding; `{...}` are str.format
     templates), and which subprogram structure the reader executes."""
 
-    fold_style: str  # "linuxcnc_sub", "macro_call" (Fanuc G65, Okuma CALL), "local_sub" (Haas M97), "repeat"
+    fold_style: FoldStyle
     x_param: str  # how the body names the X base
     a_param: str  # how the body names the A base
     param_word: str  # an address taking a parameter: {address}, {param}
@@ -52,8 +78,7 @@ class Subprograms:
     local_labels: bool = False  # N<n> local subprograms called with M97 P<n> in the same file (Haas)
 
     def __post_init__(self):
-        if self.fold_style not in ("linuxcnc_sub", "macro_call", "local_sub", "repeat") \
-                or self.structure not in ("o_words", "labels", "numbered"):
+        if not isinstance(self.fold_style, FoldStyle) or self.structure not in ("o_words", "labels", "numbered"):
             raise ValueError(f"subprograms: unknown fold_style {self.fold_style!r} or structure {self.structure!r}")
 
 
@@ -151,7 +176,7 @@ LINUXCNC = Dialect(
     spindle_on="S{rpm} M3", coolant_on="M8", coolant_off="M9", spindle_off="M5", program_end="M30",
     linear_decimals=4, feed_decimals=1, inverse_feed_decimals=4, inverse_time=True, rotary=Rotary(4),
     subprograms=Subprograms(
-        fold_style="linuxcnc_sub", x_param="#1", a_param="#2", param_word="{address}{param}",
+        fold_style=FoldStyle.NUMBERED_SUBPROGRAM, x_param="#1", a_param="#2", param_word="{address}{param}",
         param_offset_word="{address}[{param}{offset}]", start="o{sub} sub", end="o{sub} endsub",
         call=("o{sub} call [{x}] [{a}]",), after_end=False, structure="o_words"),
     lathe=LatheWords(setup=("G7", "G18 G21 G90 G40 G95"), spindle_limit="", tool_change="T{tool} M6 G43",
@@ -169,7 +194,7 @@ FANUC = Dialect(
     spindle_off="M05", program_end="M30", linear_decimals=3, feed_decimals=1, inverse_feed_decimals=3,
     inverse_time=True, rotary=Rotary(3),
     subprograms=Subprograms(
-        fold_style="macro_call", x_param="#24", a_param="#1", param_word="{address}{param}",
+        fold_style=FoldStyle.NUMBERED_SUBPROGRAM, x_param="#24", a_param="#1", param_word="{address}{param}",
         param_offset_word="{address}[{param}{offset}]", start="O{sub:04d}", end="M99",
         call=("G65 P{sub:04d} X{x} A{a}",), after_end=True, structure="numbered", closing="M0*99"),
     # A Fanuc lathe in G-code system A: U / W incremental, G90 and G94 turning cycles, G99 feed per revolution.
@@ -187,17 +212,17 @@ FANUC = Dialect(
 # Haas differs from Fanuc in the program number's digits and in folding: local subprograms
 # (M97 P<N label> in the same file) with their parameters in common variables. No lathe words.
 HAAS = replace(FANUC, name="haas", title="Haas", program_start="O{number:05d} ({title})", lathe=None,
-               subprograms=replace(FANUC.subprograms, fold_style="local_sub", x_param="#101", a_param="#102",
+               subprograms=replace(FANUC.subprograms, fold_style=FoldStyle.LOCAL_LABEL, x_param="#101", a_param="#102",
                                    start="N{sub}", call=("#101={x}", "#102={a}", "M97 P{sub}"), local_labels=True))
 
 SIEMENS = Dialect(
-    name="siemens", title="Siemens", extension="mpf", max_line_length=200,
+    name="siemens", title="Siemens 840D", extension="mpf", max_line_length=200,
     percent_delimited=False, program_start="", comments=Comments("semicolon", False, ("semicolon",)),
     setup="G71 G90 G94 G17 G40", tool_change=("T{tool} D1", "M6"),
     spindle_on="S{rpm} M3", coolant_on="M8", coolant_off="M9", spindle_off="M5", program_end="M30",
     linear_decimals=4, feed_decimals=1, inverse_feed_decimals=4, inverse_time=True, rotary=Rotary(4),
     subprograms=Subprograms(
-        fold_style="repeat", x_param="R1", a_param="R2", param_word="{address}={param}",
+        fold_style=FoldStyle.REPEATED_SECTION, x_param="R1", a_param="R2", param_word="{address}={param}",
         param_offset_word="{address}={param}{offset}", start="SPACE{sub}:", end="SPACE{sub}_END:",
         call=("R1={x} R2={a}", "REPEAT SPACE{sub} SPACE{sub}_END P=1"), after_end=False, structure="labels"),
     workpiece='WORKPIECE(,"",,"BOX",112,{z_max},{z_min},-80,{x_min},{y_min},{x_max},{y_max})',
@@ -209,32 +234,69 @@ SIEMENS = Dialect(
                      spindle_limit_code="26", turret=True))
 
 OKUMA = Dialect(
-    name="okuma", title="Okuma", extension="min", percent_delimited=False, program_start="O{number:04d} ({title})",
+    name="okuma", title="Okuma OSP", extension="min", percent_delimited=False, program_start="O{number:04d} ({title})",
     comments=Comments("paren", True, ("paren",)), setup="G21 G90 G94 G17 G40 G80",
     tool_change=("T{tool} M06", "G56 H{tool}"), spindle_on="S{rpm} M03", coolant_on="M08", coolant_off="M09",
     spindle_off="M05", program_end="M30", linear_decimals=3, feed_decimals=1, inverse_feed_decimals=3,
     inverse_time=False, rotary=Rotary(3, direction_codes=("M15", "M16")),
     subprograms=Subprograms(
-        fold_style="macro_call", x_param="XST", a_param="ASP", param_word="{address}={param}",
+        fold_style=FoldStyle.NUMBERED_SUBPROGRAM, x_param="XST", a_param="ASP", param_word="{address}={param}",
         param_offset_word="{address}={param}{offset}", start="O{sub:04d}", end="RTS",
         call=("CALL O{sub:04d} XST={x} ASP={a}",), after_end=True, structure="numbered", closing="RTS",
         named_calls=True),
     work_offsets=WorkOffsets("G15 H{number}", numbered_code="15"), assigned_words=True)
 
-DIALECTS: dict[str, Dialect] = {d.name: d for d in (LINUXCNC, FANUC, HAAS, SIEMENS, OKUMA)}
+Dialects = Mapping[str, Dialect]
+"""A registry of dialects: name -> Dialect, in the order messages, documentation and the workbench list them."""
 
 
-def dialect(name: str | Dialect) -> Dialect:
-    """The dialect called `name`, or a PostError listing the known ones; a `Dialect` is returned as it is
-    (a controller not in the table, e.g. one being added: docs/post.md)."""
+def registry(*dialects: Dialect) -> Dialects:
+    """A read-only registry of `dialects`, in their order (names must differ)."""
+    table = {d.name: d for d in dialects}
+    if len(table) != len(dialects) or not all(isinstance(d, Dialect) for d in dialects):
+        raise ValueError("a dialect registry takes Dialects of different names")
+    return MappingProxyType(table)
+
+
+DIALECTS: Dialects = registry(LINUXCNC, FANUC, HAAS, SIEMENS, OKUMA)
+"""The default registry (read-only: another registry is a new one passed as `dialects=`)."""
+
+
+def dialect(name: str | Dialect, dialects: Dialects = DIALECTS) -> Dialect:
+    """The dialect called `name` in `dialects`, or a PostError listing the known ones; a `Dialect` is returned as
+    it is (a controller in no registry, e.g. one being added: docs/post.md)."""
     if isinstance(name, Dialect):
         return name
     try:
-        return DIALECTS[name]
-    except KeyError:
-        raise PostError(f"[post] dialect = {shown(name)} is not known (known: {', '.join(DIALECTS)})") from None
+        return dialects[name]
+    except (KeyError, TypeError):
+        raise PostError(f"[post] dialect = {shown(name)} is not known (known: {', '.join(dialects)})",
+                        field="dialect", section="post") from None
 
 
-def lathe_names() -> tuple[str, ...]:
-    """The names of the dialects with lathe words, in the table's order."""
-    return tuple(d.name for d in DIALECTS.values() if d.lathe is not None)
+def dialect_names(dialects: Dialects = DIALECTS) -> tuple[str, ...]:
+    """The names of the registry's dialects, in its order ([post] dialect's choices)."""
+    return tuple(dialects)
+
+
+def lathe_names(dialects: Dialects = DIALECTS) -> tuple[str, ...]:
+    """The names of the dialects with lathe words, in the registry's order ([lathe] dialect's choices)."""
+    return tuple(d.name for d in dialects.values() if d.lathe is not None)
+
+
+def probing_names(dialects: Dialects = DIALECTS) -> tuple[str, ...]:
+    """The names of the dialects with probing words, in the registry's order (those [probe] takes)."""
+    return tuple(d.name for d in dialects.values() if d.probing is not None)
+
+
+def program_extensions(dialects: Dialects = DIALECTS) -> tuple[str, ...]:
+    """Every program file extension of the registry's dialects (milling, lathe and probing programs share
+    their dialect's), once each, in its order: the output folder's vocabulary of program names."""
+    return tuple(dict.fromkeys(d.extension for d in dialects.values()))
+
+
+def dialects_meaning(names: tuple[str, ...] | None = None, dialects: Dialects = DIALECTS) -> str:
+    """The registry's dialects called `names` (None: all) as the key documentation lists them:
+    'linuxcnc (LinuxCNC, .ngc), fanuc (Fanuc, .nc), ...'."""
+    chosen = [d for d in dialects.values() if names is None or d.name in names]
+    return ", ".join(f"{d.name} ({d.title}, .{d.extension})" for d in chosen)
