@@ -177,7 +177,7 @@ def _transformed_edge(edge: TopoDS_Edge, trsf: gp_Trsf) -> TopoDS_Edge:
 def gear_face_edges(spec: GearSpec, fit_tolerance_mm: float) -> tuple[list[TopoDS_Edge], GearSolidReport]:
     """Edges of the whole transverse outline on the front face, in order around the gear."""
     profile = spec.tooth_space_profile()
-    fillet_seg, involute_seg = profile.segment("fillet"), profile.segment("involute")
+    fillet_seg, involute_seg = profile.fillet, profile.involute
     involute = fit_segment(involute_seg, fit_tolerance_mm)
     right: list[TopoDS_Edge] = []
     fillet = None
@@ -192,7 +192,7 @@ def gear_face_edges(spec: GearSpec, fit_tolerance_mm: float) -> tuple[list[TopoD
     if v > 0.0:
         space_edges.append(_arc_edge(spec.root_radius_mm, -v, v))
     space_edges.extend(right)
-    tip = profile.segment("tip")
+    tip = profile.tip
     pitch = 2.0 * math.pi / spec.teeth
     # Tip land of the tooth clockwise of space 0: from its right flank's end to the next space's left flank.
     space_edges.append(_arc_edge(spec.tip_radius_mm, tip.start, pitch - tip.start))
@@ -221,7 +221,7 @@ def modified_face_edges(spec: GearSpec, modifications: FlankModifications, x_fac
         modified = modified_tooth_space_profile(profile, modifications.side(side), x_face_mm)
         halves[side] = [BRepBuilderAPI_MakeEdge(fit_segment(seg, fit_tolerance_mm).curve).Edge()
                         for seg in modified.segments if seg.label in ("fillet", "involute") and seg.end > seg.start]
-        tip_angles[side] = modified.segment("tip").start
+        tip_angles[side] = modified.tip.start
     mirror = _mirror_y()
     space_edges = [_transformed_edge(edge, mirror) for edge in reversed(halves["left"])]
     v = profile.root_arc_half_angle_rad
@@ -314,7 +314,7 @@ def _modified_section_wires(spec: GearSpec, modifications: FlankModifications, x
             raise RuntimeError("the modified sections differ in their segments (a relief start at the tip?)")
         fitted[side] = [_fit_section_family([segments[k] for segments in flanks], fit_tolerance_mm)
                         for k in range(len(flanks[0]))]
-        tip_angles[side] = [section.segment("tip").start for section in sections]
+        tip_angles[side] = [section.tip.start for section in sections]
     mirror = _mirror_y()
     pitch = 2.0 * math.pi / spec.teeth
     v = profile.root_arc_half_angle_rad

@@ -182,7 +182,7 @@ def contact_counts(spec: GearSpec, tool: Tool, scallop_mm: float,
             params = even_arc_length_parameters(segment, contact_spacing_mm)
         flank += len(params) - (1 if flank else 0)
     v = profile.root_arc_half_angle_rad
-    tip_edge = profile.segment("tip").start
+    tip_edge = profile.tip.start
     tip_angle = 2.0 * tip_edge - 2.0 * math.pi / spec.teeth
     return ContactCounts(flank, _flat_sweep_steps(spec.root_radius_mm, 2.0 * v, scallop_mm) + 1,
                          _flat_sweep_steps(spec.tip_radius_mm, tip_angle, scallop_mm) + 1)
@@ -243,8 +243,8 @@ def _with_root_and_tip(spec: GearSpec, profile: ToothSpaceProfile, tool: Tool, s
     d = tool.flat_width_mm
     v = profile.root_arc_half_angle_rad
     root = _flat_sweep(spec.root_radius_mm, v, -v, -d / 2.0, d / 2.0, scallop_mm)
-    left_edge = left_profile.segment("tip").start  # clockwise polar angle of the flank's tip edge
-    right_edge = (right_profile or left_profile).segment("tip").start
+    left_edge = left_profile.tip.start  # clockwise polar angle of the flank's tip edge
+    right_edge = (right_profile or left_profile).tip.start
     pitch = 2.0 * math.pi / spec.teeth
     tip = _flat_sweep(spec.tip_radius_mm, -left_edge, right_edge - pitch, -d / 2.0, d / 2.0, scallop_mm)
     return SpacePoses(right, root, left, tip)

@@ -168,7 +168,7 @@ def helix_range_mm(spec: GearSpec) -> tuple[float, float]:
 
 def _flank_point(spec: GearSpec, radius_mm: float, side: str) -> tuple[np.ndarray, np.ndarray]:
     """Space 0's involute point at `radius_mm` on `side` and its normal, in the gap frame (= machine Y, Z)."""
-    involute = spec.tooth_space_profile().segment("involute")
+    involute = spec.tooth_space_profile().involute
     t = math.sqrt(max((radius_mm / spec.base_radius_mm) ** 2 - 1.0, 0.0))
     t = min(max(t, involute.start), involute.end)
     point, normal = involute.points(np.array([t]))[0], involute.normals(np.array([t]))[0]

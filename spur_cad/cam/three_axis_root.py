@@ -101,7 +101,7 @@ def flat_mill_root(spec: GearSpec, tool_radius_mm: float, samples: _SpaceSamples
     first = lowest_reached(points, normals)
     form = float(np.hypot(*points[first]))
     if first > 0:  # refined between the last sample not reached and the first reached
-        involute = profile.segment("involute")
+        involute = profile.involute
         fine = np.linspace(parameters[first - 1], parameters[first], 201)
         fine_points = involute.points(fine)
         form = float(np.hypot(*fine_points[lowest_reached(fine_points, involute.normals(fine))]))

@@ -29,7 +29,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from spur_cad.errors import GearSpecError
-from spur_cad.geometry.profile import CircularArc, Segment, ToothSpaceProfile
+from spur_cad.geometry.profile import CircularArc, Involute, Segment, ToothSpaceProfile
 from spur_cad.geometry.roots import brentq
 from spur_cad.geometry.sampling import ProfileSamples, sample_profile, segment_parameters
 
@@ -283,7 +283,7 @@ def modified_tooth_space_profile(profile: ToothSpaceProfile, flank: FlankModific
     reliefs' starts and carried on to where the moved flank meets the tip circle; the root fillet moved by the
     form point's removal along the form point's normal, faded in as (beta / beta_F)^2 from the root circle (so the
     outline stays closed and the root circle unchanged); root arc unchanged; tip arc from the new flank end."""
-    involute = profile.segment("involute")
+    involute = profile.involute
     rb = involute.base_radius_mm
     lead = float(flank.lead_offset_mm(x_face_mm))
 
@@ -308,14 +308,14 @@ def modified_tooth_space_profile(profile: ToothSpaceProfile, flank: FlankModific
         if seg.label == "fillet":
             t_form = involute.start
             removal = float(involute_offset(t_form))
-            normal = tuple(float(v) for v in involute.normals(np.array(t_form)))
+            normal_x, normal_y = (float(v) for v in involute.normals(np.array(t_form)))
             span = seg.end - seg.start
             segments.append(ModifiedSegment(seg, lambda beta, s=span, r=removal: r * (np.asarray(beta) / s) ** 2,
-                                            fixed_normal=normal))
-        elif seg.label == "involute":
+                                            fixed_normal=(normal_x, normal_y)))
+        elif isinstance(seg, Involute):
             for a, b in zip(cuts, cuts[1:]):
                 segments.append(ModifiedSegment(replace(seg, start=a, end=b), involute_offset))
-        elif seg.label == "tip":
+        elif isinstance(seg, CircularArc) and seg.label == "tip":
             x, y = segments[-1].points(np.array([t_end]))[0]
             segments.append(CircularArc("tip", seg.radius_mm, math.atan2(x, y), seg.end))
         else:

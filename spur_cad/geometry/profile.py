@@ -23,7 +23,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Protocol, TypeVar
 
 import numpy as np
 
@@ -37,7 +37,7 @@ if TYPE_CHECKING:  # annotations only: spec.py builds profiles with this module 
 SEGMENT_LABELS = ("root", "fillet", "involute", "tip")
 
 
-def _rotate_clockwise(angle: np.ndarray, x: np.ndarray, y: np.ndarray) -> np.ndarray:
+def _rotate_clockwise(angle: np.ndarray | float, x: np.ndarray, y: np.ndarray) -> np.ndarray:
     """Turn vectors (x, y) clockwise by `angle` (R(-angle)); returns an (N, 2) array."""
     c, s = np.cos(angle), np.sin(angle)
     return np.stack([x * c + y * s, -x * s + y * c], axis=-1)
@@ -292,7 +292,32 @@ class EllipticFillet:
 
 
 Fillet = TrochoidalFillet | EllipticFillet
-Segment = CircularArc | Involute | TrochoidalFillet | EllipticFillet
+_S = TypeVar("_S")
+
+
+class Segment(Protocol):
+    """What every segment of a tooth-space profile offers, whatever curve it is: the root and tip arcs, the
+    involute, the rack's trochoid or ellipse fillet here, and the shaper cutter's fillet of an internal gear
+    (geometry/internal.py). Its parameter runs from `start` to `end`, root side first."""
+
+    @property
+    def label(self) -> str: ...
+
+    @property
+    def start(self) -> float: ...
+
+    @property
+    def end(self) -> float: ...
+
+    def points(self, parameter: np.ndarray) -> np.ndarray: ...
+
+    def normals(self, parameter: np.ndarray) -> np.ndarray: ...
+
+    def curvature_radii(self, parameter: np.ndarray) -> np.ndarray: ...
+
+    def chord_error_bound(self, a: np.ndarray, b: np.ndarray) -> np.ndarray: ...
+
+    def arc_length_bound(self, a: np.ndarray, b: np.ndarray) -> np.ndarray: ...
 
 
 @dataclass(frozen=True)
@@ -318,6 +343,28 @@ class ToothSpaceProfile:
             if seg.label == label:
                 return seg
         return None
+
+    @property
+    def involute(self) -> Involute:
+        """The involute flank; every profile has one (GearSpec refuses a gear whose form circle reaches the tip)."""
+        return self._required("involute", Involute)
+
+    @property
+    def tip(self) -> CircularArc:
+        """The tip arc; every profile has one."""
+        return self._required("tip", CircularArc)
+
+    @property
+    def fillet(self) -> Segment | None:
+        """The fillet (a rack's or, for an internal gear, a shaper cutter's), or None for a sharp rack corner on the
+        rolling line."""
+        return self.segment("fillet")
+
+    def _required(self, label: str, kind: type[_S]) -> _S:
+        seg = self.segment(label)
+        if not isinstance(seg, kind):
+            raise ValueError(f"the tooth-space profile has no {label} segment")
+        return seg
 
 
 @dataclass(frozen=True)
@@ -377,11 +424,12 @@ def build_tooth_space_profile(spec: GearSpec) -> ToothSpaceProfile:
 
     t_dist = _flank_point_t_distance(spec, corner)
     undercut = t_dist > r * math.sin(alpha) + 1e-12
-    fillet: Fillet | None = _rack_fillet(spec, corner, d1, beta_max)
+    generated: Fillet = _rack_fillet(spec, corner, d1, beta_max)
+    fillet: Fillet | None = generated
     if rho == 0.0 and abs(B) < 1e-12:
         fillet = None  # a sharp rack corner on the rolling line generates no fillet
     else:
-        speeds = fillet.speeds(np.linspace(0.0, beta_max, 2049))
+        speeds = generated.speeds(np.linspace(0.0, beta_max, 2049))
         if speeds.min() <= 1e-9 * spec.module_mm:
             raise GearSpecError(
                 f"rack tip radius {rho:g} mm: the fillet envelope has a cusp for this tooth count and profile "

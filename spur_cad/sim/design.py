@@ -149,7 +149,7 @@ def modification_removal_mm(spec: GearSpec, grid: DesignGrid, mods) -> np.ndarra
     from spur_cad.geometry.modifications import normal_offset_mm
 
     profile = spec.tooth_space_profile()
-    involute, fillet = profile.segment("involute"), profile.segment("fillet")
+    involute, fillet = profile.involute, profile.fillet
     rb = spec.base_radius_mm
     params = space_parameters(profile, grid.spacing_mm)
     label = np.array(FEATURES)[grid.feature]

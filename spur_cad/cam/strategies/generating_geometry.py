@@ -152,7 +152,7 @@ class GeneratingPass:
 
 def flank_rolls(spec: GearSpec, target_mm: float) -> tuple[np.ndarray, float]:
     """Involute rolls of the flank passes (form circle -> tip) and the largest flat deviation left."""
-    involute = spec.tooth_space_profile().segment("involute")
+    involute = spec.tooth_space_profile().involute
     rb, t0, t_end = spec.base_radius_mm, involute.start, involute.end
     goal = _FLANK_SAFETY * target_mm
     rolls, worst = [t0], 0.0
@@ -176,7 +176,7 @@ def _rack_point_z(spec: GearSpec, t: np.ndarray) -> np.ndarray:
     """Machine Z of the rack's point T (flank/round tangent point) at involute roll t (flank mode)."""
     corner = rack_corner(spec)
     alpha, r = spec.pressure_angle_rad, spec.reference_radius_mm
-    theta_b = spec.tooth_space_profile().segment("involute").base_angle_rad
+    theta_b = spec.tooth_space_profile().involute.base_angle_rad
     phi = theta_b + np.asarray(t, float) - alpha
     return (corner.corner_offset_mm * math.sin(alpha) + (r - corner.corner_depth_mm) * math.cos(alpha)
             - r * math.sin(alpha) * phi)
@@ -185,7 +185,7 @@ def _rack_point_z(spec: GearSpec, t: np.ndarray) -> np.ndarray:
 def flank_poses(spec: GearSpec, tool: Tool, rolls: np.ndarray, tool_end: str = "rack") -> tuple[np.ndarray, ...]:
     """(A rad, Y, Z) of the tool tip centre for the right-flank passes at involute rolls `rolls` (ascending)."""
     rb, r_t = spec.base_radius_mm, tool.effective_corner_radius_mm
-    theta_b = spec.tooth_space_profile().segment("involute").base_angle_rad
+    theta_b = spec.tooth_space_profile().involute.base_angle_rad
     t = np.asarray(rolls, float)
     a = theta_b + t
     y = -(rb * t + tool.diameter_mm / 2.0)
@@ -228,7 +228,7 @@ def land_pose(spec: GearSpec, psi: np.ndarray) -> tuple[np.ndarray, ...]:
 
 def land_angles(spec: GearSpec, tool: Tool, goal: float) -> tuple[np.ndarray, float]:
     """Directions psi of the land passes over the tooth on the +Y side of space 0, and the leftover."""
-    tip = spec.tooth_space_profile().segment("tip")
+    tip = spec.tooth_space_profile().tip
     if tip is None:  # pointed teeth: no land
         return np.zeros(0), 0.0
     ra = spec.tip_radius_mm
@@ -315,7 +315,7 @@ def _greedy_rolls(start: float, stop: float, pose, points_between, tool: Tool, g
 def tip_rolls(spec: GearSpec, tool: Tool, goal: float) -> tuple[np.ndarray, np.ndarray, float]:
     """Fillet contact angles (junction -> 0) and root rolls (v -> 0) of the right half, and the leftover."""
     profile = spec.tooth_space_profile()
-    fillet = profile.segment("fillet")
+    fillet = profile.fillet
     worst = 0.0
     betas = np.zeros(1)
     if fillet is not None and fillet.end > 0.0:
@@ -387,10 +387,10 @@ def rough_passes_per_space(spec: GearSpec, tool: Tool, target_mm: float) -> floa
     """Closed-form estimate of the passes per space (before planning them): flanks from the midpoint
     deviation r_b t dt^2 / 8, fillet and root from the cusp l^2 / (8 r_t) over their arc lengths (a flat
     end mill: l / 2)."""
-    involute = spec.tooth_space_profile().segment("involute")
+    involute = spec.tooth_space_profile().involute
     rb, t0, t1 = spec.base_radius_mm, involute.start, involute.end
     flank = math.sqrt(rb / (8.0 * target_mm)) * (2.0 / 3.0) * (t1**1.5 - t0**1.5) + 1.0
-    fillet = spec.tooth_space_profile().segment("fillet")
+    fillet = spec.tooth_space_profile().fillet
     length = 0.0
     if fillet is not None:
         pts = fillet.points(np.linspace(fillet.start, fillet.end, 257))
@@ -464,8 +464,8 @@ def generating_tool_limits(spec: GearSpec, corner_radius_mm: float, target_scall
     probe = Tool(diameter_mm=max(min(tip_max, flank_rack if tool_end == "rack" else flank_raised), 2 * r_t + 1e-6),
                  kind="bull_nose", corner_radius_mm=max(r_t, 1e-9))
     plan_flank = flank_poses(spec, probe, rolls, tool_end)
-    betas = np.linspace(0.0, spec.tooth_space_profile().segment("fillet").end, 9) \
-        if spec.tooth_space_profile().segment("fillet") is not None else np.zeros(1)
+    fillet = spec.tooth_space_profile().fillet
+    betas = np.linspace(0.0, fillet.end, 9) if fillet is not None else np.zeros(1)
     plan_tip = fillet_pose(spec, probe, betas)
     y = np.concatenate([plan_flank[1], plan_tip[1]])
     z = np.concatenate([plan_flank[2], plan_tip[2]])

@@ -162,7 +162,7 @@ def flank_roll_step(spec: GearSpec, target_mm: float) -> float:
     """Even roll spacing whose generating flats leave at most `target` at the largest roll any section sees."""
     from spur_cad.cam.strategies.generating_flat import flat_leftover_mm as _flat_leftover
 
-    involute = spec.tooth_space_profile().segment("involute")
+    involute = spec.tooth_space_profile().involute
     lo, hi = face_turn_range(spec)
     t_worst = involute.end + (hi - lo)
     rb, goal = spec.base_radius_mm, _SAFETY * target_mm
@@ -246,7 +246,7 @@ def helical_passes_estimate(spec: GearSpec, target_mm: float, tool: Tool | None 
     largest roll any section sees, tip mode at the root's spacing sqrt(8 target / r_f) / r_f over the widened
     fillet-to-fillet range with up to four passes per roll (a `tool` corner below rho: two more per contact
     angle, the rolls spaced for the rest of the target)."""
-    involute = spec.tooth_space_profile().segment("involute")
+    involute = spec.tooth_space_profile().involute
     lo, hi = face_turn_range(spec)
     t_worst = involute.end + (hi - lo)
     goal = _SAFETY * target_mm
@@ -278,7 +278,7 @@ def _first_tip_step(spec: GearSpec, goal: float) -> float:
 def _flank_rolls(spec: GearSpec, target_mm: float) -> tuple[tuple[int, Feature, np.ndarray], ...]:
     """(side, feature, rolls) of both flanks' passes: right tip -> root, left root -> tip, evenly spaced over the
     rolls any section sees."""
-    involute = spec.tooth_space_profile().segment("involute")
+    involute = spec.tooth_space_profile().involute
     lo, hi = face_turn_range(spec)
     step = flank_roll_step(spec, target_mm)
     return ((1, Feature.RIGHT_FLANK, _even(involute.start - hi, involute.end - lo, step)[::-1]),
@@ -289,7 +289,7 @@ def _flank_passes(spec: GearSpec, tool: Tool, target_mm: float, points: np.ndarr
     """(mode, feature, roll, a rad, y0, z0, dy/dx, dz/dx, side) of both flanks' passes (right tip -> root, left
     root -> tip)."""
     rb, alpha_t = spec.base_radius_mm, spec.pressure_angle_rad
-    theta_b = spec.tooth_space_profile().segment("involute").base_angle_rad
+    theta_b = spec.tooth_space_profile().involute.base_angle_rad
     radius = tool.diameter_mm / 2.0
     out = []
     for side, feature, rolls in _flank_rolls(spec, target_mm):
@@ -456,7 +456,7 @@ def _tip_passes(spec: GearSpec, tool: Tool, target_mm: float) -> list[tuple]:
 
 def _land_passes(spec: GearSpec, tool: Tool, target_mm: float) -> list[tuple]:
     """Land passes along X over the tooth on the +Y side of space 0, angles widened by the face's turn."""
-    tip = spec.tooth_space_profile().segment("tip")
+    tip = spec.tooth_space_profile().tip
     if tip is None:
         return []
     lo, hi = face_turn_range(spec)

@@ -82,7 +82,7 @@ class FlankSupport:
     """The removal a straight flank pass at design roll t makes to touch one side's modified flank (no lead)."""
 
     def __init__(self, spec: GearSpec, mods: FlankModifications, side: str):
-        involute = spec.tooth_space_profile().segment("involute")
+        involute = spec.tooth_space_profile().involute
         flank = mods.side(side)
         self.rb = spec.base_radius_mm
         t = np.linspace(involute.start, involute.end, _FLANK_SAMPLES)
@@ -168,7 +168,7 @@ def _helical_raised_ends(spec: GearSpec, tool: Tool, passes: tuple[GeneratingPas
     sin(t_F - t_e) in that pass's frame (below it the corner would follow the rack's round over the fillet, which the
     tip passes cut and which moves less than the flank); never lower than the planned line."""
     rb, r_t = spec.base_radius_mm, tool.effective_corner_radius_mm
-    t_form = spec.tooth_space_profile().segment("involute").start
+    t_form = spec.tooth_space_profile().involute.start
     ends = {}
     for side in (1, -1):
         flank = [p for p in passes if p.mode == "flank" and p.side == side]
@@ -266,8 +266,8 @@ def modified_passes(spec: GearSpec, tool: Tool, passes: tuple[GeneratingPass, ..
                     tolerance_mm: float) -> tuple[GeneratingPass, ...]:
     """`passes` (one space's, planned for the design) moved onto the modified flanks (see the module docstring)."""
     profile = spec.tooth_space_profile()
-    fillet = profile.segment("fillet")
-    involute = profile.segment("involute")
+    fillet = profile.fillet
+    involute = profile.involute
     x = _face_samples(spec)
     supports = {+1: FlankSupport(spec, mods, "right"), -1: FlankSupport(spec, mods, "left")}
     sides = {+1: mods.right, -1: mods.left}

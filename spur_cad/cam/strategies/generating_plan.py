@@ -143,7 +143,7 @@ def plan_generating(spec: GearSpec, tool: Tool, params: GeneratingParams, *, lan
         _refuse_gouging_passes(spec, tool, params, {"flank": (fa, fy, fz), "fillet": (ba, by, bz),
                                                     "root": (ra, ry, rz), "land": (la, ly, lz)})
     rb = spec.base_radius_mm
-    fillet = profile.segment("fillet")
+    fillet = profile.fillet
     passes: list[GeneratingPass] = []
 
     def add(mode, feature, roll, beta, a, y, z, side, radius):
@@ -212,7 +212,7 @@ def _plan_helical(spec: GearSpec, tool: Tool, params: GeneratingParams, lands: b
     tips = np.array(sorted({p.roll_rad for p in passes if p.mode == "tip"}, reverse=True))
     land = np.array([p.roll_rad for p in passes if p.mode == "land"])
     step = flank_roll_step(spec, target)
-    t_worst = spec.tooth_space_profile().segment("involute").end + hi - lo
+    t_worst = spec.tooth_space_profile().involute.end + hi - lo
     tip_bound = TIP_SAFETY_HELICAL * target
     if tool.effective_corner_radius_mm < spec.rack_tip_radius_mm - CORNER_MATCH_MM:
         # rolls spaced for the rest of the target, plus what the corner leaves between its contact angles
