@@ -30,7 +30,7 @@ def build_cad(job: Job, checkpoint: Callable[[], None] | None = None,
     shape, report = build_gear_shape(job.gear, job.gear_section.blank_features(), modifications=job.modifications)
     if checkpoint is not None:
         checkpoint()
-    if job.machine.axes == 3:  # the blank lying flat: a disk of the face width, clamped on its bore
+    if not job.machine.setup.rotary_axis:  # the blank lying flat: a disk of the face width, clamped on its bore
         stock = build_flat_stock_shape(job.gear, job.stock, job.gear_section.blank_features())
     else:
         stock = build_stock_shape(job.gear, job.stock)

@@ -131,9 +131,6 @@ class GearSection:
         )
         if not self.internal:
             return GearSpec(**common)
-        if self.helix_angle_deg != 0.0:
-            raise GearSpecError("internal = true: internal gears are spur only (helix_angle_deg must be 0)",
-                                field="helix_angle_deg")
         return InternalGearSpec(**common, shaper_cutter_teeth=self.shaper_cutter_teeth,
                                 shaper_cutter_profile_shift_coefficient=self.shaper_cutter_profile_shift_coefficient,
                                 rim_outer_diameter_mm=self.rim_outer_diameter_mm,
@@ -725,14 +722,15 @@ def _job_from_data(data: dict, source: str, text: str, strategies: Strategies = 
     except GearSpecError as exc:
         blamed = _blamed_key(exc, 'gear', tables['gear'])
         raise JobFileError(f"{where('gear', blamed)}: invalid gear: {exc}", section="gear", field=blamed) from None
-    if spec.is_internal and any(name.startswith("tools") for name in tables) \
-            and sections.get("machine", Machine()).axes != 3:
+    setup = sections.get("machine", Machine()).setup
+    if spec.kind.teeth_inward and any(name.startswith("tools") for name in tables) and not setup.cuts(spec.kind):
         raise JobFileError(f"{where('gear', 'internal')}: internal = true: the rotary table cannot cut an internal "
                            "gear (its tool cannot reach inside the ring along the rotary axis); cut it with [machine] "
                            "axes = 3 or leave out [tools]", section="gear", field="internal")
-    if modification_tables and (spec.is_internal or sections.get("machine", Machine()).axes == 3):
+    if modification_tables and not (spec.kind.follows_modifications and setup.follows_modifications):
         table = next(iter(modification_tables))
-        what = "an internal gear's ring" if spec.is_internal else "the 3-axis variant ([machine] axes = 3)"
+        what = ("the 3-axis variant ([machine] axes = 3)" if spec.kind.follows_modifications
+                else "an internal gear's ring")
         raise JobFileError(f"{_where(source, text, table)}: [{table}] flank modifications are cut by generating or "
                            f"perimeter finishing on the rotary table only; {what} does not follow them: leave them "
                            "out",
@@ -805,7 +803,7 @@ def _check_export(spec: GearSpec, gear_section: GearSection, export: ExportSecti
     if not (export.dxf or export.svg):
         return
     blamed = "dxf" if export.dxf else "svg"
-    if spec.is_helical:
+    if not spec.kind.cut_straight:
         raise JobFileError(f"{where('export', blamed)}: [export] {blamed} = true: a helical gear's teeth are not "
                            "straight, and a wire, laser or waterjet cuts straight (spur) teeth only",
                            section="export", field=blamed)

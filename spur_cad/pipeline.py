@@ -231,7 +231,7 @@ def budget_stage(job: Job, plan: CamPlan, sim_result: SimResult | None, grading:
     """The simulated gear on the budget's machine, graded (spur_cad.result.ErrorBudgetFacts; None without a
     simulation): the budget acts on the simulated flanks, the cut is not simulated again. None for 3 axes: its
     index errors are the rotary table's (docs/simulation.md)."""
-    if sim_result is None or grading is None or job.machine.axes == 3:
+    if sim_result is None or grading is None or not job.machine.setup.rotary_axis:
         return None
     from spur_cad.grade.simulated import grade_simulation
     from spur_cad.sim.budget import apply_budget
@@ -272,15 +272,15 @@ def program_info(job: Job, plan: CamPlan, operation: str, restart_comment: str |
     radius = stock.blank_radius_mm(spec)
     x_front, x_back = stock.blank_x_range_mm(spec)
     box = (x_front, -radius, -radius, x_back + stock.stub_length_mm, radius, radius)
-    three_axes = job.machine.axes == 3
-    if three_axes:  # the blank lying flat, Z0 on its top face
+    rotary = job.machine.setup.rotary_axis
+    if not rotary:  # the blank lying flat, Z0 on its top face
         box = (-radius, -radius, -spec.face_width_mm, radius, radius, 0.0)
     title = f"spur_cad {__version__} {operation}" + (" restart" if restart_comment else "") + f": {job.job.name}"
     comments = program_comments(job, plan, operation) + ((restart_comment,) if restart_comment else ())
     return ProgramInfo(title=title, comments=comments, rotary_clamp_code=job.machine.rotary_clamp_code,
                        rotary_unclamp_code=job.machine.rotary_unclamp_code, blank_box_mm=box,
                        approach_z_mm=approach_z_mm, first_space_a_reference_deg=a_reference_deg,
-                       rotary_axis=not three_axes)
+                       rotary_axis=rotary)
 
 
 def lathe_program(job: Job) -> tuple[str, bytes]:
@@ -351,7 +351,7 @@ def restart_program(job: Job, plan: CamPlan, point: RestartPoint) -> tuple[str, 
 def program_comments(job: Job, plan: CamPlan, operation: str) -> tuple[str, ...]:
     """Header comments of a program: gear data, tool, strategy, estimated time (no date: outputs are reproducible)."""
     spec = job.gear
-    if job.machine.axes == 3:
+    if not job.machine.setup.rotary_axis:
         return _three_axis_comments(job, plan, operation)
     if operation in ("roughing", "roughing_bottom"):
         planned = getattr(plan, operation)
@@ -378,7 +378,7 @@ def program_comments(job: Job, plan: CamPlan, operation: str) -> tuple[str, ...]
     tool = planned.tool
     minutes = planned.estimate.time_s / 60.0
     helix = ()
-    if spec.is_helical:  # spur headers stay as they were (byte-identical reference outputs)
+    if spec.kind.helical:  # spur headers stay as they were (byte-identical reference outputs)
         helix = (f"helix: beta = {spec.helix_angle_deg:g} deg {spec.hand} hand (m and alpha normal), lead "
                  f"{spec.lead_mm:.4f} mm: along it A changes by {-spec.hand_sign * 360.0 / spec.lead_mm:+.6f} deg "
                  "per mm of X",)
@@ -400,7 +400,7 @@ def _three_axis_comments(job: Job, plan: CamPlan, operation: str) -> tuple[str, 
     """Header comments of a 3-axis program ([machine] axes = 3): gear, tool, what it does, the set-up."""
     spec, planned = job.gear, getattr(plan, operation)
     tool = planned.tool
-    if operation == "roughing" and spec.is_internal:
+    if operation == "roughing" and spec.kind.teeth_inward:
         entry = "a plunge in the blank's bore" if job.stock.inner_diameter_mm > 0.0 else "a helix at the centre"
         what = (f"3-axis roughing of the ring's hole: {len(planned.levels.heights_mm)} levels, {entry}, concentric "
                 f"passes from the centre out to {job.roughing.finish_stock_mm:g} mm from the outline; the rim's "
@@ -456,7 +456,7 @@ def simulates_with_kernels(job: Job, plan: CamPlan) -> bool:
     """Whether simulate_stage runs the 4-axis simulation, whose kernels load numba (a job lying flat is simulated
     by spur_cad.sim.flat, in numpy)."""
     cuts = any(planned is not None for planned in (plan.roughing, plan.roughing_bottom, plan.finishing))
-    return job.simulation.enabled and cuts and job.machine.axes != 3
+    return job.simulation.enabled and cuts and job.machine.setup.rotary_axis
 
 
 def simulate_stage(job: Job, plan: CamPlan, progress: Callable[[float], None] | None = None) -> SimResult | None:
@@ -467,7 +467,7 @@ def simulate_stage(job: Job, plan: CamPlan, progress: Callable[[float], None] | 
                                                                       plan.finishing) if planned is not None]
     if not job.simulation.enabled or not operations:
         return None
-    if job.machine.axes == 3:  # the blank lying flat (a ring's: the rim's disc, its bore): spur_cad.sim.flat
+    if not job.machine.setup.rotary_axis:  # lying flat (a ring's blank: the rim's disc, its bore): spur_cad.sim.flat
         from spur_cad.sim.flat import simulate_flat
 
         depths = -plan.finishing.toolpath.z[plan.finishing.toolpath.motion_mask] if plan.finishing is not None \

@@ -11,6 +11,9 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
+from spur_cad.cam.setups import ROTARY_TABLE, MachineSetup
+from spur_cad.geometry.kinds import EXTERNAL_SPUR, GearKind
+
 if TYPE_CHECKING:  # annotations only: the CAD kernel and the simulator load when a job uses them
     from spur_cad.cad.specs import GearSolidReport
     from spur_cad.cam.estimate import Estimate
@@ -97,7 +100,7 @@ class SetupFacts:
     flank_allowance_mm: float
     roughing_step_down_mm: float | None
     roughing_step_over_mm: float | None
-    axes: int = 4  # [machine] axes: 3, the blank lying flat (the sheet describes that set-up)
+    machine_setup: MachineSetup = ROTARY_TABLE  # [machine] axes's set-up (the sheet describes it)
 
 
 @dataclass(frozen=True)
@@ -307,3 +310,4 @@ class JobResult:
     error_budget: ErrorBudgetFacts | None = None  # the expected grade with the machine's errors (None: no simulation)
     correction: dict | None = None  # spur-cad correct's correction.json when the run is a corrected set (the report)
     modifications: ModificationInspection | None = None  # the flank modifications on the inspection sheet
+    kind: GearKind = EXTERNAL_SPUR  # the gear's kind (spur_cad.geometry.kinds; not in summary.json)

@@ -68,7 +68,7 @@ def build_result(job, samples: ProfileSamples, cad: CadResult | None, plan: CamP
     modifications = (None if job.modifications is None
                      else modification_inspection(job.gear, job.modifications, inspection))
     return JobResult(
-        version=__version__, job=JobFacts(job.job.name, job.source), gear=job.gear.facts(),
+        version=__version__, job=JobFacts(job.job.name, job.source), gear=job.gear.facts(), kind=job.gear.kind,
         inspection=inspection, modifications=modifications,
         profile=ProfileFacts(job.job.profile_tolerance_mm, len(samples), counts), cad=cad,
         tools=tools_facts(plan, job.machine, plan.roughing.tool if plan.roughing is not None else job.tools.roughing,
@@ -132,7 +132,7 @@ def setup_facts(job, plan: CamPlan, post: PostSettings) -> SetupFacts:
         job.machine.name, 2.0 * stock.blank_radius_mm(spec), x_min, x_max, stock.stub_diameter_mm,
         stock.stub_length_mm, post.work_offset, post.rotary_sign, post.coolant, job.machine.clearance_mm,
         float(z.min()) if z.size else None, float(z.max()) if z.size else None, rough.finish_stock_mm,
-        rough.flank_allowance_mm, *steps, axes=job.machine.axes)
+        rough.flank_allowance_mm, *steps, machine_setup=job.machine.setup)
 
 
 def tools_facts(plan: CamPlan, machine: Machine, roughing_tool: Tool | None,

@@ -267,7 +267,7 @@ def test_report_sheet_says_between_pins_and_no_span():
     from spur_cad.report.sheet import inspection_rows
 
     ring = _ring()
-    result = SimpleNamespace(inspection=inspection_facts(ring), modifications=None, gear=ring)
+    result = SimpleNamespace(inspection=inspection_facts(ring), modifications=None, gear=ring, kind=ring.kind)
     rows = {row.label: row.value for row in inspection_rows(result)}
     assert rows["span measurement"].startswith("not for an internal gear")
     assert float(rows["dimension between pins (balls)"]) == pytest.approx(inspection_facts(ring).dimension_over_pins_mm,

@@ -73,7 +73,6 @@ def _package_sources():
             yield path.relative_to(ROOT).as_posix(), path.read_text(encoding="utf-8")
 
 
-@pytest.mark.xfail(strict=True, reason="issue 45: the readers are converted in the next steps")
 def test_flags_are_read_only_where_kinds_and_setups_are_defined():
     """Acceptance of issue 45: code asks spec.kind and machine.setup; the flags stay in at most three modules each."""
     assert len(KIND_MODULES) <= 3 and len(SETUP_MODULES) <= 3

@@ -474,16 +474,16 @@ def build_gear_shape(spec: GearSpec, features: BlankFeatures = BlankFeatures(),
     tolerance = default_fit_tolerance_mm(spec) if fit_tolerance_mm is None else fit_tolerance_mm
     edges, report = gear_face_edges(spec, tolerance)
     b = spec.face_width_mm
-    if spec.is_internal:
+    if spec.kind.teeth_inward:
         shape = _ring_shape(edges, spec)
     elif modifications is not None and not modifications.is_zero:
         if modifications.has_lead:
             shape = _loft_lead_modified(spec, modifications, tolerance, report)
         else:
             edges = modified_face_edges(spec, modifications, 0.0, tolerance)
-            shape = _sweep_helical(edges, spec) if spec.is_helical else _extrude(edges, b)
+            shape = _sweep_helical(edges, spec) if spec.kind.solid == "sweep" else _extrude(edges, b)
     else:
-        shape = _sweep_helical(edges, spec) if spec.is_helical else _extrude(edges, b)
+        shape = _sweep_helical(edges, spec) if spec.kind.solid == "sweep" else _extrude(edges, b)
     if features.bore_diameter_mm > 0.0:
         shape = _cut(shape, _x_cylinder(features.bore_diameter_mm / 2.0, -1.0, b + 1.0))
     if features.keyway_width_mm > 0.0:
@@ -522,7 +522,8 @@ def build_flat_stock_shape(spec: GearSpec, stock: StockSpec, features: BlankFeat
     require_instance(stock, StockSpec, "stock")
     stock.validate(spec)
     shape = _x_cylinder(stock.blank_radius_mm(spec), 0.0, spec.face_width_mm)
-    bore_mm = stock.inner_diameter_mm if spec.is_internal else features.bore_diameter_mm  # a ring: its blank's bore
+    # a ring: its blank's bore
+    bore_mm = stock.inner_diameter_mm if spec.kind.teeth_inward else features.bore_diameter_mm
     if bore_mm > 0.0:
         shape = _cut(shape, _x_cylinder(bore_mm / 2.0, -1.0, spec.face_width_mm + 1.0))
     return shape

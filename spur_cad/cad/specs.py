@@ -45,7 +45,7 @@ class BlankFeatures:
                 raise GearSpecError(f"{name} must be a number, got {type(value).__name__}", field=name)
             if not math.isfinite(value) or value < 0.0:
                 raise GearSpecError(f"{name} = {value:g} mm must be zero (none) or positive", field=name)
-        if spec.is_internal and (self.bore_diameter_mm > 0.0 or self.keyway_width_mm > 0.0):
+        if spec.kind.teeth_inward and (self.bore_diameter_mm > 0.0 or self.keyway_width_mm > 0.0):
             raise GearSpecError("an internal gear has no bore or keyway (its inside is the teeth; the rim is "
                                 "rim_outer_diameter_mm)", field="bore_diameter_mm")
         wall = spec.module_mm
@@ -98,19 +98,19 @@ class StockSpec:
     def validate(self, spec: GearSpec) -> None:
         """Raise StockError for keys outside their ranges, a half-given stub or one wider than the blank."""
         check_section(self, "stock", StockError)
-        if spec.is_internal:
+        if spec.kind.teeth_inward:
             rim = spec.rim_outer_diameter_mm
             if 0.0 < self.blank_diameter_mm < rim - 1e-9:
                 raise StockError(f"blank_diameter_mm = {self.blank_diameter_mm:g} is smaller than the internal gear's "
                                  f"rim_outer_diameter_mm ({rim:g} mm)", field="blank_diameter_mm")
         tip_diameter = 2.0 * spec.tip_radius_mm
-        if self.inner_diameter_mm > 0.0 and not spec.is_internal:
+        if self.inner_diameter_mm > 0.0 and not spec.kind.teeth_inward:
             raise StockError("inner_diameter_mm is an internal gear's blank bore (an external gear's bore is [gear] "
                              "bore_diameter_mm)", field="inner_diameter_mm")
-        if spec.is_internal and self.inner_diameter_mm > tip_diameter - 1e-9:
+        if spec.kind.teeth_inward and self.inner_diameter_mm > tip_diameter - 1e-9:
             raise StockError(f"inner_diameter_mm = {self.inner_diameter_mm:g} is not below the ring's tip diameter "
                              f"{tip_diameter:.4f} mm: the teeth would be short", field="inner_diameter_mm")
-        if not spec.is_internal and 0.0 < self.blank_diameter_mm < tip_diameter - 1e-9:
+        if not spec.kind.teeth_inward and 0.0 < self.blank_diameter_mm < tip_diameter - 1e-9:
             short = (tip_diameter - self.blank_diameter_mm) / 2.0
             raise StockError(f"blank_diameter_mm = {self.blank_diameter_mm:g} is smaller than the tip diameter "
                              f"{tip_diameter:.4f} mm: the teeth would be {short:.4f} mm short of the tip circle",
@@ -132,5 +132,5 @@ class StockSpec:
         radial allowance."""
         if self.blank_diameter_mm > 0.0:
             return self.blank_diameter_mm / 2.0
-        outside = spec.rim_outer_diameter_mm / 2.0 if spec.is_internal else spec.tip_radius_mm
+        outside = spec.rim_outer_diameter_mm / 2.0 if spec.kind.teeth_inward else spec.tip_radius_mm
         return outside + self.radial_allowance_mm

@@ -176,7 +176,7 @@ def check_cam_inputs(inputs: CamInputs) -> tuple[ToolRecommendations, RoughingLe
     recommendations and the roughing levels (None without a roughing tool)."""
     spec, machine, stock = inputs.spec, inputs.machine, inputs.stock
     strategy = get_strategy(inputs.finishing.strategy, inputs.strategies)
-    if spec.is_helical and inputs.finishing_tool is not None and not strategy.helical:
+    if inputs.finishing_tool is not None and not spec.kind.accepts_strategy(strategy):
         raise MachineError(f"[finishing] strategy = {shown(inputs.finishing.strategy)} is for spur gears; a "
                            f"helical gear (helix_angle_deg = {spec.helix_angle_deg:g}) is finished by "
                            "strategy = \"generating\"",
@@ -328,7 +328,7 @@ def plan_cam(inputs: CamInputs, checkpoint: Callable[[], None] | None = None) ->
     """Tool recommendations always; toolpaths and estimates for the tools the job gives (pure).
     `checkpoint()` is called between the steps (a front end may stop there)."""
     check = checkpoint if checkpoint is not None else (lambda: None)
-    if inputs.machine.axes == 3:  # the blank lying flat (spur_cad.cam.three_axis)
+    if not inputs.machine.setup.rotary_axis:  # the blank lying flat (spur_cad.cam.three_axis)
         return _plan_three_axis(inputs, inputs.profile_tolerance_mm)
     rec, levels = check_cam_inputs(inputs)
     blank = inputs.stock.blank_radius_mm(inputs.spec)
@@ -364,7 +364,7 @@ def suggested_flank_roughing(inputs: CamInputs, roughing: RoughingPlan, blank: f
     """Roughing by levels with one tool (a job file's default strategy): roughing by flanks with the same tool,
     cutting data and allowances, when it takes at most TWO_STAGE_PAYS_FRACTION of `roughing`'s time and leaves
     nothing uncut; else None. Not for helical gears (a flank plan of theirs takes seconds)."""
-    if inputs.roughing.strategy != "levels" or inputs.spec.is_helical:
+    if inputs.roughing.strategy != "levels" or inputs.spec.kind.helical:
         return None
     flank_inputs = dataclasses.replace(inputs, roughing=dataclasses.replace(inputs.roughing, strategy="flank"))
     try:  # bounded as the job's own roughing would be
@@ -387,7 +387,7 @@ def suggested_top_tool(inputs: CamInputs, roughing: RoughingPlan, blank: float) 
     flutes 3 D long (or the job tool's length). Not for helical gears (a plan of theirs takes seconds) nor by
     levels (the workbench's suggested_two_stage)."""
     spec, tool = inputs.spec, inputs.roughing_tool
-    if inputs.roughing.strategy != "flank" or spec.is_helical or roughing.flank is None:
+    if inputs.roughing.strategy != "flank" or spec.kind.helical or roughing.flank is None:
         return None
     widest_mm = 2.0 * space_half_width_mm(flank_polyline(spec), spec.reference_radius_mm)
     diameter = float(np.floor(widest_mm / TOP_TOOL_STEP_MM + 1e-9) * TOP_TOOL_STEP_MM)
@@ -550,7 +550,7 @@ def suggested_two_stage(inputs: CamInputs) -> TwoStageSuggestion | None:
     roughing; None when none saves at least 1 - TWO_STAGE_PAYS_FRACTION of the bottom tool's time alone (by the job's
     strategy; the two stages run by levels)."""
     spec, bottom = inputs.spec, inputs.roughing_tool
-    if bottom is None or spec.is_helical:  # not suggested for helical gears (each of their roughing plans takes
+    if bottom is None or spec.kind.helical:  # not suggested for helical gears (each of their roughing plans takes
         return None                        # seconds); a job file may still name a [tools.bottom] for one
     blank = inputs.stock.blank_radius_mm(spec)
     job_strategy = _plan_roughing(inputs, roughing_levels(spec, bottom, inputs.roughing, blank), blank, bottom)
@@ -649,7 +649,7 @@ def _comparison_estimate(spec: GearSpec, tool: Tool, machine: Machine, blank: fl
     MAX_COMPARISON_MOVES (or cannot be planned with this tool). A table that only indexes is taken as
     simultaneous here: the figure says what that strategy would take."""
     strategy = get_strategy(section.strategy)
-    if spec.is_helical and not strategy.helical:  # perimeter is for spur gears only
+    if not spec.kind.accepts_strategy(strategy):  # perimeter is for spur gears only
         return None
     simultaneous = dataclasses.replace(machine, rotary_simultaneous=True)
     params = params_from_section(strategy, section, **overrides)
@@ -670,12 +670,13 @@ def check_three_axis_inputs(inputs: CamInputs):
     from spur_cad.cam.three_axis import check_three_axis
 
     spec = inputs.spec
-    if inputs.finishing_tool is not None and inputs.roughing_tool is None:
+    if inputs.machine.setup.finishing_needs_roughing and inputs.finishing_tool is not None \
+            and inputs.roughing_tool is None:
         raise ToolError("[machine] axes = 3 needs [tools.roughing]: finishing cuts only the finish stock around the "
                         "outline", field="diameter_mm", section="tools.roughing")
     root = check_three_axis(spec, inputs.finishing_tool, inputs.roughing_tool)
     inputs.three_axis.validate(spec.face_width_mm)
-    if spec.is_internal:  # the rotary-table strategies' recommendations do not apply to a ring
+    if spec.kind.teeth_inward:  # the rotary-table strategies' recommendations do not apply to a ring
         from spur_cad.cam.three_axis_ring import ring_tool_recommendations
 
         return ring_tool_recommendations(spec, inputs.machine.clearance_mm), root
@@ -702,7 +703,7 @@ def _plan_three_axis(inputs: CamInputs, tolerance_mm: float) -> CamPlan:
 
     spec, machine, stock = inputs.spec, inputs.machine, inputs.stock
     rec, root = check_three_axis_inputs(inputs)
-    if spec.is_internal:
+    if spec.kind.teeth_inward:
         return _plan_three_axis_ring(inputs, tolerance_mm, root)
     blank = stock.blank_radius_mm(spec)
     roughing = finishing = None

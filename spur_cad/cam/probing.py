@@ -257,7 +257,7 @@ def plan_probe(spec: GearSpec, stock: StockSpec, machine: Machine, probe: ProbeS
     """The probing plan of `spec` as cut from `stock`; ProbeError (naming the key) for a helical gear or a
     ball that does not reach a point without touching the design elsewhere."""
     probe.validate()
-    if spec.is_helical:
+    if spec.kind.helical:
         raise ProbeError(f"[probe] probes spur gears only: [gear] helix_angle_deg = {spec.helix_angle_deg:g} (a "
                          "helical flank's normal leaves the transverse plane); leave [probe] out")
     ball, stem = probe.ball_radius_mm, probe.stem_diameter_mm / 2.0

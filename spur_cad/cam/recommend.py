@@ -79,7 +79,7 @@ def generating_max_diameter_mm(spec: GearSpec, corner_radius_mm: float, target_s
     rho = spec.rack_tip_radius_mm
     if corner_radius_mm > rho + 1e-12:
         return 0.0
-    if spec.is_helical:
+    if spec.kind.helical:
         if corner_radius_mm == 0.0 and rho > 0.0:
             return 0.0
         return max(2.0 * rack_corner(spec).normal_corner_offset_mm + 2.0 * corner_radius_mm, 0.0)
@@ -152,7 +152,7 @@ def _check_flat_finishing(spec: GearSpec, tool: Tool, rec: ToolRecommendations) 
     strategies' own checks say why a strategy cannot take it)."""
     largest = rec.finishing_flat_end_mill_max_diameter_mm
     if largest <= 0.0:
-        if spec.is_helical:
+        if spec.kind.helical:
             why = (f"a helical gear is finished by generation with a corner radius 0 < r_t <= the rack tip radius "
                    f"rho = {spec.rack_tip_radius_mm:g} mm")
         else:

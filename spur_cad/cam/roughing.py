@@ -212,14 +212,14 @@ def _check_clamp(spec: GearSpec, machine: Machine, params: RoughingParams) -> No
     if not (machine.rotary_clamp_code and machine.rotary_unclamp_code):
         raise MachineError("[roughing] clamp_rotary needs [machine] rotary_clamp_code and rotary_unclamp_code",
                            field="clamp_rotary", section="roughing")
-    if spec.is_helical:
+    if spec.kind.helical:
         raise MachineError("[roughing] clamp_rotary cannot be used for a helical gear: its passes turn A along the "
                            "lead", field="clamp_rotary", section="roughing")
 
 
 def check_helical_roughing_machine(spec: GearSpec, machine: Machine) -> None:
     """Helical roughing turns A with X while cutting: a table that only indexes cannot run it."""
-    if spec.is_helical and not machine.rotary_simultaneous:
+    if spec.kind.helical and not machine.rotary_simultaneous:
         raise MachineError(f"roughing a helical gear (helix_angle_deg = {spec.helix_angle_deg:g}) turns A with X "
                            "along the lead while cutting, but [machine] rotary_simultaneous = false (the table only "
                            "indexes)", field="rotary_simultaneous", section="machine")
@@ -277,7 +277,7 @@ def roughing_toolpath(spec: GearSpec, tool: Tool, machine: Machine, params: Roug
             passes.levels(a_tip, k, tip_heights, [tip_offsets] * len(tip_heights), [-1] * len(tip_heights),
                           Feature.TIP)
     path = builder.build()
-    if spec.is_helical:
+    if spec.kind.helical:
         path = follow_lead(path, spec, machine)
     return path
 
@@ -559,6 +559,6 @@ def _flank_toolpath(spec: GearSpec, tool: Tool, machine: Machine, params: Roughi
             f"flank roughing leaves {plan.uncut_mm2:.3g} mm^2 of each tooth space's section farther than "
             "flank_allowance_mm from the design (its stock model); finishing would meet it: choose [roughing] "
             "strategy = \"levels\"",))
-    if spec.is_helical:
+    if spec.kind.helical:
         path = follow_lead(path, spec, machine)
     return path

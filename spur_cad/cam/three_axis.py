@@ -26,6 +26,7 @@ import numpy as np
 
 from spur_cad.cam.ir import MoveKind, Operation, Toolpath, ToolpathBuilder
 from spur_cad.cam.machine import Machine, MachineError, RoughingParams
+from spur_cad.cam.setups import LYING_FLAT
 from spur_cad.cam.three_axis_root import (
     FlatMillRoot,
     RootThickness,
@@ -73,16 +74,16 @@ def check_three_axis(spec: GearSpec, finishing_tool: Tool | None, roughing_tool:
     """Refuse what the 3-axis variant cannot cut: a helical gear (at [machine] axes), a finishing tool that is not
     a flat end mill, one whose root leaves the involute above the active profile's start (naming the largest
     radius that works); the root the finishing tool leaves (None without one)."""
-    if spec.is_helical:
+    if not LYING_FLAT.cuts(spec.kind):
         raise MachineError(f"[machine] axes = 3 cuts spur gears only (helix_angle_deg = {spec.helix_angle_deg:g}: a "
                            "helical gear needs the rotary table, axes = 4)", field="axes", section="machine")
     for role, tool in (("roughing", roughing_tool), ("finishing", finishing_tool)):
-        if tool is not None and tool.kind != "flat":
+        if tool is not None and not LYING_FLAT.accepts_tool_kind(tool.kind):
             raise ToolError(f"[machine] axes = 3 cuts with the side of a flat end mill: the {role} tool is "
                             f"{tool.kind}", field="kind", section=f"tools.{role}")
     if finishing_tool is None:
         return None
-    if spec.is_internal:  # a ring: its spaces open outward (spur_cad.cam.three_axis_ring)
+    if spec.kind.teeth_inward:  # a ring: its spaces open outward (spur_cad.cam.three_axis_ring)
         return check_ring_root(spec, finishing_tool)
     root = flat_mill_root(spec, finishing_tool.diameter_mm / 2.0)
     if not root.fits:

@@ -49,7 +49,7 @@ def active_profile_start_radius_mm(spec: GearSpec) -> float:
     """Radius where the active profile starts in mesh with the basic rack: the line of action meets the mating
     rack's addendum line (h_a* m below the rolling line shifted by x m); the base radius if that is below it.
     A ring's: ring_active_profile_start(spec)'s radius."""
-    if spec.is_internal:
+    if spec.kind.teeth_inward:
         return ring_active_profile_start(spec)[0]
     alpha = spec.pressure_angle_rad
     r, rb = spec.reference_radius_mm, spec.base_radius_mm
@@ -112,9 +112,9 @@ def flat_mill_root(spec: GearSpec, tool_radius_mm: float, samples: _SpaceSamples
                                                  distance_upper_bound=limit)[0] >= limit))
     fillet_radius = profile.min_fillet_curvature_radius_mm if follows and samples.fillet is not None \
         else tool_radius_mm
-    form = min(form, profile.form_radius_mm) if spec.is_internal else max(form, profile.form_radius_mm)
+    form = min(form, profile.form_radius_mm) if spec.kind.teeth_inward else max(form, profile.form_radius_mm)
     return FlatMillRoot(tool_radius_mm, form, profile.form_radius_mm, active_profile_start_radius_mm(spec),
-                        float(fillet_radius), not follows, spec.is_internal)
+                        float(fillet_radius), not follows, spec.kind.teeth_inward)
 
 
 def largest_flat_mill_radius_mm(spec: GearSpec, resolution_mm: float = 0.005) -> float:
@@ -186,7 +186,7 @@ def root_thickness(spec: GearSpec, tool_radius_mm: float) -> RootThickness:
     from spur_cad.geometry.sampling import gear_outline
 
     outline = Polygon(gear_outline(spec, ROOT_THICKNESS_TOLERANCE_MM))
-    if spec.is_internal:  # a ring: the rim disc less the hole; the tool's disk opens the hole instead
+    if spec.kind.teeth_inward:  # a ring: the rim disc less the hole; the tool's disk opens the hole instead
         from shapely.geometry import Point
 
         rim = Point(0.0, 0.0).buffer(spec.rim_outer_diameter_mm / 2.0, quad_segs=ROOT_THICKNESS_QUAD_SEGMENTS)

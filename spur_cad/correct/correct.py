@@ -306,7 +306,7 @@ def correct_job(job, measured, measured_source: str):
     from spur_cad.pipeline import build_programs, plan_cam, run_job
 
     spec = job.gear
-    if spec.is_helical:
+    if spec.kind.helical:
         raise SpurCadError("correcting from measured points of a helical gear is not supported yet (spur gears only)")
     if job.tools.finishing is None:
         raise SpurCadError("the job has no [tools.finishing]: there is no finishing program to correct")

@@ -66,7 +66,7 @@ def span_measurement(spec: GearSpec, teeth_spanned: int) -> SpanMeasurement:
         raise ValueError(f"teeth spanned must be between 1 and {spec.teeth - 1}, got {teeth_spanned}")
     transverse = (teeth_spanned - 1) * spec.base_pitch_mm + base_thickness_mm(spec)
     contact = math.hypot(spec.base_radius_mm, transverse / 2.0)
-    length = transverse * math.cos(spec.base_helix_angle_rad) if spec.is_helical else transverse
+    length = transverse * math.cos(spec.base_helix_angle_rad) if spec.kind.measured_in == "normal" else transverse
     return SpanMeasurement(teeth_spanned, length, contact)
 
 
@@ -108,7 +108,8 @@ def over_pins(spec: GearSpec, pin_diameter_mm: float) -> OverPinsMeasurement:
     rb = spec.base_radius_mm
     # Helical gears (balls): the ball's transverse section is an ellipse; its effective size on the base
     # circle is D / cos(beta_b) (ISO 21771: inv(a_Mt) = D / (m_n z cos(a_n)) + ...).
-    ball = pin_diameter_mm / math.cos(spec.base_helix_angle_rad) if spec.is_helical else pin_diameter_mm
+    normal = spec.kind.measured_in == "normal"
+    ball = pin_diameter_mm / math.cos(spec.base_helix_angle_rad) if normal else pin_diameter_mm
     inv_alpha_m = (ball / (2.0 * rb) + spec.tooth_thickness_mm / (2.0 * spec.reference_radius_mm)
                    + involute_function(spec.pressure_angle_rad) - math.pi / spec.teeth)
     alpha_m = inverse_involute_function(inv_alpha_m)
@@ -136,7 +137,7 @@ def recommended_pin_diameter_mm(spec: GearSpec) -> float:
         target = 0.5 * (spec.form_radius_mm + spec.tip_radius_mm)
     roll = math.sqrt((target / rb) ** 2 - 1.0)
     diameter = 2.0 * rb * (math.tan(spec.base_half_space_angle_rad + roll) - roll)
-    if spec.is_helical:
+    if spec.kind.measured_in == "normal":
         diameter *= math.cos(spec.base_helix_angle_rad)
     return max(PIN_DIAMETER_STEP_MM, round(diameter / PIN_DIAMETER_STEP_MM) * PIN_DIAMETER_STEP_MM)
 
@@ -148,7 +149,7 @@ def chordal_thickness(spec: GearSpec, measuring_radius_mm: float | None = None) 
     spur gear of radius r_v = r / cos^2(beta) with the normal thickness s_n = s_t cos(beta):
     chord 2 r_v sin(psi), height h_a + r_v (1 - cos(psi)), psi = s_n / (2 r_v)."""
     radius = spec.reference_radius_mm if measuring_radius_mm is None else measuring_radius_mm
-    if spec.is_helical and measuring_radius_mm is None:
+    if spec.kind.measured_in == "normal" and measuring_radius_mm is None:
         cos_beta = math.cos(spec.helix_angle_rad)
         virtual = radius / cos_beta**2
         psi = spec.tooth_thickness_mm * cos_beta / (2.0 * virtual)
@@ -166,7 +167,7 @@ def minimum_teeth_without_undercut(spec: GearSpec) -> float:
     point: (h_f* - x) m - rho (1 - sin(alpha)) <= r sin^2(alpha), with r = m z / 2.
     """
     alpha = spec.pressure_angle_rad
-    if spec.is_helical:  # the rack's round in the normal section, the flank at alpha_t, r = z m_n / (2 cos beta)
+    if spec.kind.helical:  # the rack's round in the normal section, the flank at alpha_t, r = z m_n / (2 cos beta)
         height = ((spec.dedendum_coefficient - spec.profile_shift_coefficient) * spec.module_mm
                   - spec.rack_tip_radius_mm * (1.0 - math.sin(spec.normal_pressure_angle_rad)))
         return 2.0 * height * math.cos(spec.helix_angle_rad) / (spec.module_mm * math.sin(alpha) ** 2)
@@ -322,7 +323,7 @@ def modification_inspection(spec: GearSpec, mods: FlankModifications, sheet: Ins
         roll = math.sqrt(max(contact_radius_mm**2 - spec.base_radius_mm**2, 0.0))
         found = []
         for side in sides:
-            lead = side.lead_offset_mm(spec.face_width_mm / 2.0) if spec.is_helical else side.lead_offset_mm(
+            lead = side.lead_offset_mm(spec.face_width_mm / 2.0) if spec.kind.helical else side.lead_offset_mm(
                 along_face).min()
             found.append(1000.0 * float(side.profile_offset_mm(roll) + lead))
         return found[0], found[1]

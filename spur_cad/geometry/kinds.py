@@ -74,6 +74,12 @@ class GearKind:
         return -1 if self.teeth_inward else 1
 
     @property
+    def follows_modifications(self) -> bool:
+        """Flank modifications ([modifications]: reliefs, crowning, slopes) are defined for its flanks: external
+        teeth (a ring's are not modified)."""
+        return not self.teeth_inward
+
+    @property
     def cut_straight(self) -> bool:
         """A 2-D outline (DXF/SVG for a wire, laser or waterjet) is the whole part: straight teeth."""
         return self.prismatic

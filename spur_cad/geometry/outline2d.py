@@ -303,7 +303,7 @@ def _space_segments(spec: GearSpec, tolerance_mm: float) -> list[Segment2D]:
     for segment in profile.segments:
         if segment.label in ("root", "tip"):
             continue
-        right.extend(_fitted_segment(segment, tolerance_mm, spec.is_internal))
+        right.extend(_fitted_segment(segment, tolerance_mm, spec.kind.teeth_inward))
     right = list(closed_chain(right))
     left = [s.mirrored() for s in right]
     down = [s.reversed() for s in reversed(right)]
@@ -339,7 +339,7 @@ def gear_outline_arcs(spec: GearSpec, tolerance_mm: float) -> Outline2D:
     """
     if not (math.isfinite(tolerance_mm) and tolerance_mm > 0.0):
         raise ValueError(f"tolerance must be a positive number, got {tolerance_mm}")
-    if spec.is_internal:
+    if spec.kind.teeth_inward:
         raise ValueError("an internal gear's outline is two loops: use internal_gear_outline_arcs")
     return _toothed_loop(spec, tolerance_mm)
 
@@ -359,7 +359,7 @@ def internal_gear_outline_arcs(spec: GearSpec, tolerance_mm: float) -> tuple[Out
     (clockwise: the material on its left), arcs exact and fillet and involute by biarcs within tolerance_mm."""
     if not (math.isfinite(tolerance_mm) and tolerance_mm > 0.0):
         raise ValueError(f"tolerance must be a positive number, got {tolerance_mm}")
-    if not spec.is_internal:
+    if not spec.kind.teeth_inward:
         raise ValueError("not an internal gear: use gear_outline_arcs")
     rim_top = (0.0, spec.rim_outer_diameter_mm / 2.0)
     rim = Outline2D((Arc2D(rim_top, rim_top, (0.0, 0.0), True),))

@@ -51,7 +51,7 @@ def profile_roll_mm(spec, radius_mm):
     ring's negative (ISO 21771 signs an internal gear's radii so), so that every profile trace runs from the root
     to the tip in increasing position and a slope + means material rising toward the tip, external or internal."""
     roll = np.sqrt(np.maximum(np.asarray(radius_mm, float) ** 2 - spec.base_radius_mm ** 2, 0.0))
-    return -roll if spec.is_internal else roll
+    return spec.kind.roll_sign * roll
 
 
 def profile_range_mm(spec, start_radius_mm: float | None = None) -> tuple[float, float]:

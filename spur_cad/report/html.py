@@ -91,7 +91,7 @@ def program_notes(result: JobResult) -> tuple[str, ...]:
             notes.append(f"Roughing by flanks: {rough.passes_per_space} passes per space, A turned by +-({turns}) "
                          f"deg to the flank segments, down to {number(rough.lowest_level_height_mm, 3)} mm above "
                          f"the root circle{tips}.")
-        elif result.setup is not None and result.setup.axes == 3:
+        elif result.setup is not None and not result.setup.machine_setup.rotary_axis:
             notes.append(f"Roughing on 3 axes: {rough.levels_per_space} levels down to Z "
                          f"{number(min(rough.level_heights_mm), 3)} mm, each a series of passes offset from the "
                          "blank inward to the finish stock.")
@@ -182,13 +182,13 @@ def report_context(result: JobResult, images: dict[str, bytes]) -> dict:
         "warnings": sheet.warning_lines(result), "setup_rows": sheet.setup_rows(result),
         "totals_rows": sheet.totals_rows(result), "operation_table": sheet.operation_table(result),
         "tool_table": sheet.tool_table(result), "gear_rows": sheet.gear_rows(result),
-        "helical": result.gear.is_helical, "inspection_rows": sheet.inspection_rows(result),
+        "helical": result.kind.helical, "inspection_rows": sheet.inspection_rows(result),
         "expected_tolerance": sheet.expected_tolerance(result), "limit_rows": sheet.limit_rows(result),
         "advice_rows": sheet.advice_rows(result), "advice_strategy": result.tools.advice_strategy,
         "program_table": sheet.program_table(result),
         # the comparison strategies are rotary-table strategies: none for a gear lying flat
         "finishing_comparison": finishing_comparison(result.finishing)
-        if result.finishing is not None and (result.setup is None or result.setup.axes != 3) else None,
+        if result.finishing is not None and (result.setup is None or result.setup.machine_setup.rotary_axis) else None,
         "program_notes": program_notes(result), "simulation_rows": sheet.simulation_rows(result),
         "gouge_within_resolution": (not sim.enabled) or sim.max_gouge_mm <= sim.resolution_mm,
         "simulation_verdict": verdict, "feature_table": sheet.feature_table(result),

@@ -124,7 +124,7 @@ def _value(value: object, digits: int) -> str:
 
 def gear_rows(result: JobResult) -> tuple[Row, ...]:
     """The gear's data, labelled (helical rows for a helical gear)."""
-    labels = GEAR_LABELS + (HELICAL_LABELS if result.gear.is_helical else ())
+    labels = GEAR_LABELS + (HELICAL_LABELS if result.kind.helical else ())
     return tuple(Row(label, _value(getattr(result.gear, name), digits), unit) for name, label, unit, digits in labels)
 
 
@@ -132,7 +132,7 @@ def limit_rows(result: JobResult) -> tuple[Row, ...]:
     """The gear's tool limits, labelled (0 shown as 'none fits'); a gear cut lying flat shows the limits of the
     3-axis variant (FLAT_LIMIT_LABELS)."""
     rec = result.tools.recommendations
-    labels = FLAT_LIMIT_LABELS if result.setup is not None and result.setup.axes == 3 else LIMIT_LABELS
+    labels = LIMIT_LABELS if result.setup is None or result.setup.machine_setup.rotary_axis else FLAT_LIMIT_LABELS
     return tuple(Row(_limit_label(rec, name, label), number(getattr(rec, name), 3) if getattr(rec, name) > 0.0
                      else "none fits", "mm" if getattr(rec, name) > 0.0 else "") for name, label in labels)
 
@@ -219,7 +219,7 @@ def operation_table(result: JobResult) -> Table:
             strategy = (f"roughing by flanks, {facts.passes_per_space} passes per space"
                         if facts.passes_per_space is not None else
                         f"3-axis roughing, {facts.levels_per_space} levels of passes offset from the blank inward"
-                        if setup is not None and setup.axes == 3 else
+                        if setup is not None and not setup.machine_setup.rotary_axis else
                         f"z-level roughing, {facts.levels_per_space} levels per space")
             stock = (f"{number(setup.finish_stock_mm, 2)} to {number(setup.flank_allowance_mm, 2)} mm"
                      if setup is not None else "-")
@@ -250,8 +250,7 @@ def totals_rows(result: JobResult) -> tuple[Row, ...]:
     rows = [Row("operations", str(len(operations))),
             Row("tools", str(len({tool.tool_number for tool in tools})))]
     if setup is not None and setup.z_min_mm is not None:
-        rows.append(Row("programmed tool-tip Z (from the blank's top face)" if setup.axes == 3 else
-                        "programmed tool-tip Z (from the rotary axis)",
+        rows.append(Row(f"programmed tool-tip Z (from {setup.machine_setup.z_origin})",
                         f"{number(setup.z_min_mm, 3)} to {number(setup.z_max_mm, 3)}", "mm"))
     if tools:
         rows += [Row("largest spindle speed", number(max(t.spindle_rpm for t in tools), 0), "rpm"),
@@ -266,7 +265,7 @@ def setup_rows(result: JobResult) -> tuple[Row, ...]:
     setup, gear = result.setup, result.gear
     if setup is None:
         return ()
-    if setup.axes == 3:
+    if not setup.machine_setup.rotary_axis:
         return _flat_setup_rows(setup, gear)
     rows = [Row("machine", setup.machine_name),
             Row("blank diameter", number(setup.blank_diameter_mm, 3), "mm"),
@@ -324,7 +323,7 @@ def program_table(result: JobResult) -> Table:
 
 def inspection_rows(result: JobResult) -> tuple[Row, ...]:
     """The inspection sheet: span, pins, chordal thickness, each to 4 decimals, with the allowance."""
-    ins, helical = result.inspection, result.gear.is_helical
+    ins, helical = result.inspection, result.kind.measured_in == "normal"
     nominal = ins.tooth_thickness_mm + ins.thickness_reduction_mm
     span = f"span measurement W_k over k = {ins.span_teeth_k} teeth" + (
         f" (normal section; needs face width > {number(ins.span_min_face_width_mm, 2)} mm)" if helical else "")

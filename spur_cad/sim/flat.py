@@ -211,7 +211,7 @@ def simulate_flat(spec: GearSpec, blank_radius_mm: float, operations: Sequence[C
     extra = np.concatenate([stations, 0.5 * (stations[1:] + stations[:-1])]) if len(stations) else np.zeros(0)
     check_design_size(spec, spacing, b, len(extra), settings.resolution_mm)
     grid = design_grid(spec, spacing, 0.0, b, extra)
-    ring_bore_mm = bore_radius_mm if spec.is_internal else None
+    ring_bore_mm = bore_radius_mm if spec.kind.teeth_inward else None
     return simulate_flat_grid(grid, blank_radius_mm, operations, settings, b, stations, ring_bore_mm)
 
 

@@ -382,7 +382,7 @@ class JobFeature(_Proxy):
             outputs[f"{title}Time"] = op.seconds / 60.0 if op is not None else 0.0
             outputs[f"{title}TimeWithAcceleration"] = op.seconds_with_acceleration / 60.0 if op is not None else 0.0
             outputs[f"{title}ProgramLines"] = op.program_lines if op is not None else 0
-        flat = job.gear.face_width_mm if job.machine.axes == 3 else None  # drawn lying flat
+        flat = None if job.machine.setup.rotary_axis else job.gear.face_width_mm  # drawn lying flat
         for name in schema.TOOL_ROLES:  # the bottom tool's program has no toolpath object (see workbench/README.md)
             target = getattr(obj, f"{name.capitalize()}Toolpath")
             if target is not None:

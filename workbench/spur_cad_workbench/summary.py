@@ -12,6 +12,7 @@ import hashlib
 import json
 from dataclasses import dataclass
 
+from spur_cad.cam.setups import ROTARY_TABLE, SETUPS, MachineSetup
 from spur_cad_workbench.schema import OPERATION_TITLES, job_data
 
 OPERATION_NAMES = {"roughing": "Roughing", "roughing_bottom": "Roughing the bottom (bottom tool)",
@@ -173,11 +174,17 @@ def modification_summary(gear: dict[str, object]) -> str:
     return "; ".join(parts) or "none"
 
 
+def machine_setup(job: dict[str, object]) -> MachineSetup:
+    """The set-up the panel's MachineAxes chooses (spur_cad.cam.setups; the rotary table for a value none has, as
+    the job file's loader would refuse it)."""
+    return SETUPS.get(int(job.get("MachineAxes", ROTARY_TABLE.axes)), ROTARY_TABLE)  # type: ignore[call-overload]
+
+
 def _three_axis_summary(job: dict[str, object], units=None) -> str:
     """The folded "3-axis" group: how a through-cut gear is held; nothing on the rotary table (its fields are off)."""
     from spur_cad_workbench.units import text as length_text
 
-    if int(job.get("MachineAxes", 4)) != 3:
+    if not machine_setup(job).reads_section("three_axis"):
         return ""
     if int(job.get("HoldingTabs", 0)):
         return f"{job['HoldingTabs']} holding tabs"
@@ -202,7 +209,8 @@ def group_summary(group: str, job: dict[str, object], units=None) -> str:
         text = (f"{job.get('RoughingStrategy', 'levels')}, flank allowance "
                 f"{length_text(float(job.get('FlankAllowance', 0.0)), 'mm', units)}")
     elif group == "Machine":
-        text = str(job.get("MachineName", "")) + (", 3 axes" if int(job.get("MachineAxes", 4)) == 3 else "")
+        setup = machine_setup(job)
+        text = str(job.get("MachineName", "")) + ("" if setup.rotary_axis else f", {setup.axes} axes")
     elif group == "3-axis":
         text = _three_axis_summary(job, units)
     elif group == "Post":

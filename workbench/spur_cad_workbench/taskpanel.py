@@ -27,6 +27,7 @@ import FreeCAD
 import FreeCADGui
 from PySide import QtCore, QtGui
 
+from spur_cad.cam.setups import SETUP_SECTIONS
 from spur_cad_workbench import compat, schema, units
 from spur_cad_workbench.properties import document_values, write_values
 from spur_cad_workbench.summary import (
@@ -34,6 +35,7 @@ from spur_cad_workbench.summary import (
     group_summary,
     limits_text,
     long_job_advice,
+    machine_setup,
     modification_summary,
     plan_figures,
     values_signature,
@@ -473,7 +475,7 @@ class JobTaskPanel:
             label.setVisible(group in advice)
         self._highlight(next((p.prop for p in result.problems if p.prop in self.widgets), None))
         two_stage = bool(values["job"].get("UseBottomTool"))
-        flat = int(values["job"]["MachineAxes"]) == 3  # the rotary table's tool limits do not apply
+        flat = not machine_setup(values["job"]).rotary_axis  # the rotary table's tool limits do not apply
         notes = {**({} if flat else recommendation_notes(result.recommendations, two_stage, FreeCAD.Units)),
                  **unusual_value_notes(values["job"], FreeCAD.Units)}
         finishing_invalid = any(problem.group == "Finishing tool" for problem in result.problems)
@@ -489,10 +491,10 @@ class JobTaskPanel:
             for field in schema.JOB_FIELDS:
                 if field.section == section and field.key:
                     self.widgets[field.prop].setEnabled(enabled)
-        axes = int(values["job"]["MachineAxes"])
+        setup = machine_setup(values["job"])
         for field in schema.JOB_FIELDS:
-            if field.section == "three_axis":  # tabs and onion skin: 3-axis programs only
-                self.widgets[field.prop].setEnabled(axes == 3)
+            if field.section in SETUP_SECTIONS:  # e.g. tabs and onion skin: 3-axis programs only
+                self.widgets[field.prop].setEnabled(setup.reads_section(field.section))
         modified = bool(schema.modification_tables(values["gear"]))  # a gear without them: no section
         self.modifications_section.widget.setVisible(modified)
         self.modifications_section.set_summary(modification_summary(values["gear"]) if modified else "")
@@ -524,7 +526,7 @@ class JobTaskPanel:
             first = result.problems[0]
             self.summary.setText(f"{len(result.problems)} problem: {first.advice}")
             self.summary.setStyleSheet(ERROR_STYLE)
-        flat = int(values["job"]["MachineAxes"]) == 3
+        flat = not machine_setup(values["job"]).rotary_axis
         self.summary_limits.setText(THREE_AXIS_LIMITS if flat else limits_text(
             result.recommendations, with_roughing_limit, bool(values["job"].get("UseBottomTool")), FreeCAD.Units))
         figures, source = self._figures(values_signature(values)) if result.ok else (None, "")

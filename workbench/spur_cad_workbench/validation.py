@@ -203,7 +203,8 @@ def validate(values: dict[str, dict[str, object]], source: str = "job", units=No
     except SpurCadError as exc:
         return Validation(None, (_problem(exc, source, values, units),),
                           recommend_tools(spec, blank, clearance, strategy=strategy))
-    check = check_three_axis_inputs if job.machine.axes == 3 else check_cam_inputs  # the blank flat, or on the table
+    # the blank on the table, or lying flat
+    check = check_cam_inputs if job.machine.setup.rotary_axis else check_three_axis_inputs
     try:
         rec, _ = check(cam_inputs(job))
     except SpurCadError as exc:

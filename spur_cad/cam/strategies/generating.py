@@ -115,7 +115,7 @@ class GeneratingStrategy:
         corner = spec.rack_tip_radius_mm
         if corner <= 0.0:  # a sharp rack: no tool with a corner can play it
             return None
-        if spec.is_helical:
+        if spec.kind.helical:
             flat = floor_to_step(0.95 * 2.0 * rack_corner(spec).normal_corner_offset_mm, 0.05)
         else:
             limits = generating_tool_limits(spec, corner, target_scallop_mm, blank_radius_mm)

@@ -46,7 +46,7 @@ def tool_advice(spec: GearSpec, tool: Tool, params: GeneratingParams, plan: Gene
                 blank_radius_mm: float) -> GeneratingAdvice:
     """Limits for this tool's corner radius, the largest tool with the advised corner radius (rho), and the
     flute length this tool's passes need."""
-    if spec.is_helical:  # any corner up to rho (rho advised: fewest passes); the tip mode bounds the diameter
+    if spec.kind.helical:  # any corner up to rho (rho advised: fewest passes); the tip mode bounds the diameter
         rho, d_n = spec.rack_tip_radius_mm, rack_corner(spec).normal_corner_offset_mm
         largest = 2.0 * d_n + 2.0 * tool.effective_corner_radius_mm
         return GeneratingAdvice(rho, rho, None, None, largest, largest, None, None,

@@ -344,7 +344,7 @@ def check_generating_tool(spec: GearSpec, tool: Tool) -> None:
     """ToolError when the tool cannot play the rack: corner radius above the rack tip radius (or the
     fillet's smallest curvature radius), or a flat wider than the rack's tip flat 2 d_1. A flat end mill
     (r_t = 0 <= rho) plays it with its sharp corner; its flat is its whole diameter, so D <= 2 d_1."""
-    if spec.is_helical:
+    if spec.kind.helical:
         check_helical_generating_tool(spec, tool)
         return
     tool.validate("finishing")

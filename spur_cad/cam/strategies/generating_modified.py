@@ -274,10 +274,10 @@ def modified_passes(spec: GearSpec, tool: Tool, passes: tuple[GeneratingPass, ..
     form_normal = involute.normals(np.array(involute.start))
     form_removal = {s: float(sides[s].profile_offset_mm(spec.base_radius_mm * involute.start)) for s in sides}
     lowered = {}
-    if not spec.is_helical:
+    if not spec.kind.helical:
         passes, lowered = _touching_modified_contacts(spec, tool, passes, mods, supports)
-    raised = {} if spec.is_helical else _raised_ends(spec, tool, passes)
-    helical_ends = _helical_raised_ends(spec, tool, passes, x) if spec.is_helical else {}
+    raised = {} if spec.kind.helical else _raised_ends(spec, tool, passes)
+    helical_ends = _helical_raised_ends(spec, tool, passes, x) if spec.kind.helical else {}
     out = []
     for p in passes:
         side = p.side
@@ -285,14 +285,14 @@ def modified_passes(spec: GearSpec, tool: Tool, passes: tuple[GeneratingPass, ..
         if p.mode == "flank":
             rolls = p.roll_rad - side * p.dy_per_x * x / spec.base_radius_mm
             removal = supports[side].removal_mm(rolls) + lead
-            if spec.is_helical:
+            if spec.kind.helical:
                 removal = removal - _envelope_growth_mm(tool, p.dy_per_x, p.dy_per_x + side * np.gradient(removal, x))
             dy, dz = side * removal, np.zeros_like(x)
             if (side, p.roll_rad) in helical_ends:
                 dz = helical_ends[side, p.roll_rad] - (p.z_mm + x * p.dz_per_x)
         elif p.mode == "tip" and fillet is not None and fillet.end > 0.0 \
-                and (p.feature != Feature.ROOT if spec.is_helical else not math.isnan(p.beta_rad)):
-            beta = helical_fillet_parameters(spec, tool, p, x, fillet) if spec.is_helical else p.beta_rad
+                and (p.feature != Feature.ROOT if spec.kind.helical else not math.isnan(p.beta_rad)):
+            beta = helical_fillet_parameters(spec, tool, p, x, fillet) if spec.kind.helical else p.beta_rad
             removal = (form_removal[side] + lead) * (beta / fillet.end) ** 2
             normal = form_normal * np.array([1.0 if side > 0 else -1.0, 1.0])
             # section X lies turned by its turn (0 for a spur gear): the form normal turns with it
@@ -300,12 +300,12 @@ def modified_passes(spec: GearSpec, tool: Tool, passes: tuple[GeneratingPass, ..
             moved = -removal[:, None] * np.stack([normal[0] * np.cos(turns) - normal[1] * np.sin(turns),
                                                   normal[0] * np.sin(turns) + normal[1] * np.cos(turns)], axis=-1)
             dy, dz = moved[:, 0], moved[:, 1]
-            if spec.is_helical:
+            if spec.kind.helical:
                 dy = dy - side * _envelope_growth_mm(tool, p.dy_per_x, p.dy_per_x + np.gradient(dy, x))
         else:
             out.append(p)
             continue
         z = (max(p.z_mm, raised.get((p.side, p.roll_rad), p.z_mm)) - lowered.get((p.side, p.roll_rad), 0.0)
              if p.mode == "flank" else p.z_mm)
-        out.append(replace(p, z_mm=z, path=_path(x, dy, dz, tolerance_mm, side if spec.is_helical else 0)))
+        out.append(replace(p, z_mm=z, path=_path(x, dy, dz, tolerance_mm, side if spec.kind.helical else 0)))
     return tuple(out)

@@ -122,7 +122,7 @@ def plan_generating(spec: GearSpec, tool: Tool, params: GeneratingParams, *, lan
     given a flank pass of its own so the kink is cut exactly (spur gears; a helical pass meets a roll at one X)."""
     params.validate()
     check_generating_tool(spec, tool)
-    if spec.is_helical:
+    if spec.kind.helical:
         return _plan_helical(spec, tool, params, lands)
     profile = spec.tooth_space_profile()
     target = params.target_scallop_mm
@@ -179,7 +179,7 @@ def plan_generating(spec: GearSpec, tool: Tool, params: GeneratingParams, *, lan
 def planned_passes_per_space(spec: GearSpec, tool: Tool, params: GeneratingParams, *, lands: bool = True) -> int:
     """plan_generating(...).passes_per_space (without kink passes), refused as it would be; a helical gear's
     passes are counted, not placed (their ends take a bisection each), so the work bound does not plan them twice."""
-    if not spec.is_helical:
+    if not spec.kind.helical:
         return plan_generating(spec, tool, params, lands=lands, check=False).passes_per_space
     params.validate()
     check_generating_tool(spec, tool)
