@@ -341,7 +341,7 @@ def pair_problems(pair: GearPair, facts: PairFacts | None = None) -> list[PairEr
             problems.append(PairError(f"tip interference: the pinion's tips strike the ring's tips as they leave "
                                       f"mesh (margin {math.degrees(margin):.4f} deg < 0); a smaller pinion, a "
                                       "shorter addendum or more ring profile shift", field="teeth"))
-    ratio, which = ((facts.total_contact_ratio, "total") if pair.helix_angle_deg else
+    ratio, which = ((facts.total_contact_ratio, "total") if facts.overlap_ratio > 0.0 else  # spur: eps_beta = 0
                     (facts.transverse_contact_ratio, "transverse"))
     if ratio < MIN_CONTACT_RATIO:
         problems.append(PairError(f"the {which} contact ratio {ratio:.4f} is below {MIN_CONTACT_RATIO:g}: the pair "
