@@ -45,6 +45,7 @@ from spur_cad.geometry.internal import InternalGearSpec
 from spur_cad.geometry.modifications import SIDES, FlankModifications, flank_modification
 from spur_cad.geometry.spec import MAX_TEETH, MIN_TEETH, GearSpec
 from spur_cad.keys import check_section, coerce, key, keys_of, section_problems, type_problem
+from spur_cad.mate_section import MateSection, check_mate
 from spur_cad.post.settings import PostSettings
 
 
@@ -252,6 +253,7 @@ class Job:
     job: JobSection
     gear_section: GearSection
     gear: GearSpec
+    mate: MateSection | None = None  # [mate]: the mating gear (None: the basic rack)
     stock: StockSpec = field(default_factory=StockSpec)
     tools: ToolsSection = field(default_factory=ToolsSection)
     roughing: RoughingParams = field(default_factory=RoughingParams)
@@ -291,6 +293,7 @@ class Job:
 SECTIONS: dict[str, type] = {
     "job": JobSection,
     "gear": GearSection,
+    "mate": MateSection,
     "stock": StockSpec,
     "tools.roughing": Tool,
     "tools.finishing": Tool,
@@ -736,6 +739,7 @@ def _job_from_data(data: dict, source: str, text: str, strategies: Strategies = 
                            "out",
                            section=table, field=None)
     modifications, modification_values = _modifications(modification_tables, spec, source, text)
+    _check_mate(spec, sections.get("mate"), tables.get("mate", {}), where)
     for check, name in ((gear_section.blank_features().validate, "gear"),
                         (sections.get("stock", StockSpec()).validate, "stock")):
         try:
@@ -764,12 +768,25 @@ def _job_from_data(data: dict, source: str, text: str, strategies: Strategies = 
         _check_probe(spec, sections, tools, tables, where)
     if "export" in sections:
         _check_export(spec, gear_section, sections["export"], tables, where)
-    optional = {name: sections[name] for name in ("stock", "roughing", "machine", "three_axis", "post", "simulation",
-                                                  "export", "lathe", "probe") if name in sections}
+    optional = {name: sections[name] for name in ("mate", "stock", "roughing", "machine", "three_axis", "post",
+                                                  "simulation", "export", "lathe", "probe") if name in sections}
     finishing = sections["finishing"] if "finishing" in sections else types["finishing"]()  # the registry's default
     return Job(source=source, job=sections.get("job", JobSection()), gear_section=gear_section, gear=spec,
                tools=tools, finishing=finishing, **optional, text=text, strategies=dict(strategies),
                modifications=modifications, modification_values=modification_values)
+
+
+def _check_mate(spec: GearSpec, mate: MateSection | None, given: dict,
+                where: Callable[[str, str | None], str]) -> None:
+    """[mate] (None: not given): a pair that runs (spur_cad.mate_section.check_mate), else one line at the [mate]
+    key to blame."""
+    if mate is None:
+        return
+    try:
+        check_mate(spec, mate, given)
+    except SpurCadError as exc:
+        blamed = _blamed_key(exc, "mate", given)
+        raise JobFileError(f"{where('mate', blamed)}: [mate] {exc}", section="mate", field=blamed) from None
 
 
 def _check_probe(spec: GearSpec, sections: dict, tools: ToolsSection, tables: dict,

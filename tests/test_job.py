@@ -125,7 +125,8 @@ def test_profile_tolerance_range():
 
 # --- every declared range, from the declarations -----------------------------------------------------------
 
-MINIMAL = {"gear": {"teeth": 23, "module_mm": 4.0, "face_width_mm": 20.0}, "tools.roughing": {"diameter_mm": 3.0},
+MINIMAL = {"gear": {"teeth": 23, "module_mm": 4.0, "face_width_mm": 20.0}, "mate": {"teeth": 40},
+           "tools.roughing": {"diameter_mm": 3.0},
            "tools.finishing": {"diameter_mm": 3.0}, "tools.bottom": {"diameter_mm": 2.0},
            "tools.roughing_top": {"diameter_mm": 6.0}}
 

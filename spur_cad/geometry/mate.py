@@ -325,8 +325,8 @@ def pair_problems(pair: GearPair, facts: PairFacts | None = None) -> list[PairEr
              "this gear's tips reach the mate's", "teeth")):
         if roll < 0.0:
             problems.append(PairError(f"involute interference: {whose} flank past its base circle's tangent point "
-                                      f"(by {-roll:.4f} mm along the line of action); fewer addendum, more profile "
-                                      "shift or more teeth", field=field))
+                                      f"(by {-roll:.4f} mm along the line of action); a smaller addendum, more "
+                                      "profile shift or more teeth", field=field))
         elif member.form_diameter_mm is not None:
             below = member.form_diameter_mm - sap if not member.internal else sap - member.form_diameter_mm
             if below > INTERFERENCE_TOLERANCE_MM:
@@ -374,8 +374,10 @@ def pair_at_centre_distance(pair: GearPair, centre_distance_mm: float) -> GearPa
             except PairError:
                 reach.append(abs(reference) * math.cos(pair.transverse_pressure_angle_rad))
         low, high = sorted(reach)
-        needs = "no working pressure angle" if math.isnan(shift_sum) else f"a mate shift of {mate_shift:.4f}"
-        raise PairError(f"centre_distance_mm = {centre_distance_mm:g} mm cannot be reached: it needs {needs}, and "
-                        f"mate shifts {SHIFT_RANGE[0]:g} to {SHIFT_RANGE[1]:g} reach {low:.4f} to {high:.4f} mm",
+        why = (f"the base circles leave no working pressure angle below "
+               f"{abs(reference) * math.cos(pair.transverse_pressure_angle_rad):.4f} mm" if math.isnan(shift_sum)
+               else f"it needs a mate shift of {mate_shift:.4f}")
+        raise PairError(f"centre_distance_mm = {centre_distance_mm:g} mm cannot be reached: {why}; mate shifts "
+                        f"{SHIFT_RANGE[0]:g} to {SHIFT_RANGE[1]:g} reach {low:.4f} to {high:.4f} mm",
                         field="centre_distance_mm")
     return replace(pair, mate=replace(pair.mate, profile_shift_coefficient=mate_shift))

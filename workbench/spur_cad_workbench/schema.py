@@ -153,6 +153,8 @@ TOOL_SWITCHES = {"roughing": _f("UseRoughingTool", "bool", "Roughing tool", "too
 
 # Every section the job file may leave out, and the switch (a job property) that says whether it is there.
 SECTION_SWITCHES = {**{f"tools.{role}": switch for role, switch in TOOL_SWITCHES.items()},
+                    "mate": _f("UseMate", "bool", "Mate", "mate", "",
+                               "design against this mating gear ([mate]); off: the checks assume the basic rack"),
                     "lathe": _f("WriteLatheProgram", "bool", "Lathe", "lathe", "",
                                 "write the blank's lathe program (blank.<ext>) with the job's files"),
                     "probe": _f("WriteProbeProgram", "bool", "Probe", "probe", "",
@@ -426,7 +428,7 @@ def field_by_prop(prop: str) -> Field:
 # Titles that splitting the property name would not give (after dropping the tool role's word).
 _TITLES = {"UseRoughingTool": "Rough with this tool", "UseFinishingTool": "Finish with this tool",
            "UseBottomTool": "Rough the bottom with this tool", "WriteLatheProgram": "Write the lathe program",
-           "WriteProbeProgram": "Write the probing program",
+           "WriteProbeProgram": "Write the probing program", "UseMate": "Design against a mate",
            "StickOut": "Stick-out", "StepOverFraction": "Step-over (fraction of D)",
            "MaxLevelDepthFraction": "Level depth (fraction of D)", "FinishingStrategy": "Strategy",
            "RoughingStrategy": "Strategy", "MaxRadialEngagementFraction": "Radial engagement (fraction of D)",
