@@ -27,6 +27,7 @@ import math
 import typing
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
+from typing import Any
 
 from spur_cad.errors import shown
 
@@ -170,12 +171,12 @@ def type_problem(k: Key, value: object) -> str | None:
     return None if ok else f"must be {_TYPE_NAMES[k.type]}, got {_shown(value)}"
 
 
-def coerce(k: Key, value: object) -> object:
+def coerce(k: Key, value: Any) -> Any:
     """A value that passed `type_problem` as the key's type (int -> float for float keys)."""
     return float(value) if k.type is float else value
 
 
-def value_problem(k: Key, value: object, values: dict) -> str | None:
+def value_problem(k: Key, value: Any, values: dict) -> str | None:
     """What is wrong with a well-typed `value` of key `k` ('must be in [0, 100] mm, got -1'), or None.
 
     `values` holds the section's other values (for bounds naming another key).
@@ -211,15 +212,16 @@ def section_problems(cls: type, values: dict) -> list[tuple[str, str]]:
     return problems
 
 
-def check_section(obj: object, section: str, error: type[Exception]) -> None:
+def check_section(obj: Any, section: str, error: Callable[..., Exception]) -> None:
     """Raise `error(f"[{section}] {key} {problem}", field=key)` for the first key of dataclass
     instance `obj` outside its declared range or choices (the sections' validate() call this first)."""
-    values = {k.name: getattr(obj, k.name) for k in keys_of(type(obj))}
-    for k in keys_of(type(obj)):
+    cls: type = type(obj)
+    values = {k.name: getattr(obj, k.name) for k in keys_of(cls)}
+    for k in keys_of(cls):
         problem = type_problem(k, values[k.name])
         if problem:
             raise error(f"[{section}] {k.name} {problem}", field=k.name)
-    problems = section_problems(type(obj), values)
+    problems = section_problems(cls, values)
     if problems:
         name, problem = problems[0]
         raise error(f"[{section}] {name} {problem}", field=name)

@@ -116,5 +116,5 @@ def remove_colour_bar(document) -> None:
     view = view_3d(document)
     scene = scene_graph(view) if view is not None else None
     old = find_colour_bar(scene) if scene is not None else None
-    if old is not None:
+    if scene is not None and old is not None:
         scene.removeChild(old)

@@ -114,7 +114,7 @@ def display_flat_path(path: Toolpath, face_width_mm: float, limit: int = MAX_DIS
     ys = y0[owner] + (y1 - y0)[owner] * t
     zs = z0[owner] + (z1 - z0)[owner] * t
     on_arc = arc[owner]
-    if on_arc.any():
+    if on_arc.any() and path.center_x is not None and path.center_y is not None:
         cx = np.nan_to_num(path.center_x[moves])[owner][on_arc]
         cy = np.nan_to_num(path.center_y[moves])[owner][on_arc]
         begin = np.arctan2(y0[owner][on_arc] - cy, x0[owner][on_arc] - cx)
@@ -136,7 +136,7 @@ def gcode_text(display: DisplayPath) -> str:
 
 def polylines(display: DisplayPath) -> list[tuple[bool, np.ndarray]]:
     """The drawn path split into runs of rapid or feed segments: (is_rapid, points incl. the run's start)."""
-    runs = []
+    runs: list[tuple[bool, np.ndarray]] = []
     points, rapid = display.points, display.rapid
     if len(points) < 2:
         return runs

@@ -20,6 +20,8 @@ throwException reports it), and a user's typing error is no program error. So Fr
 
 from __future__ import annotations
 
+from collections.abc import Set as AbstractSet
+
 import FreeCAD
 
 from spur_cad_workbench import compat, schema, units
@@ -273,7 +275,7 @@ class GearFeature(_Proxy):
         report(obj, None)
 
 
-def precise_outputs(obj, missing: set[str] = frozenset()) -> dict[str, str]:
+def precise_outputs(obj, missing: AbstractSet[str] = frozenset()) -> dict[str, str]:
     """The gear's length outputs as text to 0.1 um in the user's unit schema (schema.PRECISE); "none" for the
     `missing` ones (the gear has no such value)."""
     return {f"{field.prop}{schema.PRECISE_SUFFIX}": "none" if field.prop in missing else
@@ -446,8 +448,9 @@ def update_toolpath(obj, planned, flat_face_width_mm: float | None = None) -> No
                    "SpindleSpeed": float(path.spindle_rpm)}
     if uses_path_module(obj):
         has_points = drawn is not None and len(drawn.points) > 0
-        obj.Path = compat.new_path(compat.path_module(), gcode_text(drawn) if has_points else "")
-        if has_points and FreeCAD.GuiUp:  # else the path is drawn from (0, 0, 0), through the gear
+        shown = gcode_text(drawn) if drawn is not None and has_points else ""
+        obj.Path = compat.new_path(compat.path_module(), shown)
+        if drawn is not None and has_points and FreeCAD.GuiUp:  # else drawn from (0, 0, 0), through the gear
             compat.set_path_start(obj.ViewObject, drawn.points[0])
     else:
         import Part
@@ -456,7 +459,7 @@ def update_toolpath(obj, planned, flat_face_width_mm: float | None = None) -> No
                                           for _, run in polylines(drawn)]
         obj.Shape = Part.makeCompound(wires)
     write_outputs(obj, outputs)
-    obj.Label = toolpath_label(obj.Operation, outputs["DisplayedMoves"], outputs["Moves"])
+    obj.Label = toolpath_label(obj.Operation, int(outputs["DisplayedMoves"]), int(outputs["Moves"]))
     report(obj, None)
     show_fresh(obj)
     obj.purgeTouched()  # set by the job's recompute: nothing left for the toolpath itself to do

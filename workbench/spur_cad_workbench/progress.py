@@ -4,6 +4,8 @@ timers fire. Outside the GUI (freecadcmd, macros run headless) it does nothing."
 
 from __future__ import annotations
 
+from typing import Any
+
 import FreeCAD
 
 from spur_cad_workbench import compat
@@ -21,7 +23,7 @@ class WorkProgress:
         self.stages = stages
         self._indicator = None
         self._ticks_done = 0
-        self._qt = None
+        self._qt: tuple[Any, Any] | None = None
 
     def __enter__(self) -> WorkProgress:
         if not FreeCAD.GuiUp:

@@ -10,10 +10,14 @@ command runs it modally (compat.exec_dialog). The choices' ranges (`OperationCho
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from spur_cad_workbench import compat
+
+if TYPE_CHECKING:
+    from spur_cad.cam.ir import Toolpath
 
 OPERATION_TITLES = {"roughing": "Roughing", "roughing_bottom": "Roughing, bottom tool", "finishing": "Finishing"}
 SECOND_UNIT = {"roughing": "level", "roughing_bottom": "level", "finishing": "pass"}
@@ -25,7 +29,7 @@ class OperationChoices:
     space, then optionally by level (roughing) or pass (generating finishing) within the space."""
 
     operation: str
-    toolpath: object  # spur_cad.cam.ir.Toolpath
+    toolpath: Toolpath
 
     @property
     def by_station(self) -> bool:

@@ -61,6 +61,7 @@ from __future__ import annotations
 
 import re
 from dataclasses import dataclass
+from typing import Any
 
 from spur_cad.job import MODIFICATION_SECTIONS, SECTIONS
 from spur_cad.keys import keys_of
@@ -318,9 +319,9 @@ NEW_STOCK_ALLOWANCE_MODULES = 0.125
 small gear's finishing tool takes off the tips in one pass: about 0.4 module)."""
 
 
-def new_stock_values(gear_values: dict[str, object]) -> dict[str, object]:
+def new_stock_values(gear_values: dict[str, Any]) -> dict[str, object]:
     """The stock property values a new stock starts from for a gear with these property values."""
-    stock = dict(default_values()["stock"])
+    stock: dict[str, Any] = dict(default_values()["stock"])
     module_mm = float(gear_values.get("Module", 0.0))
     if module_mm > 0.0:
         stock["RadialAllowance"] = min(float(stock["RadialAllowance"]), NEW_STOCK_ALLOWANCE_MODULES * module_mm)
@@ -383,7 +384,7 @@ def job_data(values: dict[str, dict[str, object]]) -> dict[str, dict]:
             if field.section.startswith(MODIFICATIONS) and (field.section not in modification_tables(values[role])
                                                             or field.prop in inherited_side_props(values[role])):
                 continue
-            target = data
+            target: dict = data
             for part in field.section.split("."):
                 target = target.setdefault(part, {})
             target[field.key] = values[role][field.prop]
@@ -452,6 +453,6 @@ def title(field: Field) -> str:
         words = words[1:]
     key = "".join(words)
     if field.prop in _TITLES or key in _TITLES:
-        return _TITLES.get(field.prop, _TITLES.get(key))
+        return _TITLES[field.prop] if field.prop in _TITLES else _TITLES[key]
     text = " ".join(word if len(word) == 1 else word.lower() for word in words)
     return text[:1].upper() + text[1:]

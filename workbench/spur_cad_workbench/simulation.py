@@ -79,7 +79,7 @@ def result_points(result) -> tuple[np.ndarray, np.ndarray]:
         transverse = np.concatenate([grid.row_points(k, grid.rows_x[r])[0] for k in range(grid.teeth)])
         return np.column_stack([np.full(len(transverse), grid.rows_x[r]), transverse])
 
-    points = np.concatenate([row(r) for r in rows])
+    points = np.concatenate([row(int(r)) for r in rows])
     deviation = np.concatenate([result.deviation[:, :, r].reshape(-1) for r in rows])
     return points, deviation
 

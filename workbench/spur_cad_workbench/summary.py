@@ -11,6 +11,7 @@ from __future__ import annotations
 import hashlib
 import json
 from dataclasses import dataclass
+from typing import Any
 
 from spur_cad.cam.setups import ROTARY_TABLE, SETUPS, MachineSetup
 from spur_cad_workbench.schema import OPERATION_TITLES, job_data
@@ -174,13 +175,13 @@ def modification_summary(gear: dict[str, object]) -> str:
     return "; ".join(parts) or "none"
 
 
-def machine_setup(job: dict[str, object]) -> MachineSetup:
+def machine_setup(job: dict[str, Any]) -> MachineSetup:
     """The set-up the panel's MachineAxes chooses (spur_cad.cam.setups; the rotary table for a value none has, as
     the job file's loader would refuse it)."""
-    return SETUPS.get(int(job.get("MachineAxes", ROTARY_TABLE.axes)), ROTARY_TABLE)  # type: ignore[call-overload]
+    return SETUPS.get(int(job.get("MachineAxes", ROTARY_TABLE.axes)), ROTARY_TABLE)
 
 
-def _three_axis_summary(job: dict[str, object], units=None) -> str:
+def _three_axis_summary(job: dict[str, Any], units=None) -> str:
     """The folded "3-axis" group: how a through-cut gear is held; nothing on the rotary table (its fields are off)."""
     from spur_cad_workbench.units import text as length_text
 
@@ -193,7 +194,7 @@ def _three_axis_summary(job: dict[str, object], units=None) -> str:
     return "cut through, no tabs"
 
 
-def group_summary(group: str, job: dict[str, object], units=None) -> str:
+def group_summary(group: str, job: dict[str, Any], units=None) -> str:
     """What a folded group of the job panel holds, in a few words ('T1 flat D 4 mm', 'generating, scallop
     5 um'; lengths in the user's unit schema, `units` = FreeCAD.Units, None for mm); '' for groups without one.
     Cut at GROUP_SUMMARY_CHARS with an ellipsis."""

@@ -112,7 +112,7 @@ def message(sentence: str, units=None) -> str:
 
     def converted(found: re.Match) -> str:
         if found.group("value") is not None:
-            return one(float(found.group("value")), found.group(found.lastindex))
+            return one(float(found.group("value")), found.group(found.lastindex or 0))
         high, unit = float(found.group("high")), found.group("range_unit")
         low_text, high_text = (one(float(found.group(end)), unit, like=high) for end in ("low", "high"))
         return f"{found.group('open')}{low_text}, {high_text}{found.group('close')}"

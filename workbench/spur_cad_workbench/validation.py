@@ -11,10 +11,14 @@ from __future__ import annotations
 
 import re
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 from spur_cad.errors import SpurCadError
 from spur_cad_workbench import units as unit_text
 from spur_cad_workbench.schema import TOOL_SWITCHES, job_data
+
+if TYPE_CHECKING:
+    from spur_cad.job import Job
 
 # Panel groups (the property groups of schema.JOB_FIELDS, plus the gear and stock objects).
 SECTION_GROUPS = {"tools.roughing": "Roughing tool", "tools.finishing": "Finishing tool", "tools.bottom": "Bottom tool",
@@ -40,7 +44,7 @@ class Validation:
     """Outcome of checking a job: the Job when valid, the problems (at most one: the first the command line
     finds), recommendations when known."""
 
-    job: object | None
+    job: Job | None
     problems: tuple[Problem, ...]
     recommendations: object | None
 
@@ -136,10 +140,10 @@ def _advice(message: str, section: str | None, key: str | None, values: dict | N
         radius = f" for a corner radius of {corner:g} mm" if isinstance(corner, float) else ""
         reason = _with_titles(message.split(";")[0], section or "").removeprefix("finishing strategy generating: ")
         return f"{group}: diameter at most {float(found.group(1)):.3g} mm{radius} ({reason})"
-    if field is not None and body.startswith(f"{key} "):
-        return f"{group}: {title(field).lower()} {_with_titles(body[len(key) + 1:], section)}"
+    if field is not None and key is not None and body.startswith(f"{key} "):
+        return f"{group}: {title(field).lower()} {_with_titles(body[len(key) + 1:], section or '')}"
     if field is not None:
-        return f"{group}, {title(field).lower()}: {_with_titles(body, section)}"
+        return f"{group}, {title(field).lower()}: {_with_titles(body, section or '')}"
     return f"{group}: {_with_titles(body, section or '')}"
 
 
@@ -158,11 +162,11 @@ def sentence(exc: SpurCadError, source: str, units=None) -> str:
         body = advice(message, exc.section, exc.field, None, units)
         return body if body.endswith(".") else f"{body}."
     body = _INVALID_PREFIX.sub("", message)
-    if field is not None:
+    if field is not None and exc.field is not None:
         body = _with_unit(body, field)
         rest = body[len(exc.field) + 1:] if body.startswith(f"{exc.field} ") else None
-        body = title(field) + (f" {_with_titles(rest, exc.section)}" if rest is not None
-                               else f": {_with_titles(body, exc.section)}")
+        body = title(field) + (f" {_with_titles(rest, exc.section or '')}" if rest is not None
+                               else f": {_with_titles(body, exc.section or '')}")
     else:
         body = _with_titles(body, exc.section or "")
         body = body[:1].upper() + body[1:]
@@ -337,7 +341,7 @@ def suggest_tools(values: dict[str, dict[str, object]]) -> dict[str, object]:
         candidate = {**chosen, "UseRoughingTool": True, "RoughingToolKind": "flat",
                      "RoughingToolDiameter": round(diameter, 6), "RoughingCornerRadius": 0.0}
         single = validate({**values, "job": {**values["job"], **candidate}})
-        if single.ok:
+        if single.ok and single.job is not None:
             return _with_two_stage(values, candidate, suggested_two_stage(cam_inputs(single.job)))
         diameter -= ROUGHING_STEP_MM
     return chosen
