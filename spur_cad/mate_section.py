@@ -67,10 +67,11 @@ class MateSection:
 
 def _member_of_spec(spec: GearSpec) -> PairMember:
     """The gear as a pair member: its generated form circle and (a ring's) generated root circle."""
-    return PairMember(spec.teeth, internal=spec.is_internal, profile_shift_coefficient=spec.profile_shift_coefficient,
+    return PairMember(spec.teeth, internal=spec.kind.teeth_inward,
+                      profile_shift_coefficient=spec.profile_shift_coefficient,
                       addendum_coefficient=spec.addendum_coefficient, dedendum_coefficient=spec.dedendum_coefficient,
                       thickness_reduction_mm=spec.thickness_reduction_mm, form_diameter_mm=2.0 * spec.form_radius_mm,
-                      root_diameter_mm=2.0 * spec.root_radius_mm if spec.is_internal else None)
+                      root_diameter_mm=2.0 * spec.root_radius_mm if spec.kind.teeth_inward else None)
 
 
 def _mate_form_diameter_mm(spec: GearSpec, mate: MateSection, shift: float) -> float | None:
