@@ -282,7 +282,6 @@ def _write(out_dir, files: dict[str, bytes], received: list[int]) -> list:
 def _verify(args: argparse.Namespace, received: list[int], loaded: list) -> int:
     """`spur-cad verify`: read the programs, simulate, print the verdict, write the set; 0 pass, 1 fail."""
 
-    from spur_cad.dialects import DIALECTS
     from spur_cad.errors import shown, shown_path
     from spur_cad.job import load_job
     from spur_cad.outputs import check_output_folder
@@ -298,7 +297,7 @@ def _verify(args: argparse.Namespace, received: list[int], loaded: list) -> int:
                             args.a_offset_deg)
     options.validate()
     dialect = args.dialect or job.post.dialect
-    known = DIALECTS.get(dialect)  # None for a name the table does not hold (the reader says so)
+    known = job.dialects.get(dialect)  # None for a name the registry does not hold (the reader says so)
     rs274_checkable = known is not None and known.rs274_checkable  # LinuxCNC's interpreter reads these programs
     if args.reader == "rs274" and not rs274_checkable:
         raise SpurCadError(f"--reader rs274 reads LinuxCNC programs only (the dialect is {shown(dialect)})")
@@ -309,7 +308,8 @@ def _verify(args: argparse.Namespace, received: list[int], loaded: list) -> int:
             with open_program_file(name, source) as handle:  # a regular file of bounded size, checked first
                 programs.append(read_canonical(handle, source, lambda: _checkpoint(received)))
         else:
-            programs.append(read_program_file(name, dialect, source, checkpoint=lambda: _checkpoint(received)))
+            programs.append(read_program_file(name, dialect, source, checkpoint=lambda: _checkpoint(received),
+                                              dialects=job.dialects))
         _checkpoint(received)
     result = verify_moves(job, programs, options, progress=lambda fraction: _checkpoint(received))
     if rs274_checkable:

@@ -30,7 +30,8 @@ from spur_cad.cam.probing import ProbeSection
 from spur_cad.cam.strategies import REGISTRY, FinishingParams, Strategies, finishing_section_type
 from spur_cad.cam.three_axis_tabs import ThreeAxisSection
 from spur_cad.cam.tools import Tool
-from spur_cad.cam.turning import LatheSection, check_lathe_blank
+from spur_cad.cam.turning import LatheSection, check_lathe_blank, lathe_section_type
+from spur_cad.dialects import DIALECTS, Dialects
 from spur_cad.errors import (
     MAX_SHOWN_CHARS,
     GearSpecError,
@@ -46,7 +47,7 @@ from spur_cad.geometry.modifications import SIDES, FlankModifications, flank_mod
 from spur_cad.geometry.spec import MAX_TEETH, MIN_TEETH, GearSpec
 from spur_cad.keys import check_section, coerce, key, keys_of, section_problems, type_problem
 from spur_cad.mate_section import MateSection, check_mate
-from spur_cad.post.settings import PostSettings
+from spur_cad.post.settings import PostSettings, post_settings_type
 
 
 @dataclass(frozen=True)
@@ -273,6 +274,7 @@ class Job:
     report_template_text: str | None = field(default=None, repr=False, compare=False)  # [job] report_template's
     rotary_calibration: CalibrationTable | None = field(default=None, repr=False, compare=False)  # [machine]'s file
     strategies: Strategies = field(default_factory=lambda: dict(REGISTRY), repr=False, compare=False)  # [finishing]'s
+    dialects: Dialects = field(default_factory=lambda: dict(DIALECTS), repr=False, compare=False)  # [post], [lathe]'s
 
     def located(self, error: SpurCadError) -> str:
         """An error raised after loading, prefixed with 'file:line' of the key it blames (its section's
@@ -311,10 +313,12 @@ SECTIONS: dict[str, type] = {
 }
 
 
-def job_sections(strategies: Strategies = REGISTRY) -> dict[str, type]:
+def job_sections(strategies: Strategies = REGISTRY, dialects: Dialects = DIALECTS) -> dict[str, type]:
     """SECTIONS with the [finishing] section made from the keys of `strategies`' parameters (the same class
-    as FinishingParams for the default registry's strategies)."""
-    return {**SECTIONS, "finishing": finishing_section_type(strategies)}
+    as FinishingParams for the default registry's strategies), and [post] and [lathe] taking the names of the
+    registry `dialects` (PostSettings and LatheSection for the default registry)."""
+    return {**SECTIONS, "finishing": finishing_section_type(strategies), "post": post_settings_type(dialects),
+            "lathe": lathe_section_type(dialects)}
 
 
 _TOOL_ROLES = ("roughing", "finishing", "bottom", "roughing_top")
@@ -424,9 +428,11 @@ def _longest_number(text: str, source: str) -> str:
     return where
 
 
-def parse_job(text: str, source: str = "<job>", strategies: Strategies = REGISTRY) -> Job:
+def parse_job(text: str, source: str = "<job>", strategies: Strategies = REGISTRY,
+              dialects: Dialects = DIALECTS) -> Job:
     """Validate a job file's text; raises JobFileError (or GearSpecError wrapped into it). `strategies`: the
-    finishing strategies [finishing] strategy names and whose keys it takes."""
+    finishing strategies [finishing] strategy names and whose keys it takes; `dialects`: the controllers
+    [post] dialect and [lathe] dialect name."""
     if len(text) > MAX_JOB_FILE_BYTES:
         raise JobFileError(f"{source}: the job file is larger than {MAX_JOB_FILE_BYTES // 1024} KiB; a job file is "
                            "a few kilobytes of TOML")
@@ -440,15 +446,15 @@ def parse_job(text: str, source: str = "<job>", strategies: Strategies = REGISTR
     except RecursionError:
         raise JobFileError(f"{_deepest_value(text, source)}: arrays or tables nested too deeply for a job file") \
             from None
-    return _job_from_data(data, source, text, strategies)
+    return _job_from_data(data, source, text, strategies, dialects)
 
 
-def job_from_dict(data: dict, source: str, strategies: Strategies = REGISTRY) -> Job:
+def job_from_dict(data: dict, source: str, strategies: Strategies = REGISTRY, dialects: Dialects = DIALECTS) -> Job:
     """Validate a job given as nested dicts (the TOML structure), e.g. built by the FreeCAD workbench.
 
     Same checks and messages as parse_job, without line numbers (`source` names the origin).
     """
-    return _job_from_data(data, source, "", strategies)
+    return _job_from_data(data, source, "", strategies, dialects)
 
 
 def _tables(data: dict, source: str, text: str) -> dict[str, object]:
@@ -708,12 +714,13 @@ def _check_added_material(mods: FlankModifications | None, finish_stock_mm: floa
                            f"finishing ([roughing] finish_stock_mm = {finish_stock_mm:g} mm)", section=table, field=key)
 
 
-def _job_from_data(data: dict, source: str, text: str, strategies: Strategies = REGISTRY) -> Job:
+def _job_from_data(data: dict, source: str, text: str, strategies: Strategies = REGISTRY,
+                   dialects: Dialects = DIALECTS) -> Job:
     """Validate parsed job data; `text` (the file's text, or "") only locates keys for messages."""
     data, modification_tables = _split_modifications(data, source, text)
     tables, autos = _without_auto(_tables(data, source, text), lambda name, key_name: _where(source, text, name,
                                                                                               key_name))
-    types = job_sections(strategies)
+    types = job_sections(strategies, dialects)
     sections = {name: _load_section(tables[name], name, source, text, types) for name in types if name in tables}
 
     def where(name: str, key_name: str | None) -> str:
@@ -765,15 +772,16 @@ def _job_from_data(data: dict, source: str, text: str, strategies: Strategies = 
             blamed = _blamed_key(exc, name, tables.get(name, {}))
             raise JobFileError(f"{where(name, blamed)}: {exc}", section=name, field=blamed) from None
     if "probe" in sections:
-        _check_probe(spec, sections, tools, tables, where)
+        _check_probe(spec, sections, tools, tables, where, dialects)
     if "export" in sections:
         _check_export(spec, gear_section, sections["export"], tables, where)
-    optional = {name: sections[name] for name in ("mate", "stock", "roughing", "machine", "three_axis", "post",
+    optional = {name: sections[name] for name in ("mate", "stock", "roughing", "machine", "three_axis",
                                                   "simulation", "export", "lathe", "probe") if name in sections}
     finishing = sections["finishing"] if "finishing" in sections else types["finishing"]()  # the registry's default
+    post = sections["post"] if "post" in sections else types["post"]()  # the registry's default dialect
     return Job(source=source, job=sections.get("job", JobSection()), gear_section=gear_section, gear=spec,
-               tools=tools, finishing=finishing, **optional, text=text, strategies=dict(strategies),
-               modifications=modifications, modification_values=modification_values)
+               tools=tools, finishing=finishing, post=post, **optional, text=text, strategies=dict(strategies),
+               dialects=dict(dialects), modifications=modifications, modification_values=modification_values)
 
 
 def _check_mate(spec: GearSpec, mate: MateSection | None, given: dict,
@@ -790,7 +798,7 @@ def _check_mate(spec: GearSpec, mate: MateSection | None, given: dict,
 
 
 def _check_probe(spec: GearSpec, sections: dict, tools: ToolsSection, tables: dict,
-                 where: Callable[[str, str | None], str]) -> None:
+                 where: Callable[[str, str | None], str], dialects: Dialects) -> None:
     """[probe] needs a dialect with probing words, a tool number of its own, a spur gear and a ball that reaches
     every point (spur_cad.cam.probing.plan_probe): one line at the key to blame."""
     from spur_cad.cam.probing import ProbeError, plan_probe
@@ -798,7 +806,7 @@ def _check_probe(spec: GearSpec, sections: dict, tools: ToolsSection, tables: di
 
     probe: ProbeSection = sections["probe"]
     try:
-        probing_dialect(sections.get("post", PostSettings()).dialect)
+        probing_dialect(sections.get("post", PostSettings()).dialect, dialects)
         for role in _TOOL_ROLES:
             tool = getattr(tools, role)
             if tool is not None and tool.tool_number == probe.tool_number:
@@ -902,7 +910,8 @@ def with_files(job: Job, folder: Path, side_folders: Sequence[Path] = ()) -> Job
     return with_rotary_calibration(with_report_template(job, folder, side_folders), folder, side_folders)
 
 
-def load_job(path: str | Path, strategies: Strategies = REGISTRY, side_folders: Sequence[Path] = ()) -> Job:
+def load_job(path: str | Path, strategies: Strategies = REGISTRY, side_folders: Sequence[Path] = (),
+             dialects: Dialects = DIALECTS) -> Job:
     """Read and validate a job file from disk (a regular file of at most MAX_JOB_FILE_BYTES: a FIFO or a device
     is refused before it is read); the files it names ([job] report_template, [machine] rotary_calibration_file) are
     read from the job file's folder or one of `side_folders` (`--side-files`), never from elsewhere."""
@@ -916,4 +925,4 @@ def load_job(path: str | Path, strategies: Strategies = REGISTRY, side_folders: 
         raise JobFileError(f"{source}: the job file is not UTF-8 text") from None
     if "\x00" in text:
         raise JobFileError(f"{source}: the job file contains NUL characters (not a text file)")
-    return with_files(parse_job(text, source, strategies), Path(path).parent, side_folders)
+    return with_files(parse_job(text, source, strategies, dialects), Path(path).parent, side_folders)

@@ -8,6 +8,7 @@ import re
 import sys
 
 from spur_cad.cam.strategies import REGISTRY, Strategies
+from spur_cad.dialects import DIALECTS, Dialects
 from spur_cad.job import MODIFICATION_SECTIONS, job_sections
 from spur_cad.keys import keys_of, toml_literal
 
@@ -119,11 +120,11 @@ def _accepted(k) -> str:
     return "any"
 
 
-def job_file_reference_markdown(strategies: Strategies = REGISTRY) -> str:
+def job_file_reference_markdown(strategies: Strategies = REGISTRY, dialects: Dialects = DIALECTS) -> str:
     """docs/job-file.md: the introduction, one table per section from its key declarations (the [finishing]
-    keys from the strategies of `strategies`), the notes."""
+    keys from the strategies of `strategies`, the dialects [post] and [lathe] take from `dialects`), the notes."""
     sections = {}
-    for name, cls in job_sections(strategies).items():
+    for name, cls in job_sections(strategies, dialects).items():
         sections[name] = cls
         if name == "gear":  # the flank modification tables follow [gear]
             sections.update(MODIFICATION_SECTIONS)

@@ -140,6 +140,18 @@ def keys_of(cls: type) -> tuple[Key, ...]:
     return tuple(found)
 
 
+def with_key(cls: type, name: str, field: dataclasses.Field) -> type:
+    """A subclass of section dataclass `cls`, of the same name and checks, whose key `name` is `field` (a
+    `key(...)` declared anew): how a section takes the names of a registry other than the default one (another
+    set of dialects: spur_cad.post.settings.post_settings_type, spur_cad.cam.turning.lathe_section_type)."""
+    hints = typing.get_type_hints(cls)
+    if name not in {f.name for f in dataclasses.fields(cls)} or METADATA_KEY not in field.metadata:
+        raise TypeError(f"{cls.__name__}: {name!r} is not one of its keys, or {field!r} is not a key(...)")
+    section = dataclasses.make_dataclass(cls.__name__, [(name, hints[name], field)], bases=(cls,), frozen=True)
+    section.__module__, section.__qualname__, section.__doc__ = cls.__module__, cls.__qualname__, cls.__doc__
+    return section
+
+
 def key_of(cls: type, name: str) -> Key:
     for k in keys_of(cls):
         if k.name == name:

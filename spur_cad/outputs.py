@@ -19,7 +19,8 @@ How (all inside the output folder, so on one filesystem):
 Every file found in the folder is untrusted input, our own manifest and journal included (an output
 folder may be a shared folder or a colleague's unpacked archive). They are read only if they are
 regular files of a bounded size, and every name in them must be a plain file name of the set's own
-vocabulary (`OUTPUT_NAME`) and the staging folder a direct child with the staging prefix; anything
+vocabulary (`Vocabulary`: spur_cad's fixed names, and the program names with the extensions of the dialects
+of the run's registry, spur_cad.dialects) and the staging folder a direct child with the staging prefix; anything
 else is refused (ForeignFileError: "... was not written by spur_cad: remove it or choose another
 folder") before anything is touched. Only files a validated manifest or journal lists are ever
 removed, and only the new set's names are overwritten: the user's own files are never touched.
@@ -30,6 +31,7 @@ from __future__ import annotations
 import contextlib
 import errno
 import fcntl
+import functools
 import json
 import os
 import re
@@ -42,6 +44,7 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 
+from spur_cad.dialects import program_extensions
 from spur_cad.errors import SpurCadError, shown_path
 
 MANIFEST = ".spur_cad-set.json"
@@ -50,18 +53,46 @@ STAGING_PREFIX = ".spur_cad-staging-"
 STAGING_MARK = ".spur_cad-staging"  # the first file of every staging folder: a folder without it is not ours
 LOCK_WAIT_S = 60.0  # another run holds the folder's lock for the milliseconds of its switch; longer is not a run
 MAX_BOOKKEEPING_BYTES = 64 * 1024  # a manifest or journal lists a few dozen names
-_PROGRAM_EXTENSION = r"(ngc|nc|mpf|min)"  # every milling and lathe dialect's (checked in tests/test_outputs.py)
 _OPERATION = r"(roughing|roughing_bottom|finishing)"
-OUTPUT_NAME = re.compile(
-    r"profile\.(csv|png)|(gear|stock|job)\.step|report\.html|summary\.json"  # spur-cad run
-    r"|gear\.(dxf|svg)"  # [export]
-    rf"|{_OPERATION}\.{_PROGRAM_EXTENSION}|(blank|probe)\.{_PROGRAM_EXTENSION}"  # programs
-    rf"|{_OPERATION}_(space|station)\d{{1,7}}(_(level|pass)\d{{1,7}})?\.{_PROGRAM_EXTENSION}"  # restart programs
-    r"|verify\.json|deviation_map\.csv"  # spur-cad verify
-    r"|grade\.json|k_chart\.png"  # spur-cad grade
-    r"|correction\.json",  # spur-cad correct (with the corrected programs)
-    re.ASCII)  # digits are 0-9 only
-"""The vocabulary of output sets: every name spur_cad writes into an output folder (fullmatch)."""
+_EXTENSION = re.compile(r"[a-z0-9]{1,8}", re.ASCII)  # what a dialect's program extension may be here
+
+
+@dataclass(frozen=True)
+class Vocabulary:
+    """The vocabulary of output sets: every name spur_cad writes into an output folder, the programs' with the
+    extensions of a dialect registry's programs (milling, lathe, probing: `program_extensions(dialects)`; the
+    default registry's unless a run gives another)."""
+
+    program_extensions: tuple[str, ...] = program_extensions()
+
+    def __post_init__(self):
+        if not self.program_extensions or not all(isinstance(e, str) and _EXTENSION.fullmatch(e)
+                                                  for e in self.program_extensions):
+            raise ValueError(f"program extensions must be 1 to 8 lower-case letters or digits, got "
+                             f"{self.program_extensions!r}")
+
+    def matches(self, name: object) -> bool:
+        """True for a plain file name of the vocabulary (no separator, no '..', no control character)."""
+        return isinstance(name, str) and _output_name(self.program_extensions).fullmatch(name) is not None
+
+
+@functools.cache
+def _output_name(extensions: tuple[str, ...]) -> re.Pattern:
+    """The vocabulary's names for these program extensions, as one regular expression (fullmatch)."""
+    program = f"({'|'.join(extensions)})"
+    return re.compile(
+        r"profile\.(csv|png)|(gear|stock|job)\.step|report\.html|summary\.json"  # spur-cad run
+        r"|gear\.(dxf|svg)"  # [export]
+        rf"|{_OPERATION}\.{program}|(blank|probe)\.{program}"  # programs
+        rf"|{_OPERATION}_(space|station)\d{{1,7}}(_(level|pass)\d{{1,7}})?\.{program}"  # restart programs
+        r"|verify\.json|deviation_map\.csv"  # spur-cad verify
+        r"|grade\.json|k_chart\.png"  # spur-cad grade
+        r"|correction\.json",  # spur-cad correct (with the corrected programs)
+        re.ASCII)  # digits are 0-9 only
+
+
+VOCABULARY = Vocabulary()
+"""The default registry's vocabulary (spur_cad.dialects.DIALECTS)."""
 STAGING_NAME = re.compile(re.escape(STAGING_PREFIX) + r"[a-z0-9_]{8}", re.ASCII)  # 8 random characters (hex
 # since issue 33; tempfile.mkdtemp's alphabet before)
 
@@ -87,9 +118,10 @@ class Journal:
         return json.dumps({"staging": self.staging, "new": list(self.new), "old": list(self.old)}).encode()
 
 
-def check_output_folder(out_dir: str | os.PathLike) -> Path:
+def check_output_folder(out_dir: str | os.PathLike, vocabulary: Vocabulary = VOCABULARY) -> Path:
     """Refuse, before any computation, an --out that is not a folder, a symbolic link to nothing, a name
-    the system refuses (too long), or a place that cannot be created or written."""
+    the system refuses (too long), or a place that cannot be created or written (a manifest or journal
+    naming anything outside `vocabulary` is foreign)."""
     out = Path(out_dir)
     try:
         if any(len(os.fsencode(part)) > 255 for part in out.parts):
@@ -104,7 +136,7 @@ def check_output_folder(out_dir: str | os.PathLike) -> Path:
         if out.is_dir():  # a foreign manifest or journal is refused now, not after the run
             with _opened(out) as folder:
                 if _try_lock(folder):  # busy: another run's staging folder may be half made; checked when writing
-                    _check_bookkeeping(out, folder)
+                    _check_bookkeeping(out, folder, vocabulary)
     except OutputError:
         raise
     except (OSError, ValueError) as exc:  # a path too long for the system, a NUL byte, ...
@@ -112,30 +144,30 @@ def check_output_folder(out_dir: str | os.PathLike) -> Path:
     return out
 
 
-def is_output_name(name: str) -> bool:
+def is_output_name(name: str, vocabulary: Vocabulary = VOCABULARY) -> bool:
     """True for a plain file name of the output sets' vocabulary (no separator, no '..', no control character)."""
-    return isinstance(name, str) and OUTPUT_NAME.fullmatch(name) is not None
+    return vocabulary.matches(name)
 
 
 def write_output_set(out_dir: str | os.PathLike, files: dict[str, bytes],
-                     checkpoint: Callable[[], None] | None = None) -> list[Path]:
-    """Replace the set in `out_dir` (created if needed) by `files` (name -> content; names of OUTPUT_NAME);
+                     checkpoint: Callable[[], None] | None = None, vocabulary: Vocabulary = VOCABULARY) -> list[Path]:
+    """Replace the set in `out_dir` (created if needed) by `files` (name -> content; names of `vocabulary`);
     returns the paths. Raises OutputError (ForeignFileError for a file not ours) with nothing changed.
 
     Every operation is relative to descriptors of the output folder and of our staging folder, opened once
     (without following links): a name in the folder swapped for a link while the set is written cannot
     redirect a write, a move or a removal to another folder."""
     for name in files:
-        if not is_output_name(name):
+        if not vocabulary.matches(name):
             raise ValueError(f"output names must be plain file names of the output vocabulary, got {name!r}")
-    out = check_output_folder(out_dir)
+    out = check_output_folder(out_dir, vocabulary)
     try:
         out.mkdir(parents=True, exist_ok=True)
     except OSError as exc:
         raise OutputError(f"--out {shown_path(out)}: cannot create it: {exc.strerror or exc}") from None
     with _locked(out, checkpoint) as folder:
-        _recover(out, folder)
-        old = _read_manifest(out, folder)
+        _recover(out, folder, vocabulary)
+        old = _read_manifest(out, folder, vocabulary)
         for name in files:
             if _in_the_way(folder, name):
                 raise OutputError(f"--out {shown_path(out)}: {name} is in the way (a folder or special file); "
@@ -150,12 +182,12 @@ def write_output_set(out_dir: str | os.PathLike, files: dict[str, bytes],
                 _write_synced(staging, MANIFEST, json.dumps(list(journal.new)).encode())
                 os.fsync(staging)
             except BaseException:
-                _remove_staging(folder, staging_name, staging)  # our own fresh folder
+                _remove_staging(folder, staging_name, staging, vocabulary)  # our own fresh folder
                 raise
             with _signals_held():
                 os.replace(JOURNAL, JOURNAL, src_dir_fd=staging, dst_dir_fd=folder)
                 os.fsync(folder)
-                _switch(folder, journal, staging)
+                _switch(folder, journal, staging, vocabulary)
         finally:
             os.close(staging)
     return [out / name for name in files]
@@ -179,25 +211,25 @@ def write_file_atomically(path: str | os.PathLike, content: bytes) -> Path:
     return path
 
 
-def recover(out: Path) -> None:
+def recover(out: Path, vocabulary: Vocabulary = VOCABULARY) -> None:
     """Complete a switch an earlier run left half-done, then remove our staging folders. Everything is
     validated first (ForeignFileError, nothing touched, when a file is not ours)."""
     with _locked(out) as folder:
-        _recover(out, folder)
+        _recover(out, folder, vocabulary)
 
 
-def _recover(out: Path, folder: int) -> None:
-    journal, strays = _check_bookkeeping(out, folder)
+def _recover(out: Path, folder: int, vocabulary: Vocabulary) -> None:
+    journal, strays = _check_bookkeeping(out, folder, vocabulary)
     if journal is not None:
-        _switch(folder, journal, None)
+        _switch(folder, journal, None, vocabulary)
     for name in strays:
-        _remove_staging(folder, name)
+        _remove_staging(folder, name, vocabulary=vocabulary)
 
 
-def _check_bookkeeping(out: Path, folder: int) -> tuple[Journal | None, list[str]]:
+def _check_bookkeeping(out: Path, folder: int, vocabulary: Vocabulary) -> tuple[Journal | None, list[str]]:
     """The journal (None without one) and the names of stray staging folders, every one of them validated with
     the manifest (ForeignFileError when a file is not ours); nothing is changed."""
-    journal = _read_journal(out, folder)
+    journal = _read_journal(out, folder, vocabulary)
     strays = [entry for entry in sorted(os.listdir(folder)) if STAGING_NAME.fullmatch(entry) and
               (journal is None or entry != journal.staging)]
     if journal is not None:
@@ -209,20 +241,20 @@ def _check_bookkeeping(out: Path, folder: int) -> tuple[Journal | None, list[str
         staging = _open_staging(out, folder, name)
         if staging is not None:
             try:
-                _check_staging(out / name, staging)
+                _check_staging(out / name, staging, vocabulary)
             finally:
                 os.close(staging)
-    _read_manifest(out, folder)
+    _read_manifest(out, folder, vocabulary)
     return journal, strays
 
 
-def current_set(out_dir: str | os.PathLike) -> list[str]:
+def current_set(out_dir: str | os.PathLike, vocabulary: Vocabulary = VOCABULARY) -> list[str]:
     """Names of the set the folder holds (from its validated manifest; [] when it holds none)."""
     out = Path(out_dir)
     if not out.is_dir():
         return []
     with _opened(out) as folder:
-        return sorted(_read_manifest(out, folder))
+        return sorted(_read_manifest(out, folder, vocabulary))
 
 
 def _foreign(path: Path, reason: str) -> ForeignFileError:
@@ -252,25 +284,25 @@ def _read_bookkeeping(path: Path, folder: int) -> object | None:
         raise _foreign(path, "not the JSON spur_cad writes") from None
 
 
-def _names(value: object, path: Path, what: str) -> tuple[str, ...]:
+def _names(value: object, path: Path, what: str, vocabulary: Vocabulary) -> tuple[str, ...]:
     if not isinstance(value, list):
         raise _foreign(path, f"{what} is not a list of names")
     for name in value:
-        if not is_output_name(name):
+        if not vocabulary.matches(name):
             shown = shown_path(name) if isinstance(name, str) else type(name).__name__
             raise _foreign(path, f"{what} names {shown!s}, not a file of an output set")
     return tuple(value)
 
 
-def _read_manifest(out: Path, folder: int) -> set[str]:
+def _read_manifest(out: Path, folder: int, vocabulary: Vocabulary) -> set[str]:
     """The current set's names from the manifest; the empty set without one (files of older versions that kept
     no manifest are left alone: they are overwritten only where the new set has the same name)."""
     path = out / MANIFEST
     data = _read_bookkeeping(path, folder)
-    return set() if data is None else set(_names(data, path, "the manifest"))
+    return set() if data is None else set(_names(data, path, "the manifest", vocabulary))
 
 
-def _read_journal(out: Path, folder: int) -> Journal | None:
+def _read_journal(out: Path, folder: int, vocabulary: Vocabulary) -> Journal | None:
     path = out / JOURNAL
     data = _read_bookkeeping(path, folder)
     if data is None:
@@ -280,7 +312,8 @@ def _read_journal(out: Path, folder: int) -> Journal | None:
     staging = data["staging"]
     if not isinstance(staging, str) or STAGING_NAME.fullmatch(staging) is None:
         raise _foreign(path, "its staging folder is not one of spur_cad's in this folder")
-    return Journal(staging, _names(data["new"], path, "its new set"), _names(data["old"], path, "its old set"))
+    return Journal(staging, _names(data["new"], path, "its new set", vocabulary),
+                   _names(data["old"], path, "its old set", vocabulary))
 
 
 def _open_child_folder(folder: int, name: str) -> int:
@@ -301,12 +334,12 @@ def _open_staging(out: Path, folder: int, name: str) -> int | None:
         raise
 
 
-def _ours(entry: os.DirEntry) -> bool:
-    return entry.is_file(follow_symlinks=False) and (is_output_name(entry.name) or
+def _ours(entry: os.DirEntry, vocabulary: Vocabulary) -> bool:
+    return entry.is_file(follow_symlinks=False) and (vocabulary.matches(entry.name) or
                                                      entry.name in (MANIFEST, JOURNAL, STAGING_MARK))
 
 
-def _check_staging(path: Path, staging: int) -> None:
+def _check_staging(path: Path, staging: int, vocabulary: Vocabulary) -> None:
     """A staging folder must be one we made (ours by owner, mode 0700 and its mark) and hold only regular files
     of our names: a user's folder renamed to the staging pattern is not emptied."""
     info = os.fstat(staging)
@@ -316,7 +349,7 @@ def _check_staging(path: Path, staging: int) -> None:
     if STAGING_MARK not in {entry.name for entry in entries}:
         raise _foreign(path, f"no {STAGING_MARK} mark")
     for entry in entries:
-        if not _ours(entry):
+        if not _ours(entry, vocabulary):
             raise _foreign(path / entry.name, "not a file of an output set")
 
 
@@ -339,7 +372,8 @@ def _new_staging(folder: int) -> tuple[str, int]:
         return name, staging
 
 
-def _remove_staging(folder: int, name: str, staging: int | None = None) -> None:
+def _remove_staging(folder: int, name: str, staging: int | None = None,
+                    vocabulary: Vocabulary = VOCABULARY) -> None:
     """Remove a staging folder of ours: the regular files of our names in it, then the folder. Relative to its
     descriptor (`staging`, or opened here without following a link and checked again as ours on that very
     descriptor): a link or a user's folder put in its place meanwhile is never emptied. What cannot be removed
@@ -348,14 +382,14 @@ def _remove_staging(folder: int, name: str, staging: int | None = None) -> None:
     if opened:
         try:
             staging = _open_child_folder(folder, name)
-            _check_staging(Path(name), staging)
+            _check_staging(Path(name), staging, vocabulary)
         except (OSError, ForeignFileError):
             if staging is not None:
                 os.close(staging)
             return
     try:
         for entry in list(os.scandir(staging)):
-            if _ours(entry):
+            if _ours(entry, vocabulary):
                 with contextlib.suppress(FileNotFoundError):
                     os.unlink(entry.name, dir_fd=staging)
     finally:
@@ -365,7 +399,7 @@ def _remove_staging(folder: int, name: str, staging: int | None = None) -> None:
         os.rmdir(name, dir_fd=folder)
 
 
-def _switch(folder: int, journal: Journal, staging: int | None) -> None:
+def _switch(folder: int, journal: Journal, staging: int | None, vocabulary: Vocabulary) -> None:
     """Move the staged files into place, remove the old set's extra files, record the new set (the journal
     and its names were validated). `staging`: the journal's staging folder, opened (None: open it here)."""
     opened = staging is None
@@ -376,24 +410,24 @@ def _switch(folder: int, journal: Journal, staging: int | None) -> None:
             staging = None
         if staging is not None:
             try:  # checked again on this very descriptor: the name may have been given to another folder
-                _check_staging(Path(journal.staging), staging)
+                _check_staging(Path(journal.staging), staging, vocabulary)
             except BaseException:
                 os.close(staging)
                 raise
     try:
-        _move_in(folder, journal, staging, staged_manifest=not opened)
+        _move_in(folder, journal, staging, vocabulary, staged_manifest=not opened)
         os.fsync(folder)
         with contextlib.suppress(FileNotFoundError):
             os.unlink(JOURNAL, dir_fd=folder)
         if staging is not None:
-            _remove_staging(folder, journal.staging, staging)
+            _remove_staging(folder, journal.staging, staging, vocabulary)
     finally:
         if opened and staging is not None:
             os.close(staging)
     os.fsync(folder)
 
 
-def _move_in(folder: int, journal: Journal, staging: int | None, staged_manifest: bool) -> None:
+def _move_in(folder: int, journal: Journal, staging: int | None, vocabulary: Vocabulary, staged_manifest: bool) -> None:
     """The switch's renames and removals, relative to the folders' descriptors. The manifest staged by this run
     is moved in (`staged_manifest`); when completing an earlier run's switch it is written anew from the
     journal's validated names."""
@@ -416,7 +450,7 @@ def _move_in(folder: int, journal: Journal, staging: int | None, staged_manifest
         _write_synced(fresh, MANIFEST, json.dumps(list(journal.new)).encode())
         os.replace(MANIFEST, MANIFEST, src_dir_fd=fresh, dst_dir_fd=folder)
     finally:
-        _remove_staging(folder, fresh_name, fresh)
+        _remove_staging(folder, fresh_name, fresh, vocabulary)
         os.close(fresh)
 
 

@@ -247,7 +247,7 @@ def build_programs(job: Job, plan: CamPlan, notes: tuple[str, ...] = ()) -> tupl
                                                                                  dict[str, bytes]]:
     """G-code for each toolpath the plan has: (posted programs by operation, files roughing.<ext>, ...); `notes`
     are added to every header's comments (e.g. spur-cad correct's corrections)."""
-    from spur_cad.post import dialect, post_program
+    from spur_cad.post import post_program
 
     settings = job.post
     programs: dict[str, PostedProgram] = {}
@@ -258,8 +258,8 @@ def build_programs(job: Job, plan: CamPlan, notes: tuple[str, ...] = ()) -> tupl
             continue
         info = program_info(job, plan, name)
         info = dataclasses.replace(info, comments=info.comments + notes)
-        program = programs[name] = post_program(operation.toolpath, settings, info)
-        files[f"{name}.{dialect(settings.dialect).extension}"] = program.text.encode()
+        program = programs[name] = post_program(operation.toolpath, settings, info, dialects=job.dialects)
+        files[f"{name}.{program.extension}"] = program.text.encode()
     return programs, files
 
 
@@ -292,8 +292,8 @@ def lathe_program(job: Job) -> tuple[str, bytes]:
     comments = (f"gear: z = {spec.teeth}, m = {spec.module_mm:g} mm, b = {spec.face_width_mm:g} mm, tip diameter "
                 f"{2 * spec.tip_radius_mm:.4f} mm",)
     text = post_lathe(plan_lathe(spec, stock, job.lathe), job.lathe, f"spur_cad {__version__} blank: {job.job.name}",
-                      comments)
-    return f"blank.{lathe_extension(job.lathe.dialect)}", text.encode()
+                      comments, dialects=job.dialects)
+    return f"blank.{lathe_extension(job.lathe.dialect, job.dialects)}", text.encode()
 
 
 def probe_program(job: Job) -> tuple[str, bytes]:
@@ -306,8 +306,8 @@ def probe_program(job: Job) -> tuple[str, bytes]:
             f"x = {spec.profile_shift_coefficient:g}, b = {spec.face_width_mm:g} mm, reference radius "
             f"{spec.reference_radius_mm:.4f} mm, form radius {spec.form_radius_mm:.4f} mm")
     plan = plan_probe(spec, job.stock, job.machine, job.probe)
-    text = post_probe(plan, job.post, f"spur_cad {__version__} probe: {job.job.name}", gear)
-    return f"probe.{probing_dialect(job.post.dialect).extension}", text.encode()
+    text = post_probe(plan, job.post, f"spur_cad {__version__} probe: {job.job.name}", gear, job.dialects)
+    return f"probe.{probing_dialect(job.post.dialect, job.dialects).extension}", text.encode()
 
 
 def export_files(job: Job) -> dict[str, bytes]:
@@ -333,7 +333,7 @@ def restart_program(job: Job, plan: CamPlan, point: RestartPoint) -> tuple[str, 
     (e.g. roughing_space5.ngc) and text."""
     from spur_cad.cam.common import safe_height_mm
     from spur_cad.cam.restart import RestartError, restart_toolpath, run_reference_a_deg
-    from spur_cad.post import dialect, post_program
+    from spur_cad.post import post_program
 
     planned = getattr(plan, point.operation)
     if planned is None:
@@ -344,8 +344,9 @@ def restart_program(job: Job, plan: CamPlan, point: RestartPoint) -> tuple[str, 
     comment = (f"restart at {point.text()}: the full program's moves from move {start} on, after a move to the "
                f"clearance height Z {clearance:.3f} mm and to the first move's X, Y and A")
     reference = run_reference_a_deg(planned.toolpath, start) if planned.toolpath.space[start] >= 0 else None
-    program = post_program(path, job.post, program_info(job, plan, point.operation, comment, clearance, reference))
-    return f"{point.label()}.{dialect(job.post.dialect).extension}", program.text.encode()
+    program = post_program(path, job.post, program_info(job, plan, point.operation, comment, clearance, reference),
+                           dialects=job.dialects)
+    return f"{point.label()}.{program.extension}", program.text.encode()
 
 
 def program_comments(job: Job, plan: CamPlan, operation: str) -> tuple[str, ...]:

@@ -205,11 +205,12 @@ class ProgramFacts:
 
 @dataclass(frozen=True)
 class PostFacts:
-    """The post: dialect, folding and each program's size."""
+    """The post: dialect, folding and each program's size, and the programs' file extension (the dialect's)."""
 
     dialect: str
     folded: bool
     programs: tuple[ProgramFacts, ...]
+    extension: str
 
     def program(self, operation: str) -> ProgramFacts | None:
         return next((p for p in self.programs if p.operation == operation), None)

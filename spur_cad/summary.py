@@ -15,6 +15,7 @@ from spur_cad.cam.machine import Machine, RoughingParams
 from spur_cad.cam.plan import CamPlan, FinishingPlan, RoughingPlan
 from spur_cad.cam.recommend import ToolRecommendations
 from spur_cad.cam.tools import Tool
+from spur_cad.dialects import dialect
 from spur_cad.geometry.inspection import inspection_facts, modification_inspection
 from spur_cad.geometry.sampling import ProfileSamples
 from spur_cad.post.program import PostedProgram
@@ -76,7 +77,8 @@ def build_result(job, samples: ProfileSamples, cad: CadResult | None, plan: CamP
         roughing=roughing_facts(plan, job.machine, simulation), finishing=finishing_facts(plan.finishing),
         warnings=tuple(plan.warnings) + engagement_warnings(simulation, job.roughing, plan),
         post=PostFacts(post.dialect, post.folded, tuple(ProgramFacts(name, p.lines, p.bytes, p.subprograms)
-                                                        for name, p in programs.items())),
+                                                        for name, p in programs.items()),
+                       dialect(post.dialect, job.dialects).extension),
         simulation=simulation_facts(simulation, job.simulation.resolution_mm), grading=grading,
         lathe=lathe_facts(job), timings_s=seconds, setup=setup_facts(job, plan, post), error_budget=error_budget)
 

@@ -148,7 +148,7 @@ def _section_classes() -> dict[str, type]:
     """Job-file sections and their dataclasses, read from spur_cad.job.Job's fields (so new sections count)."""
     hints = typing.get_type_hints(Job)
     sections = {("gear" if f.name == "gear_section" else f.name): hints[f.name] for f in dataclasses.fields(Job)
-                if f.name not in ("source", "gear", "tools", "text", "strategies", "report_template_text",
+                if f.name not in ("source", "gear", "tools", "text", "strategies", "dialects", "report_template_text",
                                   "rotary_calibration", "modifications", "modification_values")}
     sections["tools.roughing"] = sections["tools.finishing"] = sections["tools.bottom"] = Tool
     sections.update(MODIFICATION_SECTIONS)  # read with [gear]: the Job holds them as FlankModifications

@@ -23,17 +23,19 @@ Pure: no file I/O, no CAD kernel. `plan_lathe(spec, stock, lathe)` checks everyt
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass
 
 import numpy as np
 
 from spur_cad.cad.specs import StockSpec
-from spur_cad.dialects import WORK_OFFSETS, dialects_meaning, lathe_names
-from spur_cad.errors import SpurCadError, require_instance
+from spur_cad.dialects import DIALECTS, WORK_OFFSETS, Dialects, dialects_meaning, lathe_names
+from spur_cad.errors import SpurCadError, require_instance, shown
 from spur_cad.geometry.spec import GearSpec
-from spur_cad.keys import check_section, key
+from spur_cad.keys import check_section, key, key_of, with_key
 
+DEFAULT_LATHE_DIALECT = "siemens"
 MAX_PASSES = 10_000
 """Largest number of passes and plunges one lathe program may have (far more than any blank needs)."""
 BAR_STEP_MM = 5.0
@@ -63,7 +65,7 @@ class LatheError(SpurCadError, ValueError):
 class LatheSection:
     """[lathe]: the blank's lathe program from bar stock (docs/lathe.md); X as diameter, Z0 on the front face."""
 
-    dialect: str = key("siemens", label="LatheDialect", group="Lathe", choices=lathe_names(),
+    dialect: str = key(DEFAULT_LATHE_DIALECT, label="LatheDialect", group="Lathe", choices=lathe_names(),
                        meaning=f"the lathe's control: {dialects_meaning(lathe_names())}; see docs/lathe.md")
     bar_diameter_mm: float = key(0.0, unit="mm", low=0.0, high=2000.0, label="LatheBarDiameter", group="Lathe",
                                  meaning="diameter of the bar stock, 0: the blank diameter + 2 mm rounded up to "
@@ -126,9 +128,31 @@ class LatheSection:
     def validate(self) -> None:
         """Raise LatheError for a key outside its range or choices, or keys that contradict each other."""
         check_section(self, "lathe", LatheError)
+        names = key_of(type(self), "dialect").names  # the registry's this section was made for
+        if self.dialect not in names:  # a registry without lathe words gives no choices to check
+            raise LatheError(f"[lathe] dialect = {shown(self.dialect)} is not known (known: "
+                             f"{', '.join(names) or 'no dialect with lathe words'})", field="dialect")
         if self.parting_tool_number == self.turning_tool_number:
             raise LatheError(f"[lathe] parting_tool_number = {self.parting_tool_number} is the turning insert's "
                              "number too; the blade needs a turret position of its own", field="parting_tool_number")
+
+
+def lathe_section_type(dialects: Dialects = DIALECTS) -> type[LatheSection]:
+    """The [lathe] section for a registry of dialects: LatheSection for the default registry, else a subclass
+    whose `dialect` key takes the registry's dialects with lathe words (its default siemens when among them,
+    else the first)."""
+    names = lathe_names(dialects)
+    return _lathe_section_type(names, f"the lathe's control: {dialects_meaning(names, dialects)}; see docs/lathe.md")
+
+
+@functools.cache
+def _lathe_section_type(names: tuple[str, ...], meaning: str) -> type[LatheSection]:
+    declared = key_of(LatheSection, "dialect")
+    if names == declared.names and meaning == declared.meaning:
+        return LatheSection
+    default = DEFAULT_LATHE_DIALECT if DEFAULT_LATHE_DIALECT in names or not names else names[0]
+    return with_key(LatheSection, "dialect", key(default, label=declared.label, group=declared.group,
+                                                 meaning=meaning, choices=names))
 
 
 @dataclass(frozen=True)

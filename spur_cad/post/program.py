@@ -20,7 +20,7 @@ import numpy as np
 
 from spur_cad.cam.ir import MoveKind, Toolpath
 from spur_cad.cam.machine import check_rotary_code
-from spur_cad.dialects import Dialect, FoldStyle
+from spur_cad.dialects import DIALECTS, Dialect, Dialects, FoldStyle
 from spur_cad.dialects import dialect as dialect_named
 from spur_cad.errors import PostError, require_instance, shown
 from spur_cad.post.header import program_head, setup_blocks
@@ -64,13 +64,13 @@ class _Run:
 
 
 def post_program(path: Toolpath, settings: PostSettings, info: ProgramInfo,
-                 dialect: Dialect | None = None) -> PostedProgram:
-    """Write `path` as one program in the settings' dialect, or in `dialect` when given (a controller that is
-    not in the table, e.g. one being added: docs/post.md; settings.dialect is then not used)."""
+                 dialect: Dialect | None = None, dialects: Dialects = DIALECTS) -> PostedProgram:
+    """Write `path` as one program in the settings' dialect (of the registry `dialects`), or in `dialect` when
+    given (a controller in no registry, e.g. one being added: docs/post.md; settings.dialect is then not used)."""
     settings.validate()
     if dialect is not None:
         require_instance(dialect, Dialect, "dialect")
-    d = dialect_named(settings.dialect if dialect is None else dialect)
+    d = dialect_named(settings.dialect if dialect is None else dialect, dialects)
     if len(path) == 0:
         raise PostError(f"{shown(info.title)}: the toolpath is empty")
     _check_numbers(path, info)

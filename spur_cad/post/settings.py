@@ -2,13 +2,16 @@
 
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass
 
-from spur_cad.dialects import WORK_OFFSETS, dialect_names, dialects_meaning
+from spur_cad.dialects import DIALECTS, WORK_OFFSETS, Dialects, dialect_names, dialects_meaning
 from spur_cad.errors import PostError, shown
-from spur_cad.keys import check_section, key
+from spur_cad.keys import check_section, key, key_of, with_key
 
-__all__ = ["WORK_OFFSETS", "PostError", "PostSettings", "dialect_names"]
+__all__ = ["WORK_OFFSETS", "PostError", "PostSettings", "dialect_names", "post_settings_type"]
+
+DEFAULT_DIALECT = "linuxcnc"
 
 
 @dataclass(frozen=True)
@@ -21,7 +24,7 @@ class PostSettings:
     the count, "stop" stops numbering).
     """
 
-    dialect: str = key("linuxcnc", label="PostDialect", group="Post", names_from=dialect_names,
+    dialect: str = key(DEFAULT_DIALECT, label="PostDialect", group="Post", names_from=dialect_names,
                        meaning=f"G-code dialect: {dialects_meaning()}; see docs/post.md")
     line_numbers: bool = key(False, label="LineNumbers", group="Post", meaning="write N block numbers")
     line_number_step: int = key(1, low=1, high="max_line_number", label="LineNumberStep", group="Post",
@@ -46,11 +49,31 @@ class PostSettings:
 
     def validate(self) -> None:
         check_section(self, "post", PostError)
-        if self.dialect not in dialect_names():
-            raise PostError(f"[post] dialect = {shown(self.dialect)} is not known "
-                            f"(known: {', '.join(dialect_names())})",
+        names = key_of(type(self), "dialect").names  # the registry's this section was made for
+        if self.dialect not in names:
+            raise PostError(f"[post] dialect = {shown(self.dialect)} is not known (known: {', '.join(names)})",
                             field="dialect")
         if self.folded and self.rotary_mode == "wrapped":
             raise PostError("[post] folded = true needs rotary_mode = 'unwound': a folded space pattern adds "
                             "its angles to the space's base angle, which cannot stay inside [0, 360); "
                             "set folded = false to write a wrapped program", field="folded")
+
+
+def post_settings_type(dialects: Dialects = DIALECTS) -> type[PostSettings]:
+    """The [post] section for a registry of dialects: PostSettings for the default registry, else a subclass
+    whose `dialect` key takes the registry's names (its default linuxcnc when the registry has it, else its
+    first dialect) and lists them in its meaning."""
+    names = dialect_names(dialects)
+    return _post_settings_type(names, f"G-code dialect: {dialects_meaning(None, dialects)}; see docs/post.md")
+
+
+@functools.cache
+def _post_settings_type(names: tuple[str, ...], meaning: str) -> type[PostSettings]:
+    declared = key_of(PostSettings, "dialect")
+    if names == declared.names and meaning == declared.meaning:
+        return PostSettings
+    if not names:
+        raise ValueError("a [post] section needs a registry of at least one dialect")
+    return with_key(PostSettings, "dialect", key(DEFAULT_DIALECT if DEFAULT_DIALECT in names else names[0],
+                                                 label=declared.label, group=declared.group, meaning=meaning,
+                                                 names_from=lambda: names))

@@ -176,11 +176,9 @@ TOOL_HEAD = ("tool", "used for", "type", "D [mm]", "corner r [mm]", "flat [mm]",
 
 def program_file(result: JobResult, operation: str) -> str:
     """The operation's program file as the output set names it ('-' when no program was written)."""
-    from spur_cad.dialects import dialect
-
     if result.post.program(operation) is None:
         return "-"
-    return f"{operation}.{dialect(result.post.dialect).extension}"
+    return f"{operation}.{result.post.extension}"
 
 
 def tool_table(result: JobResult) -> Table:

@@ -213,7 +213,7 @@ def verify_programs(job_obj, paths: list[str], dialect: str | None = None, point
     programs = []
     with WorkProgress("Verify program", ("reading", "simulation")) as work:
         for path in paths:  # regular files of bounded size, read as a stream (spur-cad verify's reader)
-            programs.append(read_program_file(path, dialect or job.post.dialect))
+            programs.append(read_program_file(path, dialect or job.post.dialect, dialects=job.dialects))
             work.events()
         work.stage_done("reading")
         result = verify_moves(job, programs, VerifyOptions(point), progress=lambda done: work.advance("simulation",
