@@ -195,3 +195,38 @@ def test_a_new_dialects_lathe_words_write_and_read_the_blank_program():
     with pytest.raises(LatheError, match="dialect = 'acme_mill' is not known"):
         post_lathe(plan, lathe, job.job.name, dialect=without)
 
+
+
+# --- the documents that list the controllers follow the registry ----------------------------------------------
+
+
+def _table_rows(document: str, first_row: str) -> list[list[str]]:
+    """The cells of the markdown table of `document` whose first line starts with `first_row`."""
+    lines = (ROOT / document).read_text(encoding="utf-8").splitlines()
+    start = next(i for i, line in enumerate(lines) if line.startswith(first_row))
+    rows = []
+    for line in lines[start:]:
+        if not line.startswith("|"):
+            break
+        rows.append([cell.strip() for cell in line.strip().strip("|").split("|")])
+    return rows
+
+
+def test_the_documents_name_every_dialect_of_the_registry():
+    """docs/post.md's table has one column per dialect, in the registry's order, titled and filed as the table
+    says; docs/verification.md's reader table a row per dialect; docs/lathe.md a column per lathe dialect; the
+    README and docs/usage.md name every controller. A dialect added to the registry fails here until they do."""
+    post = _table_rows("docs/post.md", "| | LinuxCNC |")
+    assert post[0][1:] == [d.title for d in DIALECTS.values()]
+    files = next(row for row in post if row[0] == "file")[1:]
+    assert [cell.split(",")[0] for cell in files] == [f"`.{d.extension}`" for d in DIALECTS.values()]
+    assert [("%" in cell) for cell in files] == [d.percent_delimited for d in DIALECTS.values()]
+    reader = _table_rows("docs/verification.md", "| dialect | subprograms")
+    assert [row[0] for row in reader[2:]] == [f"`{name}`" for name in DIALECTS]
+    lathe = _table_rows("docs/lathe.md", "| | Siemens 840D")
+    lathe_titles = lathe[0][1:]
+    assert len(lathe_titles) == len(lathe_names()) and all(
+        any(title.startswith(DIALECTS[name].title) for title in lathe_titles) for name in lathe_names())
+    for document in ("README.md", "docs/usage.md"):
+        text = " ".join((ROOT / document).read_text(encoding="utf-8").split())
+        assert all(d.title.split()[0] in text for d in DIALECTS.values()), document

@@ -55,3 +55,23 @@ def test_the_solid_examples_run_and_agree_with_the_exact_outline(document):
     solid = namespace["part"] if document == "docs/cad.md" else namespace["solid"]
     assert isinstance(solid, build123d.Solid)
     assert solid.bounding_box().min.Z == pytest.approx(-spec.face_width_mm / 2.0, abs=1e-6)
+
+
+def test_the_how_to_add_a_dialect_example_of_docs_post_md_runs_as_written(capsys, monkeypatch):
+    """docs/post.md's worked example: its table entry is the dialect tests/test_dialect_table.py defines, and the
+    registry made from it takes a job file's `[post] dialect = "acme"`, writes `.acm` programs that start as the
+    entry says, has them in the output vocabulary and reads them back: what each print's comment says it prints."""
+    from spur_cad.dialects import DIALECTS
+    from tests.test_dialect_table import ACME
+
+    (entry,) = python_blocks("docs/post.md", "ACME = replace(")
+    (run,) = python_blocks("docs/post.md", "dialects=WITH_ACME")
+    monkeypatch.chdir(ROOT)  # the example names the reference job relative to the checkout
+    namespace: dict = {}
+    exec(compile(entry, "docs/post.md", "exec"), namespace)
+    assert namespace["ACME"] == ACME and tuple(namespace["WITH_ACME"]) == (*DIALECTS, "acme")
+    exec(compile(run, "docs/post.md", "exec"), namespace)
+    printed = capsys.readouterr().out.splitlines()
+    promised = [line.split("# ", 1)[1] for line in run.splitlines() if line.startswith("print(")]
+    assert printed == promised
+    assert "acme" not in DIALECTS  # nothing global changed
