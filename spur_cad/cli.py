@@ -93,12 +93,21 @@ def _parser() -> argparse.ArgumentParser:
                        help="exit 1 when the gear is worse than this flank tolerance class")
     grade.add_argument("--debug", action="store_true", help="show tracebacks of internal errors")
     correct = sub.add_parser("correct", help="identify the machine's errors from a measured gear and write corrected "
-                                             "programs (tool size, index table, slopes) with correction.json and "
+                                             "programs (tool size, the rotary table's error e(A), slopes) with "
+                                             "correction.json and "
                                              "report.html")
     correct.add_argument("job", help="TOML job file the measured gear was cut with")
     correct.add_argument("measured", help="CSV of measured points as spur-cad grade reads it (x_mm,y_mm[,X_mm]; "
                                           "the scan's frame within half a pitch of the machine's, space 0 at A 0), "
                                           "or the probe log of the job's probe program (size and slopes only)")
+    correct.add_argument("--datum", choices=("best-fit", "axis"), help="CSV: 'best-fit' (default) fits the centre "
+                         "and the turn, and cannot see a once-per-turn error (an eccentric gear); 'axis' takes the "
+                         "file's origin as the gear's datum axis (the bore) and fits the turn only, so the table's "
+                         "once-per-turn error is seen and corrected. A probe log has its own datum, the A axis")
+    correct.add_argument("--once-per-turn", choices=("table", "blank"), default="table",
+                         help="with --datum axis: take a once-per-turn error for the table's (default: the A words are "
+                              "corrected, right for every blank) or for the blank clamped off the A axis (Y and Z "
+                              "corrected, for this set-up only); the scan cannot tell them apart (docs/correction.md)")
     correct.add_argument("--out", required=True, help="folder for the corrected programs and correction.json")
     correct.add_argument("--quiet", action="store_true", help="print nothing but errors")
     correct.add_argument("--debug", action="store_true", help="show tracebacks of internal errors")
@@ -380,12 +389,11 @@ def _grade(args: argparse.Namespace, received: list[int], loaded: list) -> int:
 
 
 def _correct(args: argparse.Namespace, received: list[int], loaded: list) -> int:
-    """`spur-cad correct`: identify the size, index and slope errors in the measured points, write the corrected
-    set."""
-    import numpy as np
-
+    """`spur-cad correct`: identify the size, the table's e(A) and the slopes in the measured points, write the
+    corrected set."""
     from spur_cad.correct.correct import correct_job
     from spur_cad.errors import shown_path
+    from spur_cad.grade.measured import MeasuredPoints
     from spur_cad.grade.probe_log import read_measured_file
     from spur_cad.job import load_job
     from spur_cad.outputs import check_output_folder
@@ -395,19 +403,29 @@ def _correct(args: argparse.Namespace, received: list[int], loaded: list) -> int
     loaded.append(load_job(args.job, side_folders=_side_folders(args.side_files)))
     measured = read_measured_file(args.measured)  # a scan's CSV, or the job's probe log
     _checkpoint(received)
-    identified, files = correct_job(loaded[0], measured, shown_path(args.measured))
+    if args.datum == "best-fit" and not isinstance(measured, MeasuredPoints):
+        raise SpurCadError(f"{shown_path(args.measured)}: a probe log is read against the A axis (the gear's datum "
+                           "axis in the cutting setup); --datum is for CSV scans")
+    identified, applied, files = correct_job(loaded[0], measured, shown_path(args.measured),
+                                             args.datum or "best-fit", args.once_per_turn)
     _checkpoint(received)
     paths = _write(out_dir, files, received)
     if not args.quiet:
         print(f"size error: {identified.size_um:+.2f} um +- {identified.size_uncertainty_um:.2f} "
               "(+: material left; the finishing tool is programmed for it)")
-        index = identified.index_arcsec
-        if identified.index_visible:
-            print(f"index errors: {np.nanmin(index):+.1f} to {np.nanmax(index):+.1f} arcsec +- "
-                  f"{identified.index_uncertainty_arcsec:.1f} (relative to their mean; each space's A corrected)")
-        else:
-            print("index errors: not seen by a probe log (the table's error is in the cutting and the probing): "
+        table = identified.table
+        if table is None:
+            print("table error e(A): not seen by a probe log (the probe turns on the table that cut the gear): "
                   "not corrected")
+        else:
+            kept = ", ".join(f"order {h.order} {h.amplitude_arcsec:.1f} arcsec" for h in table.kept) or "none"
+            print(f"table error e(A), orders {table.harmonics[0].order} to {table.harmonics[-1].order} tested: "
+                  f"{kept} (every block's A corrected)")
+            if not table.first_order_visible:
+                print("once-per-turn error: not seen on a best-fit scan (an eccentric gear); use --datum axis")
+            elif applied.once_per_turn is not None:
+                print(f"once-per-turn error taken for the {applied.once_per_turn}'s; a blank off the A axis leaves "
+                      "the same gear: probe the bore's centre at set-up (correction.json)")
         for name, slopes in (("profile slope", identified.profile_slope_um),
                              ("helix slope", identified.helix_slope_um)):
             print(f"{name}: " + ", ".join(f"{side} {value:+.2f} um" for side, value in slopes.items())

@@ -87,7 +87,7 @@ def _output_name(extensions: tuple[str, ...]) -> re.Pattern:
         rf"|{_OPERATION}_(space|station)\d{{1,7}}(_(level|pass)\d{{1,7}})?\.{program}"  # restart programs
         r"|verify\.json|deviation_map\.csv"  # spur-cad verify
         r"|grade\.json|k_chart\.png"  # spur-cad grade
-        r"|correction\.json",  # spur-cad correct (with the corrected programs)
+        r"|correction\.json|a_axis\.comp",  # spur-cad correct (with the corrected programs)
         re.ASCII)  # digits are 0-9 only
 
 

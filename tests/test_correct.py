@@ -1,53 +1,55 @@
-"""Corrected programs from a measured gear (issue 30, point 4): a planted machine (tool 8 um larger in radius than
-the program assumes, rotary index error 25 arcsec x sin(A + 40 deg)) cuts the reference gear in simulation; its
-flank points, written as a scan would (turned and shifted), give back the size error and every space's index
-error; `spur-cad correct` writes the corrected programs."""
+"""Corrected programs from a measured gear (issues 30 and 46): a planted machine (tests/machine_model.py: tools 8 um
+larger in radius than programmed, the table standing 25 arcsec x sin(A + 40 deg) further at each block's commanded A)
+cuts the reference gear from its LinuxCNC finishing program as rs274 interprets it, in an independent 2-D section;
+the scan of that cut about the gear's datum axis gives back the size error and the table's e(A), and `spur-cad correct
+--datum axis` writes programs that, cut on the same machine, give the design. Also for a second-order table error and
+a blank clamped off the A axis (which leaves the same gear as a once-per-turn table error)."""
 
 from __future__ import annotations
 
 import dataclasses
+import json
 import math
 
 import numpy as np
 import pytest
 
+from spur_cad.correct.contact import contact_angles
 from spur_cad.correct.correct import finishing_cut, ideal_flanks
 from spur_cad.correct.identify import identify
 from spur_cad.grade.measured import read_points_csv
+from spur_cad.grade.simulated import profile_range_mm
 from spur_cad.job import load_job
 from spur_cad.pipeline import job_stock, plan_cam
 from tests.gears import REFERENCE_JOB
+from tests.machine_model import Harmonic, PlantedMachine, cut_planes, flank_figures
+from tests.machine_model import scan_csv as machine_scan_csv
+from tests.rs274_helper import rs274_path, run_rs274
 
 TOOL_RADIUS_ERROR_UM = 8.0
-INDEX_AMPLITUDE_ARCSEC = 25.0
-INDEX_PHASE_DEG = 40.0
-ARCSEC_DEG = 1.0 / 3600.0
+ISSUE_MACHINE = PlantedMachine(TOOL_RADIUS_ERROR_UM, (Harmonic(25.0, 1, 40.0),))
+SECOND_ORDER = PlantedMachine(0.0, (Harmonic(15.0, 2, 0.0),))
+OFF_CENTRE_BLANK = PlantedMachine(0.0, (), (5.0, 0.0))
 SCAN_TURN_DEG = 2.7  # within half a pitch (7.8 deg) of the machine's frame: the scan's spaces keep their numbers
-SCAN_CENTRE_MM = (0.04, -0.025)
 SCAN_ROWS_MM = (8.0, 10.0, 12.0)
+SECTION_X_MM = 10.0
+ACCEPTANCE_UM = 2.0
+needs_rs274 = pytest.mark.skipif(rs274_path() is None, reason="rs274 (linuxcnc-uspace) not installed")
 
 
-def planted_index_arcsec(teeth: int) -> np.ndarray:
-    """The planted machine's index error of each space: 25 arcsec x sin(A + 40 deg) at the space's index angle
-    A = -k 360 / z (in [0, 360))."""
-    a_deg = np.mod(-360.0 * np.arange(teeth) / teeth, 360.0)
-    return INDEX_AMPLITUDE_ARCSEC * np.sin(np.radians(a_deg + INDEX_PHASE_DEG))
-
-
-def planted_cut(job, path, tool, rows_mm=SCAN_ROWS_MM):
-    """The finishing toolpath cut on the planted machine over the rows' X range: every move of space k stands e_k
-    further in A than its A word (an independent turn of the IR, not the correction's code), the tool 8 um larger in
-    radius."""
-    a = path.a.copy()
-    spaces = path.space >= 0
-    a[spaces] += planted_index_arcsec(job.gear.teeth)[path.space[spaces]] * ARCSEC_DEG
-    bigger = dataclasses.replace(tool, diameter_mm=tool.diameter_mm + 2.0 * TOOL_RADIUS_ERROR_UM / 1000.0)
+def planted_cut(job, path, tool, rows_mm=SCAN_ROWS_MM, machine=ISSUE_MACHINE):
+    """The finishing toolpath cut in spur_cad's simulator on a machine whose table stands e(A) further at each row's
+    own A (the machine's e, evaluated per row of the IR: an independent plant, not the correction's code) with the tool
+    larger by its radius error, over the rows' X range (for the slope and modification tests, whose traces need many
+    planes)."""
+    a = path.a + machine.table_error_arcsec(path.a) / 3600.0
+    bigger = dataclasses.replace(tool, diameter_mm=tool.diameter_mm + 2.0 * machine.tool_radius_error_um / 1000.0)
     return finishing_cut(job.gear, path.replace(a=a), bigger, job_stock(job), (rows_mm[0], rows_mm[-1]))
 
 
 def scan_csv(result, rows_mm=SCAN_ROWS_MM, planted_mm=None) -> str:
-    """The cut's involute points (the design point moved along its normal by the simulated deviation) in the rows
-    at rows_mm, turned by SCAN_TURN_DEG and shifted by SCAN_CENTRE_MM as a scan's frame would be, in the
+    """A simulated cut's involute points (the design point moved along its normal by the simulated deviation) in the
+    rows at rows_mm, about the gear's datum axis, turned by SCAN_TURN_DEG as a scan's frame would be, in the
     `spur-cad grade` CSV format. planted_mm(side, radius_mm, x_mm): a deviation (mm, + material) added to each
     point of that side and radius in the row at x, e.g. a slope."""
     grid = result.grid
@@ -64,8 +66,8 @@ def scan_csv(result, rows_mm=SCAN_ROWS_MM, planted_mm=None) -> str:
         for k in range(grid.teeth):
             points, normals = grid.space_points(k)[flank], grid.space_normals(k)[flank]
             moved = points + (result.deviation[k, flank, row] + planted)[:, None] * normals
-            y = c * moved[:, 0] - s * moved[:, 1] + SCAN_CENTRE_MM[0]
-            z = s * moved[:, 0] + c * moved[:, 1] + SCAN_CENTRE_MM[1]
+            y = c * moved[:, 0] - s * moved[:, 1]
+            z = s * moved[:, 0] + c * moved[:, 1]
             lines += [f"{a:.6f},{b:.6f},{grid.rows_x[row]:.4f}" for a, b in zip(y, z)]
     return "\n".join(lines) + "\n"
 
@@ -78,55 +80,167 @@ def reference():
 
 
 @pytest.fixture(scope="module")
-def planted_scan(reference):
-    job, plan, _ = reference
-    return scan_csv(planted_cut(job, plan.finishing.toolpath, plan.finishing.tool))
+def original_program(tmp_path_factory) -> str:
+    from spur_cad.cli import main
+
+    folder = tmp_path_factory.mktemp("original")
+    assert main(["run", str(REFERENCE_JOB), "--out", str(folder / "out"), "--quiet"]) == 0
+    return (folder / "out" / "finishing.ngc").read_text()
 
 
-def test_the_planted_machines_size_and_index_errors_are_identified(reference, planted_scan):
-    job, _, ideal = reference
-    found = identify(job.gear, read_points_csv(planted_scan, "scan.csv"), ideal)
-    assert found.size_um == pytest.approx(-TOOL_RADIUS_ERROR_UM, abs=1.0)  # a larger tool: less material
-    planted = planted_index_arcsec(job.gear.teeth)
-    assert np.all(np.isfinite(found.index_arcsec))
-    assert np.abs(found.index_arcsec - (planted - planted.mean())).max() < 2.0  # relative to their mean
+def machine_cut(job, program: str, machine: PlantedMachine, planes=SCAN_ROWS_MM):
+    """The program cut on the machine (tests/machine_model.py) in the planes, with the job's finishing tool as
+    programmed (the machine adds its radius error)."""
+    tool = job.tools.finishing
+    return cut_planes(job.gear, program, machine, tool.diameter_mm, tool.corner_radius_mm, planes)
+
+
+@pytest.fixture(scope="module")
+def planted_scan(reference, original_program):
+    """The scan about the datum axis of the issue's machine's cut of the original finishing program."""
+    return machine_scan_csv(machine_cut(reference[0], original_program, ISSUE_MACHINE), SCAN_TURN_DEG)
+
+
+@needs_rs274
+def test_the_planted_machines_size_and_table_error_are_identified(reference, planted_scan):
+    job, plan, ideal = reference
+    spec = job.gear
+    contacts = contact_angles(spec, plan.finishing.toolpath, plan.finishing.tool)
+    found = identify(spec, read_points_csv(planted_scan, "scan.csv"), contacts, ideal, datum="axis")
+    assert found.size_um == pytest.approx(-TOOL_RADIUS_ERROR_UM, abs=0.5)  # a larger tool: less material
+    assert [h.order for h in found.table.kept] == [1]  # nothing else passes the significance test
+    first = found.table.kept[0]
+    assert first.amplitude_arcsec == pytest.approx(25.0, abs=0.5)
+    assert math.degrees(math.atan2(first.cos_arcsec, first.sin_arcsec)) == pytest.approx(40.0, abs=1.0)
     assert found.scan_turn_deg == pytest.approx(SCAN_TURN_DEG, abs=0.01)
-    assert found.size_uncertainty_um < 1.0 and found.index_uncertainty_arcsec < 2.0
+    assert found.size_uncertainty_um < 0.5 and first.uncertainty_arcsec < 1.0
+    # the same gear as a blank off the A axis: every flank moved by c . n with |c| = r_b E
+    eccentricity_um = spec.base_radius_mm * 25.0 * math.pi / (180.0 * 3600.0) * 1000.0
+    assert math.hypot(*found.blank_offset_um) == pytest.approx(eccentricity_um, abs=0.1)
+    best_fit = identify(spec, read_points_csv(planted_scan, "scan.csv"), contacts, ideal, datum="best-fit")
+    assert not best_fit.table.first_order_visible and not best_fit.table.kept  # the fitted centre takes it
+    assert best_fit.size_um == pytest.approx(-TOOL_RADIUS_ERROR_UM, abs=0.5)
+
+
+@needs_rs274
+def test_the_contact_angles_turn_each_flank_normal_onto_the_tools_side(reference):
+    """Generating finishing cuts each flank point where its normal lies along the machine's Y (the tool's side):
+    the right flank's normal turned by A points along -Y, the left's along +Y (spur_cad.cam.strategies.
+    generating_geometry), so A = 180 deg - angle(n), resp. -angle(n); the contacts found from the toolpath's poses
+    agree within the passes' spacing."""
+    from spur_cad.sim.design import design_grid
+
+    job, plan, _ = reference
+    spec = job.gear
+    contacts = contact_angles(spec, plan.finishing.toolpath, plan.finishing.tool)
+    grid = design_grid(spec, 0.05, 0.0, 0.0, np.zeros(0))
+    names = np.array(grid.feature_names())
+    for side, target_deg in (("right", 180.0), ("left", 0.0)):
+        on = names == f"{side} involute"
+        points, normals = grid.points[on], grid.normals[on]
+        roll = np.sqrt(np.hypot(points[:, 0], points[:, 1]) ** 2 - spec.base_radius_mm ** 2)
+        inside = (roll > contacts.roll_mm[side][0]) & (roll < contacts.roll_mm[side][-1])
+        expected = target_deg - np.degrees(np.arctan2(normals[:, 1], normals[:, 0]))
+        found = contacts.at(np.full(len(roll), side), roll, np.zeros(len(roll)))
+        assert np.abs(np.mod(found - expected + 180.0, 360.0) - 180.0)[inside].max() < 0.1
+        assert len(contacts.roll_mm[side]) >= 5
 
 
 @pytest.fixture(scope="module")
 def corrected(tmp_path_factory, planted_scan):
-    """`spur-cad correct` on the planted machine's scan: (exit code, output folder)."""
+    """`spur-cad correct --datum axis` on the planted machine's scan: (exit code, output folder)."""
     from spur_cad.cli import main
 
     folder = tmp_path_factory.mktemp("correct")
     (folder / "scan.csv").write_text(planted_scan)
-    code = main(["correct", str(REFERENCE_JOB), str(folder / "scan.csv"), "--out", str(folder / "out"), "--quiet"])
+    code = main(["correct", str(REFERENCE_JOB), str(folder / "scan.csv"), "--datum", "axis", "--out",
+                 str(folder / "out"), "--quiet"])
     return code, folder / "out"
 
 
+@needs_rs274
 def test_correct_writes_the_corrected_programs_and_correction_json(reference, corrected):
-    import json
-
     job, _, _ = reference
     code, out = corrected
     assert code == 0
     assert sorted(p.name for p in out.iterdir() if not p.name.startswith(".")) == \
-        ["correction.json", "finishing.ngc", "report.html", "roughing.ngc"]
+        ["a_axis.comp", "correction.json", "finishing.ngc", "report.html", "roughing.ngc"]
     correction = json.loads((out / "correction.json").read_text())
+    assert correction["datum"] == "axis"
     size = correction["size_error_um"]
-    assert size["value"] == pytest.approx(-TOOL_RADIUS_ERROR_UM, abs=1.0) and 0.0 <= size["uncertainty"] < 1.0
+    assert size["value"] == pytest.approx(-TOOL_RADIUS_ERROR_UM, abs=0.5) and 0.0 <= size["uncertainty"] < 0.5
     tool = correction["corrections"]["finishing_tool_diameter_mm"]
-    assert tool["before"] == 2.0 and tool["programmed"] == pytest.approx(2.016, abs=0.002)  # the tool as it cuts
-    planted = planted_index_arcsec(job.gear.teeth)
-    index = np.array(correction["index_error_arcsec"]["values"])
-    assert np.abs(index - (planted - planted.mean())).max() < 2.0
-    a_correction = np.array(correction["corrections"]["a_correction_deg"]) * 3600.0
-    assert np.abs(a_correction + index).max() < 0.01  # each space's A turned back by its error
+    assert tool["before"] == 2.0 and tool["programmed"] == pytest.approx(2.016, abs=0.001)  # the tool as it cuts
+    table = correction["table_error_arcsec"]
+    assert table["kept"] == [1] and table["orders_tested"] == [1, job.gear.teeth // 2]
+    first = table["harmonics"][0]
+    assert first["amplitude"] == pytest.approx(25.0, abs=0.5) and first["phase_deg"] == pytest.approx(40.0, abs=1.0)
+    assert correction["corrections"]["a_words"]["orders"] == [1] and "unfolded" in correction["corrections"]
+    once = correction["once_per_turn"]
+    assert once["found"] and once["assumed"] == "table" and "bore" in once["check"] and "same gear" in once["why"]
     assert set(correction["not_corrected"]) >= {"slopes_off_the_involute", "form"}
     assert correction["profile_slope_um"]["corrected"] and correction["helix_slope_um"]["corrected"]
-    header = (out / "finishing.ngc").read_text().split("\n", 40)[:40]
-    assert any("corrected from" in line and "D 2.016" in line for line in header)
+    program = (out / "finishing.ngc").read_text()
+    header = program.split("\n", 40)[:40]
+    assert any("corrected from" in line and "D 2.016" in line and "unfolded" in line for line in header)
+    assert " sub" not in program and " call" not in program  # unfolded: a per-block correction
+    for name in ("finishing.ngc", "roughing.ngc"):  # LinuxCNC's own interpreter takes every corrected program
+        ok, _, messages = run_rs274(out / name)
+        assert ok, (name, messages)
+
+
+@needs_rs274
+def test_the_compensation_file_holds_minus_the_corrections_a_change(corrected, original_program):
+    """a_axis.comp (LinuxCNC COMP_FILE_TYPE 1: nominal, forward trim, reverse trim, deg): the trim at each nominal
+    A is the identified e(A), the same the corrected program takes off its A words, in at most 256 lines over the
+    A the programs command."""
+    out = corrected[1]
+    rows = np.loadtxt(out / "a_axis.comp")
+    assert rows.shape[1] == 3 and len(rows) <= 256 and np.all(np.diff(rows[:, 0]) > 0.0)
+    assert np.array_equal(rows[:, 1], rows[:, 2])
+    planted = ISSUE_MACHINE.table_error_arcsec(rows[:, 0]) / 3600.0
+    assert np.abs(rows[:, 1] - planted).max() * 3600.0 < 0.5  # the planted table's, within 0.5 arcsec
+    ok, canon, _ = run_rs274(out / "finishing.ngc")
+    a_words = [float(line.split(",")[3]) for line in canon if line.startswith("STRAIGHT_")]
+    assert rows[0, 0] <= min(a_words) and max(a_words) <= rows[-1, 0]
+
+
+MACHINES = {"issue": (ISSUE_MACHINE, "table"), "second order": (SECOND_ORDER, "table"),
+            "off-centre blank, taken for the table": (OFF_CENTRE_BLANK, "table"),
+            "off-centre blank, taken for the blank": (OFF_CENTRE_BLANK, "blank")}
+
+
+@needs_rs274
+@pytest.mark.parametrize("case", list(MACHINES))
+def test_the_corrected_program_cut_on_the_planted_machine_gives_the_design(reference, original_program, tmp_path,
+                                                                           case):
+    """Issue 46's acceptance: the machine's cut of the original program scanned about the datum axis, corrected with
+    --datum axis, and the corrected finishing program cut on the same machine: F_p <= 2 um per side about the datum
+    axis, the size within 2 um of the design and no gouge beyond 2 um; the original program on that machine fails
+    the same bounds (the correction switched off)."""
+    from spur_cad.cli import main
+
+    machine, once_per_turn = MACHINES[case]
+    job = reference[0]
+    spec = job.gear
+    (tmp_path / "scan.csv").write_text(machine_scan_csv(machine_cut(job, original_program, machine), SCAN_TURN_DEG))
+    assert main(["correct", str(REFERENCE_JOB), str(tmp_path / "scan.csv"), "--datum", "axis", "--once-per-turn",
+                 once_per_turn, "--out", str(tmp_path / "out"), "--quiet"]) == 0
+    program = (tmp_path / "out" / "finishing.ngc").read_text()
+    evaluation = profile_range_mm(spec)
+    after = flank_figures(spec, machine_cut(job, program, machine, (SECTION_X_MM,))[SECTION_X_MM], evaluation)
+    before = flank_figures(spec, machine_cut(job, original_program, machine, (SECTION_X_MM,))[SECTION_X_MM],
+                           evaluation)
+    for figures, corrected_ in ((after, True), (before, False)):
+        within = (max(figures.pitch_total_um.values()) <= ACCEPTANCE_UM and abs(figures.size_um) <= ACCEPTANCE_UM
+                  and figures.gouge_um <= ACCEPTANCE_UM)
+        assert within == corrected_, (case, corrected_, figures.pitch_total_um, figures.size_um, figures.gouge_um)
+    correction = json.loads((tmp_path / "out" / "correction.json").read_text())
+    if machine.blank_offset_um != (0.0, 0.0):  # the gear's centre as cut about the datum: minus the blank's offset
+        centre = correction["once_per_turn"]["as_gear_centre_um"]
+        assert np.allclose(centre, -np.array(machine.blank_offset_um), atol=0.2), centre
+        moved = "y_z_words" if once_per_turn == "blank" else "a_words"
+        assert moved in correction["corrections"] and correction["once_per_turn"]["assumed"] == once_per_turn
 
 
 @pytest.mark.parametrize("text, message", [
@@ -141,86 +255,6 @@ def test_bad_measured_files_are_one_line_and_nothing_is_written(tmp_path, capsys
     err = capsys.readouterr().err.strip()
     assert code == 2 and len(err.splitlines()) == 1 and message in err, err
     assert not (tmp_path / "out").exists()
-
-
-SECTION_X_MM = 10.0  # the transverse section of the 2-D cut (mid face)
-
-
-def _sweeps(program_text: str) -> np.ndarray:
-    """(Y, Z, A) of every cutting move of the program that sweeps along X through the section, as the independent
-    reader (tests/gcode_reader.py) interprets the text, in the order they run."""
-    from tests.gcode_reader import read_program
-
-    moves = read_program(program_text, "linuxcnc").moves
-    sweeps = [move.end[1:] for move in moves if not move.rapid and move.start[1:] == move.end[1:]
-              and min(move.start[0], move.end[0]) < SECTION_X_MM < max(move.start[0], move.end[0])]
-    return np.array(sweeps)
-
-
-def cut_2d(spec, program_text: str, tool_diameter_mm: float, corner_radius_mm: float,
-           index_arcsec: np.ndarray | None) -> dict[str, np.ndarray]:
-    """The section at SECTION_X_MM cut by the program's sweeps on a machine whose table stands index_arcsec[k]
-    further in A in space k (a program's spaces are its equal runs of sweeps, in order) with a tool of the given
-    size: shapely silhouettes (tests/silhouette.py), and each flank's mean signed distance of the design's involute
-    points in the profile evaluation range to the cut (um, + material), per side and space."""
-    import shapely
-
-    from spur_cad.grade.simulated import profile_range_mm
-    from tests.silhouette import design_boundary, place_silhouettes
-
-    sweeps = _sweeps(program_text)
-    per_space, rest = divmod(len(sweeps), spec.teeth)
-    assert rest == 0 and per_space > 10, len(sweeps)
-    a_deg = sweeps[:, 2].copy()
-    if index_arcsec is not None:
-        a_deg += np.repeat(index_arcsec, per_space) * ARCSEC_DEG
-    union = shapely.union_all(place_silhouettes(sweeps[:, 0], sweeps[:, 1], a_deg, tool_diameter_mm,
-                                                corner_radius_mm, 12.0))
-    points, _ = design_boundary(spec, range(spec.teeth), ("involute",))
-    rings = shapely.get_rings(shapely.get_parts(union))
-    segments = np.concatenate([np.stack([c[:-1], c[1:]], axis=1) for c in map(shapely.get_coordinates, rings)])
-    tree = shapely.STRtree(shapely.linestrings(segments))
-    (index, _), found = tree.query_nearest(shapely.points(points), return_distance=True, all_matches=False)
-    distance = np.full(len(points), np.nan)
-    distance[index] = found
-    distance[shapely.contains_xy(union, points[:, 0], points[:, 1])] *= -1.0  # inside the tool's sweep: gouged
-    angle = np.arctan2(points[:, 1], points[:, 0])
-    space = np.mod(np.rint((angle - math.pi / 2.0) / (2.0 * math.pi / spec.teeth)), spec.teeth).astype(int)
-    local = np.mod(angle - math.pi / 2.0 - space * 2.0 * math.pi / spec.teeth + math.pi, 2.0 * math.pi) - math.pi
-    # (space 0's gap is centred on +Z; local < 0 and > 0 are its two flanks)
-    roll = np.sqrt(np.maximum(np.hypot(points[:, 0], points[:, 1]) ** 2 - spec.base_radius_mm ** 2, 0.0))
-    start, end = profile_range_mm(spec)
-    in_range = (roll >= start) & (roll <= end)
-    flanks = {}
-    for name, on_side in (("minus", local < 0.0), ("plus", local > 0.0)):
-        flanks[name] = np.array([distance[in_range & on_side & (space == k)].mean() for k in range(spec.teeth)])
-        flanks[name] *= 1000.0
-    return flanks
-
-
-def pitch_total_um(spec, flank_um: np.ndarray) -> float:
-    """F_p of one side: the spread of the flanks' positions as arcs on the reference circle (normal / cos alpha)."""
-    return float(np.ptp(flank_um)) * spec.reference_radius_mm / spec.base_radius_mm
-
-
-def test_the_corrected_programs_cut_on_the_planted_machine_give_the_design(reference, corrected, tmp_path):
-    from spur_cad.cli import main
-
-    job, _, _ = reference
-    spec, tool = job.gear, job.tools.finishing
-    planted = planted_index_arcsec(spec.teeth)
-    real_diameter = tool.diameter_mm + 2.0 * TOOL_RADIUS_ERROR_UM / 1000.0
-    assert main(["run", str(REFERENCE_JOB), "--out", str(tmp_path / "original"), "--quiet"]) == 0
-    original = (tmp_path / "original" / "finishing.ngc").read_text()
-    ideal = cut_2d(spec, original, tool.diameter_mm, tool.corner_radius_mm, None)
-    before = cut_2d(spec, original, real_diameter, tool.corner_radius_mm, planted)
-    after = cut_2d(spec, (corrected[1] / "finishing.ngc").read_text(), real_diameter, tool.corner_radius_mm, planted)
-    for side in ("minus", "plus"):
-        assert pitch_total_um(spec, ideal[side]) < 0.5 and np.abs(ideal[side]).max() < 2.0  # the program's scallops
-        assert pitch_total_um(spec, before[side]) > 8.0 and np.abs(before[side]).max() > 5.0  # the planted machine
-        assert pitch_total_um(spec, after[side]) < 2.0, after[side]
-        assert np.abs(after[side]).max() < 2.0, after[side]
-        assert np.abs(after[side] - ideal[side]).max() < 0.5  # what the program cuts on an ideal machine
 
 
 def correction_section_rows(page: str) -> dict[str, list[str]]:
@@ -277,14 +311,18 @@ def test_the_corrected_sets_report_has_a_correction_section_with_correction_json
     size, before, after = correction["size_error_um"], correction["before"], correction["predicted_after"]
     row = rows["flank position (tool size) [\u00b5m]"]
     assert near(row[0], size["value"]) and near(row[1], size["uncertainty"])
-    assert "D 2.0160 mm" in row[2] and near(row[3], before["flank_position_um"]) and near(row[4], 0.0)
-    index = [v for v in correction["index_error_arcsec"]["values"] if v is not None]
-    low, high = rows["index error, range over the spaces [arcsec]"][0].split(" to ")
-    assert near(low, min(index)) and near(high, max(index))
+    programmed = correction["corrections"]["finishing_tool_diameter_mm"]["programmed"]
+    assert f"D {programmed:.4f} mm" in row[2] and near(row[3], before["flank_position_um"]) and near(row[4], 0.0)
+    first = correction["table_error_arcsec"]["harmonics"][0]
+    row = rows["table error e(A), order 1 [arcsec]"]
+    amplitude, phase = row[0].replace("\u2212", "-").replace("\u00b0)", "").split(" \u00d7 sin(1A ")
+    assert near(amplitude, first["amplitude"]) and near(phase, first["phase_deg"])
+    assert near(row[1], first["uncertainty"])
+    assert "every block's A moved by -e(A)" in row[2] and "unfolded" in row[2]
     for side in ("right", "left"):
         row = rows[f"F_p, {side} flanks [\u00b5m]"]
         assert near(row[3], before["F_p_um"][side]) and near(row[4], after["F_p_um"][side])
-        assert before["F_p_um"][side] > 8.0 and after["F_p_um"][side] < 0.5  # the planted 25 arcsec table, removed
+        assert before["F_p_um"][side] > 10.0 and after["F_p_um"][side] < 0.5  # the planted 25 arcsec table, removed
         for name, label in (("profile_slope_um", "profile slope f_H\u03b1"),
                             ("helix_slope_um", "helix slope f_H\u03b2")):
             found = correction[name]["by_side"][side]
@@ -293,3 +331,4 @@ def test_the_corrected_sets_report_has_a_correction_section_with_correction_json
             assert near(row[3], before[name][side]) and near(row[4], after[name][side])
     text = html.unescape(page)
     assert all(reason in text for reason in correction["not_corrected"].values())
+    assert correction["once_per_turn"]["why"] in text and correction["once_per_turn"]["check"] in text

@@ -11,13 +11,14 @@ import json
 import numpy as np
 import pytest
 
+from spur_cad.correct.contact import contact_angles
 from spur_cad.correct.correct import corrected_plan_of, finishing_cut, ideal_flanks
 from spur_cad.correct.identify import identify
 from spur_cad.grade.measured import grade_measured, read_points_csv
 from spur_cad.job import load_job
 from spur_cad.pipeline import job_stock, plan_cam
 from tests.gears import REFERENCE_JOB
-from tests.test_correct import TOOL_RADIUS_ERROR_UM, planted_cut, planted_index_arcsec, scan_csv
+from tests.test_correct import ISSUE_MACHINE, TOOL_RADIUS_ERROR_UM, planted_cut, scan_csv
 from tests.test_correct_slopes import HELIX_SLOPE_UM, PROFILE_SLOPE_UM, ROWS_MM, SLOPE_TOLERANCE_UM, slopes_mm
 
 DESIGN_PROFILE_SLOPE_UM = 6.0  # f_Halpha designed on both flanks, beside the example's reliefs and crowning
@@ -52,18 +53,25 @@ def exact_scan(modified):
     return scan_csv(cut, ROWS_MM)
 
 
-def assert_no_error(found, index_arcsec: float = 0.5, size_um: float = 0.5, slope_um: float = SLOPE_TOLERANCE_UM):
-    """The identified errors are zero within the given bounds: size, every space's index and each side's slopes."""
+def identified(job, plan, scan: str, ideal):
+    """identify on the scan about the datum axis, the contacts from the plan's finishing."""
+    contacts = contact_angles(job.gear, plan.finishing.toolpath, plan.finishing.tool)
+    return identify(job.gear, read_points_csv(scan, "scan.csv"), contacts, ideal, job.modifications, "axis")
+
+
+def assert_no_error(found, table_arcsec: float = 0.5, size_um: float = 0.5, slope_um: float = SLOPE_TOLERANCE_UM):
+    """The identified errors are zero within the given bounds: size, every order of the table's error tested and
+    each side's slopes."""
     assert abs(found.size_um) < size_um, found.size_um
-    assert np.all(np.isfinite(found.index_arcsec)) and np.abs(found.index_arcsec).max() < index_arcsec
+    assert max(h.amplitude_arcsec for h in found.table.harmonics) < table_arcsec, found.table
     for side in ("right", "left"):
         assert abs(found.profile_slope_um[side]) < slope_um, found.profile_slope_um
         assert abs(found.helix_slope_um[side]) < slope_um, found.helix_slope_um
 
 
 def test_a_gear_cut_to_its_modified_design_identifies_no_correction(modified, exact_scan):
-    _, job, _, ideal = modified
-    assert_no_error(identify(job.gear, read_points_csv(exact_scan, "scan.csv"), ideal, job.modifications))
+    _, job, plan, ideal = modified
+    assert_no_error(identified(job, plan, exact_scan, ideal))
 
 
 def test_correct_writes_no_correction_for_a_gear_cut_to_its_modified_design(modified, exact_scan, tmp_path):
@@ -76,7 +84,7 @@ def test_correct_writes_no_correction_for_a_gear_cut_to_its_modified_design(modi
     assert abs(correction["size_error_um"]["value"]) < 0.5
     assert correction["corrections"]["finishing_tool_diameter_mm"]["programmed"] == pytest.approx(
         job.tools.finishing.diameter_mm, abs=0.001)
-    assert np.abs(np.array(correction["corrections"]["a_correction_deg"])).max() * 3600.0 < 0.5
+    assert correction["table_error_arcsec"]["kept"] == [] and "a_words" not in correction["corrections"]
     for name in ("profile_slope_um", "helix_slope_um"):
         assert all(abs(found["value"]) < SLOPE_TOLERANCE_UM for found in correction[name]["by_side"].values())
 
@@ -86,30 +94,30 @@ def planted(modified):
     """What the planted machine's scan of the modified gear, with the planted slopes, gives back."""
     _, job, plan, ideal = modified
     cut = planted_cut(job, plan.finishing.toolpath, plan.finishing.tool, ROWS_MM)
-    scan = scan_csv(cut, ROWS_MM, slopes_mm(job.gear))
-    return identify(job.gear, read_points_csv(scan, "scan.csv"), ideal, job.modifications)
+    return identified(job, plan, scan_csv(cut, ROWS_MM, slopes_mm(job.gear)), ideal)
 
 
 def test_the_planted_machines_errors_are_identified_on_a_modified_gear(modified, planted):
     _, job, _, _ = modified
     assert planted.size_um == pytest.approx(-TOOL_RADIUS_ERROR_UM, abs=1.0)
-    index = planted_index_arcsec(job.gear.teeth)
-    assert np.abs(planted.index_arcsec - (index - index.mean())).max() < 2.0
+    assert [h.order for h in planted.table.kept] == [1]
+    assert planted.table.kept[0].amplitude_arcsec == pytest.approx(ISSUE_MACHINE.table[0].amplitude_arcsec, abs=1.0)
     for side in ("right", "left"):
         assert planted.profile_slope_um[side] == pytest.approx(PROFILE_SLOPE_UM[side], abs=SLOPE_TOLERANCE_UM)
         assert planted.helix_slope_um[side] == pytest.approx(HELIX_SLOPE_UM[side], abs=SLOPE_TOLERANCE_UM)
 
 
 def test_the_corrected_programs_cut_on_the_planted_machine_give_the_modified_design(modified, planted):
-    """The corrected plan (tool as it cuts, passes moved for the slopes, A turned per space) cut on the planted
-    machine with its slopes: no error is left, and every modification is cut as designed (graded against the
+    """The corrected plan (tool as it cuts, passes moved for the slopes, every row's A moved by -e(A)) cut on the
+    planted machine with its slopes: no error is left, and every modification is cut as designed (graded against the
     modified design, spur_cad.grade.design_trace)."""
-    _, job, _, ideal = modified
-    _, plan, not_corrected = corrected_plan_of(job, planted)
-    assert not_corrected is None
+    _, job, original, ideal = modified
+    _, plan, applied = corrected_plan_of(job, planted)
+    assert applied.slopes_not_corrected is None and applied.table_orders == (1,)
     cut = planted_cut(job, plan.finishing.toolpath, job.tools.finishing, ROWS_MM)  # the real tool: 8 um larger
-    points = read_points_csv(scan_csv(cut, ROWS_MM, slopes_mm(job.gear)), "cut.csv")
-    assert_no_error(identify(job.gear, points, ideal, job.modifications), index_arcsec=2.0, size_um=1.0,
+    scan = scan_csv(cut, ROWS_MM, slopes_mm(job.gear))
+    points = read_points_csv(scan, "cut.csv")
+    assert_no_error(identified(job, original, scan, ideal), table_arcsec=2.0, size_um=1.0,
                     slope_um=2 * SLOPE_TOLERANCE_UM)
     grading = grade_measured(job.gear, points, modifications=job.modifications)
     named = {(found.side, found.symbol): found for found in grading.modifications_cut}

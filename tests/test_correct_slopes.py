@@ -7,16 +7,17 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from spur_cad.correct.correct import finishing_cut, pressure_angle_change_deg, slope_corrected_finishing
+from spur_cad.correct.contact import contact_angles
+from spur_cad.correct.correct import finishing_cut, slope_corrected_finishing
 from spur_cad.correct.identify import identify
+from spur_cad.correct.summary import pressure_angle_change_deg
 from spur_cad.grade.measured import read_points_csv
 from spur_cad.grade.simulated import helix_range_mm, profile_range_mm
 from spur_cad.pipeline import job_stock
 from tests.test_correct import (
-    INDEX_AMPLITUDE_ARCSEC,
+    ISSUE_MACHINE,
     TOOL_RADIUS_ERROR_UM,
     planted_cut,
-    planted_index_arcsec,
     reference,  # noqa: F401  (the module's fixture)
     scan_csv,
 )
@@ -49,7 +50,8 @@ def sloped(reference):  # noqa: F811
     job, plan, ideal = reference
     cut = planted_cut(job, plan.finishing.toolpath, plan.finishing.tool, ROWS_MM)
     scan = scan_csv(cut, ROWS_MM, slopes_mm(job.gear))
-    return identify(job.gear, read_points_csv(scan, "scan.csv"), ideal)
+    contacts = contact_angles(job.gear, plan.finishing.toolpath, plan.finishing.tool)
+    return identify(job.gear, read_points_csv(scan, "scan.csv"), contacts, ideal, datum="axis")
 
 
 def test_planted_slopes_are_identified_per_side_with_the_size_and_index(reference, sloped):  # noqa: F811
@@ -59,10 +61,10 @@ def test_planted_slopes_are_identified_per_side_with_the_size_and_index(referenc
         assert sloped.helix_slope_um[side] == pytest.approx(HELIX_SLOPE_UM[side], abs=SLOPE_TOLERANCE_UM)
         assert 0.0 < sloped.profile_slope_uncertainty_um[side] < SLOPE_TOLERANCE_UM
         assert 0.0 < sloped.helix_slope_uncertainty_um[side] < SLOPE_TOLERANCE_UM
-    # slopes centred on their ranges leave the flanks' means, so the size and the index errors come back as before
+    # slopes centred on their ranges leave the flanks' means, so the size and the table's error come back as before
     assert sloped.size_um == pytest.approx(-TOOL_RADIUS_ERROR_UM, abs=1.0)
-    planted = planted_index_arcsec(job.gear.teeth)
-    assert np.abs(sloped.index_arcsec - (planted - planted.mean())).max() < 2.0 < INDEX_AMPLITUDE_ARCSEC
+    assert [h.order for h in sloped.table.kept] == [1]
+    assert sloped.table.kept[0].amplitude_arcsec == pytest.approx(ISSUE_MACHINE.table[0].amplitude_arcsec, abs=1.0)
 
 
 def test_the_pressure_angle_change_of_a_profile_slope_worked_by_hand(reference):  # noqa: F811
@@ -81,7 +83,8 @@ def test_the_corrected_finishing_cuts_the_opposite_slopes(reference, sloped):  #
     finishing, not_corrected = slope_corrected_finishing(job, plan.finishing, sloped)
     assert not_corrected is None
     cut = finishing_cut(job.gear, finishing.toolpath, finishing.tool, job_stock(job), (ROWS_MM[0], ROWS_MM[-1]))
-    found = identify(job.gear, read_points_csv(scan_csv(cut, ROWS_MM), "cut.csv"), ideal)
+    contacts = contact_angles(job.gear, plan.finishing.toolpath, plan.finishing.tool)
+    found = identify(job.gear, read_points_csv(scan_csv(cut, ROWS_MM), "cut.csv"), contacts, ideal, datum="axis")
     for side in ("right", "left"):
         assert found.profile_slope_um[side] == pytest.approx(-PROFILE_SLOPE_UM[side], abs=2 * SLOPE_TOLERANCE_UM)
         assert found.helix_slope_um[side] == pytest.approx(-HELIX_SLOPE_UM[side], abs=2 * SLOPE_TOLERANCE_UM)

@@ -1,21 +1,22 @@
-"""Identify a machine's systematic errors from a measured gear (docs/correction.md): the tool's size error, each
-tooth space's index error and each flank side's profile and helix slope, with their uncertainties. Pure functions
-of the design and the points.
+"""Identify a machine's systematic errors from a measured gear (docs/correction.md): the tool's size error, the
+rotary table's error e(A) as a function of the commanded A, and each flank side's profile and helix slope, with their
+uncertainties. Pure functions of the design, the points and the A at which the finishing cut each flank point.
 
-Model. Every involute point of space k and side s deviates along its design normal (mm, + material) by
+Model. Every involute point of side s deviates along its design normal (mm, + material) by
 
-    d = size_s - e_k (p x n) + ideal(roll) + noise
+    d = size_s - e(A) (p x n) + slope_s,profile t_profile + slope_s,helix t_helix + ideal(roll) + noise
 
-where size_s is the flank's shift by the tool (+: the tool cut too little, a smaller tool or wear), e_k the
-space's index error (rad: the table stood e_k further in A than commanded, which turns the space's cut by -e_k
-in the part frame, spur_cad.sim.budget), p x n the point's lever (+r_b on one side, -r_b on the other: the same
-along the whole involute) and ideal(roll) what the program leaves on an ideal machine (its scallops, the same
-in every space). Per flank, the mean of d - ideal separates the terms: the two flanks of a space move the same
-way by the size and opposite ways by a turn.
+where size_s is the flank's shift by the tool (+: the tool cut too little, a smaller tool or wear), e(A) the table's
+error (rad: the table stood e(A) further in A than commanded) at the A that cut the point (spur_cad.correct.contact),
+which turns the point's cut by -e(A) in the part frame, p x n the point's lever (+-r_b on an involute), and ideal(roll)
+what the program leaves on an ideal machine (its scallops, the same in every space). e(A) is a Fourier series whose
+orders are chosen from the data (spur_cad.correct.table).
 
-What a scan cannot tell apart: its best-fit rotation absorbs the mean index error and, with it, half the
-difference between the left and right flanks' sizes (a turn moves the sides oppositely). So the index errors
-are relative to their mean and the two sides' sizes are reported as measured, but only their mean is the tool's.
+What a scan cannot tell apart: its fitted rotation takes the mean of e(A) and, with it, half the difference between
+the left and right flanks' sizes (a turn moves the sides oppositely), so only the mean size is the tool's. A
+once-per-turn e(A) moves every flank by c . n, exactly as a blank off the A axis (or the gear measured about another
+centre) does: on a datum-axis scan it is seen but not told from an off-centre blank; on a best-fit scan the fitted
+centre takes it whole and it is not seen at all.
 """
 
 from __future__ import annotations
@@ -26,6 +27,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from spur_cad.correct.contact import ContactAngles
+from spur_cad.correct.table import TableError, blank_offset_mm, fit_flank_model
 from spur_cad.grade.iso1328 import evaluate_trace
 from spur_cad.grade.measured import (  # _design: the grader's design points
     MeasuredPoints,
@@ -33,7 +36,7 @@ from spur_cad.grade.measured import (  # _design: the grader's design points
     fit,
     flank_traces,
 )
-from spur_cad.grade.simulated import SIDES, profile_range_mm
+from spur_cad.grade.simulated import SIDES, helix_range_mm, profile_range_mm
 
 ARCSEC_RAD = math.pi / (180.0 * 3600.0)
 MIN_FLANK_POINTS = 5
@@ -57,20 +60,22 @@ class Identified:
 
     size_um: the flanks' shift by the tool, mean of both sides (+: material left, the tool cut too little);
     side_size_um: per side as measured (their difference is a scan's rotation: not the tool's);
-    index_arcsec: per space (machine numbering), relative to the mean over the measured spaces; NaN where a
-    space has not both flanks measured; flank_position_um: per side and space, the flank's mean deviation about the
-    gear's axis (the fit's centre remainder taken off) less the side's size; flank_residual_um: that less the
-    index error's share, what the corrections leave; profile_slope_um / helix_slope_um: per side, f_Halpha /
-    f_Hbeta of the deviations less the ideal cut's (side_slopes), missing for a side without such traces."""
+    table: the rotary table's error e(A) (spur_cad.correct.table.TableError), None from a probe log (which cannot see
+    it); blank_offset_um: the once-per-turn order of e(A) read as a blank off the A axis instead (the gear's centre as
+    cut about the datum axis, part frame), None without a kept order 1; datum: 'axis', 'best-fit' or 'probe log';
+    flank_position_um: per side and space, the flank's position at the reference circle (um of arc, mean over the
+    planes) about the datum (or the fitted centre) less the side's size; flank_residual_um: that less the table's
+    share, what the corrections leave; profile_slope_um / helix_slope_um: per side, f_Halpha / f_Hbeta of the
+    deviations less the ideal cut's and the table's share (side_slopes), missing for a side without such traces."""
 
     size_um: float
     size_uncertainty_um: float
     side_size_um: dict[str, float]
-    index_arcsec: np.ndarray
-    index_uncertainty_arcsec: float
+    table: TableError | None
+    blank_offset_um: tuple[float, float] | None
+    datum: str
     flank_mean_um: dict[str, np.ndarray]
     points_used: int
-    centre_shift_um: tuple[float, float]
     scan_turn_deg: float
     profile_slope_um: dict[str, float] = dataclasses.field(default_factory=dict)
     profile_slope_uncertainty_um: dict[str, float] = dataclasses.field(default_factory=dict)
@@ -78,7 +83,11 @@ class Identified:
     helix_slope_uncertainty_um: dict[str, float] = dataclasses.field(default_factory=dict)
     flank_position_um: dict[str, np.ndarray] = dataclasses.field(default_factory=dict)
     flank_residual_um: dict[str, np.ndarray] = dataclasses.field(default_factory=dict)
-    index_visible: bool = True  # False from an on-machine probe log: the probe shares the table's index errors
+
+    @property
+    def table_visible(self) -> bool:
+        """False from an on-machine probe log: the probe is carried by the table that cut the gear."""
+        return self.table is not None
 
 
 @dataclass(frozen=True)
@@ -117,79 +126,89 @@ def space_numbering_offset(angle_rad: float, teeth: int) -> int:
     return int(round((angle_rad - ((angle_rad + 0.5 * pitch) % pitch - 0.5 * pitch)) / pitch))
 
 
-def identify(spec, measured: MeasuredPoints, ideal: IdealFlanks | None = None, modifications=None) -> Identified:
-    """Fit the scan (spur_cad.grade.measured.fit), take each involute point's deviation minus the ideal cut's in the
-    profile evaluation range, and separate size and index per space (see the module docstring). Uncertainties:
-    the flank means' noise is read from the scatter over the spaces of each space's size (the sum of its two
-    flanks, constant in the model); an index error's is that over the lever's 2 r_b, the size's over sqrt(z).
-    `modifications` (the job's FlankModifications): the points are read from the modified design, as the grader reads
-    them (spur_cad.grade.measured.fit), so that a designed relief, crowning or slope is no machine error; `ideal`
-    must then be read from it too (spur_cad.correct.correct.ideal_flanks)."""
+def _positions_um(spec, axial, deviation, space, side, roll) -> dict[str, np.ndarray]:
+    """Per side and space (machine numbering) the flank's position at the reference circle (um of arc, the grader's
+    flank_traces), NaN where not measured."""
+    _, positions = flank_traces(spec, axial, deviation, space, side, roll)
+    found = {name: np.full(spec.teeth, np.nan) for name in SIDES}
+    for name in SIDES:
+        for k, value in positions[name].items():
+            found[name][k] = value
+    return found
+
+
+def identify(spec, measured: MeasuredPoints, contacts: ContactAngles, ideal: IdealFlanks | None = None,
+             modifications=None, datum: str = "best-fit") -> Identified:
+    """Fit the scan (spur_cad.grade.measured.fit: the rotation, and the centre unless `datum` is 'axis'), take each
+    involute point's deviation less the ideal cut's in the profile evaluation range, and fit the model of the module
+    docstring (spur_cad.correct.table.fit_flank_model): each side's size and slopes and the table's e(A) at the A that
+    cut each point (`contacts`, from the job's finishing). `modifications` (the job's FlankModifications): the points
+    are read from the modified design, as the grader reads them, so that a designed relief, crowning or slope is no
+    machine error; `ideal` must then be read from it too (spur_cad.correct.correct.ideal_flanks)."""
     design = _design(spec)
     points, normals, space, side, roll, _ = design
-    params, deviation, nearest = fit(spec, measured, design, modifications=modifications)
+    params, deviation, nearest = fit(spec, measured, design, datum, modifications)
     offset = space_numbering_offset(float(params[0]), spec.teeth)
     machine_space = (space[nearest] - offset) % spec.teeth
     lever = points[nearest, 0] * normals[nearest, 1] - points[nearest, 1] * normals[nearest, 0]
     start, end = profile_range_mm(spec)
-    point_roll = roll[nearest]
-    used = np.isin(side[nearest], SIDES) & (point_roll >= start) & (point_roll <= end)
+    front, back = helix_range_mm(spec.face_width_mm, spec.module_mm)
+    point_side, point_roll = side[nearest], roll[nearest]
+    used = np.isin(point_side, SIDES) & (point_roll >= start) & (point_roll <= end)
     corrected = deviation.copy()
     if ideal is not None:
         for name in SIDES:
-            on = used & (side[nearest] == name)
+            on = used & (point_side == name)
             corrected[on] -= ideal.at(name, point_roll[on])
+    flank_id = machine_space * 2 + (point_side == "left")
     flank_mean = {name: np.full(spec.teeth, np.nan) for name in SIDES}
-    flank_lever = {name: np.full(spec.teeth, np.nan) for name in SIDES}
-    flank_normal = {name: np.full((spec.teeth, 2), np.nan) for name in SIDES}
     for name in SIDES:
         for k in range(spec.teeth):
-            on = used & (side[nearest] == name) & (machine_space == k)
+            on = used & (point_side == name) & (machine_space == k)
             if np.count_nonzero(on) >= MIN_FLANK_POINTS:
                 flank_mean[name][k] = corrected[on].mean()
-                flank_lever[name][k] = lever[on].mean()
-                flank_normal[name][k] = normals[nearest[on]].mean(axis=0)
-    right, left = flank_mean["right"], flank_mean["left"]
-    both = np.isfinite(right) & np.isfinite(left)
+    both = np.isfinite(flank_mean["right"]) & np.isfinite(flank_mean["left"])
     if np.count_nonzero(both) < 4:
         raise ValueError("fewer than four tooth spaces have both flanks measured in the profile evaluation range")
-    # The fit's centre takes a once-per-turn index error for eccentricity. A centre moved by c moves a flank by
-    # c . n: the sum of a space's flanks by c . (n_r + n_l), which a turn leaves alone (the sizes are the same in
-    # every space), so the sums give the size and the centre, and the differences then the turns.
-    normal_sum = flank_normal["right"][both] + flank_normal["left"][both]
-    design_matrix = np.column_stack([np.full(len(normal_sum), 2.0), normal_sum])
-    (size, cx, cy), *_ = np.linalg.lstsq(design_matrix, (right + left)[both], rcond=None)
-    residual = (right + left)[both] - design_matrix @ np.array([size, cx, cy])
-    sum_noise = float(np.sqrt(np.sum(residual ** 2) / max(len(residual) - 3, 1)))
-    centre = np.array([cx, cy])
-    difference = (right - left) - (flank_normal["right"] - flank_normal["left"]) @ centre
-    # d_right - d_left = size_r - size_l - e (lever_r - lever_l): the size difference is a constant, like the mean e
-    turn = -difference / (flank_lever["right"] - flank_lever["left"])
-    index = np.where(both, turn - np.nanmean(turn[both]), np.nan) / ARCSEC_RAD
-    lever_span = float(np.nanmean(np.abs(flank_lever["right"] - flank_lever["left"])))
-    side_size = {name: float(np.nanmean(flank_mean[name] - flank_normal[name] @ centre)) for name in SIDES}
-    position = {name: flank_mean[name] - flank_normal[name] @ centre - side_size[name] for name in SIDES}
-    relative_turn = turn - np.nanmean(turn[both])
-    traces, _ = flank_traces(spec, measured.axial, corrected, space[nearest], side[nearest], roll[nearest])
+    a_deg = contacts.at(point_side[used], point_roll[used], machine_space[used])
+    profile_t = (point_roll[used] - 0.5 * (start + end)) / (end - start)
+    model = fit_flank_model(point_side[used], lever[used], a_deg, profile_t,
+                            (measured.axial[used] - 0.5 * (front + back)) / (back - front), corrected[used],
+                            flank_id[used], spec.teeth, datum == "axis", contacts.span_deg())
+    table_part = np.zeros(len(corrected))
+    table_part[used] = model.table_part_mm
+    size = 0.5 * (model.size_mm["right"] + model.size_mm["left"])
+    blank = None
+    if any(h.order == 1 for h in model.table.kept):
+        turn = -offset * 2.0 * math.pi / spec.teeth  # the design's numbering to the machine's (its part frame at A 0)
+        c, s = math.cos(turn), math.sin(turn)
+        design_normals = normals[nearest[used]]
+        machine_normals = np.column_stack([c * design_normals[:, 0] - s * design_normals[:, 1],
+                                           s * design_normals[:, 0] + c * design_normals[:, 1]])
+        cy, cz = blank_offset_mm(model.table, lever[used], a_deg, machine_normals)
+        blank = (cy * 1000.0, cz * 1000.0)
+    labels = (machine_space[used], point_side[used], point_roll[used])
+    axial = measured.axial[used]
+    before = _positions_um(spec, axial, corrected[used], *labels)
+    after = _positions_um(spec, axial, corrected[used] - table_part[used], *labels)
+    cos_alpha = spec.base_radius_mm / spec.reference_radius_mm
+    side_arc = {name: model.size_mm[name] * 1000.0 / cos_alpha for name in SIDES}
+    traces, _ = flank_traces(spec, axial, corrected[used] - table_part[used], *labels)
     profile, helix = side_slopes(traces, "profile"), side_slopes(traces, "helix")
     return Identified(
-        size_um=float(size) * 1000.0,
-        size_uncertainty_um=sum_noise / (2.0 * math.sqrt(len(residual))) * 1000.0,
-        side_size_um={name: value * 1000.0 for name, value in side_size.items()},
-        index_arcsec=index,
-        index_uncertainty_arcsec=sum_noise / lever_span / ARCSEC_RAD,  # a difference's noise is a sum's
+        size_um=size * 1000.0, size_uncertainty_um=model.size_uncertainty_mm * 1000.0,
+        side_size_um={name: value * 1000.0 for name, value in model.size_mm.items()},
+        table=model.table, blank_offset_um=blank, datum=datum,
         flank_mean_um={name: flank_mean[name] * 1000.0 for name in SIDES},
         points_used=int(np.count_nonzero(used)),
-        centre_shift_um=(float(cx) * 1000.0, float(cy) * 1000.0),
         scan_turn_deg=-math.degrees((params[0] + math.pi / spec.teeth) % (2 * math.pi / spec.teeth)
                                     - math.pi / spec.teeth),
         profile_slope_um={name: found.value_um for name, found in profile.items()},
         profile_slope_uncertainty_um={name: found.uncertainty_um for name, found in profile.items()},
         helix_slope_um={name: found.value_um for name, found in helix.items()},
         helix_slope_uncertainty_um={name: found.uncertainty_um for name, found in helix.items()},
-        flank_position_um={name: np.where(both, value, np.nan) * 1000.0 for name, value in position.items()},
-        flank_residual_um={name: np.where(both, position[name] + relative_turn * flank_lever[name], np.nan) * 1000.0
-                           for name in SIDES})
+        flank_position_um={name: before[name] - side_arc[name] for name in SIDES},
+        flank_residual_um={name: after[name] - side_arc[name] for name in SIDES})
 
 
 def identify_probed(spec, space: np.ndarray, side: np.ndarray, roll_mm: np.ndarray, axial_mm: np.ndarray,
@@ -224,12 +243,11 @@ def identify_probed(spec, space: np.ndarray, side: np.ndarray, roll_mm: np.ndarr
     return Identified(
         size_um=size * 1000.0, size_uncertainty_um=noise / math.sqrt(len(spread)) * 1000.0,
         side_size_um={name: value * 1000.0 for name, value in side_size.items()},
-        index_arcsec=unseen, index_uncertainty_arcsec=math.nan,
+        table=None, blank_offset_um=None, datum="probe log",
         flank_mean_um={name: flank_mean[name] * 1000.0 for name in SIDES}, points_used=int(np.count_nonzero(used)),
-        centre_shift_um=(0.0, 0.0), scan_turn_deg=0.0,
+        scan_turn_deg=0.0,
         profile_slope_um={name: found.value_um for name, found in profile.items()},
         profile_slope_uncertainty_um={name: found.uncertainty_um for name, found in profile.items()},
         helix_slope_um={name: found.value_um for name, found in helix.items()},
         helix_slope_uncertainty_um={name: found.uncertainty_um for name, found in helix.items()},
-        flank_position_um={name: unseen for name in SIDES}, flank_residual_um={name: unseen for name in SIDES},
-        index_visible=False)
+        flank_position_um={name: unseen for name in SIDES}, flank_residual_um={name: unseen for name in SIDES})

@@ -502,17 +502,29 @@ def correction_table(correction: dict | None) -> Table | None:
     if correction is None:
         return None
     before, after = correction["before"], correction["predicted_after"]
-    size, index = correction["size_error_um"], correction["index_error_arcsec"]
-    tool = correction["corrections"]["finishing_tool_diameter_mm"]
-    measured = [v for v in index["values"] if v is not None]
+    size, table = correction["size_error_um"], correction["table_error_arcsec"]
+    changes = correction["corrections"]
+    tool = changes["finishing_tool_diameter_mm"]
     rows = [(f"flank position (tool size) [{MICRO}]", signed(size["value"], 1), number(size["uncertainty"], 1),
              f"finishing tool programmed as D {number(tool['programmed'], 4)} mm (D {number(tool['before'], 4)} mm "
-             "in the tool table)", signed(before["flank_position_um"], 1), signed(after["flank_position_um"], 1)),
-            ("index error, range over the spaces [arcsec]", f"{signed(min(measured), 1)} to {signed(max(measured), 1)}",
-             number(index["uncertainty"], 1), "each space's A words turned back by its error", "", "") if measured else
-            ("index error [arcsec]", "not seen", "", "not corrected (below): a probe log shares the table's error",
-             "", "")]
-    rows += [(f"F_p, {side} flanks [{MICRO}]", "", "", "by the index correction", number(value, 1),
+             "in the tool table)", signed(before["flank_position_um"], 1), signed(after["flank_position_um"], 1))]
+    if "harmonics" not in table:
+        rows.append(("table error e(A) [arcsec]", "not seen", "", "not corrected (below): a probe log turns on the "
+                     "table that cut the gear", "", ""))
+    else:
+        kept = [h for h in table["harmonics"] if h["kept"]]
+        how = ("every block's A moved by -e(A)" if "a_words" in changes else "not corrected")
+        if "y_z_words" in changes:
+            how += "; order 1 as the blank's offset: every block's Y, Z moved"
+        if "unfolded" in changes:
+            how += " (programs unfolded)"
+        rows += [(f"table error e(A), order {h['order']} [arcsec]",
+                  f"{number(h['amplitude'], 1)} \u00d7 sin({h['order']}A {signed(h['phase_deg'], 1)}\u00b0)",
+                  number(h["uncertainty"], 1), how, "", "") for h in kept]
+        if not kept:
+            rows.append(("table error e(A) [arcsec]", "none found", "", f"orders {table['orders_tested'][0]} to "
+                         f"{table['orders_tested'][-1]} tested", "", ""))
+    rows += [(f"F_p, {side} flanks [{MICRO}]", "", "", "by the table's correction", number(value, 1),
               number(after["F_p_um"][side], 1)) for side, value in before["F_p_um"].items() if value is not None]
     for name, label, symbol in (("profile_slope_um", "profile slope", "f_H\u03b1"),
                                 ("helix_slope_um", "helix slope", "f_H\u03b2")):
@@ -531,5 +543,10 @@ def correction_table(correction: dict | None) -> Table | None:
 
 
 def correction_notes(correction: dict | None) -> tuple[str, ...]:
-    """What the corrected programs do not correct, and why (correction.json's not_corrected), one line each."""
-    return () if correction is None else tuple(correction["not_corrected"].values())
+    """What the corrected programs do not correct, and why (correction.json's not_corrected), one line each; first, for
+    a once-per-turn error, which model was assumed and what the user checks (once_per_turn)."""
+    if correction is None:
+        return ()
+    once = correction.get("once_per_turn", {})
+    told = (once["why"], once["check"]) if once.get("found") else ()
+    return told + tuple(correction["not_corrected"].values())

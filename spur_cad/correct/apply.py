@@ -1,0 +1,83 @@
+"""What `spur-cad correct` changes in the programs for the table's error and an off-centre blank (docs/correction.md,
+issue 46), and the record of it (AppliedCorrection, which correction.json and the report's Correction section show).
+
+- The table: every block's A moved by -e(A) at its own commanded A (table_corrected): the table then stands at
+  A - e(A) + e(A - e(A)), the commanded A within e's change over e itself (25 arcsec of a 25 arcsec once-per-turn
+  error: 1e-4 arcsec).
+- An off-centre blank: every block's Y and Z moved by the datum axis's offset turned to that block's A
+  (blank_corrected): the part frame's origin, the gear's datum, is then where the program assumes the A axis.
+- Both differ from block to block, so a folded program (one subprogram for every space, the space's A base its only
+  parameter) cannot carry them: the corrected programs are written unfolded.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from spur_cad.correct.table import TableError
+
+ONCE_PER_TURN_MODELS = ("table", "blank")
+"""What a once-per-turn error found on a datum-axis scan is taken for: the table's e(A) (corrected in the A words,
+right for every later blank) or a blank off the A axis (corrected in Y and Z, right for this set-up only)."""
+
+
+@dataclass(frozen=True)
+class AppliedCorrection:
+    """What the corrected programs change: the finishing tool's programmed diameter (mm), the orders of the table's
+    e(A) moved out of the A words, the blank offset moved out of Y and Z (the datum axis from the A axis in the
+    table's frame at A 0, um; None when not applied), which model a once-per-turn error was taken for (None without
+    one), whether the programs were unfolded, and why the slopes were not corrected (None when they were)."""
+
+    diameter_before_mm: float
+    diameter_programmed_mm: float
+    table_orders: tuple[int, ...]
+    blank_offset_um: tuple[float, float] | None
+    once_per_turn: str | None
+    unfolded: bool
+    slopes_not_corrected: str | None
+
+    def __post_init__(self) -> None:
+        if self.once_per_turn not in (None, *ONCE_PER_TURN_MODELS):
+            raise ValueError(f"once_per_turn must be one of {ONCE_PER_TURN_MODELS} or None, got {self.once_per_turn!r}")
+        if not (self.diameter_before_mm > 0.0 and self.diameter_programmed_mm > 0.0):
+            raise ValueError("the finishing tool's diameters must be positive")
+        if self.blank_offset_um is not None and not all(map(math.isfinite, self.blank_offset_um)):
+            raise ValueError(f"blank offset {self.blank_offset_um} must be finite")
+
+    @property
+    def per_block(self) -> bool:
+        """Whether a correction differs from block to block (and the programs are unfolded)."""
+        return bool(self.table_orders) or self.blank_offset_um is not None
+
+
+def table_corrected(path, table: TableError, orders: tuple[int, ...]):
+    """The toolpath with every row's A moved by -e(A) of the given kept orders, e evaluated at the row's own A."""
+    if not orders:
+        return path
+    return path.replace(a=path.a - table.at(path.a, orders) / 3600.0)
+
+
+def blank_corrected(path, datum_offset_um: tuple[float, float]):
+    """The toolpath with every row's Y and Z moved by the datum axis's offset from the A axis (um, the table's frame
+    at A 0) turned to the row's A: a part point p about the datum is at R(A) (p + b) in the machine."""
+    by, bz = np.asarray(datum_offset_um, dtype=float) / 1000.0
+    a = np.radians(path.a)
+    c, s = np.cos(a), np.sin(a)
+    return path.replace(y=path.y + c * by - s * bz, z=path.z + s * by + c * bz)
+
+
+def linuxcnc_compensation(table: TableError, orders: tuple[int, ...], a_range_deg: tuple[float, float]) -> str:
+    """A LinuxCNC joint compensation file for the A joint ([JOINT_n] COMP_FILE with COMP_FILE_TYPE = 1: lines
+    'nominal forward_trim reverse_trim', trim = actual - nominal, deg, in increasing nominal order, at most 256
+    lines), the table's error of the given orders over the A range the programs command (widened by a step each
+    side). Both directions alike: e(A) here is a position error, no backlash."""
+    low, high = a_range_deg
+    step = max(1.0, math.ceil((high - low + 2.0) / 250.0))
+    start = math.floor(low / step) * step - step
+    count = int(math.ceil((high - start) / step)) + 2
+    nominal = start + step * np.arange(count)
+    trim = table.at(nominal, orders) / 3600.0
+    return "".join(f"{a:.4f} {t:.7f} {t:.7f}\n" for a, t in zip(nominal, trim))
