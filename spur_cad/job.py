@@ -17,9 +17,10 @@ import dataclasses
 import difflib
 import re
 import tomllib
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
+from types import MappingProxyType
 
 from spur_cad.cad.specs import BlankFeatures, StockSpec
 from spur_cad.cam.calibration import CalibrationTable, parse_calibration_table
@@ -313,12 +314,19 @@ SECTIONS: dict[str, type] = {
 }
 
 
-def job_sections(strategies: Strategies = REGISTRY, dialects: Dialects = DIALECTS) -> dict[str, type]:
+def job_sections(strategies: Strategies = REGISTRY, dialects: Dialects = DIALECTS,
+                 sections: Mapping[str, type] = MappingProxyType({})) -> dict[str, type]:
     """SECTIONS with the [finishing] section made from the keys of `strategies`' parameters (the same class
-    as FinishingParams for the default registry's strategies), and [post] and [lathe] taking the names of the
-    registry `dialects` (PostSettings and LatheSection for the default registry)."""
-    return {**SECTIONS, "finishing": finishing_section_type(strategies), "post": post_settings_type(dialects),
-            "lathe": lathe_section_type(dialects)}
+    as FinishingParams for the default registry's strategies), [post] and [lathe] taking the names of the
+    registry `dialects` (PostSettings and LatheSection for the default registry), and the classes of `sections`
+    in place of theirs: each a subclass of the section it replaces, with keys of its own (e.g. a key being added,
+    declared in a test)."""
+    types = {**SECTIONS, "finishing": finishing_section_type(strategies), "post": post_settings_type(dialects),
+             "lathe": lathe_section_type(dialects)}
+    for name, cls in sections.items():
+        if name not in types or not (isinstance(cls, type) and issubclass(cls, types[name])):
+            raise TypeError(f"sections: [{name}] must be a subclass of the section it replaces")
+    return {**types, **sections}
 
 
 _TOOL_ROLES = ("roughing", "finishing", "bottom", "roughing_top")
@@ -429,10 +437,11 @@ def _longest_number(text: str, source: str) -> str:
 
 
 def parse_job(text: str, source: str = "<job>", strategies: Strategies = REGISTRY,
-              dialects: Dialects = DIALECTS) -> Job:
+              dialects: Dialects = DIALECTS, sections: Mapping[str, type] = MappingProxyType({})) -> Job:
     """Validate a job file's text; raises JobFileError (or GearSpecError wrapped into it). `strategies`: the
     finishing strategies [finishing] strategy names and whose keys it takes; `dialects`: the controllers
-    [post] dialect and [lathe] dialect name."""
+    [post] dialect and [lathe] dialect name; `sections`: section classes in place of the standard ones
+    (job_sections)."""
     if len(text) > MAX_JOB_FILE_BYTES:
         raise JobFileError(f"{source}: the job file is larger than {MAX_JOB_FILE_BYTES // 1024} KiB; a job file is "
                            "a few kilobytes of TOML")
@@ -446,15 +455,16 @@ def parse_job(text: str, source: str = "<job>", strategies: Strategies = REGISTR
     except RecursionError:
         raise JobFileError(f"{_deepest_value(text, source)}: arrays or tables nested too deeply for a job file") \
             from None
-    return _job_from_data(data, source, text, strategies, dialects)
+    return _job_from_data(data, source, text, strategies, dialects, sections)
 
 
-def job_from_dict(data: dict, source: str, strategies: Strategies = REGISTRY, dialects: Dialects = DIALECTS) -> Job:
+def job_from_dict(data: dict, source: str, strategies: Strategies = REGISTRY, dialects: Dialects = DIALECTS,
+                  sections: Mapping[str, type] = MappingProxyType({})) -> Job:
     """Validate a job given as nested dicts (the TOML structure), e.g. built by the FreeCAD workbench.
 
     Same checks and messages as parse_job, without line numbers (`source` names the origin).
     """
-    return _job_from_data(data, source, "", strategies, dialects)
+    return _job_from_data(data, source, "", strategies, dialects, sections)
 
 
 def _tables(data: dict, source: str, text: str) -> dict[str, object]:
@@ -715,12 +725,12 @@ def _check_added_material(mods: FlankModifications | None, finish_stock_mm: floa
 
 
 def _job_from_data(data: dict, source: str, text: str, strategies: Strategies = REGISTRY,
-                   dialects: Dialects = DIALECTS) -> Job:
+                   dialects: Dialects = DIALECTS, sections: Mapping[str, type] = MappingProxyType({})) -> Job:
     """Validate parsed job data; `text` (the file's text, or "") only locates keys for messages."""
     data, modification_tables = _split_modifications(data, source, text)
     tables, autos = _without_auto(_tables(data, source, text), lambda name, key_name: _where(source, text, name,
                                                                                               key_name))
-    types = job_sections(strategies, dialects)
+    types = job_sections(strategies, dialects, sections)
     sections = {name: _load_section(tables[name], name, source, text, types) for name in types if name in tables}
 
     def where(name: str, key_name: str | None) -> str:

@@ -6,6 +6,8 @@ from __future__ import annotations
 
 import re
 import sys
+from collections.abc import Mapping
+from types import MappingProxyType
 
 from spur_cad.cam.strategies import REGISTRY, Strategies
 from spur_cad.dialects import DIALECTS, Dialects
@@ -120,11 +122,13 @@ def _accepted(k) -> str:
     return "any"
 
 
-def job_file_reference_markdown(strategies: Strategies = REGISTRY, dialects: Dialects = DIALECTS) -> str:
+def job_file_reference_markdown(strategies: Strategies = REGISTRY, dialects: Dialects = DIALECTS,
+                                replaced: Mapping[str, type] = MappingProxyType({})) -> str:
     """docs/job-file.md: the introduction, one table per section from its key declarations (the [finishing]
-    keys from the strategies of `strategies`, the dialects [post] and [lathe] take from `dialects`), the notes."""
+    keys from the strategies of `strategies`, the dialects [post] and [lathe] take from `dialects`, the classes
+    of `replaced` in place of their sections: spur_cad.job.job_sections), the notes."""
     sections = {}
-    for name, cls in job_sections(strategies, dialects).items():
+    for name, cls in job_sections(strategies, dialects, replaced).items():
         sections[name] = cls
         if name == "gear":  # the flank modification tables follow [gear]
             sections.update(MODIFICATION_SECTIONS)
