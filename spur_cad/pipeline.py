@@ -21,6 +21,7 @@ import numpy as np
 from spur_cad.cad_stage import build_cad
 from spur_cad.cam.plan import CamInputs, CamPlan
 from spur_cad.cam.plan import plan_cam as plan_cam_inputs
+from spur_cad.cam.three_axis import ThreeAxisFinishingFacts
 from spur_cad.errors import shown_path
 from spur_cad.geometry.sampling import ProfileSamples, sample_profile
 from spur_cad.inputs import step_timestamp
@@ -207,9 +208,8 @@ def grade_stage(job: Job, sim_result: SimResult | None, plan: CamPlan | None = N
 
 def three_axis_profile_start_mm(plan: CamPlan | None) -> float | None:
     """Where a 3-axis plan's finishing tool leaves the involute (radius, mm); None for any other plan."""
-    if plan is None or plan.finishing is None or plan.finishing.result.strategy != "three_axis":
-        return None
-    return plan.finishing.result.facts.form_diameter_mm / 2.0
+    facts = plan.finishing.result.facts if plan is not None and plan.finishing is not None else None
+    return facts.form_diameter_mm / 2.0 if isinstance(facts, ThreeAxisFinishingFacts) else None
 
 
 def error_budget(job: Job, plan: CamPlan):

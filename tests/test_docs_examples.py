@@ -75,3 +75,49 @@ def test_the_how_to_add_a_dialect_example_of_docs_post_md_runs_as_written(capsys
     promised = [line.split("# ", 1)[1] for line in run.splitlines() if line.startswith("print(")]
     assert printed == promised
     assert "acme" not in DIALECTS  # nothing global changed
+
+
+def test_the_architecture_strategy_example_registers_and_finishes_a_gear_tip_land_first():
+    """docs/architecture.md's worked strategy example, run as written and passed as a registry of its own: the
+    loader takes its strategy and key, and every tooth space is finished tip land first, the tip passes touching
+    the tip circle (the bull-nose section's distance from the axis written out here: the flat's height over the
+    axis within the flat, the corner's circle beside it)."""
+    import numpy as np
+
+    from spur_cad.cam.finishing import plan_finishing
+    from spur_cad.cam.ir import Feature
+    from spur_cad.cam.strategies import REGISTRY
+    from spur_cad.job import parse_job
+    from tests.workbench_helper import small_job_text
+
+    def finish(job):
+        return plan_finishing(job.gear, job.tools.finishing, job.machine, job.finishing,
+                              job.stock.blank_radius_mm(job.gear), job.strategies)
+
+    (block,) = python_blocks("docs/architecture.md", "class TipFirstStrategy")
+    namespace: dict = {}
+    exec(compile(block, "docs/architecture.md", "exec"), namespace)
+    strategy = namespace["TipFirstStrategy"]()
+    strategies = {**REGISTRY, strategy.name: strategy}
+    text = small_job_text().replace("[finishing]\n", '[finishing]\nstrategy = "tip_first"\n')
+    job = parse_job(text, "tip_first.toml", strategies=strategies)
+    assert job.finishing.strategy == "tip_first" and job.finishing.tip_land_first is True
+    path, result = finish(job)
+    assert result.strategy == "tip_first" and result.facts.tip_land_first
+    assert result.report_text() == f"Finishing: tip_first, {result.points_per_flank} contacts per flank, the tip " \
+                                   "land, then the flanks."
+    assert any(w.startswith("finishing strategy tip_first: ") for w in path.warnings)
+    cutting = path.feature != Feature.NONE
+    for k in range(job.gear.teeth):
+        features = path.feature[cutting & (path.space == k)]
+        runs = [int(f) for i, f in enumerate(features) if i == 0 or f != features[i - 1]]
+        assert runs == [Feature.TIP, Feature.RIGHT_FLANK, Feature.LEFT_FLANK]  # (along_x: the root with the right)
+    tool, r_a = job.tools.finishing, job.gear.tip_radius_mm
+    tip = cutting & (path.feature == Feature.TIP)
+    beside = np.maximum(np.abs(path.y[tip]) - tool.flat_width_mm / 2.0, 0.0)
+    distance = np.hypot(beside, path.z[tip] + tool.corner_radius_mm) - tool.corner_radius_mm
+    assert np.allclose(distance, r_a, atol=1e-6)
+    last = parse_job(text.replace('strategy = "tip_first"\n', 'strategy = "tip_first"\ntip_land_first = false\n'),
+                     "tip_first.toml", strategies=strategies)
+    features = finish(last)[0].feature
+    assert features[features != Feature.NONE][-1] == Feature.TIP  # its own key puts the land last

@@ -133,8 +133,8 @@ def test_raised_end_fits_a_tool_the_rack_end_cannot_take():
     big = _tool(4.4, 0.5)
     # One tool does both modes, and tip mode cannot take this flat (2 d_1 + 2 r_t = 2.84 mm) ...
     assert limits.tip_mode_max_diameter_mm < big.diameter_mm
-    with pytest.raises(ToolError, match="largest diameter for tip mode"):
-        get_strategy("generating").generate(spec, big, MACHINE, GeneratingParams(), spec.tip_radius_mm + 0.5)
+    with pytest.raises(ToolError, match="largest diameter for tip mode"):  # the strategy's tool check refuses it
+        get_strategy("generating").check_tool(spec, big)
     # ... but its flank passes with the raised end pass the exact gouge check (the rack end's do not).
     from spur_cad.cam.strategies.generating_geometry import (
         GOUGE_TOLERANCE_MM,
@@ -377,9 +377,9 @@ def test_tool_errors_name_the_values():
     spec = _gear("reference_z23_m4")
     strategy = get_strategy("generating")
     with pytest.raises(ToolError, match=r"r_t = 1 mm is larger than the rack tip radius rho = 0.8 mm"):
-        strategy.generate(spec, _tool(3.0, 1.0), MACHINE, GeneratingParams(), spec.tip_radius_mm + 0.5)
+        strategy.check_tool(spec, _tool(3.0, 1.0))
     with pytest.raises(ToolError, match=r"flat width d = 2 mm .* 2 d_1 = 1.83"):
-        strategy.generate(spec, _tool(3.0, 0.5), MACHINE, GeneratingParams(), spec.tip_radius_mm + 0.5)
+        strategy.check_tool(spec, _tool(3.0, 0.5))
 
 
 def test_strategy_is_registered_and_the_default_and_the_job_file_takes_its_keys():
@@ -394,8 +394,8 @@ def test_strategy_is_registered_and_the_default_and_the_job_file_takes_its_keys(
     assert (job.finishing.cutting_direction, job.finishing.flank_tool_end) == ("conventional", "raised")
     with pytest.raises((JobFileError, MachineError), match="cutting_direction"):
         parse_job(text.replace("'conventional'", "'sideways'"))
-    with pytest.raises(MachineError, match="flank_tool_end"):
-        GeneratingParams(flank_tool_end="low").validate()
+    with pytest.raises(MachineError, match="flank_tool_end"):  # checked when made
+        GeneratingParams(flank_tool_end="low")
 
 
 def test_tip_lands_are_cut_only_when_the_blank_stands_above_the_tip_circle():

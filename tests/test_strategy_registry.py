@@ -156,3 +156,24 @@ def test_the_default_registry_is_unchanged_and_read_only():
     assert strategy_names() == ("perimeter", "along_x", "generating")
     with pytest.raises(TypeError):
         REGISTRY["rows"] = RowsStrategy()  # type: ignore[index]
+
+
+def test_the_default_section_class_is_the_section_the_registry_makes():
+    """FinishingParams is written out as a dataclass (typed for callers and the type checker); it must hold what
+    finishing_section_type makes from REGISTRY's strategies: the same keys, in order, with the same types,
+    defaults and declarations (the strategy names from the registry)."""
+    from spur_cad.cam.strategies import FinishingParams, finishing_section_type
+    from spur_cad.keys import keys_of
+
+    made = finishing_section_type(dict(REGISTRY) | {"rows": RowsStrategy()})  # a registry's own section ...
+    assert [k.name for k in keys_of(made)][-1] == "rows_per_flank"
+    made = finishing_section_type(dict(REGISTRY))  # ... and a copy of REGISTRY: the written class
+    assert made is FinishingParams
+    from spur_cad.cam.strategies import _section_type
+
+    generated, written = keys_of(_section_type(tuple(REGISTRY.items()))), keys_of(FinishingParams)
+    assert [k.name for k in written] == [k.name for k in generated]
+    for w, g in zip(written, generated):
+        assert (str(w.type), w.default, w.unit, w.low, w.high, w.choices, w.meaning, w.label, w.group) == \
+            (str(g.type), g.default, g.unit, g.low, g.high, g.choices, g.meaning, g.label, g.group), w.name
+        assert (w.names_from() if w.names_from else None) == (g.names_from() if g.names_from else None)

@@ -10,6 +10,7 @@ import numpy as np
 import pytest
 
 from spur_cad.cam.ir import MAX_TOOLPATH_MOVES
+from spur_cad.cam.machine import MachineError
 from spur_cad.errors import SpurCadError, WorkLimitError
 from spur_cad.geometry.sampling import sample_profile
 from spur_cad.job import load_job
@@ -27,7 +28,6 @@ def small_job():
 
 @pytest.mark.parametrize("section, values, key", [
     ("finishing", {"strategy": "perimeter", "step_over_mm": 1e-9}, "finishing.step_over_mm"),
-    ("finishing", {"target_scallop_mm": 1e-9}, "finishing.target_scallop_mm"),
     ("roughing", {"step_over_fraction": 1e-9}, "roughing.step_over_fraction"),
     ("roughing", {"max_level_depth_fraction": 1e-9}, "roughing.max_level_depth_fraction"),
     ("roughing", {"flank_allowance_mm": 0.02 + 1e-9}, "roughing.flank_allowance_mm"),
@@ -40,6 +40,21 @@ def test_runaway_toolpaths_are_refused_before_they_are_built(small_job, section,
     assert time.perf_counter() - started < 30.0  # generous: the refusal comes from an estimate, not the work
     assert info.value.key == key
     assert f"[{section}] {key.split('.')[1]}" in str(info.value)
+
+
+def test_the_lowest_target_scallop_is_refused_before_perimeter_finishing_is_built():
+    """A target scallop below its key's range is refused when the parameters are made (MachineError); at the
+    lowest it takes, perimeter finishing of the reference gear (20 mm face width: about 3.5e7 moves) is refused
+    by its estimate, naming the key."""
+    job = load_job(REFERENCE)
+    finishing = dataclasses.replace(job.finishing, strategy="perimeter", target_scallop_mm=1e-9)
+    with pytest.raises(MachineError, match=r"\[finishing\] target_scallop_mm must be in \[0\.0001, 0\.1\] mm"):
+        plan_cam(dataclasses.replace(job, finishing=finishing))
+    started = time.perf_counter()
+    with pytest.raises(WorkLimitError) as info:
+        plan_cam(dataclasses.replace(job, finishing=dataclasses.replace(finishing, target_scallop_mm=0.0001)))
+    assert time.perf_counter() - started < 30.0  # generous: the refusal comes from an estimate, not the work
+    assert info.value.key == "finishing.target_scallop_mm" and "[finishing] target_scallop_mm" in str(info.value)
 
 
 def test_move_estimates_bound_the_real_toolpaths(small_job):

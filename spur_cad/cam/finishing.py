@@ -2,12 +2,14 @@
 
 from __future__ import annotations
 
+from typing import Any
+
 from spur_cad.cam.ir import Toolpath
 from spur_cad.cam.machine import Machine
 from spur_cad.cam.strategies import (
     REGISTRY,
-    FinishingParams,
     FinishingResult,
+    FinishingSection,
     Strategies,
     get_strategy,
     params_from_section,
@@ -16,30 +18,39 @@ from spur_cad.cam.tools import Tool, ToolError
 from spur_cad.geometry.modifications import FlankModifications
 from spur_cad.geometry.spec import GearSpec
 
-MODIFYING_STRATEGIES = ("generating", "perimeter")
-"""The finishing strategies that cut flank modifications (along_x places its contacts on the design flank)."""
 
-
-def plan_finishing(spec: GearSpec, tool: Tool, machine: Machine, section: FinishingParams,
+def plan_finishing(spec: GearSpec, tool: Tool, machine: Machine, section: FinishingSection,
                    blank_radius_mm: float, strategies: Strategies = REGISTRY,
                    modifications: FlankModifications | None = None, profile_tolerance_mm: float = 0.001,
-                   **overrides) -> tuple[Toolpath, FinishingResult]:
+                   **overrides: Any) -> tuple[Toolpath, FinishingResult]:
+    """The strategy's tool check (`check_tool`), then `generate_finishing` (for callers that have not checked the
+    tool: the plan checks it with its other cheap checks first, cam.plan.check_finishing_work)."""
+    get_strategy(section.strategy, strategies).check_tool(spec, tool)
+    return generate_finishing(spec, tool, machine, section, blank_radius_mm, strategies, modifications,
+                              profile_tolerance_mm, **overrides)
+
+
+def generate_finishing(spec: GearSpec, tool: Tool, machine: Machine, section: FinishingSection,
+                       blank_radius_mm: float, strategies: Strategies = REGISTRY,
+                       modifications: FlankModifications | None = None, profile_tolerance_mm: float = 0.001,
+                       **overrides: Any) -> tuple[Toolpath, FinishingResult]:
     """Toolpath and result of the strategy named by `section.strategy`, with its parameters taken from
     the section (`overrides` replace some, e.g. the reference process's contact spacing), found in
-    `strategies`. Flank `modifications` are cut by the strategies in MODIFYING_STRATEGIES (others refuse them)."""
+    `strategies`, for a tool its `check_tool` has passed. Flank `modifications` are cut by the strategies that
+    declare `follows_modifications` (refused for the others)."""
     strategy = get_strategy(section.strategy, strategies)
     params = params_from_section(strategy, section, **overrides)
-    strategy.check_tool(spec, tool)
     if modifications is None:
         return strategy.generate(spec, tool, machine, params, blank_radius_mm)
-    if strategy.name not in MODIFYING_STRATEGIES:
+    if not strategy.follows_modifications:
+        following = " or ".join(f"'{name}'" for name, other in strategies.items() if other.follows_modifications)
         raise ToolError(f"[finishing] strategy = '{strategy.name}' does not cut flank modifications "
-                        "([gear.modifications]); use strategy = 'generating' or 'perimeter'", field="strategy",
+                        f"([gear.modifications]); use strategy = {following}", field="strategy",
                         section="finishing")
     return strategy.generate(spec, tool, machine, params, blank_radius_mm, modifications, profile_tolerance_mm)
 
 
-def finishing_toolpath(spec: GearSpec, tool: Tool, machine: Machine, section: FinishingParams,
+def finishing_toolpath(spec: GearSpec, tool: Tool, machine: Machine, section: FinishingSection,
                        blank_radius_mm: float) -> Toolpath:
     """The finishing operation as IR (pure function)."""
     return plan_finishing(spec, tool, machine, section, blank_radius_mm)[0]

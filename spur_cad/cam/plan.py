@@ -16,7 +16,7 @@ from spur_cad.cad.specs import StockSpec
 from spur_cad.cam.common import check_moves
 from spur_cad.cam.contacts import ContactCounts, contact_counts
 from spur_cad.cam.estimate import Estimate, estimate, move_seconds
-from spur_cad.cam.finishing import plan_finishing
+from spur_cad.cam.finishing import generate_finishing
 from spur_cad.cam.flank_roughing import UNCUT_MM2, FlankPlan
 from spur_cad.cam.ir import Toolpath
 from spur_cad.cam.machine import Machine, MachineError, RoughingParams, check_travel
@@ -42,9 +42,11 @@ from spur_cad.cam.roughing import (
     tip_heights_mm,
 )
 from spur_cad.cam.strategies import (
+    COMPARISON_STRATEGY,
     REGISTRY,
     FinishingParams,
     FinishingResult,
+    FinishingSection,
     Strategies,
     get_strategy,
     params_from_section,
@@ -159,7 +161,7 @@ class CamInputs:
     roughing_tool: Tool | None
     finishing_tool: Tool | None
     roughing: RoughingParams
-    finishing: FinishingParams
+    finishing: FinishingSection  # [finishing] of `strategies` (FinishingParams for the default registry)
     machine: Machine
     bottom_tool: Tool | None = None  # two-stage roughing: the smaller tool for the bottom of the spaces
     top_tool: Tool | None = None  # two-stage roughing offered: a larger tool above roughing_tool ([tools.roughing_top])
@@ -177,9 +179,10 @@ def check_cam_inputs(inputs: CamInputs) -> tuple[ToolRecommendations, RoughingLe
     spec, machine, stock = inputs.spec, inputs.machine, inputs.stock
     strategy = get_strategy(inputs.finishing.strategy, inputs.strategies)
     if inputs.finishing_tool is not None and not spec.kind.accepts_strategy(strategy):
+        helical = " or ".join(f'"{name}"' for name, other in inputs.strategies.items() if other.helical)
         raise MachineError(f"[finishing] strategy = {shown(inputs.finishing.strategy)} is for spur gears; a "
                            f"helical gear (helix_angle_deg = {spec.helix_angle_deg:g}) is finished by "
-                           "strategy = \"generating\"",
+                           f"strategy = {helical}",
                            field="strategy", section="finishing")
     blank = stock.blank_radius_mm(spec)
     check_blank_allowance(spec, stock, inputs.finishing_tool,
@@ -602,9 +605,10 @@ def _plan_roughing(inputs: CamInputs, levels: RoughingLevels, blank: float, tool
     return RoughingPlan(tool, levels, lowest_above_root, path, estimate(path, inputs.machine), heights, flank)
 
 
-def check_finishing_work(spec: GearSpec, tool: Tool, machine: Machine, section: FinishingParams,
+def check_finishing_work(spec: GearSpec, tool: Tool, machine: Machine, section: FinishingSection,
                          strategies: Strategies = REGISTRY, **overrides) -> None:
-    """Refuse finishing whose contacts per flank or moves exceed the limits, before generating it."""
+    """The strategy's tool check, then refuse finishing whose contacts per flank or moves exceed the limits,
+    before generating it (what generate_finishing trusts)."""
     strategy = get_strategy(section.strategy, strategies)
     params = params_from_section(strategy, section, **overrides)
     strategy.check_tool(spec, tool)
@@ -621,25 +625,25 @@ def check_finishing_work(spec: GearSpec, tool: Tool, machine: Machine, section: 
         raise WorkLimitError(f"finishing would need more than {MAX_CONTACTS_PER_FLANK:,} contact points per flank "
                              f"for target_scallop_mm = {params.target_scallop_mm:.3g}; raise [finishing] "
                              "target_scallop_mm", field="target_scallop_mm", section="finishing")
-    driver = "step_over_mm" if getattr(params, "step_over_mm", 0.0) > 0.0 else "target_scallop_mm"
+    driver = "step_over_mm" if getattr(params, "step_over_mm", 0.0) > 0.0 else "target_scallop_mm"  # stations
     check_moves("finishing", strategy.estimate_moves(spec, tool, params), "finishing", driver)
 
 
 def _plan_finishing(inputs: CamInputs, blank: float, check: Callable[[], None]) -> FinishingPlan:
     spec, tool, machine = inputs.spec, inputs.finishing_tool, inputs.machine
-    path, result = plan_finishing(spec, tool, machine, inputs.finishing, blank, inputs.strategies,
-                                  inputs.modifications, inputs.profile_tolerance_mm)
+    path, result = generate_finishing(spec, tool, machine, inputs.finishing, blank, inputs.strategies,
+                                      inputs.modifications, inputs.profile_tolerance_mm)  # checked: check_cam_inputs
     check_travel(machine, path.x, path.y, path.z, path.a, "finishing")
     own = estimate(path, machine)
     check()
     target = inputs.finishing.target_scallop_mm
     reference = _comparison_estimate(spec, tool, machine, blank,
-                                     FinishingParams(strategy="perimeter", target_scallop_mm=target,
+                                     FinishingParams(strategy=COMPARISON_STRATEGY, target_scallop_mm=target,
                                                      step_over_mm=REFERENCE_STATION_STEP_MM),
                                      contact_spacing_mm=REFERENCE_CONTACT_SPACING_MM)
     check()
-    perimeter = own if inputs.finishing.strategy == "perimeter" else _comparison_estimate(
-        spec, tool, machine, blank, FinishingParams(strategy="perimeter", target_scallop_mm=target))
+    perimeter = own if inputs.finishing.strategy == COMPARISON_STRATEGY else _comparison_estimate(
+        spec, tool, machine, blank, FinishingParams(strategy=COMPARISON_STRATEGY, target_scallop_mm=target))
     return FinishingPlan(tool, result, path, own, reference, perimeter)
 
 
@@ -654,10 +658,9 @@ def _comparison_estimate(spec: GearSpec, tool: Tool, machine: Machine, blank: fl
     simultaneous = dataclasses.replace(machine, rotary_simultaneous=True)
     params = params_from_section(strategy, section, **overrides)
     try:
-        check_finishing_work(spec, tool, simultaneous, section, **overrides)
+        check_finishing_work(spec, tool, simultaneous, section, **overrides)  # the tool check with the others
         if strategy.estimate_moves(spec, tool, params) > MAX_COMPARISON_MOVES:
             return None
-        strategy.check_tool(spec, tool)
         return strategy.estimate(spec, tool, simultaneous, params, blank)  # without building its toolpath
     except (WorkLimitError, MachineError, ToolError):
         return None
@@ -728,7 +731,8 @@ def _plan_three_axis(inputs: CamInputs, tolerance_mm: float) -> CamPlan:
         facts = ThreeAxisFinishingFacts(tool.diameter_mm / 2.0, 2 * root.form_radius_mm, 2 * root.rack_form_radius_mm,
                                         2 * root.active_start_radius_mm, root.fillet_radius_mm, len(levels),
                                         segments, arcs, root_thickness(spec, tool.diameter_mm / 2.0), engagement)
-        result = FinishingResult("three_axis", None, None, len(levels), 0.0, np.zeros(0), facts=facts)
+        result = FinishingResult("three_axis", None, None, len(levels), 0.0, np.zeros(0), facts=facts,
+                                 lying_flat=True)
         finishing = FinishingPlan(tool, result, path, estimate(path, machine), None, None)
     return CamPlan(rec, roughing, finishing, (THREE_AXIS_BUDGET_WARNING,))
 
@@ -776,6 +780,7 @@ def _plan_three_axis_ring(inputs: CamInputs, tolerance_mm: float, root) -> CamPl
                                         2 * root.active_start_radius_mm, root.fillet_radius_mm, len(levels),
                                         segments, arcs, root_thickness(spec, tool.diameter_mm / 2.0), engagement,
                                         "cutter")
-        result = FinishingResult("three_axis", None, None, len(levels), 0.0, np.zeros(0), facts=facts)
+        result = FinishingResult("three_axis", None, None, len(levels), 0.0, np.zeros(0), facts=facts,
+                                 lying_flat=True)
         finishing = FinishingPlan(tool, result, path, estimate(path, machine), None, None)
     return CamPlan(rec, roughing, finishing, (THREE_AXIS_BUDGET_WARNING,))

@@ -9,6 +9,7 @@ import dataclasses
 import numpy as np
 
 from spur_cad.cam.ir import Feature
+from spur_cad.cam.strategies import get_strategy
 from spur_cad.correct.apply import (
     ONCE_PER_TURN_MODELS,
     AppliedCorrection,
@@ -67,9 +68,6 @@ def corrected_job(job, identified: Identified):
     return dataclasses.replace(job, tools=dataclasses.replace(tools, finishing=finishing))
 
 
-SLOPE_STRATEGY = "generating"
-"""The finishing strategy whose passes can follow a slope: each generating flank pass is one straight line along X,
-tangent to the involute at one roll, its normal along the machine's Y (spur_cad.cam.strategies.generating_geometry)."""
 
 FLANK_SIDES = {Feature.RIGHT_FLANK: "right", Feature.LEFT_FLANK: "left"}
 
@@ -102,9 +100,11 @@ def slope_corrected_finishing(job, finishing, identified: Identified):
     reason) when its strategy has no straight passes to move."""
     from spur_cad.cam.strategies.generating import passes_toolpath
 
-    if finishing.result.strategy != SLOPE_STRATEGY:
+    if not get_strategy(finishing.result.strategy, job.strategies).corrects_slopes:
+        following = " or ".join(name for name, strategy in job.strategies.items() if strategy.corrects_slopes)
         return finishing, (f"the {finishing.result.strategy} finishing strategy's moves are not straight passes "
-                           "tangent at one roll: the slopes are not corrected (generating finishing can follow them)")
+                           f"tangent at one roll: the slopes are not corrected ({following} finishing can follow "
+                           "them)")
     spec = job.gear
     passes = slope_corrected_passes(spec, finishing.result.passes, identified)
     toolpath = passes_toolpath(spec, finishing.tool, job.machine, finishing.result.params, passes,

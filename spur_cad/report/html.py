@@ -12,6 +12,8 @@ from importlib import resources
 from typing import TYPE_CHECKING
 
 from spur_cad.cam.plan import REFERENCE_CONTACT_SPACING_MM, REFERENCE_STATION_STEP_MM
+from spur_cad.cam.strategies import COMPARISON_STRATEGY
+from spur_cad.cam.three_axis import ThreeAxisFinishingFacts
 from spur_cad.dependencies import require_jinja2
 from spur_cad.errors import SpurCadError, one_line
 from spur_cad.report import sheet
@@ -69,7 +71,7 @@ def finishing_comparison(finish: FinishingFacts) -> Table:
     rows = [(f"this job's finishing ({finish.strategy})", f"{own.moves:,}", duration(own.time_s),
              duration(own.time_with_acceleration_s))]
     others = [(finish.perimeter, "perimeter finishing at this job's target scallop")] \
-        if finish.strategy != "perimeter" else []
+        if finish.strategy != COMPARISON_STRATEGY else []
     others.append((finish.reference_strategy, reference))
     for other, label in others:
         if other is None:
@@ -151,8 +153,9 @@ def _tool_reach_note(result: JobResult) -> str:
     """A 3-axis finish whose flat end mill cannot follow the generated fillet: the root's leftover is the tool's
     reach (expected, the design's fillet being tighter than the tool), not a flank error; '' otherwise."""
     finish = result.finishing
-    facts = finish.strategy_facts if finish is not None and finish.strategy == "three_axis" else None
-    if facts is None or abs(facts.form_diameter_mm - facts.rack_form_diameter_mm) < 1e-6:
+    facts = finish.strategy_facts if finish is not None else None
+    if not isinstance(facts, ThreeAxisFinishingFacts) or \
+            abs(facts.form_diameter_mm - facts.rack_form_diameter_mm) < 1e-6:
         return ""
     root = [f.max_leftover_mm for f in result.simulation.per_feature if f.feature.endswith(("fillet", "root"))]
     generated = f"{facts.generated_by}-generated"

@@ -27,7 +27,7 @@ def plan_images(profile_png: bytes, spec: GearSpec, blank_radius_mm: float, plan
         from spur_cad.report.figures import modification_chart_png
 
         images["modifications"] = modification_chart_png(modifications, spec.base_radius_mm)
-    if plan.finishing is not None and plan.finishing.result.strategy == "three_axis":
+    if plan.finishing is not None and plan.finishing.result.lying_flat:
         return images  # [machine] axes = 3: no level or contact figures (the report's text says what was planned)
     if plan.roughing is not None and plan.roughing.flank is not None:
         images["roughing"] = roughing_flank_png(spec, plan.roughing.flank, plan.roughing.tool, blank_radius_mm)
@@ -55,7 +55,7 @@ def simulation_images(result: JobResult, spec: GearSpec, plan: CamPlan, sim: Sim
         return {}
     from spur_cad.report.figures import deviation_map_png
 
-    lying_flat = plan.finishing is not None and plan.finishing.result.strategy == "three_axis"
+    lying_flat = plan.finishing is not None and plan.finishing.result.lying_flat
     images = {"deviation": deviation_map_png(sim, lying_flat)}
     rough = result.setup
     if sim.engagement is not None and result.tools.roughing is not None and rough.roughing_step_down_mm is not None:

@@ -2,11 +2,12 @@
 `REGISTRY`, and the [finishing] section made from a registry.
 
 A strategy's module declares everything about it: its [finishing] keys (the `key(...)` fields of its
-parameters dataclass, with their checks), its tool check, its typed facts for summary.json and the report
-(`FinishingResult.facts`, with `report_text()`) and its typed tool advice. The job loader, the workbench
-panel, docs/job-file.md, the summary and the report learn them from a registry; adding a strategy is one
-module and one entry in REGISTRY (docs/architecture.md). Functions take `strategies=` to use another
-registry (a mapping name -> strategy), e.g. a strategy defined in a test.
+parameters dataclass, with their checks), its capabilities (helical, follows_modifications,
+corrects_slopes, lying_flat, simultaneous_rotary), its tool check, its typed facts for summary.json and
+the report (`FinishingResult.facts`, with `report_text()`) and its typed tool advice. The job loader, the
+workbench panel, docs/job-file.md, the summary and the report learn them from a registry; adding a
+strategy is one module and one entry in REGISTRY (docs/architecture.md). Functions take `strategies=` to
+use another registry (a mapping name -> strategy), e.g. a strategy defined in a test.
 """
 
 from __future__ import annotations
@@ -14,7 +15,9 @@ from __future__ import annotations
 import dataclasses
 import functools
 from collections.abc import Mapping
+from dataclasses import dataclass
 from types import MappingProxyType
+from typing import Any, Protocol
 
 from spur_cad.cam.machine import MachineError
 from spur_cad.cam.strategies.along_x import AlongXStrategy
@@ -23,8 +26,11 @@ from spur_cad.cam.strategies.base import (
     FinishingStrategy,
     TargetScallopParams,
     params_from_section,
+    step_over_key,
+    target_scallop_key,
 )
 from spur_cad.cam.strategies.generating import GeneratingStrategy
+from spur_cad.cam.strategies.generating_plan import cutting_direction_key, flank_tool_end_key
 from spur_cad.cam.strategies.perimeter import PerimeterStrategy
 from spur_cad.errors import shown
 from spur_cad.keys import METADATA_KEY, check_section, key
@@ -38,6 +44,9 @@ REGISTRY: Strategies = MappingProxyType({
 })
 """The default registry (read-only: another registry is a new mapping passed as `strategies=`)."""
 DEFAULT_STRATEGY = GeneratingStrategy.name
+COMPARISON_STRATEGY = PerimeterStrategy.name
+"""The strategy every rotary-table finishing is compared with (the shop-tested process, and with the reference
+process's spacing the reference strategy): summary.json's `perimeter_*` and `reference_strategy_*` keys."""
 
 
 def strategy_names(strategies: Strategies = REGISTRY) -> tuple[str, ...]:
@@ -54,10 +63,48 @@ def get_strategy(name: str, strategies: Strategies = REGISTRY) -> FinishingStrat
                            field="strategy", section="finishing") from None
 
 
+class FinishingSection(Protocol):
+    """What every registry's [finishing] section holds: the strategy's name and the target scallop (every
+    strategy reads it); the other keys are the registry's strategies' (taken by `params_from_section`)."""
+
+    @property
+    def strategy(self) -> str: ...
+
+    @property
+    def target_scallop_mm(self) -> float: ...
+
+    def validate(self) -> None: ...
+
+
+def _strategy_key(default: str, names: tuple[str, ...]) -> Any:
+    return key(default, label="FinishingStrategy", group="Finishing strategy",
+               meaning="a finishing strategy name (see docs/cam.md)", names_from=lambda: names)
+
+
+@dataclass(frozen=True)
+class FinishingParams:
+    """[finishing] of the default registry: the strategy and, in registry order, its strategies' keys (each
+    declared once, by the strategy's module; tests/test_strategy_registry.py checks that this class is the
+    section `finishing_section_type` makes from REGISTRY)."""
+
+    strategy: str = _strategy_key(DEFAULT_STRATEGY, tuple(REGISTRY))
+    target_scallop_mm: float = target_scallop_key()
+    step_over_mm: float = step_over_key()
+    cutting_direction: str = cutting_direction_key()
+    flank_tool_end: str = flank_tool_end_key()
+
+    def validate(self) -> None:
+        """Every key in its range and the strategy known (the job loader runs it once)."""
+        check_section(self, "finishing", MachineError)
+        get_strategy(self.strategy, REGISTRY)
+
+
 def finishing_section_type(strategies: Strategies = REGISTRY) -> type:
     """The [finishing] section's dataclass for a registry: `strategy` and, in registry order, every
     strategy's keys (a key several strategies share is declared once, in a common base such as
-    `base.TargetScallopParams`)."""
+    `base.TargetScallopParams`). FinishingParams for the default registry."""
+    if tuple(strategies.items()) == tuple(REGISTRY.items()):
+        return FinishingParams
     return _section_type(tuple(strategies.items()))
 
 
@@ -66,9 +113,7 @@ def _section_type(entries: tuple[tuple[str, FinishingStrategy], ...]) -> type:
     strategies = dict(entries)
     names = tuple(strategies)
     default = DEFAULT_STRATEGY if DEFAULT_STRATEGY in strategies else names[0]
-    fields: dict[str, tuple] = {"strategy": (str, key(default, label="FinishingStrategy", group="Finishing strategy",
-                                                      meaning="a finishing strategy name (see docs/cam.md)",
-                                                      names_from=lambda: names))}
+    fields: dict[str, tuple] = {"strategy": (str, _strategy_key(default, names))}
     declared: dict[str, str] = {}
     for strategy in strategies.values():
         if not issubclass(strategy.params_type, TargetScallopParams):  # the plan and the advice read the target
@@ -85,7 +130,7 @@ def _section_type(entries: tuple[tuple[str, FinishingStrategy], ...]) -> type:
                 fields[f.name] = (f.type, dataclasses.field(default=f.default, metadata=f.metadata))
                 declared[f.name] = strategy.name
 
-    def validate(self) -> None:
+    def validate(self: Any) -> None:
         check_section(self, "finishing", MachineError)
         get_strategy(self.strategy, strategies)
 
@@ -95,8 +140,6 @@ def _section_type(entries: tuple[tuple[str, FinishingStrategy], ...]) -> type:
                                       frozen=True, namespace=namespace)
 
 
-FinishingParams = finishing_section_type(REGISTRY)
-"""The [finishing] section of the default registry."""
-
-__all__ = ["DEFAULT_STRATEGY", "REGISTRY", "FinishingParams", "FinishingResult", "FinishingStrategy", "Strategies",
-           "finishing_section_type", "get_strategy", "params_from_section", "strategy_names"]
+__all__ = ["COMPARISON_STRATEGY", "DEFAULT_STRATEGY", "REGISTRY", "FinishingParams", "FinishingResult",
+           "FinishingSection", "FinishingStrategy", "Strategies", "finishing_section_type", "get_strategy",
+           "params_from_section", "strategy_names"]

@@ -9,15 +9,17 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, replace
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from spur_cad.cam.allowances import BottomAllowance, generating_bottom_allowance
 from spur_cad.cam.common import PLUNGE_FEED_FRACTION, safe_height_mm
 from spur_cad.cam.contacts import SpacePoses, TransversePoses
+from spur_cad.cam.estimate import Estimate
 from spur_cad.cam.ir import Feature, MoveKind, Operation, Toolpath, ToolpathBuilder
 from spur_cad.cam.machine import Machine
-from spur_cad.cam.strategies.base import FinishingResult, floor_to_step
+from spur_cad.cam.strategies.base import FinishingResult, estimate_by_generating, floor_to_step
 from spur_cad.cam.strategies.generating_advice import passes_flute_length_mm, tool_advice
 from spur_cad.cam.strategies.generating_flat import flat_deviation_mm
 from spur_cad.cam.strategies.generating_geometry import (
@@ -43,6 +45,9 @@ from spur_cad.cam.tools import Tool, ToolError
 from spur_cad.geometry.modifications import FlankModifications
 from spur_cad.geometry.profile import rack_corner
 from spur_cad.geometry.spec import GearSpec
+
+if TYPE_CHECKING:  # annotations only: the recommendations are computed above the strategies (cam.recommend)
+    from spur_cad.cam.recommend import ToolRecommendations
 
 
 @dataclass(frozen=True)
@@ -96,18 +101,21 @@ class GeneratingStrategy:
     params_type = GeneratingParams
     helical = True  # through the normal rack (generating_helical)
     simultaneous_rotary = False  # A is clamped for every pass; it indexes only at the safe height
+    follows_modifications = True  # the planned passes moved onto the modified flanks (generating_modified)
+    corrects_slopes = True  # each flank pass is a straight line along X: spur-cad correct moves it (correct.py)
+    lying_flat = False
 
-    def largest_tool(self, recommendations) -> tuple[str, float]:
+    def largest_tool(self, recommendations: ToolRecommendations) -> tuple[str, float]:
         """The largest tool with the advised corner radius rho."""
         return "finishing_generating_max_diameter_mm", recommendations.finishing_generating_max_diameter_mm
 
-    def bottom_allowance(self, tool: Tool | None, recommendations) -> BottomAllowance:
+    def bottom_allowance(self, tool: Tool | None, recommendations: ToolRecommendations) -> BottomAllowance:
         """The passes never plunge: near the root they take what roughing left above it side-on, one roll at a
         time, at most a slot's depth, LAND_PASS_DEPTH_FRACTION x D (without a tool: of the largest generating
         tool, recommendations.finishing_generating_max_diameter_mm)."""
         return generating_bottom_allowance(tool, recommendations)
 
-    def suggested_tool(self, spec: GearSpec, recommendations, target_scallop_mm: float,
+    def suggested_tool(self, spec: GearSpec, recommendations: ToolRecommendations, target_scallop_mm: float,
                        blank_radius_mm: float) -> tuple[float, float] | None:
         """The advised corner radius (the rack tip radius: tip mode exact) and a diameter at 95 % of the
         largest that fits both modes with the rack end, in 0.05 mm steps (helical: 95 % of the rack's normal
@@ -126,6 +134,10 @@ class GeneratingStrategy:
     def check_tool(self, spec: GearSpec, tool: Tool) -> None:
         check_generating_tool(spec, tool)
 
+    def estimate(self, spec: GearSpec, tool: Tool, machine: Machine, params: GeneratingParams,
+                 blank_radius_mm: float) -> Estimate:
+        return estimate_by_generating(self, spec, tool, machine, params, blank_radius_mm)
+
     def estimate_moves(self, spec: GearSpec, tool: Tool, params: GeneratingParams) -> int:
         """Counted with the land passes (an upper bound when the blank is turned to the tip diameter), without
         the clamp rows (which are no motion)."""
@@ -137,8 +149,6 @@ class GeneratingStrategy:
         """The passes planned for the design, moved onto the modified flanks when `modifications` are given
         (generating_modified; their offsets along X as lines within `profile_tolerance_mm`), with a flank pass at
         each relief's start roll (spur gears: the kink cut exactly)."""
-        params.validate()
-        machine.validate()
         kinks = () if modifications is None else tuple(sorted({
             k / spec.base_radius_mm for side in (modifications.right, modifications.left)
             for k in side.profile_kinks_roll_mm()}))

@@ -347,7 +347,6 @@ def check_generating_tool(spec: GearSpec, tool: Tool) -> None:
     if spec.kind.helical:
         check_helical_generating_tool(spec, tool)
         return
-    tool.validate("finishing")
     rho = spec.rack_tip_radius_mm
     r_t = tool.effective_corner_radius_mm
     profile = spec.tooth_space_profile()

@@ -134,7 +134,6 @@ def rack_distances_mm(spec: GearSpec, points: np.ndarray, a_rad: float, phi: flo
 def check_helical_generating_tool(spec: GearSpec, tool: Tool) -> None:
     """ToolError unless the tool's corner fits inside the rack's round (0 < r_t <= rho; a flat end mill only for a
     sharp rack) and its flat fits the rack's tip flat."""
-    tool.validate("finishing")
     rho, r_t = spec.rack_tip_radius_mm, tool.effective_corner_radius_mm
     if r_t > rho + CORNER_MATCH_MM:
         raise ToolError(f"finishing strategy generating for a helical gear: tool corner radius r_t = {r_t:g} mm is "

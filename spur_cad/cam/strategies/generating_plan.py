@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
@@ -20,7 +21,6 @@ from spur_cad.cam.strategies.generating_geometry import (
     TIP_MODE_SAFETY,
     TIP_SAFETY_HELICAL,
     GeneratingPass,
-    check_generating_tool,
     design_points,
     fillet_pose,
     flank_poses,
@@ -48,6 +48,19 @@ from spur_cad.geometry.spec import GearSpec
 from spur_cad.keys import key
 
 
+def cutting_direction_key() -> Any:
+    """generating's [finishing] key cutting_direction, declared here once (GeneratingParams and the default
+    registry's section, strategies.FinishingParams, take their field from here)."""
+    return key("climb", label="CuttingDirection", group="Finishing strategy", choices=CUTTING_DIRECTIONS,
+               meaning="generating: climb or conventional milling (spindle clockwise, M3)")
+
+
+def flank_tool_end_key() -> Any:
+    """generating's [finishing] key flank_tool_end, declared here once."""
+    return key("rack", label="FlankToolEnd", group="Finishing strategy", choices=FLANK_TOOL_ENDS,
+               meaning="generating: tool end on the rack's tip round (rack) or raised per pass (raised)")
+
+
 @dataclass(frozen=True)
 class GeneratingParams(TargetScallopParams):
     """[finishing] keys the generating strategy uses.
@@ -59,11 +72,8 @@ class GeneratingParams(TargetScallopParams):
     pass) or "raised" (per pass, just low enough for the straight side to cut the whole flat).
     """
 
-    cutting_direction: str = key("climb", label="CuttingDirection", group="Finishing strategy",
-                                 choices=CUTTING_DIRECTIONS,
-                                 meaning="generating: climb or conventional milling (spindle clockwise, M3)")
-    flank_tool_end: str = key("rack", label="FlankToolEnd", group="Finishing strategy", choices=FLANK_TOOL_ENDS,
-                              meaning="generating: tool end on the rack's tip round (rack) or raised per pass (raised)")
+    cutting_direction: str = cutting_direction_key()
+    flank_tool_end: str = flank_tool_end_key()
 
 
 @dataclass(frozen=True)
@@ -119,9 +129,8 @@ def plan_generating(spec: GearSpec, tool: Tool, params: GeneratingParams, *, lan
                     check: bool = True, kink_rolls_rad: tuple[float, ...] = ()) -> GeneratingPlan:
     """The passes of tooth space 0 (the land beside it when `lands`, both flanks, fillets and root), in
     cutting order. `kink_rolls_rad`: involute rolls where a modified flank has a kink (a relief's start), each
-    given a flank pass of its own so the kink is cut exactly (spur gears; a helical pass meets a roll at one X)."""
-    params.validate()
-    check_generating_tool(spec, tool)
+    given a flank pass of its own so the kink is cut exactly (spur gears; a helical pass meets a roll at one X).
+    The tool is one `check_generating_tool` has passed (the strategy's check_tool, run by the plan)."""
     if spec.kind.helical:
         return _plan_helical(spec, tool, params, lands)
     profile = spec.tooth_space_profile()
@@ -181,8 +190,6 @@ def planned_passes_per_space(spec: GearSpec, tool: Tool, params: GeneratingParam
     passes are counted, not placed (their ends take a bisection each), so the work bound does not plan them twice."""
     if not spec.kind.helical:
         return plan_generating(spec, tool, params, lands=lands, check=False).passes_per_space
-    params.validate()
-    check_generating_tool(spec, tool)
     _check_helical_work(spec, tool, params.target_scallop_mm)
     return helical_pass_count(spec, tool, params.target_scallop_mm, lands)
 

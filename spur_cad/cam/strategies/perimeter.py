@@ -48,13 +48,16 @@ class PerimeterStrategy(ContactStrategy):
     description = "transverse stations along X, once around the gear at each (simultaneous Y/Z/A)"
     params_type = PerimeterParams
     simultaneous_rotary = True
+    helical = False  # transverse contacts of a spur gear
+    follows_modifications = True  # each station's contacts on the flanks modified at its X
+    corrects_slopes = False
+    lying_flat = False
 
     def check_tool(self, spec: GearSpec, tool: Tool) -> None:
         """A round corner (the scallop is bounded by it) and a flat within the root arc."""
         check_flat_fits_root_arc(spec, tool, self.name)
 
     def estimate_moves(self, spec: GearSpec, tool: Tool, params: PerimeterParams) -> int:
-        params.validate()
         counts = contact_counts(spec, tool, params.target_scallop_mm, params.contact_spacing_mm)
         stations = math.ceil(spec.face_width_mm / station_step_mm(tool, params.target_scallop_mm,
                                                                    params.step_over_mm)) + 1
@@ -115,7 +118,7 @@ class PerimeterStrategy(ContactStrategy):
     def _stations_path(spec: GearSpec, tool: Tool, machine: Machine, params: PerimeterParams,
                        blank_radius_mm: float, poses: list[SpacePoses], stations: np.ndarray) -> Toolpath:
         """The toolpath of `stations`: `poses` holds one space's poses for all of them, or one for each."""
-        builder = finishing_builder(tool, machine, params)
+        builder = finishing_builder(tool, machine)
         feed, safe_z = tool.feed_mm_min(machine), safe_height_mm(blank_radius_mm, machine)
         if len(poses) == 1:
             _tile_stations(builder, spec, machine, poses[0], stations, feed, safe_z)
