@@ -756,7 +756,7 @@ def _job_from_data(data: dict, source: str, text: str, strategies: Strategies = 
                            "out",
                            section=table, field=None)
     modifications, modification_values = _modifications(modification_tables, spec, source, text)
-    _check_mate(spec, sections.get("mate"), tables.get("mate", {}), where)
+    spec = _mated(spec, sections.get("mate"), tables.get("mate", {}), where)
     for check, name in ((gear_section.blank_features().validate, "gear"),
                         (sections.get("stock", StockSpec()).validate, "stock")):
         try:
@@ -794,17 +794,17 @@ def _job_from_data(data: dict, source: str, text: str, strategies: Strategies = 
                dialects=dict(dialects), modifications=modifications, modification_values=modification_values)
 
 
-def _check_mate(spec: GearSpec, mate: MateSection | None, given: dict,
-                where: Callable[[str, str | None], str]) -> None:
-    """[mate] (None: not given): a pair that runs (spur_cad.mate_section.check_mate), else one line at the [mate]
-    key to blame."""
+def _mated(spec: GearSpec, mate: MateSection | None, given: dict, where: Callable[[str, str | None], str]) -> GearSpec:
+    """The gear with the start of its active profile in mesh with [mate] (None: not given, the gear as it is), if
+    the pair runs (spur_cad.mate_section.check_mate); else one line at the [mate] key to blame."""
     if mate is None:
-        return
+        return spec
     try:
-        check_mate(spec, mate, given)
+        _, facts = check_mate(spec, mate, given)
     except SpurCadError as exc:
         blamed = _blamed_key(exc, "mate", given)
         raise JobFileError(f"{where('mate', blamed)}: [mate] {exc}", section="mate", field=blamed) from None
+    return dataclasses.replace(spec, active_profile_start_diameter_mm=facts.start_of_active_profile_diameter_mm)
 
 
 def _check_probe(spec: GearSpec, sections: dict, tools: ToolsSection, tables: dict,

@@ -178,9 +178,11 @@ def _flank_point(spec: GearSpec, radius_mm: float, side: str) -> tuple[np.ndarra
 
 def design_points(spec: GearSpec, probe: ProbeSection) -> list[ProbePoint]:
     """Every point in program order: per space (A = -k * 360/z), the pitch points, then in trace spaces the
-    profile traces (form circle -> tip) and the helix traces (front -> back); right flank before left."""
+    profile traces (form circle, or [mate]'s start of active profile when above it, -> tip) and the helix
+    traces (front -> back); right flank before left."""
     rb = spec.base_radius_mm
-    roll_form = math.sqrt(max(spec.form_radius_mm ** 2 - rb ** 2, 0.0))
+    start_radius = max(spec.form_radius_mm, spec.active_profile_start_diameter_mm / 2.0)  # [mate]'s SAP when given
+    roll_form = math.sqrt(max(start_radius ** 2 - rb ** 2, 0.0))
     roll_tip = math.sqrt(spec.tip_radius_mm ** 2 - rb ** 2)
     rolls = np.linspace(roll_form, roll_form + (1.0 - TIP_EXCLUDED_FRACTION) * (roll_tip - roll_form),
                         probe.profile_points)

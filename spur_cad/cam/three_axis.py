@@ -33,6 +33,7 @@ from spur_cad.cam.three_axis_root import (
     check_ring_root,
     flat_mill_root,
     largest_flat_mill_radius_mm,
+    unreachable_message,
 )
 from spur_cad.cam.three_axis_tabs import (
     TabBand,
@@ -87,11 +88,8 @@ def check_three_axis(spec: GearSpec, finishing_tool: Tool | None, roughing_tool:
         return check_ring_root(spec, finishing_tool)
     root = flat_mill_root(spec, finishing_tool.diameter_mm / 2.0)
     if not root.fits:
-        largest = largest_flat_mill_radius_mm(spec)
-        raise ToolError(f"a D {finishing_tool.diameter_mm:g} mm flat end mill's side leaves the involute at diameter "
-                        f"{2 * root.form_radius_mm:.3f} mm, above the active profile's start at "
-                        f"{2 * root.active_start_radius_mm:.3f} mm; the largest tool radius that works is "
-                        f"{largest:.3f} mm (D {2 * largest:.2f} mm)", field="diameter_mm", section="tools.finishing")
+        raise ToolError(unreachable_message(spec, finishing_tool, root), field="diameter_mm",
+                        section="tools.finishing")
     return root
 
 

@@ -9,6 +9,7 @@ of the active profile: the involute must be cut down to there.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from dataclasses import dataclass
 
@@ -16,6 +17,8 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 from spur_cad.cam.tools import Tool, ToolError
+from spur_cad.errors import SpurCadError
+from spur_cad.geometry.mate import GearPair, PairMember, pair_facts
 from spur_cad.geometry.spec import GearSpec
 
 ROOT_SAMPLE_SPACING_MM = 0.005
@@ -46,9 +49,12 @@ class FlatMillRoot:
 
 
 def active_profile_start_radius_mm(spec: GearSpec) -> float:
-    """Radius where the active profile starts in mesh with the basic rack: the line of action meets the mating
+    """Radius where the active profile starts: in mesh with the real mate when the job gives one ([mate]:
+    spec.active_profile_start_diameter_mm), else with the basic rack: the line of action meets the mating
     rack's addendum line (h_a* m below the rolling line shifted by x m); the base radius if that is below it.
-    A ring's: ring_active_profile_start(spec)'s radius."""
+    A ring's without a mate: ring_active_profile_start(spec)'s radius."""
+    if spec.active_profile_start_diameter_mm > 0.0:
+        return spec.active_profile_start_diameter_mm / 2.0
     if spec.kind.teeth_inward:
         return ring_active_profile_start(spec)[0]
     alpha = spec.pressure_angle_rad
@@ -214,16 +220,60 @@ def root_thickness(spec: GearSpec, tool_radius_mm: float) -> RootThickness:
                          chord(cut, fillet), chord(gear, fillet))
 
 
+def active_profile_start_source(spec: GearSpec) -> str:
+    """What sets the start of the active profile, as a message names it."""
+    if spec.active_profile_start_diameter_mm > 0.0:
+        return "set by the mate's tips"
+    if spec.kind.teeth_inward:
+        return f"set by {ring_active_profile_start(spec)[1]}: no [mate]"
+    return "set by the basic rack: no [mate]"
+
+
+def _fits_text(spec: GearSpec) -> str:
+    largest = largest_flat_mill_radius_mm(spec)
+    return f"D {2 * largest:.2f} mm fits" if largest > 0.0 else "none fits"
+
+
+def _remedies(spec: GearSpec) -> str:
+    """What the designer can change when no flat end mill reaches the active profile, each with the largest tool
+    it would allow (found as for the job itself): the real mate (one like the gear at the standard centre distance
+    as the example), half the rack tip radius, 0.2 more profile shift, a protuberance rack."""
+    options = []
+    if spec.active_profile_start_diameter_mm == 0.0 and not spec.kind.teeth_inward:
+        pair = GearPair(PairMember(spec.teeth, profile_shift_coefficient=spec.profile_shift_coefficient),
+                        PairMember(spec.teeth), spec.module_mm, spec.pressure_angle_deg, spec.helix_angle_deg)
+        sap = pair_facts(pair).start_of_active_profile_diameter_mm
+        mated = dataclasses.replace(spec, active_profile_start_diameter_mm=sap)
+        options.append(f"[mate] (a z{spec.teeth} mate: SAP {sap:.3f} mm, {_fits_text(mated)})")
+    if spec.rack_tip_radius_mm > 0.0:
+        smaller = dataclasses.replace(spec, rack_tip_radius_mm=round(spec.rack_tip_radius_mm / 2.0, 6))
+        options.append(f"rack_tip_radius_mm {smaller.rack_tip_radius_mm:g} ({_fits_text(smaller)})")
+    try:
+        shifted = dataclasses.replace(spec, profile_shift_coefficient=spec.profile_shift_coefficient + 0.2)
+        options.append(f"profile shift {shifted.profile_shift_coefficient:g} ({_fits_text(shifted)})")
+    except SpurCadError:
+        pass
+    return ", ".join(options) + " or a protuberance rack"
+
+
+def unreachable_message(spec: GearSpec, tool: Tool, root: FlatMillRoot) -> str:
+    """One line: where the tool's side leaves the involute, the active profile's start and what sets it, then the
+    largest tool that works, or when none does what the designer can change and with what effect."""
+    ring = spec.kind.teeth_inward
+    head = (f"a D {tool.diameter_mm:g} mm flat end mill's side leaves the {'ring' + chr(39) + 's ' if ring else ''}"
+            f"involute at diameter {2 * root.form_radius_mm:.3f} mm, {'inside' if ring else 'above'} the active "
+            f"profile's start at {2 * root.active_start_radius_mm:.3f} mm ({active_profile_start_source(spec)})")
+    largest = largest_flat_mill_radius_mm(spec)
+    if largest > 0.0:
+        return f"{head}; the largest tool radius that works is {largest:.3f} mm (D {2 * largest:.2f} mm)"
+    return f"{head}; no flat end mill fits; change: {_remedies(spec)}"
+
+
 def check_ring_root(spec: GearSpec, finishing_tool: Tool) -> FlatMillRoot:
-    """The root the finishing tool leaves in the ring's spaces; ToolError (one line) when its fillet reaches the
-    active profile, naming the largest tool radius that works and what sets the active profile's start."""
+    """The root the finishing tool leaves in the ring's spaces; ToolError (one line, unreachable_message) when its
+    fillet reaches the active profile."""
     root = flat_mill_root(spec, finishing_tool.diameter_mm / 2.0)
     if not root.fits:
-        largest = largest_flat_mill_radius_mm(spec)
-        _, source = ring_active_profile_start(spec)
-        raise ToolError(f"a D {finishing_tool.diameter_mm:g} mm flat end mill's side leaves the ring's involute at "
-                        f"diameter {2 * root.form_radius_mm:.3f} mm, inside the active profile's start at "
-                        f"{2 * root.active_start_radius_mm:.3f} mm (set by {source}); the largest tool radius that "
-                        f"works is {largest:.3f} mm (D {2 * largest:.2f} mm)", field="diameter_mm",
+        raise ToolError(unreachable_message(spec, finishing_tool, root), field="diameter_mm",
                         section="tools.finishing")
     return root

@@ -118,6 +118,9 @@ class GearSpec:
     face_width_mm: float = 10.0
     helix_angle_deg: float = 0.0
     hand: str = "right"
+    active_profile_start_diameter_mm: float = 0.0
+    """Where the flank must be exact from: the start of the active profile (SAP) in mesh with the real mate
+    ([mate], spur_cad.geometry.mate); 0: not given, the checks assume the basic rack as the mate."""
     _profile_cache: dict = field(default_factory=dict, init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:
@@ -159,6 +162,8 @@ class GearSpec:
                      unit=" mm")
         _range_check("helix_angle_deg", self.helix_angle_deg, 0.0, MAX_HELIX_ANGLE_DEG, low_open=False,
                      high_open=False, unit=" deg")
+        _range_check("active_profile_start_diameter_mm", self.active_profile_start_diameter_mm, 0.0, 1e5,
+                     low_open=False, high_open=False, unit=" mm")
         if self.root_radius_mm <= 0.0:
             raise GearSpecError(
                 f"root radius {self.root_radius_mm:.4f} mm is not positive: the dedendum "

@@ -56,11 +56,14 @@ def profile_roll_mm(spec, radius_mm):
 
 def profile_range_mm(spec, start_radius_mm: float | None = None) -> tuple[float, float]:
     """The profile evaluation range in profile_roll_mm: form circle (or `start_radius_mm`: where a 3-axis tool
-    leaves the involute, above the rack's form circle; a ring's: inside its cutter-generated form circle) to 95 %
-    of the way to the tip circle (ISO 1328-1 leaves the tip's last 5 % out, an internal gear's as well: its tip is
-    the circle toward the axis)."""
+    leaves the involute, above the rack's form circle; a ring's: inside its cutter-generated form circle), or the
+    start of the active profile in mesh with the mate ([mate]: spec.active_profile_start_diameter_mm) when that is
+    nearer the tip (ISO 1328-1 evaluates from the SAP), to 95 % of the way to the tip circle (ISO 1328-1 leaves the
+    tip's last 5 % out, an internal gear's as well: its tip is the circle toward the axis)."""
     start_radius = spec.form_radius_mm if start_radius_mm is None else start_radius_mm
     start, tip = float(profile_roll_mm(spec, start_radius)), float(profile_roll_mm(spec, spec.tip_radius_mm))
+    if spec.active_profile_start_diameter_mm > 0.0:  # roll positions grow toward the tip, a ring's too
+        start = max(start, float(profile_roll_mm(spec, spec.active_profile_start_diameter_mm / 2.0)))
     return start, start + (1.0 - TIP_EXCLUDED_FRACTION) * (tip - start)
 
 
