@@ -387,6 +387,8 @@ def _remove_staging(folder: int, name: str, staging: int | None = None,
             if staging is not None:
                 os.close(staging)
             return
+    if staging is None:  # opened above, or given
+        return
     try:
         for entry in list(os.scandir(staging)):
             if _ours(entry, vocabulary):

@@ -230,3 +230,13 @@ def test_the_documents_name_every_dialect_of_the_registry():
     for document in ("README.md", "docs/usage.md"):
         text = " ".join((ROOT / document).read_text(encoding="utf-8").split())
         assert all(d.title.split()[0] in text for d in DIALECTS.values()), document
+
+
+def test_every_dialect_has_its_hand_written_golden_program_and_decimals():
+    """The test tables written from the manuals (independent of the table, so never derived from it) cover the
+    registry: a golden program per dialect (tests/test_post_golden.py) and its decimals (tests/test_post.py)."""
+    from tests.test_post import DECIMALS
+    from tests.test_post_golden import GOLDEN
+
+    assert set(GOLDEN) == set(DIALECTS) == set(DECIMALS)
+    assert all(DECIMALS[d.name] == (d.linear_decimals, d.rotary.decimals) for d in DIALECTS.values())

@@ -18,6 +18,7 @@ from spur_cad.correct.apply import (
     table_corrected,
 )
 from spur_cad.correct.identify import IdealFlanks, Identified
+from spur_cad.dialects import dialect
 from spur_cad.grade.measured import MeasuredPoints
 from spur_cad.grade.simulated import SIDES, helix_range_mm, profile_range_mm
 
@@ -221,7 +222,7 @@ def correct_job(job, measured, measured_source: str, datum: str = "best-fit", on
     notes = (f"corrected from {measured_source}: " + "; ".join(changes) + " (correction.json)",)
     _, files = build_programs(fixed, corrected_plan, notes)
     summary = correction_summary(spec, identified, applied, measured_source)
-    if applied.table_orders and job.post.dialect == "linuxcnc":
+    if applied.table_orders and dialect(job.post.dialect, job.dialects).rs274_checkable:  # a LinuxCNC control
         a_values = np.concatenate([planned.toolpath.a for planned in (corrected_plan.roughing,
                                                                       corrected_plan.roughing_bottom,
                                                                       corrected_plan.finishing)

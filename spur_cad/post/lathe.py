@@ -13,7 +13,7 @@ import math
 from collections.abc import Sequence
 
 from spur_cad.cam.turning import LatheError, LathePlan, LatheSection
-from spur_cad.dialects import DIALECTS, Dialect, Dialects, lathe_names
+from spur_cad.dialects import DIALECTS, Dialect, Dialects, LatheWords, lathe_names
 from spur_cad.errors import require_instance, shown
 from spur_cad.post.header import comment_line, program_head, setup_blocks
 from spur_cad.post.program import MAX_COORDINATE_MM
@@ -34,6 +34,13 @@ def lathe_dialect(dialect: str | Dialect, dialects: Dialects = DIALECTS) -> Dial
     return found
 
 
+def _lathe_words(d: Dialect) -> LatheWords:
+    """The lathe words of a dialect lathe_dialect returned (it has them)."""
+    if d.lathe is None:
+        raise LatheError(f"[lathe] dialect = {shown(d.name)} has no lathe words", field="dialect")
+    return d.lathe
+
+
 def lathe_extension(dialect: str | Dialect, dialects: Dialects = DIALECTS) -> str:
     """The program file's extension for a lathe dialect (siemens mpf, fanuc nc, linuxcnc ngc)."""
     return lathe_dialect(dialect, dialects).extension
@@ -50,8 +57,8 @@ def _number(value: float, decimals: int) -> str:
 class _Program:
     """The blocks of one lathe program in one dialect (its file frame and its lathe words)."""
 
-    def __init__(self, lathe: LatheSection, d: Dialect):
-        self.lathe, self.d, self.words = lathe, d, d.lathe
+    def __init__(self, lathe: LatheSection, d: Dialect, words: LatheWords):
+        self.lathe, self.d, self.words = lathe, d, words
         self.lines: list[str] = []
 
     def comment(self, text: str) -> str:
@@ -137,9 +144,10 @@ def post_lathe(plan: LathePlan, lathe: LatheSection, title: str, comments: Seque
     _check_plan(plan)
     if not plan.moves:
         raise LatheError("the lathe plan has no moves")
-    program = _Program(lathe, d)
+    program = _Program(lathe, d, _lathe_words(d))
     program.header(plan, title, [str(c) for c in comments])
-    tool, motion, position, feed = 0, "", (None, None), None
+    tool, motion, feed = 0, "", None
+    position: tuple[int | None, int | None] = (None, None)
     for move in plan.moves:
         if move.tool != tool:
             program.tool_call(move.tool)

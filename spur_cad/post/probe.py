@@ -11,7 +11,7 @@ appears inside one bounded inert comment.
 from __future__ import annotations
 
 from spur_cad.cam.probing import ProbeError, ProbePlan
-from spur_cad.dialects import DIALECTS, Dialect, Dialects, probing_names
+from spur_cad.dialects import DIALECTS, Dialect, Dialects, ProbingWords, probing_names
 from spur_cad.errors import require_instance, shown
 from spur_cad.post.header import comment_line, program_head, setup_blocks
 from spur_cad.post.settings import PostSettings
@@ -47,11 +47,11 @@ def _number(value: float, decimals: int) -> str:
     return f"{sign}{whole}.{f'{fraction:0{decimals}d}'.rstrip('0') or '0'}"
 
 
-def _header_comments(plan: ProbePlan, d: Dialect, gear_comment: str) -> list[str]:
+def _header_comments(plan: ProbePlan, words: ProbingWords, gear_comment: str) -> list[str]:
     probe, points = plan.section, plan.points
     kinds = {kind: sum(p.kind == kind for p in points) for kind in ("pitch", "profile", "helix")}
     log = ("each trip's ball centre goes to probe.log as X Y Z A B C U V W, one line per point in program order"
-           if not d.probing.record else
+           if not words.record else
            "each trip's ball centre is written by DPRNT as X Y Z A, one line per point in program order")
     return [
         gear_comment,
@@ -70,8 +70,8 @@ def _header_comments(plan: ProbePlan, d: Dialect, gear_comment: str) -> list[str
 class _Writer:
     """Numbers and words of one probing program in dialect `d` with the [post] settings' A convention."""
 
-    def __init__(self, d: Dialect, settings: PostSettings, plan: ProbePlan):
-        self.d, self.settings, self.plan = d, settings, plan
+    def __init__(self, d: Dialect, words: ProbingWords, settings: PostSettings, plan: ProbePlan):
+        self.d, self.words, self.settings, self.plan = d, words, settings, plan
         self.lines: list[str] = []
         probe = plan.section
         self.clear_z = f"Z{self.number(plan.clearance_z_mm)}"
@@ -97,17 +97,18 @@ class _Writer:
 
     def start(self, title: str, gear_comment: str) -> None:
         d, probe, settings = self.d, self.plan.section, self.settings
-        self.lines += program_head(d, probe.program_number, title, _header_comments(self.plan, d, gear_comment))
+        comments = _header_comments(self.plan, self.words, gear_comment)
+        self.lines += program_head(d, probe.program_number, title, comments)
         self.lines += [*setup_blocks(d, (d.setup,), settings.work_offset), d.spindle_off,
                        *(block.format(tool=probe.tool_number) for block in d.tool_change)]
         if probe.probe_on_code:
             self.lines.append(probe.probe_on_code)
-        self.lines += [f"G0 {self.clear_z}", d.probing.log_open]
+        self.lines += [f"G0 {self.clear_z}", self.words.log_open]
 
     def point(self, number: int, point, move, leave_to_clearance: bool) -> None:
         """The blocks of one point: reach the start (from the clearance height or straight from the last
         back-off), the probe move, the record and the no-trip check where the control needs them, the back-off."""
-        words, lines = self.d.probing, self.lines
+        words, lines = self.words, self.lines
         self.comment(f"P{number} space {point.space} {point.side} {point.kind} r {point.radius_mm:.4f} "
                      f"x {point.x_mm:.4f}")
         if move.link_via_clearance:
@@ -127,7 +128,7 @@ class _Writer:
 
     def end(self) -> None:
         d, probe = self.d, self.plan.section
-        self.lines.append(d.probing.log_close)
+        self.lines.append(self.words.log_close)
         if probe.probe_off_code:
             self.lines.append(probe.probe_off_code)
         self.lines.append(d.program_end)
@@ -146,7 +147,9 @@ def post_probe(plan: ProbePlan, settings: PostSettings, title: str, gear_comment
     require_instance(plan, ProbePlan, "plan")
     require_instance(settings, PostSettings, "settings")
     d = probing_dialect(settings.dialect, dialects)
-    writer = _Writer(d, settings, plan)
+    if d.probing is None:  # probing_dialect returns dialects with probing words only
+        raise ProbeError(f"[post] dialect = {shown(d.name)} has no probing words", field="dialect", section="post")
+    writer = _Writer(d, d.probing, settings, plan)
     writer.start(title, gear_comment)
     space = None
     for index, (point, move) in enumerate(zip(plan.points, plan.moves)):

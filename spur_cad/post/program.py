@@ -63,6 +63,14 @@ class _Run:
     a_reference: float  # the exact A (degrees, sign applied) the run's A words are written relative to
 
 
+@dataclass(frozen=True)
+class _Call:
+    """A run written as a call of subprogram `index` (of the program's subprogram bodies) with its base."""
+
+    index: int
+    run: _Run
+
+
 def post_program(path: Toolpath, settings: PostSettings, info: ProgramInfo,
                  dialect: Dialect | None = None, dialects: Dialects = DIALECTS) -> PostedProgram:
     """Write `path` as one program in the settings' dialect (of the registry `dialects`), or in `dialect` when
@@ -85,13 +93,13 @@ def post_program(path: Toolpath, settings: PostSettings, info: ProgramInfo,
     runs = _runs(path, x, a_signed, rot, settings.rotary_sign * info.first_space_a_reference_deg
                  if info.first_space_a_reference_deg is not None else None)
     centers = None
-    if path.center_x is not None:
+    if path.center_x is not None and path.center_y is not None:
         centers = (np.rint(np.nan_to_num(path.center_x) * lin).astype(np.int64),
                    np.rint(np.nan_to_num(path.center_y) * lin).astype(np.int64))
     columns = _Columns(path.kind, x, y, z, a_signed, path.inverse_time, feed, rot, centers)
     writer = _Writer(d, settings, info, columns, path.tool_number, int(round(path.spindle_rpm)))
 
-    body: list[tuple[str, object]] = []  # ("lines", [...]) or ("call", (sub index, run))
+    body: list[list[str] | _Call] = []  # inline blocks, or a call of subprogram `index` for a run
     sub_bodies: list[list[str]] = []
     if settings.folded:
         keys = [writer.run_key(run) if path.space[run.start] >= 0 else None for run in runs]
@@ -105,14 +113,14 @@ def post_program(path: Toolpath, settings: PostSettings, info: ProgramInfo,
                 if key not in subs:
                     subs[key] = len(sub_bodies)
                     sub_bodies.append(writer.run_lines(run, folded=True))
-                body.append(("call", (subs[key], run)))
+                body.append(_Call(subs[key], run))
             else:
-                body.append(("lines", writer.run_lines(run, folded=False)))
+                body.append(writer.run_lines(run, folded=False))
     else:
-        body = [("lines", writer.run_lines(run, folded=False)) for run in runs]
+        body = [writer.run_lines(run, folded=False) for run in runs]
     text = writer.program(body, sub_bodies)
     return PostedProgram(text=text, extension=d.extension, lines=text.count("\n"), bytes=len(text.encode()),
-                         subprograms=len(sub_bodies), calls=sum(1 for kind, _ in body if kind == "call"))
+                         subprograms=len(sub_bodies), calls=sum(1 for item in body if isinstance(item, _Call)))
 
 
 ARC_RADIUS_TOLERANCE_MM = 1e-4
@@ -143,7 +151,9 @@ def _check_numbers(path: Toolpath, info: ProgramInfo) -> None:
         raise PostError(f"{shown(info.title)}: spindle speed {path.spindle_rpm:g} rpm would be written as S0")
     arcs = path.arc_mask
     if arcs.any():
-        _check_arcs(path, arcs, info)
+        if path.center_x is None or path.center_y is None:
+            raise PostError(f"{shown(info.title)}: the toolpath has arcs without centres")
+        _check_arcs(path, path.center_x, path.center_y, arcs, info)
     check_rotary_code(info.rotary_clamp_code, "rotary_clamp_code")
     check_rotary_code(info.rotary_unclamp_code, "rotary_unclamp_code")
     if not info.rotary_axis and (np.any(path.a) or np.any(path.kind == MoveKind.CLAMP_ROTARY)
@@ -151,10 +161,11 @@ def _check_numbers(path: Toolpath, info: ProgramInfo) -> None:
         raise PostError(f"{shown(info.title)}: the toolpath turns or clamps A, and the machine has no rotary axis")
 
 
-def _check_arcs(path: Toolpath, arcs: np.ndarray, info: ProgramInfo) -> None:
+def _check_arcs(path: Toolpath, center_x: np.ndarray, center_y: np.ndarray, arcs: np.ndarray,
+                info: ProgramInfo) -> None:
     """Refuse arcs a control would refuse or misread: a centre that is not a finite number within range, A turned,
     an end off the start's circle, an end at the start (read as a full turn)."""
-    cx, cy, starts = path.center_x[arcs], path.center_y[arcs], path.start_poses()[arcs]
+    cx, cy, starts = center_x[arcs], center_y[arcs], path.start_poses()[arcs]
     if not (np.all(np.isfinite(cx)) and np.all(np.isfinite(cy)) and max(np.abs(cx).max(), np.abs(cy).max())
             <= MAX_COORDINATE_MM) or np.any(path.a[arcs]):
         raise PostError(f"{shown(info.title)}: an arc has a centre that is not a finite number within "
@@ -298,6 +309,8 @@ class _Writer:
         last_x, last_y, last_z, _ = modal.position
         if last_x is None or last_y is None:
             raise PostError(f"{shown(self.info.title)}: move {index} is an arc from an unknown position")
+        if self.c.centers is None:
+            raise PostError(f"{shown(self.info.title)}: move {index} is an arc without a centre")
         i, j = int(self.c.centers[0][index]) - last_x, int(self.c.centers[1][index]) - last_y
         if (x, y) == (last_x, last_y):
             return []  # shorter than the precision (a full turn, which this would be read as, is refused before)
@@ -352,7 +365,7 @@ class _Writer:
             head.append(mode)
             modal.feed_mode = mode
             modal.feed_units = None
-        motion = {MoveKind.ARC_CW: "G2", MoveKind.ARC_CCW: "G3"}.get(kind, "G1")
+        motion = {int(MoveKind.ARC_CW): "G2", int(MoveKind.ARC_CCW): "G3"}.get(kind, "G1")
         if modal.motion != motion:
             head.append(motion)
             modal.motion = motion
@@ -367,7 +380,7 @@ class _Writer:
             modal.feed_units = f
         return head
 
-    def program(self, body: list[tuple[str, object]], sub_bodies: list[list[str]]) -> str:
+    def program(self, body: list[list[str] | _Call], sub_bodies: list[list[str]]) -> str:
         """The whole program: header, subprogram definitions (before or after the main body, per dialect),
         the main body with its calls, the end; block numbers and the line-length check last."""
         d, s, info = self.d, self.settings, self.info
@@ -423,17 +436,17 @@ class _Writer:
             lines += [subs.start.format(sub=sub_ids[index]), *body, subs.end.format(sub=sub_ids[index])]
         return lines
 
-    def _main_body(self, body: list[tuple[str, object]], sub_bodies: list[list[str]], sub_ids: list[int]) -> list[str]:
+    def _main_body(self, body: list[list[str] | _Call], sub_bodies: list[list[str]], sub_ids: list[int]) -> list[str]:
         """Inline runs and subprogram calls in order; a repeat-style dialect writes each section at its first use."""
         d, subs = self.d, self.d.subprograms
         lin_dec, rot_dec = d.linear_decimals, d.rotary.decimals
         main: list[str] = []
         written: set[int] = set()
-        for kind, item in body:
-            if kind == "lines":
+        for item in body:
+            if not isinstance(item, _Call):
                 main += item
                 continue
-            index, run = item
+            index, run = item.index, item.run
             if subs.fold_style == FoldStyle.REPEATED_SECTION and index not in written:  # first use: the section itself
                 written.add(index)
                 main += [subs.call[0].format(x=_number(run.x_base or 0, lin_dec), a=_number(run.a_base, rot_dec)),
