@@ -227,6 +227,21 @@ def error_budget(job: Job, plan: CamPlan):
                        machine.linear_accuracy_um, deflection)
 
 
+def finishing_point_angles(job: Job, plan: CamPlan, grid):
+    """The commanded A that cut each involute point of the grid (spur_cad.sim.contact), or None where the finishing's
+    contacts are not a transverse section's (a helical gear; an internal one, not checked) or cannot be found: the
+    budget then turns each space rigidly at its index angle."""
+    from spur_cad.sim.contact import contact_angles, flank_point_angles
+
+    if plan.finishing is None or job.gear.kind.helical or job.gear.kind.teeth_inward:
+        return None
+    try:
+        contacts = contact_angles(job.gear, plan.finishing.toolpath, plan.finishing.tool)
+    except ValueError:
+        return None
+    return flank_point_angles(job.gear, grid, contacts)
+
+
 def budget_stage(job: Job, plan: CamPlan, sim_result: SimResult | None, grading: Grading | None):
     """The simulated gear on the budget's machine, graded (spur_cad.result.ErrorBudgetFacts; None without a
     simulation): the budget acts on the simulated flanks, the cut is not simulated again. None for 3 axes: its
@@ -238,7 +253,8 @@ def budget_stage(job: Job, plan: CamPlan, sim_result: SimResult | None, grading:
     from spur_cad.summary import error_budget_facts
 
     budget = error_budget(job, plan)
-    deviation, terms = apply_budget(sim_result.grid, sim_result.deviation, budget)
+    deviation, terms = apply_budget(sim_result.grid, sim_result.deviation, budget,
+                                    finishing_point_angles(job, plan, sim_result.grid))
     expected = grade_simulation(job.gear, dataclasses.replace(sim_result, deviation=deviation))
     return error_budget_facts(job, terms, budget.deflection, grading, expected)
 

@@ -14,13 +14,13 @@ import math
 import numpy as np
 import pytest
 
-from spur_cad.correct.contact import contact_angles
 from spur_cad.correct.correct import finishing_cut, ideal_flanks
 from spur_cad.correct.identify import identify
 from spur_cad.grade.measured import read_points_csv
 from spur_cad.grade.simulated import profile_range_mm
 from spur_cad.job import load_job
 from spur_cad.pipeline import job_stock, plan_cam
+from spur_cad.sim.contact import contact_angles
 from tests.gears import REFERENCE_JOB
 from tests.machine_model import Harmonic, PlantedMachine, cut_planes, flank_figures
 from tests.machine_model import scan_csv as machine_scan_csv

@@ -11,12 +11,12 @@ import json
 import numpy as np
 import pytest
 
-from spur_cad.correct.contact import contact_angles
 from spur_cad.correct.correct import corrected_plan_of, finishing_cut, ideal_flanks
 from spur_cad.correct.identify import identify
 from spur_cad.grade.measured import grade_measured, read_points_csv
 from spur_cad.job import load_job
 from spur_cad.pipeline import job_stock, plan_cam
+from spur_cad.sim.contact import contact_angles
 from tests.gears import REFERENCE_JOB
 from tests.test_correct import ISSUE_MACHINE, TOOL_RADIUS_ERROR_UM, planted_cut, scan_csv
 from tests.test_correct_slopes import HELIX_SLOPE_UM, PROFILE_SLOPE_UM, ROWS_MM, SLOPE_TOLERANCE_UM, slopes_mm

@@ -7,13 +7,13 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from spur_cad.correct.contact import contact_angles
 from spur_cad.correct.correct import finishing_cut, slope_corrected_finishing
 from spur_cad.correct.identify import identify
 from spur_cad.correct.summary import pressure_angle_change_deg
 from spur_cad.grade.measured import read_points_csv
 from spur_cad.grade.simulated import helix_range_mm, profile_range_mm
 from spur_cad.pipeline import job_stock
+from spur_cad.sim.contact import contact_angles
 from tests.test_correct import (
     ISSUE_MACHINE,
     TOOL_RADIUS_ERROR_UM,

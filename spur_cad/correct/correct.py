@@ -185,11 +185,11 @@ def correct_job(job, measured, measured_source: str, datum: str = "best-fit", on
     Returns (Identified, AppliedCorrection, {name: bytes})."""
     import json
 
-    from spur_cad.correct.contact import contact_angles
     from spur_cad.correct.identify import identify
     from spur_cad.correct.summary import correction_summary
     from spur_cad.errors import SpurCadError
     from spur_cad.pipeline import build_programs, plan_cam, run_job
+    from spur_cad.sim.contact import contact_angles
 
     spec = job.gear
     if spec.kind.helical:

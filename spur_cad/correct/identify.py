@@ -7,7 +7,7 @@ Model. Every involute point of side s deviates along its design normal (mm, + ma
     d = size_s - e(A) (p x n) + slope_s,profile t_profile + slope_s,helix t_helix + ideal(roll) + noise
 
 where size_s is the flank's shift by the tool (+: the tool cut too little, a smaller tool or wear), e(A) the table's
-error (rad: the table stood e(A) further in A than commanded) at the A that cut the point (spur_cad.correct.contact),
+error (rad: the table stood e(A) further in A than commanded) at the A that cut the point (spur_cad.sim.contact),
 which turns the point's cut by -e(A) in the part frame, p x n the point's lever (+-r_b on an involute), and ideal(roll)
 what the program leaves on an ideal machine (its scallops, the same in every space). e(A) is a Fourier series whose
 orders are chosen from the data (spur_cad.correct.table).
@@ -27,7 +27,6 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from spur_cad.correct.contact import ContactAngles
 from spur_cad.correct.table import TableError, blank_offset_mm, fit_flank_model
 from spur_cad.grade.iso1328 import evaluate_trace
 from spur_cad.grade.measured import (  # _design: the grader's design points
@@ -37,6 +36,7 @@ from spur_cad.grade.measured import (  # _design: the grader's design points
     flank_traces,
 )
 from spur_cad.grade.simulated import SIDES, helix_range_mm, profile_range_mm
+from spur_cad.sim.contact import ContactAngles
 
 ARCSEC_RAD = math.pi / (180.0 * 3600.0)
 MIN_FLANK_POINTS = 5

@@ -477,7 +477,18 @@ def error_budget_text(result: JobResult) -> str:
             f"{signed(shift['total'], 1)} {MICRO} along its normal (runout {signed(shift['runout'], 1)}, tool radius "
             f"{signed(shift['tool_radius'], 1)}, linear axes {signed(shift['linear'], 1)}, deflection "
             f"{signed(shift['deflection'], 1)}), {bent}; the tooth thickness on the reference circle changes by "
-            f"{signed(budget.tooth_thickness_change_um, 1)} {MICRO}.")
+            f"{signed(budget.tooth_thickness_change_um, 1)} {MICRO}." + eccentric_gear_text(terms))
+
+
+def eccentric_gear_text(terms) -> str:
+    """What a once-per-turn table error applied at each flank point's cutting A makes (an eccentric gear), and that a
+    best-fit measurement does not show it; empty when the budget was applied per space or has none."""
+    if terms.eccentricity_um < 0.05:
+        return ""
+    return (f" Its once-per-turn part makes an eccentric gear, the teeth about a centre "
+            f"{number(terms.eccentricity_um, 1)} {MICRO} off the axis they were cut on: the expected F_p counts it "
+            "about that axis (the datum, the bore); a best-fit measurement, which fits the centre to the teeth, "
+            "will not show it (spur-cad grade --datum axis does).")
 
 
 def warning_lines(result: JobResult) -> tuple[str, ...]:

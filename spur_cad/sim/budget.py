@@ -5,9 +5,12 @@ positions its axes within an accuracy and bends its tool under the cutting force
 budget acts on the simulated deviations of the flanks (the involute points ISO 1328 grades), exactly enough
 for deviations of micrometres:
 
-- an index error e_k (arcsec) of space k turns that space's cut by -e_k in the part frame: a point p with
-  normal n moves by -e_k (p x n) along n, which is -e_k r_b on an involute flank (the arc r e_k on the
-  reference circle, as the grader reads it);
+- the table's error e(A) (arcsec) turns a point's cut by -e(A) in the part frame, at the A that cut the point: a
+  point p with normal n moves by -e(A) (p x n) along n, which is -e(A) r_b on an involute flank (the arc r e on the
+  reference circle, as the grader reads it). With the finishing's contact angles (spur_cad.sim.contact: generating
+  and perimeter finishing cut each flank point at its own A, tens of degrees per flank) e is taken at each point's
+  A, so a once-per-turn error makes the eccentric gear a real table makes; without them (a helical gear) at each
+  space's index angle, a rigid turn of the space;
 - runout (half the total indicated runout of spindle and tool: the longest edge cuts), a tool larger than
   the program assumes and the linear positioning accuracy (half of it, worst case into the material) move
   every flank into the material by their size;
@@ -16,7 +19,8 @@ for deviations of micrometres:
 Index errors: the calibration table when the job names one (the machine's measured error at each A), else a
 once-per-turn sine of the positioning accuracy's amplitude (the worm wheel's eccentricity, the usual largest
 term); plus the repeatability as a pseudo-random draw per space, uniform in +-repeatability / 2, from the
-fixed seed RANDOM_SEED: the same job gives the same figures on every computer.
+fixed seed RANDOM_SEED: the same job gives the same figures on every computer (a non-repeatable error, drawn once per
+space: the space's index).
 """
 
 from __future__ import annotations
@@ -95,6 +99,7 @@ class BudgetTerms:
     random_index_arcsec: tuple[float, ...]
     index_error_arcsec: tuple[float, ...]
     flank_shift_um: dict[str, float]
+    eccentricity_um: float = 0.0  # r_b x the systematic error's once-per-turn amplitude, when applied per point
 
     def to_json(self) -> dict:
         return {"index_source": self.index_source, "random_seed": self.random_seed,
@@ -119,6 +124,21 @@ def index_errors(budget: ErrorBudget, teeth: int) -> tuple[np.ndarray, np.ndarra
     return a_deg, systematic, random, source
 
 
+def systematic_at(budget: ErrorBudget, a_deg: np.ndarray) -> np.ndarray:
+    """The table's systematic error (arcsec) at the commanded A (deg): the calibration table's, else the accuracy's
+    once-per-turn sine."""
+    if budget.calibration is not None:
+        return budget.calibration.error_at(a_deg)
+    return budget.rotary_accuracy_arcsec * np.sin(np.radians(a_deg))
+
+
+def once_per_turn_arcsec(budget: ErrorBudget) -> float:
+    """The amplitude (arcsec) of the systematic error's first harmonic over the turn (1 deg samples)."""
+    a = np.radians(np.arange(360.0))
+    error = systematic_at(budget, np.degrees(a))
+    return float(np.hypot(2.0 * np.mean(error * np.cos(a)), 2.0 * np.mean(error * np.sin(a))))
+
+
 def flank_shifts_um(budget: ErrorBudget) -> dict[str, float]:
     """Every flank's shift along its normal by each term and their total (um, + out of the material)."""
     shifts = {"runout": 0.0 - budget.runout_tir_um / 2.0, "tool_radius": 0.0 - budget.tool_radius_error_um,
@@ -132,21 +152,34 @@ def flank_mask(grid) -> np.ndarray:
     return np.array([name.endswith("involute") for name in grid.feature_names()])
 
 
-def apply_budget(grid, deviation: np.ndarray, budget: ErrorBudget) -> tuple[np.ndarray, BudgetTerms]:
+def apply_budget(grid, deviation: np.ndarray, budget: ErrorBudget,
+                 point_a_deg: np.ndarray | None = None) -> tuple[np.ndarray, BudgetTerms]:
     """The deviations (space, point, row; mm, + material) of the flanks cut on the budget's machine (a new
-    array; fillets, root and tip keep theirs) and the terms as applied."""
+    array; fillets, root and tip keep theirs) and the terms as applied. point_a_deg (space, involute point): the
+    commanded A that cut each involute point (spur_cad.sim.contact.flank_point_angles); the systematic error is
+    then taken there, else at each space's index angle."""
     a_deg, systematic, random, source = index_errors(budget, grid.teeth)
     total = systematic + random
     shifts = flank_shifts_um(budget)
     mask = flank_mask(grid)
     p, n = grid.points[mask], grid.normals[mask]
     lever_mm = p[:, 0] * n[:, 1] - p[:, 1] * n[:, 0]  # p x n: the normal motion per radian of turn (r_b on flanks)
-    change = -(total * ARCSEC_RAD)[:, None] * lever_mm[None, :] + shifts["total"] / 1000.0
+    eccentricity_um = 0.0
+    if point_a_deg is None:
+        per_point = np.repeat(total[:, None], len(lever_mm), axis=1)
+        source += ", at each space's index angle (a rigid turn of the space)"
+    else:
+        per_point = systematic_at(budget, point_a_deg) + random[:, None]
+        source += ", at the A that cut each flank point"
+        eccentricity_um = round(float(np.mean(np.abs(lever_mm))) * once_per_turn_arcsec(budget) * ARCSEC_RAD
+                                * 1000.0, 3)
+    change = -(per_point * ARCSEC_RAD) * lever_mm[None, :] + shifts["total"] / 1000.0
     moved = np.array(deviation, dtype=float, copy=True)
     flank = np.flatnonzero(mask)
     for space in range(len(moved)):  # a space at a time: no temporary the size of the whole gear's deviations
         moved[space, flank, :] += change[space, :, None]
     terms = BudgetTerms(source, RANDOM_SEED, tuple(round(float(a), 6) for a in a_deg),
                         tuple(round(float(e), 3) for e in systematic), tuple(round(float(e), 3) for e in random),
-                        tuple(round(float(e), 3) for e in total), {k: round(v, 3) for k, v in shifts.items()})
+                        tuple(round(float(e), 3) for e in total), {k: round(v, 3) for k, v in shifts.items()},
+                        eccentricity_um)
     return moved, terms

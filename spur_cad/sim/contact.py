@@ -21,6 +21,9 @@ from spur_cad.cam.ir import MoveKind
 CONTACT_SPACING_MM = 0.02
 """Involute points are taken this far apart along the flank when finding each pose's contact: a pose's roll length is
 known to about this (0.01 deg of A on the reference gear's 37 deg per 15 mm flank)."""
+TOOL_LENGTH_DIAMETERS = 10.0
+"""The tool's section is taken this many diameters long at least (its flute length or stick-out when longer; a job
+may give neither): generating finishing touches the flank with the tool's side, several millimetres above its tip."""
 CONTACT_TOLERANCE_MM = 0.05
 """A pose touches the flank when its tool comes this close to an involute point (the finishing's passes touch the
 design within their scallop; roughing and positioning moves are far off)."""
@@ -84,7 +87,7 @@ def contact_angles(spec, toolpath, tool) -> ContactAngles:
     cutting = (toolpath.kind == MoveKind.LINEAR) & (toolpath.space == 0)
     poses = np.unique(np.round(np.column_stack([toolpath.y[cutting], toolpath.z[cutting], toolpath.a[cutting]]), 7),
                       axis=0)
-    length = max(tool.flute_length_mm, tool.diameter_mm)
+    length = max(tool.flute_length_mm, tool.stick_out_mm, TOOL_LENGTH_DIAMETERS * tool.diameter_mm)
     found: dict[str, list[tuple[float, float]]] = {"right": [], "left": []}
     for name in found:
         on = side == name
@@ -112,3 +115,14 @@ def contact_angles(spec, toolpath, tool) -> ContactAngles:
         angles[name] = np.array([table[table[:, 0] == r, 1].mean() for r in unique_roll])
     return ContactAngles(rolls, angles, spec.teeth)
 
+
+
+def flank_point_angles(spec, grid, contacts: ContactAngles) -> np.ndarray:
+    """The commanded A (deg) that cut each involute point of a design grid (spur_cad.sim.design.DesignGrid), per tooth
+    space: (teeth, involute points) in the grid's order of its involute points."""
+    names = np.array(grid.feature_names())
+    flank = np.array([name.endswith("involute") for name in names])
+    side = np.array([name.split()[0] for name in names[flank]])
+    roll = np.sqrt(np.maximum(np.hypot(grid.points[flank, 0], grid.points[flank, 1]) ** 2
+                              - spec.base_radius_mm ** 2, 0.0))
+    return np.stack([contacts.at(side, roll, np.full(len(roll), k)) for k in range(grid.teeth)])
