@@ -44,6 +44,7 @@ from spur_cad.errors import (
     shown_path,
 )
 from spur_cad.geometry.internal import InternalGearSpec
+from spur_cad.geometry.mate import GearPair
 from spur_cad.geometry.modifications import SIDES, FlankModifications, flank_modification
 from spur_cad.geometry.spec import MAX_TEETH, MIN_TEETH, GearSpec
 from spur_cad.keys import check_section, coerce, key, keys_of, section_problems, type_problem
@@ -256,6 +257,7 @@ class Job:
     gear_section: GearSection
     gear: GearSpec
     mate: MateSection | None = None  # [mate]: the mating gear (None: the basic rack)
+    pair: GearPair | None = None  # the gear and its [mate] as they mesh (spur_cad.geometry.mate)
     stock: StockSpec = field(default_factory=StockSpec)
     tools: ToolsSection = field(default_factory=ToolsSection)
     roughing: RoughingParams = field(default_factory=RoughingParams)
@@ -756,7 +758,7 @@ def _job_from_data(data: dict, source: str, text: str, strategies: Strategies = 
                            "out",
                            section=table, field=None)
     modifications, modification_values = _modifications(modification_tables, spec, source, text)
-    spec = _mated(spec, sections.get("mate"), tables.get("mate", {}), where)
+    spec, pair = _mated(spec, sections.get("mate"), tables.get("mate", {}), where)
     for check, name in ((gear_section.blank_features().validate, "gear"),
                         (sections.get("stock", StockSpec()).validate, "stock")):
         try:
@@ -791,20 +793,22 @@ def _job_from_data(data: dict, source: str, text: str, strategies: Strategies = 
     post = sections["post"] if "post" in sections else types["post"]()  # the registry's default dialect
     return Job(source=source, job=sections.get("job", JobSection()), gear_section=gear_section, gear=spec,
                tools=tools, finishing=finishing, post=post, **optional, text=text, strategies=dict(strategies),
-               dialects=dict(dialects), modifications=modifications, modification_values=modification_values)
+               dialects=dict(dialects), modifications=modifications, modification_values=modification_values,
+               pair=pair)
 
 
-def _mated(spec: GearSpec, mate: MateSection | None, given: dict, where: Callable[[str, str | None], str]) -> GearSpec:
-    """The gear with the start of its active profile in mesh with [mate] (None: not given, the gear as it is), if
-    the pair runs (spur_cad.mate_section.check_mate); else one line at the [mate] key to blame."""
+def _mated(spec: GearSpec, mate: MateSection | None, given: dict,
+           where: Callable[[str, str | None], str]) -> tuple[GearSpec, GearPair | None]:
+    """The gear with the start of its active profile in mesh with [mate], and the pair (None: no [mate], the gear
+    as it is), if the pair runs (spur_cad.mate_section.check_mate); else one line at the [mate] key to blame."""
     if mate is None:
-        return spec
+        return spec, None
     try:
-        _, facts = check_mate(spec, mate, given)
+        pair, facts = check_mate(spec, mate, given)
     except SpurCadError as exc:
         blamed = _blamed_key(exc, "mate", given)
         raise JobFileError(f"{where('mate', blamed)}: [mate] {exc}", section="mate", field=blamed) from None
-    return dataclasses.replace(spec, active_profile_start_diameter_mm=facts.start_of_active_profile_diameter_mm)
+    return dataclasses.replace(spec, active_profile_start_diameter_mm=facts.start_of_active_profile_diameter_mm), pair
 
 
 def _check_probe(spec: GearSpec, sections: dict, tools: ToolsSection, tables: dict,

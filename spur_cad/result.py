@@ -13,6 +13,7 @@ from typing import TYPE_CHECKING, Any
 
 from spur_cad.cam.setups import ROTARY_TABLE, MachineSetup
 from spur_cad.geometry.kinds import EXTERNAL_SPUR, GearKind
+from spur_cad.geometry.mate import GearPair, PairFacts
 
 if TYPE_CHECKING:  # annotations only: the CAD kernel and the simulator load when a job uses them
     from spur_cad.cad.specs import GearSolidReport
@@ -312,3 +313,5 @@ class JobResult:
     correction: dict | None = None  # spur-cad correct's correction.json when the run is a corrected set (the report)
     modifications: ModificationInspection | None = None  # the flank modifications on the inspection sheet
     kind: GearKind = EXTERNAL_SPUR  # the gear's kind (spur_cad.geometry.kinds; not in summary.json)
+    pair: GearPair | None = None  # the gear and its [mate] (None: no [mate], the checks assume the basic rack)
+    mate: PairFacts | None = None  # the pair's ISO 21771 quantities (summary.json's `mate`)

@@ -17,6 +17,7 @@ from spur_cad.cam.recommend import ToolRecommendations
 from spur_cad.cam.tools import Tool
 from spur_cad.dialects import dialect
 from spur_cad.geometry.inspection import inspection_facts, modification_inspection
+from spur_cad.geometry.mate import GearPair, PairFacts, pair_facts
 from spur_cad.geometry.sampling import ProfileSamples
 from spur_cad.post.program import PostedProgram
 from spur_cad.post.settings import PostSettings
@@ -80,7 +81,8 @@ def build_result(job, samples: ProfileSamples, cad: CadResult | None, plan: CamP
                                                         for name, p in programs.items()),
                        dialect(post.dialect, job.dialects).extension),
         simulation=simulation_facts(simulation, job.simulation.resolution_mm), grading=grading,
-        lathe=lathe_facts(job), timings_s=seconds, setup=setup_facts(job, plan, post), error_budget=error_budget)
+        lathe=lathe_facts(job), timings_s=seconds, setup=setup_facts(job, plan, post), error_budget=error_budget,
+        pair=job.pair, mate=pair_facts(job.pair) if job.pair is not None else None)
 
 
 BUDGET_INPUTS = ("rotary_accuracy_arcsec", "rotary_repeatability_arcsec", "rotary_calibration_file",
@@ -263,6 +265,8 @@ def summary_json(result: JobResult) -> dict:
         "spur_cad_version": result.version,
         "job": {"name": result.job.name, "file": result.job.file},
         "gear": dataclasses.asdict(result.gear),
+        **({"mate": mate_json(result.pair, result.mate)} if result.pair is not None and result.mate is not None
+           else {}),
         "inspection": _inspection_json(result.inspection),
         **({"modifications": modifications_json(result.modifications)} if result.modifications is not None else {}),
         "profile": {"tolerance_mm": result.profile.tolerance_mm, "points": result.profile.points,
@@ -286,6 +290,20 @@ def summary_json(result: JobResult) -> dict:
         summary["lathe"] = dataclasses.asdict(result.lathe)
     summary["timings_s"] = dict(result.timings_s)
     return summary
+
+
+MATE_INTERNALS = ("internal", "start_of_active_profile_roll_mm", "mate_start_of_active_profile_roll_mm")
+"""PairFacts fields summary.json's `mate` leaves out (the mate's own `internal` is there; the rolls are the
+computation's)."""
+
+
+def mate_json(pair: GearPair, facts: PairFacts) -> dict:
+    """summary.json's `mate` ([mate] jobs only): the mate as it meshes (its shift solved when a centre distance
+    set it) and the pair's quantities (spur_cad.geometry.mate.PairFacts, mm and degrees)."""
+    mate = pair.mate
+    return {"teeth": mate.teeth, "internal": mate.internal, "profile_shift_coefficient": mate.profile_shift_coefficient,
+            "addendum_coefficient": mate.addendum_coefficient, "dedendum_coefficient": mate.dedendum_coefficient,
+            **{name: value for name, value in dataclasses.asdict(facts).items() if name not in MATE_INTERNALS}}
 
 
 def modifications_json(facts) -> dict:

@@ -17,6 +17,7 @@ from spur_cad.cam.three_axis import ThreeAxisFinishingFacts
 from spur_cad.dependencies import require_jinja2
 from spur_cad.errors import SpurCadError, one_line
 from spur_cad.report import sheet
+from spur_cad.report.pair import NO_MATE_NOTE, pair_rows
 from spur_cad.report.sheet import Table, duration, number
 
 if TYPE_CHECKING:
@@ -185,6 +186,7 @@ def report_context(result: JobResult, images: dict[str, bytes]) -> dict:
         "warnings": sheet.warning_lines(result), "setup_rows": sheet.setup_rows(result),
         "totals_rows": sheet.totals_rows(result), "operation_table": sheet.operation_table(result),
         "tool_table": sheet.tool_table(result), "gear_rows": sheet.gear_rows(result),
+        "pair_rows": pair_rows(result), "no_mate_note": NO_MATE_NOTE if result.pair is None else "",
         "helical": result.kind.helical, "inspection_rows": sheet.inspection_rows(result),
         "expected_tolerance": sheet.expected_tolerance(result), "limit_rows": sheet.limit_rows(result),
         "advice_rows": sheet.advice_rows(result), "advice_strategy": result.tools.advice_strategy,

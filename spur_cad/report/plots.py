@@ -114,7 +114,9 @@ def tooth_space_png(spec: GearSpec, samples: ProfileSamples, modified_flanks: di
     profile = spec.tooth_space_profile()
     circles = sorted((("tip", spec.tip_radius_mm), ("reference", spec.reference_radius_mm),
                       ("base", spec.base_radius_mm), ("form", profile.form_radius_mm),
-                      ("root", spec.root_radius_mm)), key=lambda item: -item[1])
+                      ("root", spec.root_radius_mm))
+                     + ((("SAP (mate)", spec.active_profile_start_diameter_mm / 2.0),)
+                        if spec.active_profile_start_diameter_mm > 0.0 else ()), key=lambda item: -item[1])
     label_gap = 0.045 * (spec.tip_radius_mm - spec.root_radius_mm + 1.0)  # labels of close circles kept apart
     label_y = np.inf
     for name, radius in circles:  # top down, each label at least label_gap below the one above it
