@@ -222,7 +222,8 @@ def test_correct_reads_the_probe_log_for_the_tool_size_and_says_it_cannot_see_th
     assert "not seen" in report and "turns on the table that cut the gear" in report
 
 
-def test_a_probe_log_of_a_machine_with_a_table_error_still_corrects_the_size_and_cannot_see_the_table(cut, tmp_path):
+def test_a_probe_log_of_a_machine_with_a_table_error_still_corrects_the_size_and_cannot_see_the_table(cut, tmp_path,
+                                                                                                      capsys):
     """Issue 46: the reference gear cut on the planted machine of tests/test_correct.py (tool 8 um larger, the table
     standing 25 arcsec x sin(A + 40 deg) further at each row's A; spur_cad's simulator) and probed on the same table:
     each space probed at its index angle A_k, where the table stands e(A_k) further, so the probe sees the space
@@ -256,3 +257,9 @@ def test_a_probe_log_of_a_machine_with_a_table_error_still_corrects_the_size_and
     assert not correction["table_error_arcsec"]["seen"] and "never e itself" in correction["not_corrected"][
         "table_error"]
     assert "a_words" not in correction["corrections"] and "unfolded" not in correction["corrections"]
+    # a probe log has its own datum, the A axis: --datum best-fit is refused in one line and nothing is written
+    capsys.readouterr()
+    assert main(["correct", str(work / "job.toml"), str(work / "probe.log"), "--datum", "best-fit", "--out",
+                 str(work / "other")]) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and "--datum is for CSV scans" in err and not (work / "other").exists()
