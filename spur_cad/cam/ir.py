@@ -19,6 +19,7 @@ from __future__ import annotations
 import dataclasses
 from dataclasses import dataclass, field
 from enum import IntEnum
+from typing import Any
 
 import numpy as np
 
@@ -103,7 +104,7 @@ class Toolpath:
     def arc_mask(self) -> np.ndarray:
         return (self.kind == MoveKind.ARC_CW) | (self.kind == MoveKind.ARC_CCW)
 
-    def replace(self, **arrays: np.ndarray) -> "Toolpath":
+    def replace(self, **arrays: Any) -> "Toolpath":
         """A copy with some arrays replaced (same length), e.g. feeds converted to inverse time."""
         return dataclasses.replace(self, **arrays)
 
@@ -158,14 +159,15 @@ class ToolpathBuilder:
                              "station": full(station, np.int32), "feature": full(feature, np.int8),
                              "center_x": np.full(n, NAN), "center_y": np.full(n, NAN)})
 
-    def last_pose(self) -> tuple[float, float, float, float] | None:
+    def last_pose(self) -> tuple[float, float, float, float]:
+        """(x, y, z, a) of the last move added; a path's first move has no pose before it (ValueError)."""
         if self._rows:
             row = self._rows[-1]
             return row[1], row[2], row[3], row[4]
         if self._chunks:
             c = self._chunks[-1]
             return float(c["x"][-1]), float(c["y"][-1]), float(c["z"][-1]), float(c["a"][-1])
-        return None
+        raise ValueError("the toolpath has no move yet, so no last pose")
 
     def build(self) -> Toolpath:
         self._flush_rows()
@@ -197,7 +199,7 @@ def arc_sweeps_rad(path: Toolpath) -> tuple[np.ndarray, np.ndarray]:
     An arc whose end is its start is a full turn."""
     radius, sweep = np.zeros(len(path)), np.zeros(len(path))
     arcs = path.arc_mask
-    if not arcs.any():
+    if not arcs.any() or path.center_x is None or path.center_y is None:
         return radius, sweep
     x0, y0 = path.start_poses()[:, 0][arcs], path.start_poses()[:, 1][arcs]
     cx, cy = path.center_x[arcs], path.center_y[arcs]
@@ -216,6 +218,8 @@ def arc_points(path: Toolpath, index: int, max_chord_error_mm: float) -> np.ndar
     radius, sweep = arc_sweeps_rad(path)
     r, s = float(radius[index]), float(sweep[index])
     x0, y0 = path.start_poses()[index, :2]
+    if path.center_x is None or path.center_y is None:
+        raise ValueError(f"move {index} is not an arc: the toolpath has no arcs")
     cx, cy = float(path.center_x[index]), float(path.center_y[index])
     step = 2.0 * np.arccos(max(0.0, 1.0 - max_chord_error_mm / max(r, 1e-12))) if r > max_chord_error_mm else np.pi
     n = max(1, int(np.ceil(abs(s) / max(step, 1e-6))))

@@ -449,11 +449,12 @@ def _pass_legs(x_from: float, x_to: float, x_material: tuple[float, float]) -> l
 def _closest_to_axis_mm(plan, radius: float) -> float:
     """The flat tool bottom's least distance from the gear axis over a space's passes and links (Y and Z
     interpolated along each leg, sampled at 65 points; A does not change the distance)."""
-    points, previous, floor = [], None, _passes_floor_mm(plan, radius)
+    legs: list[tuple[float, float]] = []
+    previous, floor = None, _passes_floor_mm(plan, radius)
     for p in plan.passes:
-        points.extend((y, z) for y, z, _ in _link_poses(previous, p, floor))
+        legs.extend((y, z) for y, z, _ in _link_poses(previous, p, floor))
         previous = p
-    points = np.array(points)
+    points = np.array(legs)
     t = np.linspace(0.0, 1.0, 65)[:, None, None]
     path = (points[:-1] + t * (points[1:] - points[:-1])).reshape(-1, 2) if len(points) > 1 else points
     y, z = np.abs(path[:, 0]), path[:, 1]

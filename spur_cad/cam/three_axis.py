@@ -124,6 +124,7 @@ def _entry_split(loop: list[Segment2D], bands: tuple[TabBand, ...] = ()) -> list
         raise MachineError("the finishing outline has no tip arc to enter on", field="axes", section="machine")
     i = max(tips, key=lambda k: loop[k].length_mm)
     arc = loop[i]
+    assert isinstance(arc, Arc2D)  # i is one of the tip arcs found above
     middle = arc.point_at(0.5)
     first, second = Arc2D(arc.start_xy, middle, arc.center_xy, False), Arc2D(middle, arc.end_xy, arc.center_xy, False)
     return [second, *loop[i + 1:], *loop[:i], first]
@@ -237,13 +238,13 @@ def finishing_toolpath(spec: GearSpec, tool: Tool, machine: Machine, tolerance_m
     for index, z in enumerate(levels):
         builder.move(MoveKind.RAPID, start[0], start[1], safe_z, 0.0)
         builder.move(MoveKind.LINEAR, start[0], start[1], z, 0.0, feed / 2.0, station=index)
-        builder.arc(not ccw, *loop[0].start_xy, z, *centre, feed, station=index)
+        builder.arc(not ccw, loop[0].start_xy[0], loop[0].start_xy[1], z, centre[0], centre[1], feed, station=index)
         if bands and z < tab_top:
             _add_held(builder, pieces, z, tab_top, feed, index)
         else:
             for segment in loop:
                 _add_segment(builder, segment, z, feed, index)
-        builder.arc(not ccw, end[0], end[1], z, *centre, feed, station=index)
+        builder.arc(not ccw, end[0], end[1], z, centre[0], centre[1], feed, station=index)
         builder.move(MoveKind.RAPID, end[0], end[1], safe_z, 0.0)
     return builder.build(), levels, len(loop)
 
@@ -307,7 +308,7 @@ def _roughing_level_with_tabs(builder: ToolpathBuilder, rings: list, z: float, t
                               outside: float, feed: float, safe_z: float, index: int, clearance_mm: float) -> None:
     """One roughing level below the tabs' top: the same passes as without tabs (entered the same way), the lines
     in a tab's band at the tab's top."""
-    points = []
+    points: list[np.ndarray] = []
     for _, ring in rings:
         coords = np.asarray(ring.coords)[:-1]
         if not points:
@@ -321,7 +322,7 @@ def _roughing_level_with_tabs(builder: ToolpathBuilder, rings: list, z: float, t
     builder.move(MoveKind.LINEAR, float(points[0][0]), float(points[0][1]), z, 0.0, feed / 2.0, station=index)
     lines = [Line2D((float(a[0]), float(a[1])), (float(b[0]), float(b[1]))) for a, b in zip(points[:-1], points[1:])
              if (a[0], a[1]) != (b[0], b[1])]
-    pieces = split_at_bands(lines, bands)
+    pieces = split_at_bands(list[Segment2D](lines), bands)
     _add_held(builder, pieces, z, tab_top, feed, index)
     builder.move(MoveKind.RAPID, float(points[-1][0]), float(points[-1][1]), safe_z, 0.0)
 

@@ -71,9 +71,11 @@ def ring_finishing_loop(spec: GearSpec, tool: Tool, tolerance_mm: float) -> list
             and s.counterclockwise]
     if not tips:
         raise MachineError("the ring's finishing outline has no tip arc to enter on", field="axes", section="machine")
-    innermost = min(loop[i].radius_mm for i in tips)
-    i = max((k for k in tips if loop[k].radius_mm <= innermost + 1e-9), key=lambda k: loop[k].length_mm)
+    radius_mm = {i: s.radius_mm for i, s in enumerate(loop) if isinstance(s, Arc2D)}
+    innermost = min(radius_mm[i] for i in tips)
+    i = max((k for k in tips if radius_mm[k] <= innermost + 1e-9), key=lambda k: loop[k].length_mm)
     arc = loop[i]
+    assert isinstance(arc, Arc2D)  # i is one of the tip arcs found above
     middle = arc.point_at(0.5)
     first, second = Arc2D(arc.start_xy, middle, arc.center_xy, True), Arc2D(middle, arc.end_xy, arc.center_xy, True)
     return [second, *loop[i + 1:], *loop[:i], first]
@@ -107,10 +109,10 @@ def ring_finishing_toolpath(spec: GearSpec, tool: Tool, machine: Machine, tolera
     for index, z in enumerate(levels):
         builder.move(MoveKind.RAPID, start[0], start[1], safe_z, 0.0)
         builder.move(MoveKind.LINEAR, start[0], start[1], z, 0.0, feed / 2.0, station=index)
-        builder.arc(not ccw, *loop[0].start_xy, z, *centre, feed, station=index)
+        builder.arc(not ccw, loop[0].start_xy[0], loop[0].start_xy[1], z, centre[0], centre[1], feed, station=index)
         for segment in loop:
             _add_segment(builder, segment, z, feed, index)
-        builder.arc(not ccw, end[0], end[1], z, *centre, feed, station=index)
+        builder.arc(not ccw, end[0], end[1], z, centre[0], centre[1], feed, station=index)
         builder.move(MoveKind.RAPID, end[0], end[1], safe_z, 0.0)
     return builder.build(), levels, len(loop)
 
