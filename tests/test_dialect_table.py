@@ -28,7 +28,7 @@ from tests.test_post import assert_same_moves
 
 ROOT = Path(__file__).resolve().parent.parent
 READERS_OF_THE_TABLE = ("spur_cad/post/program.py", "spur_cad/post/lathe.py", "spur_cad/verify/reader.py",
-                        "spur_cad/cli.py")
+                        "spur_cad/verify/program_text.py", "spur_cad/verify/controller.py", "spur_cad/cli.py")
 NAMES = frozenset(DIALECTS)
 INFO = ProgramInfo("spur_cad test (new dialect)", ("gear: z = 12",))
 

@@ -15,16 +15,25 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Protocol
-
-if TYPE_CHECKING:  # pragma: no cover
-    from spur_cad.geometry.spec import GearSpec
+from typing import Protocol
 
 SOLIDS = ("extrude", "sweep")
 """How cad/solid.py makes the toothed body: the section extruded along X, or swept along the helix."""
 
 SECTIONS = ("transverse", "normal")
 """The section a kind's inspection sizes (span, balls, chordal thickness) are measured in."""
+
+
+class _Helix(Protocol):
+    """What a kind reads of a spec (spur_cad.geometry.spec, which imports this module: the kinds name no spec
+    type, so the two make no loop)."""
+
+    @property
+    def hand_sign(self) -> int: ...
+    @property
+    def helix_angle_rad(self) -> float: ...
+    @property
+    def reference_radius_mm(self) -> float: ...
 
 
 class _Strategy(Protocol):
@@ -84,14 +93,14 @@ class GearKind:
         """A 2-D outline (DXF/SVG for a wire, laser or waterjet) is the whole part: straight teeth."""
         return self.prismatic
 
-    def section_turn_rad(self, spec: GearSpec, x_mm: float) -> float:
+    def section_turn_rad(self, spec: _Helix, x_mm: float) -> float:
         """Angle by which the transverse section at axial position X is turned about the axis, in the positive A
         sense: 0 for a prismatic kind; a helix: hand_sign X tan(beta) / r (right hand turns with +X)."""
         if self.prismatic:
             return 0.0
         return spec.hand_sign * x_mm * math.tan(spec.helix_angle_rad) / spec.reference_radius_mm
 
-    def lead_mm(self, spec: GearSpec) -> float:
+    def lead_mm(self, spec: _Helix) -> float:
         """p_z = 2 pi r / tan(beta), one turn of the helix on the reference cylinder; inf for a prismatic kind."""
         if self.prismatic:
             return math.inf

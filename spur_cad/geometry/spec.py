@@ -10,14 +10,11 @@ from __future__ import annotations
 import dataclasses
 import math
 from dataclasses import dataclass, field, fields
-from typing import TYPE_CHECKING
 
 from spur_cad.errors import GearSpecError
 from spur_cad.geometry.involute import involute_function
 from spur_cad.geometry.kinds import EXTERNAL_HELICAL, EXTERNAL_SPUR, GearKind
-
-if TYPE_CHECKING:  # pragma: no cover
-    from spur_cad.geometry.profile import ToothSpaceProfile
+from spur_cad.geometry.profile import ToothSpaceProfile, build_tooth_space_profile
 
 MIN_TEETH = 5
 MAX_TEETH = 1000
@@ -306,11 +303,9 @@ class GearSpec:
         return self.tooth_thickness_at_radius_mm(self.tip_radius_mm)
 
     # --- quantities of the generated profile -----------------------------------------------
-    def tooth_space_profile(self) -> "ToothSpaceProfile":
+    def tooth_space_profile(self) -> ToothSpaceProfile:
         """The exact rack-generated tooth-space profile (built once per spec, then reused)."""
         if "profile" not in self._profile_cache:
-            from spur_cad.geometry.profile import build_tooth_space_profile
-
             self._profile_cache["profile"] = build_tooth_space_profile(self)
         return self._profile_cache["profile"]
 
