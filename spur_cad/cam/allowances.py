@@ -15,6 +15,27 @@ starts, and what roughing leaves above the root for finishing by generation."""
 
 
 @dataclass(frozen=True)
+class ToolRecommendations:
+    """Limits for the tools of one gear (mm): what cam.recommend computes and the strategies read (here, below
+    both, so that neither names the other)."""
+
+    finishing_max_flat_width_mm: float  # root arc length 2 v r_f
+    finishing_max_corner_radius_mm: float  # smallest fillet curvature radius
+    plunge_allowance_mm: float  # what roughing may leave above the root: the finishing strategy's bottom allowance
+    roughing_max_diameter_mm: float  # space width at height r_f + that allowance
+    required_flute_length_mm: float  # deepest cut below the stock surface (finishing reaches the root)
+    required_stick_out_mm: float  # flute length + clearance above the blank
+    # Finishing by generation (docs/cam.md), with either flank_tool_end; 0.0 when no such tool fits:
+    finishing_generating_max_diameter_mm: float = 0.0  # largest tool with the advised corner radius rho
+    finishing_flat_end_mill_max_diameter_mm: float = 0.0  # largest flat end mill (r_t = 0): its flat within 2 d_1
+    bottom_allowance_rule: str = ""  # the rule that sets plunge_allowance_mm, in words (BottomAllowance.rule)
+
+    def as_dict(self) -> dict[str, float]:
+        """The figures (summary.json's `tools` keys), without the rule's words."""
+        return {name: value for name, value in self.__dict__.items() if name != "bottom_allowance_rule"}
+
+
+@dataclass(frozen=True)
 class BottomAllowance:
     """What roughing may leave above the root for the finishing strategy to take, and the rule that sets it (the
     words follow "more than" in the messages)."""

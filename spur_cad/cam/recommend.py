@@ -7,7 +7,6 @@ them when the space axis points up the tool axis.
 from __future__ import annotations
 
 import dataclasses
-from dataclasses import dataclass
 
 import numpy as np
 
@@ -15,6 +14,7 @@ from spur_cad.cam.allowances import (  # noqa: F401  (re-exported: the names cal
     LAND_PASS_DEPTH_FRACTION,
     PLUNGE_CAPACITY_FRACTION,
     BottomAllowance,
+    ToolRecommendations,
     generating_bottom_allowance,
     generating_pass_allowance,
     plunge_allowance,
@@ -45,26 +45,6 @@ def space_half_width_mm(flank: np.ndarray, height_mm: float) -> float:
         t = (height_mm - y[i]) / (y[i + 1] - y[i])
         candidates.append(x[i] + t * (x[i + 1] - x[i]))
     return float(min(candidates)) if candidates else float(x[-1])
-
-
-@dataclass(frozen=True)
-class ToolRecommendations:
-    """Limits for the tools of one gear (mm)."""
-
-    finishing_max_flat_width_mm: float  # root arc length 2 v r_f
-    finishing_max_corner_radius_mm: float  # smallest fillet curvature radius
-    plunge_allowance_mm: float  # what roughing may leave above the root: the finishing strategy's bottom allowance
-    roughing_max_diameter_mm: float  # space width at height r_f + that allowance
-    required_flute_length_mm: float  # deepest cut below the stock surface (finishing reaches the root)
-    required_stick_out_mm: float  # flute length + clearance above the blank
-    # Finishing by generation (docs/cam.md), with either flank_tool_end; 0.0 when no such tool fits:
-    finishing_generating_max_diameter_mm: float = 0.0  # largest tool with the advised corner radius rho
-    finishing_flat_end_mill_max_diameter_mm: float = 0.0  # largest flat end mill (r_t = 0): its flat within 2 d_1
-    bottom_allowance_rule: str = ""  # the rule that sets plunge_allowance_mm, in words (BottomAllowance.rule)
-
-    def as_dict(self) -> dict[str, float]:
-        """The figures (summary.json's `tools` keys), without the rule's words."""
-        return {name: value for name, value in self.__dict__.items() if name != "bottom_allowance_rule"}
 
 
 def generating_max_diameter_mm(spec: GearSpec, corner_radius_mm: float, target_scallop_mm: float,

@@ -26,8 +26,8 @@ from spur_cad.geometry.modifications import FlankModifications
 from spur_cad.geometry.spec import GearSpec
 from spur_cad.keys import check_section, key
 
-if TYPE_CHECKING:  # annotations only: the recommendations are computed above the strategies (cam.recommend)
-    from spur_cad.cam.recommend import ToolRecommendations
+if TYPE_CHECKING:  # annotations only: computed by cam.recommend, above the strategies
+    from spur_cad.cam.allowances import ToolRecommendations
 
 
 class StrategyFacts(Protocol):
