@@ -7,7 +7,7 @@ from __future__ import annotations
 
 import dataclasses
 import re
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -169,6 +169,27 @@ class CamInputs:
     profile_tolerance_mm: float = 0.001  # [job] profile_tolerance_mm: the 3-axis finishing arcs' chordal tolerance
     three_axis: ThreeAxisSection = field(default_factory=ThreeAxisSection)  # [three_axis]: tabs or an onion skin
     modifications: FlankModifications | None = None  # [gear.modifications]: cut by generating or perimeter finishing
+
+    @property
+    def roughing_tool_set(self) -> Tool:
+        """The roughing tool, which planning needs (check_cam_inputs refuses a job without one first)."""
+        return _required_tool(self.roughing_tool, "roughing")
+
+    @property
+    def finishing_tool_set(self) -> Tool:
+        """The finishing tool, which planning needs (check_cam_inputs refuses a job without one first)."""
+        return _required_tool(self.finishing_tool, "finishing")
+
+    @property
+    def bottom_tool_set(self) -> Tool:
+        """The bottom tool of two-stage roughing (asked for only when [tools.roughing_bottom] is given)."""
+        return _required_tool(self.bottom_tool, "roughing_bottom")
+
+
+def _required_tool(tool: Tool | None, role: str) -> Tool:
+    if tool is None:
+        raise ToolError(f"[tools.{role}] is required for this plan", field="diameter_mm", section=f"tools.{role}")
+    return tool
 
 
 def check_cam_inputs(inputs: CamInputs) -> tuple[ToolRecommendations, RoughingLevels | None]:
@@ -389,7 +410,7 @@ def suggested_top_tool(inputs: CamInputs, roughing: RoughingPlan, blank: float) 
     than the space at the reference circle (suggested_two_stage's range), with the job tool's cutting data and
     flutes 3 D long (or the job tool's length). Not for helical gears (a plan of theirs takes seconds) nor by
     levels (the workbench's suggested_two_stage)."""
-    spec, tool = inputs.spec, inputs.roughing_tool
+    spec, tool = inputs.spec, inputs.roughing_tool_set
     if inputs.roughing.strategy != "flank" or spec.kind.helical or roughing.flank is None:
         return None
     widest_mm = 2.0 * space_half_width_mm(flank_polyline(spec), spec.reference_radius_mm)
@@ -403,7 +424,7 @@ def suggested_top_tool(inputs: CamInputs, roughing: RoughingPlan, blank: float) 
     limit_s = TWO_STAGE_PAYS_FRACTION * _seconds(roughing)
     try:  # the upper program first: when it alone takes too long, the lower one is not planned
         upper = _plan_roughing(staged, lowest_roughing_level(spec, top, inputs.roughing, blank), blank)
-        if upper.flank.uncut_mm2 > UNCUT_MM2 or _seconds(upper) > limit_s:
+        if upper.flank is None or upper.flank.uncut_mm2 > UNCUT_MM2 or _seconds(upper) > limit_s:
             return None
         flank = flank_plan_for(spec, tool, inputs.roughing, blank, roughing.levels, tips=False,
                                first=(upper.flank, top))
@@ -460,7 +481,7 @@ def _plan_two_stage(inputs: CamInputs, levels: RoughingLevels,
     (_plan_flank_two_stage): the roughing tool takes all it reaches, the bottom tool what it leaves."""
     if inputs.roughing.strategy == "flank":
         return _plan_flank_two_stage(inputs, levels, blank)
-    spec, bottom = inputs.spec, inputs.bottom_tool
+    spec, bottom = inputs.spec, inputs.bottom_tool_set
     bottom_levels = roughing_levels(spec, bottom, inputs.roughing, blank)
     alone = _plan_roughing(inputs, bottom_levels, blank, bottom)
     _, j, below = _two_stage_split(inputs, levels, blank, bottom_levels, alone)
@@ -480,12 +501,13 @@ def _plan_flank_two_stage(inputs: CamInputs, levels: RoughingLevels,
     """Two-stage roughing by flanks: the roughing tool's flank plan (with the tip lands) down to its own lowest
     level, then the bottom tool's from the section the first leaves in every space (its stock model starts there:
     flank_roughing.stock_after_all_spaces), whose completeness check covers the whole space."""
-    spec, bottom, params = inputs.spec, inputs.bottom_tool, inputs.roughing
+    spec, bottom, params = inputs.spec, inputs.bottom_tool_set, inputs.roughing
     upper = _plan_roughing(inputs, levels, blank)
     bottom_levels = roughing_levels(spec, bottom, params, blank)
     flank = flank_plan_for(spec, bottom, params, blank, bottom_levels, tips=False, first=(upper.flank, upper.tool))
     if not flank.passes:
-        raise MachineError(f"two-stage roughing: the roughing tool (D {inputs.roughing_tool.diameter_mm:g} mm) leaves "
+        raise MachineError("two-stage roughing: the roughing tool "
+                           f"(D {inputs.roughing_tool_set.diameter_mm:g} mm) leaves "
                            f"nothing for the bottom tool (D {bottom.diameter_mm:g} mm) to cut; leave out "
                            "[tools.bottom]", field="diameter_mm", section="tools.bottom")
     lower = _plan_roughing(inputs, bottom_levels, blank, bottom, tips=False, flank=flank)
@@ -504,9 +526,9 @@ def _two_stage_split(inputs: CamInputs, levels: RoughingLevels, blank: float, bo
                      alone: RoughingPlan) -> tuple[float, int, np.ndarray]:
     """(feed-bound seconds of both tools' levels, index of the roughing tool's lowest level, the bottom tool's
     levels below it) of the split `_plan_two_stage` describes; `alone`: the bottom tool's plan of all its levels."""
-    spec, bottom = inputs.spec, inputs.bottom_tool
+    spec, bottom = inputs.spec, inputs.bottom_tool_set
     root, set_height = spec.root_radius_mm, inputs.roughing.bottom_tool_above_root_mm
-    splits = range(len(levels.heights_mm))
+    splits: Sequence[int] = range(len(levels.heights_mm))
     if set_height > 0.0:
         at_or_above = np.flatnonzero(levels.heights_mm >= root + set_height - 1e-9)
         if len(at_or_above) == 0:
@@ -525,7 +547,8 @@ def _two_stage_split(inputs: CamInputs, levels: RoughingLevels, blank: float, bo
         if below.any() and (best is None or total < best[0]):
             best = (total, j, below)
     if best is None:
-        raise MachineError(f"two-stage roughing: the roughing tool (D {inputs.roughing_tool.diameter_mm:g} mm) reaches "
+        raise MachineError("two-stage roughing: the roughing tool "
+                           f"(D {inputs.roughing_tool_set.diameter_mm:g} mm) reaches "
                            f"as deep as the bottom tool (D {bottom.diameter_mm:g} mm); leave out [tools.bottom]",
                            field="diameter_mm", section="tools.bottom")
     return best
@@ -593,7 +616,7 @@ def _plan_roughing(inputs: CamInputs, levels: RoughingLevels, blank: float, tool
     """One roughing program: the spaces' levels, and the tip lands' passes when `tips`; `flank`: the flank
     strategy's plan when the caller has made it."""
     spec, stock = inputs.spec, inputs.stock
-    tool = tool or inputs.roughing_tool
+    tool = tool or inputs.roughing_tool_set
     lowest_above_root = levels.lowest_height_mm - spec.root_radius_mm
     if flank is None and inputs.roughing.strategy == "flank":
         flank = flank_plan_for(spec, tool, inputs.roughing, blank, levels, tips)
@@ -630,7 +653,7 @@ def check_finishing_work(spec: GearSpec, tool: Tool, machine: Machine, section: 
 
 
 def _plan_finishing(inputs: CamInputs, blank: float, check: Callable[[], None]) -> FinishingPlan:
-    spec, tool, machine = inputs.spec, inputs.finishing_tool, inputs.machine
+    spec, tool, machine = inputs.spec, inputs.finishing_tool_set, inputs.machine
     path, result = generate_finishing(spec, tool, machine, inputs.finishing, blank, inputs.strategies,
                                       inputs.modifications, inputs.profile_tolerance_mm)  # checked: check_cam_inputs
     check_travel(machine, path.x, path.y, path.z, path.a, "finishing")
@@ -722,7 +745,7 @@ def _plan_three_axis(inputs: CamInputs, tolerance_mm: float) -> CamPlan:
         loop = finishing_loop(spec, tool, tolerance_mm)
         engagement = None if roughing is None else finishing_engagement(
             loop, tool,
-            roughing_leaves(spec, inputs.roughing_tool, offsets[-1]), inputs.roughing)
+            roughing_leaves(spec, inputs.roughing_tool_set, offsets[-1]), inputs.roughing)
         path, levels, segments = finishing_toolpath(spec, tool, machine, tolerance_mm, blank,
                                                     None if engagement is None else engagement.step_down_mm,
                                                     inputs.three_axis)
@@ -771,7 +794,7 @@ def _plan_three_axis_ring(inputs: CamInputs, tolerance_mm: float, root) -> CamPl
         tool = inputs.finishing_tool
         engagement = None if roughing is None else finishing_engagement(
             ring_finishing_loop(spec, tool, tolerance_mm), tool,
-            ring_roughing_leaves(spec, inputs.roughing_tool, offsets[0]), inputs.roughing)
+            ring_roughing_leaves(spec, inputs.roughing_tool_set, offsets[0]), inputs.roughing)
         path, levels, segments = ring_finishing_toolpath(spec, tool, machine, tolerance_mm,
                                                          None if engagement is None else engagement.step_down_mm)
         check_travel(machine, path.x, path.y, path.z, path.a, "finishing")
