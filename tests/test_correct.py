@@ -338,3 +338,16 @@ def test_the_corrected_sets_report_has_a_correction_section_with_correction_json
     text = html.unescape(page)
     assert all(reason in text for reason in correction["not_corrected"].values())
     assert correction["once_per_turn"]["why"] in text and correction["once_per_turn"]["check"] in text
+
+
+def test_contact_angles_do_not_depend_on_the_turn_a_pose_is_cut_on(reference):
+    """An unwound program (perimeter finishing goes round the gear at every station) cuts space 0 at A - 360 n too:
+    the same poses, the same contacts (the table's error is periodic)."""
+    job, plan, _ = reference
+    path = plan.finishing.toolpath
+    unwound = path.replace(a=path.a - 360.0 * (np.arange(len(path)) % 3))
+    plain = contact_angles(job.gear, path, plan.finishing.tool)
+    turned = contact_angles(job.gear, unwound, plan.finishing.tool)
+    for side in ("right", "left"):
+        assert np.array_equal(plain.roll_mm[side], turned.roll_mm[side])
+        assert np.abs(plain.a_deg[side] - turned.a_deg[side]).max() < 1e-6

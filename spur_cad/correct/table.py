@@ -2,7 +2,7 @@
 
 Every flank point was cut at its own commanded A (spur_cad.sim.contact); the table stood e(A) further, which
 turns the point's cut by -e(A) in the part frame and moves it by -e(A) (p x n) along its normal (p x n = +-r_b on an
-involute). Over the gear, the flanks' points sample e(A) over the whole turn (each flank over tens of degrees, the
+involute). Over the gear, the flanks' points sample e(A) over the whole turn (each flank over a range of A, the
 spaces 360 / z apart), so e(A) is fitted as a series
 
     e(A) = sum over the orders h kept of  c_h cos(h A) + s_h sin(h A)

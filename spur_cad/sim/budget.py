@@ -8,9 +8,9 @@ for deviations of micrometres:
 - the table's error e(A) (arcsec) turns a point's cut by -e(A) in the part frame, at the A that cut the point: a
   point p with normal n moves by -e(A) (p x n) along n, which is -e(A) r_b on an involute flank (the arc r e on the
   reference circle, as the grader reads it). With the finishing's contact angles (spur_cad.sim.contact: generating
-  and perimeter finishing cut each flank point at its own A, tens of degrees per flank) e is taken at each point's
-  A, so a once-per-turn error makes the eccentric gear a real table makes; without them (a helical gear) at each
-  space's index angle, a rigid turn of the space;
+  and perimeter finishing cut each flank point at its own A: 24 and 3 deg per flank of the reference gear) e is
+  taken at each point's A, so a once-per-turn error makes the eccentric gear a real table makes; without them (a
+  helical gear) at each space's index angle, a rigid turn of the space;
 - runout (half the total indicated runout of spindle and tool: the longest edge cuts), a tool larger than
   the program assumes and the linear positioning accuracy (half of it, worst case into the material) move
   every flank into the material by their size;

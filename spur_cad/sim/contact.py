@@ -2,7 +2,7 @@
 
 A rotary table's error is a function e(A) of the commanded A, and every block of the finishing carries its own A:
 generating finishing turns each flank point's normal onto the tool's side (A clamped per pass), perimeter finishing
-onto the corner, so a flank of one space is cut over tens of degrees of A (about 37 deg per flank of the reference
+onto the corner, so a flank of one space is cut over a range of A (generating: 24 deg per flank of the reference
 gear). A table error moves a flank point by r_b e(A) along its normal at the A that cut it, not at the space's index
 angle. This module finds that A from the finishing toolpath itself, for any strategy: for each cutting pose of
 space 0, the involute point the tool touches (the nearest to the tool's section in the transverse plane, inside
@@ -20,7 +20,7 @@ from spur_cad.cam.ir import MoveKind
 
 CONTACT_SPACING_MM = 0.02
 """Involute points are taken this far apart along the flank when finding each pose's contact: a pose's roll length is
-known to about this (0.01 deg of A on the reference gear's 37 deg per 15 mm flank)."""
+known to about this (0.03 deg of A on the reference gear's 24 deg per 18 mm of roll length)."""
 TOOL_LENGTH_DIAMETERS = 10.0
 """The tool's section is taken this many diameters long at least (its flute length or stick-out when longer; a job
 may give neither): generating finishing touches the flank with the tool's side, several millimetres above its tip."""
@@ -85,8 +85,10 @@ def contact_angles(spec, toolpath, tool) -> ContactAngles:
     side = np.array([name.split()[0] for name in names[flank]])
     roll = np.sqrt(np.maximum(np.hypot(points[:, 0], points[:, 1]) ** 2 - spec.base_radius_mm ** 2, 0.0))
     cutting = (toolpath.kind == MoveKind.LINEAR) & (toolpath.space == 0)
-    poses = np.unique(np.round(np.column_stack([toolpath.y[cutting], toolpath.z[cutting], toolpath.a[cutting]]), 7),
-                      axis=0)
+    # A taken within (-180, 180]: an unwound program (perimeter finishing goes round the gear at every station) cuts
+    # space 0 at A - 360 n too, the same pose for the table's periodic error
+    wrapped = np.mod(toolpath.a[cutting] + 180.0, 360.0) - 180.0
+    poses = np.unique(np.round(np.column_stack([toolpath.y[cutting], toolpath.z[cutting], wrapped]), 7), axis=0)
     length = max(tool.flute_length_mm, tool.stick_out_mm, TOOL_LENGTH_DIAMETERS * tool.diameter_mm)
     found: dict[str, list[tuple[float, float]]] = {"right": [], "left": []}
     for name in found:
