@@ -309,3 +309,21 @@ def test_member_and_pair_validation():
         GearPair(PairMember(30, internal=True), PairMember(40, internal=True), 1.0)
     with pytest.raises(PairError, match="at least 5 teeth more"):
         GearPair(PairMember(20), PairMember(24, internal=True), 1.0)
+
+
+def test_an_internal_pair_given_by_its_centre_distance():
+    """KHK's internal form: cos(alpha_w) = (z_2 - z_1) m cos(alpha) / (2 a), x_2 - x_1 = (z_2 - z_1) (inv(alpha_w) -
+    inv(alpha)) / (2 tan(alpha)) in KHK's sign (the ring's ISO shift is its negative)."""
+    a = 15.4
+    solved = pair_at_centre_distance(GearPair(PairMember(30, profile_shift_coefficient=0.1),
+                                              PairMember(60, internal=True), 1.0), a)
+    alpha = math.radians(20.0)
+    aw = math.acos(30 * math.cos(alpha) / (2 * a))
+    x2_khk = 0.1 + 30 * (inv(aw) - inv(alpha)) / (2 * math.tan(alpha))
+    assert solved.mate.profile_shift_coefficient == pytest.approx(-x2_khk, rel=1e-9)
+    facts = pair_facts(solved)
+    assert facts.centre_distance_mm == pytest.approx(a, rel=1e-12)
+    assert facts.working_pressure_angle_deg == pytest.approx(math.degrees(aw), rel=1e-9)
+    book = _internal_textbook(1.0, 20.0, 30, 60, 0.1, x2_khk)
+    assert facts.transverse_contact_ratio == pytest.approx(book["eps"], rel=REL)
+    assert facts.mate_start_of_active_profile_diameter_mm == pytest.approx(book["sap_ring"], rel=REL)

@@ -45,19 +45,28 @@ def mate_spec(spec: GearSpec, pair: GearPair) -> GearSpec:
     require_instance(spec, GearSpec, "spec")
     require_instance(pair, GearPair, "pair")
     mate = pair.mate
-    common = dict(teeth=mate.teeth, module_mm=spec.module_mm, pressure_angle_deg=spec.pressure_angle_deg,
-                  profile_shift_coefficient=mate.profile_shift_coefficient,
-                  addendum_coefficient=mate.addendum_coefficient, dedendum_coefficient=mate.dedendum_coefficient,
-                  rack_tip_radius_mm=spec.rack_tip_radius_mm, face_width_mm=spec.face_width_mm,
-                  thickness_allowance_mm=mate.thickness_reduction_mm * math.cos(math.radians(spec.helix_angle_deg)))
+    allowance_mm = mate.thickness_reduction_mm * math.cos(math.radians(spec.helix_angle_deg))  # transverse -> normal
     if not mate.internal:
-        return GearSpec(**common, helix_angle_deg=spec.helix_angle_deg,
+        return GearSpec(teeth=mate.teeth, module_mm=spec.module_mm, pressure_angle_deg=spec.pressure_angle_deg,
+                        profile_shift_coefficient=mate.profile_shift_coefficient,
+                        addendum_coefficient=mate.addendum_coefficient, dedendum_coefficient=mate.dedendum_coefficient,
+                        rack_tip_radius_mm=spec.rack_tip_radius_mm, face_width_mm=spec.face_width_mm,
+                        thickness_allowance_mm=allowance_mm, helix_angle_deg=spec.helix_angle_deg,
                         hand="left" if spec.hand == "right" else "right")
     rim = spec.module_mm * (mate.teeth + 2.0 * (mate.dedendum_coefficient + RING_RIM_MODULES))
+
+    def ring(rack_tip_radius_mm: float) -> InternalGearSpec:
+        return InternalGearSpec(teeth=mate.teeth, module_mm=spec.module_mm, pressure_angle_deg=spec.pressure_angle_deg,
+                                profile_shift_coefficient=mate.profile_shift_coefficient,
+                                addendum_coefficient=mate.addendum_coefficient,
+                                dedendum_coefficient=mate.dedendum_coefficient, rack_tip_radius_mm=rack_tip_radius_mm,
+                                face_width_mm=spec.face_width_mm, thickness_allowance_mm=allowance_mm,
+                                rim_outer_diameter_mm=rim)
+
     try:
-        return InternalGearSpec(**common, rim_outer_diameter_mm=rim)
+        return ring(spec.rack_tip_radius_mm)
     except GearSpecError:  # the default cutter cannot carry the rack's tip round: its roots left sharp
-        return InternalGearSpec(**{**common, "rack_tip_radius_mm": 0.0}, rim_outer_diameter_mm=rim)
+        return ring(0.0)
 
 
 def mate_placement(pair: GearPair) -> gp_Trsf:
