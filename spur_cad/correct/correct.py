@@ -158,12 +158,13 @@ def corrected_plan_of(job, identified: Identified, once_per_turn: str = "table")
     finishing, slopes_not_corrected = slope_corrected_finishing(fixed, fixed_plan.finishing, identified)
     fixed_plan = dataclasses.replace(fixed_plan, finishing=finishing)
     orders, datum_offset = machine_correction(identified, once_per_turn)
+    table = identified.table
     moved = {}
     for name in ("roughing", "roughing_bottom", "finishing"):
         planned = getattr(fixed_plan, name)
         if planned is None:
             continue
-        path = table_corrected(planned.toolpath, identified.table, orders) if orders else planned.toolpath
+        path = table_corrected(planned.toolpath, table, orders) if orders and table is not None else planned.toolpath
         path = blank_corrected(path, datum_offset) if datum_offset is not None else path
         moved[name] = dataclasses.replace(planned, toolpath=path)
     applied = AppliedCorrection(
@@ -199,9 +200,12 @@ def correct_job(job, measured, measured_source: str, datum: str = "best-fit", on
     if once_per_turn not in ONCE_PER_TURN_MODELS:
         raise SpurCadError(f"--once-per-turn must be one of {', '.join(ONCE_PER_TURN_MODELS)}, got {once_per_turn!r}")
     plan = plan_cam(job)
+    finishing = plan.finishing
+    if finishing is None:
+        raise SpurCadError("the job plans no finishing: there is no finishing program to correct")
     try:
         if isinstance(measured, MeasuredPoints):
-            contacts = contact_angles(spec, plan.finishing.toolpath, plan.finishing.tool)
+            contacts = contact_angles(spec, finishing.toolpath, finishing.tool)
             identified = identify(spec, measured, contacts, ideal_flanks(job, plan), job.modifications, datum)
         else:
             identified = _identify_probe_log(job, measured, ideal_flanks(job, plan))
@@ -211,7 +215,8 @@ def correct_job(job, measured, measured_source: str, datum: str = "best-fit", on
     changes = [f"finishing tool programmed as D {fixed.tools.finishing.diameter_mm:.4f} mm (size error "
                f"{identified.size_um:+.2f} um)"]
     if applied.table_orders:
-        changes.append("every block's A moved by -e(A), the table's error of orders "
+        plural = "s" if len(applied.table_orders) > 1 else ""
+        changes.append(f"every block's A moved by -e(A), the table's error of order{plural} "
                        + ", ".join(map(str, applied.table_orders)))
     if applied.blank_offset_um is not None:
         changes.append("every block's Y and Z moved by the blank's offset turned to its A")
@@ -222,7 +227,8 @@ def correct_job(job, measured, measured_source: str, datum: str = "best-fit", on
     notes = (f"corrected from {measured_source}: " + "; ".join(changes) + " (correction.json)",)
     _, files = build_programs(fixed, corrected_plan, notes)
     summary = correction_summary(spec, identified, applied, measured_source)
-    if applied.table_orders and dialect(job.post.dialect, job.dialects).rs274_checkable:  # a LinuxCNC control
+    if applied.table_orders and identified.table is not None \
+            and dialect(job.post.dialect, job.dialects).rs274_checkable:  # a LinuxCNC control
         a_values = np.concatenate([planned.toolpath.a for planned in (corrected_plan.roughing,
                                                                       corrected_plan.roughing_bottom,
                                                                       corrected_plan.finishing)
