@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import dataclasses
 import json
+from html import unescape
 
 import pytest
 
@@ -54,3 +55,22 @@ def test_profile_png_marks_the_sap_only_with_a_mate():
     plain = dataclasses.replace(job.gear, active_profile_start_diameter_mm=0.0)
     assert tooth_space_png(job.gear, samples) != tooth_space_png(plain, samples)
     assert tooth_space_png(plain, samples) == tooth_space_png(plain, samples)
+
+
+@pytest.mark.slow
+def test_a_flat_finish_that_leaves_the_rack_fillet_is_graded_from_the_mate_sap():
+    """Lying flat, a D 1.14 mm flat end mill on the issue's z40 gear with a z40 mate: its root climbs above the rack's
+    form circle but stays below the SAP; the report says the involute is graded from the SAP, and the grade's
+    profile traces start there."""
+    text = ("[gear]\nteeth = 40\nmodule_mm = 1.0\nface_width_mm = 3.0\nrack_tip_radius_mm = 0.38\n"
+            "thickness_allowance_percent = 2.0\n[machine]\naxes = 3\n[tools.finishing]\nkind = \"flat\"\n"
+            "diameter_mm = 1.14\n[tools.roughing]\nkind = \"flat\"\ndiameter_mm = 1.0\n[mate]\nteeth = 40\n")
+    result = run_job(parse_job(text, "flat.toml"))
+    sap = result.mate.start_of_active_profile_diameter_mm
+    facts = result.finishing.strategy_facts
+    assert facts.rack_form_diameter_mm < facts.form_diameter_mm < sap
+    html = unescape(result.files["report.html"].decode())
+    assert f"graded from the mate's start of active profile, diameter {sap:.3f} mm" in html
+    rb = result.gear.base_radius_mm
+    starts = {round(t.evaluation[0], 9) for t in result.grading.traces if t.kind == "profile"}
+    assert starts == {round(((sap / 2) ** 2 - rb**2) ** 0.5, 9)}

@@ -160,12 +160,17 @@ def _tool_reach_note(result: JobResult) -> str:
         return ""
     root = [f.max_leftover_mm for f in result.simulation.per_feature if f.feature.endswith(("fillet", "root"))]
     generated = f"{facts.generated_by}-generated"
+    graded = (f"the involute it cuts is graded from diameter {number(facts.form_diameter_mm, 3)} mm")
+    if result.mate is not None:  # the mate's SAP nearer the tip than the tool's form diameter: graded from there
+        sap, ring = result.mate.start_of_active_profile_diameter_mm, result.kind.teeth_inward
+        if (sap < facts.form_diameter_mm) if ring else (sap > facts.form_diameter_mm):
+            graded = (f"the involute is graded from the mate's start of active profile, diameter {number(sap, 3)} mm "
+                      f"({'outside' if ring else 'below'} it the flank need not be exact)")
     return (f" The leftover in the root ({number(1000 * max(root, default=0.0), 1)} {sheet.MICRO} at most) and on "
             f"the involute between diameters {number(facts.form_diameter_mm, 3)} and "
             f"{number(facts.rack_form_diameter_mm, 3)} mm is where the D {number(2 * facts.tool_radius_mm, 3)} mm "
             f"flat end mill cannot reach (the {generated} fillet is tighter than its radius), as planned: expected, "
-            "not a flank error; the involute it cuts is graded from diameter "
-            f"{number(facts.form_diameter_mm, 3)} mm.")
+            f"not a flank error; {graded}.")
 
 
 def report_context(result: JobResult, images: dict[str, bytes]) -> dict:
