@@ -24,7 +24,7 @@ from types import MappingProxyType
 
 from spur_cad.cad.specs import BlankFeatures, StockSpec
 from spur_cad.cam.calibration import CalibrationTable, parse_calibration_table
-from spur_cad.cam.machine import Machine, RoughingParams
+from spur_cad.cam.machine import Machine, RoughingParams, default_roughing_strategy
 from spur_cad.cam.machine_limits import check_machine_limits
 from spur_cad.cam.materials import DEFAULT_MATERIAL, MATERIALS
 from spur_cad.cam.probing import ProbeSection
@@ -278,6 +278,9 @@ class Job:
     rotary_calibration: CalibrationTable | None = field(default=None, repr=False, compare=False)  # [machine]'s file
     strategies: Strategies = field(default_factory=lambda: dict(REGISTRY), repr=False, compare=False)  # [finishing]'s
     dialects: Dialects = field(default_factory=lambda: dict(DIALECTS), repr=False, compare=False)  # [post], [lathe]'s
+    # the file leaves [roughing] strategy out: the set-up's default, whose flank roughing falls back to levels where
+    # it cannot take the gear or tools (cam.plan.plan_cam)
+    roughing_strategy_left_out: bool = field(default=False, repr=False, compare=False)
 
     def located(self, error: SpurCadError) -> str:
         """An error raised after loading, prefixed with 'file:line' of the key it blames (its section's
@@ -734,6 +737,7 @@ def _job_from_data(data: dict, source: str, text: str, strategies: Strategies = 
                                                                                               key_name))
     types = job_sections(strategies, dialects, sections)
     sections = {name: _load_section(tables[name], name, source, text, types) for name in types if name in tables}
+    sections["roughing"], strategy_left_out = _roughing_section(sections, tables)
 
     def where(name: str, key_name: str | None) -> str:
         return _where(source, text, name, key_name)
@@ -794,7 +798,7 @@ def _job_from_data(data: dict, source: str, text: str, strategies: Strategies = 
     return Job(source=source, job=sections.get("job", JobSection()), gear_section=gear_section, gear=spec,
                tools=tools, finishing=finishing, post=post, **optional, text=text, strategies=dict(strategies),
                dialects=dict(dialects), modifications=modifications, modification_values=modification_values,
-               pair=pair)
+               pair=pair, roughing_strategy_left_out=strategy_left_out)
 
 
 def _mated(spec: GearSpec, mate: MateSection | None, given: dict,
@@ -809,6 +813,16 @@ def _mated(spec: GearSpec, mate: MateSection | None, given: dict,
         blamed = _blamed_key(exc, "mate", given)
         raise JobFileError(f"{where('mate', blamed)}: [mate] {exc}", section="mate", field=blamed) from None
     return dataclasses.replace(spec, active_profile_start_diameter_mm=facts.start_of_active_profile_diameter_mm), pair
+
+
+def _roughing_section(sections: dict, tables: dict) -> tuple[RoughingParams, bool]:
+    """[roughing] as the file gives it, its strategy the set-up's default where the file leaves it out
+    (default_roughing_strategy), and whether it does."""
+    roughing = sections.get("roughing", RoughingParams())
+    if "strategy" in tables.get("roughing", {}):
+        return roughing, False
+    axes = sections.get("machine", Machine()).axes
+    return dataclasses.replace(roughing, strategy=default_roughing_strategy(axes)), True
 
 
 def _check_probe(spec: GearSpec, sections: dict, tools: ToolsSection, tables: dict,

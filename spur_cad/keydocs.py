@@ -64,6 +64,14 @@ Notes:
   checked against what the job needs (summary `tools.required_flute_length_mm`,
   `tools.required_stick_out_mm`). See [cam.md](cam.md) for every limit.
 - `[roughing] finish_stock_mm` must be below `flank_allowance_mm`.
+- `[roughing] strategy` left out: `flank` on the rotary table (spur and helical gears, as a new workbench job),
+  wherever flank roughing can take the gear and its tools. Where it cannot (its flank segments would not fit the
+  flank allowance, no segment lies above the lowest level, its moves would exceed the work limit, a pass would
+  leave the machine's travel, or it would leave material beyond the flank allowance), roughing is by levels and
+  the report says why: a job that leaves the strategy out is refused only where levels are refused too. On 3 axes
+  (`[machine] axes = 3`: external gears lying flat, internal gears) the default is `levels`: no rotary table turns
+  a flank to the tool, and 3-axis roughing is by levels, each a series of passes offset from the outline.
+  `strategy = "flank"` given is planned as given, or refused.
 - `[machine]` travel limits: each low limit must be below its high limit.
   `rotary_clamp_code` / `rotary_unclamp_code` are needed when `[roughing] clamp_rotary`
   is true; `rotary_continuous = false` makes finishing unwind A after every station.

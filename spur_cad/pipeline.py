@@ -453,7 +453,7 @@ def cam_inputs(job: Job) -> CamInputs:
     return CamInputs(job.gear, job.stock, job.tools.roughing, job.tools.finishing, job.roughing, job.finishing,
                      job.machine, job.tools.bottom, top_tool=job.tools.roughing_top, strategies=job.strategies,
                      profile_tolerance_mm=job.job.profile_tolerance_mm, three_axis=job.three_axis,
-                     modifications=job.modifications)
+                     modifications=job.modifications, levels_fallback=job.roughing_strategy_left_out)
 
 
 def plan_cam(job: Job, checkpoint: Callable[[], None] | None = None) -> CamPlan:

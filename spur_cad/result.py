@@ -179,6 +179,8 @@ class RoughingFacts:
     two_stage_declined: DeclinedTwoStageFacts | None = None
     two_stage_suggested: SuggestedTopToolFacts | None = None
     flank_suggested: FlankSuggestionFacts | None = None
+    # roughing by flanks as the job file's default, not used (cam.plan.plan_cam): why; roughing is by levels
+    flank_fallback: str | None = None
 
 
 @dataclass(frozen=True)

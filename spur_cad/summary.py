@@ -157,12 +157,13 @@ def _roughing(roughing: RoughingPlan) -> RoughingFacts:
 
 
 def engagement_limits(params: RoughingParams, plan: CamPlan):
-    """The limits the job's roughing keeps (sim.engagement.EngagementLimits): the flank strategy's (each tool's
-    axial depth limit in two-stage roughing), or the levels'."""
+    """The limits the job's roughing keeps (sim.engagement.EngagementLimits): the flank strategy's where the plan
+    roughs by flanks (each tool's axial depth limit in two-stage roughing), or the levels' (also where a job file's
+    default flank roughing fell back to levels)."""
     from spur_cad.cam.flank_roughing import FlankLimits
     from spur_cad.sim.engagement import EngagementLimits
 
-    if params.strategy == "flank" and plan.roughing is not None:
+    if plan.roughing is not None and plan.roughing.flank is not None:
         by_operation = {name: FlankLimits.of(planned.tool, params).axial_depth_mm for name, planned in
                         (("roughing", plan.roughing), ("roughing_bottom", plan.roughing_bottom)) if planned is not None}
         return EngagementLimits(params.max_level_depth_fraction, params.max_radial_engagement_fraction,
@@ -202,6 +203,8 @@ def roughing_facts(plan: CamPlan, machine: Machine, simulation: SimResult | None
     if by_flanks is not None:
         facts = dataclasses.replace(facts, flank_suggested=FlankSuggestionFacts(
             by_flanks.flank_time_s, by_flanks.levels_time_s, by_flanks.passes_per_space))
+    if plan.flank_fallback is not None:
+        facts = dataclasses.replace(facts, flank_fallback=plan.flank_fallback)
     if plan.roughing_bottom is None:
         return facts
     stage, bottom = plan.two_stage, plan.roughing_bottom
@@ -401,6 +404,8 @@ def roughing_json(roughing: RoughingFacts, measured: bool = True) -> dict:
             "flank_time_s": by_flanks.flank_time_s, "levels_time_s": by_flanks.levels_time_s,
             "passes_per_space": by_flanks.passes_per_space,
             "time_saved_s": by_flanks.levels_time_s - by_flanks.flank_time_s}
+    if roughing.flank_fallback is not None:
+        facts["flank_fallback"] = roughing.flank_fallback
     return facts
 
 

@@ -22,6 +22,14 @@ def reference_job_text(strategy: str) -> str:
     line = next(line for line in text.splitlines() if line.startswith("strategy = "))
     return text.replace(line, f'strategy = "{strategy}"')
 
+
+def with_roughing_strategy(text: str, strategy: str) -> str:
+    """A job file's text with [roughing] strategy given (the shipped examples leave it to the default, flank: given,
+    it is planned or refused as given, never falling back to levels)."""
+    assert "[roughing]\n" in text
+    return text.replace("[roughing]\n", f"[roughing]\nstrategy = \"{strategy}\"\n", 1)
+
+
 # name: (teeth, module, pressure angle, shift, rack tip radius, allowance fraction, allowance mm)
 GEAR_CASES = {
     "reference_z23_m4": (23, 4.0, 20.0, 0.0, 0.8, 0.05, 0.0),

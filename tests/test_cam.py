@@ -103,7 +103,8 @@ def test_a_moves_only_above_the_gear_or_in_designed_finishing_moves(name):
     machine = Machine()
     blank = spec.tip_radius_mm + 0.5
     paths = [roughing_toolpath(spec, roughing, machine, RoughingParams(flank_allowance_mm=0.1 * spec.module_mm,
-                                                                       finish_stock_mm=0.005 * spec.module_mm),
+                                                                       finish_stock_mm=0.005 * spec.module_mm,
+                                                                       strategy="levels"),
                                blank),
              finishing_toolpath(spec, finishing, machine,
                                 FinishingParams(strategy="perimeter", step_over_mm=spec.face_width_mm), blank)]

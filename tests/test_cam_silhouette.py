@@ -155,7 +155,8 @@ def test_rapids_never_touch_the_stock(name):
     roughing, finishing = tools_for(name)
     blank = spec.tip_radius_mm + 0.5
     machine = Machine()
-    params = RoughingParams(flank_allowance_mm=0.1 * spec.module_mm, finish_stock_mm=0.005 * spec.module_mm)
+    params = RoughingParams(flank_allowance_mm=0.1 * spec.module_mm, finish_stock_mm=0.005 * spec.module_mm,
+                            strategy="levels")
     for path, tool in ((roughing_toolpath(spec, roughing, machine, params, blank), roughing),
                        (finishing_toolpath(spec, finishing, machine,
                                            FinishingParams(strategy="perimeter", step_over_mm=2.0), blank),

@@ -23,7 +23,7 @@ from spur_cad.sim.engagement import (
     measure_engagement,
 )
 from spur_cad.sim.simulate import shifted
-from tests.gears import REFERENCE_JOB, spec_of, tools_for
+from tests.gears import REFERENCE_JOB, spec_of, tools_for, with_roughing_strategy
 
 FEED = 600.0
 LIMITS = EngagementLimits(max_level_depth_fraction=0.5, step_over_fraction=0.5)
@@ -107,7 +107,7 @@ def test_the_planned_roughing_of_gears_of_module_1_to_5_stays_within_its_limits(
     over at most the step-over; no warning."""
     spec = spec_of(name)
     tool, _ = tools_for(name)
-    params = RoughingParams(flank_allowance_mm=0.1 * spec.module_mm, finish_stock_mm=0.02)
+    params = RoughingParams(flank_allowance_mm=0.1 * spec.module_mm, finish_stock_mm=0.02, strategy="levels")
     blank = spec.tip_radius_mm + 0.5
     path, e = _planned(spec, tool, params, blank)
     assert engagement_warnings(e, EngagementLimits(params.max_level_depth_fraction, params.step_over_fraction)) == []
@@ -132,14 +132,15 @@ def test_the_planned_roughing_of_gears_of_module_1_to_5_stays_within_its_limits(
 def test_a_module_6_gear_with_deep_levels_stays_within_its_limits_and_its_depth_limit_binds():
     spec = GearSpec(teeth=18, module_mm=6.0, pressure_angle_deg=20.0, rack_tip_radius_mm=1.5, face_width_mm=12.0)
     tool = Tool(diameter_mm=5.0, flutes=3)
-    params = RoughingParams(flank_allowance_mm=1.0, finish_stock_mm=0.05, max_level_depth_fraction=0.3)
+    params = RoughingParams(flank_allowance_mm=1.0, finish_stock_mm=0.05, max_level_depth_fraction=0.3,
+                            strategy="levels")
     _, e = _planned(spec, tool, params, spec.tip_radius_mm + 1.0)
     assert engagement_warnings(e, EngagementLimits(0.3, params.step_over_fraction)) == []
     assert e.max_axial_depth_mm == pytest.approx(0.3 * tool.diameter_mm, abs=1e-6)  # levels as deep as allowed
 
 
 def test_the_reference_job_s_roughing_is_within_its_limits_and_a_deepened_pass_is_named():
-    job = load_job(REFERENCE_JOB)
+    job = parse_job(with_roughing_strategy(REFERENCE_JOB.read_text(), "levels"), "reference_levels.toml")
     plan = plan_cam(job)
     e = roughing_engagement(job, plan)
     params, tool = job.roughing, plan.roughing.tool
@@ -172,7 +173,8 @@ def test_the_reference_job_s_roughing_is_within_its_limits_and_a_deepened_pass_i
 def test_the_helical_example_s_roughing_slots_once_per_level_and_steps_over_within_its_limit():
     """Passes following the lead: each level's first pass a slot (a_e = 1 D measured across the lead), the others
     within the step-over; no warning."""
-    job = load_job(REFERENCE_JOB.with_name("helical_gear.toml"))
+    job = parse_job(with_roughing_strategy(REFERENCE_JOB.with_name("helical_gear.toml").read_text(), "levels"),
+                    "helical_levels.toml")
     plan = plan_cam(job)
     e = roughing_engagement(job, plan)
     params = job.roughing

@@ -13,6 +13,7 @@ import pytest
 
 from spur_cad.job import parse_job
 from spur_cad.pipeline import build_programs, plan_cam
+from tests.gears import with_roughing_strategy
 from tests.rs274_helper import run_rs274
 from tests.test_post import canonical_straight_moves
 from tests.workbench_helper import ROOT
@@ -44,10 +45,8 @@ def interpreted_seconds(canon: list[str], machine) -> float:
 @pytest.mark.parametrize("strategy", ["levels", "flank"])
 @pytest.mark.parametrize("example", ["reference_gear.toml", "helical_gear.toml"])
 def test_the_estimate_is_the_time_of_the_program_rs274_reads(example, strategy, rs274, tmp_path):
-    text = (EXAMPLES / example).read_text()
-    if strategy == "flank":  # the examples rough by levels; the flank strategy's turned runs and raised feeds
-        text = text.replace("[roughing]\n", "[roughing]\nstrategy = \"flank\"\n", 1)
-    job = parse_job(text, example)
+    # both strategies: the levels' passes and the flank strategy's turned runs and raised feeds
+    job = parse_job(with_roughing_strategy((EXAMPLES / example).read_text(), strategy), example)
     assert job.roughing.strategy == strategy
     plan = plan_cam(job)
     programs, _ = build_programs(job, plan)

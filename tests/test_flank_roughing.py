@@ -23,13 +23,12 @@ from spur_cad.sim.engagement import MeasuredCut, engagement_warnings
 from spur_cad.sim.section_engagement import measure_section_engagement
 from spur_cad.sim.simulate import shifted
 from spur_cad.summary import engagement_limits, roughing_facts, roughing_json
-from tests.gears import CAM_GEARS, REFERENCE_JOB, spec_of, tools_for
+from tests.gears import CAM_GEARS, REFERENCE_JOB, spec_of, tools_for, with_roughing_strategy
 
 
-def flank_job_text(path=REFERENCE_JOB) -> str:
-    """A shipped example with [roughing] strategy = "flank" (they ship with the levels)."""
-    text = path.read_text()
-    return text.replace("[roughing]\n", "[roughing]\nstrategy = \"flank\"\n", 1)
+def flank_job_text(path=REFERENCE_JOB, strategy: str = "flank") -> str:
+    """A shipped example with [roughing] strategy given: "flank" (their default, given) or "levels"."""
+    return with_roughing_strategy(path.read_text(), strategy)
 
 
 @pytest.fixture(scope="module")
@@ -40,13 +39,13 @@ def reference():
 
 def test_the_reference_gear_roughs_in_at_most_50_minutes_with_its_own_tool_and_cutting_data(reference):
     job, plan = reference
-    levels = plan_cam(parse_job(REFERENCE_JOB.read_text(), "reference.toml"))
+    levels = plan_cam(parse_job(flank_job_text(strategy="levels"), "reference.toml"))
     assert plan.roughing.tool == levels.roughing.tool == job.tools.roughing
     flank_min = plan.roughing.estimate.time_with_acceleration_s / 60.0
     levels_min = levels.roughing.estimate.time_with_acceleration_s / 60.0
     assert flank_min <= 50.0, flank_min
     assert levels_min / flank_min >= 2.8, (levels_min, flank_min)
-    # the job as shipped (by levels) is told what roughing by flanks would take: the time of the job planned so
+    # the job by levels is told what roughing by flanks would take: the time of the job planned so
     assert levels.flank_suggested is not None and plan.flank_suggested is None
     assert levels.flank_suggested.flank_time_s == plan.roughing.estimate.time_with_acceleration_s
     assert levels.flank_suggested.levels_time_s == levels.roughing.estimate.time_with_acceleration_s
@@ -78,7 +77,8 @@ def test_the_measured_engagement_is_within_the_job_s_limits_and_the_feed_keeps_t
     assert np.all(chip[cutting] <= tool.feed_per_tooth_mm * (1.0 + 1e-9)), chip[cutting].max()
     assert (path.feed[e.index][cutting] > 1.2 * tool.feed_mm_min(job.machine)).any()
     assert e.mean_removal_rate_mm3_min > 3.0 * roughing_engagement(
-        parse_job(REFERENCE_JOB.read_text(), "r.toml"), plan_cam(parse_job(REFERENCE_JOB.read_text(), "r.toml"))
+        parse_job(flank_job_text(strategy="levels"), "r.toml"),
+        plan_cam(parse_job(flank_job_text(strategy="levels"), "r.toml"))
     ).mean_removal_rate_mm3_min
 
 

@@ -34,7 +34,7 @@ def cam_paths():
         roughing_tool, finishing_tool = tools_for(name)
         blank = spec.tip_radius_mm + 0.5
         roughing = roughing_toolpath(spec, roughing_tool, Machine(), RoughingParams(
-            flank_allowance_mm=0.1 * spec.module_mm, finish_stock_mm=0.005 * spec.module_mm), blank)
+            flank_allowance_mm=0.1 * spec.module_mm, finish_stock_mm=0.005 * spec.module_mm, strategy="levels"), blank)
         finishing = finishing_toolpath(spec, finishing_tool, Machine(), FinishingParams(strategy="perimeter",
             target_scallop_mm=0.005, step_over_mm=spec.face_width_mm / 2), blank)
         paths[name] = (spec, roughing_tool, finishing_tool, roughing, finishing)
@@ -378,8 +378,8 @@ def test_comments_cannot_break_the_program():
 def test_rotary_clamp_codes_hold_the_table_while_roughing_cuts(folded, cam_paths):
     spec, tool, *_ = cam_paths["shifted_z12"]
     machine = Machine(rotary_clamp_code="M10", rotary_unclamp_code="M11")
-    path = roughing_toolpath(spec, tool, machine, RoughingParams(flank_allowance_mm=0.1 * spec.module_mm,
-                                                                 clamp_rotary=True), spec.tip_radius_mm + 0.5)
+    params = RoughingParams(flank_allowance_mm=0.1 * spec.module_mm, clamp_rotary=True, strategy="levels")
+    path = roughing_toolpath(spec, tool, machine, params, spec.tip_radius_mm + 0.5)
     info = ProgramInfo("clamped", (), rotary_clamp_code="M10", rotary_unclamp_code="M11")
     text = post_program(path, PostSettings(folded=folded), info).text
     # Expand the program by its call order (independent reader for the moves; the M codes by text).

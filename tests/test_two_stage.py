@@ -44,6 +44,7 @@ kind = "bull_nose"
 diameter_mm = 1.5
 corner_radius_mm = 0.5
 [roughing]
+strategy = "levels"
 flank_allowance_mm = 0.15
 finish_stock_mm = 0.02
 [finishing]
@@ -193,7 +194,7 @@ def test_the_report_and_summary_show_both_programs_and_the_time_saved(two_stage,
 
 # --------------------------------------------------------------------------- by flanks (issue 29)
 
-FLANK_JOB = JOB.replace("[roughing]\n", "[roughing]\nstrategy = \"flank\"\n")
+FLANK_JOB = JOB.replace("strategy = \"levels\"", "strategy = \"flank\"")
 TOP_JOB = FLANK_JOB.replace("[tools.roughing]\nkind = \"flat\"\ndiameter_mm = 3.0\nflutes = 3\n", "").replace(
     "[tools.bottom]", "[tools.roughing]") + "\n[tools.roughing_top]\nkind = \"flat\"\ndiameter_mm = 3.0\nflutes = 3\n"
 

@@ -183,6 +183,12 @@ def test_the_default_new_job_is_valid_roughs_by_flanks_and_is_within_a_shift(wb)
     assert result.ok, result.messages
     job = result.job
     assert job.roughing.strategy == "flank" and job.roughing.flank_allowance_mm == pytest.approx(0.3)
+    # the job files' default, one constant (issue 48): a job file leaving the strategy out, the property's default
+    from spur_cad.job import job_from_dict
+
+    file_job = job_from_dict({"gear": {"teeth": 23, "module_mm": 4.0, "face_width_mm": 20.0}}, "default.toml")
+    assert file_job.roughing.strategy == values["job"]["RoughingStrategy"] == "flank"
+    assert wb.schema.default_values()["job"]["RoughingStrategy"] == "flank"
     plan = plan_cam(job)
     programs = [p for p in (plan.roughing, plan.roughing_bottom, plan.finishing) if p is not None]
     figures = wb.summary.plan_figures(job, plan)

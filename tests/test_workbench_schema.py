@@ -149,7 +149,8 @@ def _section_classes() -> dict[str, type]:
     hints = typing.get_type_hints(Job)
     sections = {("gear" if f.name == "gear_section" else f.name): hints[f.name] for f in dataclasses.fields(Job)
                 if f.name not in ("source", "gear", "tools", "text", "strategies", "dialects", "report_template_text",
-                                  "rotary_calibration", "modifications", "modification_values")}
+                                  "rotary_calibration", "modifications", "modification_values",
+                                  "roughing_strategy_left_out")}
     sections["tools.roughing"] = sections["tools.finishing"] = sections["tools.bottom"] = Tool
     sections.update(MODIFICATION_SECTIONS)  # read with [gear]: the Job holds them as FlankModifications
     # an optional section (`lathe: LatheSection | None`) is its dataclass

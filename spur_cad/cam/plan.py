@@ -150,6 +150,9 @@ class CamPlan:
     # roughing by levels (a job file's default): roughing by flanks with the same tool and cutting data, when it would
     # save at least 1 - TWO_STAGE_PAYS_FRACTION of the time (suggested_flank_roughing)
     flank_suggested: FlankSuggestion | None = None
+    # roughing by flanks as a job file's default, not used: why (the flank strategy's refusal, or what it would leave
+    # uncut); roughing is by levels (plan_cam)
+    flank_fallback: str | None = None
 
 
 @dataclass(frozen=True)
@@ -169,6 +172,9 @@ class CamInputs:
     profile_tolerance_mm: float = 0.001  # [job] profile_tolerance_mm: the 3-axis finishing arcs' chordal tolerance
     three_axis: ThreeAxisSection = field(default_factory=ThreeAxisSection)  # [three_axis]: tabs or an onion skin
     modifications: FlankModifications | None = None  # [gear.modifications]: cut by generating or perimeter finishing
+    # roughing by flanks is the job file's default, not its choice: where it cannot take the gear or tools, roughing
+    # falls back to levels (plan_cam)
+    levels_fallback: bool = False
 
     @property
     def roughing_tool_set(self) -> Tool:
@@ -350,7 +356,31 @@ def check_blank_allowance(spec: GearSpec, stock: StockSpec, finishing_tool: Tool
 
 def plan_cam(inputs: CamInputs, checkpoint: Callable[[], None] | None = None) -> CamPlan:
     """Tool recommendations always; toolpaths and estimates for the tools the job gives (pure).
-    `checkpoint()` is called between the steps (a front end may stop there)."""
+    `checkpoint()` is called between the steps (a front end may stop there).
+
+    Roughing by flanks as a job file's default (`inputs.levels_fallback`): where the flank strategy is refused or
+    leaves material beyond the flank allowance, the job is planned by levels instead (refused only where levels are
+    refused too), and CamPlan.flank_fallback says why."""
+    if not (inputs.levels_fallback and inputs.roughing.strategy == "flank"
+            and inputs.roughing_tool is not None and inputs.machine.axes != 3):
+        return _plan_cam(inputs, checkpoint)
+    try:
+        plan = _plan_cam(inputs, checkpoint)
+    except SpurCadError as exc:  # levels decide: their plan, or their own refusal
+        reason = str(exc)
+    else:
+        uncut = [planned.flank.uncut_mm2 for planned in (plan.roughing, plan.roughing_bottom)
+                 if planned is not None and planned.flank is not None and planned.flank.uncut_mm2 > UNCUT_MM2]
+        if not uncut:
+            return plan
+        reason = (f"it would leave {max(uncut):.3g} mm^2 of each tooth space's section farther than "
+                  "flank_allowance_mm from the design")
+    plan = _plan_cam(by_levels(inputs), checkpoint)
+    return dataclasses.replace(plan, flank_fallback=reason)
+
+
+def _plan_cam(inputs: CamInputs, checkpoint: Callable[[], None] | None = None) -> CamPlan:
+    """plan_cam by the strategy `inputs` name."""
     check = checkpoint if checkpoint is not None else (lambda: None)
     if not inputs.machine.setup.rotary_axis:  # the blank lying flat (spur_cad.cam.three_axis)
         return _plan_three_axis(inputs, inputs.profile_tolerance_mm)

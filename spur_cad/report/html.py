@@ -141,6 +141,9 @@ def program_notes(result: JobResult) -> tuple[str, ...]:
                          f"{duration(by_flanks.flank_time_s)} instead of {duration(by_flanks.levels_time_s)} "
                          "by levels, "
                          f"{duration(by_flanks.levels_time_s - by_flanks.flank_time_s)} less.")
+        if rough.flank_fallback is not None:
+            notes.append("Roughing by levels: the job leaves [roughing] strategy to its default, roughing by flanks, "
+                         f"which cannot take this gear with these tools ({rough.flank_fallback}).")
     if finish is not None:
         notes.append(finish.report_text)
     return tuple(notes)

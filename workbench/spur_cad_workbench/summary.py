@@ -207,7 +207,7 @@ def group_summary(group: str, job: dict[str, Any], units=None) -> str:
         scallop = length_text(float(job.get("TargetScallop", 0.0)), "mm", units)
         text = f"{job.get('FinishingStrategy', '')}, scallop {scallop}"
     elif group == "Roughing strategy":
-        text = (f"{job.get('RoughingStrategy', 'levels')}, flank allowance "
+        text = (f"{job.get('RoughingStrategy', '')}, flank allowance "
                 f"{length_text(float(job.get('FlankAllowance', 0.0)), 'mm', units)}")
     elif group == "Machine":
         setup = machine_setup(job)

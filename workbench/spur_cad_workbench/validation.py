@@ -273,15 +273,13 @@ NEW_JOB_FLANK_ALLOWANCE_FRACTION = 0.15
 on the staircase stays light."""
 
 
-NEW_JOB_ROUGHING_STRATEGY = "flank"
-"""A new job roughs by flanks (constant engagement, docs/method.md 4.1): about three times faster than levels with
-the same tool; two-stage roughing (by levels) is suggested only where it still saves a tenth of that time."""
-
-
 def new_job_values(values: dict[str, dict[str, object]]) -> dict[str, object]:
     """A new job's starting values for the gear and stock in `values`: the suggested tools (suggest_tools), the
     flank allowance a gear maker starts from (NEW_JOB_FLANK_ALLOWANCE_MM, within the finishing tool's share) and
-    roughing by flanks (NEW_JOB_ROUGHING_STRATEGY); {} if no tool fits."""
+    the job files' default roughing strategy (spur_cad.cam.machine.default_roughing_strategy: by flanks on the rotary
+    table, about three times faster than levels with the same tool; two-stage roughing by levels is suggested only
+    where it still saves a tenth of that time); {} if no tool fits."""
+    from spur_cad.cam.machine import default_roughing_strategy
     from spur_cad.cam.strategies import get_strategy
     from spur_cad.cam.suggest import suggested_finishing
 
@@ -297,7 +295,7 @@ def new_job_values(values: dict[str, dict[str, object]]) -> dict[str, object]:
     allowance = round(min(NEW_JOB_FLANK_ALLOWANCE_MM, NEW_JOB_FLANK_ALLOWANCE_FRACTION * finishing.diameter_mm), 3)
     # the roughing reach and the two-stage split depend on the allowance and the strategy: suggest the tools
     # with them
-    chosen = {"FlankAllowance": allowance, "RoughingStrategy": NEW_JOB_ROUGHING_STRATEGY}
+    chosen = {"FlankAllowance": allowance, "RoughingStrategy": default_roughing_strategy(job.machine.axes)}
     tools = suggest_tools({**values, "job": {**values["job"], **chosen}})
     return {**tools, **chosen}
 
