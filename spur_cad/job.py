@@ -821,8 +821,8 @@ def _roughing_section(sections: dict, tables: dict) -> tuple[RoughingParams, boo
     roughing = sections.get("roughing", RoughingParams())
     if "strategy" in tables.get("roughing", {}):
         return roughing, False
-    axes = sections.get("machine", Machine()).axes
-    return dataclasses.replace(roughing, strategy=default_roughing_strategy(axes)), True
+    setup = sections.get("machine", Machine()).setup
+    return dataclasses.replace(roughing, strategy=default_roughing_strategy(setup)), True
 
 
 def _check_probe(spec: GearSpec, sections: dict, tools: ToolsSection, tables: dict,

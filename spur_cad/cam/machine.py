@@ -183,11 +183,12 @@ data. It needs the rotary table, to turn A to each flank segment: on 3 axes the 
 (default_roughing_strategy)."""
 
 
-def default_roughing_strategy(axes: int) -> str:
-    """The [roughing] strategy of a job that leaves it out, on a machine of `axes` axes: DEFAULT_ROUGHING_STRATEGY on
-    the rotary table (4 axes: spur and helical gears), "levels" lying flat (3 axes: no table turns a flank to the
-    tool, and the 3-axis roughing is by levels, each a series of passes offset from the outline)."""
-    return "levels" if axes == 3 else DEFAULT_ROUGHING_STRATEGY
+def default_roughing_strategy(setup: MachineSetup) -> str:
+    """The [roughing] strategy of a job that leaves it out, in machine set-up `setup` (Machine.setup):
+    DEFAULT_ROUGHING_STRATEGY on the rotary table (spur and helical gears), "levels" lying flat (3 axes: no table
+    turns a flank to the tool, and the 3-axis roughing is by levels, each a series of passes offset from the
+    outline)."""
+    return DEFAULT_ROUGHING_STRATEGY if setup.rotary_axis else "levels"
 
 
 @dataclass(frozen=True)

@@ -362,7 +362,7 @@ def plan_cam(inputs: CamInputs, checkpoint: Callable[[], None] | None = None) ->
     leaves material beyond the flank allowance, the job is planned by levels instead (refused only where levels are
     refused too), and CamPlan.flank_fallback says why."""
     if not (inputs.levels_fallback and inputs.roughing.strategy == "flank"
-            and inputs.roughing_tool is not None and inputs.machine.axes != 3):
+            and inputs.roughing_tool is not None and inputs.machine.setup.rotary_axis):
         return _plan_cam(inputs, checkpoint)
     try:
         plan = _plan_cam(inputs, checkpoint)

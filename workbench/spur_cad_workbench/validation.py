@@ -295,7 +295,7 @@ def new_job_values(values: dict[str, dict[str, object]]) -> dict[str, object]:
     allowance = round(min(NEW_JOB_FLANK_ALLOWANCE_MM, NEW_JOB_FLANK_ALLOWANCE_FRACTION * finishing.diameter_mm), 3)
     # the roughing reach and the two-stage split depend on the allowance and the strategy: suggest the tools
     # with them
-    chosen = {"FlankAllowance": allowance, "RoughingStrategy": default_roughing_strategy(job.machine.axes)}
+    chosen = {"FlankAllowance": allowance, "RoughingStrategy": default_roughing_strategy(job.machine.setup)}
     tools = suggest_tools({**values, "job": {**values["job"], **chosen}})
     return {**tools, **chosen}
 
