@@ -26,7 +26,11 @@ from spur_cad.geometry.mate import (
 )
 from spur_cad.geometry.spec import MAX_TEETH, MIN_TEETH, GearSpec
 from spur_cad.keys import check_section, key
+from spur_cad.mate_mesh import trochoid_intrusion_mm
 
+TROCHOID_TOLERANCE_MM = 0.001
+"""A tip corner may enter the other gear's outline by this much (its sampling and the mesh's steps) before it
+counts as trochoid interference."""
 CENTRE_DISTANCE_TOLERANCE_MM = 0.001
 """A centre distance given with the mate's shift may differ from the shifts' working centre distance by this much
 (a drawing's rounding); more is an inconsistency, refused."""
@@ -110,6 +114,20 @@ def gear_pair(spec: GearSpec, mate: MateSection) -> GearPair:
     return dataclasses.replace(pair, mate=dataclasses.replace(pair.mate, form_diameter_mm=form))
 
 
+def _trochoid_problems(spec: GearSpec, pair: GearPair, facts: PairFacts) -> list[PairError]:
+    """Trochoid interference of an external pair (spur_cad.mate_mesh): a tip corner entering the other gear's
+    material by more than TROCHOID_TOLERANCE_MM as the pair meshes."""
+    into_gear, into_mate = trochoid_intrusion_mm(spec, pair, facts)
+    problems = []
+    for depth, text, field in ((into_gear, "the mate's tip corners cut into this gear's", "addendum_coefficient"),
+                               (into_mate, "this gear's tip corners cut into the mate's", "teeth")):
+        if depth > TROCHOID_TOLERANCE_MM:
+            problems.append(PairError(f"trochoid interference: {text} root fillet by {depth:.4f} mm as the teeth "
+                                      "pass through the mesh; a smaller addendum, more profile shift or a larger "
+                                      "centre distance", field=field))
+    return problems
+
+
 def check_mate(spec: GearSpec, mate: MateSection, given: dict) -> tuple[GearPair, PairFacts]:
     """The pair and its facts, or PairError blaming the [mate] key to change: a centre distance that disagrees with
     a shift also given (`given`: the keys the file sets), one that cannot be reached, then the first of
@@ -129,6 +147,8 @@ def check_mate(spec: GearSpec, mate: MateSection, given: dict) -> tuple[GearPair
         problems = pair_problems(pair, facts)
     except PairError as exc:
         problems = [exc]
+    if not problems and not facts.internal:  # internal pairs: KHK's tip interference in pair_problems
+        problems = _trochoid_problems(spec, pair, facts)
     if problems:
         first = problems[0]
         if by_distance and first.field == "profile_shift_coefficient" and "profile_shift_coefficient" not in given:

@@ -327,3 +327,21 @@ def test_an_internal_pair_given_by_its_centre_distance():
     book = _internal_textbook(1.0, 20.0, 30, 60, 0.1, x2_khk)
     assert facts.transverse_contact_ratio == pytest.approx(book["eps"], rel=REL)
     assert facts.mate_start_of_active_profile_diameter_mm == pytest.approx(book["sap_ring"], rel=REL)
+
+
+@pytest.mark.parametrize("z1, x1, z2, x2, ha2", [(15, 0.3, 15, 0.3, 1.2), (30, 0.0, 20, 0.0, 1.28)])
+def test_the_followed_tip_corners_reach_as_deep_as_the_clearance_says(z1, x1, z2, x2, ha2):
+    """spur_cad.mate_mesh follows the mate's tip corners through the mesh: where the only fault is a tip clearance
+    c < 0 (the corner passes the line of centres below the root circle), they enter this gear by -c (3 um: the
+    mesh's steps and the outline's sampling); a sound pair's corners never enter either gear."""
+    from spur_cad.mate_mesh import trochoid_intrusion_mm  # noqa: PLC0415 (the job layer, imported only here)
+    from spur_cad.mate_section import MateSection, gear_pair  # noqa: PLC0415
+
+    spec = GearSpec(teeth=z1, module_mm=1.0, profile_shift_coefficient=x1, rack_tip_radius_mm=0.2, face_width_mm=5)
+    pair = gear_pair(spec, MateSection(teeth=z2, profile_shift_coefficient=x2, addendum_coefficient=ha2))
+    facts = pair_facts(pair)
+    assert facts.root_clearance_mm < 0.0
+    into_gear, into_mate = trochoid_intrusion_mm(spec, pair, facts)
+    assert into_gear == pytest.approx(-facts.root_clearance_mm, abs=3e-3) and into_mate == 0.0
+    sound = gear_pair(spec, MateSection(teeth=z2, profile_shift_coefficient=x2))
+    assert trochoid_intrusion_mm(spec, sound, pair_facts(sound)) == (0.0, 0.0)
