@@ -27,7 +27,7 @@ import sys
 import threading
 import time
 import traceback
-from typing import TYPE_CHECKING, BinaryIO, Callable
+from typing import IO, TYPE_CHECKING, BinaryIO, Callable
 
 if TYPE_CHECKING:
     from spur_cad.job import Job
@@ -56,6 +56,10 @@ class CadWorker:
         self._read = False  # the worker's outcome has been read (result() was called to its end)
         self._process = subprocess.Popen([sys.executable, "-m", "spur_cad.cad_worker", str(os.getpid())],
                                          stdin=subprocess.PIPE, stdout=subprocess.PIPE, start_new_session=True)
+        if self._process.stdin is None or self._process.stdout is None:  # never: both are PIPE above
+            raise RuntimeError("the CAD worker process started without its pipes")
+        self._stdin: IO[bytes] = self._process.stdin
+        self._stdout: IO[bytes] = self._process.stdout
         # The outcome is read as it comes, not when the run asks for it: a worker whose STEP files fill the pipe
         # would otherwise stay alive, holding OCP's 300 MB, until the main process has simulated and reported
         self._chunks: list[bytes] = []
@@ -70,8 +74,8 @@ class CadWorker:
         message = pickle.dumps((job, timestamp), protocol=pickle.HIGHEST_PROTOCOL)
         self._submitted = True
         try:
-            self._process.stdin.write(message)
-            self._process.stdin.flush()  # stdin stays open: the worker's lifeline
+            self._stdin.write(message)
+            self._stdin.flush()  # stdin stays open: the worker's lifeline
         except BrokenPipeError:  # the worker has ended; result() says so
             pass
 
@@ -103,7 +107,7 @@ class CadWorker:
 
     def _drain(self) -> None:
         """The reader thread: the worker's stdout to its end, kept in memory (the facts and the STEP files)."""
-        descriptor = self._process.stdout.fileno()
+        descriptor = self._stdout.fileno()
         try:
             while chunk := os.read(descriptor, READ_BYTES):
                 self._chunks.append(chunk)
@@ -122,9 +126,9 @@ class CadWorker:
                 self._process.kill()
                 self._process.wait()
         self._reader.join(STOP_WAIT_S)  # the worker has ended: its stdout reaches end-of-file
-        streams = [self._process.stdin]
+        streams = [self._stdin]
         if not self._reader.is_alive():  # never closed under a thread still reading it (its number could be reused)
-            streams.append(self._process.stdout)
+            streams.append(self._stdout)
         for stream in streams:
             try:
                 stream.close()
@@ -158,7 +162,7 @@ def _serve(source: BinaryIO, sink: BinaryIO) -> None:
     try:
         start = time.perf_counter()
         value = build_cad(job, None, timestamp)
-        message = ("done", value, time.perf_counter() - start)
+        message: tuple[str, object, float | None] = ("done", value, time.perf_counter() - start)
     except Exception as exc:  # noqa: BLE001 - every failure goes back to the main process, which decides
         message = ("error", _transferable(exc), None)
     sink.write(pickle.dumps(message, protocol=pickle.HIGHEST_PROTOCOL))

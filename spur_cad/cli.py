@@ -356,6 +356,8 @@ def _grade(args: argparse.Namespace, received: list[int], loaded: list) -> int:
     spec = job.gear
     _checkpoint(received)
     fit = grading.fit
+    if fit is None:  # never: a measured grading has its fit
+        raise ValueError("the measured grading has no fit")
     if fit.datum == "probe log":
         print(f"probe log: {grading.points} trips, datum the A axis (no fit), rms {fit.rms_deviation_um:.2f} um "
               "from the design")

@@ -142,7 +142,7 @@ def run_job(job: Job, progress: Callable[[str, float], None] | None = None,
         images = timed("plan_figures", None, lambda: plan_images(png, job.gear, job.stock.blank_radius_mm(job.gear),
                                                                  plan, job.modifications))
         waits_before_simulating = worker is not None and simulates_with_kernels(job, plan)
-        if waits_before_simulating:
+        if worker is not None and waits_before_simulating:
             cad, step = cad_from_worker(worker, timed, seconds)
         sim_result = timed("simulation", "simulation",
                            lambda: simulate_stage(job, plan, lambda fraction: tell("simulation", fraction)))
@@ -304,12 +304,14 @@ def lathe_program(job: Job) -> tuple[str, bytes]:
     from spur_cad.cam.turning import plan_lathe
     from spur_cad.post.lathe import lathe_extension, post_lathe
 
-    spec, stock = job.gear, job.stock
+    spec, stock, lathe = job.gear, job.stock, job.lathe
+    if lathe is None:
+        raise ValueError(f"job {job.job.name!r} has no [lathe] section: no lathe program")
     comments = (f"gear: z = {spec.teeth}, m = {spec.module_mm:g} mm, b = {spec.face_width_mm:g} mm, tip diameter "
                 f"{2 * spec.tip_radius_mm:.4f} mm",)
-    text = post_lathe(plan_lathe(spec, stock, job.lathe), job.lathe, f"spur_cad {__version__} blank: {job.job.name}",
+    text = post_lathe(plan_lathe(spec, stock, lathe), lathe, f"spur_cad {__version__} blank: {job.job.name}",
                       comments, dialects=job.dialects)
-    return f"blank.{lathe_extension(job.lathe.dialect, job.dialects)}", text.encode()
+    return f"blank.{lathe_extension(lathe.dialect, job.dialects)}", text.encode()
 
 
 def probe_program(job: Job) -> tuple[str, bytes]:
@@ -317,11 +319,13 @@ def probe_program(job: Job) -> tuple[str, bytes]:
     from spur_cad.cam.probing import plan_probe
     from spur_cad.post.probe import post_probe, probing_dialect
 
-    spec = job.gear
+    spec, probe = job.gear, job.probe
+    if probe is None:
+        raise ValueError(f"job {job.job.name!r} has no [probe] section: no probing program")
     gear = (f"gear: z = {spec.teeth}, m = {spec.module_mm:g} mm, alpha = {spec.pressure_angle_deg:g} deg, "
             f"x = {spec.profile_shift_coefficient:g}, b = {spec.face_width_mm:g} mm, reference radius "
             f"{spec.reference_radius_mm:.4f} mm, form radius {spec.form_radius_mm:.4f} mm")
-    plan = plan_probe(spec, job.stock, job.machine, job.probe)
+    plan = plan_probe(spec, job.stock, job.machine, probe)
     text = post_probe(plan, job.post, f"spur_cad {__version__} probe: {job.job.name}", gear, job.dialects)
     return f"probe.{probing_dialect(job.post.dialect, job.dialects).extension}", text.encode()
 
@@ -389,12 +393,14 @@ def program_comments(job: Job, plan: CamPlan, operation: str) -> tuple[str, ...]
                          "the root")
     else:
         planned = plan.finishing
+        if planned is None:
+            raise ValueError(f"the plan has no finishing for the {operation} program's header")
         result = planned.result
         strategy = (f"strategy: {result.strategy}, {result.describe()}, target scallop "
                     f"{job.finishing.target_scallop_mm * 1000:g} um")
     tool = planned.tool
     minutes = planned.estimate.time_s / 60.0
-    helix = ()
+    helix: tuple[str, ...] = ()
     if spec.kind.helical:  # spur headers stay as they were (byte-identical reference outputs)
         helix = (f"helix: beta = {spec.helix_angle_deg:g} deg {spec.hand} hand (m and alpha normal), lead "
                  f"{spec.lead_mm:.4f} mm: along it A changes by {-spec.hand_sign * 360.0 / spec.lead_mm:+.6f} deg "
@@ -512,5 +518,6 @@ def roughing_engagement(job: Job, plan: CamPlan) -> Engagement | None:
     if not cuts:
         return None
     stock = job_stock(job)
-    measure = measure_section_engagement if plan.roughing.flank is not None else measure_engagement
+    by_flanks = plan.roughing is not None and plan.roughing.flank is not None  # roughing_bottom comes with roughing
+    measure = measure_section_engagement if by_flanks else measure_engagement
     return measure(job.gear.teeth, stock.radius_mm, (stock.x_min, stock.x_max), cuts, job.gear.section_turn_rad(1.0))

@@ -299,7 +299,7 @@ class JobResult:
     gear: GearFacts
     inspection: InspectionSheet
     profile: ProfileFacts
-    cad: CadResult
+    cad: CadResult | None  # None only while a run's CAD worker still builds (a finished run's result has it)
     tools: ToolsFacts
     roughing: RoughingFacts | None
     finishing: FinishingFacts | None

@@ -6,13 +6,13 @@ rename or remove one. A golden test (tests/test_summary_golden.py) keeps them fo
 from __future__ import annotations
 
 import dataclasses
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any, overload
 
 import numpy as np
 
 from spur_cad.cam.estimate import Estimate
 from spur_cad.cam.machine import Machine, RoughingParams
-from spur_cad.cam.plan import CamPlan, FinishingPlan, RoughingPlan
+from spur_cad.cam.plan import CamPlan, FinishingPlan, RoughingPlan, TwoStage
 from spur_cad.cam.recommend import ToolRecommendations
 from spur_cad.cam.tools import Tool
 from spur_cad.dialects import dialect
@@ -46,6 +46,8 @@ from spur_cad.result import (
 from spur_cad.version import __version__
 
 if TYPE_CHECKING:  # the simulator loads only when a job uses it
+    from _typeshed import DataclassInstance  # any dataclass instance (typeshed only: no module at run time)
+
     from spur_cad.grade.grading import Grading
     from spur_cad.sim.simulate import SimResult
 
@@ -113,6 +115,12 @@ def lathe_facts(job) -> LatheFacts | None:
                       g.stub_length, job.lathe.part_off, job.lathe.work_offset)
 
 
+@overload
+def tool_facts(tool: Tool, machine: Machine) -> ToolFacts: ...
+@overload
+def tool_facts(tool: None, machine: Machine) -> None: ...
+@overload
+def tool_facts(tool: Tool | None, machine: Machine) -> ToolFacts | None: ...
 def tool_facts(tool: Tool | None, machine: Machine) -> ToolFacts | None:
     if tool is None:
         return None
@@ -129,14 +137,15 @@ def setup_facts(job, plan: CamPlan, post: PostSettings) -> SetupFacts:
     x_min, x_max = stock.blank_x_range_mm(spec)
     tool = job.tools.roughing
     flank = plan.roughing.flank if plan.roughing is not None else None
-    steps = ((flank.limits.axial_depth_mm, flank.limits.radial_engagement_mm) if flank is not None else
-             (rough.max_level_depth_fraction * tool.diameter_mm, rough.step_over_fraction * tool.diameter_mm)
-             if tool is not None else (None, None))
+    steps: tuple[float | None, float | None] = (
+        (flank.limits.axial_depth_mm, flank.limits.radial_engagement_mm) if flank is not None else
+        (rough.max_level_depth_fraction * tool.diameter_mm, rough.step_over_fraction * tool.diameter_mm)
+        if tool is not None else (None, None))
     return SetupFacts(
         job.machine.name, 2.0 * stock.blank_radius_mm(spec), x_min, x_max, stock.stub_diameter_mm,
         stock.stub_length_mm, post.work_offset, post.rotary_sign, post.coolant, job.machine.clearance_mm,
         float(z.min()) if z.size else None, float(z.max()) if z.size else None, rough.finish_stock_mm,
-        rough.flank_allowance_mm, *steps, machine_setup=job.machine.setup)
+        rough.flank_allowance_mm, steps[0], steps[1], machine_setup=job.machine.setup)
 
 
 def tools_facts(plan: CamPlan, machine: Machine, roughing_tool: Tool | None,
@@ -144,7 +153,7 @@ def tools_facts(plan: CamPlan, machine: Machine, roughing_tool: Tool | None,
     result = plan.finishing.result if plan.finishing is not None else None
     advice = result.tool_advice if result is not None else None
     return ToolsFacts(plan.recommendations, tool_facts(roughing_tool, machine), tool_facts(finishing_tool, machine),
-                      result.strategy if advice is not None else None, advice)
+                      result.strategy if result is not None and advice is not None else None, advice)
 
 
 def _roughing(roughing: RoughingPlan) -> RoughingFacts:
@@ -194,24 +203,31 @@ def roughing_facts(plan: CamPlan, machine: Machine, simulation: SimResult | None
     declined = plan.two_stage_declined
     if declined is not None:
         facts = dataclasses.replace(facts, two_stage_declined=DeclinedTwoStageFacts(
-            tool_facts(declined.roughing_tool, machine), declined.two_stage_time_s, declined.bottom_tool_alone_time_s))
+            tool_facts(_larger_tool(declined), machine), declined.two_stage_time_s, declined.bottom_tool_alone_time_s))
     suggested = plan.two_stage_suggested
     if suggested is not None:
         facts = dataclasses.replace(facts, two_stage_suggested=SuggestedTopToolFacts(
-            suggested.roughing_tool.diameter_mm, suggested.two_stage_time_s, suggested.bottom_tool_alone_time_s))
+            _larger_tool(suggested).diameter_mm, suggested.two_stage_time_s, suggested.bottom_tool_alone_time_s))
     by_flanks = plan.flank_suggested
     if by_flanks is not None:
         facts = dataclasses.replace(facts, flank_suggested=FlankSuggestionFacts(
             by_flanks.flank_time_s, by_flanks.levels_time_s, by_flanks.passes_per_space))
     if plan.flank_fallback is not None:
         facts = dataclasses.replace(facts, flank_fallback=plan.flank_fallback)
-    if plan.roughing_bottom is None:
-        return facts
     stage, bottom = plan.two_stage, plan.roughing_bottom
+    if stage is None or bottom is None:  # two-stage roughing has both, one-tool roughing neither
+        return facts
     two_stage = TwoStageFacts(tool_facts(bottom.tool, machine),
                               stage.split_height_above_root_mm, stage.chosen, _roughing(bottom),
                               stage.two_stage_time_s, stage.bottom_tool_alone_time_s, stage.gain_s)
     return dataclasses.replace(facts, two_stage=two_stage)
+
+
+def _larger_tool(stage: TwoStage) -> Tool:
+    """The larger (upper) tool of a declined or suggested two-stage roughing, which always names it."""
+    if stage.roughing_tool is None:
+        raise ValueError("a declined or suggested two-stage roughing names its larger tool")
+    return stage.roughing_tool
 
 
 def finishing_facts(finishing: FinishingPlan | None) -> FinishingFacts | None:
@@ -264,7 +280,7 @@ def _inspection_json(inspection) -> dict:
 def summary_json(result: JobResult) -> dict:
     """summary.json's content: every key as users' scripts read it."""
     tools = result.tools
-    summary = {
+    summary: dict[str, Any] = {
         "spur_cad_version": result.version,
         "job": {"name": result.job.name, "file": result.job.file},
         "gear": dataclasses.asdict(result.gear),
@@ -330,12 +346,14 @@ def error_budget_json(budget: ErrorBudgetFacts | None) -> dict | None:
             "deflection": dataclasses.asdict(budget.deflection) if budget.deflection is not None else None}
 
 
-def facts_json(facts: object) -> dict:
+def facts_json(facts: DataclassInstance) -> dict:
     """A strategy's typed facts or advice as JSON: its fields in order, None fields left out."""
     return {name: value for name, value in dataclasses.asdict(facts).items() if value is not None}
 
 
-def cad_json(cad: CadResult) -> dict:
+def cad_json(cad: CadResult | None) -> dict:
+    if cad is None:  # the pipeline adds the CAD facts before it writes summary.json
+        raise ValueError("summary.json needs the CAD stage's facts: the result has none yet")
     report = cad.report
     return {
         "fit_tolerance_mm": report.fit_tolerance_mm,

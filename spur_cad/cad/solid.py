@@ -54,6 +54,7 @@ from OCP.TopoDS import TopoDS, TopoDS_Edge, TopoDS_Shape, TopoDS_Solid, TopoDS_W
 from spur_cad.cad.ocp_compat import Array1OfVec, HArray1OfBoolean, HArray1OfPnt, HArray1OfReal, MakeSegment2d
 from spur_cad.cad.specs import BlankFeatures, GearSolidReport, StockSpec
 from spur_cad.errors import ArgumentError, WorkLimitError, require_instance
+from spur_cad.geometry.internal import InternalGearSpec
 from spur_cad.geometry.modifications import SIDES, FlankModifications, modified_tooth_space_profile
 from spur_cad.geometry.profile import Segment
 from spur_cad.geometry.sampling import segment_parameters
@@ -439,7 +440,7 @@ def _x_cylinder(radius: float, x0: float, x1: float) -> TopoDS_Shape:
     return BRepPrimAPI_MakeCylinder(gp_Ax2(gp_Pnt(x0, 0, 0), gp_Dir(1, 0, 0)), radius, x1 - x0).Shape()
 
 
-def _ring_shape(edges: list[TopoDS_Edge], spec: GearSpec) -> TopoDS_Shape:
+def _ring_shape(edges: list[TopoDS_Edge], spec: InternalGearSpec) -> TopoDS_Shape:
     """An internal gear: the transverse face between the rim circle (rim_outer_diameter_mm) and the toothed inner
     outline, extruded over 0 <= X <= b (a face with a hole: no boolean, which took a minute on a 60-tooth ring)."""
     circle = gp_Circ(gp_Ax2(gp_Pnt(0.0, 0.0, 0.0), gp_Dir(1.0, 0.0, 0.0)), spec.rim_outer_diameter_mm / 2.0)
@@ -474,7 +475,7 @@ def build_gear_shape(spec: GearSpec, features: BlankFeatures = BlankFeatures(),
     tolerance = default_fit_tolerance_mm(spec) if fit_tolerance_mm is None else fit_tolerance_mm
     edges, report = gear_face_edges(spec, tolerance)
     b = spec.face_width_mm
-    if spec.kind.teeth_inward:
+    if isinstance(spec, InternalGearSpec):  # the kind with teeth inward: a ring
         shape = _ring_shape(edges, spec)
     elif modifications is not None and not modifications.is_zero:
         if modifications.has_lead:

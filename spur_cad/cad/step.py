@@ -142,14 +142,15 @@ def style_blocks(model) -> list[tuple[int, int, int]]:
 
     count = len(_entities_of_type(model, Presentation))
     last = model.NbEntities()
-    starts = []
+    starts: list[int] = []
     index = last
     while len(starts) < count and index > 0:  # the styles are the model's last entities: a short walk back
         if isinstance(model.Value(index), Presentation):
             starts.append(index)
         index -= 1
     starts.sort()
-    part_of_colour = {colour[:3]: part for part, colour in enumerate((GEAR_COLOUR, STOCK_COLOUR))}
+    part_of_colour: dict[tuple[float, ...] | None, int] = {
+        colour[:3]: part for part, colour in enumerate((GEAR_COLOUR, STOCK_COLOUR))}
     blocks = []
     for start, end in zip(starts, [*(start - 1 for start in starts[1:]), last]):
         entities = [model.Value(i) for i in range(start, end + 1)]

@@ -18,6 +18,7 @@ over the flank's traces of one side.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass, replace
 
 import numpy as np
@@ -27,6 +28,10 @@ from spur_cad.grade.grading import Trace
 
 MIN_FIT_POINTS = 8
 """A trace needs this many points on the flank (and more than its shapes) to read modification amounts from it."""
+
+Shape = tuple[str, str, float, Callable[[np.ndarray], np.ndarray]]
+"""A modification fitted in a trace: name, symbol, designed amount (mm) and its unit shape along the trace (mm of
+roll length or face position to mm of removal)."""
 
 
 @dataclass(frozen=True)
@@ -77,11 +82,11 @@ def with_design(traces, mods: FlankModifications) -> tuple[Trace, ...]:
     return tuple(found)
 
 
-def _profile_shapes(flank: FlankModification) -> list[tuple[str, str, float, object]]:
+def _profile_shapes(flank: FlankModification) -> list[Shape]:
     """(name, symbol, designed um, unit shape of the roll length) of the profile modifications read from a trace."""
     unit = FlankModification(flank.form_roll_mm, flank.tip_roll_mm, flank.face_width_mm)
-    shapes = [("profile slope", "f_Halpha", flank.profile_slope_mm,
-               replace(unit, profile_slope_mm=1.0).profile_offset_mm)]
+    shapes: list[Shape] = [("profile slope", "f_Halpha", flank.profile_slope_mm,
+                            replace(unit, profile_slope_mm=1.0).profile_offset_mm)]
     if flank.profile_crowning_mm:
         shapes.append(("profile crowning", "C_alpha", flank.profile_crowning_mm,
                        replace(unit, profile_crowning_mm=1.0).profile_offset_mm))
@@ -96,10 +101,11 @@ def _profile_shapes(flank: FlankModification) -> list[tuple[str, str, float, obj
     return shapes
 
 
-def _lead_shapes(flank: FlankModification) -> list[tuple[str, str, float, object]]:
+def _lead_shapes(flank: FlankModification) -> list[Shape]:
     """(name, symbol, designed um, unit shape of the face position) of the lead modifications read from a trace."""
     unit = FlankModification(flank.form_roll_mm, flank.tip_roll_mm, flank.face_width_mm)
-    shapes = [("helix slope", "f_Hbeta", flank.helix_slope_mm, replace(unit, helix_slope_mm=1.0).lead_offset_mm)]
+    shapes: list[Shape] = [("helix slope", "f_Hbeta", flank.helix_slope_mm,
+                            replace(unit, helix_slope_mm=1.0).lead_offset_mm)]
     if flank.lead_crowning_mm:
         shapes.append(("lead crowning", "C_beta", flank.lead_crowning_mm,
                        replace(unit, lead_crowning_mm=1.0).lead_offset_mm))
@@ -113,7 +119,7 @@ def _lead_shapes(flank: FlankModification) -> list[tuple[str, str, float, object
     return shapes
 
 
-def _fitted_amounts_um(position_mm: np.ndarray, removal_um: np.ndarray, shapes) -> np.ndarray | None:
+def _fitted_amounts_um(position_mm: np.ndarray, removal_um: np.ndarray, shapes: list[Shape]) -> np.ndarray | None:
     """Least-squares amounts (um) of `shapes` in a removal trace, beside a constant; None for too few points."""
     if len(position_mm) < max(MIN_FIT_POINTS, len(shapes) + 2):
         return None
@@ -135,7 +141,7 @@ def _valleys(position_mm: np.ndarray, removal_um: np.ndarray) -> tuple[np.ndarra
 def modifications_cut(traces, mods: FlankModifications) -> tuple[ModificationCut, ...]:
     """Each flank side's modifications as designed and as cut (see the module docstring), from traces that carry
     their design trace (`with_design`): profile traces on the usable involute, helix traces over the face."""
-    found = []
+    found: list[ModificationCut] = []
     for side in SIDES:
         flank = mods.side(side)
         for kind, shapes, (low, high) in (("profile", _profile_shapes(flank), (flank.form_roll_mm, flank.tip_roll_mm)),

@@ -127,15 +127,17 @@ class Grading:
         cut = {} if self.modifications_cut is None else {
             "modifications_cut": [item.to_json() for item in self.modifications_cut]}
         where = {name: place.to_json() for name, place in self.where.items()}
-        if self.measured:
+        if self.fit is not None:  # measured
             return {"standard": STANDARD, "points": self.points, "notes": list(self.notes),
                     "fit": self.fit.to_json(), "deviations_um": dict(self.deviations_um), "where": where,
                     "classes": dict(self.classes), "class": self.overall_class, "validity": list(self.validity), **cut}
+        tolerances, unrounded, pitch = self.class5_tolerances_um, self.class5_unrounded_um, self.pitch
+        if tolerances is None or unrounded is None or pitch is None:
+            raise ValueError("a simulated grading without its class 5 tolerances and pitch has no JSON form")
         return {"standard": STANDARD, "deviations_um": dict(self.deviations_um), "where": where,
                 "classes": dict(self.classes), "class": self.overall_class,
-                "class5_tolerances_um": dict(self.class5_tolerances_um),
-                "class5_unrounded_um": dict(self.class5_unrounded_um),
-                "pitch": {side: p.to_json() for side, p in self.pitch.items()}, "validity": list(self.validity), **cut}
+                "class5_tolerances_um": dict(tolerances), "class5_unrounded_um": dict(unrounded),
+                "pitch": {side: p.to_json() for side, p in pitch.items()}, "validity": list(self.validity), **cut}
 
 
 def worst_deviations(measured: list[Trace]) -> tuple[dict[str, float], dict[str, Location]]:
@@ -177,7 +179,8 @@ def classes_of(spec, worst: dict[str, float], graded: set[str]) -> tuple[dict[st
     d, b, m = 2.0 * spec.reference_radius_mm, spec.face_width_mm, spec.module_mm
     classes = {DEVIATIONS[kind]: class_of(kind, worst[DEVIATIONS[kind]], d, b, m) for kind in KINDS
                if DEVIATIONS[kind] in graded}
-    overall = None if not classes or any(c is None for c in classes.values()) else max(classes.values())
+    within = [c for c in classes.values() if c is not None]
+    overall = None if not classes or len(within) < len(classes) else max(within)
     return classes, overall
 
 

@@ -113,14 +113,14 @@ def finishing_png(spec: GearSpec, tool: Tool, y: np.ndarray, z: np.ndarray, a_de
 
     tips = machine_to_part(y, z, a_deg)
     dense = sample_space(spec.tooth_space_profile(), 0.005)[0]
-    contacts = []
+    touching_sets = []
     for side in (1.0, -1.0):  # right and left corner-circle centres
         centres = machine_to_part(y + side * half_flat, z + r_t, a_deg)
         d = np.hypot(dense[None, :, 0] - centres[:, None, 0], dense[None, :, 1] - centres[:, None, 1])
         nearest = d.argmin(axis=1)
         touching = np.abs(d[np.arange(len(centres)), nearest] - r_t) < 0.01
-        contacts.append(dense[nearest[touching]])
-    contacts = np.concatenate(contacts)
+        touching_sets.append(dense[nearest[touching]])
+    contacts = np.concatenate(touching_sets)
     phi = np.linspace(0.0, math.pi / 2, 12)
     top = tool.diameter_mm  # the tool drawn one diameter up from its tip
     profile_y = np.concatenate([[-half_flat - r_t], -half_flat - r_t * np.sin(phi[::-1]),
@@ -317,12 +317,12 @@ def passes_png(spec: GearSpec, tool: Tool, passes: tuple, blank_radius_mm: float
     profile_y = np.concatenate([[-half_flat - r_t], -half_flat - r_t * np.sin(phi[::-1]),
                                 half_flat + r_t * np.sin(phi), [half_flat + r_t]])
     profile_z = np.concatenate([[top], r_t - r_t * np.cos(phi[::-1]), r_t - r_t * np.cos(phi), [top]])
-    shapes, contacts = [], []
+    shapes, nearest_points = [], []
     for p in passes:
         shapes.append(machine_to_part(p.y_mm + profile_y, p.z_mm + profile_z, np.full(len(profile_y), p.a_deg)))
         distance = tool_signed_distance(turn_points(design, math.radians(p.a_deg)), p.y_mm, p.z_mm, tool)
-        contacts.append(design[int(np.argmin(distance))])
-    contacts = np.array(contacts)
+        nearest_points.append(design[int(np.argmin(distance))])
+    contacts = np.array(nearest_points)
     x_low, x_high = -0.75 * spec.pitch_mm, 1.25 * spec.pitch_mm
     highest = max([blank_radius_mm] + [float(shape[:, 1].max()) for shape in shapes])
     y_low, y_high = spec.root_radius_mm - 1.0, highest + 0.5  # every tool outline inside the plot
@@ -406,12 +406,12 @@ def modification_chart_figure(mods: FlankModifications, base_radius_mm: float, w
         rolls = np.union1d(rolls, flank.profile_kinks_roll_mm())
         faces = np.union1d(faces, flank.lead_kinks_mm())
     if stacked:  # inches: left, right, top (the diameter axis), bottom margins, axes height, gap between the axes
-        left, right, top_in, bottom, axes_h, gap = 0.62, 0.08, 0.42, 0.42, 1.35, 0.78
+        left, right_in, top_in, bottom, axes_h, gap = 0.62, 0.08, 0.42, 0.42, 1.35, 0.78
         height_in = top_in + 2.0 * axes_h + gap + bottom
     else:
-        left, right, top_in, bottom, axes_h, gap = 0.85, 0.15, 0.55, 0.5, 2.4, 0.0
+        left, right_in, top_in, bottom, axes_h, gap = 0.85, 0.15, 0.55, 0.5, 2.4, 0.0
         height_in = top_in + axes_h + bottom
-    fig = figure(width_in, height_in, left=left / width_in, right=1.0 - right / width_in, bottom=bottom / height_in,
+    fig = figure(width_in, height_in, left=left / width_in, right=1.0 - right_in / width_in, bottom=bottom / height_in,
                  top=1.0 - top_in / height_in)
     fig.subplots_adjust(hspace=gap / axes_h, wspace=0.3)
     profile_ax, lead_ax = fig.subplots(2, 1) if stacked else fig.subplots(1, 2)

@@ -104,6 +104,8 @@ def program_notes(result: JobResult) -> tuple[str, ...]:
         stage = rough.two_stage
         if stage is not None and stage.bottom.passes_per_space is not None:
             larger = result.tools.roughing
+            if larger is None:  # never: two-stage roughing is planned with the job's roughing tool
+                raise ValueError("two-stage roughing without a roughing tool")
             notes.append(f"Two-stage roughing by flanks: the larger tool (T{larger.tool_number}, D "
                          f"{number(larger.diameter_mm, 3)} mm) down to {number(stage.split_height_above_root_mm, 3)} "
                          f"mm above the root circle, then the smaller (T{stage.bottom_tool.tool_number}, D "
@@ -181,8 +183,8 @@ def report_context(result: JobResult, images: dict[str, bytes]) -> dict:
     and the typed result itself (`result`)."""
     sim, grading = result.simulation, result.grading
     verdict = ""
-    if sim.enabled:
-        worst = sim.worst_leftover
+    worst = sim.worst_leftover
+    if sim.enabled and worst is not None:  # a simulation's largest leftover has its place
         within = sim.max_gouge_mm <= sim.resolution_mm
         verdict = (f"Largest gouge {number(1000 * sim.max_gouge_mm, 1)} {sheet.MICRO} "
                    f"({'within' if within else 'beyond'} the resolution). Largest leftover "

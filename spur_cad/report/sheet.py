@@ -12,6 +12,8 @@ import dataclasses
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
+from spur_cad.result import FinishingFacts, RoughingFacts
+
 if TYPE_CHECKING:
     from spur_cad.result import JobResult, ToolFacts
 
@@ -192,10 +194,10 @@ def tool_table(result: JobResult) -> Table:
     return Table(TOOL_HEAD, tuple(tool_cells(role, tool) for role, tool in used if tool is not None))
 
 
-def _operations(result: JobResult) -> list[tuple[str, object, object]]:
+def _operations(result: JobResult) -> list[tuple[str, RoughingFacts | FinishingFacts, ToolFacts | None]]:
     """(operation, facts, its tool) of the operations the job has."""
     rough, finish, tools = result.roughing, result.finishing, result.tools
-    out = []
+    out: list[tuple[str, RoughingFacts | FinishingFacts, ToolFacts | None]] = []
     if rough is not None:
         out.append(("roughing", rough, tools.roughing))
         if rough.two_stage is not None:
@@ -213,7 +215,7 @@ def operation_table(result: JobResult) -> Table:
     rows = []
     for name, facts, tool in operations:
         program = program_file(result, name)
-        if name.startswith("roughing"):
+        if isinstance(facts, RoughingFacts):  # roughing and roughing_bottom
             strategy = (f"roughing by flanks, {facts.passes_per_space} passes per space"
                         if facts.passes_per_space is not None else
                         f"3-axis roughing, {facts.levels_per_space} levels of passes offset from the blank inward"
@@ -357,6 +359,8 @@ def inspection_rows(result: JobResult) -> tuple[Row, ...]:
 def modification_rows(result: JobResult) -> list[Row]:
     """The flank modifications (right / left flank, ISO 21771 names) and where span and pins touch them."""
     mods = result.modifications
+    if mods is None:
+        return []
 
     def pair(values: tuple[float, float], digits: int) -> str:
         return f"{number(values[0], digits)} / {number(values[1], digits)}"
@@ -381,8 +385,9 @@ def modification_rows(result: JobResult) -> list[Row]:
 def expected_tolerance(result: JobResult) -> str | None:
     """The span and thickness the simulated cut leaves (from the involute flanks' deviations), or None."""
     ins, sim = result.inspection, result.simulation
-    flanks = [sim.feature(f"{side} involute") for side in ("right", "left")]
-    if not (sim.enabled and all(flanks) and ins.span_measurement_mm is not None):
+    found = [sim.feature(f"{side} involute") for side in ("right", "left")]
+    flanks = [f for f in found if f is not None]
+    if not (sim.enabled and len(flanks) == len(found) and ins.span_measurement_mm is not None):
         return None
     low = -max(f.max_gouge_mm for f in flanks)
     high = max(f.max_leftover_mm for f in flanks)
@@ -496,8 +501,8 @@ def warning_lines(result: JobResult) -> tuple[str, ...]:
     items = list(result.warnings)
     sim = result.simulation
     if sim.enabled:
-        if sim.max_gouge_mm > sim.resolution_mm:
-            w = sim.worst_gouge
+        w = sim.worst_gouge
+        if sim.max_gouge_mm > sim.resolution_mm and w is not None:  # a gouge has its place
             items.append(f"simulation: gouge of {number(1000 * sim.max_gouge_mm, 1)} {MICRO} at tooth space "
                          f"{w.space}, {w.feature}, X = {number(w.x_mm, 3)} mm")
         if sim.uncut_points:

@@ -37,7 +37,7 @@ def plan_images(profile_png: bytes, spec: GearSpec, blank_radius_mm: float, plan
                                                  blank_radius_mm)
     if plan.finishing is not None and plan.finishing.result.passes:
         images["finishing"] = passes_png(spec, plan.finishing.tool, plan.finishing.result.passes, blank_radius_mm)
-    elif plan.finishing is not None:
+    elif plan.finishing is not None and plan.finishing.result.poses is not None:  # a contact strategy's poses
         poses = plan.finishing.result.poses
         parts = (poses.right_flank, poses.root, poses.left_flank, poses.tip)
         y = np.concatenate([p.y for p in parts])
@@ -58,13 +58,16 @@ def simulation_images(result: JobResult, spec: GearSpec, plan: CamPlan, sim: Sim
     lying_flat = plan.finishing is not None and plan.finishing.result.lying_flat
     images = {"deviation": deviation_map_png(sim, lying_flat)}
     rough = result.setup
-    if sim.engagement is not None and result.tools.roughing is not None and rough.roughing_step_down_mm is not None:
+    # step-down and step-over: both given (with a roughing tool) or neither
+    step_down = rough.roughing_step_down_mm if rough is not None else None
+    step_over = rough.roughing_step_over_mm if rough is not None else None
+    if (sim.engagement is not None and result.tools.roughing is not None and step_down is not None
+            and step_over is not None):
         from spur_cad.report.figures import engagement_png
 
         diameter = result.tools.roughing.diameter_mm
         flank = plan.roughing.flank if plan.roughing is not None and plan.roughing_bottom is None else None
-        images["engagement"] = engagement_png(sim.engagement, rough.roughing_step_over_mm / diameter,
-                                              rough.roughing_step_down_mm / diameter,
+        images["engagement"] = engagement_png(sim.engagement, step_over / diameter, step_down / diameter,
                                               flank.limits.slot_depth_mm / diameter if flank is not None else None)
     if result.grading is not None and result.grading.has_profile_traces:
         from spur_cad.report.figures import k_chart_png

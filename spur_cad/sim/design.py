@@ -74,7 +74,9 @@ def sample_space(profile: ToothSpaceProfile, spacing_mm: float) -> tuple[np.ndar
 
     The last point (left tooth centre) is left out: it is the next space's first point.
     """
-    pts, nrm, feat = [], [], []
+    pts: list[np.ndarray] = []
+    nrm: list[np.ndarray] = []
+    feat: list[np.ndarray] = []
     for segment in profile.segments:  # right half, root -> tip
         if segment.end <= segment.start:
             continue
@@ -130,7 +132,7 @@ def design_grid(spec: GearSpec, spacing_mm: float, x_min: float, x_max: float,
 
 def space_parameters(profile: ToothSpaceProfile, spacing_mm: float) -> np.ndarray:
     """Each `sample_space` point's parameter on its segment (same order: right tooth centre -> left)."""
-    params = []
+    params: list[np.ndarray] = []
     for segment in profile.segments:
         if segment.end <= segment.start:
             continue

@@ -426,11 +426,16 @@ def measure_engagement(teeth: int, blank_radius_mm: float, x_range_mm: tuple[flo
             axial_depth_mm=np.where(engaged, acc[:, 5] - acc[:, 6], 0.0),
             removed_mm3=acc[:, 0] * field.row_w * field.col_w, minutes=move_minutes(cut.path)[fed],
             radial_step=step / d))
+
+    def joined(name: str) -> np.ndarray:
+        """One per-move field of every cut, in the cuts' order."""
+        return np.concatenate([p[name] for p in parts])
+
     return Engagement(
-        operation=tuple(name for p in parts for name in p["operation"]),
-        **{key: np.concatenate([p[key] for p in parts]) for key in
-           ("index", "space", "level", "diameter_mm", "radial_fraction", "axial_depth_mm", "removed_mm3", "minutes",
-            "radial_step")},
+        operation=tuple(name for p in parts for name in p["operation"]), index=joined("index"),
+        space=joined("space"), level=joined("level"), diameter_mm=joined("diameter_mm"),
+        radial_fraction=joined("radial_fraction"), axial_depth_mm=joined("axial_depth_mm"),
+        removed_mm3=joined("removed_mm3"), minutes=joined("minutes"), radial_step=joined("radial_step"),
         column_mm=field.col_w)
 
 

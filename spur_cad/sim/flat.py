@@ -132,8 +132,8 @@ def level_pieces(path: Toolpath, radius_mm: float) -> dict[float, Pieces]:
     levels = {}
     for z in np.unique(depth[motion]):
         here_lines, here_arcs = lines & (depth == z), arcs & (depth == z)
-        centre = np.stack([path.center_x[here_arcs], path.center_y[here_arcs]], axis=1) if here_arcs.any() \
-            else np.zeros((0, 2))
+        centre = np.stack([path.center_x[here_arcs], path.center_y[here_arcs]], axis=1) \
+            if here_arcs.any() and path.center_x is not None and path.center_y is not None else np.zeros((0, 2))
         start_angle = np.arctan2(starts[here_arcs, 1] - centre[:, 1], starts[here_arcs, 0] - centre[:, 0])
         levels[float(z)] = Pieces(starts[here_lines, :2], ends[here_lines, :2], centre, arc_radius[here_arcs],
                                   start_angle, arc_sweep[here_arcs], radius_mm)

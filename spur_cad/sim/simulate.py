@@ -160,7 +160,7 @@ class SimResult:
             value = float(block.flat[flat]) * (1.0 if gouge else -1.0)
             if value < best:  # the first place of the extreme, as numpy's argmin over the whole gives
                 best = value
-                k, j, r = np.unravel_index(flat, block.shape)
+                k, j, r = (int(i) for i in np.unravel_index(flat, block.shape))
                 k += first_space
             first_space += block.shape[0]
         row = np.nonzero(self.gear_rows)[0][r]

@@ -14,12 +14,16 @@ import dataclasses
 import json
 import math
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from spur_cad.cam.ir import Feature, MoveKind, Operation, Toolpath
 from spur_cad.errors import SpurCadError, shown
 from spur_cad.verify.reader import ProgramMoves
+
+if TYPE_CHECKING:  # the simulator loads only when a program is simulated
+    from spur_cad.sim.simulate import Cut
 
 POINTS = ("tip", "corner-centre")
 
@@ -113,12 +117,12 @@ class VerifyResult:
 
 
 def toolpaths(moves: ProgramMoves, tools: dict, roughing_number: int | None, point: str,
-              point_tools: tuple[int, ...] = (), a_offset_deg: float = 0.0) -> list:
+              point_tools: tuple[int, ...] = (), a_offset_deg: float = 0.0) -> list[Cut]:
     """(Toolpath, Tool) per run of moves with one tool in the spindle; the job's `tools` by tool number; A is
     the program's plus `a_offset_deg` (VerifyOptions)."""
     from spur_cad.sim.simulate import Cut
 
-    cuts = []
+    cuts: list[Cut] = []
     if len(moves) == 0:
         return cuts
     change = np.nonzero(np.diff(moves.tool))[0] + 1
