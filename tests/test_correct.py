@@ -351,3 +351,22 @@ def test_contact_angles_do_not_depend_on_the_turn_a_pose_is_cut_on(reference):
     for side in ("right", "left"):
         assert np.array_equal(plain.roll_mm[side], turned.roll_mm[side])
         assert np.abs(plain.a_deg[side] - turned.a_deg[side]).max() < 1e-6
+
+
+@needs_rs274
+def test_a_scan_of_some_spaces_tests_the_orders_they_can_tell_apart(reference, planted_scan):
+    """Eight of the 23 spaces scanned: orders 1 to 4 are tested (n // 2), and the once-per-turn 25 arcsec comes back
+    (within 1 arcsec) with nothing else kept."""
+    job, plan, ideal = reference
+    spec = job.gear
+    lines = planted_scan.splitlines()
+    y, z = np.array([[float(v) for v in line.split(",")[:2]] for line in lines[1:]]).T
+    angle = np.degrees(np.arctan2(z, y)) - 90.0 - SCAN_TURN_DEG  # space k's gap at 90 deg + k 360 / z (+ the turn)
+    space = np.mod(np.rint(angle / (360.0 / spec.teeth)), spec.teeth)
+    kept_lines = [lines[0]] + [line for line, k in zip(lines[1:], space) if k < 8]
+    contacts = contact_angles(spec, plan.finishing.toolpath, plan.finishing.tool)
+    found = identify(spec, read_points_csv("\n".join(kept_lines) + "\n", "scan.csv"), contacts, ideal, datum="axis")
+    assert [h.order for h in found.table.harmonics] == [1, 2, 3, 4]
+    assert [h.order for h in found.table.kept] == [1]
+    assert found.table.kept[0].amplitude_arcsec == pytest.approx(25.0, abs=1.0)
+    assert found.size_um == pytest.approx(-TOOL_RADIUS_ERROR_UM, abs=0.5)

@@ -174,7 +174,7 @@ def identify(spec, measured: MeasuredPoints, contacts: ContactAngles, ideal: Ide
     profile_t = (point_roll[used] - 0.5 * (start + end)) / (end - start)
     model = fit_flank_model(point_side[used], lever[used], a_deg, profile_t,
                             (measured.axial[used] - 0.5 * (front + back)) / (back - front), corrected[used],
-                            flank_id[used], spec.teeth, datum == "axis", contacts.span_deg())
+                            flank_id[used], int(np.count_nonzero(both)), datum == "axis", contacts.span_deg())
     table_part = np.zeros(len(corrected))
     table_part[used] = model.table_part_mm
     size = 0.5 * (model.size_mm["right"] + model.size_mm["left"])

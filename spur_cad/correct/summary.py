@@ -47,7 +47,8 @@ HOW_ORDERS_CHOSEN = (
     f"orders 1 (on a datum-axis scan; 2 on a best-fit scan) to z // 2 are fitted together with each side's size and "
     f"slopes; an order is kept when its amplitude exceeds {SIGNIFICANCE:g} standard uncertainties (cluster-robust "
     f"over the flanks) and moves a flank by {MIN_FLANK_MOTION_UM:g} um or more (r_b x amplitude); z // 2 is the "
-    "highest order the spaces sample without aliasing, order z repeats in every space (a profile form, not a position)")
+    "highest order the spaces sample without aliasing (n // 2 for a scan of n spaces), order z repeats in every space "
+    "(a profile form, not a position)")
 
 SAME_GEAR = (
     "a once-per-turn table error and a blank clamped off the A axis leave the same gear (every flank moved by c . n, "

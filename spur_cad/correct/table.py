@@ -11,7 +11,7 @@ by least squares, together with each side's size and slopes (the columns of fit_
 
 - tested are 1 to z // 2 (z // 2: the highest order the z spaces' flanks sample at least twice per period at each
   roll length: higher orders alias with lower ones in the pitch, and order z repeats in every space, which is a
-  form error of the profile, not a position);
+  form error of the profile, not a position); a scan of fewer spaces, n, tests up to n // 2;
 - the mean (order 0) is a turn of the whole gear, which the scan's fitted rotation takes;
 - order 1 on a datum-axis scan only: a best fit of the centre takes a once-per-turn error whole (it is an eccentric
   gear), and so does a once-per-turn error look exactly like a blank off the A axis (FirstHarmonic);
@@ -120,7 +120,8 @@ def fit_flank_model(side: np.ndarray, lever_mm: np.ndarray, a_deg: np.ndarray, p
                     first_order_visible: bool, a_range_deg: tuple[float, float]) -> FlankModel:
     """Fit d = size_side + e(A) lever + slope_side,profile t_profile + slope_side,helix t_helix to the points
     (deviation less the ideal cut's, mm), t the position over the evaluation range (-1/2 to 1/2, 0 at its middle);
-    the orders of e(A) chosen as the module docstring says. `flank`: a label per point naming its flank (the
+    the orders of e(A) chosen as the module docstring says, up to half of `teeth`, the number of spaces measured
+    (z when all are). `flank`: a label per point naming its flank (the
     clusters of the uncertainty)."""
     sides = ("right", "left")
     base = [(side == name).astype(float) for name in sides]
@@ -128,7 +129,7 @@ def fit_flank_model(side: np.ndarray, lever_mm: np.ndarray, a_deg: np.ndarray, p
     fixed = np.column_stack(base)
     keep = np.abs(fixed).sum(axis=0) > 0.0  # a side without helix spread (one plane) has no helix column
     fixed = fixed[:, keep]
-    tested = list(range(1 if first_order_visible else 2, teeth // 2 + 1))
+    tested = list(range(1 if first_order_visible else 2, teeth // 2 + 1))  # teeth: the spaces measured, at most z
     floor_arcsec = MIN_FLANK_MOTION_UM / 1000.0 / float(np.mean(np.abs(lever_mm))) / ARCSEC_RAD
     coef, _, covariance = _solve(np.column_stack([fixed, _columns(lever_mm, a_deg, tested)]), deviation_mm, flank)
     harmonics = []
