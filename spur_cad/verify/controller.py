@@ -15,7 +15,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from spur_cad.dialects import Dialect
+from spur_cad.dialects import Dialect, LatheWords
 from spur_cad.verify.limits import DIRECTED_TOLERANCE_DEG, MAX_MOVES
 from spur_cad.verify.program_text import Line, ProgramReadError, line_error
 
@@ -65,7 +65,8 @@ class ProgramMoves:
             else:
                 values = np.array(column, dtype)
             arrays.append(values)
-        return cls(source, arrays[0].astype(bool), *arrays[1:6], arrays[6].astype(bool), *arrays[7:])
+        rapid, x, y, z, a, feed, inverse_time, line, tool, spindle_rpm = arrays
+        return cls(source, rapid.astype(bool), x, y, z, a, feed, inverse_time.astype(bool), line, tool, spindle_rpm)
 
 
 def move_columns() -> list:
@@ -105,6 +106,12 @@ class Controller:
 
     def error(self, line: Line, message: str) -> ProgramReadError:
         return line_error(self.source, line, message)
+
+    def _lathe_words_at(self, line: Line) -> LatheWords:
+        """The dialect's lathe words, which a lathe program is read with (the reader checked them there)."""
+        if self.lathe_words is None:
+            raise self.error(line, f"{self.d.title} has no lathe words: this is not read as a lathe program")
+        return self.lathe_words
 
     def moves(self) -> ProgramMoves:
         """The moves made so far, as arrays (the columns start afresh)."""
@@ -227,7 +234,7 @@ class Controller:
 
     def _lathe_g_code(self, code: str, line: Line) -> bool:
         """Lathe G codes; False for the codes milling and turning share (G21, G40, G54...)."""
-        words = self.lathe_words
+        words = self._lathe_words_at(line)
         per_rev, per_minute = words.feed_codes
         if code in (per_rev, per_minute):
             if self.per_rev != (code == per_rev):
@@ -293,10 +300,10 @@ class Controller:
     def _check_lathe_move(self, line: Line) -> None:
         if not self.diameter:
             raise self.error(line, "X is a radius here; this reader reads lathe programs in diameter mode "
-                                   + f"({self.lathe_words.diameter_word})")
+                                   + f"({self._lathe_words_at(line).diameter_word})")
         if self.motion == "1" and not self.per_rev:
             raise self.error(line, "a lathe feed move without feed per revolution ("
-                                   + f"G{self.lathe_words.feed_codes[0]})")
+                                   + f"G{self._lathe_words_at(line).feed_codes[0]})")
 
 
 def _directed(current: float, target: float, direction: str, controller: Controller, line: Line) -> float:

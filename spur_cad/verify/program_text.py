@@ -5,7 +5,7 @@ that checks every line and finds where the main program ends and where every sub
 from __future__ import annotations
 
 import re
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 from spur_cad.dialects import Dialect
 from spur_cad.errors import SpurCadError, shown
@@ -91,16 +91,15 @@ class Structure:
     """Where the main program ends and where every subprogram, loop and label is (byte offsets and positions)."""
 
     end: int = -1  # offset just after the main program's last line (its M30 or M2)
-    subs: dict = None  # O<n> (and LinuxCNC o<n> sub): n -> (body start Position, offset of the closing line)
-    local_subs: dict = None  # Haas N<n> local subprograms (M97), alike
-    skips: dict = None  # LinuxCNC: offset of an 'o<n> sub' line -> Position after its 'endsub'
-    repeats: dict = None  # LinuxCNC: offset of an 'o<n> repeat' line -> (offset of its 'endrepeat', Position after)
-    labels: dict = None  # Siemens: label -> (Position after its line, offset of its line)
+    # O<n> (and LinuxCNC o<n> sub): n -> (body start Position, offset of the closing line)
+    subs: dict[int, tuple[Position, int]] = field(default_factory=dict)
+    local_subs: dict[int, tuple[Position, int]] = field(default_factory=dict)  # Haas N<n> (M97), alike
+    skips: dict[int, Position] = field(default_factory=dict)  # LinuxCNC: 'o<n> sub' line's offset -> after 'endsub'
+    # LinuxCNC: offset of an 'o<n> repeat' line -> (offset of its 'endrepeat', Position after)
+    repeats: dict[int, tuple[int, Position]] = field(default_factory=dict)
+    labels: dict[str, tuple[Position, int]] = field(default_factory=dict)  # Siemens: label -> (after, line offset)
 
     opened: int = 0  # subprograms, loops and labels met (closed or not): bounds what the index holds
-
-    def __post_init__(self):
-        self.subs, self.local_subs, self.skips, self.repeats, self.labels = {}, {}, {}, {}, {}
 
 
 def index_program(handle, syntax: Syntax, source: str) -> Structure:

@@ -249,7 +249,7 @@ class _Reader:
     def _count(self, text: str | None, line: Line) -> int:
         count = int(text) if text and len(text) <= 12 else 1 if not text else MAX_REPEAT + 1
         if not 0 <= count <= MAX_REPEAT:
-            raise self.error(line, f"repeat count {_digits(text)} outside 0..{MAX_REPEAT}")
+            raise self.error(line, f"repeat count {_digits(text or '')} outside 0..{MAX_REPEAT}")  # text given
         return count
 
     def _call(self, number: str, line: Line, depth: int, count: int = 1, local: bool = False,
