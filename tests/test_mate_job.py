@@ -9,9 +9,10 @@ import pytest
 
 from spur_cad.cli import main
 from spur_cad.errors import JobFileError
-from spur_cad.job import parse_job
+from spur_cad.job import job_from_dict, parse_job
 from spur_cad.mate_section import check_mate
 from tests.textbook import inv, inv_inverse
+from tests.workbench_helper import ROOT
 
 GEAR = "[gear]\nteeth = 40\nmodule_mm = 1.0\nface_width_mm = 10.0\nrack_tip_radius_mm = 0.38\n"
 
@@ -110,3 +111,22 @@ def test_a_refused_mate_exits_2_and_writes_nothing(tmp_path, capsys):
     assert err.startswith("spur-cad: error: ") and len(err.strip().splitlines()) == 1
     assert f"{job}:7: [mate] involute interference" in err
     assert not out.exists()
+
+
+def test_a_workbench_document_writes_mate_only_when_asked_and_lets_a_centre_distance_set_the_shift(monkeypatch):
+    """The document holds [mate] behind its UseMate switch (group Mate); a document always holds a shift, so a 0
+    shift beside a centre distance is left out of the job it writes (the centre distance sets it)."""
+    monkeypatch.syspath_prepend(str(ROOT / "workbench"))
+    from spur_cad_workbench import schema  # noqa: PLC0415 (importable once workbench/ is on the path)
+
+    job = parse_job(GEAR + "[mate]\nteeth = 40\ncentre_distance_mm = 40.5\n", "job.toml")
+    values = schema.values_from_job(job)
+    assert values["job"]["UseMate"] is True and schema.field_by_prop("MateTeeth").group == "Mate"
+    data = schema.job_data(values)
+    assert "profile_shift_coefficient" not in data["mate"] and data["mate"]["centre_distance_mm"] == 40.5
+    again = job_from_dict(data, "document")
+    assert again.pair.mate.profile_shift_coefficient == pytest.approx(job.pair.mate.profile_shift_coefficient,
+                                                                      rel=1e-12)
+    values["job"]["UseMate"] = False
+    assert "mate" not in schema.job_data(values)
+    assert "mate" not in schema.job_data(schema.values_from_job(parse_job(GEAR, "job.toml")))

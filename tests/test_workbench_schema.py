@@ -150,7 +150,7 @@ def _section_classes() -> dict[str, type]:
     sections = {("gear" if f.name == "gear_section" else f.name): hints[f.name] for f in dataclasses.fields(Job)
                 if f.name not in ("source", "gear", "tools", "text", "strategies", "dialects", "report_template_text",
                                   "rotary_calibration", "modifications", "modification_values",
-                                  "roughing_strategy_left_out")}
+                                  "roughing_strategy_left_out", "pair")}
     sections["tools.roughing"] = sections["tools.finishing"] = sections["tools.bottom"] = Tool
     sections.update(MODIFICATION_SECTIONS)  # read with [gear]: the Job holds them as FlankModifications
     # an optional section (`lathe: LatheSection | None`) is its dataclass

@@ -388,6 +388,9 @@ def job_data(values: dict[str, dict[str, object]]) -> dict[str, dict]:
             for part in field.section.split("."):
                 target = target.setdefault(part, {})
             target[field.key] = values[role][field.prop]
+    mate = data.get("mate")
+    if mate and mate.get("centre_distance_mm", 0.0) > 0.0 and mate.get("profile_shift_coefficient") == 0.0:
+        del mate["profile_shift_coefficient"]  # a document always holds a shift: 0 lets the centre distance set it
     return data
 
 
