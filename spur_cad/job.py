@@ -21,6 +21,7 @@ from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from types import MappingProxyType
+from typing import Any
 
 from spur_cad.cad.specs import BlankFeatures, StockSpec
 from spur_cad.cam.calibration import CalibrationTable, parse_calibration_table
@@ -124,7 +125,7 @@ class GearSection:
 
     def to_spec(self) -> GearSpec:
         """The GearSpec ([gear] internal = true: an InternalGearSpec, spur only)."""
-        common = dict(
+        common: dict[str, Any] = dict(
             teeth=self.teeth, module_mm=self.module_mm, pressure_angle_deg=self.pressure_angle_deg,
             profile_shift_coefficient=self.profile_shift_coefficient,
             addendum_coefficient=self.addendum_coefficient, dedendum_coefficient=self.dedendum_coefficient,
@@ -370,7 +371,7 @@ def _blamed_key(exc: SpurCadError, name: str, given: dict, sections: dict[str, t
         return exc.field
     message = str(exc)
     positions = {k: m.start() for k in names if (m := re.search(rf"\b{re.escape(k)}\b", message))}
-    for k in sorted(positions, key=positions.get):
+    for k in sorted(positions, key=lambda name: positions[name]):
         if k in given:
             return k
     return exc.field if exc.field in names else None
@@ -652,7 +653,7 @@ def _validate_sections(sections: dict, tables: dict, types: dict, autos: dict[st
             raise JobFileError(f"{where(name, blamed)}: {prefix}{exc}", section=name, field=blamed) from None
 
 
-def _split_modifications(data: object, source: str, text: str) -> tuple[object, dict[str, dict]]:
+def _split_modifications(data: dict, source: str, text: str) -> tuple[dict, dict[str, dict]]:
     """`data` without [gear.modifications], and {table name: table} of its common, .left and .right tables."""
     if not isinstance(data, dict) or not isinstance(data.get("gear"), dict) or "modifications" not in data["gear"]:
         return data, {}
@@ -714,7 +715,9 @@ def _check_added_material(mods: FlankModifications | None, finish_stock_mm: floa
     for finishing ([roughing] finish_stock_mm): the finishing tool would find nothing to cut there."""
     import numpy as np
 
-    for side in SIDES if mods is not None else ():
+    if mods is None:
+        return
+    for side in SIDES:
         flank = mods.side(side)
         rolls = np.linspace(flank.form_roll_mm, flank.tip_roll_mm, 2001)
         faces = np.linspace(0.0, flank.face_width_mm, 2001)
@@ -736,19 +739,20 @@ def _job_from_data(data: dict, source: str, text: str, strategies: Strategies = 
     tables, autos = _without_auto(_tables(data, source, text), lambda name, key_name: _where(source, text, name,
                                                                                               key_name))
     types = job_sections(strategies, dialects, sections)
-    sections = {name: _load_section(tables[name], name, source, text, types) for name in types if name in tables}
-    sections["roughing"], strategy_left_out = _roughing_section(sections, tables)
+    loaded: dict[str, Any] = {name: _load_section(tables[name], name, source, text, types)
+                              for name in types if name in tables}  # each section's dataclass, by its name
+    loaded["roughing"], strategy_left_out = _roughing_section(loaded, tables)
 
     def where(name: str, key_name: str | None) -> str:
         return _where(source, text, name, key_name)
 
-    gear_section: GearSection = sections["gear"]
+    gear_section: GearSection = loaded["gear"]
     try:
         spec = gear_section.to_spec()
     except GearSpecError as exc:
         blamed = _blamed_key(exc, 'gear', tables['gear'])
         raise JobFileError(f"{where('gear', blamed)}: invalid gear: {exc}", section="gear", field=blamed) from None
-    setup = sections.get("machine", Machine()).setup
+    setup = loaded.get("machine", Machine()).setup
     if spec.kind.teeth_inward and any(name.startswith("tools") for name in tables) and not setup.cuts(spec.kind):
         raise JobFileError(f"{where('gear', 'internal')}: internal = true: the rotary table cannot cut an internal "
                            "gear (its tool cannot reach inside the ring along the rotary axis); cut it with [machine] "
@@ -762,40 +766,40 @@ def _job_from_data(data: dict, source: str, text: str, strategies: Strategies = 
                            "out",
                            section=table, field=None)
     modifications, modification_values = _modifications(modification_tables, spec, source, text)
-    spec, pair = _mated(spec, sections.get("mate"), tables.get("mate", {}), where)
+    spec, pair = _mated(spec, loaded.get("mate"), tables.get("mate", {}), where)
     for check, name in ((gear_section.blank_features().validate, "gear"),
-                        (sections.get("stock", StockSpec()).validate, "stock")):
+                        (loaded.get("stock", StockSpec()).validate, "stock")):
         try:
             check(spec)
         except (GearSpecError, StockError) as exc:
             blamed = _blamed_key(exc, name, tables.get(name, {}))
             raise JobFileError(f"{where(name, blamed)}: invalid [{name}]: {exc}", section=name, field=blamed) from None
-    _validate_sections(sections, tables, types, autos, spec, strategies, where)
-    tools = _tools_section(sections, tables, where)
+    _validate_sections(loaded, tables, types, autos, spec, strategies, where)
+    tools = _tools_section(loaded, tables, where)
     _check_added_material(modifications if tools.finishing is not None else None,
-                          sections.get("roughing", RoughingParams()).finish_stock_mm, modification_tables, source, text)
+                          loaded.get("roughing", RoughingParams()).finish_stock_mm, modification_tables, source, text)
     _check_roughing_top(tools, where)
     try:
-        check_machine_limits(spec, sections.get("stock", StockSpec()), sections.get("machine", Machine()),
+        check_machine_limits(spec, loaded.get("stock", StockSpec()), loaded.get("machine", Machine()),
                              {role: tool for role in _TOOL_ROLES if (tool := getattr(tools, role)) is not None})
     except SpurCadError as exc:
         raise JobFileError(f"{where('machine', exc.field)}: {exc}", section="machine", field=exc.field) from None
-    if "lathe" in sections:
+    if "lathe" in loaded:
         try:
-            check_lathe_blank(spec, sections.get("stock", StockSpec()), sections["lathe"])
+            check_lathe_blank(spec, loaded.get("stock", StockSpec()), loaded["lathe"])
         except SpurCadError as exc:
             name = exc.section if exc.section in ("stock", "lathe") else "lathe"
             blamed = _blamed_key(exc, name, tables.get(name, {}))
             raise JobFileError(f"{where(name, blamed)}: {exc}", section=name, field=blamed) from None
-    if "probe" in sections:
-        _check_probe(spec, sections, tools, tables, where, dialects)
-    if "export" in sections:
-        _check_export(spec, gear_section, sections["export"], tables, where)
-    optional = {name: sections[name] for name in ("mate", "stock", "roughing", "machine", "three_axis",
-                                                  "simulation", "export", "lathe", "probe") if name in sections}
-    finishing = sections["finishing"] if "finishing" in sections else types["finishing"]()  # the registry's default
-    post = sections["post"] if "post" in sections else types["post"]()  # the registry's default dialect
-    return Job(source=source, job=sections.get("job", JobSection()), gear_section=gear_section, gear=spec,
+    if "probe" in loaded:
+        _check_probe(spec, loaded, tools, tables, where, dialects)
+    if "export" in loaded:
+        _check_export(spec, gear_section, loaded["export"], tables, where)
+    optional = {name: loaded[name] for name in ("mate", "stock", "roughing", "machine", "three_axis",
+                                                "simulation", "export", "lathe", "probe") if name in loaded}
+    finishing = loaded["finishing"] if "finishing" in loaded else types["finishing"]()  # the registry's default
+    post = loaded["post"] if "post" in loaded else types["post"]()  # the registry's default dialect
+    return Job(source=source, job=loaded.get("job", JobSection()), gear_section=gear_section, gear=spec,
                tools=tools, finishing=finishing, post=post, **optional, text=text, strategies=dict(strategies),
                dialects=dict(dialects), modifications=modifications, modification_values=modification_values,
                pair=pair, roughing_strategy_left_out=strategy_left_out)

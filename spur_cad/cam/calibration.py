@@ -46,10 +46,10 @@ def parse_calibration_table(text: str, source: str) -> CalibrationTable:
             continue
         fields = [f for f in _SEPARATOR.split(body) if f]
         try:
-            a, e = (float(f) for f in fields) if len(fields) == 2 else (None, None)
+            a, e = (float(f) for f in fields) if len(fields) == 2 else (math.nan, math.nan)
         except ValueError:
-            a = e = None
-        if a is None or not (math.isfinite(a) and math.isfinite(e)):
+            a = e = math.nan
+        if not (math.isfinite(a) and math.isfinite(e)):
             raise ValueError(f"{source}:{number}: expected two finite numbers 'A_deg error_arcsec', got "
                              f"{shown(body, 60)}")
         if not 0.0 <= a <= 360.0 or (angles and a <= angles[-1]):

@@ -218,7 +218,8 @@ def flank_poses(spec: GearSpec, profile: ToothSpaceProfile, tool: Tool, scallop_
     linear relief's kink with the upper segment's normal: a pose with each normal there changed the simulated
     leftover near it by 0.02 um)."""
     r_t = tool.effective_corner_radius_mm
-    points, normals = [], []
+    points: list[np.ndarray] = []
+    normals: list[np.ndarray] = []
     for segment in reversed(profile.segments):  # tip -> root
         if segment.label not in ("involute", "fillet") or segment.end <= segment.start:
             continue

@@ -22,6 +22,7 @@ from enum import IntEnum
 from typing import Any
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from spur_cad.geometry.frames import machine_to_part
 
@@ -143,9 +144,9 @@ class ToolpathBuilder:
         kind = MoveKind.ARC_CW if clockwise else MoveKind.ARC_CCW
         self._rows.append((int(kind), x, y, z, 0.0, feed, False, -1, station, int(feature), center_x, center_y))
 
-    def extend(self, kind: np.ndarray, x: np.ndarray, y: np.ndarray, z: np.ndarray, a: np.ndarray,
-               feed: np.ndarray, inverse_time: np.ndarray, space: np.ndarray, station: np.ndarray,
-               feature: np.ndarray) -> None:
+    def extend(self, kind: ArrayLike, x: ArrayLike, y: ArrayLike, z: ArrayLike, a: ArrayLike,
+               feed: ArrayLike, inverse_time: ArrayLike, space: ArrayLike, station: ArrayLike,
+               feature: ArrayLike) -> None:
         """Append many moves at once (arrays broadcast to a common length)."""
         self._flush_rows()
         n = max(np.size(v) for v in (kind, x, y, z, a, feed, inverse_time, space, station, feature))

@@ -86,7 +86,10 @@ def recommend_tools(spec: GearSpec, blank_radius_mm: float, clearance_mm: float,
         max_corner = 0.0
     flute = blank_radius_mm - spec.root_radius_mm
     scallop = key_of(TargetScallopParams, "target_scallop_mm")  # advice within the key's range (not a check)
-    target = min(max(target_scallop_mm, scallop.low), scallop.high)
+    low, high = scallop.low, scallop.high
+    if not (isinstance(low, (int, float)) and isinstance(high, (int, float))):
+        raise TypeError("[finishing] target_scallop_mm is bounded by numbers")
+    target = min(max(target_scallop_mm, low), high)
     generating = generating_max_diameter_mm(spec, spec.rack_tip_radius_mm, target, blank_radius_mm)
     flat_end_mill = generating_max_diameter_mm(spec, 0.0, target, blank_radius_mm)
     # the finishing limits first (the strategy's allowance without a finishing tool is its largest tool's); the
@@ -155,7 +158,8 @@ def small_tool_warnings(rec: ToolRecommendations, smallest_end_mill_mm: float, s
     name and diameter, FinishingStrategy.largest_tool) and the flat end mill's, unless the job finishes with a
     tool that has a corner (`finishing_kind` bull_nose or ball: the flat end mill's limit is not its concern).
     Limits at 0 (no such tool at all) are errors elsewhere, not warnings."""
-    limits = (("roughing tool", "roughing_max_diameter_mm", rec.roughing_max_diameter_mm),
+    limits: tuple[tuple[str, str, float], ...] = (
+              ("roughing tool", "roughing_max_diameter_mm", rec.roughing_max_diameter_mm),
               (f"finishing tool for strategy {strategy}", *finishing))
     if finishing_kind in (None, "flat"):
         limits += (("flat end mill for finishing by generation", "finishing_flat_end_mill_max_diameter_mm",

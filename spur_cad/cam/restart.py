@@ -21,7 +21,7 @@ import numpy as np
 from spur_cad.cam.ir import MoveKind, Toolpath, ToolpathBuilder
 from spur_cad.errors import SpurCadError, shown
 
-UNITS = {"space": "space", "level": "station", "station": "station", "pass": None}
+UNITS: dict[str, str | None] = {"space": "space", "level": "station", "station": "station", "pass": None}
 """Restart units and the IR column that numbers them (`pass`: the rapids of a space, one per generating pass)."""
 
 
@@ -67,7 +67,7 @@ def parse_restart(text: str) -> RestartPoint:
 def restart_index(path: Toolpath, point: RestartPoint) -> int:
     """The index of the first move of the full toolpath the restarted one keeps."""
     candidates = np.ones(len(path), bool)
-    where = []
+    where: list[str] = []
     for unit, index in point.at:
         if unit == "pass":
             rapids = np.flatnonzero(candidates & (path.kind == MoveKind.RAPID))
@@ -77,7 +77,7 @@ def restart_index(path: Toolpath, point: RestartPoint) -> int:
                                    f"(0..{available - 1})", field="restart")
             candidates = np.arange(len(path)) >= rapids[index]
         else:
-            column = getattr(path, UNITS[unit])
+            column = getattr(path, UNITS[unit] or unit)  # None only for "pass", handled above
             present = np.unique(column[candidates & (column >= 0)])
             if index not in present:
                 shown = f"{present.min()}..{present.max()}" if len(present) else "none"

@@ -284,7 +284,7 @@ def roughing_toolpath(spec: GearSpec, tool: Tool, machine: Machine, params: Roug
             _roughing_level_with_tabs(builder, rings, z, tab_top, bands, outside, feed, safe_z, index,
                                       machine.clearance_mm)
             continue
-        here = None
+        here: np.ndarray | None = None
         for _, ring in rings:
             coords = np.asarray(ring.coords)[:-1]
             if here is None:  # the level starts outside the blank, on the ray through the first ring's nearest point
@@ -300,7 +300,8 @@ def roughing_toolpath(spec: GearSpec, tool: Tool, machine: Machine, params: Roug
             for x, y in ordered:
                 builder.move(MoveKind.LINEAR, float(x), float(y), z, 0.0, feed, station=index)
             here = ordered[-1]
-        builder.move(MoveKind.RAPID, float(here[0]), float(here[1]), safe_z, 0.0)
+        if here is not None:
+            builder.move(MoveKind.RAPID, float(here[0]), float(here[1]), safe_z, 0.0)
     return builder.build(), levels, offsets
 
 

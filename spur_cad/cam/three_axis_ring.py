@@ -39,6 +39,7 @@ from spur_cad.cam.three_axis import (
     flat_tool_recommendations,
 )
 from spur_cad.cam.tools import Tool
+from spur_cad.geometry.internal import as_ring
 from spur_cad.geometry.outline2d import Arc2D, Segment2D, internal_gear_outline_arcs, offset_outline
 from spur_cad.geometry.sampling import gear_outline
 from spur_cad.geometry.spec import GearSpec
@@ -125,7 +126,7 @@ def ring_roughing_leaves(spec: GearSpec, roughing_tool: Tool, outermost_offset_m
     hole = Polygon(gear_outline(spec, ROUGHING_OUTLINE_TOLERANCE_MM))
     reached = hole.buffer(-outermost_offset_mm, quad_segs=ROUGHING_ARC_SEGMENTS).buffer(
         roughing_tool.diameter_mm / 2.0, quad_segs=4 * ROUGHING_ARC_SEGMENTS)
-    return Point(0.0, 0.0).buffer(spec.rim_outer_diameter_mm / 2.0, quad_segs=64).difference(reached)
+    return Point(0.0, 0.0).buffer(as_ring(spec).rim_outer_diameter_mm / 2.0, quad_segs=64).difference(reached)
 
 
 def ring_roughing_rings(spec: GearSpec, tool: Tool, params: RoughingParams, inner_radius_mm: float,

@@ -18,6 +18,7 @@ from scipy.spatial import cKDTree
 
 from spur_cad.cam.tools import Tool, ToolError
 from spur_cad.errors import SpurCadError
+from spur_cad.geometry.internal import as_ring, mating_pinion_mesh
 from spur_cad.geometry.mate import GearPair, PairMember, pair_facts
 from spur_cad.geometry.spec import GearSpec
 
@@ -144,15 +145,14 @@ def ring_active_profile_start(spec: GearSpec) -> tuple[float, str]:
     (h_a* + x_0) m at the cutting centre distance (the ring's analogue of the basic rack's addendum line). Along
     the line of action the ring's roll length is the pinion's plus a sin(alpha_w) (both base tangent points lie on
     one side of the pitch point)."""
-    from spur_cad.geometry.internal import mating_pinion_mesh
-
+    ring = as_ring(spec)
     m = spec.module_mm
-    if spec.mating_pinion_teeth:
-        centre_distance, alpha_w, pinion_base, pinion_tip = mating_pinion_mesh(spec)
-        source = f"the {spec.mating_pinion_teeth}-tooth mating pinion's tips"
+    if ring.mating_pinion_teeth:
+        centre_distance, alpha_w, pinion_base, pinion_tip = mating_pinion_mesh(ring)
+        source = f"the {ring.mating_pinion_teeth}-tooth mating pinion's tips"
     else:
-        cutter, mesh = spec.shaper_cutter().spec, spec.cutting_mesh()
-        centre_distance, alpha_w = mesh.centre_distance_mm, spec.cutting_pressure_angle_rad
+        cutter, mesh = ring.shaper_cutter().spec, ring.cutting_mesh()
+        centre_distance, alpha_w = mesh.centre_distance_mm, ring.cutting_pressure_angle_rad
         pinion_base = cutter.base_radius_mm
         pinion_tip = cutter.reference_radius_mm + (spec.addendum_coefficient + cutter.profile_shift_coefficient) * m
         source = f"the {cutter.teeth}-tooth shaper cutter's mesh (as a mating gear of addendum h_a* m)"
@@ -195,7 +195,7 @@ def root_thickness(spec: GearSpec, tool_radius_mm: float) -> RootThickness:
     if spec.kind.teeth_inward:  # a ring: the rim disc less the hole; the tool's disk opens the hole instead
         from shapely.geometry import Point
 
-        rim = Point(0.0, 0.0).buffer(spec.rim_outer_diameter_mm / 2.0, quad_segs=ROOT_THICKNESS_QUAD_SEGMENTS)
+        rim = Point(0.0, 0.0).buffer(as_ring(spec).rim_outer_diameter_mm / 2.0, quad_segs=ROOT_THICKNESS_QUAD_SEGMENTS)
         gear = rim.difference(outline)
         cut = rim.difference(outline.buffer(-tool_radius_mm, quad_segs=ROOT_THICKNESS_QUAD_SEGMENTS).buffer(
             tool_radius_mm, quad_segs=ROOT_THICKNESS_QUAD_SEGMENTS))

@@ -310,7 +310,7 @@ class ModificationInspection:
 def modification_inspection(spec: GearSpec, mods: FlankModifications, sheet: InspectionSheet) -> ModificationInspection:
     """What the inspection sheet says about `spec`'s flank modifications: their amounts, and whether the span and
     pin measurements of `sheet` are taken where the flanks are unmodified (else how much they read less)."""
-    sides = (mods.right, mods.left)
+    sides = (right, left) = (mods.right, mods.left)
     amounts = {name: tuple(1000.0 * getattr(side, attr) for side in sides) for attr, name in MODIFICATION_NAMES
                if any(getattr(side, attr) for side in sides)}
 
@@ -333,6 +333,9 @@ def modification_inspection(spec: GearSpec, mods: FlankModifications, sheet: Ins
     span_modified = (None if sheet.span_measurement_mm is None
                      else sheet.span_measurement_mm - (span[0] + span[1]) / 1000.0 * factor)
     return ModificationInspection(
-        amounts_um=amounts, tip_relief_start_diameters_mm=tuple(diameter(s.tip_relief_start_roll_mm) for s in sides),
-        root_relief_start_diameters_mm=tuple(diameter(s.root_relief_start_roll_mm) for s in sides),
+        amounts_um=amounts,
+        tip_relief_start_diameters_mm=(diameter(right.tip_relief_start_roll_mm),
+                                       diameter(left.tip_relief_start_roll_mm)),
+        root_relief_start_diameters_mm=(diameter(right.root_relief_start_roll_mm),
+                                        diameter(left.root_relief_start_roll_mm)),
         span_removal_um=span, pin_removal_um=removal_um(sheet.pin_contact_radius_mm), span_modified_mm=span_modified)

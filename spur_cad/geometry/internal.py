@@ -470,3 +470,11 @@ def _check_pinion_tip_interference(spec: InternalGearSpec) -> None:
         raise GearSpecError(f"tip interference: the {z1}-tooth mating pinion's tips would strike the ring's tips "
                             f"as they leave mesh (margin {math.degrees(margin):.3f} deg < 0); use fewer "
                             "mating_pinion_teeth or a smaller addendum", field="mating_pinion_teeth")
+
+
+def as_ring(spec: GearSpec) -> InternalGearSpec:
+    """`spec` as the internal gear it is, for code on a ring's path (its rim, its shaper cutter, its mating pinion);
+    ValueError for an external gear, whose kind does not take that path."""
+    if not isinstance(spec, InternalGearSpec):
+        raise ValueError(f"a {spec.kind.name} gear has no rim, shaper cutter or mating pinion: not an internal gear")
+    return spec

@@ -24,7 +24,9 @@ probe's flank sides). Pure numpy; see docs/geometry.md.
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass, replace
+from typing import Any
 
 import numpy as np
 
@@ -222,7 +224,7 @@ class ModifiedSegment:
     bounds are numerical (the offsets are micrometres on millimetre curves)."""
 
     base: Segment
-    offset: object  # callable: parameters -> removal (mm)
+    offset: Callable[[np.ndarray], Any]  # parameters -> removal (mm): an array like them, or a number
     fixed_normal: tuple[float, float] | None = None
 
     @property
@@ -310,8 +312,10 @@ def modified_tooth_space_profile(profile: ToothSpaceProfile, flank: FlankModific
             removal = float(involute_offset(t_form))
             normal_x, normal_y = (float(v) for v in involute.normals(np.array(t_form)))
             span = seg.end - seg.start
-            segments.append(ModifiedSegment(seg, lambda beta, s=span, r=removal: r * (np.asarray(beta) / s) ** 2,
-                                            fixed_normal=(normal_x, normal_y)))
+            def fillet_removal_mm(beta: np.ndarray, s: float = span, r: float = removal) -> np.ndarray:
+                return r * (np.asarray(beta) / s) ** 2
+
+            segments.append(ModifiedSegment(seg, fillet_removal_mm, fixed_normal=(normal_x, normal_y)))
         elif isinstance(seg, Involute):
             for a, b in zip(cuts, cuts[1:]):
                 segments.append(ModifiedSegment(replace(seg, start=a, end=b), involute_offset))

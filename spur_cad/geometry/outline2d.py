@@ -15,6 +15,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from spur_cad.geometry.frames import turn_points
+from spur_cad.geometry.internal import as_ring
 from spur_cad.geometry.profile import CircularArc, Segment
 from spur_cad.geometry.sampling import segment_parameters
 from spur_cad.geometry.spec import GearSpec
@@ -361,7 +362,7 @@ def internal_gear_outline_arcs(spec: GearSpec, tolerance_mm: float) -> tuple[Out
         raise ValueError(f"tolerance must be a positive number, got {tolerance_mm}")
     if not spec.kind.teeth_inward:
         raise ValueError("not an internal gear: use gear_outline_arcs")
-    rim_top = (0.0, spec.rim_outer_diameter_mm / 2.0)
+    rim_top = (0.0, as_ring(spec).rim_outer_diameter_mm / 2.0)
     rim = Outline2D((Arc2D(rim_top, rim_top, (0.0, 0.0), True),))
     teeth = _toothed_loop(spec, tolerance_mm)
     return rim, Outline2D(tuple(segment.reversed() for segment in reversed(teeth.segments)))
@@ -415,6 +416,7 @@ def _intersections(a: Segment2D, b: Segment2D) -> list[Point]:
                 candidates.append((float(base[0] - sign * h * u[1]), float(base[1] + sign * h * u[0])))
     else:
         line, arc = (a, b) if isinstance(a, Line2D) else (b, a)
+        assert isinstance(line, Line2D) and isinstance(arc, Arc2D)  # one of each, as the caller pairs them
         s = np.asarray(line.start_xy)
         direction = np.subtract(line.end_xy, line.start_xy)
         f = s - np.asarray(arc.center_xy)

@@ -48,8 +48,8 @@ def tool_advice(spec: GearSpec, tool: Tool, params: GeneratingParams, plan: Gene
     flute length this tool's passes need."""
     if spec.kind.helical:  # any corner up to rho (rho advised: fewest passes); the tip mode bounds the diameter
         rho, d_n = spec.rack_tip_radius_mm, rack_corner(spec).normal_corner_offset_mm
-        largest = 2.0 * d_n + 2.0 * tool.effective_corner_radius_mm
-        return GeneratingAdvice(rho, rho, None, None, largest, largest, None, None,
+        widest_mm = 2.0 * d_n + 2.0 * tool.effective_corner_radius_mm
+        return GeneratingAdvice(rho, rho, None, None, widest_mm, widest_mm, None, None,
                                 passes_flute_length_mm(plan.passes, tool, blank_radius_mm, spec.face_width_mm))
     end = params.flank_tool_end
     own = generating_tool_limits(spec, tool.effective_corner_radius_mm, params.target_scallop_mm, blank_radius_mm,

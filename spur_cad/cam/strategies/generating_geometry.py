@@ -166,7 +166,10 @@ def flank_rolls(spec: GearSpec, target_mm: float) -> tuple[np.ndarray, float]:
         hi = min(t_i + step, t_end)
         while flat_leftover_mm(rb, t_i, hi) <= goal:  # bracket the step
             hi = min(t_i + 2.0 * (hi - t_i), t_end)
-        t_next = brentq(lambda t, t_i=t_i: flat_leftover_mm(rb, t_i, t) - goal, t_i + 1e-15, hi, xtol=1e-13)
+        def above_goal_mm(t: float, t_i: float = t_i) -> float:
+            return flat_leftover_mm(rb, t_i, t) - goal
+
+        t_next = brentq(above_goal_mm, t_i + 1e-15, hi, xtol=1e-13)
         worst = max(worst, flat_leftover_mm(rb, t_i, t_next))
         rolls.append(t_next)
     return np.array(rolls), worst

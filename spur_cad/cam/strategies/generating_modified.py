@@ -192,7 +192,7 @@ def _touching_modified_contacts(spec: GearSpec, tool: Tool, passes: tuple[Genera
     design's contact of that roll (a relief's contacts lie 0.6 mm lower on the test gear; the raised end alone
     leaves 7 um there)}."""
     rb = spec.base_radius_mm
-    passes = _densified(passes, supports, rb)
+    passes = tuple(_densified(passes, supports, rb))
     kinks = {+1: {k / rb for k in mods.right.profile_kinks_roll_mm()},
              -1: {k / rb for k in mods.left.profile_kinks_roll_mm()}}
     out, lowered = [], {}
@@ -273,7 +273,7 @@ def modified_passes(spec: GearSpec, tool: Tool, passes: tuple[GeneratingPass, ..
     sides = {+1: mods.right, -1: mods.left}
     form_normal = involute.normals(np.array(involute.start))
     form_removal = {s: float(sides[s].profile_offset_mm(spec.base_radius_mm * involute.start)) for s in sides}
-    lowered = {}
+    lowered: dict = {}
     if not spec.kind.helical:
         passes, lowered = _touching_modified_contacts(spec, tool, passes, mods, supports)
     raised = {} if spec.kind.helical else _raised_ends(spec, tool, passes)

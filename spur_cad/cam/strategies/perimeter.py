@@ -135,7 +135,8 @@ def _modified_poses_of_stations(spec: GearSpec, tool: Tool, params: PerimeterPar
     computed: dict[tuple[float, float], SpacePoses] = {}
     out = []
     for x in stations:
-        key = tuple(round(float(modifications.side(side).lead_offset_mm(x)), 12) for side in SIDES)
+        right, left = (round(float(modifications.side(side).lead_offset_mm(x)), 12) for side in SIDES)
+        key = (right, left)
         if key not in computed:
             computed[key] = modified_space_poses(spec, tool, params.target_scallop_mm, modifications, float(x),
                                                  params.contact_spacing_mm)
