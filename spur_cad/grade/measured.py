@@ -19,6 +19,7 @@ import contextlib
 import math
 import os
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -26,6 +27,9 @@ from spur_cad.errors import SpurCadError
 from spur_cad.grade.design_trace import against_design, design_removal_mm
 from spur_cad.grade.grading import Grading, MeasuredFit, Trace, add_pitch, classes_of, validity, worst_deviations
 from spur_cad.grade.simulated import helix_range_mm, profile_range_mm, profile_roll_mm
+
+if TYPE_CHECKING:
+    from spur_cad.geometry.spec import GearSpec
 
 MAX_POINTS = 2_000_000
 MAX_MEASURED_BYTES = 128 * 1024 * 1024  # a scan of MAX_POINTS points (about 70 MB of text) fits
@@ -189,7 +193,8 @@ def fit(spec, measured: MeasuredPoints, design=None, datum: str = "best-fit", mo
 
     def residuals(p):
         params = p if datum != "axis" else [p[0], 0.0, 0.0]
-        return modified(*_deviations(tree, points, normals, y, z, x, params, turn), x)
+        deviation, nearest = _deviations(tree, points, normals, y, z, x, params, turn)
+        return modified(deviation, nearest, x)
 
     starts = np.linspace(0.0, pitch, 48, endpoint=False)  # the rotation's basin is narrower than a pitch
     costs = [np.sum(residuals([a, 0.0, 0.0]) ** 2) for a in starts]
@@ -209,7 +214,8 @@ which is about three times that in roll length near the reference circle of a 20
 10 um over the trace changes the deviation by well under 0.1 um over 0.1 mm."""
 
 
-def flank_traces(spec, axial, deviation, space, side, roll):
+def flank_traces(spec: GearSpec, axial: np.ndarray, deviation: np.ndarray, space: np.ndarray, side: np.ndarray,
+                 roll: np.ndarray) -> tuple[list[Trace], dict[str, dict[int, float]]]:
     """Profile traces per flank and plane of points labelled by space, side ('right', 'left', '' off the
     involutes) and roll length (mm); per flank and plane the deviation at the reference circle's roll length
     (interpolated along the profile trace, or a single point within REFERENCE_ROLL_TOLERANCE_MM of it), which
