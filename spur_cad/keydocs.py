@@ -100,7 +100,8 @@ Notes:
   or beam centre's path: wire radius plus spark gap for wire EDM, half the kerf for laser and waterjet;
   0 writes the part's outline for a machine that compensates itself. An offset at or above the root
   fillet's smallest curvature radius is refused (the cut would round the fillet off), as is one that
-  breaks a loop. Helical gears are refused (a wire cuts straight teeth only). See
+  breaks a loop. Helical gears are refused (a wire cuts straight teeth only). A job that writes the outline
+  and gives no `[tools.*]` is not milled: it gets no warnings about end mills below `smallest_end_mill_mm`. See
   [geometry.md](geometry.md).
 """
 

@@ -214,11 +214,17 @@ def three_axis_profile_start_mm(plan: CamPlan | None) -> float | None:
 
 def error_budget(job: Job, plan: CamPlan):
     """The job's error budget (spur_cad.sim.budget.ErrorBudget): [machine]'s accuracy keys, the calibration table
-    and the finishing tool's deflection in the job's material (on the finish stock roughing leaves)."""
+    and the finishing tool's deflection in the job's material (on the finish stock roughing leaves). On 3 axes the
+    linear axes, runout and tool size only: no table indexes the spaces, and the deflection model (a corner's arc
+    in the finish stock) is not the cut of a flat end mill's side over a whole step-down (docs/simulation.md)."""
     from spur_cad.cam.materials import MATERIALS
     from spur_cad.sim.budget import ErrorBudget, finishing_deflection
 
     machine, tool = job.machine, plan.finishing.tool if plan.finishing is not None else None
+    if not machine.setup.rotary_axis:
+        return ErrorBudget(runout_tir_um=machine.spindle_runout_um + machine.tool_runout_um,
+                           tool_radius_error_um=machine.tool_radius_error_um,
+                           linear_accuracy_um=machine.linear_accuracy_um, rotary_table=False)
     deflection = None if tool is None else finishing_deflection(
         tool.diameter_mm, tool.effective_corner_radius_mm, tool.stick_out_mm, tool.feed_per_tooth_mm,
         job.roughing.finish_stock_mm, MATERIALS[job.job.material])
@@ -244,18 +250,19 @@ def finishing_point_angles(job: Job, plan: CamPlan, grid):
 
 def budget_stage(job: Job, plan: CamPlan, sim_result: SimResult | None, grading: Grading | None):
     """The simulated gear on the budget's machine, graded (spur_cad.result.ErrorBudgetFacts; None without a
-    simulation): the budget acts on the simulated flanks, the cut is not simulated again. None for 3 axes: its
-    index errors are the rotary table's (docs/simulation.md)."""
-    if sim_result is None or grading is None or not job.machine.setup.rotary_axis:
+    simulation): the budget acts on the simulated flanks, the cut is not simulated again; on 3 axes the 3-axis
+    machine's budget (error_budget), graded as the ideal cut is (grade_stage)."""
+    if sim_result is None or grading is None:
         return None
     from spur_cad.grade.simulated import grade_simulation
     from spur_cad.sim.budget import apply_budget
     from spur_cad.summary import error_budget_facts
 
     budget = error_budget(job, plan)
-    deviation, terms = apply_budget(sim_result.grid, sim_result.deviation, budget,
-                                    finishing_point_angles(job, plan, sim_result.grid))
-    expected = grade_simulation(job.gear, dataclasses.replace(sim_result, deviation=deviation))
+    angles = finishing_point_angles(job, plan, sim_result.grid) if budget.rotary_table else None
+    deviation, terms = apply_budget(sim_result.grid, sim_result.deviation, budget, angles)
+    expected = grade_simulation(job.gear, dataclasses.replace(sim_result, deviation=deviation),
+                                three_axis_profile_start_mm(plan))
     return error_budget_facts(job, terms, budget.deflection, grading, expected)
 
 
@@ -459,7 +466,8 @@ def cam_inputs(job: Job) -> CamInputs:
     return CamInputs(job.gear, job.stock, job.tools.roughing, job.tools.finishing, job.roughing, job.finishing,
                      job.machine, job.tools.bottom, top_tool=job.tools.roughing_top, strategies=job.strategies,
                      profile_tolerance_mm=job.job.profile_tolerance_mm, three_axis=job.three_axis,
-                     modifications=job.modifications, levels_fallback=job.roughing_strategy_left_out)
+                     modifications=job.modifications, levels_fallback=job.roughing_strategy_left_out,
+                     outline_export=job.export.dxf or job.export.svg)
 
 
 def plan_cam(job: Job, checkpoint: Callable[[], None] | None = None) -> CamPlan:

@@ -192,7 +192,20 @@ def test_a_three_axis_job_runs_through_the_pipeline_without_a_rotary_axis(tmp_pa
     assert "G2 " in finishing and "G3 " in finishing and "gear axis = Z" in finishing
     for program in (finishing, roughing):
         assert not [line for line in program.splitlines() if not line.startswith("(") and " A" in line]
-    assert any("error budget is not applied" in w for w in result.warnings)
+    # the 3-axis machine's own error budget (issue 48): no index error, every flank moved into the material by half
+    # the runout, the tool's radius error and half the linear accuracy; such a uniform shift changes no ISO 1328
+    # deviation (differences along a flank or between flanks of one side) and thins the tooth by twice the shift
+    # over cos(alpha) on the reference circle
+    assert not any("error budget" in w for w in result.warnings)
+    budget, machine = result.error_budget, load_job(job_file).machine
+    assert budget is not None and set(budget.terms.index_error_arcsec) == {0.0}
+    total_um = (-(machine.spindle_runout_um + machine.tool_runout_um) / 2.0 - machine.tool_radius_error_um
+                - machine.linear_accuracy_um / 2.0)
+    assert total_um < 0.0 and budget.terms.flank_shift_um["total"] == pytest.approx(total_um)
+    assert budget.tooth_thickness_change_um == pytest.approx(2.0 * total_um / math.cos(math.radians(20.0)), abs=1e-3)
+    assert all(abs(share) <= 1e-3 for share in budget.share_um.values()), budget.share_um
+    assert budget.grading.deviations_um == pytest.approx(result.grading.deviations_um, abs=1e-3)
+    assert "no index error (no rotary table indexes the spaces)" in result.files["report.html"].decode()
     report = result.files["report.html"].decode()  # the set-up sheet of the blank lying flat, not the rotary table's
     assert "blank thickness (faced to the face width)" in report and "A zero" not in report
     assert result.grading is not None and result.simulation is not None

@@ -72,10 +72,6 @@ MAX_COMPARISON_MOVES = 2_000_000
 """Largest toolpath a comparison time is given for (perimeter, reference process's strategy; estimated from
 two stations' worth, PerimeterStrategy.estimate); beyond it the comparison is left out (None)."""
 
-THREE_AXIS_BUDGET_WARNING = ("[machine] axes = 3: the error budget is not applied (its index errors are the rotary "
-                             "table's); the simulation and grade are those of an ideal 3-axis machine")
-"""The warning of every 3-axis plan, an external gear's or a ring's."""
-
 
 @dataclass(frozen=True)
 class RoughingPlan:
@@ -175,6 +171,9 @@ class CamInputs:
     # roughing by flanks is the job file's default, not its choice: where it cannot take the gear or tools, roughing
     # falls back to levels (plan_cam)
     levels_fallback: bool = False
+    # [export] dxf or svg: the outline is written for a 2-D process (wire EDM, laser, waterjet); with no tools given
+    # nothing is milled, and the end mills' sizes are not warned about
+    outline_export: bool = False
 
     @property
     def roughing_tool_set(self) -> Tool:
@@ -391,9 +390,10 @@ def _plan_cam(inputs: CamInputs, checkpoint: Callable[[], None] | None = None) -
              if tool is not None}
     warnings: list[str] = list(check_machine_limits(inputs.spec, inputs.stock, inputs.machine, tools))
     strategy = get_strategy(inputs.finishing.strategy, inputs.strategies)
-    warnings.extend(small_tool_warnings(rec, inputs.machine.smallest_end_mill_mm, strategy.name,
-                                        strategy.largest_tool(rec),
-                                        inputs.finishing_tool.kind if inputs.finishing_tool is not None else None))
+    if tools or not inputs.outline_export:  # a job that mills, or may (its recommendations choose the tools)
+        warnings.extend(small_tool_warnings(rec, inputs.machine.smallest_end_mill_mm, strategy.name,
+                                            strategy.largest_tool(rec),
+                                            inputs.finishing_tool.kind if inputs.finishing_tool is not None else None))
     bottom = two_stage = declined = suggested = by_flanks = None
     if levels is not None and (inputs.bottom_tool is not None or inputs.top_tool is not None):
         check()
@@ -745,7 +745,8 @@ def check_three_axis_inputs(inputs: CamInputs):
 def _plan_three_axis(inputs: CamInputs, tolerance_mm: float) -> CamPlan:
     """The CAM plan of a 3-axis job ([machine] axes = 3): the checks of three_axis.check_three_axis, roughing and
     finishing as spur_cad.cam.three_axis says; no tool recommendations for the rotary-table strategies
-    (empty), no error budget (a warning says so; the cut is simulated by spur_cad.sim.flat)."""
+    (empty; the cut is simulated by spur_cad.sim.flat, its error budget is the 3-axis machine's:
+    pipeline.error_budget)."""
     from spur_cad.cam.roughing import RoughingLevels
     from spur_cad.cam.three_axis import (
         ThreeAxisFinishingFacts,
@@ -787,7 +788,7 @@ def _plan_three_axis(inputs: CamInputs, tolerance_mm: float) -> CamPlan:
         result = FinishingResult("three_axis", None, None, len(levels), 0.0, np.zeros(0), facts=facts,
                                  lying_flat=True)
         finishing = FinishingPlan(tool, result, path, estimate(path, machine), None, None)
-    return CamPlan(rec, roughing, finishing, (THREE_AXIS_BUDGET_WARNING,))
+    return CamPlan(rec, roughing, finishing, ())
 
 
 def _plan_three_axis_ring(inputs: CamInputs, tolerance_mm: float, root) -> CamPlan:
@@ -836,4 +837,4 @@ def _plan_three_axis_ring(inputs: CamInputs, tolerance_mm: float, root) -> CamPl
         result = FinishingResult("three_axis", None, None, len(levels), 0.0, np.zeros(0), facts=facts,
                                  lying_flat=True)
         finishing = FinishingPlan(tool, result, path, estimate(path, machine), None, None)
-    return CamPlan(rec, roughing, finishing, (THREE_AXIS_BUDGET_WARNING,))
+    return CamPlan(rec, roughing, finishing, ())

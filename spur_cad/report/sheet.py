@@ -471,6 +471,14 @@ def error_budget_text(result: JobResult) -> str:
         return ""
     terms, shift = budget.terms, budget.terms.flank_shift_um
     klass = budget.grading.overall_class or "beyond 11"
+    if not terms.rotary_table:
+        return (f"With the 3-axis machine's error budget the gear is expected in class {klass}: no index error (no "
+                f"rotary table indexes the spaces); every flank moved {signed(shift['total'], 1)} {MICRO} along its "
+                f"normal (runout {signed(shift['runout'], 1)}, tool radius {signed(shift['tool_radius'], 1)}, linear "
+                f"axes {signed(shift['linear'], 1)}; the side of a flat end mill cutting a whole step-down is not "
+                "the deflection model's cut: a measured figure goes in as tool_radius_error_um); the tooth "
+                f"thickness on the reference circle changes by {signed(budget.tooth_thickness_change_um, 1)} "
+                f"{MICRO}.")
     deflection = budget.deflection
     bent = (f"the finishing tool bent {number(deflection.deflection_um, 1)} {MICRO} by "
             f"{number(deflection.force_n, 2)} N "

@@ -16,6 +16,9 @@ for deviations of micrometres:
   every flank into the material by their size;
 - the finishing tool's deflection F / k (a cantilever of its stick-out) moves every flank out of the material.
 
+A 3-axis machine (the blank lying flat, [machine] axes = 3) has no table indexing the spaces: its budget is the
+flank shifts alone (runout, tool size, linear axes), no index error (ErrorBudget.rotary_table false).
+
 Index errors: the calibration table when the job names one (the machine's measured error at each A), else a
 once-per-turn sine of the positioning accuracy's amplitude (the worm wheel's eccentricity, the usual largest
 term); plus the repeatability as a pseudo-random draw per space, uniform in +-repeatability / 2, from the
@@ -39,6 +42,8 @@ FLUTED_CORE_FRACTION = 0.8
 """The fluted part of an end mill bends as a round bar of about 0.8 times its diameter."""
 RANDOM_SEED = 1328
 """Seed of the repeatability's draw per space (stated in summary.json)."""
+NO_TABLE_SOURCE = "no rotary table (3 axes): no index error"
+"""The index errors' source on a 3-axis machine."""
 @dataclass(frozen=True)
 class Deflection:
     """The finishing tool bent by the cutting force: Kienzle's force on the finishing cut's chip (thickness h,
@@ -85,6 +90,7 @@ class ErrorBudget:
     tool_radius_error_um: float = 0.0
     linear_accuracy_um: float = 0.0
     deflection: Deflection | None = None
+    rotary_table: bool = True  # False: 3 axes, no table indexes the spaces (no index error)
 
 
 @dataclass(frozen=True)
@@ -100,6 +106,7 @@ class BudgetTerms:
     index_error_arcsec: tuple[float, ...]
     flank_shift_um: dict[str, float]
     eccentricity_um: float = 0.0  # r_b x the systematic error's once-per-turn amplitude, when applied per point
+    rotary_table: bool = True  # False: the 3-axis machine's budget (no index error; index_source says so)
 
     def to_json(self) -> dict:
         return {"index_source": self.index_source, "random_seed": self.random_seed,
@@ -113,6 +120,8 @@ def index_errors(budget: ErrorBudget, teeth: int) -> tuple[np.ndarray, np.ndarra
     """Each space's A (space k is cut at A = -k 360 / z, taken in [0, 360)), its systematic and random index
     error (arcsec), and where the systematic one comes from."""
     a_deg = np.mod(-360.0 * np.arange(teeth) / teeth, 360.0)
+    if not budget.rotary_table:
+        return a_deg, np.zeros(teeth), np.zeros(teeth), NO_TABLE_SOURCE
     if budget.calibration is not None:
         systematic = budget.calibration.error_at(a_deg)
         source = f"calibration table {budget.calibration.source}"
@@ -165,7 +174,9 @@ def apply_budget(grid, deviation: np.ndarray, budget: ErrorBudget,
     p, n = grid.points[mask], grid.normals[mask]
     lever_mm = p[:, 0] * n[:, 1] - p[:, 1] * n[:, 0]  # p x n: the normal motion per radian of turn (r_b on flanks)
     eccentricity_um = 0.0
-    if point_a_deg is None:
+    if not budget.rotary_table:
+        per_point = np.zeros((grid.teeth, len(lever_mm)))
+    elif point_a_deg is None:
         per_point = np.repeat(total[:, None], len(lever_mm), axis=1)
         source += ", at each space's index angle (a rigid turn of the space)"
     else:
@@ -181,5 +192,5 @@ def apply_budget(grid, deviation: np.ndarray, budget: ErrorBudget,
     terms = BudgetTerms(source, RANDOM_SEED, tuple(round(float(a), 6) for a in a_deg),
                         tuple(round(float(e), 3) for e in systematic), tuple(round(float(e), 3) for e in random),
                         tuple(round(float(e), 3) for e in total), {k: round(v, 3) for k, v in shifts.items()},
-                        eccentricity_um)
+                        eccentricity_um, budget.rotary_table)
     return moved, terms
