@@ -1,4 +1,4 @@
-# spur_cad developer tasks. `make test`: the fast tier, before every commit (ruff + the tests not marked
+# spur_cad developer tasks. `make test`: the fast tier, before every commit (ruff, mypy + the tests not marked
 # slow/freecad/linuxcnc/browser, a few minutes). `make test-all`: everything (what CI runs through .ci/run).
 
 VENV        := .venv
@@ -32,6 +32,7 @@ demo: venv
 
 lint: venv
 	$(VENV)/bin/ruff check .
+	$(VENV)/bin/mypy
 
 test: lint
 	$(PYTHON) -m pytest -q -m "$(MARKS)" $(PYTEST_ARGS)
