@@ -26,7 +26,7 @@ from spur_cad.errors import shown_path
 from spur_cad.geometry.sampling import ProfileSamples, sample_profile
 from spur_cad.inputs import step_timestamp
 from spur_cad.job import Job
-from spur_cad.result import CadResult, JobResult
+from spur_cad.result import CadResult, CorrectionFacts, JobResult
 from spur_cad.summary import build_result, summary_json
 from spur_cad.version import __version__
 
@@ -85,14 +85,14 @@ def modified_flank_samples(job: Job) -> dict | None:
 
 def run_job(job: Job, progress: Callable[[str, float], None] | None = None,
             checkpoint: Callable[[], None] | None = None, restart: RestartPoint | None = None,
-            plan: CamPlan | None = None, correction: dict | None = None,
+            plan: CamPlan | None = None, correction: CorrectionFacts | None = None,
             cad_worker: CadWorker | None = None) -> JobResult:
     """Compute every output of the job in memory (no file I/O): the typed result with its output set in
     `files` ({name: bytes}, for spur_cad.outputs.write_output_set). `progress(stage, fraction)` is told how
     far each long stage is (the CLI draws progress bars with it); `checkpoint()` is called before every
     stage (the CLI stops there when a signal has arrived, never inside a library). `restart` adds a program
     restarting an operation there (restart_program). spur-cad correct gives its corrected `plan` (else the job's is
-    planned) and its `correction` (correction.json), which the report shows. `cad_worker` (a started
+    planned) and its `correction` (spur-cad correct's, typed), which the report shows. `cad_worker` (a started
     spur_cad.cad_worker.CadWorker, which run_job stops before it returns) builds the CAD stage in a second process
     while this one does the rest, which then never imports OCP: the command line's choice; without it (FreeCAD:
     OCCT loaded, no Python executable to start; spur-cad correct) the CAD is built here."""

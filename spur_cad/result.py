@@ -19,6 +19,7 @@ if TYPE_CHECKING:  # annotations only: the CAD kernel and the simulator load whe
     from spur_cad.cad.specs import GearSolidReport
     from spur_cad.cam.estimate import Estimate
     from spur_cad.cam.recommend import ToolRecommendations
+    from spur_cad.cam.strategies.base import StrategyFacts, ToolAdvice
     from spur_cad.geometry.inspection import InspectionSheet, ModificationInspection
     from spur_cad.geometry.spec import GearFacts
     from spur_cad.grade.grading import Grading
@@ -112,7 +113,7 @@ class ToolsFacts:
     roughing: ToolFacts | None
     finishing: ToolFacts | None
     advice_strategy: str | None = None  # the strategy whose advice `advice` is
-    advice: Any = None  # the strategy's typed advice dataclass (e.g. GeneratingAdvice), or None
+    advice: ToolAdvice | None = None  # the strategy's typed advice dataclass (e.g. GeneratingAdvice)
 
 
 @dataclass(frozen=True)
@@ -189,7 +190,7 @@ class FinishingFacts:
     sentence), its estimate, and the comparison estimates (None when not estimated)."""
 
     strategy: str
-    strategy_facts: Any
+    strategy_facts: StrategyFacts
     report_text: str
     estimate: Estimate
     perimeter: Estimate | None
@@ -291,6 +292,65 @@ class ErrorBudgetFacts:
 
 
 @dataclass(frozen=True)
+class HarmonicFacts:
+    """One kept order h of the rotary table's error e(A) = amplitude x sin(h A + phase) (arcsec, deg)."""
+
+    order: int
+    amplitude_arcsec: float
+    phase_deg: float
+    uncertainty_arcsec: float
+
+
+@dataclass(frozen=True)
+class SlopeFacts:
+    """One side's profile or helix slope (um): as identified with its uncertainty, before and as predicted after, and
+    for the profile the pressure angle change as cut it means (deg; None for a helix slope)."""
+
+    side: str
+    value_um: float
+    uncertainty_um: float
+    before_um: float
+    after_um: float
+    pressure_angle_change_deg: float | None = None
+
+
+@dataclass(frozen=True)
+class PitchFacts:
+    """One side's total pitch deviation F_p (um) before and as predicted after the table's correction."""
+
+    side: str
+    before_um: float
+    after_um: float
+
+
+@dataclass(frozen=True)
+class CorrectionFacts:
+    """spur-cad correct's correction as the report of the corrected set shows it (correction.json is its full
+    serialisation; spur_cad.correct.summary makes both): where the measured gear came from, the size error and the
+    finishing tool programmed for it, the table's kept orders (None when a probe log could not see the table), the
+    flanks' F_p and slopes before and predicted after, and what is not corrected and why, one line each."""
+
+    measured: str
+    points_used: int
+    size_um: float
+    size_uncertainty_um: float
+    tool_before_mm: float
+    tool_programmed_mm: float
+    flank_position_before_um: float
+    flank_position_after_um: float
+    table_kept: tuple[HarmonicFacts, ...] | None  # None: the table was not seen
+    table_orders_tested: tuple[int, int] | None  # (lowest, highest); None when none was tested
+    a_words_moved: bool  # every block's A moved by -e(A)
+    y_z_words_moved: bool  # order 1 taken for the blank's offset: every block's Y and Z moved
+    unfolded: bool  # the programs written unfolded
+    pitch: tuple[PitchFacts, ...]  # the sides whose every flank was measured
+    profile_slopes: tuple[SlopeFacts, ...]
+    helix_slopes: tuple[SlopeFacts, ...]
+    slopes_corrected: bool
+    notes: tuple[str, ...]
+
+
+@dataclass(frozen=True)
 class JobResult:
     """Everything a run found, and the output set's files ({name: bytes}, written by spur_cad.outputs)."""
 
@@ -312,7 +372,7 @@ class JobResult:
     files: dict[str, bytes] = field(default_factory=dict)
     setup: SetupFacts | None = None  # the report's set-up sheet (not in summary.json)
     error_budget: ErrorBudgetFacts | None = None  # the expected grade with the machine's errors (None: no simulation)
-    correction: dict | None = None  # spur-cad correct's correction.json when the run is a corrected set (the report)
+    correction: CorrectionFacts | None = None  # spur-cad correct's correction of a corrected set (the report)
     modifications: ModificationInspection | None = None  # the flank modifications on the inspection sheet
     kind: GearKind = EXTERNAL_SPUR  # the gear's kind (spur_cad.geometry.kinds; not in summary.json)
     pair: GearPair | None = None  # the gear and its [mate] (None: no [mate], the checks assume the basic rack)

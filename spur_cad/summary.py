@@ -16,7 +16,7 @@ from spur_cad.cam.plan import CamPlan, FinishingPlan, RoughingPlan, TwoStage
 from spur_cad.cam.recommend import ToolRecommendations
 from spur_cad.cam.tools import Tool
 from spur_cad.dialects import dialect
-from spur_cad.geometry.inspection import inspection_facts, modification_inspection
+from spur_cad.geometry.inspection import inspection_sheet, modification_inspection
 from spur_cad.geometry.mate import GearPair, PairFacts, pair_facts
 from spur_cad.geometry.sampling import ProfileSamples
 from spur_cad.post.program import PostedProgram
@@ -68,7 +68,7 @@ def build_result(job, samples: ProfileSamples, cad: CadResult | None, plan: CamP
     anything reads it)."""
     labels = np.array(samples.label_names())
     counts = SegmentCounts(*(int(np.count_nonzero(labels == name)) for name in SEGMENT_NAMES))
-    inspection = inspection_facts(job.gear)
+    inspection = inspection_sheet(job.gear)
     modifications = (None if job.modifications is None
                      else modification_inspection(job.gear, job.modifications, inspection))
     return JobResult(

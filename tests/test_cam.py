@@ -61,7 +61,6 @@ def test_recommendations_match_method_formulas(name):
     (dict(roughing=Tool(diameter_mm=3.0, kind="bull_nose", corner_radius_mm=0.5)), "flat end mill"),
     (dict(roughing=Tool(diameter_mm=3.0, flute_length_mm=5.0)), "required_flute_length_mm"),
     (dict(roughing=Tool(diameter_mm=3.0, stick_out_mm=8.0)), "required_stick_out_mm"),
-    (dict(roughing=Tool(diameter_mm=3.0, kind="conical")), "kind 'conical' is unknown"),
 ])
 def test_tool_limits_are_clear_errors(change, words):
     spec = spec_of("reference_z23_m4")
@@ -70,6 +69,19 @@ def test_tool_limits_are_clear_errors(change, words):
     rec = recommend_tools(spec, 50.5, 1.0, finishing)
     with pytest.raises(ToolError, match=words):
         check_tools(spec, rec, roughing, finishing)
+
+
+def test_a_tool_that_cannot_exist_is_refused_when_the_plan_s_inputs_are_made():
+    """The tools' own checks run once, when CamInputs is made; the limits against the gear (check_tools) trust them."""
+    from spur_cad.cad.specs import StockSpec
+    from spur_cad.cam.machine import Machine, RoughingParams
+    from spur_cad.cam.plan import CamInputs
+    from spur_cad.cam.strategies import FinishingParams
+
+    spec = spec_of("reference_z23_m4")
+    with pytest.raises(ToolError, match="roughing tool kind 'conical' is unknown"):
+        CamInputs(spec, StockSpec(), Tool(diameter_mm=3.0, kind="conical"), None, RoughingParams(), FinishingParams(),
+                  Machine())
 
 
 @pytest.mark.parametrize("strategy, words", [

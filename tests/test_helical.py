@@ -129,17 +129,17 @@ def test_span_balls_and_chordal_thickness_match_the_textbook(name):
 def test_the_span_needs_enough_face_width_and_is_left_out_when_none_fits():
     wide = spec_of("reference_15_right", 20.0)
     sheet = inspection_sheet(wide)
-    k = sheet["span_teeth_k"]
-    assert sheet["span_measurement_mm"] == pytest.approx(span_measurement(wide, k).length_mm)
+    k = sheet.span_teeth_k
+    assert sheet.span_measurement_mm == pytest.approx(span_measurement(wide, k).length_mm)
     length = span_measurement(wide, k).length_mm
-    assert sheet["span_min_face_width_mm"] == pytest.approx(length * math.sin(book_of("reference_15_right").beta_b))
+    assert sheet.span_min_face_width_mm == pytest.approx(length * math.sin(book_of("reference_15_right").beta_b))
     narrow = spec_of("reference_15_right", 3.0)
     sheet = inspection_sheet(narrow)
-    assert sheet["span_teeth_k"] < k
-    fits = span_min_face_width_mm(narrow, span_measurement(narrow, sheet["span_teeth_k"])) < 3.0
-    assert (sheet["span_measurement_mm"] is None) == (not fits)
+    assert sheet.span_teeth_k < k
+    fits = span_min_face_width_mm(narrow, span_measurement(narrow, sheet.span_teeth_k)) < 3.0
+    assert (sheet.span_measurement_mm is None) == (not fits)
     thin = spec_of("reference_15_right", 0.5)
-    assert inspection_sheet(thin)["span_measurement_mm"] is None
+    assert inspection_sheet(thin).span_measurement_mm is None
 
 
 # --------------------------------------------------------------------------- B-rep

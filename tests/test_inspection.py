@@ -88,9 +88,9 @@ def test_reference_gear_inspection_values_by_hand():
     inv20 = math.tan(math.radians(20)) - math.radians(20)
     cos20 = math.cos(math.radians(20))
     expected = 4 * cos20 * (2.5 * math.pi + 23 * inv20) - 0.05 * 2 * math.pi * cos20
-    assert sheet["span_teeth_k"] == 3
-    assert sheet["span_measurement_mm"] == pytest.approx(expected, abs=1e-9)
-    assert sheet["min_teeth_without_undercut"] == 20
+    assert sheet.span_teeth_k == 3
+    assert sheet.span_measurement_mm == pytest.approx(expected, abs=1e-9)
+    assert sheet.min_teeth_without_undercut == 20
 
 
 def test_chordal_thickness_at_reference_circle():
@@ -109,11 +109,11 @@ def test_inspection_of_strongly_negative_shift(teeth, shift):
                     thickness_allowance_fraction=0.05, face_width_mm=3.0)
     assert spec.reference_radius_mm + shift * spec.module_mm < spec.form_radius_mm
     sheet = inspection_sheet(spec)
-    assert spec.form_radius_mm <= sheet["span_contact_radius_mm"] <= spec.tip_radius_mm
-    assert spec.form_radius_mm <= sheet["pin_contact_radius_mm"] <= spec.tip_radius_mm
-    k = sheet["span_teeth_k"]
+    assert spec.form_radius_mm <= sheet.span_contact_radius_mm <= spec.tip_radius_mm
+    assert spec.form_radius_mm <= sheet.pin_contact_radius_mm <= spec.tip_radius_mm
+    k = sheet.span_teeth_k
     alpha = math.radians(20.0)
     s = spec.tooth_thickness_mm
     textbook = spec.module_mm * math.cos(alpha) * ((k - 1) * math.pi + teeth * (math.tan(alpha) - alpha)) \
         + s * math.cos(alpha)
-    assert sheet["span_measurement_mm"] == pytest.approx(textbook, abs=1e-9)
+    assert sheet.span_measurement_mm == pytest.approx(textbook, abs=1e-9)

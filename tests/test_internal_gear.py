@@ -13,7 +13,7 @@ from shapely.geometry import Polygon
 
 from spur_cad.errors import GearSpecError, JobFileError
 from spur_cad.geometry import gear_outline, sample_profile
-from spur_cad.geometry.inspection import inspection_facts
+from spur_cad.geometry.inspection import inspection_sheet
 from spur_cad.geometry.internal import InternalGearSpec
 from spur_cad.geometry.spec import GearSpec
 from spur_cad.job import parse_job
@@ -141,7 +141,7 @@ def test_dimension_between_pins_against_khk_and_the_exact_profile(changes):
     (odd z: times cos(90/z deg)); and the pin placed on the space axis at r_M touches the exact flank (D/2 from
     it, nowhere closer)."""
     ring = _ring(**changes)
-    sheet = inspection_facts(ring)
+    sheet = inspection_sheet(ring)
     z, m, x, pin = ring.teeth, ring.module_mm, ring.profile_shift_coefficient, sheet.pin_diameter_mm
     alpha = math.radians(ring.pressure_angle_deg)
     phi = brentq(lambda a: inv(a) - (math.pi / (2 * z) + inv(alpha) - pin / (z * m * math.cos(alpha))
@@ -267,9 +267,9 @@ def test_report_sheet_says_between_pins_and_no_span():
     from spur_cad.report.sheet import inspection_rows
 
     ring = _ring()
-    result = SimpleNamespace(inspection=inspection_facts(ring), modifications=None, gear=ring, kind=ring.kind)
+    result = SimpleNamespace(inspection=inspection_sheet(ring), modifications=None, gear=ring, kind=ring.kind)
     rows = {row.label: row.value for row in inspection_rows(result)}
     assert rows["span measurement"].startswith("not for an internal gear")
-    assert float(rows["dimension between pins (balls)"]) == pytest.approx(inspection_facts(ring).dimension_over_pins_mm,
+    assert float(rows["dimension between pins (balls)"]) == pytest.approx(inspection_sheet(ring).dimension_over_pins_mm,
                                                                           abs=1e-4)
     assert not any("over pins" in label or "undercut" in label for label in rows)

@@ -263,11 +263,11 @@ def test_the_inspection_sheet_lists_the_modifications_and_says_where_span_and_pi
 
 
 def test_a_span_taken_on_a_modified_flank_is_a_warning_with_what_it_reads():
-    from spur_cad.geometry.inspection import inspection_facts, modification_inspection
+    from spur_cad.geometry.inspection import inspection_sheet, modification_inspection
     from spur_cad.pipeline import run_job
 
     job = parse_job(GEAR + "[gear.modifications]\nprofile_slope_um = 20\n", "f.toml")
-    sheet = inspection_facts(job.gear)
+    sheet = inspection_sheet(job.gear)
     facts = modification_inspection(job.gear, job.modifications, sheet)
     rb = job.gear.base_radius_mm
     l_form = roll_length_mm(rb, 2 * job.gear.form_radius_mm)

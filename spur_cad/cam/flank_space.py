@@ -15,6 +15,7 @@ import numpy as np
 from spur_cad.cam.common import offset_flank
 from spur_cad.cam.machine import MachineError, RoughingParams
 from spur_cad.cam.tools import Tool
+from spur_cad.geometry.frames import turn_points_by
 from spur_cad.geometry.sampling import full_space_points, sample_profile
 from spur_cad.geometry.spec import GearSpec
 
@@ -48,16 +49,6 @@ def _largest(geometry):
 
     parts = shapely.get_parts(geometry)
     return max(parts, key=lambda part: part.area)
-
-
-def rotate(points: np.ndarray, angle_rad: float | np.ndarray) -> np.ndarray:
-    """R(angle) p for points (n, 2) (y, z); several angles (m,) give (m, n, 2)."""
-    c, s = np.cos(angle_rad), np.sin(angle_rad)
-    y, z = points[..., 0], points[..., 1]
-    if np.ndim(angle_rad) == 0:
-        return np.stack([c * y - s * z, s * y + c * z], axis=-1)
-    c, s = c[:, None], s[:, None]
-    return np.stack([c * y - s * z, s * y + c * z], axis=-1)
 
 
 @dataclass(frozen=True)
@@ -100,7 +91,7 @@ class SpaceGeometry:
         self.slices = _Slices.of(spec, tool)
         pitch = 2.0 * math.pi / spec.teeth
         space = full_space_points(sample_profile(spec.tooth_space_profile(), 1e-4 * spec.module_mm))
-        chunks = [rotate(space, k * pitch) for k in (-1, 0, 1)]  # spaces -1, 0, 1: the teeth beside space 0
+        chunks = [turn_points_by(space, k * pitch) for k in (-1, 0, 1)]  # spaces -1, 0, 1: the teeth beside space 0
         ring = np.concatenate(chunks + [np.zeros((1, 2))])
         design = shapely.Polygon(ring).buffer(0.0)
         self.design = design
@@ -126,7 +117,7 @@ class SpaceGeometry:
         slices = self.slices
         half = slices.half_widths_mm
         radius = float(half.max())
-        turned = rotate(points, turn_rad)
+        turned = turn_points_by(points, turn_rad)
         shift = float(np.abs(slices.turns_rad).max()) * self.max_radius_mm
         if shift == 0.0:
             low, high = _edge_reach(turned[None], tip_z_mm)
@@ -140,7 +131,7 @@ class SpaceGeometry:
         keep = keep | np.roll(keep, 1) | np.roll(keep, -1)  # the neighbours: the edges crossing the tip height
         keep[0], keep[-1] = keep[0] or keep[1], keep[-1] or keep[-2]
         index = np.flatnonzero(keep)
-        subset = rotate(points[index], turn_rad + slices.turns_rad)
+        subset = turn_points_by(points[index], turn_rad + slices.turns_rad)
         low, high = _edge_reach(subset, tip_z_mm, np.diff(index) == 1)
         if sign > 0:
             return float(-np.min(low - half))
@@ -177,7 +168,7 @@ def _evaluate(geo: SpaceGeometry, i0: int, i1: int, radius: float) -> FlankSegme
     best = None
     for fraction in (1.0, 0.75, 0.5, 0.25, 0.0):
         turn = full * fraction
-        turned = rotate(points, turn)
+        turned = turn_points_by(points, turn)
         tip_z = float(turned[:, 1].min())
         side, far = geo.limits(turn, tip_z)
         if far <= side + TOL_MM:
@@ -240,7 +231,7 @@ def clean_up_segment(geo: SpaceGeometry, piece, turns_deg: list[float]) -> Flank
     points = np.asarray(piece.exterior.coords)
     low, high = min(turns_deg), max(turns_deg)
     for turn_deg in sorted(np.linspace(low, high, 9), key=lambda t: abs(t - 0.5 * (low + high))):
-        turned = rotate(points, math.radians(turn_deg))
+        turned = turn_points_by(points, math.radians(turn_deg))
         tip = float(turned[:, 1].min())
         side, far = geo.limits(math.radians(turn_deg), tip)
         radius = float(geo.slices.half_widths_mm.max())

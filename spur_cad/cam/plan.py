@@ -196,6 +196,18 @@ def _required_tool(tool: Tool | None, role: str) -> Tool:
         raise ToolError(f"[tools.{role}] is required for this plan", field="diameter_mm", section=f"tools.{role}")
     return tool
 
+    def __post_init__(self) -> None:
+        """Every section and tool checked once, here, as the job loader checks them (MachineError or ToolError
+        naming the key): the plan's functions and the generators they call trust their inputs."""
+        self.machine.validate()
+        self.roughing.validate()
+        self.finishing.validate()
+        self.three_axis.validate(self.spec.face_width_mm)
+        for role, tool in (("roughing", self.roughing_tool), ("finishing", self.finishing_tool),
+                           ("bottom", self.bottom_tool), ("roughing_top", self.top_tool)):
+            if tool is not None:
+                tool.validate(role)
+
 
 def check_cam_inputs(inputs: CamInputs) -> tuple[ToolRecommendations, RoughingLevels | None]:
     """Every check that needs no toolpath (cheap enough for a GUI to run while the user types): tool
@@ -226,7 +238,6 @@ def check_cam_inputs(inputs: CamInputs) -> tuple[ToolRecommendations, RoughingLe
     if inputs.roughing_tool is None:
         return rec, None
     tool = inputs.roughing_tool
-    inputs.roughing.validate()
     check_helical_roughing_machine(spec, machine)
     moves, driver = estimated_roughing_moves(spec, tool, inputs.roughing, blank)
     check_moves("roughing", moves, "roughing", driver)
@@ -266,7 +277,6 @@ def tool_conflicts(inputs: CamInputs, rec: ToolRecommendations) -> list[ToolErro
         strategy = get_strategy(inputs.finishing.strategy, inputs.strategies)
         collect(lambda: strategy.check_tool(spec, finishing))
     if roughing is not None and collect(lambda: check_tools(spec, rec, roughing, None)) and finishing is not None:
-        inputs.roughing.validate()
         moves, driver = estimated_roughing_moves(spec, roughing, inputs.roughing, blank)
         check_moves("roughing", moves, "roughing", driver)  # the levels' work bounded before they are made
         collect(lambda: check_roughing_reach(roughing, roughing_levels(spec, roughing, inputs.roughing, blank)
@@ -318,7 +328,6 @@ def check_two_stage_tools(spec: GearSpec, rec: ToolRecommendations, roughing_too
         check_tools(spec, rec, bottom, None)
     except ToolError as exc:
         raise ToolError(f"[tools.bottom] {exc}", field=exc.field, section="tools.bottom") from None
-    roughing_tool.validate("roughing")
     if roughing_tool.kind != "flat":
         raise ToolError(f"roughing tool kind '{roughing_tool.kind}': roughing uses a flat end mill", field="kind",
                         section="tools.roughing")
@@ -731,7 +740,6 @@ def check_three_axis_inputs(inputs: CamInputs):
         raise ToolError("[machine] axes = 3 needs [tools.roughing]: finishing cuts only the finish stock around the "
                         "outline", field="diameter_mm", section="tools.roughing")
     root = check_three_axis(spec, inputs.finishing_tool, inputs.roughing_tool)
-    inputs.three_axis.validate(spec.face_width_mm)
     if spec.kind.teeth_inward:  # the rotary-table strategies' recommendations do not apply to a ring
         from spur_cad.cam.three_axis_ring import ring_tool_recommendations
 
@@ -765,7 +773,6 @@ def _plan_three_axis(inputs: CamInputs, tolerance_mm: float) -> CamPlan:
     blank = stock.blank_radius_mm(spec)
     roughing = finishing = None
     if inputs.roughing_tool is not None:
-        inputs.roughing.validate()
         tool = inputs.roughing_tool
         path, levels, offsets = roughing_toolpath(spec, tool, machine, inputs.roughing, blank, inputs.three_axis)
         check_travel(machine, path.x, path.y, path.z, path.a, "roughing")
@@ -814,7 +821,6 @@ def _plan_three_axis_ring(inputs: CamInputs, tolerance_mm: float, root) -> CamPl
     rec = ring_tool_recommendations(spec, machine.clearance_mm)
     roughing = finishing = None
     if inputs.roughing_tool is not None:
-        inputs.roughing.validate()
         tool = inputs.roughing_tool
         path, levels, offsets = ring_roughing_toolpath(spec, tool, machine, inputs.roughing,
                                                        inputs.stock.inner_diameter_mm / 2.0)

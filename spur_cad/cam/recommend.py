@@ -106,10 +106,10 @@ def recommend_tools(spec: GearSpec, blank_radius_mm: float, clearance_mm: float,
 def check_tools(spec: GearSpec, recommendations: ToolRecommendations, roughing: Tool | None,
                 finishing: Tool | None) -> None:
     """Raise ToolError naming the violated limit and its value (the finishing strategy's own tool rule,
-    e.g. the flat width, is its `check_tool`)."""
+    e.g. the flat width, is its `check_tool`), for tools already checked in themselves (Tool.validate, run once
+    when the plan's inputs are made)."""
     rec = recommendations
     if finishing is not None:
-        finishing.validate("finishing")
         if finishing.kind == "flat":
             _check_flat_finishing(spec, finishing, rec)
         if finishing.effective_corner_radius_mm > rec.finishing_max_corner_radius_mm + 1e-9:
@@ -119,7 +119,6 @@ def check_tools(spec: GearSpec, recommendations: ToolRecommendations, roughing: 
                             section="tools.finishing")
         _check_lengths(finishing, "finishing", rec)
     if roughing is not None:
-        roughing.validate("roughing")
         if roughing.kind != "flat":
             raise ToolError(f"roughing tool kind '{roughing.kind}': roughing uses a flat end mill (docs/method.md)",
                             field="kind", section="tools.roughing")

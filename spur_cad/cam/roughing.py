@@ -232,10 +232,8 @@ def roughing_toolpath(spec: GearSpec, tool: Tool, machine: Machine, params: Roug
     """The roughing operation as IR (pure function); `levels` when the caller has computed them already. `tips`:
     after each space, the passes over the tip land beside it (tip_heights_mm; two-stage roughing's bottom tool
     leaves them to the larger tool). `flank_plan`: the flank strategy's plan when the caller has it (flank_plan_for);
-    `stub_length_mm`: the holding stub's (whether the flank strategy's passes may run on over it)."""
-    params.validate()
-    machine.validate()
-    tool.validate("roughing")
+    `stub_length_mm`: the holding stub's (whether the flank strategy's passes may run on over it). The inputs are
+    trusted: checked when the plan's inputs were made (cam.plan.CamInputs)."""
     _check_clamp(spec, machine, params)
     check_helical_roughing_machine(spec, machine)
     if levels is None:

@@ -18,6 +18,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from spur_cad.correct.table import TableError
+from spur_cad.geometry.frames import turn_points_by
 
 ONCE_PER_TURN_MODELS = ("table", "blank")
 """What a once-per-turn error found on a datum-axis scan is taken for: the table's e(A) (corrected in the A words,
@@ -64,9 +65,8 @@ def blank_corrected(path, datum_offset_um: tuple[float, float]):
     """The toolpath with every row's Y and Z moved by the datum axis's offset from the A axis (um, the table's frame
     at A 0) turned to the row's A: a part point p about the datum is at R(A) (p + b) in the machine."""
     by, bz = np.asarray(datum_offset_um, dtype=float) / 1000.0
-    a = np.radians(path.a)
-    c, s = np.cos(a), np.sin(a)
-    return path.replace(y=path.y + c * by - s * bz, z=path.z + s * by + c * bz)
+    moved = turn_points_by(np.array([[by, bz]]), np.radians(path.a))[:, 0]  # R(A) b at each row's A
+    return path.replace(y=path.y + moved[:, 0], z=path.z + moved[:, 1])
 
 
 def linuxcnc_compensation(table: TableError, orders: tuple[int, ...], a_range_deg: tuple[float, float]) -> str:

@@ -187,7 +187,7 @@ def correct_job(job, measured, measured_source: str, datum: str = "best-fit", on
     import json
 
     from spur_cad.correct.identify import identify
-    from spur_cad.correct.summary import correction_summary
+    from spur_cad.correct.summary import correction_facts, correction_summary
     from spur_cad.errors import SpurCadError
     from spur_cad.pipeline import build_programs, plan_cam, run_job
     from spur_cad.sim.contact import contact_angles
@@ -246,7 +246,8 @@ def correct_job(job, measured, measured_source: str, datum: str = "best-fit", on
     # as deviations (a warned "gouge" of the size error): it is left out; the Correction section predicts the gear
     # on the measured machine instead
     unsimulated = dataclasses.replace(fixed, simulation=dataclasses.replace(fixed.simulation, enabled=False))
-    files["report.html"] = run_job(unsimulated, plan=corrected_plan, correction=summary).files["report.html"]
+    files["report.html"] = run_job(unsimulated, plan=corrected_plan,
+                                   correction=correction_facts(summary)).files["report.html"]
     return identified, applied, files
 
 

@@ -28,6 +28,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from spur_cad.correct.table import TableError, blank_offset_mm, fit_flank_model
+from spur_cad.geometry.frames import turn_points
 from spur_cad.grade.iso1328 import evaluate_trace
 from spur_cad.grade.measured import (  # _design: the grader's design points
     MeasuredPoints,
@@ -181,10 +182,7 @@ def identify(spec, measured: MeasuredPoints, contacts: ContactAngles, ideal: Ide
     blank = None
     if any(h.order == 1 for h in model.table.kept):
         turn = -offset * 2.0 * math.pi / spec.teeth  # the design's numbering to the machine's (its part frame at A 0)
-        c, s = math.cos(turn), math.sin(turn)
-        design_normals = normals[nearest[used]]
-        machine_normals = np.column_stack([c * design_normals[:, 0] - s * design_normals[:, 1],
-                                           s * design_normals[:, 0] + c * design_normals[:, 1]])
+        machine_normals = turn_points(normals[nearest[used]], turn)
         cy, cz = blank_offset_mm(model.table, lever[used], a_deg, machine_normals)
         blank = (cy * 1000.0, cz * 1000.0)
     labels = (machine_space[used], point_side[used], point_roll[used])

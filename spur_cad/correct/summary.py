@@ -12,6 +12,7 @@ from spur_cad.correct.apply import AppliedCorrection
 from spur_cad.correct.identify import Identified
 from spur_cad.correct.table import MIN_FLANK_MOTION_UM, SIGNIFICANCE, TableError
 from spur_cad.grade.simulated import helix_range_mm, profile_range_mm
+from spur_cad.result import CorrectionFacts, HarmonicFacts, PitchFacts, SlopeFacts
 
 NOT_CORRECTED = {
     "slopes_off_the_involute": "the fillet, root and land passes keep their place: a slope is measured on the "
@@ -211,3 +212,33 @@ def correction_summary(spec, identified: Identified, applied: AppliedCorrection,
                                    "on the machine that cut the measured gear",
         "not_corrected": not_corrected,
     }
+
+
+def correction_facts(summary: dict) -> CorrectionFacts:
+    """The correction as the corrected set's report shows it, typed, from correction.json's data (`correction_summary`):
+    the same rounded figures the file holds, read here, beside the writer of its keys."""
+    before, after = summary["before"], summary["predicted_after"]
+    size, table, changes = summary["size_error_um"], summary["table_error_arcsec"], summary["corrections"]
+    tool = changes["finishing_tool_diameter_mm"]
+    kept = (tuple(HarmonicFacts(h["order"], h["amplitude"], h["phase_deg"], h["uncertainty"])
+                  for h in table["harmonics"] if h["kept"]) if "harmonics" in table else None)
+    tested = table.get("orders_tested") or None
+
+    def slopes(name: str) -> tuple[SlopeFacts, ...]:
+        return tuple(SlopeFacts(side, found["value"], found["uncertainty"], before[name][side], after[name][side],
+                                found.get("pressure_angle_change_deg"))
+                     for side, found in summary[name]["by_side"].items())
+
+    once = summary.get("once_per_turn", {})
+    told = (once["why"], once["check"]) if once.get("found") else ()
+    return CorrectionFacts(
+        measured=summary["measured"], points_used=summary["points_used"], size_um=size["value"],
+        size_uncertainty_um=size["uncertainty"], tool_before_mm=tool["before"], tool_programmed_mm=tool["programmed"],
+        flank_position_before_um=before["flank_position_um"], flank_position_after_um=after["flank_position_um"],
+        table_kept=kept, table_orders_tested=(tested[0], tested[-1]) if tested else None,
+        a_words_moved="a_words" in changes, y_z_words_moved="y_z_words" in changes, unfolded="unfolded" in changes,
+        pitch=tuple(PitchFacts(side, value, after["F_p_um"][side]) for side, value in before["F_p_um"].items()
+                    if value is not None),
+        profile_slopes=slopes("profile_slope_um"), helix_slopes=slopes("helix_slope_um"),
+        slopes_corrected=summary["profile_slope_um"]["corrected"],
+        notes=told + tuple(summary["not_corrected"].values()))

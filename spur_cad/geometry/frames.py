@@ -27,6 +27,24 @@ def turn_points(points: np.ndarray, angle_rad: float) -> np.ndarray:
     return np.stack([points[:, 0] * c - points[:, 1] * s, points[:, 0] * s + points[:, 1] * c], axis=-1)
 
 
+def turn_points_by(points: np.ndarray, angle_rad: float | np.ndarray) -> np.ndarray:
+    """Points (..., 2) (y, z) turned counter-clockwise by `angle_rad`; an array of angles (m,) turns (n, 2) points
+    by each, giving (m, n, 2) (numpy's cos and sin, for arrays of angles)."""
+    c, s = np.cos(angle_rad), np.sin(angle_rad)
+    y, z = points[..., 0], points[..., 1]
+    if np.ndim(angle_rad) == 0:
+        return np.stack([c * y - s * z, s * y + c * z], axis=-1)
+    c, s = c[:, None], s[:, None]
+    return np.stack([c * y - s * z, s * y + c * z], axis=-1)
+
+
+def turned_clockwise(angle_rad: np.ndarray | float, x: np.ndarray, y: np.ndarray) -> np.ndarray:
+    """Vectors (x, y) turned clockwise by `angle_rad` (R(-angle)), as an (N, 2) array (the profile's curves are
+    built in their own frame and turned into the gap frame with it)."""
+    c, s = np.cos(angle_rad), np.sin(angle_rad)
+    return np.stack([x * c + y * s, -x * s + y * c], axis=-1)
+
+
 def turn_point(y: float, z: float, angle_rad: float) -> tuple[float, float]:
     """One point (y, z) turned counter-clockwise by `angle_rad`."""
     c, s = math.cos(angle_rad), math.sin(angle_rad)

@@ -7,7 +7,6 @@ inspector should measure on the finished part.
 
 from __future__ import annotations
 
-import dataclasses
 import math
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
@@ -178,7 +177,7 @@ def minimum_teeth_without_undercut(spec: GearSpec) -> float:
 
 @dataclass(frozen=True)
 class InspectionSheet:
-    """The inspection values a report or summary shows (mm; see `inspection_facts`)."""
+    """The inspection values a report or summary shows (mm; see `inspection_sheet`)."""
 
     span_teeth_k: int
     span_measurement_mm: float | None  # None: the face is too narrow for a span over k teeth (helical)
@@ -245,10 +244,11 @@ def internal_inspection_facts(spec: InternalGearSpec) -> InspectionSheet:
         min_teeth_without_undercut=0, min_teeth_without_undercut_exact=0.0, pins_between=True)
 
 
-def inspection_facts(spec: GearSpec) -> InspectionSheet:
-    """The inspection values a report or summary shows. Helical gears: span and chordal thickness in the
-    normal section, over balls; the span's k is lowered until the anvils fit the face width (b > W sin(beta_b)),
-    and the span is None when not even k = 1 fits (measure over balls)."""
+def inspection_sheet(spec: GearSpec) -> InspectionSheet:
+    """The inspection values the report, summary.json's `inspection` and scripts read (one typed result).
+    Helical gears: span and chordal thickness in the normal section, over balls; the span's k is lowered until
+    the anvils fit the face width (b > W sin(beta_b)), and the span is None when not even k = 1 fits (measure
+    over balls)."""
     require_instance(spec, GearSpec, "spec")
     if isinstance(spec, InternalGearSpec):
         return internal_inspection_facts(spec)
@@ -270,11 +270,6 @@ def inspection_facts(spec: GearSpec) -> InspectionSheet:
         chordal_height_mm=chord.chordal_height_mm, chordal_measuring_radius_mm=chord.measuring_radius_mm,
         tooth_thickness_mm=spec.tooth_thickness_mm, thickness_reduction_mm=spec.thickness_reduction_mm,
         min_teeth_without_undercut=math.ceil(z_min - 1e-9), min_teeth_without_undercut_exact=z_min)
-
-
-def inspection_sheet(spec: GearSpec) -> dict[str, float | int | None]:
-    """`inspection_facts` as a dict (for scripts: summary.json's `inspection`)."""
-    return dataclasses.asdict(inspection_facts(spec))
 
 
 MODIFICATION_NAMES = (  # (FlankModification field, ISO 21771 name as the sheet shows it)

@@ -28,6 +28,7 @@ from typing import Protocol, TypeVar
 import numpy as np
 
 from spur_cad.errors import GearSpecError
+from spur_cad.geometry.frames import turned_clockwise
 from spur_cad.geometry.involute import involute_function
 from spur_cad.geometry.kinds import GearKind
 from spur_cad.geometry.roots import brentq, minimize_bounded
@@ -67,12 +68,6 @@ class GeneratedGear(Protocol):
     def base_half_space_angle_rad(self) -> float: ...
     @property
     def tip_thickness_mm(self) -> float: ...
-
-
-def _rotate_clockwise(angle: np.ndarray | float, x: np.ndarray, y: np.ndarray) -> np.ndarray:
-    """Turn vectors (x, y) clockwise by `angle` (R(-angle)); returns an (N, 2) array."""
-    c, s = np.cos(angle), np.sin(angle)
-    return np.stack([x * c + y * s, -x * s + y * c], axis=-1)
 
 
 @dataclass(frozen=True)
@@ -122,12 +117,12 @@ class Involute:
     def points(self, t: np.ndarray) -> np.ndarray:
         t = np.asarray(t, dtype=float)
         rb = self.base_radius_mm
-        return _rotate_clockwise(self.base_angle_rad, rb * (np.sin(t) - t * np.cos(t)),
+        return turned_clockwise(self.base_angle_rad, rb * (np.sin(t) - t * np.cos(t)),
                                  rb * (np.cos(t) + t * np.sin(t)))
 
     def normals(self, t: np.ndarray) -> np.ndarray:
         t = np.asarray(t, dtype=float)
-        return _rotate_clockwise(self.base_angle_rad, -np.cos(t), np.sin(t))
+        return turned_clockwise(self.base_angle_rad, -np.cos(t), np.sin(t))
 
     def curvature_radii(self, t: np.ndarray) -> np.ndarray:
         return -self.base_radius_mm * np.asarray(t, dtype=float)
@@ -174,13 +169,13 @@ class TrochoidalFillet:
     def points(self, beta: np.ndarray) -> np.ndarray:
         beta = np.asarray(beta, dtype=float)
         B, rho, r = self.corner_depth_mm, self.corner_radius_mm, self.reference_radius_mm
-        return _rotate_clockwise(self.roll_angle(beta), B * np.tan(beta) + rho * np.sin(beta),
+        return turned_clockwise(self.roll_angle(beta), B * np.tan(beta) + rho * np.sin(beta),
                                  r - B - rho * np.cos(beta))
 
     def normals(self, beta: np.ndarray) -> np.ndarray:
         """Into the space, i.e. into the rack tooth: from the contact point toward the corner centre."""
         beta = np.asarray(beta, dtype=float)
-        return _rotate_clockwise(self.roll_angle(beta), -np.sin(beta), np.cos(beta))
+        return turned_clockwise(self.roll_angle(beta), -np.sin(beta), np.cos(beta))
 
     def _speed_terms(self, beta: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """The two beta-dependent terms of |dP/dbeta| = rho + (B^2 sec^3 + B rho sec^2) / r."""
@@ -271,14 +266,14 @@ class EllipticFillet:
 
     def points(self, beta: np.ndarray) -> np.ndarray:
         u, _, _, y, _, _, phi, _, _ = self._terms(beta)
-        return _rotate_clockwise(phi, u, y)
+        return turned_clockwise(phi, u, y)
 
     def normals(self, beta: np.ndarray) -> np.ndarray:
         """Into the space: the ellipse's inward normal (-sin b, s cos b), normalised, turned with the gear."""
         beta = np.asarray(beta, dtype=float)
         nx, ny = -np.sin(beta), self.stretch * np.cos(beta)
         length = np.hypot(nx, ny)
-        return _rotate_clockwise(self.roll_angle(beta), nx / length, ny / length)
+        return turned_clockwise(self.roll_angle(beta), nx / length, ny / length)
 
     def _velocity(self, beta: np.ndarray):
         """dP/dbeta in the turned frame, w = (u' + phi' y, y' - phi' u), and its derivative."""

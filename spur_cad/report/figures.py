@@ -9,6 +9,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from spur_cad.geometry.frames import turn_points
 from spur_cad.geometry.sampling import full_space_points, sample_profile
 from spur_cad.geometry.spec import GearSpec
 from spur_cad.report.plots import _png, figure, figure_for_extent, set_title
@@ -82,10 +83,8 @@ def roughing_flank_png(spec: GearSpec, plan: FlankPlan, tool: Tool, blank_radius
             corners = np.array([[p.y_mm - radius, p.z_mm], [p.y_mm + radius, p.z_mm],
                                 [p.y_mm + radius, p.z_mm + p.axial_depth_mm],
                                 [p.y_mm - radius, p.z_mm + p.axial_depth_mm], [p.y_mm - radius, p.z_mm]])
-            turn = math.radians(p.turn_deg)  # the machine frame turned back into the space's: R(-turn)
-            c, s = math.cos(turn), math.sin(turn)
-            drawn += [np.column_stack([c * corners[:, 0] + s * corners[:, 1], -s * corners[:, 0] + c * corners[:, 1]]),
-                      gap]
+            # the machine frame turned back into the space's: R(-turn)
+            drawn += [turn_points(corners, -math.radians(p.turn_deg)), gap]
         joined = np.concatenate(drawn)
         ax.plot(joined[:, 0], joined[:, 1], "-", lw=0.7, color=colours[run % len(colours)])
     turns = ", ".join(f"{abs(s.turn_deg):.1f}" for s in plan.segments)

@@ -15,7 +15,7 @@ from typing import TYPE_CHECKING
 from spur_cad.result import FinishingFacts, RoughingFacts
 
 if TYPE_CHECKING:
-    from spur_cad.result import JobResult, ToolFacts
+    from spur_cad.result import CorrectionFacts, JobResult, ToolFacts
 
 MICRO = "\u00b5m"
 
@@ -519,58 +519,49 @@ def warning_lines(result: JobResult) -> tuple[str, ...]:
     return tuple(items)
 
 
-def correction_table(correction: dict | None) -> Table | None:
-    """The corrected set's errors (spur-cad correct's correction.json): each one identified with its uncertainty,
-    what the programs change for it, and the deviation before and as predicted after on the machine that cut the
-    measured gear. None for a run that is not a correction."""
+def correction_table(correction: CorrectionFacts | None) -> Table | None:
+    """The corrected set's errors (spur-cad correct's correction): each one identified with its uncertainty, what the
+    programs change for it, and the deviation before and as predicted after on the machine that cut the measured
+    gear. None for a run that is not a correction."""
     if correction is None:
         return None
-    before, after = correction["before"], correction["predicted_after"]
-    size, table = correction["size_error_um"], correction["table_error_arcsec"]
-    changes = correction["corrections"]
-    tool = changes["finishing_tool_diameter_mm"]
-    rows = [(f"flank position (tool size) [{MICRO}]", signed(size["value"], 1), number(size["uncertainty"], 1),
-             f"finishing tool programmed as D {number(tool['programmed'], 4)} mm (D {number(tool['before'], 4)} mm "
-             "in the tool table)", signed(before["flank_position_um"], 1), signed(after["flank_position_um"], 1))]
-    if "harmonics" not in table:
+    c = correction
+    rows = [(f"flank position (tool size) [{MICRO}]", signed(c.size_um, 1), number(c.size_uncertainty_um, 1),
+             f"finishing tool programmed as D {number(c.tool_programmed_mm, 4)} mm (D {number(c.tool_before_mm, 4)} "
+             "mm in the tool table)", signed(c.flank_position_before_um, 1), signed(c.flank_position_after_um, 1))]
+    if c.table_kept is None:
         rows.append(("table error e(A) [arcsec]", "not seen", "", "not corrected (below): a probe log turns on the "
                      "table that cut the gear", "", ""))
     else:
-        kept = [h for h in table["harmonics"] if h["kept"]]
-        how = ("every block's A moved by -e(A)" if "a_words" in changes else "not corrected")
-        if "y_z_words" in changes:
+        how = "every block's A moved by -e(A)" if c.a_words_moved else "not corrected"
+        if c.y_z_words_moved:
             how += "; order 1 as the blank's offset: every block's Y, Z moved"
-        if "unfolded" in changes:
+        if c.unfolded:
             how += " (programs unfolded)"
-        rows += [(f"table error e(A), order {h['order']} [arcsec]",
-                  f"{number(h['amplitude'], 1)} \u00d7 sin({h['order']}A {signed(h['phase_deg'], 1)}\u00b0)",
-                  number(h["uncertainty"], 1), how, "", "") for h in kept]
-        if not kept:
-            rows.append(("table error e(A) [arcsec]", "none found", "", f"orders {table['orders_tested'][0]} to "
-                         f"{table['orders_tested'][-1]} tested", "", ""))
-    rows += [(f"F_p, {side} flanks [{MICRO}]", "", "", "by the table's correction", number(value, 1),
-              number(after["F_p_um"][side], 1)) for side, value in before["F_p_um"].items() if value is not None]
-    for name, label, symbol in (("profile_slope_um", "profile slope", "f_H\u03b1"),
-                                ("helix_slope_um", "helix slope", "f_H\u03b2")):
-        slope = correction[name]
-        for side, found in slope["by_side"].items():
+        rows += [(f"table error e(A), order {h.order} [arcsec]",
+                  f"{number(h.amplitude_arcsec, 1)} \u00d7 sin({h.order}A {signed(h.phase_deg, 1)}\u00b0)",
+                  number(h.uncertainty_arcsec, 1), how, "", "") for h in c.table_kept]
+        if not c.table_kept:
+            lowest, highest = c.table_orders_tested if c.table_orders_tested is not None else ("", "")
+            rows.append(("table error e(A) [arcsec]", "none found", "", f"orders {lowest} to {highest} tested", "",
+                         ""))
+    rows += [(f"F_p, {p.side} flanks [{MICRO}]", "", "", "by the table's correction", number(p.before_um, 1),
+              number(p.after_um, 1)) for p in c.pitch]
+    for slopes, label, symbol in ((c.profile_slopes, "profile slope", "f_H\u03b1"),
+                                  (c.helix_slopes, "helix slope", "f_H\u03b2")):
+        for found in slopes:
             how = "not corrected (below)"
-            if slope["corrected"]:
+            if c.slopes_corrected:
                 how = "flank passes moved along their normal"
-                if "pressure_angle_change_deg" in found:
-                    how += f" (pressure angle as cut {signed(found['pressure_angle_change_deg'], 4)} deg)"
-            rows.append((f"{label} {symbol}, {side} flanks [{MICRO}]", signed(found["value"], 1),
-                         number(found["uncertainty"], 1), how, signed(before[name][side], 1),
-                         signed(after[name][side], 1)))
+                if found.pressure_angle_change_deg is not None:
+                    how += f" (pressure angle as cut {signed(found.pressure_angle_change_deg, 4)} deg)"
+            rows.append((f"{label} {symbol}, {found.side} flanks [{MICRO}]", signed(found.value_um, 1),
+                         number(found.uncertainty_um, 1), how, signed(found.before_um, 1), signed(found.after_um, 1)))
     return Table(("error", "identified", "uncertainty (1 s.d.)", "corrected by", "before", "predicted after"),
                  tuple(rows))
 
 
-def correction_notes(correction: dict | None) -> tuple[str, ...]:
-    """What the corrected programs do not correct, and why (correction.json's not_corrected), one line each; first, for
-    a once-per-turn error, which model was assumed and what the user checks (once_per_turn)."""
-    if correction is None:
-        return ()
-    once = correction.get("once_per_turn", {})
-    told = (once["why"], once["check"]) if once.get("found") else ()
-    return told + tuple(correction["not_corrected"].values())
+def correction_notes(correction: CorrectionFacts | None) -> tuple[str, ...]:
+    """What the corrected programs do not correct, and why, one line each; first, for a once-per-turn error, which
+    model was assumed and what the user checks."""
+    return () if correction is None else correction.notes

@@ -17,6 +17,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from spur_cad.cam.ir import MoveKind
+from spur_cad.geometry.frames import turn_points
 
 CONTACT_SPACING_MM = 0.02
 """Involute points are taken this far apart along the flank when finding each pose's contact: a pose's roll length is
@@ -96,10 +97,8 @@ def contact_angles(spec, toolpath, tool) -> ContactAngles:
         flank_points, flank_roll = points[on], roll[on]
         ends = (float(flank_roll.min()), float(flank_roll.max()))
         for y, z, a in poses:
-            angle = math.radians(a)  # the points at R(A) p in the machine, taken about the tool's tip centre
-            c, s = math.cos(angle), math.sin(angle)
-            my = c * flank_points[:, 0] - s * flank_points[:, 1] - y
-            mz = s * flank_points[:, 0] + c * flank_points[:, 1] - z
+            turned = turn_points(flank_points, math.radians(a))  # the points at R(A) p in the machine, taken
+            my, mz = turned[:, 0] - y, turned[:, 1] - z  # about the tool's tip centre
             distance = _tool_distance_mm(my, mz, tool.diameter_mm, tool.corner_radius_mm, length)
             nearest = int(np.argmin(distance))
             touched = float(flank_roll[nearest])

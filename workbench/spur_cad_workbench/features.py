@@ -250,7 +250,7 @@ class GearFeature(_Proxy):
     def execute(self, obj):
         from spur_cad.cad.solid import build_gear_shape
         from spur_cad.errors import SpurCadError
-        from spur_cad.geometry.inspection import inspection_facts
+        from spur_cad.geometry.inspection import inspection_sheet
 
         try:
             job = job_of(obj)
@@ -258,7 +258,7 @@ class GearFeature(_Proxy):
         except SpurCadError as exc:
             fail(obj, exc)
             return
-        spec, sheet = job.gear, inspection_facts(job.gear)
+        spec, sheet = job.gear, inspection_sheet(job.gear)
         outputs = {
             "ReferenceRadius": spec.reference_radius_mm, "BaseRadius": spec.base_radius_mm,
             "TipRadius": spec.tip_radius_mm, "RootRadius": spec.root_radius_mm, "FormRadius": spec.form_radius_mm,

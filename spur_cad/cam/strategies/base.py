@@ -273,8 +273,9 @@ def finishing_builder(tool: Tool, machine: Machine) -> ToolpathBuilder:
     return ToolpathBuilder(Operation.FINISHING, tool.tool_number, tool.spindle_rpm(machine))
 
 
-def params_from_section(strategy: FinishingStrategy, section: object, **overrides: Any) -> Any:
-    """The strategy's parameters taken by name from the [finishing] section (fields it lacks keep defaults)."""
+def params_from_section(strategy: FinishingStrategy, section: object, **overrides: Any) -> TargetScallopParams:
+    """The strategy's parameters taken by name from the [finishing] section (fields it lacks keep defaults),
+    checked as they are made (MachineError naming the key)."""
     values = {f.name: getattr(section, f.name) for f in dataclasses.fields(strategy.params_type)
               if hasattr(section, f.name)}
     return strategy.params_type(**{**values, **overrides})

@@ -55,6 +55,7 @@ import numpy as np
 from spur_cad.cam.ir import Feature
 from spur_cad.cam.tools import Tool, ToolError
 from spur_cad.errors import WorkLimitError
+from spur_cad.geometry.frames import turn_points
 from spur_cad.geometry.profile import rack_corner
 from spur_cad.geometry.spec import GearSpec
 
@@ -123,8 +124,7 @@ def rack_clearance_mm(spec: GearSpec, points: np.ndarray, a_rad: float, phi: flo
 def rack_distances_mm(spec: GearSpec, points: np.ndarray, a_rad: float, phi: float) -> np.ndarray:
     """Signed distance of each machine point (N, 3: X, Y, Z at A = a_rad) from the rack tooth at roll phi."""
     turn = phi - a_rad  # the same part point with A = phi
-    c, s = math.cos(turn), math.sin(turn)
-    x, y, z = points[:, 0], points[:, 1] * c - points[:, 2] * s, points[:, 1] * s + points[:, 2] * c
+    x, (y, z) = points[:, 0], turn_points(points[:, 1:], turn).T
     tan_h = spec.hand_sign * math.tan(spec.helix_angle_rad)
     axis_y = -spec.reference_radius_mm * phi - tan_h * x
     n = (y - axis_y) * math.cos(spec.helix_angle_rad)
@@ -191,9 +191,8 @@ def _tip_rolls_within(spec: GearSpec, rolls: np.ndarray, points: np.ndarray, out
     open_ = points
     r = spec.reference_radius_mm
     for phi in rolls:
-        c, s = math.cos(-phi), math.sin(-phi)
         moved = outline - np.array([r * phi, 0.0])
-        part = np.stack([moved[:, 0] * c - moved[:, 1] * s, moved[:, 0] * s + moved[:, 1] * c], axis=-1)
+        part = turn_points(moved, -phi)
         a, edge = part[:-1], np.diff(part, axis=0)  # distance to the outline's segments, not its vertices
         rel = open_[:, None, :] - a[None, :, :]
         u = np.clip((rel * edge[None]).sum(axis=-1) / np.maximum((edge * edge).sum(axis=-1), 1e-300), 0.0, 1.0)
