@@ -15,6 +15,7 @@ import math
 import numpy as np
 from shapely import Polygon, contains_xy, distance, points
 
+from spur_cad.geometry.frames import turn_points, turn_points_by
 from spur_cad.geometry.mate import GearPair, PairFacts
 from spur_cad.geometry.mate_gear import mate_spec
 from spur_cad.geometry.sampling import gear_outline
@@ -34,17 +35,7 @@ def _tip_corners(spec: GearSpec) -> np.ndarray:
     corner = tip.points(np.array([tip.start]))[0]
     pair = np.array([corner, corner * np.array([-1.0, 1.0])])
     pitch = 2.0 * math.pi / spec.teeth
-    turned = []
-    for k in range(-NEAR_TEETH, NEAR_TEETH + 1):
-        c, s = math.cos(k * pitch), math.sin(k * pitch)
-        turned.append(pair @ np.array([[c, s], [-s, c]]))
-    return np.concatenate(turned)
-
-
-def _rotate(xy: np.ndarray, angle: np.ndarray) -> np.ndarray:
-    """Points `xy` (n, 2) turned counter-clockwise by each `angle` (m,): (m, n, 2)."""
-    c, s = np.cos(angle)[:, None], np.sin(angle)[:, None]
-    return np.stack([c * xy[:, 0] - s * xy[:, 1], s * xy[:, 0] + c * xy[:, 1]], axis=-1)
+    return np.concatenate([turn_points(pair, k * pitch) for k in range(-NEAR_TEETH, NEAR_TEETH + 1)])
 
 
 def corner_intrusion_mm(body: GearSpec, other: GearSpec, centre_distance_mm: float) -> float:
@@ -54,9 +45,9 @@ def corner_intrusion_mm(body: GearSpec, other: GearSpec, centre_distance_mm: flo
     z1, z2 = body.teeth, other.teeth
     phi = np.linspace(-3.0, 3.0, STEPS) * 2.0 * math.pi / z1  # body's turn
     corners = _tip_corners(other)
-    own = _rotate(corners, math.pi - math.pi / z2 - phi * z1 / z2)  # other's turn, opposite and in ratio
+    own = turn_points_by(corners, math.pi - math.pi / z2 - phi * z1 / z2)  # other's turn, opposite and in ratio
     world = own + np.array([0.0, centre_distance_mm])
-    relative = np.concatenate([_rotate(world[i], np.array([-phi[i]]))[0] for i in range(len(phi))])
+    relative = np.concatenate([turn_points_by(world[i], np.array([-phi[i]]))[0] for i in range(len(phi))])
     material = Polygon(gear_outline(body, OUTLINE_TOLERANCE_MM))
     inside = contains_xy(material, relative[:, 0], relative[:, 1])
     if not inside.any():

@@ -175,6 +175,18 @@ class CamInputs:
     # nothing is milled, and the end mills' sizes are not warned about
     outline_export: bool = False
 
+    def __post_init__(self) -> None:
+        """Every section and tool checked once, here, as the job loader checks them (MachineError or ToolError
+        naming the key): the plan's functions and the generators they call trust their inputs."""
+        self.machine.validate()
+        self.roughing.validate()
+        self.finishing.validate()
+        self.three_axis.validate(self.spec.face_width_mm)
+        for role, tool in (("roughing", self.roughing_tool), ("finishing", self.finishing_tool),
+                           ("bottom", self.bottom_tool), ("roughing_top", self.top_tool)):
+            if tool is not None:
+                tool.validate(role)
+
     @property
     def roughing_tool_set(self) -> Tool:
         """The roughing tool, which planning needs (check_cam_inputs refuses a job without one first)."""
@@ -195,18 +207,6 @@ def _required_tool(tool: Tool | None, role: str) -> Tool:
     if tool is None:
         raise ToolError(f"[tools.{role}] is required for this plan", field="diameter_mm", section=f"tools.{role}")
     return tool
-
-    def __post_init__(self) -> None:
-        """Every section and tool checked once, here, as the job loader checks them (MachineError or ToolError
-        naming the key): the plan's functions and the generators they call trust their inputs."""
-        self.machine.validate()
-        self.roughing.validate()
-        self.finishing.validate()
-        self.three_axis.validate(self.spec.face_width_mm)
-        for role, tool in (("roughing", self.roughing_tool), ("finishing", self.finishing_tool),
-                           ("bottom", self.bottom_tool), ("roughing_top", self.top_tool)):
-            if tool is not None:
-                tool.validate(role)
 
 
 def check_cam_inputs(inputs: CamInputs) -> tuple[ToolRecommendations, RoughingLevels | None]:
