@@ -21,14 +21,38 @@ collapsible sections, checked as you type.
 
 from __future__ import annotations
 
-from collections.abc import Mapping
-
 import FreeCAD
 import FreeCADGui
 from PySide import QtCore, QtGui
 
 from spur_cad.cam.setups import SETUP_SECTIONS
 from spur_cad_workbench import compat, schema, units
+from spur_cad_workbench.panel_widgets import (
+    ADVICE_STYLE,
+    BIG,
+    CHART_DPI,
+    CHART_MIN_WIDTH_IN,
+    ERROR_STYLE,
+    FIELD_MIN_WIDTH_PX,
+    HIGHLIGHT_STYLE,
+    MODIFICATIONS_TITLE,
+    NOTE_STYLE,
+    PANEL_MIN_WIDTH_PX,
+    QUANTITY_UNITS,
+    REVALIDATE_DELAY_MS,
+    THREE_AXIS_LIMITS,
+    TITLE_WIDTH_PX,
+    FieldWidgets,
+    NumberBox,
+    Section,
+    group_names,
+    png_bytes,
+    quantity_unit,
+    scroll_area_of,
+    show_start,
+    size_policy,
+    wrapped_label,
+)
 from spur_cad_workbench.properties import document_values, write_values
 from spur_cad_workbench.summary import (
     figures_text,
@@ -41,155 +65,6 @@ from spur_cad_workbench.summary import (
     values_signature,
 )
 from spur_cad_workbench.validation import recommendation_notes, sentence, unusual_value_notes, validate
-
-ERROR_COLOUR = "#b00020"
-ERROR_STYLE = f"color: {ERROR_COLOUR};"
-HIGHLIGHT_STYLE = f"border: 2px solid {ERROR_COLOUR};"
-NOTE_STYLE = "color: #555555;"
-ADVICE_STYLE = "color: #8a5a00;"
-BIG = 1e9
-TITLE_WIDTH_PX = 120
-"""The task box's title (the job's label) is elided to this width: FreeCAD's task box never wraps its title,
-so a long job name would widen the panel beyond the dock."""
-FIELD_MIN_WIDTH_PX = 112
-PANEL_MIN_WIDTH_PX = 170  # fits a 240 px task dock: its scroll area's 220 px less the task box's margins
-QUANTITY_UNITS = {"length": "mm", "distance": "mm", "angle": "deg", "speed": "mm/min"}
-NUMBER_DECIMALS = 6
-THREE_AXIS_LIMITS = ("3 axes, the gear lying flat: flat end mills; the finishing tool's radius is the root fillet's "
-                     "at least, and its side must reach the active profile (docs/cam.md).")
-MODIFICATIONS_TITLE = "Flank modifications"  # the gear's: a longer title is elided in a narrow dock
-CHART_DPI = 96
-CHART_MIN_WIDTH_IN = 2.5
-"""The modification chart is drawn this wide at least (its tick labels need it) and scaled down to the section's
-width in a narrower dock."""
-REVALIDATE_DELAY_MS = 250  # typing: check once the keys pause (a check plans roughing levels: up to 0.5 s)
-
-
-def quantity_unit(field) -> str:
-    """The unit a quantity field is set and read in: the key's own for micrometres (machine accuracy), else its
-    kind's (mm, deg, mm/min)."""
-    return field.unit if field.unit in schema.SET_IN_KEY_UNIT else QUANTITY_UNITS[field.kind]
-
-
-def _policy(name: str):
-    """A QSizePolicy.Policy member (scoped name on PySide6, see compat.qt_enum)."""
-    return compat.qt_enum(QtGui.QSizePolicy, "Policy", name)
-
-
-def _group_names() -> list[str]:
-    names: list[str] = []
-    for field in schema.JOB_FIELDS:
-        if field.group not in names:
-            names.append(field.group)
-    return names
-
-
-class NumberBox(QtGui.QDoubleSpinBox):
-    """A spin box for numbers with a unit suffix: six decimals can be typed, the text shows only the digits the
-    value has (87.5 m/min, 0.0005 s), not a fixed count."""
-
-    def __init__(self):
-        super().__init__()
-        self.setDecimals(NUMBER_DECIMALS)
-        self.setRange(-BIG, BIG)
-
-    def textFromValue(self, value: float) -> str:  # noqa: N802 (Qt's name)
-        return format(round(value, NUMBER_DECIMALS), f".{NUMBER_DECIMALS + 6}g")
-
-
-class Section:
-    """A titled, collapsible part of the panel: a header button and a body with a form layout."""
-
-    def __init__(self, title: str, collapsed: bool, on_open=None):
-        self.widget = QtGui.QWidget()
-        layout = QtGui.QVBoxLayout(self.widget)
-        layout.setContentsMargins(0, 0, 0, 0)
-        layout.setSpacing(2)
-        self.header = QtGui.QToolButton()
-        self.header.setObjectName(f"section:{title}")
-        self.header.setText(title)
-        self.header.setCheckable(True)
-        self.header.setToolButtonStyle(compat.qt_enum(QtCore.Qt, "ToolButtonStyle", "ToolButtonTextBesideIcon"))
-        self.header.setSizePolicy(_policy("Ignored"), _policy("Fixed"))  # a long summary never widens the panel
-        self.header.setStyleSheet("QToolButton { border: none; font-weight: bold; text-align: left; }")
-        self.body = QtGui.QWidget()
-        self.form = QtGui.QFormLayout(self.body)
-        self.form.setRowWrapPolicy(compat.qt_enum(QtGui.QFormLayout, "RowWrapPolicy", "WrapLongRows"))
-        self.form.setFieldGrowthPolicy(compat.qt_enum(QtGui.QFormLayout, "FieldGrowthPolicy", "AllNonFixedFieldsGrow"))
-        self.form.setContentsMargins(8, 0, 0, 4)
-        self.summary = _wrapped_label(NOTE_STYLE, f"section-summary:{title}")
-        self.summary.setContentsMargins(22, 0, 0, 0)
-        self.summary.setVisible(False)
-        layout.addWidget(self.header)
-        layout.addWidget(self.summary)
-        layout.addWidget(self.body)
-        self.on_open = on_open  # called after the body is shown (the panel scrolls its fields to their start)
-        self.header.toggled.connect(self.set_open)
-        self.header.setChecked(not collapsed)
-        self.set_open(not collapsed)
-
-    def set_summary(self, summary: str) -> None:
-        """Show what the group holds under its title while it is folded ('T1 flat D 4 mm')."""
-        self.summary.setText(summary)
-        self.summary.setVisible(bool(summary) and not self.is_open)
-
-    def set_open(self, is_open: bool) -> None:
-        self.header.setChecked(is_open)
-        arrow = "DownArrow" if is_open else "RightArrow"
-        self.header.setArrowType(compat.qt_enum(QtCore.Qt, "ArrowType", arrow))
-        self.body.setVisible(is_open)
-        self.summary.setVisible(bool(self.summary.text()) and not is_open)
-        if is_open and self.on_open is not None:
-            self.on_open()
-
-    @property
-    def is_open(self) -> bool:
-        return self.header.isChecked()
-
-
-def show_start(widget: QtGui.QWidget) -> None:
-    """Scroll a field's text to its start unless the user is typing in it: a narrow field shows "-1000.00 mm"
-    cut as "-1000.0" rather than "000.00 mm" (a lost minus sign), and "generic 4-axis VM" not "eneric 4-axis VMC"."""
-    edit = widget if isinstance(widget, QtGui.QLineEdit) else getattr(widget, "lineEdit", lambda: None)()
-    if edit is not None and not edit.hasFocus():
-        edit.setCursorPosition(0)
-
-
-def _wrapped_label(style: str = "", name: str = "") -> QtGui.QLabel:
-    label = QtGui.QLabel()
-    label.setWordWrap(True)
-    label.setObjectName(name)
-    if style:
-        label.setStyleSheet(style)
-    label.setSizePolicy(_policy("Ignored"), _policy("Preferred"))
-    return label
-
-
-class FieldWidgets(Mapping):
-    """The panel's fields by property name, looked up by object name on every access.
-
-    Python wrappers of FreeCAD's Gui::QuantitySpinBox (made by FreeCADGui.UiLoader) are invalidated
-    ("Internal C++ object already deleted") after some Qt calls that take them, although the widget
-    lives on (FreeCAD 0.20, PySide2 5.15); a wrapper looked up afresh is always valid."""
-
-    def __init__(self, form: QtGui.QWidget):
-        self._form = form
-        self._props: list[str] = []
-
-    def add(self, prop: str) -> None:
-        self._props.append(prop)
-
-    def __getitem__(self, prop: str) -> QtGui.QWidget:
-        widget = self._form.findChild(QtGui.QWidget, prop) if prop in self._props else None
-        if widget is None:
-            raise KeyError(prop)
-        return widget
-
-    def __iter__(self):
-        return iter(self._props)
-
-    def __len__(self) -> int:
-        return len(self._props)
 
 
 class JobTaskPanel:
@@ -226,7 +101,7 @@ class JobTaskPanel:
         self._timer = QtCore.QTimer(self.form)
         self._timer.setSingleShot(True)
         self._timer.timeout.connect(self.revalidate)
-        for group in _group_names():
+        for group in group_names():
             section = Section(group, collapsed=True,  # the summary on top and each header say what they hold
                               on_open=lambda group=group: self._show_starts(group))
             self.sections[group] = section
@@ -246,10 +121,10 @@ class JobTaskPanel:
         box.setObjectName("summary")
         box.setFrameShape(compat.qt_enum(QtGui.QFrame, "Shape", "StyledPanel"))
         layout = QtGui.QVBoxLayout(box)
-        self.summary = _wrapped_label(name="summary:status")
-        self.summary_figures = _wrapped_label(name="summary:figures")
-        self.summary_advice = _wrapped_label(ADVICE_STYLE, "summary:advice")
-        self.summary_limits = _wrapped_label(NOTE_STYLE, "summary:limits")
+        self.summary = wrapped_label(name="summary:status")
+        self.summary_figures = wrapped_label(name="summary:figures")
+        self.summary_advice = wrapped_label(ADVICE_STYLE, "summary:advice")
+        self.summary_limits = wrapped_label(NOTE_STYLE, "summary:limits")
         self.plan_button = QtGui.QPushButton("Plan (update the figures)")
         self.plan_button.setObjectName("summary:plan")
         self.plan_button.setToolTip("Plan the toolpaths for the values in this panel and show the cycle time, moves "
@@ -263,10 +138,10 @@ class JobTaskPanel:
     def _modifications_section(self) -> Section:
         """The gear's flank modifications: a note (what they are, where to edit them) and their chart."""
         self._chart_key: str | None = None  # the gear values the chart was drawn for
-        self.modifications_note = _wrapped_label(NOTE_STYLE, "modifications:note")
+        self.modifications_note = wrapped_label(NOTE_STYLE, "modifications:note")
         self.modifications_chart = QtGui.QLabel()
         self.modifications_chart.setObjectName("modifications:chart")
-        self.modifications_chart.setSizePolicy(_policy("Ignored"), _policy("Fixed"))  # never widens the panel
+        self.modifications_chart.setSizePolicy(size_policy("Ignored"), size_policy("Fixed"))  # never widens the panel
         self.modifications_section = Section(MODIFICATIONS_TITLE, collapsed=True, on_open=self._show_modifications)
         self.modifications_section.form.addRow(self.modifications_note)
         self.modifications_section.form.addRow(self.modifications_chart)
@@ -303,7 +178,7 @@ class JobTaskPanel:
         figure = modification_chart_figure(job.modifications, job.gear.base_radius_mm,
                                            max(CHART_MIN_WIDTH_IN, width_px / CHART_DPI), stacked=True)
         pixmap = QtGui.QPixmap()
-        pixmap.loadFromData(_png_bytes(figure, CHART_DPI), "PNG")
+        pixmap.loadFromData(png_bytes(figure, CHART_DPI), "PNG")
         if pixmap.width() > width_px:
             pixmap = pixmap.scaledToWidth(width_px, compat.qt_enum(QtCore.Qt, "TransformationMode",
                                                                    "SmoothTransformation"))
@@ -312,7 +187,7 @@ class JobTaskPanel:
         self.modifications_chart.setVisible(True)
 
     def _message_label(self, group: str) -> QtGui.QLabel:
-        label = _wrapped_label(ERROR_STYLE, f"message:{group}")
+        label = wrapped_label(ERROR_STYLE, f"message:{group}")
         label.setVisible(False)
         self.messages[group] = label
         return label
@@ -322,12 +197,12 @@ class JobTaskPanel:
         widget.setObjectName(field.prop)
         widget.setToolTip(field.doc)
         widget.setMinimumWidth(FIELD_MIN_WIDTH_PX)
-        widget.setSizePolicy(_policy("Ignored"), _policy("Fixed"))
+        widget.setSizePolicy(size_policy("Ignored"), size_policy("Fixed"))
         label = QtGui.QLabel(schema.title(field))
         label.setWordWrap(True)  # a long title takes two lines rather than the field's width
         label.setObjectName(f"label:{field.prop}")
         label.setToolTip(field.doc)
-        note = _wrapped_label(NOTE_STYLE, f"note:{field.prop}")
+        note = wrapped_label(NOTE_STYLE, f"note:{field.prop}")
         note.setVisible(False)
         self.labels[field.prop], self.notes[field.prop] = label, note
         section.form.addRow(label, widget)
@@ -578,7 +453,7 @@ class JobTaskPanel:
         if not problems:
             return None
         prop = self.highlighted
-        scroll = _scroll_area_of(self.form)
+        scroll = scroll_area_of(self.form)
         if prop is None:
             label = self.messages.get(problems[0].group, self.messages["Job"])
             if scroll is not None:
@@ -619,26 +494,6 @@ class JobTaskPanel:
             gui_doc.resetEdit()
         else:
             FreeCADGui.Control.closeDialog()
-
-
-def _png_bytes(figure, dpi: int) -> bytes:
-    """A matplotlib figure as PNG bytes at `dpi` (the screen's: the chart's text at its point size)."""
-    import io
-
-    from matplotlib.backends.backend_agg import FigureCanvasAgg
-
-    FigureCanvasAgg(figure)
-    buffer = io.BytesIO()
-    figure.savefig(buffer, format="png", dpi=dpi)
-    return buffer.getvalue()
-
-
-def _scroll_area_of(widget):
-    """The nearest scroll area holding `widget` (FreeCAD's task view is one), or None."""
-    parent = widget.parentWidget()
-    while parent is not None and not isinstance(parent, QtGui.QScrollArea):
-        parent = parent.parentWidget()
-    return parent
 
 
 def _job_figures(job_obj):
