@@ -54,7 +54,7 @@ from OCP.TopoDS import TopoDS, TopoDS_Edge, TopoDS_Shape, TopoDS_Solid, TopoDS_W
 from spur_cad.cad.ocp_compat import Array1OfVec, HArray1OfBoolean, HArray1OfPnt, HArray1OfReal, MakeSegment2d
 from spur_cad.cad.specs import BlankFeatures, GearSolidReport, StockSpec
 from spur_cad.errors import ArgumentError, WorkLimitError, require_instance
-from spur_cad.geometry.internal import InternalGearSpec
+from spur_cad.geometry.internal import InternalGearSpec, as_ring
 from spur_cad.geometry.modifications import SIDES, FlankModifications, modified_tooth_space_profile
 from spur_cad.geometry.profile import Segment
 from spur_cad.geometry.sampling import segment_parameters
@@ -475,8 +475,8 @@ def build_gear_shape(spec: GearSpec, features: BlankFeatures = BlankFeatures(),
     tolerance = default_fit_tolerance_mm(spec) if fit_tolerance_mm is None else fit_tolerance_mm
     edges, report = gear_face_edges(spec, tolerance)
     b = spec.face_width_mm
-    if isinstance(spec, InternalGearSpec):  # the kind with teeth inward: a ring
-        shape = _ring_shape(edges, spec)
+    if spec.kind.teeth_inward:
+        shape = _ring_shape(edges, as_ring(spec))
     elif modifications is not None and not modifications.is_zero:
         if modifications.has_lead:
             shape = _loft_lead_modified(spec, modifications, tolerance, report)

@@ -9,7 +9,7 @@ import math
 from dataclasses import dataclass
 
 from spur_cad.errors import GearSpecError, StockError
-from spur_cad.geometry.internal import InternalGearSpec
+from spur_cad.geometry.internal import as_ring
 from spur_cad.geometry.spec import GearSpec
 from spur_cad.keys import check_section, key
 
@@ -99,8 +99,8 @@ class StockSpec:
     def validate(self, spec: GearSpec) -> None:
         """Raise StockError for keys outside their ranges, a half-given stub or one wider than the blank."""
         check_section(self, "stock", StockError)
-        if isinstance(spec, InternalGearSpec):  # the kind with teeth inward, whose outside is the rim
-            rim = spec.rim_outer_diameter_mm
+        if spec.kind.teeth_inward:
+            rim = as_ring(spec).rim_outer_diameter_mm
             if 0.0 < self.blank_diameter_mm < rim - 1e-9:
                 raise StockError(f"blank_diameter_mm = {self.blank_diameter_mm:g} is smaller than the internal gear's "
                                  f"rim_outer_diameter_mm ({rim:g} mm)", field="blank_diameter_mm")
@@ -133,5 +133,5 @@ class StockSpec:
         radial allowance."""
         if self.blank_diameter_mm > 0.0:
             return self.blank_diameter_mm / 2.0
-        outside = spec.rim_outer_diameter_mm / 2.0 if isinstance(spec, InternalGearSpec) else spec.tip_radius_mm
+        outside = as_ring(spec).rim_outer_diameter_mm / 2.0 if spec.kind.teeth_inward else spec.tip_radius_mm
         return outside + self.radial_allowance_mm
