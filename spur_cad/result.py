@@ -159,6 +159,16 @@ class FlankSuggestionFacts:
 
 
 @dataclass(frozen=True)
+class LevelsSuggestionFacts:
+    """Roughing by flanks: roughing by levels with the same tool and cutting data would save time (cam.plan
+    suggested_levels_roughing)."""
+
+    levels_time_s: float
+    flank_time_s: float
+    levels_per_space: int
+
+
+@dataclass(frozen=True)
 class RoughingFacts:
     """One roughing operation: its levels and its estimate (and two-stage roughing's bottom operation)."""
 
@@ -182,6 +192,7 @@ class RoughingFacts:
     flank_suggested: FlankSuggestionFacts | None = None
     # roughing by flanks as the job file's default, not used (cam.plan.plan_cam): why; roughing is by levels
     flank_fallback: str | None = None
+    levels_suggested: LevelsSuggestionFacts | None = None
 
 
 @dataclass(frozen=True)

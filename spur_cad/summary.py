@@ -31,6 +31,7 @@ from spur_cad.result import (
     JobFacts,
     JobResult,
     LatheFacts,
+    LevelsSuggestionFacts,
     PostFacts,
     ProfileFacts,
     ProgramFacts,
@@ -217,6 +218,10 @@ def roughing_facts(plan: CamPlan, machine: Machine, simulation: SimResult | None
             by_flanks.flank_time_s, by_flanks.levels_time_s, by_flanks.passes_per_space))
     if plan.flank_fallback is not None:
         facts = dataclasses.replace(facts, flank_fallback=plan.flank_fallback)
+    by_levels = plan.levels_suggested
+    if by_levels is not None:
+        facts = dataclasses.replace(facts, levels_suggested=LevelsSuggestionFacts(
+            by_levels.levels_time_s, by_levels.flank_time_s, by_levels.levels_per_space))
     stage, bottom = plan.two_stage, plan.roughing_bottom
     if stage is None or bottom is None:  # two-stage roughing has both, one-tool roughing neither
         return facts
@@ -427,6 +432,12 @@ def roughing_json(roughing: RoughingFacts, measured: bool = True) -> dict:
             "time_saved_s": by_flanks.levels_time_s - by_flanks.flank_time_s}
     if roughing.flank_fallback is not None:
         facts["flank_fallback"] = roughing.flank_fallback
+    by_levels = roughing.levels_suggested
+    if by_levels is not None:
+        facts["levels_suggested"] = {
+            "levels_time_s": by_levels.levels_time_s, "flank_time_s": by_levels.flank_time_s,
+            "levels_per_space": by_levels.levels_per_space,
+            "time_saved_s": by_levels.flank_time_s - by_levels.levels_time_s}
     return facts
 
 

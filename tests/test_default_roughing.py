@@ -1,19 +1,20 @@
 """The default roughing strategy (issue 48): a job file that leaves [roughing] strategy out roughs by flanks on the
 rotary table and by levels on 3 axes, the workbench's new job starts from the same default, and where flank roughing
 cannot take the gear or tools the default falls back to levels with a note, so that such a job is refused only
-where levels are refused too (a strategy the file gives is planned or refused as given)."""
+where levels are refused too (a strategy the file gives is planned or refused as given); where levels would be
+quicker than flanks, the plan and the report say so."""
 
 from __future__ import annotations
 
 import numpy as np
 import pytest
 
-from spur_cad.cam.machine import DEFAULT_ROUGHING_STRATEGY, MachineError, RoughingParams
+from spur_cad.cam.machine import DEFAULT_ROUGHING_STRATEGY, Machine, MachineError, RoughingParams
 from spur_cad.job import parse_job
 from spur_cad.pipeline import plan_cam, run_job
-from spur_cad.report.html import program_notes
+from spur_cad.report.html import program_notes, strategy_notes
 from spur_cad.summary import roughing_facts, roughing_json
-from tests.gears import REFERENCE_JOB
+from tests.gears import REFERENCE_JOB, with_roughing_strategy
 
 # The reference gear's roughing alone, on a table whose A travels only from -360 to 0 deg (not continuous): its
 # levels index A from 0 down to -352.2 deg, while its flank passes turn A up to +-31.1 deg beyond the spaces' own.
@@ -101,3 +102,36 @@ def test_where_levels_are_refused_too_the_default_gets_the_levels_refusal():
         plan_cam(limited_table(None, a_max_deg=-10.0))
     with pytest.raises(MachineError, match=r"roughing needs A = 0\.000 deg"):
         plan_cam(limited_table("levels", a_max_deg=-10.0))
+
+
+# Flank passes held to a light engagement and a short axial depth, with a coarse staircase allowed: by levels quicker
+CAUTIOUS_FLANKS = {"flank_allowance_mm": "1.0", "max_radial_engagement_fraction": "0.05", "max_axial_depth_mm": "2.0"}
+
+
+def _reference_with(values: dict[str, str], strategy: str | None = None):
+    text = REFERENCE_JOB.read_text()
+    for name, value in values.items():
+        line = next((line for line in text.splitlines() if line.startswith(f"{name} = ")), None)
+        text = (text.replace(line, f"{name} = {value}") if line is not None
+                else text.replace("[roughing]\n", f"[roughing]\n{name} = {value}\n", 1))
+    return parse_job(with_roughing_strategy(text, strategy) if strategy else text, "reference_variant.toml")
+
+
+def test_where_levels_would_be_quicker_than_the_default_flanks_the_plan_says_so_with_the_levels_plan_s_time():
+    plan = plan_cam(_reference_with(CAUTIOUS_FLANKS))
+    levels = plan_cam(_reference_with(CAUTIOUS_FLANKS, "levels"))
+    suggestion = plan.levels_suggested
+    assert plan.roughing.flank is not None and suggestion is not None and levels.levels_suggested is None
+    assert suggestion.levels_time_s == levels.roughing.estimate.time_with_acceleration_s  # the job planned so
+    assert suggestion.flank_time_s == plan.roughing.estimate.time_with_acceleration_s
+    assert suggestion.levels_per_space == len(levels.roughing.levels.heights_mm)
+    assert suggestion.levels_time_s <= 0.9 * suggestion.flank_time_s
+    facts = roughing_facts(plan, Machine())
+    saved = roughing_json(facts, measured=False)["levels_suggested"]["time_saved_s"]
+    assert saved == pytest.approx(suggestion.flank_time_s - suggestion.levels_time_s)
+    (note,) = strategy_notes(facts)
+    assert note.startswith("Roughing by levels ([roughing] strategy = \"levels\", the same tool and cutting data, ")
+    # the shipped reference job roughs quicker by flanks (38.6 min against 2 h 26 min): nothing to say
+    shipped = plan_cam(parse_job(REFERENCE_JOB.read_text(), "reference.toml"))
+    assert shipped.roughing.flank is not None and shipped.levels_suggested is None
+    assert strategy_notes(roughing_facts(shipped, Machine())) == []

@@ -112,6 +112,16 @@ class FlankSuggestion:
 
 
 @dataclass(frozen=True)
+class LevelsSuggestion:
+    """Roughing by levels instead of the job's flanks, with the same tool and cutting data (times with the machine's
+    accelerations)."""
+
+    levels_time_s: float
+    flank_time_s: float
+    levels_per_space: int
+
+
+@dataclass(frozen=True)
 class TwoStage:
     """Two-stage roughing: where the bottom tool takes over and what it saves against that tool alone (times with
     the machine's accelerations)."""
@@ -149,6 +159,9 @@ class CamPlan:
     # roughing by flanks as a job file's default, not used: why (the flank strategy's refusal, or what it would leave
     # uncut); roughing is by levels (plan_cam)
     flank_fallback: str | None = None
+    # roughing by flanks with one tool: roughing by levels with the same tool and cutting data, when it would save at
+    # least 1 - TWO_STAGE_PAYS_FRACTION of the time (suggested_levels_roughing)
+    levels_suggested: LevelsSuggestion | None = None
 
 
 @dataclass(frozen=True)
@@ -403,7 +416,7 @@ def _plan_cam(inputs: CamInputs, checkpoint: Callable[[], None] | None = None) -
         warnings.extend(small_tool_warnings(rec, inputs.machine.smallest_end_mill_mm, strategy.name,
                                             strategy.largest_tool(rec),
                                             inputs.finishing_tool.kind if inputs.finishing_tool is not None else None))
-    bottom = two_stage = declined = suggested = by_flanks = None
+    bottom = two_stage = declined = suggested = by_flanks = by_levels_instead = None
     if levels is not None and (inputs.bottom_tool is not None or inputs.top_tool is not None):
         check()
         roughing, bottom, two_stage, declined, notes = _plan_tool_pair(inputs, levels, blank)
@@ -416,11 +429,33 @@ def _plan_cam(inputs: CamInputs, checkpoint: Callable[[], None] | None = None) -
         suggested = suggested_top_tool(inputs, roughing, blank)
         check()
         by_flanks = suggested_flank_roughing(inputs, roughing, blank)
+        check()
+        by_levels_instead = suggested_levels_roughing(inputs, roughing, blank)
     if inputs.finishing_tool is not None:
         check()
         finishing = _plan_finishing(inputs, blank, check)
         warnings.extend(finishing.toolpath.warnings)
-    return CamPlan(rec, roughing, finishing, tuple(warnings), bottom, two_stage, declined, suggested, by_flanks)
+    return CamPlan(rec, roughing, finishing, tuple(warnings), bottom, two_stage, declined, suggested, by_flanks,
+                   levels_suggested=by_levels_instead)
+
+
+def suggested_levels_roughing(inputs: CamInputs, roughing: RoughingPlan, blank: float) -> LevelsSuggestion | None:
+    """Roughing by flanks with one tool (the job files' default): roughing by levels with the same tool, cutting data
+    and allowances (the same levels: the flank plan's lowest level is theirs), when it takes at most
+    TWO_STAGE_PAYS_FRACTION of `roughing`'s time; else None (suggested_flank_roughing the other way round). A gear
+    whose flank passes are held to a light engagement and a short axial depth may rough quicker by levels."""
+    if inputs.roughing.strategy != "flank" or roughing.flank is None:
+        return None
+    levels_inputs = by_levels(inputs)
+    try:  # bounded as the job's own roughing would be
+        moves, driver = estimated_roughing_moves(inputs.spec, roughing.tool, levels_inputs.roughing, blank)
+        check_moves("roughing by levels", moves, "roughing", driver)
+        levels = _plan_roughing(levels_inputs, roughing.levels, blank)
+    except SpurCadError:  # levels cannot rough this space with this tool (a work bound, the travel): no suggestion
+        return None
+    if _seconds(levels) > TWO_STAGE_PAYS_FRACTION * _seconds(roughing):
+        return None
+    return LevelsSuggestion(_seconds(levels), _seconds(roughing), len(levels.levels.heights_mm))
 
 
 def suggested_flank_roughing(inputs: CamInputs, roughing: RoughingPlan, blank: float) -> FlankSuggestion | None:

@@ -22,7 +22,7 @@ from spur_cad.report.sheet import Table, duration, number
 
 if TYPE_CHECKING:
     from spur_cad.report.template_bounds import TemplateLimits
-    from spur_cad.result import FinishingFacts, JobResult
+    from spur_cad.result import FinishingFacts, JobResult, RoughingFacts
 
 TEMPLATE_NAME = "report.html.j2"
 
@@ -136,19 +136,34 @@ def program_notes(result: JobResult) -> tuple[str, ...]:
                          f"({duration(suggested.roughing_tool_alone_time_s)} -> "
                          f"{duration(suggested.two_stage_time_s)}): name it [tools.roughing_top] (two-stage "
                          "roughing by flanks, the same cutting data).")
-        by_flanks = rough.flank_suggested
-        if by_flanks is not None:
-            notes.append(f"Roughing by flanks ([roughing] strategy = \"flank\", the same tool and cutting data, "
-                         f"{by_flanks.passes_per_space} passes per space) would take "
-                         f"{duration(by_flanks.flank_time_s)} instead of {duration(by_flanks.levels_time_s)} "
-                         "by levels, "
-                         f"{duration(by_flanks.levels_time_s - by_flanks.flank_time_s)} less.")
-        if rough.flank_fallback is not None:
-            notes.append("Roughing by levels: the job leaves [roughing] strategy to its default, roughing by flanks, "
-                         f"which cannot take this gear with these tools ({rough.flank_fallback}).")
+        notes.extend(strategy_notes(rough))
     if finish is not None:
         notes.append(finish.report_text)
     return tuple(notes)
+
+
+def strategy_notes(rough: RoughingFacts) -> list[str]:
+    """Sentences on the roughing strategy not used: the other strategy when it would save a tenth of the time (by
+    flanks for a job by levels, by levels for one by flanks), and why a job file's default flank roughing fell back
+    to levels."""
+    notes = []
+    by_flanks = rough.flank_suggested
+    if by_flanks is not None:
+        notes.append(f"Roughing by flanks ([roughing] strategy = \"flank\", the same tool and cutting data, "
+                     f"{by_flanks.passes_per_space} passes per space) would take "
+                     f"{duration(by_flanks.flank_time_s)} instead of {duration(by_flanks.levels_time_s)} "
+                     "by levels, "
+                     f"{duration(by_flanks.levels_time_s - by_flanks.flank_time_s)} less.")
+    by_levels = rough.levels_suggested
+    if by_levels is not None:
+        notes.append(f"Roughing by levels ([roughing] strategy = \"levels\", the same tool and cutting data, "
+                     f"{by_levels.levels_per_space} levels per space) would take "
+                     f"{duration(by_levels.levels_time_s)} instead of {duration(by_levels.flank_time_s)} "
+                     f"by flanks, {duration(by_levels.flank_time_s - by_levels.levels_time_s)} less.")
+    if rough.flank_fallback is not None:
+        notes.append("Roughing by levels: the job leaves [roughing] strategy to its default, roughing by flanks, "
+                     f"which cannot take this gear with these tools ({rough.flank_fallback}).")
+    return notes
 
 
 def _image_uri(png: bytes | None) -> str:
