@@ -72,7 +72,7 @@ class Section:
         self.widget = QtGui.QWidget()
         layout = QtGui.QVBoxLayout(self.widget)
         layout.setContentsMargins(0, 0, 0, 0)
-        layout.setSpacing(2)
+        layout.setSpacing(1)
         self.header = QtGui.QToolButton()
         self.header.setObjectName(f"section:{title}")
         self.header.setText(title)

@@ -194,6 +194,18 @@ def _three_axis_summary(job: dict[str, Any], units=None) -> str:
     return "cut through, no tabs"
 
 
+def _mate_summary(job: dict[str, Any], units=None) -> str:
+    """The folded "Mate" group: the mating gear when the job designs against one ("z 40", "z 60 ring, a 40 mm");
+    nothing when it does not (the checks then assume the basic rack, as the group's switch says)."""
+    from spur_cad_workbench.units import text as length_text
+
+    if not job.get("UseMate"):
+        return ""
+    text = f"z {int(job.get('MateTeeth', 0))}" + (" ring" if job.get("MateInternal") else "")
+    centre_mm = float(job.get("MateCentreDistance", 0.0))
+    return text + (f", a {length_text(centre_mm, 'mm', units)}" if centre_mm > 0.0 else "")
+
+
 def group_summary(group: str, job: dict[str, Any], units=None) -> str:
     """What a folded group of the job panel holds, in a few words ('T1 flat D 4 mm', 'generating, scallop
     5 um'; lengths in the user's unit schema, `units` = FreeCAD.Units, None for mm); '' for groups without one.
@@ -228,6 +240,8 @@ def group_summary(group: str, job: dict[str, Any], units=None) -> str:
         text = f"{' + '.join(formats)}, offset {offset}" if formats else "not written"
     elif group == "Job":
         text = str(job.get("JobName", ""))
+    elif group == "Mate":
+        text = _mate_summary(job, units)
     else:
         return ""
     return text if len(text) <= GROUP_SUMMARY_CHARS else text[:GROUP_SUMMARY_CHARS - 1].rstrip() + "\u2026"
