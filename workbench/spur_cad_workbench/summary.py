@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import hashlib
 import json
+from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
@@ -206,6 +207,16 @@ def _mate_summary(job: dict[str, Any], units=None) -> str:
     return text + (f", a {length_text(centre_mm, 'mm', units)}" if centre_mm > 0.0 else "")
 
 
+# The groups whose summary is one property's value or state
+_SWITCH_SUMMARIES: dict[str, Callable[[dict[str, Any]], str]] = {
+    "Job": lambda job: str(job.get("JobName", "")),
+    "Post": lambda job: str(job.get("PostDialect", "")),
+    "Simulation": lambda job: "on" if job.get("SimulationEnabled") else "off",
+    "Lathe": lambda job: "program written" if job.get("WriteLatheProgram") else "no program",
+    "Probe": lambda job: "program written" if job.get("WriteProbeProgram") else "no program",
+}
+
+
 def group_summary(group: str, job: dict[str, Any], units=None) -> str:
     """What a folded group of the job panel holds, in a few words ('T1 flat D 4 mm', 'generating, scallop
     5 um'; lengths in the user's unit schema, `units` = FreeCAD.Units, None for mm); '' for groups without one.
@@ -226,20 +237,12 @@ def group_summary(group: str, job: dict[str, Any], units=None) -> str:
         text = str(job.get("MachineName", "")) + ("" if setup.rotary_axis else f", {setup.axes} axes")
     elif group == "3-axis":
         text = _three_axis_summary(job, units)
-    elif group == "Post":
-        text = str(job.get("PostDialect", ""))
-    elif group == "Simulation":
-        text = "on" if job.get("SimulationEnabled") else "off"
-    elif group == "Lathe":
-        text = "program written" if job.get("WriteLatheProgram") else "no program"
-    elif group == "Probe":
-        text = "program written" if job.get("WriteProbeProgram") else "no program"
+    elif group in _SWITCH_SUMMARIES:
+        text = _SWITCH_SUMMARIES[group](job)
     elif group == "2-D export":
         formats = [name for name, prop in (("DXF", "ExportDxf"), ("SVG", "ExportSvg")) if job.get(prop)]
         offset = length_text(float(job.get("ExportOffset", 0.0)), "mm", units)
         text = f"{' + '.join(formats)}, offset {offset}" if formats else "not written"
-    elif group == "Job":
-        text = str(job.get("JobName", ""))
     elif group == "Mate":
         text = _mate_summary(job, units)
     else:
