@@ -22,6 +22,7 @@ from spur_cad.job import load_job
 from spur_cad.pipeline import job_stock, plan_cam
 from spur_cad.sim.contact import contact_angles
 from tests.gears import REFERENCE_JOB
+from tests.linuxcnc_comp import EMCMOT_COMP_SIZE, load_comp, motor_command
 from tests.machine_model import Harmonic, PlantedMachine, cut_planes, flank_figures
 from tests.machine_model import scan_csv as machine_scan_csv
 from tests.rs274_helper import rs274_path, run_rs274
@@ -190,19 +191,25 @@ def test_correct_writes_the_corrected_programs_and_correction_json(reference, co
 
 
 @needs_rs274
-def test_the_compensation_file_holds_minus_the_corrections_a_change(corrected, original_program):
-    """a_axis.comp (LinuxCNC COMP_FILE_TYPE 1: nominal, forward trim, reverse trim, deg): the trim at each nominal
-    A is the identified e(A), the same the corrected program takes off its A words, in at most 256 lines over the
-    A the programs command."""
+def test_with_the_compensation_file_the_original_program_puts_the_table_at_its_a(corrected, original_program,
+                                                                                  tmp_path):
+    """a_axis.comp, loaded as LinuxCNC loads a COMP_FILE_TYPE = 1 file and applied as its motion controller does
+    (tests/linuxcnc_comp.py, from LinuxCNC's usrmotLoadComp, EMCMOT_SET_JOINT_COMP and compute_screw_comp): every
+    line an entry, at most 256, and at each A word of the ORIGINAL finishing program (rs274) the planted table, which
+    stands e(A) further than its motor, stands at the commanded A within 0.5 arcsec (25 arcsec without the file)."""
     out = corrected[1]
-    rows = np.loadtxt(out / "a_axis.comp")
-    assert rows.shape[1] == 3 and len(rows) <= 256 and np.all(np.diff(rows[:, 0]) > 0.0)
-    assert np.array_equal(rows[:, 1], rows[:, 2])
-    planted = ISSUE_MACHINE.table_error_arcsec(rows[:, 0]) / 3600.0
-    assert np.abs(rows[:, 1] - planted).max() * 3600.0 < 0.5  # the planted table's, within 0.5 arcsec
-    ok, canon, _ = run_rs274(out / "finishing.ngc")
-    a_words = [float(line.split(",")[3]) for line in canon if line.startswith("STRAIGHT_")]
-    assert rows[0, 0] <= min(a_words) and max(a_words) <= rows[-1, 0]
+    text = (out / "a_axis.comp").read_text()
+    entries = load_comp(text, comp_file_type=1)
+    assert len(entries) == len(text.splitlines()) <= EMCMOT_COMP_SIZE
+    (tmp_path / "finishing.ngc").write_text(original_program)
+    ok, canon, _ = run_rs274(tmp_path / "finishing.ngc")
+    a_words = np.array([float(line.split(",")[3]) for line in canon if line.startswith("STRAIGHT_")])
+    assert ok and entries[0].nominal <= a_words.min() and a_words.max() <= entries[-1].nominal
+    for moving_up in (True, False):
+        motor = motor_command(entries, a_words, moving_up)
+        table = motor + ISSUE_MACHINE.table_error_arcsec(motor) / 3600.0
+        assert np.abs(table - a_words).max() * 3600.0 < 0.5
+    assert np.abs(ISSUE_MACHINE.table_error_arcsec(a_words)).max() > 20.0
 
 
 MACHINES = {"issue": (ISSUE_MACHINE, "table"), "second order": (SECOND_ORDER, "table"),

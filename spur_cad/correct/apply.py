@@ -69,15 +69,31 @@ def blank_corrected(path, datum_offset_um: tuple[float, float]):
     return path.replace(y=path.y + moved[:, 0], z=path.z + moved[:, 1])
 
 
+LINUXCNC_COMP_SIZE = 256
+"""The most entries LinuxCNC's motion controller takes in one joint's compensation table (EMCMOT_COMP_SIZE,
+src/emc/motion/motion.h; command.c's EMCMOT_SET_JOINT_COMP refuses more, "too many compensation entries")."""
+
+
 def linuxcnc_compensation(table: TableError, orders: tuple[int, ...], a_range_deg: tuple[float, float]) -> str:
-    """A LinuxCNC joint compensation file for the A joint ([JOINT_n] COMP_FILE with COMP_FILE_TYPE = 1: lines
-    'nominal forward_trim reverse_trim', trim = actual - nominal, deg, in increasing nominal order, at most 256
-    lines), the table's error of the given orders over the A range the programs command (widened by a step each
-    side). Both directions alike: e(A) here is a position error, no backlash."""
-    low, high = a_range_deg
-    step = max(1.0, math.ceil((high - low + 2.0) / 250.0))
-    start = math.floor(low / step) * step - step
-    count = int(math.ceil((high - start) / step)) + 2
-    nominal = start + step * np.arange(count)
-    trim = table.at(nominal, orders) / 3600.0
+    """A LinuxCNC joint compensation file for the A joint, for [JOINT_n] COMP_FILE with COMP_FILE_TYPE = 1 (which
+    must be set: LinuxCNC's default, 0, reads the columns as actual positions): per line 'nominal forward_trim
+    reverse_trim' in degrees (the joint's machine units with [TRAJ] ANGULAR_UNITS = degree), nominal strictly
+    increasing, at most LINUXCNC_COMP_SIZE lines, nothing else in the file (LinuxCNC's loader stops at the first line
+    that is not three numbers).
+
+    The trim is what LinuxCNC adds to the commanded joint position (control.c: motor_pos_cmd = pos_cmd +
+    backlash_filt, interpolated linearly between nominals, held at the end values outside the table), so trim =
+    nominal - actual = -e(A) (usrmotintf.cc usrmotLoadComp: a type 0 file's actual positions become nom - actual):
+    the table then stands at A - e(A) + e(A - e(A)), A within e's change over e (as table_corrected). Both
+    directions alike: e(A) is a position error, no backlash.
+
+    The nominals cover the A the programs command and the turn 0 to 360 deg (a [AXIS_A] WRAPPED_ROTARY machine
+    commands the joint there), each widened by a step, at whole-degree steps as fine as the entry limit allows."""
+    low = min(a_range_deg[0], 0.0)
+    high = max(a_range_deg[1], 360.0)
+    step = max(1.0, math.ceil((high - low) / (LINUXCNC_COMP_SIZE - 5)))  # lines <= span / step + 5
+    start = (math.floor(low / step) - 1) * step
+    stop = (math.ceil(high / step) + 1) * step
+    nominal = start + step * np.arange(int(round((stop - start) / step)) + 1)
+    trim = -table.at(nominal, orders) / 3600.0
     return "".join(f"{a:.4f} {t:.7f} {t:.7f}\n" for a, t in zip(nominal, trim))

@@ -238,9 +238,11 @@ def correct_job(job, measured, measured_source: str, datum: str = "best-fit", on
         summary["corrections"]["compensation_file"] = {
             "file": COMPENSATION_FILE,
             "how": "for the user who would rather fix the machine than the program: LinuxCNC's joint compensation "
-                   "for the A joint ([JOINT_n] COMP_FILE = a_axis.comp, COMP_FILE_TYPE = 1: nominal, forward and "
-                   "reverse trim in degrees, trim = actual - nominal = e(A)); with it loaded, run the original "
-                   "programs, not the corrected ones (their A words already carry the correction)"}
+                   "for the A joint ([JOINT_n] COMP_FILE = a_axis.comp with COMP_FILE_TYPE = 1, which must be set: "
+                   "nominal, forward and reverse trim in degrees, trim = nominal - actual = -e(A), which LinuxCNC "
+                   "adds to the commanded A; nominal is the joint's machine position, the programs' A with a zero A "
+                   "work offset); with it loaded, run the original programs, not the corrected ones (their A words "
+                   "already carry the correction)"}
     files["correction.json"] = (json.dumps(summary, indent=2) + "\n").encode()
     # the report's own simulation would cut the corrected programs on an ideal machine, where the corrections show
     # as deviations (a warned "gouge" of the size error): it is left out; the Correction section predicts the gear
