@@ -16,10 +16,12 @@ from __future__ import annotations
 import ast
 import dataclasses
 import re
+import subprocess
 import sys
 import types
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -480,3 +482,54 @@ def test_a_planted_ocp_import_is_found(tmp_path):
     (tmp_path / "m.py").write_text("from OCP.TColgp import TColgp_HArray1OfPnt, TColgp_Array1OfPnt\n")
     differing = ocp_imports(ROOT / "spur_cad" / "cad" / "ocp_compat.py")
     assert ocp_imports(tmp_path / "m.py") & differing == {"OCP.TColgp.TColgp_HArray1OfPnt"}
+
+
+# --- frames, imports inside a layer, the kernel on first use -------------------------------------------------
+
+
+@pytest.mark.parametrize("a_deg", [0.0, 30.0, -117.5, 250.0])
+def test_a_turns_the_part_as_the_page_writes_it(a_deg):
+    """'(y cos A - z sin A, y sin A + z cos A) when A is commanded', written out here."""
+    from spur_cad.geometry.frames import machine_to_part, part_to_machine
+
+    y, z = 3.0, 11.0
+    a = a_deg * np.pi / 180.0
+    expected = [y * np.cos(a) - z * np.sin(a), y * np.sin(a) + z * np.cos(a)]
+    assert part_to_machine(np.array([[y, z]]), a_deg)[0] == pytest.approx(expected, abs=1e-12)
+    assert machine_to_part(np.array([expected[0]]), np.array([expected[1]]), np.array([a_deg]))[0] == pytest.approx(
+        [y, z], abs=1e-12)
+
+
+@pytest.mark.parametrize("space, psi_deg", [(0, 0.0), (1, 7.0), (5, -12.5), (16, 3.0)])
+def test_a_contact_of_space_k_is_brought_up_by_psi_minus_k_pitches(space, psi_deg):
+    """'space k is brought up under the tool by A = -k * 360/z'; a contact at gap polar angle psi (from +y toward
+    +x) 'is brought onto the vertical through the axis by A = psi - k * 360/z'."""
+    from spur_cad.geometry.frames import gap_to_part, part_to_machine
+
+    teeth, radius_mm = 17, 20.0
+    psi = psi_deg * np.pi / 180.0
+    contact = np.array([[radius_mm * np.sin(psi), radius_mm * np.cos(psi)]])  # in space k's gap frame
+    machine = part_to_machine(gap_to_part(contact, space, teeth), psi_deg - space * 360.0 / teeth)[0]
+    assert machine == pytest.approx([0.0, radius_mm], abs=1e-9)
+
+
+def test_inside_cam_the_layers_order_holds():
+    """'in cam/: machine and tools below the strategies, the strategies below finishing and plan'; and 'the
+    simulation and report stages never import the job loader or the pipeline'."""
+    from tests.test_imports import import_graph
+
+    graph = {module: {i.target for i in found} for module, found in import_graph().items()}
+    strategies = {m for m in graph if m.startswith("spur_cad.cam.strategies")}
+    assert not {m for m in ("spur_cad.cam.machine", "spur_cad.cam.tools") if graph[m] & strategies}
+    assert not {m for m in strategies if graph[m] & {"spur_cad.cam.finishing", "spur_cad.cam.plan"}}
+    stages = [m for m in graph if m.startswith(("spur_cad.sim", "spur_cad.report"))]
+    assert not {m for m in stages if graph[m] & {"spur_cad.job", "spur_cad.pipeline"}}
+
+
+def test_import_spur_cad_loads_no_cad_kernel():
+    """'`import spur_cad` loads no CAD kernel' (nor does a GearSpec): neither OCP nor a front-end."""
+    code = ("import json, sys, spur_cad; spur_cad.GearSpec(teeth=20, module_mm=2); "
+            "print(json.dumps(sorted({m.split('.')[0] for m in sys.modules} & {'OCP', 'cadquery', 'build123d'})))")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120, check=False,
+                         cwd=ROOT)
+    assert out.stdout.strip() == "[]", out.stderr
