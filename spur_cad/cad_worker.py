@@ -27,6 +27,7 @@ import sys
 import threading
 import time
 import traceback
+from types import TracebackType
 from typing import IO, TYPE_CHECKING, BinaryIO, Callable
 
 if TYPE_CHECKING:
@@ -138,7 +139,8 @@ class CadWorker:
     def __enter__(self) -> CadWorker:
         return self
 
-    def __exit__(self, exc_type, exc, traceback_) -> None:
+    def __exit__(self, exc_type: type[BaseException] | None, exc: BaseException | None,
+                 traceback_: TracebackType | None) -> None:
         try:
             if isinstance(exc, Exception) and self._submitted and not self._read:
                 self.result()  # raises the CAD stage's error, if any, in place of the run's

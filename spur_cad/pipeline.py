@@ -14,7 +14,7 @@ import io
 import json
 import os
 import time
-from typing import TYPE_CHECKING, Callable
+from typing import TYPE_CHECKING, Callable, TypeVar
 
 import numpy as np
 
@@ -26,7 +26,7 @@ from spur_cad.errors import shown_path
 from spur_cad.geometry.sampling import ProfileSamples, sample_profile
 from spur_cad.inputs import step_timestamp
 from spur_cad.job import Job
-from spur_cad.result import CadResult, CorrectionFacts, JobResult
+from spur_cad.result import CadResult, CorrectionFacts, ErrorBudgetFacts, JobResult
 from spur_cad.summary import build_result, summary_json
 from spur_cad.version import __version__
 
@@ -34,9 +34,13 @@ if TYPE_CHECKING:
     from spur_cad.cad_worker import CadWorker
     from spur_cad.cam.restart import RestartPoint
     from spur_cad.grade.grading import Grading
-    from spur_cad.post.program import PostedProgram
+    from spur_cad.post.program import PostedProgram, ProgramInfo
+    from spur_cad.sim.budget import ErrorBudget
+    from spur_cad.sim.design import DesignGrid
     from spur_cad.sim.engagement import Engagement
     from spur_cad.sim.simulate import SimResult, StockCylinder
+
+Value = TypeVar("Value")  # what a stage computes (run_job's timer returns it)
 
 
 def profile_csv(samples: ProfileSamples, unmodified: np.ndarray | None = None) -> bytes:
@@ -111,7 +115,7 @@ def run_job(job: Job, progress: Callable[[str, float], None] | None = None,
     timestamp = step_timestamp(os.environ)  # checked before any work (the CLI checks it before any import)
     seconds: dict[str, float] = {}
 
-    def timed(name: str, stage: str | None, compute: Callable):
+    def timed(name: str, stage: str | None, compute: Callable[[], Value]) -> Value:
         if checkpoint is not None:
             checkpoint()
         start = time.perf_counter()
@@ -212,7 +216,7 @@ def three_axis_profile_start_mm(plan: CamPlan | None) -> float | None:
     return facts.form_diameter_mm / 2.0 if isinstance(facts, ThreeAxisFinishingFacts) else None
 
 
-def error_budget(job: Job, plan: CamPlan):
+def error_budget(job: Job, plan: CamPlan) -> ErrorBudget:
     """The job's error budget (spur_cad.sim.budget.ErrorBudget): [machine]'s accuracy keys, the calibration table
     and the finishing tool's deflection in the job's material (on the finish stock roughing leaves). On 3 axes the
     linear axes, runout and tool size only: no table indexes the spaces, and the deflection model (a corner's arc
@@ -233,7 +237,7 @@ def error_budget(job: Job, plan: CamPlan):
                        machine.linear_accuracy_um, deflection)
 
 
-def finishing_point_angles(job: Job, plan: CamPlan, grid):
+def finishing_point_angles(job: Job, plan: CamPlan, grid: DesignGrid) -> np.ndarray | None:
     """The commanded A that cut each involute point of the grid (spur_cad.sim.contact), or None where the finishing's
     contacts are not a transverse section's (a helical gear; an internal one, not checked) or cannot be found: the
     budget then turns each space rigidly at its index angle."""
@@ -248,7 +252,8 @@ def finishing_point_angles(job: Job, plan: CamPlan, grid):
     return flank_point_angles(job.gear, grid, contacts)
 
 
-def budget_stage(job: Job, plan: CamPlan, sim_result: SimResult | None, grading: Grading | None):
+def budget_stage(job: Job, plan: CamPlan, sim_result: SimResult | None,
+                 grading: Grading | None) -> ErrorBudgetFacts | None:
     """The simulated gear on the budget's machine, graded (spur_cad.result.ErrorBudgetFacts; None without a
     simulation): the budget acts on the simulated flanks, the cut is not simulated again; on 3 axes the 3-axis
     machine's budget (error_budget), graded as the ideal cut is (grade_stage)."""
@@ -287,7 +292,7 @@ def build_programs(job: Job, plan: CamPlan, notes: tuple[str, ...] = ()) -> tupl
 
 
 def program_info(job: Job, plan: CamPlan, operation: str, restart_comment: str | None = None,
-                 approach_z_mm: float | None = None, a_reference_deg: float | None = None):
+                 approach_z_mm: float | None = None, a_reference_deg: float | None = None) -> ProgramInfo:
     """The header, machine codes and blank box (for Siemens WORKPIECE) of one program."""
     from spur_cad.post import ProgramInfo
 

@@ -18,13 +18,13 @@ over the flank's traces of one side.
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, replace
 
 import numpy as np
 
 from spur_cad.geometry.modifications import SIDES, FlankModification, FlankModifications, normal_offset_mm
-from spur_cad.grade.grading import Trace
+from spur_cad.grade.grading import Grading, Trace
 
 MIN_FIT_POINTS = 8
 """A trace needs this many points on the flank (and more than its shapes) to read modification amounts from it."""
@@ -69,7 +69,7 @@ def design_removal_mm(mods: FlankModifications, side: np.ndarray, roll_mm: np.nd
     return removal
 
 
-def with_design(traces, mods: FlankModifications) -> tuple[Trace, ...]:
+def with_design(traces: Sequence[Trace], mods: FlankModifications) -> tuple[Trace, ...]:
     """The traces with their design trace (um, -removal): a profile trace's profile modifications, a helix trace's
     lead modifications. The other direction's modification is a constant along a trace and is not charted (a
     profile trace at the face of a crowned flank is drawn against the involute moved by the crowning there)."""
@@ -138,7 +138,7 @@ def _valleys(position_mm: np.ndarray, removal_um: np.ndarray) -> tuple[np.ndarra
     return (position[valley], removal[valley]) if np.count_nonzero(valley) >= MIN_FIT_POINTS else (position, removal)
 
 
-def modifications_cut(traces, mods: FlankModifications) -> tuple[ModificationCut, ...]:
+def modifications_cut(traces: Sequence[Trace], mods: FlankModifications) -> tuple[ModificationCut, ...]:
     """Each flank side's modifications as designed and as cut (see the module docstring), from traces that carry
     their design trace (`with_design`): profile traces on the usable involute, helix traces over the face."""
     found: list[ModificationCut] = []
@@ -164,7 +164,7 @@ def modifications_cut(traces, mods: FlankModifications) -> tuple[ModificationCut
     return tuple(found)
 
 
-def against_design(grading, mods: FlankModifications | None):
+def against_design(grading: Grading, mods: FlankModifications | None) -> Grading:
     """A Grading of traces taken against the modified design, with their design traces and the modifications as
     cut (unchanged when the gear has no modification)."""
     if mods is None:

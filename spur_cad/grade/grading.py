@@ -13,6 +13,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from spur_cad.geometry.spec import GearSpec
 from spur_cad.grade.iso1328 import (
     DEVIATIONS,
     KINDS,
@@ -173,7 +174,7 @@ def add_pitch(worst: dict[str, float], where: dict[str, Location], side: str,
     return SidePitch(tuple(round(float(v), 3) for v in single), f_pt, f_p)
 
 
-def classes_of(spec, worst: dict[str, float], graded: set[str]) -> tuple[dict[str, int | None], int | None]:
+def classes_of(spec: GearSpec, worst: dict[str, float], graded: set[str]) -> tuple[dict[str, int | None], int | None]:
     """Each graded deviation's class (in the tolerance order of ISO 1328-1) and the gear's (the worst; None when
     one is beyond 11 or nothing is graded)."""
     d, b, m = 2.0 * spec.reference_radius_mm, spec.face_width_mm, spec.module_mm
@@ -184,13 +185,13 @@ def classes_of(spec, worst: dict[str, float], graded: set[str]) -> tuple[dict[st
     return classes, overall
 
 
-def validity(spec) -> tuple[str, ...]:
+def validity(spec: GearSpec) -> tuple[str, ...]:
     """Where the gear is outside the range of the standard's formulas."""
     d, b, m = 2.0 * spec.reference_radius_mm, spec.face_width_mm, spec.module_mm
     return tuple(validity_problems(spec.teeth, d, m, b, math.degrees(spec.helix_angle_rad)))
 
 
-def class5(spec) -> tuple[dict[str, float], dict[str, float]]:
+def class5(spec: GearSpec) -> tuple[dict[str, float], dict[str, float]]:
     """The gear's class-5 tolerances: rounded as the standard tabulates them, and unrounded (um)."""
     d, b, m = 2.0 * spec.reference_radius_mm, spec.face_width_mm, spec.module_mm
     return ({kind: tolerance_um(kind, 5, d, b, m) for kind in KINDS},

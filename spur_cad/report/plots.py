@@ -5,6 +5,7 @@ from __future__ import annotations
 import io
 
 import numpy as np
+from matplotlib.axes import Axes
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 
@@ -28,7 +29,8 @@ def figure(width_in: float, height_in: float, left: float = 0.1, right: float = 
     return fig
 
 
-def figure_for_extent(width_in: float, x_range: float, y_range: float, margins_in=(0.75, 0.15, 0.6, 0.4),
+def figure_for_extent(width_in: float, x_range: float, y_range: float,
+                      margins_in: tuple[float, float, float, float] = (0.75, 0.15, 0.6, 0.4),
                       largest_height_in: float = 9.0) -> Figure:
     """A figure for one equal-aspect plot of data `x_range` wide and `y_range` tall: the height follows the
     data (no band of empty space above and below), margins (left, right, bottom, top) fixed in inches."""
@@ -39,7 +41,7 @@ def figure_for_extent(width_in: float, x_range: float, y_range: float, margins_i
                   top=1.0 - top / height_in)
 
 
-def set_title(ax, text: str, fontsize: float) -> None:
+def set_title(ax: Axes, text: str, fontsize: float) -> None:
     """The axes' title at matplotlib's default place above the plot, fixed there: left automatic, every draw
     measures the y axis's tick labels again to dodge a top axis or offset text that these plots do not have."""
     ax.set_title(text, fontsize=fontsize, y=1.0)
@@ -78,7 +80,7 @@ def removal_magnification(spec: GearSpec, largest_removal_mm: float) -> float:
     return float(max(step * decade for step in (1.0, 2.0, 5.0) if step * decade <= wanted))
 
 
-def _plot_modified_flanks(ax, spec: GearSpec, flanks: dict) -> None:
+def _plot_modified_flanks(ax: Axes, spec: GearSpec, flanks: dict[str, tuple[np.ndarray, np.ndarray]]) -> None:
     """The modified flanks (`flanks`: side -> (modified points, unmodified points), right-half gap frame) with their
     removal magnified; the left side drawn mirrored."""
     largest = max(float(np.linalg.norm(modified - design, axis=1).max()) for modified, design in flanks.values())

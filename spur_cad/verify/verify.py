@@ -13,6 +13,7 @@ from __future__ import annotations
 import dataclasses
 import json
 import math
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING
 
@@ -23,7 +24,8 @@ from spur_cad.errors import SpurCadError, shown
 from spur_cad.verify.reader import ProgramMoves
 
 if TYPE_CHECKING:  # the simulator loads only when a program is simulated
-    from spur_cad.sim.simulate import Cut
+    from spur_cad.job import Job
+    from spur_cad.sim.simulate import Cut, SimResult
 
 POINTS = ("tip", "corner-centre")
 
@@ -161,13 +163,13 @@ def station_positions(path: Toolpath) -> np.ndarray:
     return np.unique(np.round(path.x[feed & transverse], 6))
 
 
-def _where(result, k: int, flat_index: int, rows: np.ndarray, names: list[str]) -> SpacePlace:
+def _where(result: SimResult, k: int, flat_index: int, rows: np.ndarray, names: list[str]) -> SpacePlace:
     j, r = np.unravel_index(flat_index, result.deviation[k][:, rows].shape)
     row = np.nonzero(rows)[0][r]
     return SpacePlace(names[j], int(j), float(result.grid.rows_x[row]), int(result.station_of_row()[row]))
 
 
-def space_verdicts(result) -> tuple[SpaceVerdict, ...]:
+def space_verdicts(result: SimResult) -> tuple[SpaceVerdict, ...]:
     """The largest gouge and leftover of each tooth space inside the face width, and where they are."""
     rows, names = result.gear_rows, result.grid.feature_names()
     verdicts = []
@@ -179,7 +181,7 @@ def space_verdicts(result) -> tuple[SpaceVerdict, ...]:
     return tuple(verdicts)
 
 
-def deviation_map_csv(result) -> str:
+def deviation_map_csv(result: SimResult) -> str:
     """Per space, feature and row of the face width: the smallest and largest deviation (um)."""
     rows = np.nonzero(result.gear_rows)[0]
     names = result.grid.feature_names()
@@ -195,8 +197,8 @@ def deviation_map_csv(result) -> str:
     return "\n".join(lines) + "\n"
 
 
-def verify_moves(job, programs: list[ProgramMoves], options: VerifyOptions = VerifyOptions(),
-                 progress=None) -> VerifyResult:
+def verify_moves(job: Job, programs: list[ProgramMoves], options: VerifyOptions = VerifyOptions(),
+                 progress: Callable[[float], None] | None = None) -> VerifyResult:
     """Simulate the job's stock cut by `programs` in order and judge the part (see the module docstring)."""
     from spur_cad.pipeline import job_stock
     from spur_cad.sim.simulate import SimSettings, simulate
