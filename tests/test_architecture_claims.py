@@ -117,39 +117,51 @@ def _relative(path: Path) -> str:
 # --- every path the page names exists -----------------------------------------------------------------------
 
 
+ROOTS = ("spur_cad/", "tests/", "workbench/", "benchmarks/", ".ci/", "docs/", "resources/")
+
+
 def named_paths(text: str) -> set[str]:
     """The repository paths the page names in backticks or in its layer block (spur_cad/..., tests/...,
     workbench/..., benchmarks/...; `.py` files and folders)."""
     tokens = set(re.findall(r"`([^`\s]+)`", text)) | set(text.split())
-    roots = ("spur_cad/", "tests/", "workbench/", "benchmarks/", ".ci/", "docs/")
-    return {t.rstrip(".,;:)") for t in tokens if t.startswith(roots) and re.fullmatch(r"[\w./-]+", t.rstrip(".,;:)"))}
+    found = {t.rstrip(".,;:)") for t in tokens if t.startswith(ROOTS)}
+    return {t for t in found if re.fullmatch(r"[\w./-]+", t) and re.fullmatch(r"[\w-]*(\.(py|md|toml|txt|sh|json))?/?",
+                                                                        t.rsplit("/", 1)[-1] or "x")}
 
 
 def short_paths(text: str) -> set[str]:
     """Module paths the page names relative to spur_cad/ (`cam/plan.py`, `strategies/base.py`, `post/header.py`)."""
-    return {t for t in re.findall(r"`([\w/]+\.py)`", text) if not t.startswith(("spur_cad/", "tests/", "workbench/"))}
+    folders = {p.name for p in (ROOT / "spur_cad").rglob("*") if p.is_dir()}
+    return {t for t in re.findall(r"`([\w/]+\.py)`", text)
+            if "/" in t and t.split("/")[0] in folders and not t.startswith(ROOTS)}
 
 
 EXAMPLES = {"spur_cad/cam/strategies/tip_first.py"}
 """Paths the page names as what a reader would add (its worked example)."""
 
 
-def missing_paths(text: str, root: Path) -> list[str]:
-    missing = [p for p in sorted(named_paths(text) - EXAMPLES) if not (root / p).exists()]
-    for short in sorted(short_paths(text)):
-        found = list((root / "spur_cad").rglob(short.rsplit("/", 1)[-1]))
-        if not any(_relative(f).endswith(short) for f in found) if root == ROOT else not found:
-            missing.append(short)
+def missing_paths(text: str) -> list[str]:
+    """The paths the text names that do not exist (short ones: no module of spur_cad/ ends with them)."""
+    missing = [p for p in sorted(named_paths(text) - EXAMPLES) if not (ROOT / p).exists()]
+    modules = [_relative(f) for f in (ROOT / "spur_cad").rglob("*.py")]
+    missing += [short for short in sorted(short_paths(text)) if not any(m.endswith("/" + short) for m in modules)]
     return missing
 
 
 def test_every_path_the_page_names_exists():
-    assert missing_paths(_page(), ROOT) == []
+    assert missing_paths(_page()) == []
 
 
 def test_a_renamed_path_is_found():
-    assert missing_paths("see `spur_cad/cam/planner.py` and `cam/plan.py`", ROOT) == ["spur_cad/cam/planner.py"]
-    assert missing_paths("see `cam/plans.py`", ROOT) == ["cam/plans.py"]
+    assert missing_paths("see `spur_cad/cam/planner.py` and `cam/plan.py`") == ["spur_cad/cam/planner.py"]
+    assert missing_paths("see `cam/plans.py`, `strategies/bases.py` and `strategies/base.py`") == [
+        "cam/plans.py", "strategies/bases.py"]
+
+
+@pytest.mark.parametrize("document", [*sorted(p.name for p in (ROOT / "docs").glob("*.md")), "../README.md"])
+def test_every_path_the_documents_name_exists(document):
+    """The same for every page of docs/ and the README (paths of this repository; others' are not read)."""
+    assert missing_paths((ROOT / "docs" / document).read_text(encoding="utf-8")) == []
 
 
 # --- the names the page gives to functions, types and fields -----------------------------------------------
@@ -533,3 +545,29 @@ def test_import_spur_cad_loads_no_cad_kernel():
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120, check=False,
                          cwd=ROOT)
     assert out.stdout.strip() == "[]", out.stderr
+
+
+NAMED_STRATEGY_ALLOWED = {
+    ("spur_cad/summary.py", "perimeter"): "summary.json's perimeter_* keys (the comparison with perimeter finishing)",
+}
+"""Where a strategy's name may be written outside spur_cad/cam/strategies/ (docs/architecture.md: 'no module keeps
+a list of strategy names ... none of them names one, but for the comparison with the perimeter strategy')."""
+
+
+def strategy_names_written(paths: list[Path], names: set[str]) -> set[tuple[str, str]]:
+    """(file, name) for every string constant of `paths` that is exactly a strategy's name."""
+    return {(_relative(p) if p.is_relative_to(ROOT) else p.name, node.value)
+            for p in paths for node in ast.walk(ast.parse(p.read_text(encoding="utf-8")))
+            if isinstance(node, ast.Constant) and isinstance(node.value, str) and node.value in names}
+
+
+def test_no_module_outside_the_strategies_names_a_strategy():
+    from spur_cad.cam.strategies import REGISTRY
+
+    outside = [p for p in SOURCES if not _relative(p).startswith("spur_cad/cam/strategies/")]
+    assert strategy_names_written(outside, set(REGISTRY)) == set(NAMED_STRATEGY_ALLOWED)
+
+
+def test_a_planted_strategy_name_is_found(tmp_path):
+    (tmp_path / "m.py").write_text('"""Uses along_x."""\nif strategy.name == "along_x":\n    pass\n')
+    assert strategy_names_written([tmp_path / "m.py"], {"along_x", "perimeter"}) == {("m.py", "along_x")}
