@@ -24,9 +24,9 @@ from spur_cad.geometry.mate import (
     pair_facts,
     pair_problems,
 )
+from spur_cad.geometry.mate_mesh import trochoid_intrusion_mm
 from spur_cad.geometry.spec import MAX_TEETH, MIN_TEETH, GearSpec
 from spur_cad.keys import check_section, key
-from spur_cad.mate_mesh import trochoid_intrusion_mm
 
 TROCHOID_TOLERANCE_MM = 0.001
 """A tip corner may enter the other gear's outline by this much (its sampling and the mesh's steps) before it
@@ -115,7 +115,7 @@ def gear_pair(spec: GearSpec, mate: MateSection) -> GearPair:
 
 
 def _trochoid_problems(spec: GearSpec, pair: GearPair, facts: PairFacts) -> list[PairError]:
-    """Trochoid interference of an external pair (spur_cad.mate_mesh): a tip corner entering the other gear's
+    """Trochoid interference of an external pair (spur_cad.geometry.mate_mesh): a tip corner entering the other gear's
     material by more than TROCHOID_TOLERANCE_MM as the pair meshes."""
     into_gear, into_mate = trochoid_intrusion_mm(spec, pair, facts)
     problems = []

@@ -331,10 +331,10 @@ def test_an_internal_pair_given_by_its_centre_distance():
 
 @pytest.mark.parametrize("z1, x1, z2, x2, ha2", [(15, 0.3, 15, 0.3, 1.2), (30, 0.0, 20, 0.0, 1.28)])
 def test_the_followed_tip_corners_reach_as_deep_as_the_clearance_says(z1, x1, z2, x2, ha2):
-    """spur_cad.mate_mesh follows the mate's tip corners through the mesh: where the only fault is a tip clearance
-    c < 0 (the corner passes the line of centres below the root circle), they enter this gear by -c (3 um: the
-    mesh's steps and the outline's sampling); a sound pair's corners never enter either gear."""
-    from spur_cad.mate_mesh import trochoid_intrusion_mm  # noqa: PLC0415 (the job layer, imported only here)
+    """spur_cad.geometry.mate_mesh follows the mate's tip corners through the mesh: where the only fault is a tip
+    clearance c < 0 (the corner passes the line of centres below the root circle), they enter this gear by -c (3 um:
+    the mesh's steps and the outline's sampling); a sound pair's corners never enter either gear."""
+    from spur_cad.geometry.mate_mesh import trochoid_intrusion_mm  # noqa: PLC0415
     from spur_cad.mate_section import MateSection, gear_pair  # noqa: PLC0415
 
     spec = GearSpec(teeth=z1, module_mm=1.0, profile_shift_coefficient=x1, rack_tip_radius_mm=0.2, face_width_mm=5)

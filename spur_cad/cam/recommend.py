@@ -19,7 +19,9 @@ from spur_cad.cam.allowances import (  # noqa: F401  (re-exported: the names cal
     generating_pass_allowance,
     plunge_allowance,
 )
+from spur_cad.cam.fillet_reach import applies, fillet_reach, refusal_text
 from spur_cad.cam.tools import Tool, ToolError
+from spur_cad.geometry.mate import GearPair
 from spur_cad.geometry.sampling import sample_profile
 from spur_cad.geometry.spec import GearSpec
 
@@ -104,15 +106,23 @@ def recommend_tools(spec: GearSpec, blank_radius_mm: float, clearance_mm: float,
 
 
 def check_tools(spec: GearSpec, recommendations: ToolRecommendations, roughing: Tool | None,
-                finishing: Tool | None) -> None:
+                finishing: Tool | None, pair: GearPair | None = None) -> None:
     """Raise ToolError naming the violated limit and its value (the finishing strategy's own tool rule,
     e.g. the flat width, is its `check_tool`), for tools already checked in themselves (Tool.validate, run once
-    when the plan's inputs are made)."""
+    when the plan's inputs are made). With the gear's `pair` (its [mate]) a finishing corner above the fillet's
+    tightest curvature is accepted when what it leaves in the fillet is below the mate's SAP and clear of the mate's
+    tip path (cam.fillet_reach)."""
     rec = recommendations
     if finishing is not None:
         if finishing.kind == "flat":
             _check_flat_finishing(spec, finishing, rec)
-        if finishing.effective_corner_radius_mm > rec.finishing_max_corner_radius_mm + 1e-9:
+        corner = finishing.effective_corner_radius_mm
+        if corner > rec.finishing_max_corner_radius_mm + 1e-9 and pair is not None and applies(spec, pair):
+            reach = fillet_reach(spec, pair, corner)
+            if reach is None or not reach.fits:
+                raise ToolError(refusal_text(spec, pair, corner, reach), field="corner_radius_mm",
+                                section="tools.finishing")
+        elif corner > rec.finishing_max_corner_radius_mm + 1e-9:
             raise ToolError(f"finishing tool corner radius {finishing.effective_corner_radius_mm:.4f} mm exceeds "
                             f"finishing_max_corner_radius_mm = {rec.finishing_max_corner_radius_mm:.4f} mm "
                             "(smallest curvature radius of the root fillet)", field="corner_radius_mm",

@@ -1,0 +1,147 @@
+"""Issue 47 (3): the finishing corner's fillet reach on the rotary table follows the mate's SAP (cam.fillet_reach).
+
+References independent of spur_cad's profile and mesh code: the SAP from ISO 21771's formulas (inv alpha_w from the
+shift sum, a_w, the mate's tip circle d + 2 (h_a + x) m, the roll length a_w sin alpha_w - sqrt(r_a2^2 - r_b2^2));
+what a corner r_t leaves from a brute-force sweep of a trapezoid rack tooth rounded by r_t (shapely opening) rolling
+over the blank; the mate's tip corners from the involute function, turned through the mesh.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from scipy.optimize import brentq
+from shapely import Polygon, contains_xy, distance, points
+from shapely.geometry import Point
+from shapely.ops import unary_union
+
+from spur_cad.cam.fillet_reach import fillet_reach, largest_reaching_corner_mm
+from spur_cad.cam.recommend import check_tools, recommend_tools
+from spur_cad.cam.tools import Tool, ToolError
+from spur_cad.geometry.mate import GearPair, PairMember
+from spur_cad.geometry.spec import GearSpec
+
+M, ALPHA = 1.0, math.radians(20.0)
+Z1, X1, RHO = 30, 0.3, 0.38
+Z2 = 20
+CORNER = 0.44  # above the design fillet's tightest curvature radius (0.401 mm)
+
+
+def inv(a: float) -> float:
+    return math.tan(a) - a
+
+
+def reference_pair(addendum2: float) -> tuple[float, float, float]:
+    """(alpha_w, a_w, SAP diameter of gear 1) after ISO 21771 for the z30 x0.3 gear and a z20 x0 mate."""
+    alpha_w = brentq(lambda a: inv(a) - inv(ALPHA) - 2.0 * X1 * math.tan(ALPHA) / (Z1 + Z2), 1e-3, 1.2)
+    a_w = M * (Z1 + Z2) / 2.0 * math.cos(ALPHA) / math.cos(alpha_w)
+    rb1, rb2 = M * Z1 / 2.0 * math.cos(ALPHA), M * Z2 / 2.0 * math.cos(ALPHA)
+    ra2 = M * Z2 / 2.0 + addendum2 * M
+    roll = a_w * math.sin(alpha_w) - math.sqrt(ra2**2 - rb2**2)
+    return alpha_w, a_w, 2.0 * math.hypot(rb1, roll)
+
+
+def pair_of(addendum2: float) -> GearPair:
+    return GearPair(PairMember(Z1, profile_shift_coefficient=X1), PairMember(Z2, addendum_coefficient=addendum2), M)
+
+
+def gear(sap_diameter_mm: float = 0.0) -> GearSpec:
+    return GearSpec(teeth=Z1, module_mm=M, profile_shift_coefficient=X1, rack_tip_radius_mm=RHO,
+                    active_profile_start_diameter_mm=sap_diameter_mm)
+
+
+def rotate(p: np.ndarray, angle: float) -> np.ndarray:
+    c, s = math.cos(angle), math.sin(angle)
+    return p @ np.array([[c, s], [-s, c]])
+
+
+def brute_force_material(corner_mm: float) -> Polygon:
+    """Gear 1 as a rack tooth rounded by `corner_mm` leaves it (spaces -1, 0, 1; space 0 on +y): the blank less the
+    rack tooth at 6001 rolls. Rack frame: rolling line y = r, tooth half-width pi m / 4 - x m tan(alpha) there,
+    tip at the root circle r - (1.25 - x) m, narrowing by tan(alpha) per unit depth."""
+    r = M * Z1 / 2.0
+    half = math.pi * M / 4.0 - X1 * M * math.tan(ALPHA)
+    tip_y, top_y = r - (1.25 - X1) * M, r + 3.0 * M
+    w_tip, w_top = half - (r - tip_y) * math.tan(ALPHA), half + (top_y - r) * math.tan(ALPHA)
+    sharp = Polygon([(-w_tip, tip_y), (w_tip, tip_y), (w_top, top_y), (-w_top, top_y)])
+    tooth = np.array(sharp.buffer(-corner_mm, quad_segs=64).buffer(corner_mm, quad_segs=64).exterior.coords)
+    teeth = [tooth + np.array([k * math.pi * M, 0.0]) for k in (-1, 0, 1)]
+    cuts = []
+    for phi in np.linspace(-5.0 * M / r, 5.0 * M / r, 6001):
+        for t in teeth:
+            cuts.append(Polygon(rotate(t - np.array([r * phi, 0.0]), -phi)))
+    blank = Point(0.0, 0.0).buffer(r + (1.0 + X1) * M, quad_segs=512)
+    return blank.difference(unary_union(cuts))
+
+
+def mate_corner_path(addendum2: float) -> np.ndarray:
+    """The mate's tooth-0 tip corners in gear 1's frame through the mesh (gear 1 turning +-2 pitches), kept within
+    1.5 half-pitches of space 0's axis (where brute_force_material is exact)."""
+    alpha_w, a_w, _ = reference_pair(addendum2)
+    r2 = M * Z2 / 2.0
+    ra2 = r2 + addendum2 * M
+    alpha_a = math.acos(r2 * math.cos(ALPHA) / ra2)
+    psi = math.pi / (2.0 * Z2) + inv(ALPHA) - inv(alpha_a)  # half the tip's angular thickness
+    corners = ra2 * np.array([[math.sin(psi), -math.cos(psi)], [-math.sin(psi), -math.cos(psi)]])  # tooth down
+    out = []
+    for phi in np.linspace(-2.0, 2.0, 4001) * 2.0 * math.pi / Z1:
+        mate = rotate(corners, -phi * Z1 / Z2) + np.array([0.0, a_w])  # turning opposite to gear 1
+        out.append(rotate(mate, -phi))  # gear 1 turned by phi: its frame turned back
+    path = np.concatenate(out)
+    angle = np.arctan2(path[:, 0], path[:, 1])
+    return path[np.abs(angle) < 1.5 * math.pi / Z1]
+
+
+def test_sap_is_iso_21771s_and_half_a_millimetre_above_the_form_circle() -> None:
+    _, _, sap = reference_pair(0.7)
+    spec = gear(sap)
+    reach = fillet_reach(spec, pair_of(0.7), CORNER)
+    assert reach is not None
+    assert reach.sap_diameter_mm == pytest.approx(sap, rel=1e-9)
+    assert sap - 2.0 * spec.tooth_space_profile().form_radius_mm >= 0.5
+    assert spec.tooth_space_profile().min_fillet_curvature_radius_mm < CORNER
+
+
+def test_corner_refused_without_the_mate_and_accepted_with_it() -> None:
+    _, _, sap = reference_pair(0.7)
+    tool = Tool(diameter_mm=1.2, kind="bull_nose", corner_radius_mm=CORNER)
+    bare = gear()
+    rec = recommend_tools(bare, bare.tip_radius_mm + 0.5, 2.0)
+    with pytest.raises(ToolError, match="exceeds finishing_max_corner_radius_mm = 0.4009 mm"):
+        check_tools(bare, rec, None, tool)
+    mated = gear(sap)
+    check_tools(mated, recommend_tools(mated, mated.tip_radius_mm + 0.5, 2.0), None, tool, pair_of(0.7))
+
+
+def test_what_the_corner_leaves_is_below_the_sap_and_clear_of_the_mates_tips() -> None:
+    """Brute force: the swept outline leaves the design's only below the SAP, and the mate's tip corners stay out
+    of it; with the design's own rack round the corners stay out too (the mesh reference is sound)."""
+    _, _, sap = reference_pair(0.7)
+    left, design = brute_force_material(CORNER), brute_force_material(RHO)
+    path = mate_corner_path(0.7)
+    for material in (left, design):
+        assert not contains_xy(material, path[:, 0], path[:, 1]).any()
+    # the corners touch the design's involute (within the sweep's and path's sampling) as the pair meshes
+    assert float(np.min(distance(design.exterior, points(path)))) < 5e-3
+    extra = left.difference(design)  # what the corner leaves beyond the design
+    thick = [g for g in getattr(extra, "geoms", [extra]) if g.area > 1e-8]
+    assert thick, "the larger corner should leave material in the fillet"
+    highest = max(float(np.max(np.hypot(*np.array(g.exterior.coords).T))) for g in thick)
+    assert highest <= sap / 2.0, (highest, sap / 2.0)
+
+
+def test_mate_reaching_deep_refuses_the_corner_its_tips_would_hit() -> None:
+    """A mate of addendum 1.2 m: the involute still starts below its SAP, but its tip corners enter what the corner
+    leaves (brute force), and check_tools refuses, naming the largest corner that works (not 0)."""
+    _, _, sap = reference_pair(1.2)
+    spec = gear(sap)
+    reach = fillet_reach(spec, pair_of(1.2), CORNER)
+    assert reach is not None and reach.form_diameter_mm <= sap
+    path = mate_corner_path(1.2)
+    assert contains_xy(brute_force_material(CORNER), path[:, 0], path[:, 1]).any()
+    tool = Tool(diameter_mm=1.2, kind="bull_nose", corner_radius_mm=CORNER)
+    with pytest.raises(ToolError, match=r"mate's tip corners enter .* the largest corner radius that works is 0\.4"):
+        check_tools(spec, recommend_tools(spec, spec.tip_radius_mm + 0.5, 2.0), None, tool, pair_of(1.2))
+    assert largest_reaching_corner_mm(spec, pair_of(1.2)) >= spec.tooth_space_profile().min_fillet_curvature_radius_mm
