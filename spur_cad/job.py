@@ -14,8 +14,6 @@ spur_cad.keydocs writes docs/job-file.md from the same declarations
 from __future__ import annotations
 
 import dataclasses
-import difflib
-import re
 import tomllib
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
@@ -23,15 +21,13 @@ from pathlib import Path
 from types import MappingProxyType
 from typing import Any
 
-from spur_cad.cad.specs import BlankFeatures, StockSpec
+from spur_cad.cad.specs import StockSpec
 from spur_cad.cam.calibration import CalibrationTable, parse_calibration_table
 from spur_cad.cam.machine import Machine, RoughingParams, default_roughing_strategy
 from spur_cad.cam.machine_limits import check_machine_limits
-from spur_cad.cam.materials import DEFAULT_MATERIAL, MATERIALS
 from spur_cad.cam.probing import ProbeSection
 from spur_cad.cam.strategies import REGISTRY, FinishingParams, Strategies, finishing_section_type
 from spur_cad.cam.three_axis_tabs import ThreeAxisSection
-from spur_cad.cam.tools import Tool
 from spur_cad.cam.turning import LatheSection, check_lathe_blank, lathe_section_type
 from spur_cad.dialects import DIALECTS, Dialects
 from spur_cad.errors import (
@@ -41,212 +37,46 @@ from spur_cad.errors import (
     SpurCadError,
     StockError,
     escaped,
-    shown,
     shown_path,
 )
-from spur_cad.geometry.internal import InternalGearSpec
 from spur_cad.geometry.mate import GearPair
 from spur_cad.geometry.modifications import SIDES, FlankModifications, flank_modification
-from spur_cad.geometry.spec import MAX_TEETH, MIN_TEETH, GearSpec
-from spur_cad.keys import check_section, coerce, key, keys_of, section_problems, type_problem
+from spur_cad.geometry.spec import GearSpec
+from spur_cad.job_sections import (  # noqa: F401  (re-exported: the names callers know from here)
+    MODIFICATION_SECTIONS,
+    SECTIONS,
+    ExportSection,
+    GearSection,
+    JobSection,
+    ModificationsSection,
+    SimulationSection,
+    ToolsSection,
+)
+from spur_cad.job_toml import (  # noqa: F401  (re-exported)
+    MAX_JOB_FILE_BYTES,
+    blamed_key,
+    deepest_value,
+    load_section,
+    longest_number,
+    tables_of,
+    toml_error,
+    where_of,
+)
+from spur_cad.job_tools import (  # noqa: F401  (re-exported)
+    AUTO,
+    AUTO_KEYS,
+    DEFAULT_BOTTOM_TOOL_NUMBER,
+    DEFAULT_FINISHING_TOOL_NUMBER,
+    DEFAULT_ROUGHING_TOP_TOOL_NUMBER,
+    TOOL_ROLES,
+    check_roughing_top,
+    resolve_auto,
+    tools_section,
+    without_auto,
+)
+from spur_cad.keys import keys_of
 from spur_cad.mate_section import MateSection, check_mate
 from spur_cad.post.settings import PostSettings, post_settings_type
-
-
-@dataclass(frozen=True)
-class JobSection:
-    """[job]: name and the chordal tolerance of sampled profiles."""
-
-    name: str = key("gear job", label="JobName", group="Job", meaning="job name (summary, program headers)")
-    profile_tolerance_mm: float = key(0.001, unit="mm", low=0.0001, high=0.1, label="ProfileTolerance", group="Job",
-                                      meaning="chordal tolerance of sampled profiles (profile.csv)")
-    report_template: str = key("", label="ReportTemplate", group="Job",
-                               meaning="report.html's Jinja2 template, a file relative to the job file, in its "
-                                       "folder or a --side-files folder (empty: spur_cad's own, "
-                                       "spur_cad/report/templates/report.html.j2: copy it to start)")
-    material: str = key(DEFAULT_MATERIAL, choices=tuple(MATERIALS), label="Material", group="Job",
-                        meaning="the gear's material: its specific cutting force (Kienzle k_c1.1, m_c; "
-                                "spur_cad/cam/materials.py) sets the finishing tool's deflection in the error budget")
-
-
-@dataclass(frozen=True)
-class GearSection:
-    """[gear]: the gear as ISO 21771 names it, plus the blank's bore and keyway."""
-
-    teeth: int = key(low=MIN_TEETH, high=MAX_TEETH, label="Teeth", group="Gear", meaning="number of teeth z")
-    module_mm: float = key(unit="mm", low=0.05, high=100.0, label="Module", group="Gear", meaning="module m")
-    face_width_mm: float = key(unit="mm", low=0.5, high=2000.0, label="FaceWidth", group="Gear",
-                               meaning="face width b, along the rotary axis X")
-    pressure_angle_deg: float = key(20.0, unit="deg", low=10.0, high=35.0, label="PressureAngle", group="Gear",
-                                    meaning="pressure angle alpha")
-    profile_shift_coefficient: float = key(0.0, low=-2.0, high=3.0, label="ProfileShift", group="Gear",
-                                           meaning="profile shift coefficient x")
-    addendum_coefficient: float = key(1.0, low=0.5, high=2.0, label="AddendumCoefficient", group="Rack",
-                                      meaning="addendum coefficient h_a* of the generated gear")
-    dedendum_coefficient: float = key(1.25, low=0.5, high=2.5, label="DedendumCoefficient", group="Rack",
-                                      meaning="dedendum coefficient h_f* of the generated gear")
-    rack_tip_radius_mm: float = key(0.0, unit="mm", low=0.0, high=60.0, label="RackTipRadius", group="Rack",
-                                    meaning="tip corner radius rho of the generating rack (at most 0.6 x module)")
-    thickness_allowance_percent: float = key(0.0, unit="%", low=0.0, high=20.0, label="ThicknessAllowancePercent",
-                                             group="Allowance",
-                                             meaning="nominal tooth thickness reduced by this percentage "
-                                                     "(the reference process's profile clearance, 0-5 % typical)")
-    thickness_allowance_mm: float = key(0.0, unit="mm", low=0.0, high=50.0, label="ThicknessAllowance",
-                                        group="Allowance",
-                                        meaning="further absolute tooth thickness reduction (at most 0.5 x module; "
-                                                "normal section for helical gears)")
-    helix_angle_deg: float = key(0.0, unit="deg", low=0.0, high=45.0, label="HelixAngle", group="Gear",
-                                 meaning="helix angle beta on the reference cylinder, 0: spur gear (module, pressure "
-                                         "angle, shift, coefficients and rack tip radius are then normal-section "
-                                         "values)")
-    hand: str = key("right", label="Hand", group="Gear", choices=("right", "left"),
-                    meaning="hand of the helix (helical gears)")
-    internal: bool = key(False, label="Internal", group="Gear",
-                         meaning="internal spur gear (ring gear) cut by a pinion-type shaper cutter; its CAM needs the "
-                                 "3-axis variant (docs/geometry.md, Internal gears)")
-    shaper_cutter_teeth: int = key(20, low=MIN_TEETH, high=MAX_TEETH, label="ShaperCutterTeeth", group="Gear",
-                                   meaning="internal gears: teeth z_0 of the shaper cutter (the external gear the rack "
-                                           "generates, tip corners rounded by rack_tip_radius_mm)")
-    shaper_cutter_profile_shift_coefficient: float = key(
-        0.0, low=-1.0, high=1.5, label="ShaperCutterProfileShift", group="Gear",
-        meaning="internal gears: profile shift coefficient x_0 of the shaper cutter")
-    rim_outer_diameter_mm: float = key(0.0, unit="mm", low=0.0, high=4000.0, label="RimOuterDiameter", group="Gear",
-                                       meaning="internal gears: outside diameter of the ring's rim (at least 2 modules "
-                                               "below the root circle)")
-    mating_pinion_teeth: int = key(0, low=0, high=MAX_TEETH, label="MatingPinionTeeth", group="Gear",
-                                   meaning="internal gears: teeth of the mating pinion for the tip interference check, "
-                                           "0: not checked")
-    bore_diameter_mm: float = key(0.0, unit="mm", low=0.0, high=2000.0, label="BoreDiameter", group="Bore",
-                                  meaning="through bore diameter, 0: none")
-    keyway_width_mm: float = key(0.0, unit="mm", low=0.0, high=500.0, label="KeywayWidth", group="Bore",
-                                 meaning="hub keyway width, 0: none")
-    keyway_depth_mm: float = key(0.0, unit="mm", low=0.0, high=200.0, label="KeywayDepth", group="Bore",
-                                 meaning="hub keyway depth from the bore surface, 0: none")
-
-    def to_spec(self) -> GearSpec:
-        """The GearSpec ([gear] internal = true: an InternalGearSpec, spur only)."""
-        common: dict[str, Any] = dict(
-            teeth=self.teeth, module_mm=self.module_mm, pressure_angle_deg=self.pressure_angle_deg,
-            profile_shift_coefficient=self.profile_shift_coefficient,
-            addendum_coefficient=self.addendum_coefficient, dedendum_coefficient=self.dedendum_coefficient,
-            rack_tip_radius_mm=self.rack_tip_radius_mm,
-            thickness_allowance_fraction=self.thickness_allowance_percent / 100.0,
-            thickness_allowance_mm=self.thickness_allowance_mm, face_width_mm=self.face_width_mm,
-            helix_angle_deg=self.helix_angle_deg, hand=self.hand,
-        )
-        if not self.internal:
-            return GearSpec(**common)
-        return InternalGearSpec(**common, shaper_cutter_teeth=self.shaper_cutter_teeth,
-                                shaper_cutter_profile_shift_coefficient=self.shaper_cutter_profile_shift_coefficient,
-                                rim_outer_diameter_mm=self.rim_outer_diameter_mm,
-                                mating_pinion_teeth=self.mating_pinion_teeth)
-
-    def blank_features(self) -> BlankFeatures:
-        return BlankFeatures(self.bore_diameter_mm, self.keyway_width_mm, self.keyway_depth_mm)
-
-
-def _amount(label: str, meaning: str, signed: bool = False):
-    """A modification amount key (um): 0 = none; beyond 10 % of the module is refused with the gear."""
-    return key(0.0, unit="um", low=-10000.0 if signed else 0.0, high=10000.0, label=label,
-               group="Flank modifications", meaning=meaning)
-
-
-@dataclass(frozen=True)
-class ModificationsSection:
-    """[gear.modifications] / [gear.modifications.left] / [gear.modifications.right]: flank modifications
-    (micro-geometry, ISO 21771 names; docs/geometry.md), amounts in um removed along the flank normal, lengths in mm.
-    [gear.modifications] sets both flank sides; a .left or .right table overrides the keys it gives for that side.
-    Amounts are at most 10 % of the module; reliefs start on the usable involute (form to tip diameter)."""
-
-    tip_relief_um: float = _amount("TipRelief", "tip relief C_a: removed at the tip diameter")
-    tip_relief_start_diameter_mm: float = key(0.0, unit="mm", low=0.0, high=5000.0, label="TipReliefStartDiameter",
-                                              group="Flank modifications",
-                                              meaning="diameter d_Ca where the tip relief starts (needed with it)")
-    tip_relief_shape: str = key("linear", choices=("linear", "parabolic"), label="TipReliefShape",
-                                group="Flank modifications",
-                                meaning="tip relief along the roll length: linear or parabolic")
-    root_relief_um: float = _amount("RootRelief", "root relief C_f: removed at the form diameter (start of the "
-                                                  "usable involute)")
-    root_relief_start_diameter_mm: float = key(0.0, unit="mm", low=0.0, high=5000.0, label="RootReliefStartDiameter",
-                                               group="Flank modifications",
-                                               meaning="diameter d_Cf where the root relief starts, toward the root "
-                                                       "(needed with it)")
-    root_relief_shape: str = key("linear", choices=("linear", "parabolic"), label="RootReliefShape",
-                                 group="Flank modifications",
-                                 meaning="root relief along the roll length: linear or parabolic")
-    profile_crowning_um: float = _amount("ProfileCrowning", "profile crowning C_alpha: removed at both ends of the "
-                                                            "usable involute, parabolic, none at its middle")
-    profile_slope_um: float = _amount("ProfileSlope", "design profile slope f_Halpha: the material grows by this "
-                                                      "from the form diameter to the tip (signed, none at "
-                                                      "mid-profile)", signed=True)
-    lead_crowning_um: float = _amount("LeadCrowning", "lead crowning C_beta: removed at both faces, parabolic, none "
-                                                      "at mid-face")
-    end_relief_um: float = _amount("EndRelief", "end relief C_I / C_II: removed at the face(s), linear")
-    end_relief_length_mm: float = key(0.0, unit="mm", low=0.0, high=2000.0, label="EndReliefLength",
-                                      group="Flank modifications",
-                                      meaning="length L_I / L_II of the end relief from the face (needed with it)")
-    end_relief_faces: str = key("both", choices=("both", "front", "back"), label="EndReliefFaces",
-                                group="Flank modifications",
-                                meaning="faces with end relief: both, front (X = 0) or back (X = b)")
-    helix_slope_um: float = _amount("HelixSlope", "design helix slope f_Hbeta: the material grows by this from the "
-                                                  "front face to the back face (signed, none at mid-face)",
-                                    signed=True)
-
-
-MODIFICATION_SECTIONS: dict[str, type] = {
-    "gear.modifications": ModificationsSection,
-    "gear.modifications.left": ModificationsSection,
-    "gear.modifications.right": ModificationsSection,
-}
-"""The flank modification tables: read with [gear] (in the workbench, the gear's "Flank modifications" groups)."""
-
-
-@dataclass(frozen=True)
-class SimulationSection:
-    """[simulation]: verification by simulated cutting (see docs/simulation.md)."""
-
-    enabled: bool = key(True, label="SimulationEnabled", group="Simulation",
-                        meaning="cut the stock with the roughing and finishing IR and measure it against the design "
-                                "(summary simulation.*, deviation map in report.html)")
-    # The simulator's blades reach 0.5 mm into the material, at least 10 x the resolution: 0.05 mm at most.
-    resolution_mm: float = key(0.005, unit="mm", low=0.0005, high=0.05, label="SimulationResolution",
-                               group="Simulation",
-                               meaning="bound of the simulation's own error; finer is slower (about 4 x per halving)")
-
-    def validate(self) -> None:
-        """Raise SimulationError for a value outside its declared range (e.g. a resolution given to Simulate)."""
-        from spur_cad.sim.simulate import SimulationError
-
-        check_section(self, "simulation", SimulationError)
-
-
-@dataclass(frozen=True)
-class ExportSection:
-    """[export]: the gear's transverse outline as 2-D drawings for wire EDM, laser and waterjet (docs/geometry.md):
-    closed loops of arcs and lines within [job] profile_tolerance_mm, offset by offset_mm."""
-
-    dxf: bool = key(False, label="ExportDxf", group="2-D export",
-                    meaning="write gear.dxf: one closed LWPOLYLINE with arcs per loop, layers OUTLINE and BORE, mm "
-                            "(spur gears only)")
-    svg: bool = key(False, label="ExportSvg", group="2-D export",
-                    meaning="write gear.svg: the same loops as SVG paths with arcs, in mm (spur gears only)")
-    offset_mm: float = key(0.0, unit="mm", low=-10.0, high=10.0, label="ExportOffset", group="2-D export",
-                           meaning="loops offset this far away from the material (outside the gear, inside the bore): "
-                                   "wire radius plus spark gap for wire EDM, half the kerf for laser and waterjet, "
-                                   "so the file is the path of the cut's centre; 0: the part's own outline")
-
-    def validate(self) -> None:
-        check_section(self, "export", JobFileError)
-
-
-@dataclass(frozen=True)
-class ToolsSection:
-    """[tools]: the roughing and finishing tools (without them the job stops after the CAD stage)."""
-
-    roughing: Tool | None = None
-    finishing: Tool | None = None
-    bottom: Tool | None = None  # two-stage roughing: a smaller tool for the bottom of the spaces
-    roughing_top: Tool | None = None  # two-stage roughing offered: a larger tool for the upper part of the spaces
 
 
 @dataclass(frozen=True)
@@ -286,7 +116,7 @@ class Job:
     def located(self, error: SpurCadError) -> str:
         """An error raised after loading, prefixed with 'file:line' of the key it blames (its section's
         header when the file does not set the key, the file alone when the error names no key)."""
-        where = _where(self.source, self.text, error.section, error.field) if error.section else self.source
+        where = where_of(self.source, self.text, error.section, error.field) if error.section else self.source
         return f"{where}: {error}"
 
     def section(self, name: str):
@@ -296,28 +126,6 @@ class Job:
         if name.startswith("tools."):
             return getattr(self.tools, name.removeprefix("tools."))
         return getattr(self, name)
-
-
-# Every section of the job file and its dataclass, in the order of the documentation and the workbench.
-SECTIONS: dict[str, type] = {
-    "job": JobSection,
-    "gear": GearSection,
-    "mate": MateSection,
-    "stock": StockSpec,
-    "tools.roughing": Tool,
-    "tools.finishing": Tool,
-    "tools.bottom": Tool,
-    "tools.roughing_top": Tool,
-    "roughing": RoughingParams,
-    "finishing": FinishingParams,
-    "machine": Machine,
-    "three_axis": ThreeAxisSection,
-    "simulation": SimulationSection,
-    "export": ExportSection,
-    "post": PostSettings,
-    "lathe": LatheSection,
-    "probe": ProbeSection,
-}
 
 
 def job_sections(strategies: Strategies = REGISTRY, dialects: Dialects = DIALECTS,
@@ -335,113 +143,6 @@ def job_sections(strategies: Strategies = REGISTRY, dialects: Dialects = DIALECT
     return {**types, **sections}
 
 
-_TOOL_ROLES = ("roughing", "finishing", "bottom", "roughing_top")
-MAX_JOB_FILE_BYTES = 1024 * 1024
-"""Job files larger than this are refused before they are parsed."""
-
-
-def _line_of(text: str, table: str, key_name: str | None) -> int | None:
-    """1-based line where `key_name` is set inside `[table]` (or the table header if key_name is None)."""
-    current = ""
-    header = re.compile(r"^\s*\[\s*([A-Za-z0-9_.\- ]+?)\s*\]\s*(#.*)?$")
-    for number, line in enumerate(text.splitlines(), start=1):
-        m = header.match(line)
-        if m:
-            current = re.sub(r"\s+", "", m.group(1))
-            if key_name is None and current == table:
-                return number
-            continue
-        if key_name is not None and current == table and re.match(rf"^\s*[\"']?{re.escape(key_name)}[\"']?\s*=",
-                                                                 line):
-            return number
-    return None
-
-
-def _where(source: str, text: str, table: str, key_name: str | None = None) -> str:
-    """'file:line' of the key (its section's header when the file does not set it), or 'source'."""
-    line = (_line_of(text, table, key_name) if key_name else None) or _line_of(text, table, None)
-    return f"{source}:{line}" if line else source
-
-
-def _blamed_key(exc: SpurCadError, name: str, given: dict, sections: dict[str, type] = SECTIONS) -> str | None:
-    """The key of section `name` a cross-field error is about, for its line: the error's `field` when the
-    file sets it, else the first key the message names that the file sets, else the `field` (not set)."""
-    names = [k.name for k in keys_of(sections[name])]
-    if exc.field in names and exc.field in given:
-        return exc.field
-    message = str(exc)
-    positions = {k: m.start() for k in names if (m := re.search(rf"\b{re.escape(k)}\b", message))}
-    for k in sorted(positions, key=lambda name: positions[name]):
-        if k in given:
-            return k
-    return exc.field if exc.field in names else None
-
-
-def _load_section(table: object, name: str, source: str, text: str, sections: dict[str, type] = SECTIONS):
-    """Build section `name`'s dataclass from its TOML table, checking keys, types, ranges and choices."""
-    cls = sections[name]
-    if not isinstance(table, dict):
-        raise JobFileError(f"{_where(source, text, name)}: [{name}] must be a table")
-    known = {k.name: k for k in keys_of(cls)}
-    for key_name in table:
-        if key_name not in known:
-            close = difflib.get_close_matches(key_name[:100], known, n=2)
-            hint = (f"did you mean {' or '.join(close)}?" if close else f"known keys: {', '.join(sorted(known))}")
-            raise JobFileError(f"{_where(source, text, name, key_name)}: unknown key {shown(key_name)} in [{name}] "
-                               f"({hint})", section=name)
-    values = {}
-    for k in known.values():
-        if k.name not in table:
-            if k.required:
-                raise JobFileError(f"{_where(source, text, name)}: [{name}] is missing the required key '{k.name}'",
-                                   section=name, field=k.name)
-            values[k.name] = k.default
-            continue
-        problem = type_problem(k, table[k.name])
-        if problem:
-            raise JobFileError(f"{_where(source, text, name, k.name)}: [{name}] {k.name} {problem}", section=name,
-                               field=k.name)
-        values[k.name] = coerce(k, table[k.name])
-    problems = section_problems(cls, values)
-    if problems:
-        key_name, problem = problems[0]
-        raise JobFileError(f"{_where(source, text, name, key_name)}: [{name}] {key_name} {problem}", section=name,
-                           field=key_name)
-    return cls(**values)
-
-
-def _deepest_value(text: str, source: str) -> str:
-    """'file:line: key' of the most deeply nested value (for the one error tomllib gives no position for)."""
-    best, where = 0, source
-    for number, line in enumerate(text.splitlines(), start=1):
-        name, sep, value = line.partition("=")
-        depth = len(value) - len(value.lstrip("[{ "))
-        if sep and depth > best:
-            best, where = depth, f"{source}:{number}: {shown_path(name.strip(), MAX_SHOWN_CHARS)}"
-    return where
-
-
-def _toml_error(source: str, message: str) -> str:
-    """tomllib's 'Invalid value (at line 3, column 5)' as 'file:3: not valid TOML: invalid value (column 5)'."""
-    found = re.fullmatch(r"(.*) \(at line (\d+), column (\d+)\)", message, re.DOTALL)
-    if found is None:
-        return f"{source}: not valid TOML: {escaped(message)}"
-    what, line, column = found.groups()
-    return f"{source}:{line}: not valid TOML: {escaped(what[:1].lower() + what[1:])} (column {column})"
-
-
-def _longest_number(text: str, source: str) -> str:
-    """'file:line: key' of the longest run of digits (for the error tomllib gives no position for)."""
-    best, where = 0, source
-    for number, line in enumerate(text.splitlines(), start=1):
-        digits = max((len(run) for run in re.findall(r"\d+", line)), default=0)
-        if digits > best:
-            key_name, equals, _ = line.partition("=")
-            best, where = digits, f"{source}:{number}" + (f": {shown_path(key_name.strip(), MAX_SHOWN_CHARS)}"
-                                                          if equals else "")
-    return where
-
-
 def parse_job(text: str, source: str = "<job>", strategies: Strategies = REGISTRY,
               dialects: Dialects = DIALECTS, sections: Mapping[str, type] = MappingProxyType({})) -> Job:
     """Validate a job file's text; raises JobFileError (or GearSpecError wrapped into it). `strategies`: the
@@ -454,12 +155,12 @@ def parse_job(text: str, source: str = "<job>", strategies: Strategies = REGISTR
     try:
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
-        raise JobFileError(_toml_error(source, str(exc))) from None
+        raise JobFileError(toml_error(source, str(exc))) from None
     except ValueError as exc:  # an integer of thousands of digits (Python refuses to convert it)
-        raise JobFileError(f"{_longest_number(text, source)}: a number of thousands of digits (no key takes one: "
+        raise JobFileError(f"{longest_number(text, source)}: a number of thousands of digits (no key takes one: "
                            f"{escaped(str(exc).split(':')[0])})") from None
     except RecursionError:
-        raise JobFileError(f"{_deepest_value(text, source)}: arrays or tables nested too deeply for a job file") \
+        raise JobFileError(f"{deepest_value(text, source)}: arrays or tables nested too deeply for a job file") \
             from None
     return _job_from_data(data, source, text, strategies, dialects, sections)
 
@@ -473,172 +174,17 @@ def job_from_dict(data: dict, source: str, strategies: Strategies = REGISTRY, di
     return _job_from_data(data, source, "", strategies, dialects, sections)
 
 
-def _tables(data: dict, source: str, text: str) -> dict[str, object]:
-    """{section name: its table} of the sections `data` has; unknown sections are errors."""
-    if not isinstance(data, dict):
-        raise JobFileError(f"{source}: a job must be a table of sections")
-    top = sorted({name.split(".")[0] for name in SECTIONS})
-    tables: dict[str, object] = {}
-    for name, table in data.items():
-        children = [s for s in SECTIONS if s.startswith(name + ".")]
-        if name in SECTIONS:
-            tables[name] = table
-        elif children:
-            if not isinstance(table, dict):
-                raise JobFileError(f"{_where(source, text, name)}: [{name}] must be a table")
-            for child, child_table in table.items():
-                if f"{name}.{child}" not in SECTIONS:
-                    known = ", ".join(f"[{s}]" for s in children)
-                    raise JobFileError(f"{_where(source, text, name + '.' + child)}: unknown section "
-                                       f"[{shown_path(name + '.' + child, MAX_SHOWN_CHARS)}] (known: {known})")
-                tables[f"{name}.{child}"] = child_table
-        else:
-            raise JobFileError(f"{_where(source, text, name)}: unknown section [{shown_path(name, MAX_SHOWN_CHARS)}] "
-                               f"(known sections: {', '.join(top)})")
-    if "gear" not in tables:
-        raise JobFileError(f"{source}: the job file has no [gear] section")
-    return tables
-
-
-DEFAULT_FINISHING_TOOL_NUMBER = 2
-"""The finishing tool's number when its section gives none (the roughing tool's default is 1)."""
-DEFAULT_BOTTOM_TOOL_NUMBER = 3
-"""The bottom roughing tool's number when its section gives none."""
-DEFAULT_ROUGHING_TOP_TOOL_NUMBER = 4
-"""The larger roughing tool's number ([tools.roughing_top]) when its section gives none."""
-
-
-def _tool_label(tool: Tool) -> str:
-    corner = f" r {tool.effective_corner_radius_mm:g} mm" if tool.effective_corner_radius_mm else ""
-    return f"{tool.kind} D {tool.diameter_mm:g} mm{corner}, {tool.flutes} flutes"
-
-
-def _check_tool_numbers(first_role: str, first: Tool, role: str, tool: Tool, where: str, blamed: str) -> None:
-    """Two different end mills under one tool number would make the machine load the wrong one for one of the
-    programs: refuse (the same end mill may serve both, with its own cutting data)."""
-    def shape(tool: Tool) -> tuple:
-        return (tool.kind, tool.diameter_mm, tool.effective_corner_radius_mm, tool.flutes, tool.flute_length_mm,
-                tool.stick_out_mm, tool.gauge_length_mm)
-
-    if first.tool_number == tool.tool_number and shape(first) != shape(tool):
-        raise JobFileError(f"{where}: [tools.{role}] tool_number = {tool.tool_number} is also the {first_role} "
-                           f"tool's number, but the tools differ ({first_role} {_tool_label(first)}; {role} "
-                           f"{_tool_label(tool)}): the machine would load the wrong end mill; give each tool "
-                           "its own number", section=f"tools.{blamed}", field="tool_number")
-
-
-def _tools_section(sections: dict, tables: dict, where: Callable[[str, str | None], str]) -> ToolsSection:
-    """The tools, with the default numbers of tools whose sections give none (T2 finishing, T3 bottom, T4
-    roughing_top), and no two different tools under one number."""
-    for role, number in (("finishing", DEFAULT_FINISHING_TOOL_NUMBER), ("bottom", DEFAULT_BOTTOM_TOOL_NUMBER),
-                         ("roughing_top", DEFAULT_ROUGHING_TOP_TOOL_NUMBER)):
-        if f"tools.{role}" in sections and "tool_number" not in tables[f"tools.{role}"]:
-            sections[f"tools.{role}"] = dataclasses.replace(sections[f"tools.{role}"], tool_number=number)
-    tools = ToolsSection(**{role: sections.get(f"tools.{role}") for role in _TOOL_ROLES})
-    present = [role for role in _TOOL_ROLES if getattr(tools, role) is not None]
-    for i, first_role in enumerate(present):
-        for role in present[i + 1:]:
-            given = "tool_number" in tables[f"tools.{role}"]  # else blame the other tool's number (the default given)
-            blamed = role if given else first_role
-            _check_tool_numbers(first_role, getattr(tools, first_role), role, getattr(tools, role),
-                                where(f"tools.{blamed}", "tool_number"), blamed)
-    return tools
-
-
-def _check_roughing_top(tools: ToolsSection, where: Callable[[str, str | None], str]) -> None:
-    """[tools.roughing_top] offers two-stage roughing with a larger flat end mill above [tools.roughing]: it needs
-    that section, not [tools.bottom] as well (each makes a pair of roughing tools), and a larger diameter."""
-    top, roughing = tools.roughing_top, tools.roughing
-    if top is None:
-        return
-    name = "tools.roughing_top"
-    if roughing is None:
-        problem, key = ("needs [tools.roughing]: the larger tool roughs the upper part of the spaces, the roughing "
-                        "tool what it leaves"), "diameter_mm"
-    elif tools.bottom is not None:
-        problem, key = ("and [tools.bottom] both make two-stage roughing: give one of them (roughing_top: a larger "
-                        "tool above [tools.roughing]; bottom: a smaller one below it)"), "diameter_mm"
-    elif top.kind != "flat":
-        problem, key = f"kind = {shown(top.kind)}: roughing uses a flat end mill", "kind"
-    elif top.diameter_mm <= roughing.diameter_mm:
-        problem, key = (f"diameter_mm = {top.diameter_mm:g} must be larger than the roughing tool's "
-                        f"{roughing.diameter_mm:g} mm (it roughs the upper part of the spaces)"), "diameter_mm"
-    else:
-        return
-    raise JobFileError(f"{where(name, key)}: [{name}] {problem}", section=name, field=key)
-
-
-AUTO = "auto"
-AUTO_KEYS = ("diameter_mm", "corner_radius_mm")
-"""Tool keys a job may give as "auto": the suggestion for the gear (spur_cad.cam.suggest) takes their place."""
-_AUTO_ROLES = ("roughing", "finishing")
-_PROVISIONAL = {"diameter_mm": 1.0, "corner_radius_mm": 0.0}  # stand-ins until the suggestion is known
-
-
-def _without_auto(tables: dict, where: Callable[[str, str | None], str]) -> tuple[dict, dict[str, set[str]]]:
-    """The tables with every "auto" tool key replaced by a stand-in, and {role: its "auto" keys}; "auto"
-    anywhere else is refused with one line."""
-    autos: dict[str, set[str]] = {}
-    tables = dict(tables)
-    for name, table in list(tables.items()):
-        if not isinstance(table, dict):
-            continue
-        for key_name, value in table.items():
-            if value != AUTO:
-                continue
-            role = name.removeprefix("tools.")
-            if not name.startswith("tools.") or role not in _AUTO_ROLES or key_name not in AUTO_KEYS:
-                allowed = " and ".join(f"[tools.{r}]" for r in _AUTO_ROLES)
-                raise JobFileError(f"{where(name, key_name)}: [{name}] {key_name} = \"auto\": only "
-                                   f"{' and '.join(AUTO_KEYS)} of {allowed} may be \"auto\"",
-                                   section=name, field=key_name)
-            autos.setdefault(role, set()).add(key_name)
-            tables[name] = {**tables[name], key_name: _PROVISIONAL[key_name]}
-    return tables, autos
-
-
-def _resolve_auto(sections: dict, tables: dict, autos: dict[str, set[str]], spec: GearSpec, strategies: Strategies,
-                  where: Callable[[str, str | None], str]) -> None:
-    """Put the suggested tools' sizes (and kinds, where the table gives none) in place of the "auto" keys: the
-    finishing tool first (the roughing limit depends on it and the finishing strategy), then the roughing tool."""
-    from spur_cad.cam.strategies import get_strategy
-    from spur_cad.cam.suggest import suggested_finishing, suggested_roughing
-
-    stock, machine = sections.get("stock", StockSpec()), sections.get("machine", Machine())
-    blank = stock.blank_radius_mm(spec)
-    finishing_section = sections.get("finishing") or finishing_section_type(strategies)()
-    for role in ("finishing", "roughing"):
-        if role not in autos:
-            continue
-        name = f"tools.{role}"
-        strategy = get_strategy(finishing_section.strategy, strategies)
-        if role == "finishing":
-            shape = suggested_finishing(spec, strategy, finishing_section.target_scallop_mm, blank,
-                                        machine.clearance_mm)
-        else:
-            shape = suggested_roughing(spec, strategy, sections.get("tools.finishing"),
-                                       sections.get("roughing", RoughingParams()), stock, machine.clearance_mm)
-        first = sorted(autos[role])[0]
-        if shape is None:
-            raise JobFileError(f"{where(name, first)}: [{name}] {first} = \"auto\": no {role} tool fits this gear "
-                               "within its limits; give the tool's size", section=name, field=first)
-        chosen = {key_name: getattr(shape, key_name) for key_name in autos[role]}
-        if "kind" not in tables[name]:
-            chosen["kind"] = shape.kind
-        sections[name] = dataclasses.replace(sections[name], **chosen)
-
-
 def _validate_sections(sections: dict, tables: dict, types: dict, autos: dict[str, set[str]], spec: GearSpec,
                        strategies: Strategies, where: Callable[[str, str | None], str]) -> None:
     """Every section's own checks, the tools last: their "auto" keys are resolved once the sections the
     suggestion depends on (machine, roughing, finishing) have passed theirs."""
     for name in ("machine", "three_axis", "roughing", "finishing", "post", "export", "lathe", "probe",
-                 *(f"tools.{role}" for role in _TOOL_ROLES)):
+                 *(f"tools.{role}" for role in TOOL_ROLES)):
         if name not in sections:
             continue
         is_tool = name.startswith("tools.")
         if is_tool and autos:
-            _resolve_auto(sections, tables, autos, spec, strategies, where)
+            resolve_auto(sections, tables, autos, spec, strategies, where)
             autos = {}
         try:
             if is_tool:
@@ -649,7 +195,7 @@ def _validate_sections(sections: dict, tables: dict, types: dict, autos: dict[st
                 sections[name].validate()
         except SpurCadError as exc:
             prefix = f"[{name}] " if is_tool else ""
-            blamed = _blamed_key(exc, name, tables[name], types)
+            blamed = blamed_key(exc, name, tables[name], types)
             raise JobFileError(f"{where(name, blamed)}: {prefix}{exc}", section=name, field=blamed) from None
 
 
@@ -661,19 +207,19 @@ def _split_modifications(data: dict, source: str, text: str) -> tuple[dict, dict
     common = gear.pop("modifications")
     name = "gear.modifications"
     if not isinstance(common, dict):
-        raise JobFileError(f"{_where(source, text, name)}: [{name}] must be a table")
+        raise JobFileError(f"{where_of(source, text, name)}: [{name}] must be a table")
     common = dict(common)
     tables = {name: common}
     for child, value in common.items():
         if isinstance(value, dict) and child not in SIDES:
-            raise JobFileError(f"{_where(source, text, f'{name}.{child}')}: unknown section "
+            raise JobFileError(f"{where_of(source, text, f'{name}.{child}')}: unknown section "
                                f"[{shown_path(f'{name}.{child}', MAX_SHOWN_CHARS)}] (known: [{name}.left], "
                                f"[{name}.right])")
     for side in SIDES:
         if side in common:
             side_table = common.pop(side)
             if not isinstance(side_table, dict):
-                raise JobFileError(f"{_where(source, text, f'{name}.{side}')}: [{name}.{side}] must be a table")
+                raise JobFileError(f"{where_of(source, text, f'{name}.{side}')}: [{name}.{side}] must be a table")
             tables[f"{name}.{side}"] = side_table
     return {**data, "gear": gear}, tables
 
@@ -685,13 +231,13 @@ def _modifications(tables: dict[str, dict], spec: GearSpec, source: str,
     given (a side's resolved). Errors name the key's line in the table that gives it."""
     if not tables:
         return None, {}
-    common = _load_section(tables["gear.modifications"], "gear.modifications", source, text, MODIFICATION_SECTIONS)
+    common = load_section(tables["gear.modifications"], "gear.modifications", source, text, MODIFICATION_SECTIONS)
     given_values = {"gear.modifications": dataclasses.asdict(common)}
     sides = {}
     for side in SIDES:
         name = f"gear.modifications.{side}"
         given = tables.get(name, {})
-        own = _load_section(given, name, source, text, MODIFICATION_SECTIONS)
+        own = load_section(given, name, source, text, MODIFICATION_SECTIONS)
         values = {k.name: getattr(own if k.name in given else common, k.name) for k in keys_of(ModificationsSection)}
         if name in tables:
             given_values[name] = values
@@ -702,7 +248,7 @@ def _modifications(tables: dict[str, dict], spec: GearSpec, source: str,
             table = name if exc.field in given else "gear.modifications"
             if table not in tables:
                 table = "gear.modifications"
-            raise JobFileError(f"{_where(source, text, table, exc.field)}: [{table}] {exc}", section=table,
+            raise JobFileError(f"{where_of(source, text, table, exc.field)}: [{table}] {exc}", section=table,
                                field=exc.field) from None
     modifications = FlankModifications(**sides)
     return (None if modifications.is_zero else modifications), given_values
@@ -727,7 +273,7 @@ def _check_added_material(mods: FlankModifications | None, finish_stock_mm: floa
         key = "profile_slope_um" if abs(flank.profile_slope_mm) >= abs(flank.helix_slope_mm) else "helix_slope_um"
         table = f"gear.modifications.{side}" if key in tables.get(f"gear.modifications.{side}", {}) \
             else "gear.modifications"
-        raise JobFileError(f"{_where(source, text, table, key)}: [{table}] the {side} flank's modifications add "
+        raise JobFileError(f"{where_of(source, text, table, key)}: [{table}] the {side} flank's modifications add "
                            f"{1000 * added:.1f} um of material (the signed slopes), more than roughing leaves for "
                            f"finishing ([roughing] finish_stock_mm = {finish_stock_mm:g} mm)", section=table, field=key)
 
@@ -736,21 +282,21 @@ def _job_from_data(data: dict, source: str, text: str, strategies: Strategies = 
                    dialects: Dialects = DIALECTS, sections: Mapping[str, type] = MappingProxyType({})) -> Job:
     """Validate parsed job data; `text` (the file's text, or "") only locates keys for messages."""
     data, modification_tables = _split_modifications(data, source, text)
-    tables, autos = _without_auto(_tables(data, source, text), lambda name, key_name: _where(source, text, name,
+    tables, autos = without_auto(tables_of(data, source, text), lambda name, key_name: where_of(source, text, name,
                                                                                               key_name))
     types = job_sections(strategies, dialects, sections)
-    loaded: dict[str, Any] = {name: _load_section(tables[name], name, source, text, types)
+    loaded: dict[str, Any] = {name: load_section(tables[name], name, source, text, types)
                               for name in types if name in tables}  # each section's dataclass, by its name
     loaded["roughing"], strategy_left_out = _roughing_section(loaded, tables)
 
     def where(name: str, key_name: str | None) -> str:
-        return _where(source, text, name, key_name)
+        return where_of(source, text, name, key_name)
 
     gear_section: GearSection = loaded["gear"]
     try:
         spec = gear_section.to_spec()
     except GearSpecError as exc:
-        blamed = _blamed_key(exc, 'gear', tables['gear'])
+        blamed = blamed_key(exc, 'gear', tables['gear'])
         raise JobFileError(f"{where('gear', blamed)}: invalid gear: {exc}", section="gear", field=blamed) from None
     setup = loaded.get("machine", Machine()).setup
     if spec.kind.teeth_inward and any(name.startswith("tools") for name in tables) and not setup.cuts(spec.kind):
@@ -761,7 +307,7 @@ def _job_from_data(data: dict, source: str, text: str, strategies: Strategies = 
         table = next(iter(modification_tables))
         what = ("the 3-axis variant ([machine] axes = 3)" if spec.kind.follows_modifications
                 else "an internal gear's ring")
-        raise JobFileError(f"{_where(source, text, table)}: [{table}] flank modifications are cut by generating or "
+        raise JobFileError(f"{where_of(source, text, table)}: [{table}] flank modifications are cut by generating or "
                            f"perimeter finishing on the rotary table only; {what} does not follow them: leave them "
                            "out",
                            section=table, field=None)
@@ -772,16 +318,16 @@ def _job_from_data(data: dict, source: str, text: str, strategies: Strategies = 
         try:
             check(spec)
         except (GearSpecError, StockError) as exc:
-            blamed = _blamed_key(exc, name, tables.get(name, {}))
+            blamed = blamed_key(exc, name, tables.get(name, {}))
             raise JobFileError(f"{where(name, blamed)}: invalid [{name}]: {exc}", section=name, field=blamed) from None
     _validate_sections(loaded, tables, types, autos, spec, strategies, where)
-    tools = _tools_section(loaded, tables, where)
+    tools = tools_section(loaded, tables, where)
     _check_added_material(modifications if tools.finishing is not None else None,
                           loaded.get("roughing", RoughingParams()).finish_stock_mm, modification_tables, source, text)
-    _check_roughing_top(tools, where)
+    check_roughing_top(tools, where)
     try:
         check_machine_limits(spec, loaded.get("stock", StockSpec()), loaded.get("machine", Machine()),
-                             {role: tool for role in _TOOL_ROLES if (tool := getattr(tools, role)) is not None})
+                             {role: tool for role in TOOL_ROLES if (tool := getattr(tools, role)) is not None})
     except SpurCadError as exc:
         raise JobFileError(f"{where('machine', exc.field)}: {exc}", section="machine", field=exc.field) from None
     if "lathe" in loaded:
@@ -789,7 +335,7 @@ def _job_from_data(data: dict, source: str, text: str, strategies: Strategies = 
             check_lathe_blank(spec, loaded.get("stock", StockSpec()), loaded["lathe"])
         except SpurCadError as exc:
             name = exc.section if exc.section in ("stock", "lathe") else "lathe"
-            blamed = _blamed_key(exc, name, tables.get(name, {}))
+            blamed = blamed_key(exc, name, tables.get(name, {}))
             raise JobFileError(f"{where(name, blamed)}: {exc}", section=name, field=blamed) from None
     if "probe" in loaded:
         _check_probe(spec, loaded, tools, tables, where, dialects)
@@ -814,7 +360,7 @@ def _mated(spec: GearSpec, mate: MateSection | None, given: dict,
     try:
         pair, facts = check_mate(spec, mate, given)
     except SpurCadError as exc:
-        blamed = _blamed_key(exc, "mate", given)
+        blamed = blamed_key(exc, "mate", given)
         raise JobFileError(f"{where('mate', blamed)}: [mate] {exc}", section="mate", field=blamed) from None
     return dataclasses.replace(spec, active_profile_start_diameter_mm=facts.start_of_active_profile_diameter_mm), pair
 
@@ -839,7 +385,7 @@ def _check_probe(spec: GearSpec, sections: dict, tools: ToolsSection, tables: di
     probe: ProbeSection = sections["probe"]
     try:
         probing_dialect(sections.get("post", PostSettings()).dialect, dialects)
-        for role in _TOOL_ROLES:
+        for role in TOOL_ROLES:
             tool = getattr(tools, role)
             if tool is not None and tool.tool_number == probe.tool_number:
                 raise ProbeError(f"[probe] tool_number = {probe.tool_number} is the {role} tool's number too; the "
@@ -847,7 +393,7 @@ def _check_probe(spec: GearSpec, sections: dict, tools: ToolsSection, tables: di
         plan_probe(spec, sections.get("stock", StockSpec()), sections.get("machine", Machine()), probe)
     except SpurCadError as exc:
         name = exc.section if exc.section in ("post", "probe") else "probe"
-        blamed = _blamed_key(exc, name, tables.get(name, {}))
+        blamed = blamed_key(exc, name, tables.get(name, {}))
         raise JobFileError(f"{where(name, blamed)}: {exc}", section=name, field=blamed) from None
 
 
@@ -923,7 +469,7 @@ def _named_file(job: Job, folder: Path, side_folders: Sequence[Path], section: s
     name = getattr(job.section(section), field_name)
     if not name:
         return None
-    where = f"{_where(job.source, job.text, section, field_name)}: [{section}] {field_name}"
+    where = f"{where_of(job.source, job.text, section, field_name)}: [{section}] {field_name}"
     try:
         path = side_file_path(name, (folder, *side_folders), what, JobFileError)
         data = read_regular_file(path, what, max_bytes, JobFileError, shown_path(name))  # as the job names it
