@@ -24,6 +24,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from tests.test_docs_claims import missing_paths
+
 ROOT = Path(__file__).resolve().parents[1]
 ROTATION = re.compile(  # c y - s z / y c + z s and their spelled-out cos/sin forms, the way R(angle) is written
     r"\b(c|cos\w*|np\.cos\([^)]*\)|math\.cos\([^)]*\))\s*\*\s*[\w\[\]:, .]+?\s*[-+]\s*"
@@ -117,37 +119,6 @@ def _relative(path: Path) -> str:
 # --- every path the page names exists -----------------------------------------------------------------------
 
 
-ROOTS = ("spur_cad/", "tests/", "workbench/", "benchmarks/", ".ci/", "docs/", "resources/")
-
-
-def named_paths(text: str) -> set[str]:
-    """The repository paths the page names in backticks or in its layer block (spur_cad/..., tests/...,
-    workbench/..., benchmarks/...; `.py` files and folders)."""
-    tokens = set(re.findall(r"`([^`\s]+)`", text)) | set(text.split())
-    found = {t.rstrip(".,;:)") for t in tokens if t.startswith(ROOTS)}
-    return {t for t in found if re.fullmatch(r"[\w./-]+", t) and re.fullmatch(r"[\w-]*(\.(py|md|toml|txt|sh|json))?/?",
-                                                                        t.rsplit("/", 1)[-1] or "x")}
-
-
-def short_paths(text: str) -> set[str]:
-    """Module paths the page names relative to spur_cad/ (`cam/plan.py`, `strategies/base.py`, `post/header.py`)."""
-    folders = {p.name for p in (ROOT / "spur_cad").rglob("*") if p.is_dir()}
-    return {t for t in re.findall(r"`([\w/]+\.py)`", text)
-            if "/" in t and t.split("/")[0] in folders and not t.startswith(ROOTS)}
-
-
-EXAMPLES = {"spur_cad/cam/strategies/tip_first.py"}
-"""Paths the page names as what a reader would add (its worked example)."""
-
-
-def missing_paths(text: str) -> list[str]:
-    """The paths the text names that do not exist (short ones: no module of spur_cad/ ends with them)."""
-    missing = [p for p in sorted(named_paths(text) - EXAMPLES) if not (ROOT / p).exists()]
-    modules = [_relative(f) for f in (ROOT / "spur_cad").rglob("*.py")]
-    missing += [short for short in sorted(short_paths(text)) if not any(m.endswith("/" + short) for m in modules)]
-    return missing
-
-
 def test_every_path_the_page_names_exists():
     assert missing_paths(_page()) == []
 
@@ -156,12 +127,6 @@ def test_a_renamed_path_is_found():
     assert missing_paths("see `spur_cad/cam/planner.py` and `cam/plan.py`") == ["spur_cad/cam/planner.py"]
     assert missing_paths("see `cam/plans.py`, `strategies/bases.py` and `strategies/base.py`") == [
         "cam/plans.py", "strategies/bases.py"]
-
-
-@pytest.mark.parametrize("document", [*sorted(p.name for p in (ROOT / "docs").glob("*.md")), "../README.md"])
-def test_every_path_the_documents_name_exists(document):
-    """The same for every page of docs/ and the README (paths of this repository; others' are not read)."""
-    assert missing_paths((ROOT / "docs" / document).read_text(encoding="utf-8")) == []
 
 
 # --- the names the page gives to functions, types and fields -----------------------------------------------
