@@ -541,3 +541,20 @@ def test_no_module_outside_the_strategies_names_a_strategy():
 def test_a_planted_strategy_name_is_found(tmp_path):
     (tmp_path / "m.py").write_text('"""Uses along_x."""\nif strategy.name == "along_x":\n    pass\n')
     assert strategy_names_written([tmp_path / "m.py"], {"along_x", "perimeter"}) == {("m.py", "along_x")}
+
+
+def protocol_members() -> set[str]:
+    from spur_cad.cam.strategies.base import FinishingStrategy
+
+    members = set(FinishingStrategy.__annotations__) | {
+        name for name, value in vars(FinishingStrategy).items() if not name.startswith("_") and
+        (callable(value) or isinstance(value, property))}
+    return members
+
+
+def test_the_page_names_every_member_of_the_strategy_protocol():
+    """'Everything about a strategy is declared in its module:' the list that follows names every member of
+    strategies/base.py's FinishingStrategy protocol."""
+    listed = set(re.findall(r"`(\w+)", _section(_page(), "Finishing strategies are plug-ins")))
+    assert protocol_members() - listed == set()
+    assert {"generate", "check_tool", "bottom_allowance", "lying_flat"} <= protocol_members()  # the walk finds them
