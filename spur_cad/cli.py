@@ -21,12 +21,19 @@ import signal
 import sys
 import threading
 import warnings
+from collections.abc import Iterator
 from pathlib import Path
-from typing import NoReturn
+from types import FrameType
+from typing import TYPE_CHECKING, NoReturn, TextIO
 
 from spur_cad.errors import SpurCadError, escaped, one_line
 from spur_cad.inputs import step_timestamp
 from spur_cad.version import __version__
+
+if TYPE_CHECKING:  # the stages load only when a command needs them
+    from spur_cad.grade.grading import Grading
+    from spur_cad.grade.probe_log import ProbeLog
+    from spur_cad.job import Job
 
 EXIT_INPUT_ERROR = 2
 EXIT_INTERNAL_ERROR = 3
@@ -41,7 +48,7 @@ class Terminated(BaseException):
 class _ArgumentParser(argparse.ArgumentParser):
     """argparse with the command line's one-line errors: `spur-cad: error: ...`, exit 2 (no usage block)."""
 
-    def error(self, message: str):
+    def error(self, message: str) -> NoReturn:
         sys.stderr.write(f"spur-cad: error: {one_line(message)} (spur-cad --help)\n")
         sys.exit(EXIT_INPUT_ERROR)
 
@@ -128,7 +135,7 @@ class ProgressBars:
     tqdm is optional (FreeCAD's Addon Manager cannot install it): without it each stage gets one plain
     line when it ends."""
 
-    def __init__(self, stream) -> None:
+    def __init__(self, stream: TextIO) -> None:
         self._stream = stream
         self._bars: dict = {}
         try:
@@ -186,7 +193,7 @@ def main(argv: list[str] | None = None, *, exiting: bool = False) -> int:
     no signal can end it silently between the return and the exit."""
     received: list[int] = []  # the signals that arrived
 
-    def on_signal(signum, frame) -> None:
+    def on_signal(signum: int, frame: FrameType | None) -> None:
         received.append(signum)
 
     in_main_thread = threading.current_thread() is threading.main_thread()
@@ -275,7 +282,7 @@ def _run(args: argparse.Namespace, received: list[int], loaded: list) -> tuple[l
     return paths, result.warnings
 
 
-def _write(out_dir, files: dict[str, bytes], received: list[int]) -> list:
+def _write(out_dir: str | os.PathLike, files: dict[str, bytes], received: list[int]) -> list[Path]:
     """The output set written (spur_cad.outputs); a failure is one line naming the folder (exit 2)."""
     from spur_cad.errors import shown_path
     from spur_cad.outputs import OutputError, write_output_set
@@ -437,7 +444,7 @@ def _correct(args: argparse.Namespace, received: list[int], loaded: list) -> int
     return 0
 
 
-def _grade_probe_log(job, log, datum: str | None):
+def _grade_probe_log(job: Job, log: ProbeLog, datum: str | None) -> Grading:
     """The Grading of a probe log against the job's probing plan (recomputed from its [probe] section)."""
     from spur_cad.cam.probing import plan_probe
     from spur_cad.grade.probe_log import grade_probe_log
@@ -453,7 +460,7 @@ def _grade_probe_log(job, log, datum: str | None):
 
 
 @contextlib.contextmanager
-def _cycle_collector_paused():
+def _cycle_collector_paused() -> Iterator[None]:
     """Python's cyclic garbage collector off for one run, as it was afterwards. A run's imports (OCCT's, numba's,
     matplotlib's) leave a million long-lived objects that the collector traversed again and again (0.4 s of a 4 s
     reference run, docs/benchmarks.md), while the run itself makes few reference cycles (its figures, a fixed

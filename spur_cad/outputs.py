@@ -40,7 +40,7 @@ import signal
 import stat
 import tempfile
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -65,7 +65,7 @@ class Vocabulary:
 
     program_extensions: tuple[str, ...] = program_extensions()
 
-    def __post_init__(self):
+    def __post_init__(self) -> None:
         if not self.program_extensions or not all(isinstance(e, str) and _EXTENSION.fullmatch(e)
                                                   for e in self.program_extensions):
             raise ValueError(f"program extensions must be 1 to 8 lower-case letters or digits, got "
@@ -485,7 +485,7 @@ def _write_synced(folder: int, name: str, content: bytes) -> None:
 
 
 @contextlib.contextmanager
-def _opened(out: Path):
+def _opened(out: Path) -> Iterator[int]:
     """The output folder's descriptor (every operation on its entries is relative to it)."""
     fd = os.open(out, os.O_RDONLY | os.O_DIRECTORY | os.O_CLOEXEC)
     try:
@@ -504,7 +504,7 @@ def _try_lock(folder: int) -> bool:
 
 
 @contextlib.contextmanager
-def _locked(out: Path, checkpoint: Callable[[], None] | None = None):
+def _locked(out: Path, checkpoint: Callable[[], None] | None = None) -> Iterator[int]:
     """The folder's descriptor, with an exclusive flock on the folder itself (no lock file is left behind).
     Waits up to LOCK_WAIT_S for another holder, calling `checkpoint()` meanwhile (the CLI stops there on a
     signal); a lock held longer is no run of ours (anyone who can read the folder can take it) and is refused."""
@@ -526,7 +526,7 @@ def _locked(out: Path, checkpoint: Callable[[], None] | None = None):
 
 
 @contextlib.contextmanager
-def _signals_held():
+def _signals_held() -> Iterator[None]:
     """SIGINT and SIGTERM wait until the block is done (delivered right after it)."""
     held = {signal.SIGINT, signal.SIGTERM}
     previous = signal.pthread_sigmask(signal.SIG_BLOCK, held)

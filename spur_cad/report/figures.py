@@ -15,12 +15,14 @@ from spur_cad.geometry.spec import GearSpec
 from spur_cad.report.plots import _png, figure, figure_for_extent, set_title
 
 if TYPE_CHECKING:
+    from matplotlib.axes import Axes
     from matplotlib.figure import Figure
+    from matplotlib.patches import Rectangle
 
     from spur_cad.cam.flank_roughing import FlankPlan
     from spur_cad.cam.tools import Tool
     from spur_cad.geometry.modifications import FlankModifications
-    from spur_cad.grade.grading import Grading
+    from spur_cad.grade.grading import Grading, Trace
     from spur_cad.sim.engagement import Engagement
     from spur_cad.sim.simulate import SimResult
 
@@ -30,7 +32,7 @@ def _space_outline(spec: GearSpec) -> np.ndarray:
     return full_space_points(sample_profile(spec.tooth_space_profile(), 1e-3 * spec.module_mm))
 
 
-def _space_axes(spec: GearSpec, blank_radius_mm: float):
+def _space_axes(spec: GearSpec, blank_radius_mm: float) -> tuple[Figure, Axes]:
     """A roughing figure's axes with the design's tooth space and the blank's arc over it."""
     fig = figure(7.5, 6.0)
     ax = fig.add_subplot(1, 1, 1)
@@ -41,7 +43,7 @@ def _space_axes(spec: GearSpec, blank_radius_mm: float):
     return fig, ax
 
 
-def _space_png(fig, ax, spec: GearSpec, blank_radius_mm: float, title: str) -> bytes:
+def _space_png(fig: Figure, ax: Axes, spec: GearSpec, blank_radius_mm: float, title: str) -> bytes:
     """A roughing figure finished: equal scales from below the root to above the blank, labels, title, legend."""
     ax.set_aspect("equal")
     ax.set_xlabel("Y [mm] (space axis up)")
@@ -93,7 +95,7 @@ def roughing_flank_png(spec: GearSpec, plan: FlankPlan, tool: Tool, blank_radius
                       f"mill D {tool.diameter_mm:g} mm")
 
 
-def _rectangle(y0: float, z0: float, width: float, height: float):
+def _rectangle(y0: float, z0: float, width: float, height: float) -> Rectangle:
     from matplotlib.patches import Rectangle
 
     return Rectangle((y0, z0), width, height, fill=False, edgecolor="tab:blue", lw=0.8)
@@ -196,7 +198,7 @@ def deviation_map_png(result: SimResult, lying_flat: bool = False) -> bytes:
     return _png(fig)
 
 
-def _bars(ax, left: np.ndarray, heights: np.ndarray, width: float, colour: str, label: str) -> None:
+def _bars(ax: Axes, left: np.ndarray, heights: np.ndarray, width: float, colour: str, label: str) -> None:
     """Bars from `left` (ascending, apart by more than `width`) up from 0 drawn as one filled step outline (zero
     between the bars): it looks as `ax.bar` does, without an artist per bar to make and draw."""
     edges = np.column_stack([left, left + width]).ravel()
@@ -222,7 +224,7 @@ def k_chart_figure(spec: GearSpec, grading: Grading, lying_flat: bool = False) -
     traces = grading.traces
     profile = [t for t in traces if t.kind == "profile"]
 
-    def spread_in_range(trace) -> float:
+    def spread_in_range(trace: Trace) -> float:
         inside = (trace.position_mm >= trace.evaluation[0]) & (trace.position_mm <= trace.evaluation[1])
         return float(np.ptp(trace.deviation_um[inside])) if inside.any() else 0.0
 
@@ -266,7 +268,7 @@ def k_chart_figure(spec: GearSpec, grading: Grading, lying_flat: bool = False) -
     return fig
 
 
-def _clip_outside_evaluation(ax, traces, band_um: float) -> None:
+def _clip_outside_evaluation(ax: Axes, traces: list[Trace], band_um: float) -> None:
     """Keep a K-chart panel's scale on what is graded: when a trace beyond the evaluation range (a ring's root fillet,
     a tip corner) reaches more than twice as far as the traces inside it and the band, the panel is clipped to those
     (20 % margin) and says so."""
@@ -287,8 +289,10 @@ def _clip_outside_evaluation(ax, traces, band_um: float) -> None:
                 transform=ax.transAxes, color="0.3")
 
 
-def _design_trace(ax, trace, band_um: float) -> None:
+def _design_trace(ax: Axes, trace: Trace, band_um: float) -> None:
     """A modified flank's design trace on a K-chart panel and the tolerance band about it (half each side)."""
+    if trace.design_um is None:  # never: the caller draws it for a modified flank's trace only
+        raise ValueError("a trace without its design trace has no design to draw")
     order = np.argsort(trace.position_mm)
     position, design = trace.position_mm[order], trace.design_um[order]
     ax.plot(position, design, "-", color="k", lw=0.8, gid="design", label="design (modified)")
@@ -422,10 +426,10 @@ def modification_chart_figure(mods: FlankModifications, base_radius_mm: float, w
         lead_ax.plot(faces, -1000.0 * flank.lead_offset_mm(faces), style, color=colour, lw=1.4,
                      label=f"{side} flank")
 
-    def diameter(roll):
+    def diameter(roll: np.ndarray) -> np.ndarray:
         return 2.0 * np.sqrt(np.asarray(roll, dtype=float) ** 2 + base_radius_mm ** 2)
 
-    def roll(diam):
+    def roll(diam: np.ndarray) -> np.ndarray:
         return np.sqrt(np.maximum((np.asarray(diam, dtype=float) / 2.0) ** 2 - base_radius_mm ** 2, 0.0))
 
     top = profile_ax.secondary_xaxis("top", functions=(diameter, roll))
