@@ -472,7 +472,7 @@ def cam_inputs(job: Job) -> CamInputs:
                      job.machine, job.tools.bottom, top_tool=job.tools.roughing_top, strategies=job.strategies,
                      profile_tolerance_mm=job.job.profile_tolerance_mm, three_axis=job.three_axis,
                      modifications=job.modifications, levels_fallback=job.roughing_strategy_left_out,
-                     outline_export=job.export.dxf or job.export.svg)
+                     outline_export=job.export.dxf or job.export.svg, pair=job.pair)
 
 
 def plan_cam(job: Job, checkpoint: Callable[[], None] | None = None) -> CamPlan:

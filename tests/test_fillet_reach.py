@@ -18,10 +18,16 @@ from shapely.geometry import Point
 from shapely.ops import unary_union
 
 from spur_cad.cam.fillet_reach import fillet_reach, largest_reaching_corner_mm
+from spur_cad.cam.plan import plan_cam
 from spur_cad.cam.recommend import check_tools, recommend_tools
 from spur_cad.cam.tools import Tool, ToolError
+from spur_cad.errors import SpurCadError
 from spur_cad.geometry.mate import GearPair, PairMember
+from spur_cad.geometry.sampling import gear_outline
 from spur_cad.geometry.spec import GearSpec
+from spur_cad.job import parse_job
+from spur_cad.pipeline import cam_inputs
+from tests import silhouette
 
 M, ALPHA = 1.0, math.radians(20.0)
 Z1, X1, RHO = 30, 0.3, 0.38
@@ -145,3 +151,41 @@ def test_mate_reaching_deep_refuses_the_corner_its_tips_would_hit() -> None:
     with pytest.raises(ToolError, match=r"mate's tip corners enter .* the largest corner radius that works is 0\.4"):
         check_tools(spec, recommend_tools(spec, spec.tip_radius_mm + 0.5, 2.0), None, tool, pair_of(1.2))
     assert largest_reaching_corner_mm(spec, pair_of(1.2)) >= spec.tooth_space_profile().min_fillet_curvature_radius_mm
+
+
+JOB = ("[gear]\nteeth = 30\nmodule_mm = 1.0\nprofile_shift_coefficient = 0.3\nrack_tip_radius_mm = 0.38\n"
+       "face_width_mm = 2.0\n[stock]\nradial_allowance_mm = 0.3\n"
+       "[tools.finishing]\ndiameter_mm = {d}\nkind = \"bull_nose\"\n"
+       f"corner_radius_mm = {CORNER}\n[finishing]\nstrategy = \"{{strategy}}\"\ntarget_scallop_mm = 0.005\n"
+       "[simulation]\nenabled = false\n")
+MATE = "[mate]\nteeth = 20\naddendum_coefficient = 0.7\n"
+
+
+@pytest.mark.parametrize("strategy, diameter", [("perimeter", 0.9), ("generating", 0.9)])
+def test_the_planned_finishing_cuts_the_involute_from_the_sap_and_leaves_the_fillet_clear_of_the_mate(
+        strategy: str, diameter: float) -> None:
+    """Through the job file and the plan: refused without [mate]; with it, the finishing toolpath's silhouettes
+    (tests/silhouette.py, the commanded poses only) never enter the design, leave at most the scallop on the involute
+    from the SAP up, and the material they leave in space 0 is clear of the mate's tip corners (brute force above)."""
+    text = JOB.replace("{d}", f"{diameter:g}").replace("{strategy}", strategy)
+    alone = cam_inputs(parse_job(text, "job.toml"))
+    with pytest.raises(SpurCadError, match="corner radius"):
+        plan_cam(alone)
+    job = parse_job(text + MATE, "job.toml")
+    spec, tool = job.gear, job.tools.finishing
+    plan = plan_cam(cam_inputs(job))
+    path = plan.finishing.toolpath
+    rows = path.motion_mask & np.isin(path.space, [0]) & (path.station <= 0)
+    sils = silhouette.silhouettes_in_part_frame(path, tool.diameter_mm, CORNER, 30.0, mask=rows, substeps=4)
+    design = Polygon(gear_outline(spec, 1e-5))
+    assert silhouette.max_penetration_mm(design, sils) <= 0.5e-3
+    involute, _ = silhouette.design_boundary(spec, [0], labels=("involute",))
+    _, _, sap = reference_pair(0.7)
+    above = np.hypot(involute[:, 0], involute[:, 1]) >= sap / 2.0
+    assert silhouette.leftover_mm(involute[above], sils).max() <= 0.005 + 0.5e-3
+    left = Point(0.0, 0.0).buffer(spec.tip_radius_mm, quad_segs=512).difference(unary_union(sils))
+    path_points = mate_corner_path(0.7)
+    near = np.abs(np.arctan2(path_points[:, 0], path_points[:, 1])) < math.pi / Z1  # space 0 and its teeth' halves
+    inside = contains_xy(left, path_points[near, 0], path_points[near, 1])
+    depth = float(np.max(distance(left.exterior, points(path_points[near][inside])), initial=0.0))
+    assert depth <= 0.005 + 0.5e-3  # the involute's own scallop where the corners touch it, nothing from the fillet

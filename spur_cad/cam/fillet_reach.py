@@ -121,3 +121,19 @@ def refusal_text(spec: GearSpec, pair: GearPair, corner_radius_mm: float, reach:
     return (f"finishing tool corner radius {corner_radius_mm:.4f} mm does not reach with the mate: {why}; the largest "
             f"corner radius that works is {largest:.3f} mm; a mate with a smaller addendum (a higher SAP and a tip "
             "path farther from the fillet) would let a larger corner fit")
+
+
+def finishing_spec(spec: GearSpec, pair: GearPair | None, corner_radius_mm: float) -> GearSpec:
+    """The outline the finishing strategy cuts with a corner `corner_radius_mm`: the gear's own, unless the corner
+    is tighter-than-fillet-limited and the mate lets it leave the fillet (`fillet_reach` fits): then the reach spec,
+    which contains the design (a smaller rack tooth removes less), so a path exact for it cannot gouge the design,
+    and has the design's involute from its form circle, at or below the SAP, up."""
+    if pair is None or not applies(spec, pair):
+        return spec
+    if corner_radius_mm <= spec.tooth_space_profile().min_fillet_curvature_radius_mm + 1e-9:
+        return spec
+    reach = fillet_reach(spec, pair, corner_radius_mm)
+    if reach is None or not reach.fits:
+        return spec  # check_tools refuses the tool
+    spec_reach = reach_spec(spec, corner_radius_mm)
+    return spec if spec_reach is None else spec_reach

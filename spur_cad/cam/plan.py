@@ -16,6 +16,7 @@ from spur_cad.cad.specs import StockSpec
 from spur_cad.cam.common import check_moves
 from spur_cad.cam.contacts import ContactCounts, contact_counts
 from spur_cad.cam.estimate import Estimate, estimate, move_seconds
+from spur_cad.cam.fillet_reach import finishing_spec
 from spur_cad.cam.finishing import generate_finishing
 from spur_cad.cam.flank_roughing import UNCUT_MM2, FlankPlan
 from spur_cad.cam.ir import Toolpath
@@ -54,6 +55,7 @@ from spur_cad.cam.strategies import (
 from spur_cad.cam.three_axis_tabs import ThreeAxisSection
 from spur_cad.cam.tools import Tool, ToolError
 from spur_cad.errors import SpurCadError, StockError, WorkLimitError, shown
+from spur_cad.geometry.mate import GearPair
 from spur_cad.geometry.modifications import FlankModifications
 from spur_cad.geometry.outline2d import Arc2D
 from spur_cad.geometry.spec import GearSpec
@@ -187,6 +189,8 @@ class CamInputs:
     # [export] dxf or svg: the outline is written for a 2-D process (wire EDM, laser, waterjet); with no tools given
     # nothing is milled, and the end mills' sizes are not warned about
     outline_export: bool = False
+    # [mate]: the gear pair; with it a finishing corner may leave the fillet below the mate's SAP (cam.fillet_reach)
+    pair: GearPair | None = None
 
     def __post_init__(self) -> None:
         """Every section and tool checked once, here, as the job loader checks them (MachineError or ToolError
@@ -199,6 +203,13 @@ class CamInputs:
                            ("bottom", self.bottom_tool), ("roughing_top", self.top_tool)):
             if tool is not None:
                 tool.validate(role)
+
+    @property
+    def finishing_spec(self) -> GearSpec:
+        """The outline the finishing strategy cuts (cam.fillet_reach.finishing_spec): the gear's, or with a [mate]
+        the one a finishing corner larger than the fillet allows leaves below the SAP."""
+        corner = self.finishing_tool.effective_corner_radius_mm if self.finishing_tool is not None else 0.0
+        return finishing_spec(self.spec, self.pair, corner)
 
     @property
     def roughing_tool_set(self) -> Tool:
@@ -241,13 +252,14 @@ def check_cam_inputs(inputs: CamInputs) -> tuple[ToolRecommendations, RoughingLe
     rec = recommend_tools(spec, blank, machine.clearance_mm, inputs.finishing_tool,
                           inputs.finishing.target_scallop_mm, strategy)
     if inputs.bottom_tool is not None:
-        check_two_stage_tools(spec, rec, inputs.roughing_tool, inputs.bottom_tool, inputs.finishing_tool)
+        check_two_stage_tools(spec, rec, inputs.roughing_tool, inputs.bottom_tool, inputs.finishing_tool, inputs.pair)
     else:
         conflicts = tool_conflicts(inputs, rec)
         if conflicts:
             raise conflicts_error(inputs, conflicts)
     if inputs.finishing_tool is not None:
-        check_finishing_work(spec, inputs.finishing_tool, machine, inputs.finishing, inputs.strategies)
+        check_finishing_work(inputs.finishing_spec, inputs.finishing_tool, machine, inputs.finishing,
+                             inputs.strategies)
     if inputs.roughing_tool is None:
         return rec, None
     tool = inputs.roughing_tool
@@ -286,9 +298,9 @@ def tool_conflicts(inputs: CamInputs, rec: ToolRecommendations) -> list[ToolErro
         return True
 
     finishing, roughing = inputs.finishing_tool, inputs.roughing_tool
-    if finishing is not None and collect(lambda: check_tools(spec, rec, None, finishing)):
+    if finishing is not None and collect(lambda: check_tools(spec, rec, None, finishing, inputs.pair)):
         strategy = get_strategy(inputs.finishing.strategy, inputs.strategies)
-        collect(lambda: strategy.check_tool(spec, finishing))
+        collect(lambda: strategy.check_tool(inputs.finishing_spec, finishing))
     if roughing is not None and collect(lambda: check_tools(spec, rec, roughing, None)) and finishing is not None:
         moves, driver = estimated_roughing_moves(spec, roughing, inputs.roughing, blank)
         check_moves("roughing", moves, "roughing", driver)  # the levels' work bounded before they are made
@@ -330,13 +342,13 @@ def _short(conflict: ToolError) -> str:
 
 
 def check_two_stage_tools(spec: GearSpec, rec: ToolRecommendations, roughing_tool: Tool | None, bottom: Tool,
-                          finishing: Tool | None) -> None:
+                          finishing: Tool | None, pair: GearPair | None = None) -> None:
     """Two-stage roughing: the bottom tool meets the roughing tool's limits (it reaches the bottom of the space);
     the roughing tool is a flat end mill larger than it, with no limit of its own but fitting the space."""
     if roughing_tool is None:
         raise ToolError("[tools.bottom] needs [tools.roughing]: the bottom tool roughs below the roughing tool's "
                         "levels", field="diameter_mm", section="tools.bottom")
-    check_tools(spec, rec, None, finishing)
+    check_tools(spec, rec, None, finishing, pair)
     try:
         check_tools(spec, rec, bottom, None)
     except ToolError as exc:
@@ -727,7 +739,7 @@ def check_finishing_work(spec: GearSpec, tool: Tool, machine: Machine, section: 
 
 
 def _plan_finishing(inputs: CamInputs, blank: float, check: Callable[[], None]) -> FinishingPlan:
-    spec, tool, machine = inputs.spec, inputs.finishing_tool_set, inputs.machine
+    spec, tool, machine = inputs.finishing_spec, inputs.finishing_tool_set, inputs.machine
     path, result = generate_finishing(spec, tool, machine, inputs.finishing, blank, inputs.strategies,
                                       inputs.modifications, inputs.profile_tolerance_mm)  # checked: check_cam_inputs
     check_travel(machine, path.x, path.y, path.z, path.a, "finishing")
