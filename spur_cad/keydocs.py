@@ -56,7 +56,10 @@ Notes:
   with one line at the key: a centre distance no mate shift in [-2, 3] reaches, pointed teeth, negative tip
   clearance, involute or root interference (a tip reaching past a base tangent point or below the form circle),
   an internal pair's tip interference, a contact ratio below 1. Without `[mate]` the checks that depend on the
-  start of the active profile assume the basic rack (and say so).
+  start of the active profile assume the basic rack (and say so). On the rotary table a finishing corner larger
+  than the fillet's tightest curvature (`finishing_max_corner_radius_mm`) is accepted with an external `[mate]` of
+  a spur gear when the fillet it leaves stays below the mate's SAP and clear of the mate's tip path (docs/cam.md,
+  "Fillet reach and the mate").
 - `[stock]`: the blank is a cylinder of tip radius + `radial_allowance_mm` from
   X = -`front_margin_mm` to face width + `back_margin_mm`; a holding stub (`stub_diameter_mm`,
   `stub_length_mm`, both or neither, not wider than the blank) continues it toward the chuck (+X).
