@@ -495,6 +495,18 @@ def test_a_contact_of_space_k_is_brought_up_by_psi_minus_k_pitches(space, psi_de
     assert machine == pytest.approx([0.0, radius_mm], abs=1e-9)
 
 
+def test_the_three_posts_share_the_one_header_writer_and_the_table_lies_lowest():
+    """'one header writer, post/header.py, for the milling, lathe and probing programs'; 'The table lies in the
+    lowest layer'."""
+    from tests.test_imports import documented_layers, import_graph, layer_of
+
+    graph = {module: {i.target for i in found} for module, found in import_graph().items()}
+    posts = ("spur_cad.post.program", "spur_cad.post.lathe", "spur_cad.post.probe")
+    assert [m for m in posts if "spur_cad.post.header" not in graph[m]] == []
+    layers = documented_layers(_page())
+    assert layer_of("spur_cad.dialects", layers) == len(layers) - 1
+
+
 def test_inside_cam_the_layers_order_holds():
     """'in cam/: machine and tools below the strategies, the strategies below finishing and plan'; and 'the
     simulation and report stages never import the job loader or the pipeline'."""
@@ -558,41 +570,3 @@ def test_the_page_names_every_member_of_the_strategy_protocol():
     listed = set(re.findall(r"`(\w+)", _section(_page(), "Finishing strategies are plug-ins")))
     assert protocol_members() - listed == set()
     assert {"generate", "check_tool", "bottom_allowance", "lying_flat"} <= protocol_members()  # the walk finds them
-
-
-KEYWORDS = {  # the keyword arguments the page says each entry point takes
-    ("spur_cad.job", "parse_job"): {"strategies", "dialects", "sections"},
-    ("spur_cad.keydocs", "job_file_reference_markdown"): {"strategies", "dialects", "replaced"},
-    ("spur_cad.pipeline", "run_job"): {"cad_worker"},
-}
-FIELDS = {  # the fields the page says a dataclass has
-    ("spur_cad.cam.plan", "CamInputs"): {"strategies"},
-    ("spur_cad.cam.machine", "Machine"): {"axes"},
-    ("spur_cad.result", "JobResult"): {"setup", "kind", "files", "correction"},
-    ("spur_cad.result", "SetupFacts"): {"machine_setup"},
-}
-
-
-def missing_keywords_and_fields(keywords: dict, fields: dict) -> list[str]:
-    import importlib
-    import inspect
-
-    missing = []
-    for (module, name), expected in keywords.items():
-        parameters = set(inspect.signature(getattr(importlib.import_module(module), name)).parameters)
-        missing += [f"{name}({keyword}=)" for keyword in sorted(expected - parameters)]
-    for (module, name), expected in fields.items():
-        found = {f.name for f in dataclasses.fields(getattr(importlib.import_module(module), name))}
-        missing += [f"{name}.{field}" for field in sorted(expected - found)]
-    return missing
-
-
-def test_the_entry_points_take_the_registries_and_the_types_have_the_fields_the_page_names():
-    assert missing_keywords_and_fields(KEYWORDS, FIELDS) == []
-    assert hasattr(__import__("spur_cad.cam.machine", fromlist=["Machine"]).Machine, "setup")
-
-
-def test_a_dropped_keyword_or_field_is_found():
-    assert missing_keywords_and_fields({("spur_cad.job", "parse_job"): {"registry"}},
-                                       {("spur_cad.result", "JobResult"): {"set_up"}}) == [
-        "parse_job(registry=)", "JobResult.set_up"]

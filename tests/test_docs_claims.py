@@ -147,3 +147,44 @@ def test_a_moved_name_is_found():
     assert unresolved_names("`spur_cad.post.program.inert_comment_text`, `spur_cad.post.header.inert_comment_text`, "
                             "`spur_cad.cam.ir.Toolpath.start_poses`, `spur_cad.cam.ir.Toolpath.feed`") == [
         "spur_cad.post.program.inert_comment_text"]
+
+
+# --- docs/architecture.md: the keyword arguments and fields it names ---------------------------------------
+
+
+KEYWORDS = {  # the keyword arguments the page says each entry point takes
+    ("spur_cad.job", "parse_job"): {"strategies", "dialects", "sections"},
+    ("spur_cad.keydocs", "job_file_reference_markdown"): {"strategies", "dialects", "replaced"},
+    ("spur_cad.pipeline", "run_job"): {"cad_worker"},
+}
+FIELDS = {  # the fields the page says a dataclass has
+    ("spur_cad.cam.plan", "CamInputs"): {"strategies"},
+    ("spur_cad.cam.machine", "Machine"): {"axes"},
+    ("spur_cad.result", "JobResult"): {"setup", "kind", "files", "correction"},
+    ("spur_cad.result", "SetupFacts"): {"machine_setup"},
+}
+
+
+def missing_keywords_and_fields(keywords: dict, fields: dict) -> list[str]:
+    import importlib
+    import inspect
+
+    missing = []
+    for (module, name), expected in keywords.items():
+        parameters = set(inspect.signature(getattr(importlib.import_module(module), name)).parameters)
+        missing += [f"{name}({keyword}=)" for keyword in sorted(expected - parameters)]
+    for (module, name), expected in fields.items():
+        found = {f.name for f in dataclasses.fields(getattr(importlib.import_module(module), name))}
+        missing += [f"{name}.{field}" for field in sorted(expected - found)]
+    return missing
+
+
+def test_the_entry_points_take_the_registries_and_the_types_have_the_fields_the_page_names():
+    assert missing_keywords_and_fields(KEYWORDS, FIELDS) == []
+    assert hasattr(__import__("spur_cad.cam.machine", fromlist=["Machine"]).Machine, "setup")
+
+
+def test_a_dropped_keyword_or_field_is_found():
+    assert missing_keywords_and_fields({("spur_cad.job", "parse_job"): {"registry"}},
+                                       {("spur_cad.result", "JobResult"): {"set_up"}}) == [
+        "parse_job(registry=)", "JobResult.set_up"]
