@@ -188,3 +188,17 @@ def test_a_dropped_keyword_or_field_is_found():
     assert missing_keywords_and_fields({("spur_cad.job", "parse_job"): {"registry"}},
                                        {("spur_cad.result", "JobResult"): {"set_up"}}) == [
         "parse_job(registry=)", "JobResult.set_up"]
+
+
+def test_the_job_schema_example_is_the_machine_s_own_declaration():
+    """The `clearance_mm` declaration docs/architecture.md shows is [machine] clearance_mm's, default and metadata."""
+    from spur_cad.cam.machine import Machine
+
+    text = (ROOT / "docs" / "architecture.md").read_text(encoding="utf-8").split("\n## The job schema", 1)[1]
+    snippet = text.split("```python\n", 1)[1].split("```", 1)[0]
+    namespace: dict = {}
+    exec("from dataclasses import dataclass\nfrom spur_cad.keys import key\n@dataclass(frozen=True)\nclass Shown:\n"
+         + "".join(f"    {line}\n" for line in snippet.splitlines()), namespace)
+    shown = dataclasses.fields(namespace["Shown"])[0]
+    real = next(f for f in dataclasses.fields(Machine) if f.name == shown.name)
+    assert (shown.name, shown.default, dict(shown.metadata)) == (real.name, real.default, dict(real.metadata))
