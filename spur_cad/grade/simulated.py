@@ -22,9 +22,12 @@ flanks), and the modifications as cut are read from the same traces (spur_cad.gr
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
 
 from spur_cad.geometry.modifications import FlankModifications
+from spur_cad.geometry.spec import GearSpec
 from spur_cad.grade.design_trace import against_design
 from spur_cad.grade.grading import (
     Grading,
@@ -36,6 +39,10 @@ from spur_cad.grade.grading import (
     worst_deviations,
 )
 
+if TYPE_CHECKING:  # the simulator loads only when a job simulates
+    from spur_cad.sim.design import DesignGrid
+    from spur_cad.sim.simulate import SimResult
+
 SIDES = ("right", "left")
 TIP_EXCLUDED_FRACTION = 0.05
 
@@ -46,7 +53,7 @@ def helix_range_mm(face_width_mm: float, module_mm: float) -> tuple[float, float
     return cut, face_width_mm - cut
 
 
-def profile_roll_mm(spec, radius_mm):
+def profile_roll_mm(spec: GearSpec, radius_mm: float | np.ndarray) -> np.ndarray:
     """The profile trace's position of an involute point at `radius_mm`: its roll length sqrt(r^2 - r_b^2), a
     ring's negative (ISO 21771 signs an internal gear's radii so), so that every profile trace runs from the root
     to the tip in increasing position and a slope + means material rising toward the tip, external or internal."""
@@ -54,7 +61,7 @@ def profile_roll_mm(spec, radius_mm):
     return spec.kind.roll_sign * roll
 
 
-def profile_range_mm(spec, start_radius_mm: float | None = None) -> tuple[float, float]:
+def profile_range_mm(spec: GearSpec, start_radius_mm: float | None = None) -> tuple[float, float]:
     """The profile evaluation range in profile_roll_mm: form circle (or `start_radius_mm`: where a 3-axis tool
     leaves the involute, above the rack's form circle; a ring's: inside its cutter-generated form circle), or the
     start of the active profile in mesh with the mate ([mate]: spec.active_profile_start_diameter_mm) when that is
@@ -67,12 +74,12 @@ def profile_range_mm(spec, start_radius_mm: float | None = None) -> tuple[float,
     return start, start + (1.0 - TIP_EXCLUDED_FRACTION) * (tip - start)
 
 
-def _flank_points(grid, side: str) -> np.ndarray:
+def _flank_points(grid: DesignGrid, side: str) -> np.ndarray:
     names = grid.feature_names()
     return np.array([name == f"{side} involute" for name in names])
 
 
-def traces(spec, result, profile_start_radius_mm: float | None = None) -> list[Trace]:
+def traces(spec: GearSpec, result: SimResult, profile_start_radius_mm: float | None = None) -> list[Trace]:
     """Profile traces (three face positions) and a helix trace for both flanks of every tooth space (profiles from
     `profile_start_radius_mm`, default the form circle)."""
     grid = result.grid
@@ -97,7 +104,7 @@ def traces(spec, result, profile_start_radius_mm: float | None = None) -> list[T
     return found
 
 
-def flank_positions_um(spec, result, side: str) -> np.ndarray:
+def flank_positions_um(spec: GearSpec, result: SimResult, side: str) -> np.ndarray:
     """Arc deviation of each tooth space's `side` flank on the reference circle at mid face (um)."""
     grid = result.grid
     mask = _flank_points(grid, side)
@@ -109,7 +116,7 @@ def flank_positions_um(spec, result, side: str) -> np.ndarray:
     return np.array([result.deviation[k][mask][reference, middle] * 1000.0 / cos_alpha for k in range(grid.teeth)])
 
 
-def grade_simulation(spec, result, profile_start_radius_mm: float | None = None,
+def grade_simulation(spec: GearSpec, result: SimResult, profile_start_radius_mm: float | None = None,
                      modifications: FlankModifications | None = None) -> Grading:
     """The gear's ISO 1328-1 grade from the simulated cut: worst deviations over all flanks, their classes, the
     gear's class, the class-5 tolerances, every space's pitch, the validity of the formulas and the traces
