@@ -189,3 +189,57 @@ def test_the_planned_finishing_cuts_the_involute_from_the_sap_and_leaves_the_fil
     inside = contains_xy(left, path_points[near, 0], path_points[near, 1])
     depth = float(np.max(distance(left.exterior, points(path_points[near][inside])), initial=0.0))
     assert depth <= 0.005 + 0.5e-3  # the involute's own scallop where the corners touch it, nothing from the fillet
+
+
+@pytest.mark.linuxcnc
+def test_the_interpreted_generating_program_agrees(tmp_path) -> None:
+    """The generating finishing program as LinuxCNC's rs274 reads it: its cutting passes (fed moves along X alone)
+    seen along X never enter the design, leave at most the scallop on the involute from the SAP up, and what they
+    leave in space 0 lets the mate's tip corners in by no more than that scallop."""
+    from spur_cad.pipeline import build_programs  # noqa: PLC0415 (the posts' imports, only for this test)
+    from tests.rs274_helper import run_rs274  # noqa: PLC0415
+    from tests.test_post import canonical_straight_moves  # noqa: PLC0415
+
+    job = parse_job(JOB.replace("{d}", "0.9").replace("{strategy}", "generating") + MATE, "job.toml")
+    spec, tool = job.gear, job.tools.finishing
+    plan = plan_cam(cam_inputs(job))
+    programs, _ = build_programs(job, plan)
+    (tmp_path / "finishing.ngc").write_text(programs["finishing"].text)
+    ok, canon, messages = run_rs274(tmp_path / "finishing.ngc", timeout_s=300)
+    assert ok, messages
+    passes = np.array([end for feed, _, _, start, end in canonical_straight_moves(canon)
+                       if feed and start is not None and np.allclose(start[1:], end[1:], atol=1e-9)
+                       and start[0] != end[0]])
+    assert len(passes) % Z1 == 0
+    first = passes[: len(passes) // Z1]  # every space runs the same passes, space 0's first (A relative to 0)
+    sils = list(silhouette.place_silhouettes(first[:, 1], first[:, 2], first[:, 3], tool.diameter_mm, CORNER, 30.0))
+    assert silhouette.max_penetration_mm(Polygon(gear_outline(spec, 1e-5)), sils) <= 0.5e-3
+    involute, _ = silhouette.design_boundary(spec, [0], labels=("involute",))
+    _, _, sap = reference_pair(0.7)
+    above = np.hypot(involute[:, 0], involute[:, 1]) >= sap / 2.0
+    assert silhouette.leftover_mm(involute[above], sils).max() <= 0.005 + 0.5e-3
+    left = Point(0.0, 0.0).buffer(spec.tip_radius_mm, quad_segs=512).difference(unary_union(sils))
+    path_points = mate_corner_path(0.7)
+    near = np.abs(np.arctan2(path_points[:, 0], path_points[:, 1])) < math.pi / Z1
+    inside = contains_xy(left, path_points[near, 0], path_points[near, 1])
+    assert float(np.max(distance(left.exterior, points(path_points[near][inside])), initial=0.0)) <= 0.005 + 0.5e-3
+
+
+@pytest.mark.slow
+def test_spur_cads_simulation_of_the_whole_job_shows_no_gouge() -> None:
+    """The whole job (generating, with [mate]) through run_job and spur_cad's own simulation: no gouge, the involute
+    within the target scallop (5 um), the fillet left thicker than that (what the larger corner leaves)."""
+    from spur_cad.pipeline import run_job  # noqa: PLC0415 (the whole pipeline, only for this test)
+
+    text = JOB.replace("{d}", "0.9").replace("{strategy}", "generating").replace("enabled = false", "enabled = true")
+    text = text.replace("[tools.finishing]", "[tools.roughing]\ndiameter_mm = 0.3\n[tools.finishing]")
+    simulated = run_job(parse_job(text + MATE, "job.toml")).simulation
+    assert simulated.enabled and simulated.max_gouge_mm <= 0.5e-3
+
+    def leftover(feature: str) -> float:
+        found = [simulated.feature(f"{side} {feature}") for side in ("left", "right")]
+        assert all(f is not None for f in found)
+        return max(f.max_leftover_mm for f in found if f is not None)
+
+    assert leftover("involute") <= 0.005 + 0.5e-3
+    assert leftover("fillet") > 0.005
