@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import re
 from dataclasses import dataclass, field
+from typing import BinaryIO
 
 from spur_cad.dialects import Dialect
 from spur_cad.errors import SpurCadError, shown
@@ -24,6 +25,7 @@ class Line:
 
 
 Position = tuple[int, int]  # (byte offset of a line's start, number of lines before it)
+OpenSubprogram = tuple[re.Match, Position, int]  # a subprogram's head, its body's start and its line number
 
 _ENDS = re.compile(r"(^|\s)M0*(30|2)(\s|$)")  # M30 or M2, anywhere in a block
 _COMMENT = re.compile(r"\([^)]*\)")
@@ -73,7 +75,7 @@ class LineSource:
     """The program's lines read by byte offset from a seekable binary file: nothing but the current line and the
     file's buffer is held, however long the program."""
 
-    def __init__(self, handle):
+    def __init__(self, handle: BinaryIO) -> None:
         self.handle = handle
         self.at = 0
 
@@ -102,7 +104,7 @@ class Structure:
     opened: int = 0  # subprograms, loops and labels met (closed or not): bounds what the index holds
 
 
-def index_program(handle, syntax: Syntax, source: str) -> Structure:
+def index_program(handle: BinaryIO, syntax: Syntax, source: str) -> Structure:
     """One pass over the file: check every line (UTF-8, no NUL, length, count) and find the structure; linear in
     the file's length (a line that cannot end or open a structure is not even decoded)."""
     found = Structure()
@@ -111,7 +113,7 @@ def index_program(handle, syntax: Syntax, source: str) -> Structure:
     fanuc_family = syntax.structure == "numbered"
     o_words, labels = syntax.structure == "o_words", syntax.structure == "labels"
     closing = syntax.closing
-    current_sub: tuple[re.Match, Position, int] | None = None  # Fanuc family after the end: the open subprogram
+    current_sub: OpenSubprogram | None = None  # Fanuc family after the end: the open subprogram
     offset, number = 0, 0
     for raw in iter(lambda: handle.readline(MAX_LINE_CHARS + 3), b""):  # a line read is bounded too
         number += 1
@@ -165,8 +167,8 @@ def _check_raw_line(raw: bytes, number: int, source: str) -> None:
         raise ProgramReadError(f"{source}:{number}: not a text file (a NUL byte)")
 
 
-def _index_subprogram(found: Structure, line: Line, after: Position, current_sub, closing: re.Pattern,
-                      source: str):
+def _index_subprogram(found: Structure, line: Line, after: Position, current_sub: OpenSubprogram | None,
+                      closing: re.Pattern, source: str) -> OpenSubprogram | None:
     """Fanuc family after the end of the program: subprograms O<n> (Haas N<n>) ... M99 (Okuma RTS) and nothing
     else; returns the subprogram still open (its head, body start, line number) or None."""
     if current_sub is None:

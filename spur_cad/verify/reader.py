@@ -37,6 +37,7 @@ import math
 import os
 import re
 from collections.abc import Callable
+from typing import BinaryIO
 
 from spur_cad.dialects import DIALECTS, Dialect, Dialects, lathe_names
 from spur_cad.errors import shown, shown_path
@@ -93,7 +94,8 @@ class _Reader:
     """Executes one program's flow: variables, subprogram calls, loops and labels; every other block goes to the
     controller (spur_cad.verify.controller), which keeps the machine state and records the moves."""
 
-    def __init__(self, handle, d: Dialect, source: str, checkpoint=None, lathe: bool = False):
+    def __init__(self, handle: BinaryIO, d: Dialect, source: str, checkpoint: Callable[[], None] | None = None,
+                 lathe: bool = False) -> None:
         self.d, self.source, self.checkpoint = d, source, checkpoint
         self.syntax, self.subprograms = Syntax.of(d), d.subprograms
         self.blocks = 0
@@ -370,8 +372,9 @@ def _dialect(dialect: str | Dialect, lathe: bool, dialects: Dialects) -> Dialect
     return found
 
 
-def read_program(text: str, dialect: str | Dialect, source: str = "program", checkpoint=None,
-                 lathe: bool = False, dialects: Dialects = DIALECTS) -> ProgramMoves:
+def read_program(text: str, dialect: str | Dialect, source: str = "program",
+                 checkpoint: Callable[[], None] | None = None, lathe: bool = False,
+                 dialects: Dialects = DIALECTS) -> ProgramMoves:
     """The moves of a program's text in `dialect` (a name in the registry `dialects`, or a Dialect of
     spur_cad.dialects: a controller in no registry); raises ProgramReadError naming `source`'s line.
     `checkpoint()` is called every CHECK_EVERY_BLOCKS lines read (the CLI stops there when a signal arrived).
@@ -385,7 +388,7 @@ def read_program(text: str, dialect: str | Dialect, source: str = "program", che
     return _Reader(io.BytesIO(data), d, source, checkpoint, lathe).run()
 
 
-def open_program_file(path: str | os.PathLike, source: str | None = None):
+def open_program_file(path: str | os.PathLike, source: str | None = None) -> BinaryIO:
     """A program file opened for reading: a regular file of at most MAX_PROGRAM_BYTES (a FIFO, a device or a
     larger file is refused with one line, before reading)."""
     from spur_cad.inputs import open_regular_file
@@ -400,8 +403,9 @@ def open_program_file(path: str | os.PathLike, source: str | None = None):
     return handle
 
 
-def read_program_file(path: str | os.PathLike, dialect: str | Dialect, source: str | None = None, checkpoint=None,
-                      lathe: bool = False, dialects: Dialects = DIALECTS) -> ProgramMoves:
+def read_program_file(path: str | os.PathLike, dialect: str | Dialect, source: str | None = None,
+                      checkpoint: Callable[[], None] | None = None, lathe: bool = False,
+                      dialects: Dialects = DIALECTS) -> ProgramMoves:
     """`read_program` of a file, read as a stream: a regular file of at most MAX_PROGRAM_BYTES (a FIFO, a device
     or a larger file is refused before reading); memory holds a line at a time besides the moves."""
     d = _dialect(dialect, lathe, dialects)
