@@ -243,3 +243,19 @@ def test_spur_cads_simulation_of_the_whole_job_shows_no_gouge() -> None:
 
     assert leftover("involute") <= 0.005 + 0.5e-3
     assert leftover("fillet") > 0.005
+
+
+def test_a_sharp_rack_and_a_corner_no_rack_carries() -> None:
+    """A sharp rack (its corner's trochoid fillet as tight as 0.057 mm) with the mate takes a 0.2 mm corner (the rack
+    with that round leaves the involute below the SAP, clear of the mate); a corner beyond what any rack tooth
+    carries is refused naming the largest that works, which is not 0."""
+    _, _, sap = reference_pair(0.7)
+    sharp = GearSpec(teeth=Z1, module_mm=M, profile_shift_coefficient=X1, active_profile_start_diameter_mm=sap)
+    reach = fillet_reach(sharp, pair_of(0.7), 0.2)
+    assert reach is not None and reach.fits
+    assert reach.form_diameter_mm > 2.0 * sharp.tooth_space_profile().form_radius_mm
+    assert largest_reaching_corner_mm(sharp, pair_of(0.7)) > 0.2
+    tool = Tool(diameter_mm=1.2, kind="bull_nose", corner_radius_mm=0.55)
+    with pytest.raises(ToolError, match=r"carries a tip round that large .* the largest corner radius that works is "
+                                        r"0\.4[0-9]{2} mm$"):
+        check_tools(sharp, recommend_tools(sharp, sharp.tip_radius_mm + 0.5, 2.0), None, tool, pair_of(0.7))

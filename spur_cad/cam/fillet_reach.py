@@ -54,6 +54,13 @@ class FilletReach:
         return self.form_diameter_mm <= self.sap_diameter_mm + 1e-9 and self.mate_intrusion_mm <= MATE_CLEARANCE_MM
 
 
+def fillet_limit_mm(spec: GearSpec) -> float:
+    """The largest corner that follows the whole fillet: its tightest curvature radius; 0 for a sharp rack's root
+    corner (no fillet), as recommend_tools' finishing_max_corner_radius_mm."""
+    limit = spec.tooth_space_profile().min_fillet_curvature_radius_mm
+    return limit if math.isfinite(limit) else 0.0
+
+
 def reach_spec(spec: GearSpec, corner_radius_mm: float) -> GearSpec | None:
     """The gear as a rack with tip round max(rho, r_t) generates it: what a corner r_t leaves playing that rack
     (generating) or following that outline (perimeter). None when the rack tooth cannot carry such a round (its
@@ -91,7 +98,7 @@ def largest_reaching_corner_mm(spec: GearSpec, pair: GearPair) -> float:
     """The largest corner radius (rounded down to REACH_RESOLUTION_MM) whose reach fits, at least the fillet's
     tightest curvature radius (which follows the whole fillet). Bisection: a larger rack round is a smaller rack
     tooth, so it leaves more in the fillet and its form circle lies higher (monotone)."""
-    low = spec.tooth_space_profile().min_fillet_curvature_radius_mm
+    low = fillet_limit_mm(spec)
     high = 0.6 * spec.module_mm  # the rack tip radius's own bound (GearSpec)
     top = fillet_reach(spec, pair, high)
     if top is not None and top.fits:
@@ -103,24 +110,24 @@ def largest_reaching_corner_mm(spec: GearSpec, pair: GearPair) -> float:
             low = middle
         else:
             high = middle
-    return max(math.floor(low / REACH_RESOLUTION_MM) * REACH_RESOLUTION_MM,
-               spec.tooth_space_profile().min_fillet_curvature_radius_mm)
+    return max(math.floor(low / REACH_RESOLUTION_MM) * REACH_RESOLUTION_MM, fillet_limit_mm(spec))
 
 
 def refusal_text(spec: GearSpec, pair: GearPair, corner_radius_mm: float, reach: FilletReach | None) -> str:
     """Why the corner does not reach with the mate, the largest that does, and what would let this one fit."""
     largest = largest_reaching_corner_mm(spec, pair)
+    head = f"finishing tool corner radius {corner_radius_mm:.4f} mm does not reach with the mate"
     if reach is None:
-        why = "no rack tooth carries a tip round that large (its two rounds would overlap)"
-    elif reach.form_diameter_mm > reach.sap_diameter_mm + 1e-9:
+        return (f"{head}: no rack tooth of this module, pressure angle and dedendum carries a tip round that large "
+                f"(its two rounds would overlap); the largest corner radius that works is {largest:.3f} mm")
+    if reach.form_diameter_mm > reach.sap_diameter_mm + 1e-9:
         why = (f"the involute it cuts starts at diameter {reach.form_diameter_mm:.3f} mm, above the mate's start of "
                f"active profile at {reach.sap_diameter_mm:.3f} mm")
     else:
         why = (f"the mate's tip corners enter what it leaves in the fillet by {1000 * reach.mate_intrusion_mm:.1f} um "
                f"(at most {1000 * MATE_CLEARANCE_MM:g} um)")
-    return (f"finishing tool corner radius {corner_radius_mm:.4f} mm does not reach with the mate: {why}; the largest "
-            f"corner radius that works is {largest:.3f} mm; a mate with a smaller addendum (a higher SAP and a tip "
-            "path farther from the fillet) would let a larger corner fit")
+    return (f"{head}: {why}; the largest corner radius that works is {largest:.3f} mm; a mate with a smaller addendum "
+            "(a higher SAP and a tip path farther from the fillet) would let a larger corner fit")
 
 
 def finishing_spec(spec: GearSpec, pair: GearPair | None, corner_radius_mm: float) -> GearSpec:
@@ -130,7 +137,7 @@ def finishing_spec(spec: GearSpec, pair: GearPair | None, corner_radius_mm: floa
     and has the design's involute from its form circle, at or below the SAP, up."""
     if pair is None or not applies(spec, pair):
         return spec
-    if corner_radius_mm <= spec.tooth_space_profile().min_fillet_curvature_radius_mm + 1e-9:
+    if corner_radius_mm <= fillet_limit_mm(spec) + 1e-9:
         return spec
     reach = fillet_reach(spec, pair, corner_radius_mm)
     if reach is None or not reach.fits:
