@@ -13,9 +13,10 @@ import pytest
 
 from spur_cad.cam.ir import Feature, MoveKind
 from spur_cad.geometry.frames import turn_points
-from spur_cad.job import load_job
+from spur_cad.job import parse_job
 from spur_cad.pipeline import job_stock, plan_cam
 from spur_cad.sim import Cut, SimSettings, simulate, subset
+from tests.gears import with_roughing_strategy
 from tests.textbook import HelicalTextbook
 
 HELICAL_EXAMPLE = Path(__file__).resolve().parents[1] / "resources" / "examples" / "helical_gear.toml"
@@ -23,7 +24,9 @@ RES = 0.005
 
 
 def _job(hand: str = "right"):
-    job = load_job(HELICAL_EXAMPLE)
+    """The helical example roughing by levels (given: the default is flank, whose passes turn A by their segment's
+    turn as well; test_flank_roughing checks the helical example's flank roughing)."""
+    job = parse_job(with_roughing_strategy(HELICAL_EXAMPLE.read_text(), "levels"), str(HELICAL_EXAMPLE))
     if hand != job.gear.hand:
         job = dataclasses.replace(job, gear=dataclasses.replace(job.gear, hand=hand))
     return job

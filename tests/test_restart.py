@@ -140,9 +140,8 @@ def test_every_dialects_restart_reads_back_as_the_full_programs_tail(generating,
 
 
 def test_a_clamped_table_is_unclamped_before_a_turns_and_clamped_again_where_the_full_program_has_it():
-    job = parse_job(small_job_text() + '\n[roughing]\nclamp_rotary = true\n'.replace(
-        "[roughing]", "[machine]\nrotary_clamp_code = \"M10\"\nrotary_unclamp_code = \"M11\"\n\n[roughing]"),
-        "clamped.toml")
+    job = parse_job(small_job_text().replace("[roughing]\n", "[roughing]\nclamp_rotary = true\n") +
+                    '\n[machine]\nrotary_clamp_code = "M10"\nrotary_unclamp_code = "M11"\n', "clamped.toml")
     plan = plan_cam(job)
     path, start = restart_toolpath(plan.roughing.toolpath, parse_restart("roughing:space=3,level=2"), 30.0)
     kinds = list(path.kind[:4])

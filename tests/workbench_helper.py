@@ -40,6 +40,9 @@ kind = "bull_nose"
 diameter_mm = {finishing_diameter}
 corner_radius_mm = 0.5
 
+[roughing]
+strategy = "levels"               # given (the default is flank): the tests written for this job read levels
+
 [finishing]
 target_scallop_mm = 0.05
 step_over_mm = 1.5
@@ -51,7 +54,7 @@ SMALL_GEAR_PROPERTIES = dict(Teeth=12, Module=3.0, RackTipRadius=0.9, ThicknessA
 SMALL_STOCK_PROPERTIES = dict(RadialAllowance=0.5)
 SMALL_JOB_PROPERTIES = dict(JobName="small quick gear", ProfileTolerance=0.002, UseBottomTool=False,
                             FlankAllowance=0.1, UseRoughingTool=True,  # 0.1: the job file's default
-                            RoughingStrategy="levels",  # given (the default, as a new job's, is flank)
+                            RoughingStrategy="levels",  # as SMALL_JOB gives it (the default, a new job's, is flank)
                             RoughingToolKind="flat", RoughingToolDiameter=2.0, RoughingFlutes=3,
                             UseFinishingTool=True, FinishingToolKind="bull_nose", FinishingToolDiameter=1.5,
                             FinishingCornerRadius=0.5, TargetScallop=0.05, FinishingStepOver=1.5)
