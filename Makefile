@@ -9,6 +9,10 @@ PYTEST_ARGS ?=
 FAST_TIER   := not slow and not freecad and not linuxcnc and not browser
 # The markers `make test` selects; CI's FreeCAD 1.0 / 1.1 tiers add the FreeCAD tests (.ci/tier)
 MARKS       ?= $(FAST_TIER)
+# The fast tier runs on up to 4 workers (pytest-xdist), a test file each at a time (its module fixtures computed
+# once): every test writes under its own tmp_path. Other MARKS (the FreeCAD GUI tests start Xvfb servers) run in one
+# process. `make test PARALLEL=` runs the fast tier in one process too.
+PARALLEL    ?= $(if $(subst $(FAST_TIER),,$(MARKS)),,-n auto --maxprocesses=4 --dist loadfile)
 
 .PHONY: venv demo test test-all lint bench clean
 
@@ -35,7 +39,7 @@ lint: venv
 	$(VENV)/bin/mypy
 
 test: lint
-	$(PYTHON) -m pytest -q -m "$(MARKS)" $(PYTEST_ARGS)
+	$(PYTHON) -m pytest -q $(PARALLEL) -m "$(MARKS)" $(PYTEST_ARGS)
 
 test-all: lint
 	$(PYTHON) -m pytest -q $(PYTEST_ARGS)

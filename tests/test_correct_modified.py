@@ -74,6 +74,7 @@ def test_a_gear_cut_to_its_modified_design_identifies_no_correction(modified, ex
     assert_no_error(identified(job, plan, exact_scan, ideal))
 
 
+@pytest.mark.slow  # the command end to end (tests/test_correct.py runs it on the reference gear in the fast tier)
 def test_correct_writes_no_correction_for_a_gear_cut_to_its_modified_design(modified, exact_scan, tmp_path):
     from spur_cad.cli import main
 
@@ -107,6 +108,7 @@ def test_the_planted_machines_errors_are_identified_on_a_modified_gear(modified,
         assert planted.helix_slope_um[side] == pytest.approx(HELIX_SLOPE_UM[side], abs=SLOPE_TOLERANCE_UM)
 
 
+@pytest.mark.slow  # a second planted cut and grading; the identification above stays in the fast tier
 def test_the_corrected_programs_cut_on_the_planted_machine_give_the_modified_design(modified, planted):
     """The corrected plan (tool as it cuts, passes moved for the slopes, every row's A moved by -e(A)) cut on the
     planted machine with its slopes: no error is left, and every modification is cut as designed (graded against the
@@ -131,6 +133,7 @@ def test_the_corrected_programs_cut_on_the_planted_machine_give_the_modified_des
         assert np.ptp(trace.deviation_um) < CUT_TOLERANCE_UM, (trace.side, trace.space, trace.deviation_um)
 
 
+@pytest.mark.slow  # a full cut and probing; tests/test_probe_log.py reads probe logs in the fast tier
 def test_correct_reads_a_modified_gears_probe_log_from_the_modified_design(modified, tmp_path):
     """`spur-cad correct JOB probe.log` on the modified gear cut exactly and probed 6 um larger (tests/test_probe_log's
     probing of the simulated cut along probe.ngc's moves): the size error is the 6 um (within 1 um, as

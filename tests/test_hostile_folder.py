@@ -22,6 +22,7 @@ from pathlib import Path
 import pytest
 
 from spur_cad.outputs import JOURNAL, MANIFEST, STAGING_MARK, STAGING_PREFIX
+from tests.tiers import sweep
 
 TIME_LIMIT_S = 180
 MEMORY_LIMIT_BYTES = 6 * 1024**3
@@ -96,7 +97,7 @@ def test_a_journal_naming_another_directory_as_staging_deletes_nothing(job, worl
     assert (root / "victimdir" / "precious.txt").read_text() == "precious"
 
 
-@pytest.mark.parametrize("journal", [
+@pytest.mark.parametrize("journal", sweep([
     {"staging": STAGING_PREFIX + "abcd1234", "new": [], "old": ["../victim.txt"]},  # traversal in the old set
     {"staging": STAGING_PREFIX + "abcd1234", "new": ["../victim.txt"], "old": []},
     {"staging": "../victimdir", "new": [], "old": []},
@@ -109,7 +110,8 @@ def test_a_journal_naming_another_directory_as_staging_deletes_nothing(job, worl
     "ab",
     7,
 ], ids=["old-traversal", "new-traversal", "staging-outside", "old-absolute", "old-user-name", "missing-key",
-        "staging-number", "new-string", "list", "string", "number"])
+        "staging-number", "new-string", "list", "string", "number"],
+    fast=["old-traversal", "staging-outside", "string"]))
 def test_a_journal_not_of_our_making_is_refused_with_nothing_touched(job, world, journal):
     root, out = world
     (out / "notes.txt").write_text("mine")
@@ -118,10 +120,11 @@ def test_a_journal_not_of_our_making_is_refused_with_nothing_touched(job, world,
     check_refused_untouched(spur_cad("run", job, "--out", out, "--quiet"), before, root, out / JOURNAL)
 
 
-@pytest.mark.parametrize("manifest", ['"ab"', "5", '["../victim.txt"]', '["a", "b"]', '{"a": 1}', "[1, 2]",
-                                      "not json", '["gear.step", null]', '["roughing.txt"]'],
-                         ids=["string", "number", "traversal", "user-names", "object", "numbers", "not-json", "null",
-                              "user-roughing-notes"])
+@pytest.mark.parametrize("manifest", sweep(['"ab"', "5", '["../victim.txt"]', '["a", "b"]', '{"a": 1}', "[1, 2]",
+                                            "not json", '["gear.step", null]', '["roughing.txt"]'],
+                                           ids=["string", "number", "traversal", "user-names", "object", "numbers",
+                                                "not-json", "null", "user-roughing-notes"],
+                                           fast=["string", "traversal", "not-json"]))
 def test_a_manifest_not_of_our_making_is_refused_with_nothing_touched(job, world, manifest):
     """A manifest that is the JSON string "ab" used to delete the user's files a and b."""
     root, out = world
@@ -132,7 +135,8 @@ def test_a_manifest_not_of_our_making_is_refused_with_nothing_touched(job, world
     check_refused_untouched(spur_cad("run", job, "--out", out, "--quiet"), before, root, out / MANIFEST)
 
 
-@pytest.mark.parametrize("kind", ["fifo", "folder", "link-to-file", "dangling-link", "huge"])
+@pytest.mark.parametrize("kind", sweep(["fifo", "folder", "link-to-file", "dangling-link", "huge"],
+                                         fast=["fifo", "link-to-file"]))
 @pytest.mark.parametrize("name", [MANIFEST, JOURNAL])
 def test_bookkeeping_that_is_no_regular_file_of_ours_is_refused_without_hanging(job, world, name, kind):
     root, out = world

@@ -21,6 +21,7 @@ from pathlib import Path
 import pytest
 
 from spur_cad.report.html import ReportTemplateError, render_report
+from tests.tiers import sweep
 
 MEMORY_LIMIT_BYTES = 3 * 1024**3
 TIME_LIMIT_S = 120
@@ -85,7 +86,7 @@ NAMES = {  # how a name can lead out of the job's folder (the job is in tmp/job/
 
 
 @pytest.mark.parametrize("section, key", [("job", "report_template"), ("machine", "rotary_calibration_file")])
-@pytest.mark.parametrize("how", list(NAMES))
+@pytest.mark.parametrize("how", sweep(NAMES, fast=["dotdot", "link"]))
 def test_a_side_file_outside_the_jobs_folder_is_refused(small_job, tmp_path, secret, section, key, how):
     """Before the fix '../../../../etc/passwd' and a link to it were read and rendered into report.html."""
     folder = tmp_path / "job"
@@ -256,10 +257,10 @@ def test_spur_cads_own_template_is_well_within_the_bounds(small_result):
     assert environment.limits.call_depth > 5 and environment.limits.loop_passes > 1000
 
 
-@pytest.mark.parametrize("name, says", [
+@pytest.mark.parametrize("name, says", sweep([
     ("range-huge", "a range of 1,000,000,000 items"), ("string-times-1e10", "repeated"),
     ("macro-recursion", "nested more than 50 deep"), ("gigabytes-out", "the page passed"),
-])
+], fast=["range-huge"]))  # the other bounds are each checked in-process above (test_a_template_passing_its_bounds)
 def test_a_hostile_template_named_in_a_job_is_one_line_at_its_key(small_job, tmp_path, name, says):
     """End to end: exit 2, one line naming the job file's report_template line and the template, nothing
     written (before the fix: exit 3 with an internal error, or minutes and gigabytes)."""
@@ -299,7 +300,7 @@ CALIBRATION_TABLES = {
 }
 
 
-@pytest.mark.parametrize("name", list(CALIBRATION_TABLES))
+@pytest.mark.parametrize("name", sweep(CALIBRATION_TABLES, fast=["nan", "unsorted", "binary", "ok"]))
 def test_a_hostile_calibration_table_is_refused_at_its_key_or_used(small_job, tmp_path, name):
     table = tmp_path / "rotary.txt"
     table.write_bytes(CALIBRATION_TABLES[name].encode("utf-8", "surrogateescape").replace(b"\xc3\xbf", b"\xff"))
@@ -324,7 +325,7 @@ MEASURED = {
 }
 
 
-@pytest.mark.parametrize("name", list(MEASURED))
+@pytest.mark.parametrize("name", sweep(MEASURED, fast=["nan", "empty", "binary", "probe-short"]))
 @pytest.mark.parametrize("command", ["grade", "correct"])
 def test_a_hostile_measured_file_is_refused_in_one_line_or_graded(small_job, tmp_path, name, command):
     path = tmp_path / "measured.csv"

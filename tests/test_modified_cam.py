@@ -11,6 +11,7 @@ import pytest
 from spur_cad.job import parse_job
 from spur_cad.pipeline import job_stock, plan_cam
 from spur_cad.sim import Cut, SimSettings, simulate, subset
+from tests.tiers import sweep
 
 GEAR = "[gear]\nteeth = 23\nmodule_mm = 4.0\nface_width_mm = 20\nrack_tip_radius_mm = 1.52\n"
 TOOLS = "[tools.finishing]\ndiameter_mm = 'auto'\ncorner_radius_mm = 'auto'\n[tools.roughing]\ndiameter_mm = 'auto'\n"
@@ -36,8 +37,8 @@ GOUGE_MM = 0.001
 """Helical lead modifications: the cut reaches at most this far into the modified design anywhere (fillet too)."""
 
 
-@pytest.fixture(scope="module", params=["spur", "spur sides", "helical", "helical profile", "helical lead",
-                                        "helical end relief"])
+@pytest.fixture(scope="module", params=sweep(["spur", "spur sides", "helical", "helical profile", "helical lead",
+                                              "helical end relief"], fast=["spur", "spur sides", "helical profile"]))
 def planned(request):
     jobs = {"spur": SPUR, "spur sides": SPUR_SIDES, "helical": HELICAL, "helical profile": HELICAL_PROFILE,
             "helical lead": HELICAL_LEAD, "helical end relief": HELICAL_END}

@@ -13,6 +13,8 @@ import subprocess
 import sys
 from pathlib import Path
 
+import pytest
+
 ROOT = Path(__file__).resolve().parents[1]
 
 SCRIPT = """
@@ -36,6 +38,7 @@ json.dump([compiled, dispatchers, "cadquery" in sys.modules], sys.stdout)
 """
 
 
+@pytest.mark.slow  # three simulated runs with an empty numba cache (17 s of CPU)
 def test_a_second_run_in_the_same_process_compiles_nothing(tmp_path):
     env = {**os.environ, "NUMBA_CACHE_DIR": str(tmp_path), "PYTHONPATH": str(ROOT)}
     done = subprocess.run([sys.executable, "-c", SCRIPT], cwd=ROOT, env=env, capture_output=True, text=True,

@@ -12,15 +12,18 @@ from __future__ import annotations
 import dataclasses
 import math
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
-from scipy.spatial import cKDTree
 
 from spur_cad.cam.tools import Tool, ToolError
 from spur_cad.errors import SpurCadError
 from spur_cad.geometry.internal import as_ring, mating_pinion_mesh
 from spur_cad.geometry.mate import GearPair, PairMember, pair_facts
 from spur_cad.geometry.spec import GearSpec
+
+if TYPE_CHECKING:  # scipy.spatial costs 0.3-0.4 s to import: loaded by the 3-axis plan that uses it, not by every run
+    from scipy.spatial import cKDTree
 
 ROOT_SAMPLE_SPACING_MM = 0.005
 """Spacing of the exact outline's samples the tool circle is tested against: the nearest sample is farther than
@@ -84,6 +87,8 @@ class _SpaceSamples:
 
 
 def _space_samples(spec: GearSpec) -> _SpaceSamples:
+    from scipy.spatial import cKDTree
+
     profile = spec.tooth_space_profile()
     parts = {segment.label: _dense(segment, ROOT_SAMPLE_SPACING_MM) for segment in profile.segments}
     right = np.concatenate([p for p, _, _ in parts.values()])
