@@ -26,7 +26,7 @@ from OCP.TopLoc import TopLoc_Location
 from OCP.TopoDS import TopoDS_Shape
 
 from spur_cad.cad.solid import build_gear_shape, in_frame
-from spur_cad.cad.step import GEAR_COLOUR, STOCK_COLOUR, _own_model, _settings
+from spur_cad.cad.step import GEAR_COLOUR, STOCK_COLOUR, _own_model, _settings, coloured_assembly
 from spur_cad.errors import require_instance
 from spur_cad.geometry.mate import GearPair, pair_facts
 from spur_cad.geometry.mate_gear import mate_spec
@@ -64,40 +64,9 @@ def pair_shapes(spec: GearSpec, pair: GearPair, frame: str = "machine") -> tuple
 def pair_document(gear: TopoDS_Shape, mate: TopoDS_Shape, name: str = "pair"):
     """An XCAF document holding the assembly `name` of the parts "gear" and "mate" (each a named, coloured
     compound of its solid, placed at the identity: the shapes carry their placement), as step.job_document."""
-    from OCP.BinXCAFDrivers import BinXCAFDrivers
-    from OCP.Quantity import Quantity_Color, Quantity_ColorRGBA, Quantity_TOC_sRGB
-    from OCP.TCollection import TCollection_ExtendedString
-    from OCP.TDataStd import TDataStd_Name
-    from OCP.TDocStd import TDocStd_Document
-    from OCP.TopoDS import TopoDS_Builder, TopoDS_Compound
-    from OCP.XCAFApp import XCAFApp_Application
-    from OCP.XCAFDoc import XCAFDoc_ColorType, XCAFDoc_DocumentTool
-
-    def named(label, text: str):
-        TDataStd_Name.Set_s(label, TCollection_ExtendedString(text))
-        return label
-
-    application = XCAFApp_Application.GetApplication_s()
-    BinXCAFDrivers.DefineFormat_s(application)
-    document = TDocStd_Document(TCollection_ExtendedString("BinXCAF"))
-    application.InitDocument(document)
-    shapes = XCAFDoc_DocumentTool.ShapeTool_s(document.Main())
-    shapes.SetAutoNaming_s(False)
-    colours = XCAFDoc_DocumentTool.ColorTool_s(document.Main())
-    assembly = named(shapes.NewShape(), name)
     mate_colour = (*STOCK_COLOUR[:3], 1.0)
-    for part_name, shape, (r, g, b, alpha) in (("gear", gear, GEAR_COLOUR), ("mate", mate, mate_colour)):
-        compound = TopoDS_Compound()
-        builder = TopoDS_Builder()
-        builder.MakeCompound(compound)
-        builder.Add(compound, shape)
-        part = named(shapes.NewShape(), part_name)
-        shapes.SetShape(part, compound)
-        colours.SetColor(part, Quantity_ColorRGBA(Quantity_Color(r, g, b, Quantity_TOC_sRGB), alpha),
-                         XCAFDoc_ColorType.XCAFDoc_ColorSurf)
-        named(shapes.AddComponent(assembly, part, TopLoc_Location()), part_name)
-    shapes.UpdateAssemblies()
-    return document
+    return coloured_assembly(name, (("gear", gear, GEAR_COLOUR), ("mate", mate, mate_colour)),
+                             as_cadquery_does=False)
 
 
 def pair_step_bytes(spec: GearSpec, pair: GearPair, frame: str = "part", timestamp: str | None = None) -> bytes:

@@ -89,6 +89,17 @@ def job_document(gear: TopoDS_Shape, stock: TopoDS_Shape, name: str = "job"):
     """An XCAF document holding the assembly `name` with the parts `gear` and `stock`, coloured, both already
     in the machine frame: as CadQuery's Assembly makes it for a coloured STEP export (each part a compound
     of its solid, named, with a surface colour, placed once in the assembly at the identity)."""
+    return coloured_assembly(name, (("gear", gear, GEAR_COLOUR), ("stock", stock, STOCK_COLOUR)),
+                             as_cadquery_does=True)
+
+
+def coloured_assembly(name: str, parts: tuple[tuple[str, TopoDS_Shape, tuple[float, float, float, float]], ...],
+                      as_cadquery_does: bool):
+    """An XCAF document holding the assembly `name` of `parts` ((part name, shape, sRGBA colour) each: a named,
+    surface-coloured compound of its solid, placed at the identity; the shapes carry their own placement).
+    `as_cadquery_does`: also the layer and material tools and the assembly's own located top label, as
+    CadQuery's Assembly export makes them (the job's STEP, compared with CadQuery's); without them, the pair's."""
+    from OCP.BinXCAFDrivers import BinXCAFDrivers
     from OCP.Quantity import Quantity_Color, Quantity_ColorRGBA, Quantity_TOC_sRGB
     from OCP.TCollection import TCollection_ExtendedString
     from OCP.TDataStd import TDataStd_Name
@@ -104,18 +115,17 @@ def job_document(gear: TopoDS_Shape, stock: TopoDS_Shape, name: str = "job"):
         return label
 
     application = XCAFApp_Application.GetApplication_s()
-    from OCP.BinXCAFDrivers import BinXCAFDrivers
-
     BinXCAFDrivers.DefineFormat_s(application)
     document = TDocStd_Document(TCollection_ExtendedString("BinXCAF"))
     application.InitDocument(document)
     shapes = XCAFDoc_DocumentTool.ShapeTool_s(document.Main())
     shapes.SetAutoNaming_s(False)
     colours = XCAFDoc_DocumentTool.ColorTool_s(document.Main())
-    XCAFDoc_DocumentTool.LayerTool_s(document.Main())
-    XCAFDoc_DocumentTool.MaterialTool_s(document.Main())
+    if as_cadquery_does:
+        XCAFDoc_DocumentTool.LayerTool_s(document.Main())
+        XCAFDoc_DocumentTool.MaterialTool_s(document.Main())
     assembly = named(shapes.NewShape(), name)
-    for part_name, shape, (r, g, b, a) in (("gear", gear, GEAR_COLOUR), ("stock", stock, STOCK_COLOUR)):
+    for part_name, shape, (r, g, b, a) in parts:
         compound = TopoDS_Compound()
         builder = TopoDS_Builder()
         builder.MakeCompound(compound)
@@ -125,9 +135,10 @@ def job_document(gear: TopoDS_Shape, stock: TopoDS_Shape, name: str = "job"):
         colours.SetColor(part, Quantity_ColorRGBA(Quantity_Color(r, g, b, Quantity_TOC_sRGB), a),
                          XCAFDoc_ColorType.XCAFDoc_ColorSurf)
         named(shapes.AddComponent(assembly, part, TopLoc_Location()), part_name)
-    top = TDF_Label()
-    shapes.SetLocation(assembly, TopLoc_Location(), top)
-    named(top, name)
+    if as_cadquery_does:
+        top = TDF_Label()
+        shapes.SetLocation(assembly, TopLoc_Location(), top)
+        named(top, name)
     shapes.UpdateAssemblies()
     return document
 
