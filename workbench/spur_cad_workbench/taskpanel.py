@@ -71,7 +71,7 @@ class JobTaskPanel:
     """Task panel editing one job object; `widgets`, `labels`, `notes`, `messages` and `sections` are keyed for
     tests and macros (by property name, and by group for messages and sections)."""
 
-    def __init__(self, job_obj):
+    def __init__(self, job_obj) -> None:
         self.job = job_obj
         self.form = QtGui.QWidget()
         self.form.setObjectName("SpurCadJobPanel")
