@@ -4,6 +4,7 @@ defined, and the kinds' and set-ups' declared capabilities agree with independen
 from __future__ import annotations
 
 import ast
+import dataclasses
 import math
 from pathlib import Path
 
@@ -193,3 +194,74 @@ def test_a_setup_with_inconsistent_capabilities_is_refused():
         MachineSetup("x", axes=3, rotary_axis=True, cuts_helical=True, cuts_teeth_inward=False,
                      follows_modifications=True, tool_kinds=(), finishing_needs_roughing=False, sections=(),
                      z_origin="the rotary axis")
+
+
+# --- the set-ups' rows of the report's set-up sheet -----------------------------------------------------------
+def _sheet(setup, gear, **changes):
+    """The set-up sheet's rows as the report shows them, {label: (value, unit)}, for set-up facts of a z23 blank."""
+    from spur_cad.report.sheet import sheet_row
+    from spur_cad.result import SetupFacts
+
+    facts = SetupFacts(**(dict(machine_name="mill", blank_diameter_mm=101.5, blank_x_min_mm=-2.0, blank_x_max_mm=22.0,
+                               stub_diameter_mm=0.0, stub_length_mm=0.0, work_offset="G54", rotary_sign=1,
+                               coolant=True, clearance_mm=5.0, z_min_mm=None, z_max_mm=None, finish_stock_mm=0.2,
+                               flank_allowance_mm=0.3, roughing_step_down_mm=None, roughing_step_over_mm=None,
+                               machine_setup=setup) | changes))
+    rows = [sheet_row(row) for row in setup.setup_sheet_rows(facts, gear)]
+    assert len({row.label for row in rows}) == len(rows)
+    return {row.label: (row.value, row.unit) for row in rows}
+
+
+@pytest.mark.parametrize("setup", [ROTARY_TABLE, LYING_FLAT])
+def test_each_setup_sheet_names_the_machine_blank_work_offset_and_tooth_space_0(setup):
+    """Every set-up's sheet: the machine, the blank's diameter (3 decimals, mm), the work offset with Z = 0 where the
+    set-up's programs have it (`z_origin`), and where tooth space 0 points: +Z about the rotary axis (the machine
+    frame of docs/architecture.md), +Y lying flat (cam/three_axis.py's frame)."""
+    sheet = _sheet(setup, GearSpec(teeth=23, module_mm=4.0, face_width_mm=20.0).facts())
+    assert sheet["machine"] == ("mill", "")
+    assert sheet["blank diameter"] == ("101.500", "mm")
+    offset = sheet["work offset"][0]
+    assert offset.startswith("G54: ") and f"Z = 0 on {setup.z_origin}" in offset
+    space_0 = [value for label, (value, _) in sheet.items() if "tooth space 0" in f"{label} {value}"]
+    assert len(space_0) == 1 and ("points to +Z" if setup.rotary_axis else "points to +Y") in space_0[0]
+
+
+def test_the_rotary_table_sheet_gives_a_zero_by_the_pitch_angle_the_stub_and_the_blank_along_x():
+    """A's zero: space k under the tool at A = -k 360/z (z = 23: 15.6522 deg to 4 decimals); the stub row only with a
+    stub; the post's A sign said when it is reversed; the clearance for turning A."""
+    gear = GearSpec(teeth=23, module_mm=4.0, face_width_mm=20.0).facts()
+    sheet = _sheet(ROTARY_TABLE, gear)
+    assert "A = -k x 15.6522°" in sheet["A zero"][0] and "opposite sign" not in sheet["A zero"][0]
+    assert sheet["blank along X (front face of the gear at X = 0)"] == ("-2.000 to 22.000", "mm")
+    assert sheet["clearance above the blank for moves that turn A"] == ("5.000", "mm")
+    assert not [label for label in sheet if "stub" in label]
+    stub = _sheet(ROTARY_TABLE, gear, stub_diameter_mm=30.0, stub_length_mm=25.0, rotary_sign=-1)
+    assert stub["holding stub toward the chuck (+X)"] == ("D 30.000 x 25.000", "mm")
+    assert "(the post writes A with the opposite sign)" in stub["A zero"][0]
+
+
+def test_the_lying_flat_sheet_gives_the_blank_thickness_and_no_rotary_axis():
+    """Lying flat: the blank is faced to the face width; nothing turns A; a ring (root outside its tip) is clamped on
+    its rim and centred on the rim, an external gear on its bore."""
+    external = _sheet(LYING_FLAT, GearSpec(teeth=23, module_mm=4.0, face_width_mm=20.0).facts())
+    assert external["blank thickness (faced to the face width)"] == ("20.000", "mm")
+    assert not [label for label, (value, _) in external.items() if "A " in f"{label} " or "rotary" in value]
+    assert "on its bore" in external["gear axis"][0] and "the bore's centre" in external["work offset"][0]
+    ring = _sheet(LYING_FLAT, InternalGearSpec(**RING).facts())
+    assert ring["blank thickness (faced to the face width)"] == ("10.000", "mm")
+    assert "on its rim" in ring["gear axis"][0] and "the rim's centre" in ring["work offset"][0]
+    assert "blank diameter (the rim's outside, not cut)" in ring
+
+
+def test_each_setup_names_the_tool_limits_that_apply_to_it():
+    """The limits the report lists are fields of ToolRecommendations; lying flat the side of a flat end mill cuts,
+    so no generating tool, corner radius or flat width is a limit there (the rotary table lists them)."""
+    from spur_cad.cam.recommend import ToolRecommendations
+
+    fields = {f.name for f in dataclasses.fields(ToolRecommendations)}
+    generating = {"finishing_generating_max_diameter_mm", "finishing_max_corner_radius_mm",
+                  "finishing_max_flat_width_mm"}
+    for setup in (ROTARY_TABLE, LYING_FLAT):
+        names = [name for name, _ in setup.tool_limit_labels]
+        assert names and set(names) <= fields and len(set(names)) == len(names)
+        assert bool(generating & set(names)) is setup.rotary_axis

@@ -6,12 +6,16 @@ frozen object that declares its capabilities once (a rotary axis the programs tu
 which tools it cuts with, whether it follows flank modifications, which job sections it reads, where its Z
 starts), and code asks the set-up (`Machine.setup`), never `axes`. `axes` itself is read only here and in
 cam/machine.py: tests/test_kinds.py checks that over spur_cad/ and workbench/.
+
+Each set-up is an instance of its own class (RotaryTable, LyingFlat), which writes its rows of the report's
+set-up sheet (`setup_sheet_rows`) and names the tool limits that apply to it (`tool_limit_labels`): plain data
+(label, text, numbers, unit) that the report formats, so the report asks the set-up and does not branch on it.
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Protocol
+from typing import ClassVar, Protocol
 
 
 class _Kind(Protocol):
@@ -22,6 +26,65 @@ class _Kind(Protocol):
 
     @property
     def teeth_inward(self) -> bool: ...
+
+
+class _SheetFacts(Protocol):
+    """What a set-up's sheet reads of the run's set-up facts (spur_cad.result.SetupFacts)."""
+
+    @property
+    def machine_name(self) -> str: ...
+
+    @property
+    def blank_diameter_mm(self) -> float: ...
+
+    @property
+    def blank_x_min_mm(self) -> float: ...
+
+    @property
+    def blank_x_max_mm(self) -> float: ...
+
+    @property
+    def stub_diameter_mm(self) -> float: ...
+
+    @property
+    def stub_length_mm(self) -> float: ...
+
+    @property
+    def work_offset(self) -> str: ...
+
+    @property
+    def rotary_sign(self) -> int: ...
+
+    @property
+    def clearance_mm(self) -> float: ...
+
+
+class _SheetGear(Protocol):
+    """What a set-up's sheet reads of the gear (spur_cad.result.GearFacts)."""
+
+    @property
+    def teeth(self) -> int: ...
+
+    @property
+    def root_radius_mm(self) -> float: ...
+
+    @property
+    def tip_radius_mm(self) -> float: ...
+
+    @property
+    def face_width_mm(self) -> float: ...
+
+
+@dataclass(frozen=True)
+class SheetRow:
+    """One row of the set-up sheet as plain data: the label, the value's text with a `{}` where each of `numbers`
+    goes (the report writes each with `digits` decimals; a text without numbers is shown as it is), the unit."""
+
+    label: str
+    text: str
+    numbers: tuple[float, ...] = ()
+    digits: int = 3
+    unit: str = ""
 
 
 @dataclass(frozen=True)
@@ -70,13 +133,89 @@ class MachineSetup:
         """Whether a job-file section that belongs to one set-up (e.g. "three_axis") applies to this one."""
         return section in self.sections
 
+    tool_limit_labels: ClassVar[tuple[tuple[str, str], ...]] = ()
+    """(ToolRecommendations field, label) of the tool limits the report shows for this set-up."""
 
-ROTARY_TABLE = MachineSetup("rotary table", axes=4, rotary_axis=True, cuts_helical=True, cuts_teeth_inward=False,
-                            follows_modifications=True, tool_kinds=(), finishing_needs_roughing=False, sections=(),
-                            z_origin="the rotary axis")
-LYING_FLAT = MachineSetup("lying flat", axes=3, rotary_axis=False, cuts_helical=False, cuts_teeth_inward=True,
-                          follows_modifications=False, tool_kinds=("flat",), finishing_needs_roughing=True,
-                          sections=("three_axis",), z_origin="the blank's top face")
+    def setup_sheet_rows(self, facts: _SheetFacts, gear: _SheetGear) -> tuple[SheetRow, ...]:
+        """The set-up sheet's rows (stock, work offset, how the part sits), as a machinist sets the part up."""
+        raise NotImplementedError(f"machine set-up {self.name!r} writes no set-up sheet")
+
+
+@dataclass(frozen=True)
+class RotaryTable(MachineSetup):
+    """The gear on the rotary table: gear axis = machine X = A, the tool along Z above the part."""
+
+    tool_limit_labels: ClassVar[tuple[tuple[str, str], ...]] = (
+        ("roughing_max_diameter_mm", "largest roughing end mill (flat)"),
+        ("finishing_generating_max_diameter_mm", "largest finishing tool by generation (corner = rack tip radius)"),
+        ("finishing_flat_end_mill_max_diameter_mm", "largest flat end mill that finishes by generation"),
+        ("finishing_max_corner_radius_mm", "largest finishing corner radius (the fillet's tightest curve)"),
+        ("finishing_max_flat_width_mm", "largest finishing flat width (the root arc)"),
+        ("plunge_allowance_mm", "material roughing may leave above the root"),
+        ("required_flute_length_mm", "flute length the tools need (blank to root)"),
+        ("required_stick_out_mm", "stick-out the tools need"),
+    )
+
+    def setup_sheet_rows(self, facts: _SheetFacts, gear: _SheetGear) -> tuple[SheetRow, ...]:
+        """Stock, work offset and A's zero: the blank along X from the gear's front face, the holding stub."""
+        rows = [SheetRow("machine", facts.machine_name),
+                SheetRow("blank diameter", "{}", (facts.blank_diameter_mm,), unit="mm"),
+                SheetRow("blank along X (front face of the gear at X = 0)", "{} to {}",
+                         (facts.blank_x_min_mm, facts.blank_x_max_mm), unit="mm")]
+        if facts.stub_diameter_mm > 0.0:
+            rows.append(SheetRow("holding stub toward the chuck (+X)", "D {} x {}",
+                                 (facts.stub_diameter_mm, facts.stub_length_mm), unit="mm"))
+        rows += [
+            SheetRow("work offset",
+                     f"{facts.work_offset}: X = 0 on the gear's front face, Y = 0 and Z = 0 on the rotary axis"),
+            SheetRow("A zero", "tooth space 0's axis points to +Z; space k is brought under the tool at A = -k x {}°"
+                     + ("" if facts.rotary_sign == 1 else " (the post writes A with the opposite sign)"),
+                     (360.0 / gear.teeth,), digits=4),
+            SheetRow("gear axis", "machine X = rotary axis A; the tool along Z, above the part"),
+            SheetRow("clearance above the blank for moves that turn A", "{}", (facts.clearance_mm,), unit="mm"),
+        ]
+        return tuple(rows)
+
+
+@dataclass(frozen=True)
+class LyingFlat(MachineSetup):
+    """The blank lying flat on a 3-axis machine: gear axis = machine Z, Z = 0 on its top face; a ring (its root
+    outside its tip) clamped on its rim."""
+
+    tool_limit_labels: ClassVar[tuple[tuple[str, str], ...]] = (  # the side cuts: no generating tool, corner, flat
+        ("roughing_max_diameter_mm", "largest roughing end mill (flat)"),
+        ("finishing_flat_end_mill_max_diameter_mm", "largest finishing flat end mill (its side leaves the involute "
+                                                    "no higher than the active profile's start)"),
+        ("required_flute_length_mm", "flute length the tools need (the face width and the break-through)"),
+        ("required_stick_out_mm", "stick-out the tools need"),
+    )
+
+    def setup_sheet_rows(self, facts: _SheetFacts, gear: _SheetGear) -> tuple[SheetRow, ...]:
+        """The blank's diameter and thickness, the work offset on its axis and top face, how it is clamped."""
+        if gear.root_radius_mm > gear.tip_radius_mm:
+            blank, centre = "blank diameter (the rim's outside, not cut)", "the ring's axis (the rim's centre)"
+            axis = ("machine Z: the ring clamped flat on its rim (outside the tip circle), relieved 0.5 mm under the "
+                    "hole (the programs mill the hole away through the face width)")
+        else:
+            blank, centre = "blank diameter", "the gear axis (the bore's centre)"
+            axis = ("machine Z: the blank clamped flat on its bore or a fixture, relieved 0.5 mm under the outline "
+                    "(the programs cut through unless [three_axis] leaves tabs or a skin)")
+        return (
+            SheetRow("machine", facts.machine_name),
+            SheetRow(blank, "{}", (facts.blank_diameter_mm,), unit="mm"),
+            SheetRow("blank thickness (faced to the face width)", "{}", (gear.face_width_mm,), unit="mm"),
+            SheetRow("work offset", f"{facts.work_offset}: X = 0 and Y = 0 on {centre}, Z = 0 on the blank's top face"),
+            SheetRow("tooth space 0", "its axis points to +Y"),
+            SheetRow("gear axis", axis),
+        )
+
+
+ROTARY_TABLE = RotaryTable("rotary table", axes=4, rotary_axis=True, cuts_helical=True, cuts_teeth_inward=False,
+                           follows_modifications=True, tool_kinds=(), finishing_needs_roughing=False, sections=(),
+                           z_origin="the rotary axis")
+LYING_FLAT = LyingFlat("lying flat", axes=3, rotary_axis=False, cuts_helical=False, cuts_teeth_inward=True,
+                       follows_modifications=False, tool_kinds=("flat",), finishing_needs_roughing=True,
+                       sections=("three_axis",), z_origin="the blank's top face")
 
 SETUPS: dict[int, MachineSetup] = {setup.axes: setup for setup in (ROTARY_TABLE, LYING_FLAT)}
 """Every set-up, by its `[machine] axes` value."""

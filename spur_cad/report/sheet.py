@@ -12,6 +12,7 @@ import dataclasses
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
+from spur_cad.cam.setups import ROTARY_TABLE, SheetRow
 from spur_cad.result import FinishingFacts, RoughingFacts
 
 if TYPE_CHECKING:
@@ -94,23 +95,6 @@ HELICAL_LABELS = (
     ("lead_mm", "lead", "mm", 3),
     ("overlap_ratio", "overlap ratio", "", 3),
 )
-LIMIT_LABELS = (  # (ToolRecommendations field, label)
-    ("roughing_max_diameter_mm", "largest roughing end mill (flat)"),
-    ("finishing_generating_max_diameter_mm", "largest finishing tool by generation (corner = rack tip radius)"),
-    ("finishing_flat_end_mill_max_diameter_mm", "largest flat end mill that finishes by generation"),
-    ("finishing_max_corner_radius_mm", "largest finishing corner radius (the fillet's tightest curve)"),
-    ("finishing_max_flat_width_mm", "largest finishing flat width (the root arc)"),
-    ("plunge_allowance_mm", "material roughing may leave above the root"),
-    ("required_flute_length_mm", "flute length the tools need (blank to root)"),
-    ("required_stick_out_mm", "stick-out the tools need"),
-)
-FLAT_LIMIT_LABELS = (  # a gear cut lying flat (3 axes): the side cuts, no generating tool, corner or flat width
-    ("roughing_max_diameter_mm", "largest roughing end mill (flat)"),
-    ("finishing_flat_end_mill_max_diameter_mm", "largest finishing flat end mill (its side leaves the involute no "
-                                                "higher than the active profile's start)"),
-    ("required_flute_length_mm", "flute length the tools need (the face width and the break-through)"),
-    ("required_stick_out_mm", "stick-out the tools need"),
-)
 TOOL_KINDS = {"flat": "flat end mill", "bull_nose": "bull-nose end mill", "ball": "ball end mill"}
 OPERATION_NAMES = {"roughing": "roughing", "roughing_bottom": "roughing, bottom of the spaces",
                    "finishing": "finishing"}
@@ -131,10 +115,10 @@ def gear_rows(result: JobResult) -> tuple[Row, ...]:
 
 
 def limit_rows(result: JobResult) -> tuple[Row, ...]:
-    """The gear's tool limits, labelled (0 shown as 'none fits'); a gear cut lying flat shows the limits of the
-    3-axis variant (FLAT_LIMIT_LABELS)."""
+    """The gear's tool limits, labelled (0 shown as 'none fits'): those of the set-up (its tool_limit_labels; a gear
+    cut lying flat shows the limits of the 3-axis variant), the rotary table's for a run without set-up facts."""
     rec = result.tools.recommendations
-    labels = LIMIT_LABELS if result.setup is None or result.setup.machine_setup.rotary_axis else FLAT_LIMIT_LABELS
+    labels = (ROTARY_TABLE if result.setup is None else result.setup.machine_setup).tool_limit_labels
     return tuple(Row(_limit_label(rec, name, label), number(getattr(rec, name), 3) if getattr(rec, name) > 0.0
                      else "none fits", "mm" if getattr(rec, name) > 0.0 else "") for name, label in labels)
 
@@ -261,49 +245,18 @@ def totals_rows(result: JobResult) -> tuple[Row, ...]:
 
 
 def setup_rows(result: JobResult) -> tuple[Row, ...]:
-    """Stock, work offset and A's zero, as a machinist sets the part up."""
-    setup, gear = result.setup, result.gear
+    """Stock, work offset and how the part sits, as a machinist sets the part up: the set-up's own rows
+    (MachineSetup.setup_sheet_rows: A's zero on the rotary table, the blank's thickness lying flat), formatted here."""
+    setup = result.setup
     if setup is None:
         return ()
-    if not setup.machine_setup.rotary_axis:
-        return _flat_setup_rows(setup, gear)
-    rows = [Row("machine", setup.machine_name),
-            Row("blank diameter", number(setup.blank_diameter_mm, 3), "mm"),
-            Row("blank along X (front face of the gear at X = 0)",
-                f"{number(setup.blank_x_min_mm, 3)} to {number(setup.blank_x_max_mm, 3)}", "mm")]
-    if setup.stub_diameter_mm > 0.0:
-        rows.append(Row("holding stub toward the chuck (+X)",
-                        f"D {number(setup.stub_diameter_mm, 3)} x {number(setup.stub_length_mm, 3)}", "mm"))
-    rows += [
-        Row("work offset", f"{setup.work_offset}: X = 0 on the gear's front face, Y = 0 and Z = 0 on the rotary axis"),
-        Row("A zero", f"tooth space 0's axis points to +Z; space k is brought under the tool at "
-                      f"A = -k x {number(360.0 / gear.teeth, 4)}°"
-                      + ("" if setup.rotary_sign == 1 else " (the post writes A with the opposite sign)")),
-        Row("gear axis", "machine X = rotary axis A; the tool along Z, above the part"),
-        Row("clearance above the blank for moves that turn A", number(setup.clearance_mm, 3), "mm"),
-    ]
-    return tuple(rows)
+    return tuple(sheet_row(row) for row in setup.machine_setup.setup_sheet_rows(setup, result.gear))
 
 
-def _flat_setup_rows(setup, gear) -> tuple[Row, ...]:
-    """The set-up of the 3-axis variant ([machine] axes = 3): the blank lying flat, Z0 on its top face; a ring
-    (its root outside its tip) clamped on its rim."""
-    if gear.root_radius_mm > gear.tip_radius_mm:
-        blank, centre = "blank diameter (the rim's outside, not cut)", "the ring's axis (the rim's centre)"
-        axis = ("machine Z: the ring clamped flat on its rim (outside the tip circle), relieved 0.5 mm under the "
-                "hole (the programs mill the hole away through the face width)")
-    else:
-        blank, centre = "blank diameter", "the gear axis (the bore's centre)"
-        axis = ("machine Z: the blank clamped flat on its bore or a fixture, relieved 0.5 mm under the outline (the "
-                "programs cut through unless [three_axis] leaves tabs or a skin)")
-    return (
-        Row("machine", setup.machine_name),
-        Row(blank, number(setup.blank_diameter_mm, 3), "mm"),
-        Row("blank thickness (faced to the face width)", number(gear.face_width_mm, 3), "mm"),
-        Row("work offset", f"{setup.work_offset}: X = 0 and Y = 0 on {centre}, Z = 0 on the blank's top face"),
-        Row("tooth space 0", "its axis points to +Y"),
-        Row("gear axis", axis),
-    )
+def sheet_row(row: SheetRow) -> Row:
+    """A set-up's plain row as the report shows it: each of its numbers with its digits in place of a `{}`."""
+    text = row.text.format(*(number(value, row.digits) for value in row.numbers)) if row.numbers else row.text
+    return Row(row.label, text, row.unit)
 
 
 def program_table(result: JobResult) -> Table:
