@@ -74,7 +74,7 @@ from spur_cad.job_tools import (  # noqa: F401  (re-exported)
     tools_section,
     without_auto,
 )
-from spur_cad.keys import keys_of
+from spur_cad.keys import SectionValues, keys_of, section_values
 from spur_cad.mate_section import MateSection, check_mate
 from spur_cad.post.settings import PostSettings, post_settings_type
 
@@ -126,6 +126,23 @@ class Job:
         if name.startswith("tools."):
             return getattr(self.tools, name.removeprefix("tools."))
         return getattr(self, name)
+
+    def section_values(self) -> tuple[SectionValues, ...]:
+        """Every key of every section the job has, as the run uses it (defaults, the set-up's roughing strategy
+        and the tools' resolved "auto" keys included), in the order of SECTIONS with the [gear.modifications]
+        tables the file gives after [gear]; absent optional sections ([mate], a tool, [lathe], [probe]) left out.
+        Read from the sections' own classes (spur_cad.keys.section_values), so a key declared on a section's class,
+        a replacement's given as `sections=` included, is in summary.json's `job_file` and the report's "Job file"
+        with no other code."""
+        found = []
+        for name in SECTIONS:
+            section = self.section(name)
+            if section is not None:
+                found.append(section_values(name, section))
+            if name == "gear":
+                found.extend(section_values(table, ModificationsSection(**values))
+                             for table, values in self.modification_values.items())
+        return tuple(found)
 
 
 def job_sections(strategies: Strategies = REGISTRY, dialects: Dialects = DIALECTS,

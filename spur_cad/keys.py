@@ -164,6 +164,43 @@ def defaults_of(cls: type) -> dict[str, object]:
     return {k.name: k.default for k in keys_of(cls) if not k.required}
 
 
+Scalar = bool | int | float | str
+"""A job-file key's value (`keys_of` admits these four types only): JSON and the report take it as it is."""
+
+
+@dataclass(frozen=True)
+class KeyValue:
+    """One key of a section as a run used it: its name, its value (the file's, the default, or what "auto"
+    resolved to) and its declared unit ('' for none)."""
+
+    name: str
+    value: Scalar
+    unit: str
+
+    def __post_init__(self) -> None:
+        if not isinstance(self.value, (bool, int, float, str)):
+            raise TypeError(f"key {self.name}: a job-file value is a number, a string or a flag, not "
+                            f"{type(self.value).__name__}")
+        if self.unit not in UNITS:
+            raise ValueError(f"key {self.name}: unknown unit {self.unit!r}")
+
+
+@dataclass(frozen=True)
+class SectionValues:
+    """Every key of one section of a job as the run used it, in declaration order (summary.json's `job_file`,
+    the report's "Job file")."""
+
+    section: str
+    keys: tuple[KeyValue, ...]
+
+
+def section_values(section: str, obj: object) -> SectionValues:
+    """The keys of section dataclass instance `obj` (named `section`: 'gear', 'tools.roughing', ...) with their
+    values: every key its class declares, so a key added to the class is here with no other code."""
+    cls: type = type(obj)
+    return SectionValues(section, tuple(KeyValue(k.name, getattr(obj, k.name), k.unit) for k in keys_of(cls)))
+
+
 # --- checks ---------------------------------------------------------------------------------------------
 
 

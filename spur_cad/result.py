@@ -14,6 +14,7 @@ from typing import TYPE_CHECKING, Any
 from spur_cad.cam.setups import ROTARY_TABLE, MachineSetup
 from spur_cad.geometry.kinds import EXTERNAL_SPUR, GearKind
 from spur_cad.geometry.mate import GearPair, PairFacts
+from spur_cad.keys import SectionValues
 
 if TYPE_CHECKING:  # annotations only: the CAD kernel and the simulator load when a job uses them
     from spur_cad.cad.specs import GearSolidReport
@@ -388,3 +389,6 @@ class JobResult:
     kind: GearKind = EXTERNAL_SPUR  # the gear's kind (spur_cad.geometry.kinds; not in summary.json)
     pair: GearPair | None = None  # the gear and its [mate] (None: no [mate], the checks assume the basic rack)
     mate: PairFacts | None = None  # the pair's ISO 21771 quantities (summary.json's `mate`)
+    # every key of every section of the job as the run used it (summary.json's `job_file`, the report's
+    # "Job file"; spur_cad.job.Job.section_values)
+    job_file: tuple[SectionValues, ...] = ()

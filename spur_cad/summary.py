@@ -19,6 +19,7 @@ from spur_cad.dialects import dialect
 from spur_cad.geometry.inspection import inspection_sheet, modification_inspection
 from spur_cad.geometry.mate import GearPair, PairFacts, pair_facts
 from spur_cad.geometry.sampling import ProfileSamples
+from spur_cad.keys import Scalar, SectionValues
 from spur_cad.post.program import PostedProgram
 from spur_cad.post.settings import PostSettings
 from spur_cad.result import (
@@ -85,7 +86,8 @@ def build_result(job, samples: ProfileSamples, cad: CadResult | None, plan: CamP
                        dialect(post.dialect, job.dialects).extension),
         simulation=simulation_facts(simulation, job.simulation.resolution_mm), grading=grading,
         lathe=lathe_facts(job), timings_s=seconds, setup=setup_facts(job, plan, post), error_budget=error_budget,
-        pair=job.pair, mate=pair_facts(job.pair) if job.pair is not None else None)
+        pair=job.pair, mate=pair_facts(job.pair) if job.pair is not None else None,
+        job_file=job.section_values())
 
 
 BUDGET_INPUTS = ("rotary_accuracy_arcsec", "rotary_repeatability_arcsec", "rotary_calibration_file",
@@ -291,6 +293,7 @@ def summary_json(result: JobResult) -> dict:
     summary: dict[str, Any] = {
         "spur_cad_version": result.version,
         "job": {"name": result.job.name, "file": result.job.file},
+        "job_file": job_file_json(result.job_file),
         "gear": dataclasses.asdict(result.gear),
         **({"mate": mate_json(result.pair, result.mate)} if result.pair is not None and result.mate is not None
            else {}),
@@ -317,6 +320,13 @@ def summary_json(result: JobResult) -> dict:
         summary["lathe"] = dataclasses.asdict(result.lathe)
     summary["timings_s"] = dict(result.timings_s)
     return summary
+
+
+def job_file_json(sections: tuple[SectionValues, ...]) -> dict[str, dict[str, Scalar]]:
+    """summary.json's `job_file`: {section: {key: value}} of every key of every section the job has, as the run
+    used it (defaults included; spur_cad.job.Job.section_values). Values are JSON's own: numbers, strings as the
+    file gives them, true / false."""
+    return {section.section: {k.name: k.value for k in section.keys} for section in sections}
 
 
 MATE_INTERNALS = ("internal", "start_of_active_profile_roll_mm", "mate_start_of_active_profile_roll_mm")

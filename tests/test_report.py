@@ -36,8 +36,12 @@ def shown_duration(seconds: float) -> str:
 
 
 def visible_text(page: str) -> str:
-    """The page's text as a reader sees it (tags, the style sheet and image data left out)."""
+    """The page's text as a reader sees it (tags, the style sheet and image data left out), the folded "Job file"
+    section folded: its line alone (unfolded it lists the job file's keys by their names, as the file writes them;
+    its own test below)."""
     body = re.sub(r"<style>.*?</style>", " ", page, flags=re.DOTALL)
+    body = re.sub(r"(<details class=\"job-file\">\s*<summary>.*?</summary>).*?</details>", r"\1", body,
+                  flags=re.DOTALL)
     return html_lib.unescape(re.sub(r"<[^>]+>", " ", body))
 
 
@@ -154,6 +158,38 @@ def test_no_job_file_key_name_is_a_label(outputs):
     shown = {name for name in keys if "_" in name and re.search(rf"\b{re.escape(name)}\b", text)}
     assert shown == set()
     assert not re.search(r"\b[a-z]+(_[a-z0-9]+)*_(mm|deg|um|rpm|mm3|fraction|percent|coefficient)\b", text)
+
+
+def test_the_folded_job_file_section_lists_every_key_as_the_file_writes_it(outputs):
+    """The report's "Job file": one table per section of summary.json's `job_file`, in its order, each key of it in
+    order (every key its section's class declares: test_registry_job_key), a value the job file gives as its own
+    line writes it (read here from the file's text, comments cut), each _mm key in mm."""
+    html, summary, _ = outputs
+    folded = re.search(r'<details class="job-file">\s*<summary>Job file: [^<]*</summary>(.*?)</details>', html,
+                       re.DOTALL)
+    assert folded and folded[1].count("<table") == len(summary["job_file"])
+    tables = re.split(r"<caption>", folded[1])[1:]
+    assert [re.match(r"\[([a-z_.]+)\]</caption>", t)[1] for t in tables] == list(summary["job_file"])
+    lines = {}  # (section, key) -> the value as the file's line writes it
+    section = ""
+    for line in REFERENCE_JOB.read_text().splitlines():
+        line = line.split("#")[0].strip()
+        if line.startswith("["):
+            section = line.strip("[]")
+        elif "=" in line:
+            key, value = (part.strip() for part in line.split("=", 1))
+            lines[(section, key)] = value
+    given = 0
+    for name, table in zip(summary["job_file"], tables):
+        rows = re.findall(r'<tr><th>([a-z0-9_]+)</th><td class="(?:num|text)">([^<]*)</td>'
+                          r'<td class="unit">([^<]*)</td>', table)
+        assert [key for key, _, _ in rows] == list(summary["job_file"][name]), name
+        for key, value, unit in rows:
+            if (name, key) in lines:
+                assert html_lib.unescape(value) == lines[(name, key)], (name, key)
+                given += 1
+            assert unit == "mm" or not key.endswith("_mm"), (name, key)
+    assert given == len(lines) > 40  # every line of the file found
 
 
 def test_report_without_toolpaths_simulation_or_grade_still_renders(outputs):

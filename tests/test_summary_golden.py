@@ -29,6 +29,11 @@ gear's 2316 s of roughing are the 2316 s its flank_suggested said. The simulated
 error budget, the finishing figures and programs and the STEP files are unchanged; the helical removed volume
 grew by 0.03 mm^3 (the roughing's passes in the margins), the reference gear's is the same.
 
+Issue 45 added one key, `job_file` after `job`: every key of every section of the job as the run used it (read from
+the sections' classes, spur_cad.job.Job.section_values; tests/test_registry_job_key.py checks each against the job
+file and the keys' defaults). It was inserted into both recorded summaries from each example's job; no other key
+changed, and the STEP files and programs are byte-identical (the hashes below).
+
 Their STEP files and programs are byte-identical to that run's (SHA-256 below), but for the header's time
 (set to a fixed value before hashing; SOURCE_DATE_EPOCH sets it, tested below) and, in job.step, the order
 of the two parts' colour styles, which OCCT wrote in an order that changed from run to run when the goldens were

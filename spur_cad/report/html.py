@@ -17,6 +17,7 @@ from spur_cad.cam.three_axis import ThreeAxisFinishingFacts
 from spur_cad.dependencies import require_jinja2
 from spur_cad.errors import SpurCadError, one_line
 from spur_cad.report import sheet
+from spur_cad.report.job_file import job_file_tables
 from spur_cad.report.pair import NO_MATE_NOTE, pair_rows
 from spur_cad.report.sheet import Table, duration, number
 
@@ -229,6 +230,7 @@ def report_context(result: JobResult, images: dict[str, bytes]) -> dict:
         "error_budget_text": sheet.error_budget_text(result),
         "overall_class": (grading.overall_class or "beyond 11") if grading is not None else "",
         "grading_validity": "; ".join(grading.validity) if grading is not None and grading.validity else "",
+        "job_file": job_file_tables(result.job_file),
         "images": {name: _image_uri(images.get(name)) for name in ("profile", "modifications", "roughing", "finishing",
                                                                   "deviation", "engagement", "kchart")},
     }
