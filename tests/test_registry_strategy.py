@@ -17,8 +17,10 @@ import pytest
 from spur_cad.cam.ir import Feature
 from spur_cad.cam.machine import MachineError
 from spur_cad.cam.plan import check_cam_inputs
+from spur_cad.cam.setups import LYING_FLAT, ROTARY_TABLE
 from spur_cad.cam.strategies import REGISTRY, strategy_names
 from spur_cad.cam.strategies.along_x import AlongXParams, AlongXStrategy
+from spur_cad.cam.strategies.perimeter import PerimeterStrategy
 from spur_cad.errors import JobFileError
 from spur_cad.job import parse_job
 from spur_cad.keydocs import job_file_reference_markdown
@@ -88,6 +90,30 @@ def test_the_loader_takes_the_strategy_and_its_key_from_the_registry_it_is_given
     with pytest.raises(MachineError, match=r"strategy = 'land_first' is for spur gears; .* by strategy = "
                                            r"\"generating\"$"):
         check_cam_inputs(cam_inputs(helical))  # its declared capability (helical = False, along_x's), asked
+
+
+class LyingFlatStrategy(PerimeterStrategy):
+    """perimeter's passes, declared to cut the gear lying flat (a capability no strategy of the registry has)."""
+
+    name = "lying_flat_test"
+    lying_flat = True
+
+
+def test_a_strategy_declared_lying_flat_is_refused_on_the_rotary_table_in_one_line_at_its_key():
+    """The set-up reads the strategy's declared capability (MachineSetup.accepts_strategy): the rotary table takes
+    the strategies that are not `lying_flat`; the 3-axis set-up none of the registry's (its finishing is the plan's
+    own, cam/three_axis.py). A strategy declared lying flat, registered from this test alone, is refused on the
+    rotary table before planning, blamed on its [finishing] strategy line, naming the strategies that fit."""
+    assert all(ROTARY_TABLE.accepts_strategy(s) and not LYING_FLAT.accepts_strategy(s) for s in REGISTRY.values())
+    assert LYING_FLAT.accepts_strategy(LyingFlatStrategy()) and not ROTARY_TABLE.accepts_strategy(LyingFlatStrategy())
+    text = small_job_text().replace("[finishing]\n", '[finishing]\nstrategy = "lying_flat_test"\n')
+    job = parse_job(text, "flat.toml", strategies={**REGISTRY, LyingFlatStrategy.name: LyingFlatStrategy()})
+    with pytest.raises(MachineError) as caught:
+        check_cam_inputs(cam_inputs(job))
+    line = text.splitlines().index('strategy = "lying_flat_test"') + 1
+    assert job.located(caught.value) == (
+        f"flat.toml:{line}: [finishing] strategy = 'lying_flat_test' cuts the gear lying flat; on the rotary table "
+        '([machine] axes = 4) finish by strategy = "perimeter" or "along_x" or "generating"')
 
 
 def test_the_key_documentation_lists_the_strategy_and_its_key():

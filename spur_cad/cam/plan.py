@@ -103,6 +103,12 @@ def check_cam_inputs(inputs: CamInputs) -> tuple[ToolRecommendations, RoughingLe
                            f"helical gear (helix_angle_deg = {spec.helix_angle_deg:g}) is finished by "
                            f"strategy = {helical}",
                            field="strategy", section="finishing")
+    if not machine.setup.accepts_strategy(strategy):  # a strategy declared `lying_flat` (the 3-axis plan has its own)
+        fitting = " or ".join(f'"{name}"' for name, other in inputs.strategies.items()
+                              if machine.setup.accepts_strategy(other))
+        raise MachineError(f"[finishing] strategy = {shown(inputs.finishing.strategy)} cuts the gear lying flat; on "
+                           f"the {machine.setup.name} ([machine] axes = {machine.setup.axes}) finish by strategy = "
+                           f"{fitting}", field="strategy", section="finishing")
     blank = stock.blank_radius_mm(spec)
     check_blank_allowance(spec, stock, inputs.finishing_tool,
                           inputs.roughing if inputs.roughing_tool is not None else None)

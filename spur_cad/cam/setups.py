@@ -28,6 +28,13 @@ class _Kind(Protocol):
     def teeth_inward(self) -> bool: ...
 
 
+class _Strategy(Protocol):
+    """What a set-up asks of a finishing strategy (spur_cad.cam.strategies.FinishingStrategy)."""
+
+    @property
+    def lying_flat(self) -> bool: ...
+
+
 class _SheetFacts(Protocol):
     """What a set-up's sheet reads of the run's set-up facts (spur_cad.result.SetupFacts)."""
 
@@ -132,6 +139,12 @@ class MachineSetup:
     def reads_section(self, section: str) -> bool:
         """Whether a job-file section that belongs to one set-up (e.g. "three_axis") applies to this one."""
         return section in self.sections
+
+    def accepts_strategy(self, strategy: _Strategy) -> bool:
+        """Whether this set-up finishes with a strategy of the registry declared so: the rotary table with those that
+        are not `lying_flat`, lying flat with those that are (none yet: the 3-axis finishing, cam/three_axis.py,
+        is the plan's own and takes no [finishing] strategy)."""
+        return strategy.lying_flat != self.rotary_axis
 
     tool_limit_labels: ClassVar[tuple[tuple[str, str], ...]] = ()
     """(ToolRecommendations field, label) of the tool limits the report shows for this set-up."""
