@@ -265,3 +265,18 @@ def test_each_setup_names_the_tool_limits_that_apply_to_it():
         names = [name for name, _ in setup.tool_limit_labels]
         assert names and set(names) <= fields and len(set(names)) == len(names)
         assert bool(generating & set(names)) is setup.rotary_axis
+
+
+def test_each_setup_words_roughing_by_levels_with_the_places_the_report_fills():
+    """The set-up's phrases for roughing by levels name the levels and only the places the report fills
+    (html.program_notes: levels, lowest_above_root_mm, lowest_z_mm, tips); on the rotary table the levels are
+    counted per space down to a height above the root circle, lying flat down to a Z (from the top face)."""
+    import string
+
+    filled = {"levels", "lowest_above_root_mm", "lowest_z_mm", "tips"}
+    for setup in (ROTARY_TABLE, LYING_FLAT):
+        for phrase in (setup.levels_roughing, setup.levels_roughing_note):
+            places = {name for _, name, _, _ in string.Formatter().parse(phrase) if name is not None}
+            assert "levels" in places and places <= filled, (setup.name, phrase)
+    assert "{lowest_above_root_mm} mm above the root circle{tips}" in ROTARY_TABLE.levels_roughing_note
+    assert "down to Z {lowest_z_mm} mm" in LYING_FLAT.levels_roughing_note

@@ -8,8 +8,9 @@ starts), and code asks the set-up (`Machine.setup`), never `axes`. `axes` itself
 cam/machine.py: tests/test_kinds.py checks that over spur_cad/ and workbench/.
 
 Each set-up is an instance of its own class (RotaryTable, LyingFlat), which writes its rows of the report's
-set-up sheet (`setup_sheet_rows`) and names the tool limits that apply to it (`tool_limit_labels`): plain data
-(label, text, numbers, unit) that the report formats, so the report asks the set-up and does not branch on it.
+set-up sheet (`setup_sheet_rows`), names the tool limits that apply to it (`tool_limit_labels`) and words roughing
+by levels (`levels_roughing`, `levels_roughing_note`): plain data (label, text, numbers, unit; phrases with named
+places) that the report formats, so the report asks the set-up and does not branch on it.
 """
 
 from __future__ import annotations
@@ -148,6 +149,12 @@ class MachineSetup:
 
     tool_limit_labels: ClassVar[tuple[tuple[str, str], ...]] = ()
     """(ToolRecommendations field, label) of the tool limits the report shows for this set-up."""
+    levels_roughing: ClassVar[str] = ""
+    """The report's operation-table phrase for roughing by levels here ({levels}: levels per space)."""
+    levels_roughing_note: ClassVar[str] = ""
+    """The report's sentence on roughing by levels here ({levels}: levels per space; {lowest_above_root_mm}: the
+    lowest level above the root circle; {lowest_z_mm}: the lowest level's Z; {tips}: the tip lands' passes or
+    nothing; the values written by the report)."""
 
     def setup_sheet_rows(self, facts: _SheetFacts, gear: _SheetGear) -> tuple[SheetRow, ...]:
         """The set-up sheet's rows (stock, work offset, how the part sits), as a machinist sets the part up."""
@@ -168,6 +175,9 @@ class RotaryTable(MachineSetup):
         ("required_flute_length_mm", "flute length the tools need (blank to root)"),
         ("required_stick_out_mm", "stick-out the tools need"),
     )
+    levels_roughing: ClassVar[str] = "z-level roughing, {levels} levels per space"
+    levels_roughing_note: ClassVar[str] = ("Roughing: {levels} levels per space, the lowest {lowest_above_root_mm} mm "
+                                           "above the root circle{tips}.")
 
     def setup_sheet_rows(self, facts: _SheetFacts, gear: _SheetGear) -> tuple[SheetRow, ...]:
         """Stock, work offset and A's zero: the blank along X from the gear's front face, the holding stub."""
@@ -202,6 +212,9 @@ class LyingFlat(MachineSetup):
         ("required_flute_length_mm", "flute length the tools need (the face width and the break-through)"),
         ("required_stick_out_mm", "stick-out the tools need"),
     )
+    levels_roughing: ClassVar[str] = "3-axis roughing, {levels} levels of passes offset from the blank inward"
+    levels_roughing_note: ClassVar[str] = ("Roughing on 3 axes: {levels} levels down to Z {lowest_z_mm} mm, each a "
+                                           "series of passes offset from the blank inward to the finish stock.")
 
     def setup_sheet_rows(self, facts: _SheetFacts, gear: _SheetGear) -> tuple[SheetRow, ...]:
         """The blank's diameter and thickness, the work offset on its axis and top face, how it is clamped."""

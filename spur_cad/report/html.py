@@ -12,7 +12,7 @@ from importlib import resources
 from typing import TYPE_CHECKING
 
 from spur_cad.cam.plan import REFERENCE_CONTACT_SPACING_MM, REFERENCE_STATION_STEP_MM
-from spur_cad.cam.strategies import COMPARISON_STRATEGY
+from spur_cad.cam.strategies import COMPARISON_STRATEGY, get_strategy
 from spur_cad.cam.three_axis import ThreeAxisFinishingFacts
 from spur_cad.dependencies import require_jinja2
 from spur_cad.errors import SpurCadError, one_line
@@ -95,13 +95,10 @@ def program_notes(result: JobResult) -> tuple[str, ...]:
             notes.append(f"Roughing by flanks: {rough.passes_per_space} passes per space, A turned by +-({turns}) "
                          f"deg to the flank segments, down to {number(rough.lowest_level_height_mm, 3)} mm above "
                          f"the root circle{tips}.")
-        elif result.setup is not None and not result.setup.machine_setup.rotary_axis:
-            notes.append(f"Roughing on 3 axes: {rough.levels_per_space} levels down to Z "
-                         f"{number(min(rough.level_heights_mm), 3)} mm, each a series of passes offset from the "
-                         "blank inward to the finish stock.")
-        else:
-            notes.append(f"Roughing: {rough.levels_per_space} levels per space, the lowest "
-                         f"{number(rough.lowest_level_height_mm, 3)} mm above the root circle{tips}.")
+        else:  # by levels, in the set-up's words
+            notes.append(sheet.machine_setup(result).levels_roughing_note.format(
+                levels=rough.levels_per_space, lowest_above_root_mm=number(rough.lowest_level_height_mm, 3),
+                lowest_z_mm=number(min(rough.level_heights_mm), 3) if rough.level_heights_mm else "-", tips=tips))
         stage = rough.two_stage
         if stage is not None and stage.bottom.passes_per_space is not None:
             larger = result.tools.roughing
@@ -217,9 +214,9 @@ def report_context(result: JobResult, images: dict[str, bytes]) -> dict:
         "expected_tolerance": sheet.expected_tolerance(result), "limit_rows": sheet.limit_rows(result),
         "advice_rows": sheet.advice_rows(result), "advice_strategy": result.tools.advice_strategy,
         "program_table": sheet.program_table(result),
-        # the comparison strategies are rotary-table strategies: none for a gear lying flat
-        "finishing_comparison": finishing_comparison(result.finishing)
-        if result.finishing is not None and (result.setup is None or result.setup.machine_setup.rotary_axis) else None,
+        # the comparison strategy is a rotary-table strategy: none for a gear lying flat
+        "finishing_comparison": finishing_comparison(result.finishing) if result.finishing is not None
+        and sheet.machine_setup(result).accepts_strategy(get_strategy(COMPARISON_STRATEGY)) else None,
         "program_notes": program_notes(result), "simulation_rows": sheet.simulation_rows(result),
         "gouge_within_resolution": (not sim.enabled) or sim.max_gouge_mm <= sim.resolution_mm,
         "simulation_verdict": verdict, "feature_table": sheet.feature_table(result),

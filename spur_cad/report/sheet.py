@@ -12,7 +12,7 @@ import dataclasses
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
-from spur_cad.cam.setups import ROTARY_TABLE, SheetRow
+from spur_cad.cam.setups import ROTARY_TABLE, MachineSetup, SheetRow
 from spur_cad.result import FinishingFacts, RoughingFacts
 
 if TYPE_CHECKING:
@@ -118,9 +118,14 @@ def limit_rows(result: JobResult) -> tuple[Row, ...]:
     """The gear's tool limits, labelled (0 shown as 'none fits'): those of the set-up (its tool_limit_labels; a gear
     cut lying flat shows the limits of the 3-axis variant), the rotary table's for a run without set-up facts."""
     rec = result.tools.recommendations
-    labels = (ROTARY_TABLE if result.setup is None else result.setup.machine_setup).tool_limit_labels
+    labels = machine_setup(result).tool_limit_labels
     return tuple(Row(_limit_label(rec, name, label), number(getattr(rec, name), 3) if getattr(rec, name) > 0.0
                      else "none fits", "mm" if getattr(rec, name) > 0.0 else "") for name, label in labels)
+
+
+def machine_setup(result: JobResult) -> MachineSetup:
+    """The run's machine set-up (the rotary table's for a run without set-up facts), which the report asks."""
+    return ROTARY_TABLE if result.setup is None else result.setup.machine_setup
 
 
 def _limit_label(rec, name: str, label: str) -> str:
@@ -202,9 +207,7 @@ def operation_table(result: JobResult) -> Table:
         if isinstance(facts, RoughingFacts):  # roughing and roughing_bottom
             strategy = (f"roughing by flanks, {facts.passes_per_space} passes per space"
                         if facts.passes_per_space is not None else
-                        f"3-axis roughing, {facts.levels_per_space} levels of passes offset from the blank inward"
-                        if setup is not None and not setup.machine_setup.rotary_axis else
-                        f"z-level roughing, {facts.levels_per_space} levels per space")
+                        machine_setup(result).levels_roughing.format(levels=facts.levels_per_space))
             stock = (f"{number(setup.finish_stock_mm, 2)} to {number(setup.flank_allowance_mm, 2)} mm"
                      if setup is not None else "-")
             steps = (f"down {number(setup.roughing_step_down_mm, 2)} mm, "
