@@ -311,7 +311,6 @@ def _verify(args: argparse.Namespace, received: list[int], loaded: list) -> int:
     job = loaded[0]
     options = VerifyOptions(args.point, args.gouge_tolerance_mm, args.leftover_tolerance_mm, tuple(args.point_tools),
                             args.a_offset_deg)
-    options.validate()
     dialect = args.dialect or job.post.dialect
     known = job.dialects.get(dialect)  # None for a name the registry does not hold (the reader says so)
     rs274_checkable = known is not None and known.rs274_checkable  # LinuxCNC's interpreter reads these programs

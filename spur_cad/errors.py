@@ -43,6 +43,13 @@ class StockError(SpurCadError, ValueError):
         super().__init__(message, field=field, section="stock")
 
 
+class SimulationError(SpurCadError, ValueError):
+    """Simulation settings that cannot work (the message names the setting and its value).
+
+    Here (spur_cad.sim.simulate re-exports it) so that the job's [simulation] section refuses a bad value when it
+    is made without importing the simulator."""
+
+
 class WorkLimitError(SpurCadError, ValueError):
     """Input that would need more work (moves, points, memory) than spur_cad's limits allow; raised
     before the work is done, naming the quantity, the limit and what to change."""

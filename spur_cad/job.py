@@ -4,8 +4,9 @@ Every section is a small typed dataclass whose fields are the section's keys, ea
 with `spur_cad.keys.key` (type, unit, default, range or choices, meaning, workbench label and
 group). The loader rejects unknown sections and keys, wrong types, missing required values and
 values outside the declared ranges with a JobFileError that names the key and, where the file
-has it, the key's line; then it runs the sections' cross-field checks (`validate()`) and builds
-the GearSpec. Units are in the key names (mm, deg, percent, m_min, ...).
+has it, the key's line, as it does what a section refuses when it is made (its `__post_init__`: keys
+that contradict each other); then it builds the GearSpec and runs the checks that need it or a tool's
+role (the sections' `validate(context)`). Units are in the key names (mm, deg, percent, m_min, ...).
 
 spur_cad.keydocs writes docs/job-file.md from the same declarations
 (`python -m spur_cad.keydocs > docs/job-file.md`).
@@ -193,10 +194,12 @@ def job_from_dict(data: dict, source: str, strategies: Strategies = REGISTRY, di
 
 def _validate_sections(sections: dict, tables: dict, types: dict, autos: dict[str, set[str]], spec: GearSpec,
                        strategies: Strategies, where: Callable[[str, str | None], str]) -> None:
-    """Every section's own checks, the tools last: their "auto" keys are resolved once the sections the
-    suggestion depends on (machine, roughing, finishing) have passed theirs."""
-    for name in ("machine", "three_axis", "roughing", "finishing", "post", "export", "lathe", "probe",
-                 *(f"tools.{role}" for role in TOOL_ROLES)):
+    """The checks of a section that need more than its own keys (its own ran when it was made, load_section):
+    [three_axis]'s heights against the face width, and each tool's, which its role names, the tools last: their
+    "auto" keys are resolved once the sections the suggestion depends on (machine, roughing, finishing) are made.
+    A tool checks itself here, not when made: suggestions and the plan make tools beyond the job file's ranges
+    (bisection probes) that are never cut."""
+    for name in ("three_axis", *(f"tools.{role}" for role in TOOL_ROLES)):
         if name not in sections:
             continue
         is_tool = name.startswith("tools.")
@@ -206,10 +209,8 @@ def _validate_sections(sections: dict, tables: dict, types: dict, autos: dict[st
         try:
             if is_tool:
                 sections[name].validate(name.removeprefix("tools."))
-            elif name == "three_axis":  # its heights are checked against the face width
+            else:  # [three_axis]: its heights are checked against the face width
                 sections[name].validate(spec.face_width_mm)
-            else:
-                sections[name].validate()
         except SpurCadError as exc:
             prefix = f"[{name}] " if is_tool else ""
             blamed = blamed_key(exc, name, tables[name], types)
@@ -330,10 +331,10 @@ def _job_from_data(data: dict, source: str, text: str, strategies: Strategies = 
                            section=table, field=None)
     modifications, modification_values = _modifications(modification_tables, spec, source, text)
     spec, pair = _mated(spec, loaded.get("mate"), tables.get("mate", {}), where)
-    for check, name in ((gear_section.blank_features().validate, "gear"),
-                        (loaded.get("stock", StockSpec()).validate, "stock")):
+    for check, name in ((lambda: gear_section.blank_features().validate(spec), "gear"),
+                        (lambda: loaded.get("stock", StockSpec()).validate(spec), "stock")):
         try:
-            check(spec)
+            check()
         except (GearSpecError, StockError) as exc:
             blamed = blamed_key(exc, name, tables.get(name, {}))
             raise JobFileError(f"{where(name, blamed)}: invalid [{name}]: {exc}", section=name, field=blamed) from None

@@ -15,9 +15,7 @@ from spur_cad.cam.strategies import FinishingParams
 from spur_cad.cam.three_axis_tabs import ThreeAxisSection
 from spur_cad.cam.tools import Tool
 from spur_cad.cam.turning import LatheSection
-from spur_cad.errors import (
-    JobFileError,
-)
+from spur_cad.errors import GearSpecError, JobFileError, SimulationError
 from spur_cad.geometry.internal import InternalGearSpec
 from spur_cad.geometry.spec import MAX_TEETH, MIN_TEETH, GearSpec
 from spur_cad.keys import check_section, key
@@ -39,6 +37,10 @@ class JobSection:
     material: str = key(DEFAULT_MATERIAL, choices=tuple(MATERIALS), label="Material", group="Job",
                         meaning="the gear's material: its specific cutting force (Kienzle k_c1.1, m_c; "
                                 "spur_cad/cam/materials.py) sets the finishing tool's deflection in the error budget")
+
+    def __post_init__(self) -> None:
+        """Every key in its declared range or choices, checked once when the section is made."""
+        check_section(self, "job", JobFileError)
 
 
 @dataclass(frozen=True)
@@ -94,6 +96,11 @@ class GearSection:
                                  meaning="hub keyway width, 0: none")
     keyway_depth_mm: float = key(0.0, unit="mm", low=0.0, high=200.0, label="KeywayDepth", group="Bore",
                                  meaning="hub keyway depth from the bore surface, 0: none")
+
+    def __post_init__(self) -> None:
+        """Every key in its declared range or choices, checked once when the section is made (what the keys decide
+        together is GearSpec's to check: to_spec)."""
+        check_section(self, "gear", GearSpecError)
 
     def to_spec(self) -> GearSpec:
         """The GearSpec ([gear] internal = true: an InternalGearSpec, spur only)."""
@@ -164,6 +171,11 @@ class ModificationsSection:
                                                   "front face to the back face (signed, none at mid-face)",
                                     signed=True)
 
+    def __post_init__(self) -> None:
+        """Every key in its declared range or choices, checked once when the table is made (the amounts against the
+        gear: spur_cad.geometry.modifications.flank_modification)."""
+        check_section(self, "gear.modifications", GearSpecError)
+
 
 MODIFICATION_SECTIONS: dict[str, type] = {
     "gear.modifications": ModificationsSection,
@@ -185,10 +197,9 @@ class SimulationSection:
                                group="Simulation",
                                meaning="bound of the simulation's own error; finer is slower (about 4 x per halving)")
 
-    def validate(self) -> None:
-        """Raise SimulationError for a value outside its declared range (e.g. a resolution given to Simulate)."""
-        from spur_cad.sim.simulate import SimulationError
-
+    def __post_init__(self) -> None:
+        """Raise SimulationError for a value outside its declared range, once, when the section is made (e.g. with
+        the resolution the workbench's Simulate command asks for)."""
         check_section(self, "simulation", SimulationError)
 
 
@@ -207,7 +218,9 @@ class ExportSection:
                                    "wire radius plus spark gap for wire EDM, half the kerf for laser and waterjet, "
                                    "so the file is the path of the cut's centre; 0: the part's own outline")
 
-    def validate(self) -> None:
+    def __post_init__(self) -> None:
+        """Every key in its declared range, checked once when the section is made (the offset against the gear's
+        root: spur_cad.job's export check)."""
         check_section(self, "export", JobFileError)
 
 

@@ -59,8 +59,15 @@ def blamed_key(exc: SpurCadError, name: str, given: dict, sections: dict[str, ty
     return exc.field if exc.field in names else None
 
 
+CONSTRUCTION_PREFIX = {"stock": "invalid [stock]: "}
+"""What a refusal at a section's construction says before its message ([stock]'s do not name the section; the
+other sections' messages start with it)."""
+
+
 def load_section(table: object, name: str, source: str, text: str, sections: dict[str, type] = SECTIONS):
-    """Build section `name`'s dataclass from its TOML table, checking keys, types, ranges and choices."""
+    """Build section `name`'s dataclass from its TOML table, checking keys, types, ranges and choices here (their
+    messages name the table, e.g. [gear.modifications.left]); what the section's own `__post_init__` refuses when it
+    is made (keys that contradict each other) is said the same way, at the line of the key it blames."""
     cls = sections[name]
     if not isinstance(table, dict):
         raise JobFileError(f"{where_of(source, text, name)}: [{name}] must be a table")
@@ -89,7 +96,12 @@ def load_section(table: object, name: str, source: str, text: str, sections: dic
         key_name, problem = problems[0]
         raise JobFileError(f"{where_of(source, text, name, key_name)}: [{name}] {key_name} {problem}", section=name,
                            field=key_name)
-    return cls(**values)
+    try:
+        return cls(**values)
+    except SpurCadError as exc:
+        blamed = blamed_key(exc, name, table, sections)
+        raise JobFileError(f"{where_of(source, text, name, blamed)}: {CONSTRUCTION_PREFIX.get(name, '')}{exc}",
+                           section=name, field=blamed) from None
 
 
 def deepest_value(text: str, source: str) -> str:

@@ -12,8 +12,8 @@ one-line meaning, and the FreeCAD workbench's property label and group:
                                   label="Clearance", group="Machine")
 
 Everything else derives from these declarations: the job loader's type, range and choice
-checks and their messages (spur_cad.job), the sections' own `validate()` (which runs
-`check_section` before its cross-field checks), the workbench's properties
+checks and their messages (spur_cad.job), the sections' own `__post_init__` (which runs
+`check_section` before its cross-field checks, so an invalid section cannot be made), the workbench's properties
 (workbench/spur_cad_workbench/schema.py) and docs/job-file.md. Adding a key is one field.
 
 Lowest layer: imports only the standard library.
@@ -66,7 +66,7 @@ class Key:
     of another key of the same section (e.g. line_number_step <= max_line_number).
     `choices`: the closed set of values the key takes (checked here).
     `names_from`: a callable giving the names a registry in the code offers (dialects, finishing
-    strategies, tool kinds); the section's `validate()` checks them with the registry's message,
+    strategies, tool kinds); the section's `__post_init__` checks them with the registry's message,
     the workbench offers them in a drop-down list and the documentation lists them.
     """
 
@@ -263,7 +263,7 @@ def section_problems(cls: type, values: dict) -> list[tuple[str, str]]:
 
 def check_section(obj: Any, section: str, error: Callable[..., Exception]) -> None:
     """Raise `error(f"[{section}] {key} {problem}", field=key)` for the first key of dataclass
-    instance `obj` outside its declared range or choices (the sections' validate() call this first)."""
+    instance `obj` outside its declared range or choices (the sections' __post_init__ call this first)."""
     cls: type = type(obj)
     values = {k.name: getattr(obj, k.name) for k in keys_of(cls)}
     for k in keys_of(cls):

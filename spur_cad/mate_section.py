@@ -65,7 +65,8 @@ class MateSection:
                                             "distance of the shifts; given, the mate's shift follows from it "
                                             "(given both, they must agree within 0.001 mm)")
 
-    def validate(self) -> None:
+    def __post_init__(self) -> None:
+        """Every key in its declared range, checked once when the section is made (the pair: check_mate)."""
         check_section(self, "mate", PairError)
 
 

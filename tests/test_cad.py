@@ -23,7 +23,14 @@ from OCP.TopExp import TopExp_Explorer
 from OCP.TopoDS import TopoDS
 
 import spur_cad
-from spur_cad.cad.solid import build_gear_shape, build_stock_shape, front_face_area_mm2, solid_volume_mm3
+from spur_cad.cad.solid import (
+    build_gear_shape,
+    build_stock_shape,
+    front_face_area_mm2,
+    gear_shape,
+    solid_volume_mm3,
+    stock_shape,
+)
 from spur_cad.cad.specs import BlankFeatures, StockSpec
 from spur_cad.cad.step import step_files
 from spur_cad.errors import StockError
@@ -90,14 +97,24 @@ def test_bore_and_keyway_remove_exactly_their_area():
 
 
 @pytest.mark.parametrize("features, words", [
-    (BlankFeatures(bore_diameter_mm=80.0), "wall"),
-    (BlankFeatures(bore_diameter_mm=30.0, keyway_width_mm=8.0), "both keyway_width_mm and keyway_depth_mm"),
-    (BlankFeatures(keyway_width_mm=8.0, keyway_depth_mm=3.0), "needs a bore"),
-    (BlankFeatures(bore_diameter_mm=30.0, keyway_width_mm=8.0, keyway_depth_mm=30.0), "keyway reaches"),
+    (dict(bore_diameter_mm=80.0), "wall"),
+    (dict(bore_diameter_mm=30.0, keyway_width_mm=8.0, keyway_depth_mm=30.0), "keyway reaches"),
 ])
-def test_blank_feature_errors(features, words):
+def test_blank_features_that_do_not_suit_the_gear_are_refused_by_the_scripts_entry_point(features, words):
+    """Against the gear: checked where the features meet it (gear_shape, the job loader)."""
     with pytest.raises(spur_cad.GearSpecError, match=words):
-        build_gear_shape(spec_of("reference_z23_m4"), features)
+        gear_shape(spec_of("reference_z23_m4"), BlankFeatures(**features))
+
+
+@pytest.mark.parametrize("features, words", [
+    (dict(bore_diameter_mm=30.0, keyway_width_mm=8.0), "both keyway_width_mm and keyway_depth_mm"),
+    (dict(keyway_width_mm=8.0, keyway_depth_mm=3.0), "needs a bore"),
+    (dict(bore_diameter_mm=8.0, keyway_width_mm=8.0, keyway_depth_mm=3.0), "smaller than the bore"),
+    (dict(bore_diameter_mm=-1.0), "must be zero"),
+])
+def test_blank_features_that_cannot_exist_are_refused_when_made(features, words):
+    with pytest.raises(spur_cad.GearSpecError, match=words):
+        BlankFeatures(**features)
 
 
 def _section_points(shape, x: float, per_edge: int = 400) -> np.ndarray:
@@ -220,13 +237,17 @@ def test_stock_volume_and_stub():
 
 
 @pytest.mark.parametrize("stock, words", [
-    (StockSpec(radial_allowance_mm=-1.0), r"\[stock\] radial_allowance_mm must be in \[0, 50\] mm, got -1"),
-    (StockSpec(stub_diameter_mm=20.0), "needs both"),
-    (StockSpec(stub_diameter_mm=200.0, stub_length_mm=5.0), "larger than the blank"),
+    (dict(radial_allowance_mm=-1.0), r"\[stock\] radial_allowance_mm must be in \[0, 50\] mm, got -1"),
+    (dict(stub_diameter_mm=20.0), "needs both"),
 ])
-def test_stock_errors(stock, words):
+def test_stock_that_cannot_exist_is_refused_when_made(stock, words):
     with pytest.raises(StockError, match=words):
-        build_stock_shape(spec_of("reference_z23_m4"), stock)
+        StockSpec(**stock)
+
+
+def test_stock_that_does_not_suit_the_gear_is_refused_by_the_scripts_entry_point():
+    with pytest.raises(StockError, match="larger than the blank"):
+        stock_shape(spec_of("reference_z23_m4"), StockSpec(stub_diameter_mm=200.0, stub_length_mm=5.0))
 
 
 def test_step_round_trip_and_assembly_names(tmp_path):

@@ -306,9 +306,10 @@ def test_the_passes_follow_the_keys(job):
      "depth_of_cut_mm"),  # the passes bound: 19,000 roughing passes
 ])
 def test_settings_that_cannot_turn_the_blank_are_refused(job, changes, field):
-    lathe = dataclasses.replace(LatheSection(), **changes)
+    """Refused naming the key: by the section when it is made (its own keys), else by the plan (against the
+    stock)."""
     with pytest.raises(LatheError) as raised:
-        plan_lathe(job.gear, job.stock, lathe)
+        plan_lathe(job.gear, job.stock, dataclasses.replace(LatheSection(), **changes))
     assert raised.value.field == field and raised.value.section == "lathe"
     assert raised.value.key == f"lathe.{field}"
 

@@ -330,19 +330,20 @@ def test_wrapped_a_without_direction_codes_needs_short_moves():
         post_program(builder.build(), PostSettings(dialect="fanuc", folded=False, rotary_mode="wrapped"), INFO)
 
 
-@pytest.mark.parametrize(("settings", "message"), [
-    (PostSettings(dialect="heidenhain"), "dialect = 'heidenhain' is not known"),
-    (PostSettings(rotary_sign=2), "rotary_sign must be 1 or -1"),
-    (PostSettings(rotary_mode="spin"), "rotary_mode must be 'unwound' or 'wrapped'"),
-    (PostSettings(max_line_number=0), "max_line_number must be in 1..99999999"),
-    (PostSettings(line_number_step=0), "line_number_step must be in 1..max_line_number"),
-    (PostSettings(line_number_overflow="alarm"), "line_number_overflow must be 'wrap' or 'stop'"),
-    (PostSettings(program_number=0), "program_number must be in 1..9999"),
-    (PostSettings(rotary_mode="wrapped"), "folded = true needs rotary_mode = 'unwound'"),
+@pytest.mark.parametrize(("values", "message"), [
+    (dict(dialect="heidenhain"), "dialect = 'heidenhain' is not known"),
+    (dict(rotary_sign=2), "rotary_sign must be 1 or -1"),
+    (dict(rotary_mode="spin"), "rotary_mode must be 'unwound' or 'wrapped'"),
+    (dict(max_line_number=0), "max_line_number must be in 1..99999999"),
+    (dict(line_number_step=0), "line_number_step must be in 1..max_line_number"),
+    (dict(line_number_overflow="alarm"), "line_number_overflow must be 'wrap' or 'stop'"),
+    (dict(program_number=0), "program_number must be in 1..9999"),
+    (dict(rotary_mode="wrapped"), "folded = true needs rotary_mode = 'unwound'"),
 ])
-def test_bad_post_settings_are_named(settings, message):
+def test_bad_post_settings_are_named(values, message):
+    """Refused when the settings are made (the posts trust them)."""
     with pytest.raises(PostError, match=re.escape(message)):
-        settings.validate()
+        PostSettings(**values)
 
 
 def test_program_numbers_must_leave_room_for_the_subprograms(cam_paths):

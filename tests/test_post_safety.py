@@ -82,13 +82,14 @@ def test_rs274_reads_the_same_moves_with_hostile_text(hostile, tmp_path):
                                   "M0", "M99", "M98", "M6", "M10\n", "M\u0661\u0660"])
 def test_clamp_codes_other_than_one_m_code_are_refused(code):
     with pytest.raises(MachineError, match="rotary_clamp_code"):
-        Machine(rotary_clamp_code=code).validate()
+        Machine(rotary_clamp_code=code)
     with pytest.raises(SpurCadError, match="rotary_clamp_code"):
         post_program(two_space_toolpath(), PostSettings(), ProgramInfo("t", (), rotary_clamp_code=code))
 
 
 def test_valid_clamp_codes_are_written_as_their_own_blocks():
-    Machine(rotary_clamp_code="M10", rotary_unclamp_code="M11").validate()
+    machine = Machine(rotary_clamp_code="M10", rotary_unclamp_code="M11")  # made: its checks pass
+    assert (machine.rotary_clamp_code, machine.rotary_unclamp_code) == ("M10", "M11")
 
 
 @pytest.mark.parametrize("change, words", [

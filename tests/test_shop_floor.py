@@ -163,7 +163,7 @@ def test_an_unknown_work_offset_is_refused_naming_the_key():
     with pytest.raises(JobFileError, match=r"\[post\] work_offset .*G54"):
         parse_job(_with(small_job_text(), "post", 'work_offset = "G92"'), "s.toml")
     with pytest.raises(SpurCadError):
-        dataclasses.replace(parse_job(small_job_text(), "s.toml").post, work_offset="G53").validate()
+        dataclasses.replace(parse_job(small_job_text(), "s.toml").post, work_offset="G53")
 
 
 def test_a_job_with_a_lathe_section_writes_the_blank_program_with_the_set(tmp_path):

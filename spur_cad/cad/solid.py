@@ -302,10 +302,10 @@ def build_gear_shape(spec: GearSpec, features: BlankFeatures = BlankFeatures(),
 
     `fit_tolerance_mm` defaults to 2.5e-6 x module (see default_fit_tolerance_mm). With `modifications` the
     flanks are the modified ones: profile modifications only, the modified outline extruded or swept as the
-    design's; lead modifications, a loft through modified sections (`_loft_lead_modified`)."""
+    design's; lead modifications, a loft through modified sections (`_loft_lead_modified`). The features suit the
+    gear: checked where they meet it (the job loader, gear_shape), not here."""
     require_instance(spec, GearSpec, "spec")
     require_instance(features, BlankFeatures, "features")
-    features.validate(spec)
     tolerance = default_fit_tolerance_mm(spec) if fit_tolerance_mm is None else fit_tolerance_mm
     edges, report = gear_face_edges(spec, tolerance)
     b = spec.face_width_mm
@@ -332,10 +332,10 @@ def build_gear_shape(spec: GearSpec, features: BlankFeatures = BlankFeatures(),
 
 
 def build_stock_shape(spec: GearSpec, stock: StockSpec = StockSpec()) -> TopoDS_Shape:
-    """The blank: cylinder over the face width plus margins, and the holding stub toward +X."""
+    """The blank: cylinder over the face width plus margins, and the holding stub toward +X (the stock suits the
+    gear: checked where they meet, the job loader or stock_shape)."""
     require_instance(spec, GearSpec, "spec")
     require_instance(stock, StockSpec, "stock")
-    stock.validate(spec)
     x_start, x_end = stock.blank_x_range_mm(spec)
     shape = _x_cylinder(stock.blank_radius_mm(spec), x_start, x_end)
     if stock.stub_length_mm > 0.0:
@@ -352,10 +352,10 @@ def build_stock_shape(spec: GearSpec, stock: StockSpec = StockSpec()) -> TopoDS_
 def build_flat_stock_shape(spec: GearSpec, stock: StockSpec, features: BlankFeatures = BlankFeatures()) -> TopoDS_Shape:
     """The blank of a gear cut lying flat ([machine] axes = 3): a disk of the blank diameter over the face width
     (X 0 to b: the programs' Z0 is its top face, the gear's), through its bore when the job gives one (it is
-    clamped on it; a ring's: [stock] inner_diameter_mm, clamped on its rim); no holding stub."""
+    clamped on it; a ring's: [stock] inner_diameter_mm, clamped on its rim); no holding stub. The stock suits the
+    gear: the job loader checked it (StockSpec.validate)."""
     require_instance(spec, GearSpec, "spec")
     require_instance(stock, StockSpec, "stock")
-    stock.validate(spec)
     shape = _x_cylinder(stock.blank_radius_mm(spec), 0.0, spec.face_width_mm)
     # a ring: its blank's bore
     bore_mm = stock.inner_diameter_mm if spec.kind.teeth_inward else features.bore_diameter_mm
@@ -391,19 +391,25 @@ def in_frame(shape: TopoDS_Shape, spec: GearSpec, frame: str) -> TopoDS_Shape:
 
 def gear_shape(spec: GearSpec, features: BlankFeatures = BlankFeatures(), fit_tolerance_mm: float | None = None,
                frame: str = "machine") -> TopoDS_Shape:
-    """The gear solid as an OCP shape in `frame` (see FRAMES): needs OCP only, neither CadQuery nor build123d."""
+    """The gear solid as an OCP shape in `frame` (see FRAMES): needs OCP only, neither CadQuery nor build123d.
+    Scripts' entry point: the features are checked against the gear here, once (GearSpecError)."""
     require_instance(spec, GearSpec, "spec")
+    require_instance(features, BlankFeatures, "features")
     require_instance(frame, str, "frame")
     in_frame(TopoDS_Shape(), spec, frame)  # an unknown frame is refused before the solid is built
+    features.validate(spec)
     shape, _ = build_gear_shape(spec, features, fit_tolerance_mm)
     return in_frame(shape, spec, frame)
 
 
 def stock_shape(spec: GearSpec, stock: StockSpec = StockSpec(), frame: str = "machine") -> TopoDS_Shape:
-    """The stock as an OCP shape in `frame` (see FRAMES)."""
+    """The stock as an OCP shape in `frame` (see FRAMES). Scripts' entry point: the stock is checked against the
+    gear here, once (StockError)."""
     require_instance(spec, GearSpec, "spec")
+    require_instance(stock, StockSpec, "stock")
     require_instance(frame, str, "frame")
     in_frame(TopoDS_Shape(), spec, frame)
+    stock.validate(spec)
     return in_frame(build_stock_shape(spec, stock), spec, frame)
 
 

@@ -38,22 +38,15 @@ class BlankFeatures:
     keyway_width_mm: float = 0.0
     keyway_depth_mm: float = 0.0
 
-    def validate(self, spec: GearSpec) -> None:
-        """Raise GearSpecError unless the features leave a wall of at least one module under the root."""
+    def __post_init__(self) -> None:
+        """Raise GearSpecError for features that cannot exist (a size not a number or negative, a keyway half given,
+        without a bore or as wide as it), once, when they are made; against the gear: validate."""
         for name in ("bore_diameter_mm", "keyway_width_mm", "keyway_depth_mm"):
             value = getattr(self, name)
             if isinstance(value, bool) or not isinstance(value, (int, float)):
                 raise GearSpecError(f"{name} must be a number, got {type(value).__name__}", field=name)
             if not math.isfinite(value) or value < 0.0:
                 raise GearSpecError(f"{name} = {value:g} mm must be zero (none) or positive", field=name)
-        if spec.kind.teeth_inward and (self.bore_diameter_mm > 0.0 or self.keyway_width_mm > 0.0):
-            raise GearSpecError("an internal gear has no bore or keyway (its inside is the teeth; the rim is "
-                                "rim_outer_diameter_mm)", field="bore_diameter_mm")
-        wall = spec.module_mm
-        if self.bore_diameter_mm > 0.0 and self.bore_diameter_mm / 2.0 > spec.root_radius_mm - wall:
-            raise GearSpecError(
-                f"bore diameter {self.bore_diameter_mm:g} mm leaves less than one module ({wall:g} mm) of wall under "
-                f"the root circle (root diameter {2 * spec.root_radius_mm:.3f} mm)", field="bore_diameter_mm")
         has_width, has_depth = self.keyway_width_mm > 0.0, self.keyway_depth_mm > 0.0
         if has_width != has_depth:
             raise GearSpecError("a keyway needs both keyway_width_mm and keyway_depth_mm", field="keyway_width_mm")
@@ -63,6 +56,19 @@ class BlankFeatures:
             if self.keyway_width_mm >= self.bore_diameter_mm:
                 raise GearSpecError(f"keyway width {self.keyway_width_mm:g} mm must be smaller than the bore "
                                     f"diameter {self.bore_diameter_mm:g} mm", field="keyway_width_mm")
+
+    def validate(self, spec: GearSpec) -> None:
+        """Raise GearSpecError unless the features suit the gear: none in a ring, a wall of at least one module under
+        the root. Checked where the features meet the gear (the job loader, gear_shape), not again below."""
+        if spec.kind.teeth_inward and (self.bore_diameter_mm > 0.0 or self.keyway_width_mm > 0.0):
+            raise GearSpecError("an internal gear has no bore or keyway (its inside is the teeth; the rim is "
+                                "rim_outer_diameter_mm)", field="bore_diameter_mm")
+        wall = spec.module_mm
+        if self.bore_diameter_mm > 0.0 and self.bore_diameter_mm / 2.0 > spec.root_radius_mm - wall:
+            raise GearSpecError(
+                f"bore diameter {self.bore_diameter_mm:g} mm leaves less than one module ({wall:g} mm) of wall under "
+                f"the root circle (root diameter {2 * spec.root_radius_mm:.3f} mm)", field="bore_diameter_mm")
+        if self.keyway_width_mm > 0.0:
             top = self.bore_diameter_mm / 2.0 + self.keyway_depth_mm
             if top > spec.root_radius_mm - wall:
                 raise GearSpecError(
@@ -96,9 +102,17 @@ class StockSpec:
     stub_length_mm: float = key(0.0, unit="mm", low=0.0, high=1000.0, label="StubLength", group="Holding stub",
                                 meaning="length of the holding stub, 0: none")
 
-    def validate(self, spec: GearSpec) -> None:
-        """Raise StockError for keys outside their ranges, a half-given stub or one wider than the blank."""
+    def __post_init__(self) -> None:
+        """Raise StockError for keys outside their ranges or a half-given stub, once, when the section is made."""
         check_section(self, "stock", StockError)
+        if (self.stub_diameter_mm > 0.0) != (self.stub_length_mm > 0.0):
+            raise StockError("a holding stub needs both stub_diameter_mm and stub_length_mm",
+                             field="stub_diameter_mm")
+
+    def validate(self, spec: GearSpec) -> None:
+        """Raise StockError for a blank that does not suit the gear (below its tip or rim, a bore in an external
+        gear's blank, a stub wider than the blank). Checked where the stock meets the gear (the job loader,
+        stock_shape, CamInputs), not again below."""
         if spec.kind.teeth_inward:
             rim = as_ring(spec).rim_outer_diameter_mm
             if 0.0 < self.blank_diameter_mm < rim - 1e-9:
@@ -116,9 +130,6 @@ class StockSpec:
             raise StockError(f"blank_diameter_mm = {self.blank_diameter_mm:g} is smaller than the tip diameter "
                              f"{tip_diameter:.4f} mm: the teeth would be {short:.4f} mm short of the tip circle",
                              field="blank_diameter_mm")
-        if (self.stub_diameter_mm > 0.0) != (self.stub_length_mm > 0.0):
-            raise StockError("a holding stub needs both stub_diameter_mm and stub_length_mm",
-                                field="stub_diameter_mm")
         if self.stub_diameter_mm > 2.0 * self.blank_radius_mm(spec):
             raise StockError(f"stub diameter {self.stub_diameter_mm:g} mm is larger than the blank "
                                 f"({2 * self.blank_radius_mm(spec):.3f} mm)", field="stub_diameter_mm")

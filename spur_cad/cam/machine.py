@@ -127,7 +127,9 @@ class Machine:
         """The set-up `axes` chooses (spur_cad.cam.setups): code asks it, never `axes`."""
         return setup_for_axes(self.axes)
 
-    def validate(self) -> None:
+    def __post_init__(self) -> None:
+        """Every key in its range, each axis's travel limits in order and the clamp codes single M codes, checked
+        once when the section is made (MachineError naming the key): the CAM trusts it."""
         check_section(self, "machine", MachineError)
         for low, high in (("a_min_deg", "a_max_deg"), ("x_min_mm", "x_max_mm"), ("y_min_mm", "y_max_mm"),
                           ("z_min_mm", "z_max_mm")):
@@ -232,7 +234,9 @@ class RoughingParams:
     clamp_rotary: bool = key(False, label="ClampRotary", group="Roughing strategy",
                              meaning="clamp A around each tooth space (needs the machine's clamp codes)")
 
-    def validate(self) -> None:
+    def __post_init__(self) -> None:
+        """Every key in its range and the finish stock below the allowance, checked once when the section is made
+        (MachineError naming the key)."""
         check_section(self, "roughing", MachineError)
         if not self.finish_stock_mm < self.flank_allowance_mm:
             raise MachineError(f"[roughing] finish_stock_mm = {self.finish_stock_mm:g} must be below "

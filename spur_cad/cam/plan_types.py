@@ -147,11 +147,11 @@ class CamInputs:
     pair: GearPair | None = None
 
     def __post_init__(self) -> None:
-        """Every section and tool checked once, here, as the job loader checks them (MachineError or ToolError
-        naming the key): the plan's functions and the generators they call trust their inputs."""
-        self.machine.validate()
-        self.roughing.validate()
-        self.finishing.validate()
+        """What the job loader checks where the sections meet, checked once, here, for inputs made without it: the
+        stock and [three_axis] against the gear, and each tool, which its role names (StockError, MachineError or
+        ToolError naming the key); each section checked its own keys when it was made. The plan's functions and
+        the generators they call trust their inputs."""
+        self.stock.validate(self.spec)
         self.three_axis.validate(self.spec.face_width_mm)
         for role, tool in (("roughing", self.roughing_tool), ("finishing", self.finishing_tool),
                            ("bottom", self.bottom_tool), ("roughing_top", self.top_tool)):

@@ -106,8 +106,9 @@ class ProbeSection:
     def ball_radius_mm(self) -> float:
         return self.stylus_diameter_mm / 2.0
 
-    def validate(self) -> None:
-        """Raise ProbeError for a key outside its range, a bad probe code, or no check chosen."""
+    def __post_init__(self) -> None:
+        """Raise ProbeError for a key outside its range, a bad probe code, or no check chosen, once, when the section
+        is made (the probe against the gear: plan_probe)."""
         check_section(self, "probe", ProbeError)
         for name in ("probe_on_code", "probe_off_code"):
             code = getattr(self, name)
@@ -258,7 +259,6 @@ def _clear(outline: np.ndarray, centres: np.ndarray, ball_mm: float, stem_mm: fl
 def plan_probe(spec: GearSpec, stock: StockSpec, machine: Machine, probe: ProbeSection) -> ProbePlan:
     """The probing plan of `spec` as cut from `stock`; ProbeError (naming the key) for a helical gear or a
     ball that does not reach a point without touching the design elsewhere."""
-    probe.validate()
     if spec.kind.helical:
         raise ProbeError(f"[probe] probes spur gears only: [gear] helix_angle_deg = {spec.helix_angle_deg:g} (a "
                          "helical flank's normal leaves the transverse plane); leave [probe] out")

@@ -37,16 +37,21 @@ class ThreeAxisSection:
                                meaning="a skin this thick left on the bottom face: every level stops this far above "
                                        "it (no break-through); 0: cut through")
 
-    def validate(self, face_width_mm: float | None = None) -> None:
+    def __post_init__(self) -> None:
+        """Every key in its range and one way of holding, checked once when the section is made (MachineError
+        naming the key)."""
         check_section(self, "three_axis", MachineError)
         if self.tabs and self.onion_skin_mm > 0.0:
             raise MachineError("[three_axis] tabs and onion_skin_mm both hold the gear: give one of them",
                                field="onion_skin_mm", section="three_axis")
-        if face_width_mm is not None:
-            for name in ("tab_height_mm", "onion_skin_mm"):
-                if getattr(self, name) >= face_width_mm and (name != "tab_height_mm" or self.tabs):
-                    raise MachineError(f"[three_axis] {name} = {getattr(self, name):g} mm must be below the face "
-                                       f"width {face_width_mm:g} mm", field=name, section="three_axis")
+
+    def validate(self, face_width_mm: float) -> None:
+        """The heights against the gear's face width: checked where the section meets the gear (the job loader,
+        CamInputs), not again below."""
+        for name in ("tab_height_mm", "onion_skin_mm"):
+            if getattr(self, name) >= face_width_mm and (name != "tab_height_mm" or self.tabs):
+                raise MachineError(f"[three_axis] {name} = {getattr(self, name):g} mm must be below the face "
+                                   f"width {face_width_mm:g} mm", field=name, section="three_axis")
 
 
 @dataclass(frozen=True)

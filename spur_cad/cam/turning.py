@@ -125,8 +125,9 @@ class LatheSection:
                                       meaning="deepest plunge the blade reaches from the bar's surface (radial), "
                                               "0: not checked")
 
-    def validate(self) -> None:
-        """Raise LatheError for a key outside its range or choices, or keys that contradict each other."""
+    def __post_init__(self) -> None:
+        """Raise LatheError for a key outside its range or choices, or keys that contradict each other, once, when
+        the section is made (the stock and bar against the gear: check_lathe_blank)."""
         check_section(self, "lathe", LatheError)
         names = key_of(type(self), "dialect").names  # the registry's this section was made for
         if self.dialect not in names:  # a registry without lathe words gives no choices to check
@@ -264,13 +265,12 @@ def check_lathe_blank(spec: GearSpec, stock: StockSpec, lathe: LatheSection) -> 
 
     Refused: a bar thinner than the blank, a tool change point inside the bar, chamfers that overlap, eat
     the shoulder or need a finishing cut deeper than depth_of_cut_mm, a blade that cannot reach the stub's
-    groove or the centre, more than MAX_PASSES passes. The stock itself is validated first (StockError).
+    groove or the centre, more than MAX_PASSES passes. The sections are valid as made (their __post_init__); the
+    stock against the gear is the job loader's check (StockSpec.validate), made before this one.
     """
     require_instance(spec, GearSpec, "spec")
     require_instance(stock, StockSpec, "stock")
     require_instance(lathe, LatheSection, "lathe")
-    lathe.validate()
-    stock.validate(spec)
     g = lathe_geometry(spec, stock, lathe)
     if g.bar_diameter < g.blank_diameter - 1e-9:
         raise LatheError(f"[lathe] bar_diameter_mm = {g.bar_diameter:g} is smaller than the blank "

@@ -139,7 +139,6 @@ def post_lathe(plan: LathePlan, lathe: LatheSection, title: str, comments: Seque
     require_instance(title, str, "title")
     if dialect is not None:
         require_instance(dialect, Dialect, "dialect")
-    lathe.validate()
     d = lathe_dialect(lathe.dialect if dialect is None else dialect, dialects)
     _check_plan(plan)
     if not plan.moves:

@@ -75,7 +75,6 @@ def post_program(path: Toolpath, settings: PostSettings, info: ProgramInfo,
                  dialect: Dialect | None = None, dialects: Dialects = DIALECTS) -> PostedProgram:
     """Write `path` as one program in the settings' dialect (of the registry `dialects`), or in `dialect` when
     given (a controller in no registry, e.g. one being added: docs/post.md; settings.dialect is then not used)."""
-    settings.validate()
     if dialect is not None:
         require_instance(dialect, Dialect, "dialect")
     d = dialect_named(settings.dialect if dialect is None else dialect, dialects)

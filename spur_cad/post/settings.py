@@ -47,7 +47,9 @@ class PostSettings:
                                    "also describes the blank with WORKPIECE)")
     coolant: bool = key(True, label="Coolant", group="Post", meaning="M8 after the spindle starts, M9 before it stops")
 
-    def validate(self) -> None:
+    def __post_init__(self) -> None:
+        """Every key in its range, the dialect known and the keys agreeing, checked once when the settings are made
+        (PostError naming the key): the posts trust them."""
         check_section(self, "post", PostError)
         names = key_of(type(self), "dialect").names  # the registry's this section was made for
         if self.dialect not in names:

@@ -202,7 +202,6 @@ def simulate_flat(spec: GearSpec, blank_radius_mm: float, operations: Sequence[C
     the face width at depths 0..b below the top face (plus the finishing step-downs `station_depths_mm` and the
     middles between them); `settings` default SimSettings()."""
     settings = settings or SimSettings()
-    settings.validate()
     radii = [op.tool.diameter_mm / 2.0 for op in operations] or [0.5]
     spacing = point_spacing_mm(min(radii), settings.resolution_mm)
     b = spec.face_width_mm

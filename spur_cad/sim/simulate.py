@@ -27,7 +27,7 @@ import numpy as np
 
 from spur_cad.cam.ir import Feature, MoveKind, Toolpath
 from spur_cad.cam.tools import Tool
-from spur_cad.errors import SpurCadError
+from spur_cad.errors import SimulationError
 from spur_cad.geometry.spec import GearSpec
 from spur_cad.sim.design import DesignGrid, design_grid, modification_removal_mm
 
@@ -38,10 +38,6 @@ if TYPE_CHECKING:  # numba loads with the kernels, when a simulation runs
 CHUNK_POINTS = 4
 POSE_BATCH = 20000
 MAX_THREADS = 4
-
-
-class SimulationError(SpurCadError, ValueError):
-    """Simulation settings that cannot work (the message names the setting and its value)."""
 
 
 @dataclass(frozen=True)
@@ -66,13 +62,16 @@ class SimSettings:
     gouge_range_mm: float = 0.5  # blades reach this far into the material (deeper gouges read as this)
     leftover_range_mm: float = 1.0  # and this far out of it (more leftover reads as this)
 
-    def validate(self) -> None:
+    def __post_init__(self) -> None:
+        """Refuse settings that cannot work, once, when they are made (the simulators trust them)."""
         if not 0.0005 <= self.resolution_mm <= 0.1:
-            raise SimulationError(f"[simulation] resolution_mm = {self.resolution_mm:g} must be in [0.0005, 0.1] mm")
+            raise SimulationError(f"[simulation] resolution_mm = {self.resolution_mm:g} must be in [0.0005, 0.1] mm",
+                                  field="resolution_mm")
         for name in ("gouge_range_mm", "leftover_range_mm"):
             value = getattr(self, name)
             if not 10.0 * self.resolution_mm <= value <= 20.0:
-                raise SimulationError(f"[simulation] {name} = {value:g} must be in [10 x resolution, 20] mm")
+                raise SimulationError(f"[simulation] {name} = {value:g} must be in [10 x resolution, 20] mm",
+                                      field=name)
 
 
 @dataclass(frozen=True)
@@ -308,7 +307,6 @@ def simulate(spec: GearSpec, stock: StockCylinder, operations: Sequence[Cut],
     the scallop ridges stand). `rows_x_range` limits the rows (default: the stock's X extent). `threads`: see
     simulate_grid.
     """
-    settings.validate()
     started = time.perf_counter()
     corner_radii = [op.tool.effective_corner_radius_mm for op in operations
                     if op.tool.effective_corner_radius_mm > 0.0] or [0.5]
@@ -358,7 +356,6 @@ def simulate_grid(grid: DesignGrid, stock: StockCylinder, operations: Sequence[C
                   threads: int | None = None) -> SimResult:
     """`simulate` on a given design grid (any outline with normals, e.g. a plain cylinder in tests). A helical
     design is clipped on `threads` threads (default: simulation_threads()), with the same result for any number."""
-    settings.validate()
     started = time.perf_counter() if started is None else started
     res = settings.resolution_mm
     x_lo, x_hi = float(grid.rows_x[0]), float(grid.rows_x[-1])

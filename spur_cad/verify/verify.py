@@ -40,7 +40,8 @@ class VerifyOptions:
     point_tools: tuple[int, ...] = ()  # the tools `point` applies to (empty: every tool)
     a_offset_deg: float = 0.0  # added to every A read: the job's A of the programs' A zero (another A zero)
 
-    def validate(self) -> None:
+    def __post_init__(self) -> None:
+        """Refuse an option out of its range, once, when the options are made (verify_moves trusts them)."""
         if self.point not in POINTS:
             raise SpurCadError(f"--point must be one of {', '.join(POINTS)}, got {shown(self.point)}")
         if not (math.isfinite(self.a_offset_deg) and abs(self.a_offset_deg) <= 360.0):
@@ -203,7 +204,6 @@ def verify_moves(job: Job, programs: list[ProgramMoves], options: VerifyOptions 
     from spur_cad.pipeline import job_stock
     from spur_cad.sim.simulate import SimSettings, simulate
 
-    options.validate()
     tools = {tool.tool_number: tool for tool in (job.tools.roughing, job.tools.finishing) if tool is not None}
     roughing_number = job.tools.roughing.tool_number if job.tools.roughing is not None else None
     cuts = [cut for moves in programs for cut in toolpaths(moves, tools, roughing_number, options.point,

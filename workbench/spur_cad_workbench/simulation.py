@@ -50,9 +50,9 @@ def simulate_job(job, plan, resolution_mm: float | None = None, progress=None):
     simulator()
     from spur_cad.pipeline import simulate_stage
 
+    # the resolution asked for is checked when the section is made (SimulationError naming it)
     settings = dataclasses.replace(job.simulation, enabled=True,
                                    resolution_mm=resolution_mm or job.simulation.resolution_mm)
-    settings.validate()
     wanted = dataclasses.replace(job, simulation=settings)
     result = simulate_stage(wanted, plan, progress)
     if result is None:

@@ -65,15 +65,14 @@ def get_strategy(name: str, strategies: Strategies = REGISTRY) -> FinishingStrat
 
 class FinishingSection(Protocol):
     """What every registry's [finishing] section holds: the strategy's name and the target scallop (every
-    strategy reads it); the other keys are the registry's strategies' (taken by `params_from_section`)."""
+    strategy reads it); the other keys are the registry's strategies' (taken by `params_from_section`). Every
+    such section checks its keys and its strategy when it is made (`__post_init__`)."""
 
     @property
     def strategy(self) -> str: ...
 
     @property
     def target_scallop_mm(self) -> float: ...
-
-    def validate(self) -> None: ...
 
 
 def _strategy_key(default: str, names: tuple[str, ...]) -> Any:
@@ -93,8 +92,9 @@ class FinishingParams:
     cutting_direction: str = cutting_direction_key()
     flank_tool_end: str = flank_tool_end_key()
 
-    def validate(self) -> None:
-        """Every key in its range and the strategy known (the job loader runs it once)."""
+    def __post_init__(self) -> None:
+        """Every key in its range and the strategy known, checked once when the section is made (MachineError
+        naming the key): the plan and the strategies trust it."""
         check_section(self, "finishing", MachineError)
         get_strategy(self.strategy, REGISTRY)
 
@@ -130,12 +130,12 @@ def _section_type(entries: tuple[tuple[str, FinishingStrategy], ...]) -> type:
                 fields[f.name] = (f.type, dataclasses.field(default=f.default, metadata=f.metadata))
                 declared[f.name] = strategy.name
 
-    def validate(self: Any) -> None:
+    def __post_init__(self: Any) -> None:
         check_section(self, "finishing", MachineError)
         get_strategy(self.strategy, strategies)
 
     doc = "[finishing]: the finishing strategy and its parameters (docs/cam.md); made from the strategies' keys."
-    namespace = {"validate": validate, "__module__": __name__, "__doc__": doc}
+    namespace = {"__post_init__": __post_init__, "__module__": __name__, "__doc__": doc}
     return dataclasses.make_dataclass("FinishingParams", [(name, kind, spec) for name, (kind, spec) in fields.items()],
                                       frozen=True, namespace=namespace)
 
