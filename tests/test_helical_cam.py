@@ -391,8 +391,8 @@ def test_a_tiny_helical_target_is_refused_quickly_naming_the_key():
     job = _job()
     started = time.perf_counter()
     for target in (1e-9, 1e-7):  # below the key's range: refused by the work bound or the range
-        tiny = dataclasses.replace(job.finishing, target_scallop_mm=target)
         with pytest.raises((MachineError, WorkLimitError), match="target_scallop_mm") as error:
+            tiny = dataclasses.replace(job.finishing, target_scallop_mm=target)  # the range: refused when made
             plan_cam(dataclasses.replace(job, finishing=tiny))
         assert error.value.field == "target_scallop_mm"
     assert time.perf_counter() - started < 60.0  # a bound on the refusal, not a performance target
