@@ -11,8 +11,6 @@ import math
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
-import numpy as np
-
 from spur_cad.errors import require_instance
 from spur_cad.geometry.internal import InternalGearSpec
 from spur_cad.geometry.involute import inverse_involute_function, involute_function
@@ -164,15 +162,12 @@ def minimum_teeth_without_undercut(spec: GearSpec) -> float:
 
     No undercut while the rack flank's lowest straight point stays within the interference
     point: (h_f* - x) m - rho (1 - sin(alpha)) <= r sin^2(alpha), with r = m z / 2.
+    The rack's round lies in the normal section (alpha_n), the flank in the transverse one (alpha_t) and
+    r = z m_n / (2 cos beta); a spur gear's beta = 0 makes alpha_n = alpha_t and cos beta = 1, bit for bit.
     """
-    alpha = spec.pressure_angle_rad
-    if spec.kind.helical:  # the rack's round in the normal section, the flank at alpha_t, r = z m_n / (2 cos beta)
-        height = ((spec.dedendum_coefficient - spec.profile_shift_coefficient) * spec.module_mm
-                  - spec.rack_tip_radius_mm * (1.0 - math.sin(spec.normal_pressure_angle_rad)))
-        return 2.0 * height * math.cos(spec.helix_angle_rad) / (spec.module_mm * math.sin(alpha) ** 2)
     height = ((spec.dedendum_coefficient - spec.profile_shift_coefficient) * spec.module_mm
-              - spec.rack_tip_radius_mm * (1.0 - math.sin(alpha)))
-    return 2.0 * height / (spec.module_mm * math.sin(alpha) ** 2)
+              - spec.rack_tip_radius_mm * (1.0 - math.sin(spec.normal_pressure_angle_rad)))
+    return 2.0 * height * math.cos(spec.helix_angle_rad) / (spec.module_mm * math.sin(spec.pressure_angle_rad) ** 2)
 
 
 @dataclass(frozen=True)
@@ -312,14 +307,13 @@ def modification_inspection(spec: GearSpec, mods: FlankModifications, sheet: Ins
     def diameter(roll_mm: float) -> float:
         return 2.0 * math.hypot(spec.base_radius_mm, roll_mm) if roll_mm else 0.0
 
-    along_face = np.linspace(0.0, spec.face_width_mm, 401)
+    along_face = spec.kind.gauge_contact_x_mm(spec.face_width_mm)  # where the gauge touches each flank
 
     def removal_um(contact_radius_mm: float) -> tuple[float, float]:
         roll = math.sqrt(max(contact_radius_mm**2 - spec.base_radius_mm**2, 0.0))
         found = []
         for side in sides:
-            lead = side.lead_offset_mm(spec.face_width_mm / 2.0) if spec.kind.helical else side.lead_offset_mm(
-                along_face).min()
+            lead = side.lead_offset_mm(along_face).min()
             found.append(1000.0 * float(side.profile_offset_mm(roll) + lead))
         return found[0], found[1]
 

@@ -99,7 +99,7 @@ class ShaperFillet:
     centres moves left, lambda < 0). The contact normal passes through the pitch point I (the instantaneous
     centre), so the point is C + rho (C - I) / |C - I|: closed form, no root finding.
     Derivatives by central differences; the chord-error bound samples 9 points per interval with a 25 % margin
-    (as profile.EllipticFillet's)."""
+    (as rack.EllipticFillet's)."""
 
     label: str
     mesh: ShaperMesh

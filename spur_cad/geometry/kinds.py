@@ -17,6 +17,8 @@ import math
 from dataclasses import dataclass
 from typing import Protocol
 
+import numpy as np
+
 SOLIDS = ("extrude", "sweep")
 """How cad/solid.py makes the toothed body: the section extruded along X, or swept along the helix."""
 
@@ -109,6 +111,15 @@ class GearKind:
     def accepts_strategy(self, strategy: _Strategy) -> bool:
         """Whether a finishing strategy can finish this kind (a helical kind needs a strategy declared helical)."""
         return self.prismatic or strategy.helical
+
+    # --- asked by geometry/inspection.py (H6, issue 45) -----------------------------------------------------------
+    def gauge_contact_x_mm(self, face_width_mm: float) -> np.ndarray:
+        """Face positions X (0: front face) where a span anvil or a pin (ball) touches a flank, for the removal a
+        modified flank shows the gauge: a straight tooth touches along the whole face (401 points; the gauge rests
+        on the least-removed one), a helical tooth at one point, taken at mid-face."""
+        if self.prismatic:
+            return np.linspace(0.0, face_width_mm, 401)
+        return np.array([face_width_mm / 2.0])
 
 
 EXTERNAL_SPUR = GearKind("external spur", prismatic=True, teeth_inward=False, solid="extrude",

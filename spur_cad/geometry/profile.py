@@ -16,7 +16,8 @@ the gear centre; its half-thickness on the rolling line is e/2 (the gear's space
 tip line is the root circle's tangent y = r_f, and its right tip corner is a circle of
 radius rho centred at (d_1, r - B). Rolling: the gear turns by phi while the rack moves by
 r*phi; a rack point q is then at R(-phi) (q - (r*phi, 0)) in the gear frame and the pitch
-point at R(-phi) (0, r).
+point at R(-phi) (0, r). The rack's corner and the fillet its round generates, for each gear kind:
+geometry/rack.py.
 """
 
 from __future__ import annotations
@@ -31,6 +32,8 @@ from spur_cad.errors import GearSpecError
 from spur_cad.geometry.frames import turned_clockwise
 from spur_cad.geometry.involute import involute_function
 from spur_cad.geometry.kinds import GearKind
+from spur_cad.geometry.rack import Fillet, generating_rack
+from spur_cad.geometry.rack import rack_corner as rack_corner  # callers import it from here too
 from spur_cad.geometry.roots import brentq, minimize_bounded
 
 SEGMENT_LABELS = ("root", "fillet", "involute", "tip")
@@ -143,182 +146,6 @@ class Involute:
         return self.base_radius_mm * (b * b - a * a) / 2.0
 
 
-@dataclass(frozen=True)
-class TrochoidalFillet:
-    """Root fillet: envelope of the rack's tip-corner circle, parameter beta in [0, pi/2 - alpha].
-
-    beta is the angle of the contact point on the corner circle, measured from straight down
-    (beta = 0, the root circle) toward the rack flank (beta = pi/2 - alpha, the flank's
-    tangent point). Willis/Camus: the contact normal passes through the pitch point, which
-    fixes the roll angle at which the point is generated: phi(beta) = (d_1 - B tan beta) / r.
-    Point: R(-phi) (B tan(beta) + rho sin(beta), r - B - rho cos(beta)).
-    """
-
-    label: str
-    reference_radius_mm: float
-    corner_offset_mm: float  # d_1: corner centre from the rack tooth axis
-    corner_depth_mm: float  # B: corner centre below the rolling line
-    corner_radius_mm: float  # rho
-    start: float
-    end: float
-
-    def roll_angle(self, beta: np.ndarray) -> np.ndarray:
-        """phi at which the rack generates the fillet point of parameter beta."""
-        return (self.corner_offset_mm - self.corner_depth_mm * np.tan(beta)) / self.reference_radius_mm
-
-    def points(self, beta: np.ndarray) -> np.ndarray:
-        beta = np.asarray(beta, dtype=float)
-        B, rho, r = self.corner_depth_mm, self.corner_radius_mm, self.reference_radius_mm
-        return turned_clockwise(self.roll_angle(beta), B * np.tan(beta) + rho * np.sin(beta),
-                                 r - B - rho * np.cos(beta))
-
-    def normals(self, beta: np.ndarray) -> np.ndarray:
-        """Into the space, i.e. into the rack tooth: from the contact point toward the corner centre."""
-        beta = np.asarray(beta, dtype=float)
-        return turned_clockwise(self.roll_angle(beta), -np.sin(beta), np.cos(beta))
-
-    def _speed_terms(self, beta: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """The two beta-dependent terms of |dP/dbeta| = rho + (B^2 sec^3 + B rho sec^2) / r."""
-        sec = 1.0 / np.cos(beta)
-        B, rho = self.corner_depth_mm, self.corner_radius_mm
-        return B * B * sec**3, B * rho * sec**2
-
-    def speeds(self, beta: np.ndarray) -> np.ndarray:
-        """|dP/dbeta|; zero would mean a cusp of the envelope."""
-        t1, t2 = self._speed_terms(np.asarray(beta, dtype=float))
-        return self.corner_radius_mm + (t1 + t2) / self.reference_radius_mm
-
-    def turning_rates(self, beta: np.ndarray) -> np.ndarray:
-        """d(tangent angle)/dbeta = 1 + B sec^2(beta) / r (tangent angle is beta - phi)."""
-        beta = np.asarray(beta, dtype=float)
-        return 1.0 + self.corner_depth_mm / (np.cos(beta) ** 2 * self.reference_radius_mm)
-
-    def curvature_radii(self, beta: np.ndarray) -> np.ndarray:
-        """rho + B^2 sec^3 / (r + B sec^2): offset of the corner-centre trochoid by rho."""
-        beta = np.asarray(beta, dtype=float)
-        with np.errstate(divide="ignore"):
-            return self.speeds(beta) / self.turning_rates(beta)
-
-    def chord_error_bound(self, a: np.ndarray, b: np.ndarray) -> np.ndarray:
-        """K l^2 / 8 with interval bounds of curvature K and arc length l from monotone terms."""
-        r = self.reference_radius_mm
-        ta1, ta2 = self._speed_terms(a)
-        tb1, tb2 = self._speed_terms(b)
-        # sec is increasing on [0, pi/2): B^2 sec^3 increases, B rho sec^2 is monotone.
-        speed_low = self.corner_radius_mm + (ta1 + np.minimum(ta2, tb2)) / r
-        speed_high = self.corner_radius_mm + (tb1 + np.maximum(ta2, tb2)) / r
-        turning_high = np.maximum(np.abs(self.turning_rates(a)), np.abs(self.turning_rates(b)))
-        length = speed_high * (b - a)
-        with np.errstate(divide="ignore", invalid="ignore"):
-            curvature = np.where(speed_low > 0.0, turning_high / speed_low, np.inf)
-            bound = curvature * length * length / 8.0
-        return np.where(length == 0.0, 0.0, bound)
-
-    def arc_length_bound(self, a: np.ndarray, b: np.ndarray) -> np.ndarray:
-        ta1, ta2 = self._speed_terms(a)
-        tb1, tb2 = self._speed_terms(b)
-        speed_high = self.corner_radius_mm + (tb1 + np.maximum(ta2, tb2)) / self.reference_radius_mm
-        return speed_high * (b - a)
-
-
-@dataclass(frozen=True)
-class EllipticFillet:
-    """Root fillet of a helical gear's transverse section: envelope of the rack tip round's transverse
-    section, an ellipse with semi-axes rho / cos(beta_h) along the rolling line and rho radially
-    (`stretch` s = 1 / cos(beta_h)); parameter beta as for TrochoidalFillet, the angle on the round in
-    the rack's normal section. The rack point at beta is (s (d_n + rho sin b), r - B - rho cos b) with
-    inward normal along (-sin b, s cos b); its normal meets the rolling line at
-    x_0 = s d_n + (s - 1/s) rho sin b - (B / s) tan b, so it generates the fillet at phi = x_0 / r:
-    P = R(-phi) (u, y), u = (B / s) tan b + (rho / s) sin b, y = r - B - rho cos b (s = 1: the
-    trochoidal fillet). Derivatives are analytic; the chord-error bound samples curvature and speed
-    at 9 points per interval with a 25 % margin (not an interval-arithmetic bound).
-    """
-
-    label: str
-    reference_radius_mm: float
-    corner_offset_mm: float  # d_n: the round's centre from the rack tooth axis, normal section
-    corner_depth_mm: float  # B
-    corner_radius_mm: float  # rho
-    stretch: float  # s = 1 / cos(beta_h)
-    start: float
-    end: float
-
-    def roll_angle(self, beta: np.ndarray) -> np.ndarray:
-        beta = np.asarray(beta, dtype=float)
-        s, d, B, rho = self.stretch, self.corner_offset_mm, self.corner_depth_mm, self.corner_radius_mm
-        return (s * d + (s - 1.0 / s) * rho * np.sin(beta) - (B / s) * np.tan(beta)) / self.reference_radius_mm
-
-    def _terms(self, beta: np.ndarray):
-        """u, y, phi and their first and second derivatives in beta."""
-        beta = np.asarray(beta, dtype=float)
-        s, B, rho, r = self.stretch, self.corner_depth_mm, self.corner_radius_mm, self.reference_radius_mm
-        sin, cos, tan = np.sin(beta), np.cos(beta), np.tan(beta)
-        sec2 = 1.0 / cos**2
-        u = (B / s) * tan + (rho / s) * sin
-        du = (B / s) * sec2 + (rho / s) * cos
-        ddu = (2.0 * B / s) * sec2 * tan - (rho / s) * sin
-        y = r - B - rho * cos
-        dy, ddy = rho * sin, rho * cos
-        phi = self.roll_angle(beta)
-        dphi = ((s - 1.0 / s) * rho * cos - (B / s) * sec2) / r
-        ddphi = (-(s - 1.0 / s) * rho * sin - (2.0 * B / s) * sec2 * tan) / r
-        return u, du, ddu, y, dy, ddy, phi, dphi, ddphi
-
-    def points(self, beta: np.ndarray) -> np.ndarray:
-        u, _, _, y, _, _, phi, _, _ = self._terms(beta)
-        return turned_clockwise(phi, u, y)
-
-    def normals(self, beta: np.ndarray) -> np.ndarray:
-        """Into the space: the ellipse's inward normal (-sin b, s cos b), normalised, turned with the gear."""
-        beta = np.asarray(beta, dtype=float)
-        nx, ny = -np.sin(beta), self.stretch * np.cos(beta)
-        length = np.hypot(nx, ny)
-        return turned_clockwise(self.roll_angle(beta), nx / length, ny / length)
-
-    def _velocity(self, beta: np.ndarray):
-        """dP/dbeta in the turned frame, w = (u' + phi' y, y' - phi' u), and its derivative."""
-        u, du, ddu, y, dy, ddy, _, dphi, ddphi = self._terms(beta)
-        wx, wy = du + dphi * y, dy - dphi * u
-        dwx = ddu + ddphi * y + dphi * dy
-        dwy = ddy - ddphi * u - dphi * du
-        return wx, wy, dwx, dwy, dphi
-
-    def speeds(self, beta: np.ndarray) -> np.ndarray:
-        wx, wy, *_ = self._velocity(beta)
-        return np.hypot(wx, wy)
-
-    def turning_rates(self, beta: np.ndarray) -> np.ndarray:
-        """d(tangent angle)/dbeta: the turned velocity's angle rate minus phi'."""
-        wx, wy, dwx, dwy, dphi = self._velocity(beta)
-        with np.errstate(divide="ignore", invalid="ignore"):
-            return (wx * dwy - wy * dwx) / (wx * wx + wy * wy) - dphi
-
-    def curvature_radii(self, beta: np.ndarray) -> np.ndarray:
-        with np.errstate(divide="ignore"):
-            return self.speeds(beta) / self.turning_rates(beta)
-
-    def _sampled(self, a: np.ndarray, b: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        a, b = np.atleast_1d(np.asarray(a, float)), np.atleast_1d(np.asarray(b, float))
-        grid = a[:, None] + (b - a)[:, None] * np.linspace(0.0, 1.0, 9)[None, :]
-        speed = self.speeds(grid)
-        turning = np.abs(self.turning_rates(grid))
-        return speed, turning, b - a
-
-    def chord_error_bound(self, a: np.ndarray, b: np.ndarray) -> np.ndarray:
-        speed, turning, width = self._sampled(a, b)
-        speed_low, speed_high = 0.8 * speed.min(axis=1), 1.25 * speed.max(axis=1)
-        length = speed_high * width
-        with np.errstate(divide="ignore", invalid="ignore"):
-            curvature = np.where(speed_low > 0.0, 1.25 * turning.max(axis=1) / speed_low, np.inf)
-            bound = curvature * length * length / 8.0
-        return np.where(length == 0.0, 0.0, bound)
-
-    def arc_length_bound(self, a: np.ndarray, b: np.ndarray) -> np.ndarray:
-        speed, _, width = self._sampled(a, b)
-        return 1.25 * speed.max(axis=1) * width
-
-
-Fillet = TrochoidalFillet | EllipticFillet
 _S = TypeVar("_S")
 
 
@@ -394,45 +221,14 @@ class ToothSpaceProfile:
         return seg
 
 
-@dataclass(frozen=True)
-class RackCorner:
-    """The generating rack's right tip corner relative to the rolling line (docs/method.md), transverse
-    section; for a helical gear the round is an ellipse (`stretch` = 1 / cos(beta) along the rolling line)."""
-
-    half_thickness_on_rolling_line_mm: float  # e / 2 (transverse)
-    corner_offset_mm: float  # d_1 (transverse: the round's centre from the rack tooth axis)
-    corner_depth_mm: float  # B
-    corner_radius_mm: float  # rho
-    stretch: float = 1.0  # 1 / cos(beta): 1 for a spur gear
-
-    @property
-    def normal_corner_offset_mm(self) -> float:
-        """d_n = d_1 / s: the round's centre from the tooth axis in the rack's normal section."""
-        return self.corner_offset_mm / self.stretch
-
-
-def rack_corner(spec: GeneratedGear) -> RackCorner:
-    """d_1 and B of the generating rack: B = r - r_f - rho, d_1 = e/2 - B tan(a) - rho / cos(a); helical:
-    transverse e and alpha_t, and the elliptic round's offset s rho / cos(alpha_n) from the flank line."""
-    alpha = spec.pressure_angle_rad
-    rho = spec.rack_tip_radius_mm
-    half_e = spec.space_width_mm / 2.0
-    depth = spec.reference_radius_mm - spec.root_radius_mm - rho
-    if not spec.kind.helical:
-        offset = half_e - depth * math.tan(alpha) - rho / math.cos(alpha)
-        return RackCorner(half_e, offset, depth, rho)
-    stretch = 1.0 / math.cos(spec.helix_angle_rad)
-    offset = half_e - depth * math.tan(alpha) - stretch * rho / math.cos(spec.normal_pressure_angle_rad)
-    return RackCorner(half_e, offset, depth, rho, stretch)
-
-
 def build_tooth_space_profile(spec: GeneratedGear) -> ToothSpaceProfile:
     """Construct the exact profile of `spec`, raising GearSpecError where it cannot be cut."""
     alpha = spec.pressure_angle_rad
     r, rb, ra, rf = spec.reference_radius_mm, spec.base_radius_mm, spec.tip_radius_mm, spec.root_radius_mm
     z = spec.teeth
     half_tooth_angle = math.pi / z
-    corner = rack_corner(spec)
+    rack = generating_rack(spec)
+    corner = rack.corner(spec)
     d1, B, rho = corner.corner_offset_mm, corner.corner_depth_mm, corner.corner_radius_mm
     if spec.space_width_mm <= 0.0:
         raise GearSpecError("the tooth thickness allowance leaves no space between teeth",
@@ -449,9 +245,9 @@ def build_tooth_space_profile(spec: GeneratedGear) -> ToothSpaceProfile:
     root_half_angle = d1 / r
     beta_max = math.pi / 2.0 - spec.normal_pressure_angle_rad
 
-    t_dist = _flank_point_t_distance(spec, corner)
+    t_dist = rack.flank_point_t_distance(spec, corner)
     undercut = t_dist > r * math.sin(alpha) + 1e-12
-    generated: Fillet = _rack_fillet(spec, corner, d1, beta_max)
+    generated: Fillet = rack.fillet(spec, corner, d1, beta_max)
     fillet: Fillet | None = generated
     if rho == 0.0 and abs(B) < 1e-12:
         fillet = None  # a sharp rack corner on the rolling line generates no fillet
@@ -493,7 +289,7 @@ def build_tooth_space_profile(spec: GeneratedGear) -> ToothSpaceProfile:
         segments.append(CircularArc("root", rf, 0.0, root_half_angle))
     min_fillet_radius = math.inf
     if fillet is not None and beta_junction > 0.0:
-        fillet = _rack_fillet(spec, corner, d1, beta_junction)
+        fillet = rack.fillet(spec, corner, d1, beta_junction)
         _check_fillet_inside_tooth(fillet, half_tooth_angle)
         min_fillet_radius = float(np.min(np.abs(fillet.curvature_radii(np.linspace(0.0, beta_junction, 4097)))))
         segments.append(fillet)
@@ -505,24 +301,6 @@ def build_tooth_space_profile(spec: GeneratedGear) -> ToothSpaceProfile:
         undercut=undercut, undercut_depth_mm=undercut_depth, junction_is_tangent=junction_is_tangent,
         min_fillet_curvature_radius_mm=min_fillet_radius,
     )
-
-
-def _flank_point_t_distance(spec: GeneratedGear, corner: RackCorner) -> float:
-    """Where the rack flank's lowest straight point T (the round's tangent point) generates: its distance from
-    the pitch point along the line of action, B / sin(a) + rho (helical: T lies B + rho sin(alpha_n) below the
-    rolling line and the transverse flank is at alpha_t)."""
-    B, rho, alpha = corner.corner_depth_mm, corner.corner_radius_mm, spec.pressure_angle_rad
-    if spec.kind.helical:
-        return (B + rho * math.sin(spec.normal_pressure_angle_rad)) / math.sin(alpha)
-    return B / math.sin(alpha) + rho
-
-
-def _rack_fillet(spec: GeneratedGear, corner: RackCorner, d1: float, end: float) -> Fillet:
-    """The fillet generated by the rack's round up to parameter `end` (elliptic section for a helical gear)."""
-    r, B, rho = spec.reference_radius_mm, corner.corner_depth_mm, corner.corner_radius_mm
-    if spec.kind.helical:
-        return EllipticFillet("fillet", r, d1 / corner.stretch, B, rho, corner.stretch, 0.0, end)
-    return TrochoidalFillet("fillet", r, d1, B, rho, 0.0, end)
 
 
 def _fillet_minus_involute_angle(fillet: Fillet, rb: float, theta_b: float, beta: float) -> float:
