@@ -317,7 +317,7 @@ def _job_from_data(data: dict, source: str, text: str, strategies: Strategies = 
         blamed = blamed_key(exc, 'gear', tables['gear'])
         raise JobFileError(f"{where('gear', blamed)}: invalid gear: {exc}", section="gear", field=blamed) from None
     setup = loaded.get("machine", Machine()).setup
-    if spec.kind.teeth_inward and any(name.startswith("tools") for name in tables) and not setup.cuts(spec.kind):
+    if spec.kind.has_rim and any(name.startswith("tools") for name in tables) and not setup.cuts(spec.kind):
         raise JobFileError(f"{where('gear', 'internal')}: internal = true: the rotary table cannot cut an internal "
                            "gear (its tool cannot reach inside the ring along the rotary axis); cut it with [machine] "
                            "axes = 3 or leave out [tools]", section="gear", field="internal")

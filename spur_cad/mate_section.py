@@ -72,11 +72,11 @@ class MateSection:
 
 def _member_of_spec(spec: GearSpec) -> PairMember:
     """The gear as a pair member: its generated form circle and (a ring's) generated root circle."""
-    return PairMember(spec.teeth, internal=spec.kind.teeth_inward,
+    return PairMember(spec.teeth, internal=spec.kind.has_rim,
                       profile_shift_coefficient=spec.profile_shift_coefficient,
                       addendum_coefficient=spec.addendum_coefficient, dedendum_coefficient=spec.dedendum_coefficient,
                       thickness_reduction_mm=spec.thickness_reduction_mm, form_diameter_mm=2.0 * spec.form_radius_mm,
-                      root_diameter_mm=2.0 * spec.root_radius_mm if spec.kind.teeth_inward else None)
+                      root_diameter_mm=2.0 * spec.root_radius_mm if spec.kind.has_rim else None)
 
 
 def _mate_form_diameter_mm(spec: GearSpec, mate: MateSection, shift: float) -> float | None:

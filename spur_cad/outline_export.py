@@ -72,7 +72,7 @@ def gear_layers(spec: GearSpec, tolerance_mm: float, offset_mm: float, bore_diam
     a bore, offset by offset_mm away from the
     material (ExportError at offset_mm where the offset breaks a loop)."""
     loops: dict[str, tuple[Outline2D, ...]]
-    if spec.kind.teeth_inward:  # the rim circle and the toothed inner outline, both on OUTLINE
+    if spec.kind.has_rim:  # the rim circle and the toothed inner outline, both on OUTLINE
         loops = {OUTLINE_LAYER: internal_gear_outline_arcs(spec, tolerance_mm)}
     else:
         loops = {OUTLINE_LAYER: (gear_outline_arcs(spec, tolerance_mm),)}

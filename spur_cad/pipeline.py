@@ -21,8 +21,10 @@ import numpy as np
 from spur_cad.cad_stage import build_cad
 from spur_cad.cam.plan import CamInputs, CamPlan
 from spur_cad.cam.plan import plan_cam as plan_cam_inputs
+from spur_cad.cam.setups import LYING_FLAT, ROTARY_TABLE, MachineSetup
 from spur_cad.cam.three_axis import ThreeAxisFinishingFacts
 from spur_cad.errors import shown_path
+from spur_cad.geometry.kinds import EXTERNAL_HELICAL, EXTERNAL_SPUR, GearKind
 from spur_cad.geometry.sampling import ProfileSamples, sample_profile
 from spur_cad.inputs import step_timestamp
 from spur_cad.job import Job
@@ -33,12 +35,13 @@ from spur_cad.version import __version__
 if TYPE_CHECKING:
     from spur_cad.cad_worker import CadWorker
     from spur_cad.cam.restart import RestartPoint
+    from spur_cad.geometry.spec import GearSpec
     from spur_cad.grade.grading import Grading
     from spur_cad.post.program import PostedProgram, ProgramInfo
     from spur_cad.sim.budget import ErrorBudget
     from spur_cad.sim.design import DesignGrid
     from spur_cad.sim.engagement import Engagement
-    from spur_cad.sim.simulate import SimResult, StockCylinder
+    from spur_cad.sim.simulate import Cut, SimResult, StockCylinder
 
 Value = TypeVar("Value")  # what a stage computes (run_job's timer returns it)
 
@@ -221,14 +224,25 @@ def error_budget(job: Job, plan: CamPlan) -> ErrorBudget:
     and the finishing tool's deflection in the job's material (on the finish stock roughing leaves). On 3 axes the
     linear axes, runout and tool size only: no table indexes the spaces, and the deflection model (a corner's arc
     in the finish stock) is not the cut of a flat end mill's side over a whole step-down (docs/simulation.md)."""
+    return _BUDGETS[job.machine.setup](job, plan)
+
+
+def _lying_flat_budget(job: Job, plan: CamPlan) -> ErrorBudget:
+    """The 3-axis machine's budget: runout, tool size and linear axes (error_budget)."""
+    from spur_cad.sim.budget import ErrorBudget
+
+    machine = job.machine
+    return ErrorBudget(runout_tir_um=machine.spindle_runout_um + machine.tool_runout_um,
+                       tool_radius_error_um=machine.tool_radius_error_um,
+                       linear_accuracy_um=machine.linear_accuracy_um, rotary_table=False)
+
+
+def _rotary_table_budget(job: Job, plan: CamPlan) -> ErrorBudget:
+    """The rotary table's budget: its index errors, runout, tool size, linear axes and the finishing deflection."""
     from spur_cad.cam.materials import MATERIALS
     from spur_cad.sim.budget import ErrorBudget, finishing_deflection
 
     machine, tool = job.machine, plan.finishing.tool if plan.finishing is not None else None
-    if not machine.setup.rotary_axis:
-        return ErrorBudget(runout_tir_um=machine.spindle_runout_um + machine.tool_runout_um,
-                           tool_radius_error_um=machine.tool_radius_error_um,
-                           linear_accuracy_um=machine.linear_accuracy_um, rotary_table=False)
     deflection = None if tool is None else finishing_deflection(
         tool.diameter_mm, tool.effective_corner_radius_mm, tool.stick_out_mm, tool.feed_per_tooth_mm,
         job.roughing.finish_stock_mm, MATERIALS[job.job.material])
@@ -237,13 +251,20 @@ def error_budget(job: Job, plan: CamPlan) -> ErrorBudget:
                        machine.linear_accuracy_um, deflection)
 
 
+_BUDGETS: dict[MachineSetup, Callable[[Job, CamPlan], ErrorBudget]] = {ROTARY_TABLE: _rotary_table_budget,
+                                                                       LYING_FLAT: _lying_flat_budget}
+"""Each set-up's error budget (error_budget)."""
+CONTACT_KINDS = frozenset({EXTERNAL_SPUR})
+"""The kinds whose finishing contacts spur_cad.sim.contact finds in a transverse section (finishing_point_angles)."""
+
+
 def finishing_point_angles(job: Job, plan: CamPlan, grid: DesignGrid) -> np.ndarray | None:
     """The commanded A that cut each involute point of the grid (spur_cad.sim.contact), or None where the finishing's
     contacts are not a transverse section's (a helical gear; an internal one, not checked) or cannot be found: the
     budget then turns each space rigidly at its index angle."""
     from spur_cad.sim.contact import contact_angles, flank_point_angles
 
-    if plan.finishing is None or job.gear.kind.helical or job.gear.kind.teeth_inward:
+    if plan.finishing is None or job.gear.kind not in CONTACT_KINDS:
         return None
     try:
         contacts = contact_angles(job.gear, plan.finishing.toolpath, plan.finishing.tool)
@@ -296,19 +317,15 @@ def program_info(job: Job, plan: CamPlan, operation: str, restart_comment: str |
     """The header, machine codes and blank box (for Siemens WORKPIECE) of one program."""
     from spur_cad.post import ProgramInfo
 
-    spec, stock = job.gear, job.stock
-    radius = stock.blank_radius_mm(spec)
-    x_front, x_back = stock.blank_x_range_mm(spec)
-    box = (x_front, -radius, -radius, x_back + stock.stub_length_mm, radius, radius)
-    rotary = job.machine.setup.rotary_axis
-    if not rotary:  # the blank lying flat, Z0 on its top face
-        box = (-radius, -radius, -spec.face_width_mm, radius, radius, 0.0)
+    spec, stock, setup = job.gear, job.stock, job.machine.setup
+    box = setup.program_box_mm(stock.blank_radius_mm(spec), stock.blank_x_range_mm(spec), stock.stub_length_mm,
+                               spec.face_width_mm)
     title = f"spur_cad {__version__} {operation}" + (" restart" if restart_comment else "") + f": {job.job.name}"
     comments = program_comments(job, plan, operation) + ((restart_comment,) if restart_comment else ())
     return ProgramInfo(title=title, comments=comments, rotary_clamp_code=job.machine.rotary_clamp_code,
                        rotary_unclamp_code=job.machine.rotary_unclamp_code, blank_box_mm=box,
                        approach_z_mm=approach_z_mm, first_space_a_reference_deg=a_reference_deg,
-                       rotary_axis=rotary)
+                       writes_a=setup.writes_a)
 
 
 def lathe_program(job: Job) -> tuple[str, bytes]:
@@ -383,9 +400,12 @@ def restart_program(job: Job, plan: CamPlan, point: RestartPoint) -> tuple[str, 
 
 def program_comments(job: Job, plan: CamPlan, operation: str) -> tuple[str, ...]:
     """Header comments of a program: gear data, tool, strategy, estimated time (no date: outputs are reproducible)."""
+    return _COMMENTS[job.machine.setup](job, plan, operation)
+
+
+def _rotary_table_comments(job: Job, plan: CamPlan, operation: str) -> tuple[str, ...]:
+    """Header comments of a program on the rotary table (program_comments)."""
     spec = job.gear
-    if not job.machine.setup.rotary_axis:
-        return _three_axis_comments(job, plan, operation)
     if operation in ("roughing", "roughing_bottom"):
         planned = getattr(plan, operation)
         strategy = (f"strategy: {len(planned.levels.heights_mm)} levels per space, flank allowance "
@@ -412,11 +432,8 @@ def program_comments(job: Job, plan: CamPlan, operation: str) -> tuple[str, ...]
                     f"{job.finishing.target_scallop_mm * 1000:g} um")
     tool = planned.tool
     minutes = planned.estimate.time_s / 60.0
-    helix: tuple[str, ...] = ()
-    if spec.kind.helical:  # spur headers stay as they were (byte-identical reference outputs)
-        helix = (f"helix: beta = {spec.helix_angle_deg:g} deg {spec.hand} hand (m and alpha normal), lead "
-                 f"{spec.lead_mm:.4f} mm: along it A changes by {-spec.hand_sign * 360.0 / spec.lead_mm:+.6f} deg "
-                 "per mm of X",)
+    kind_lines = KIND_HEADER_LINES.get(spec.kind)  # spur headers stay as they were (byte-identical outputs)
+    helix = kind_lines(spec) if kind_lines is not None else ()
     return (
         f"gear: z = {spec.teeth}, m = {spec.module_mm:g} mm, alpha = {spec.pressure_angle_deg:g} deg, "
         f"x = {spec.profile_shift_coefficient:g}, b = {spec.face_width_mm:g} mm, rho = {spec.rack_tip_radius_mm:g} mm",
@@ -431,11 +448,22 @@ def program_comments(job: Job, plan: CamPlan, operation: str) -> tuple[str, ...]
     )
 
 
+def _helix_lines(spec: GearSpec) -> tuple[str, ...]:
+    """A helical gear's header line: its helix, and how A follows it along X."""
+    return (f"helix: beta = {spec.helix_angle_deg:g} deg {spec.hand} hand (m and alpha normal), lead "
+            f"{spec.lead_mm:.4f} mm: along it A changes by {-spec.hand_sign * 360.0 / spec.lead_mm:+.6f} deg "
+            "per mm of X",)
+
+
+KIND_HEADER_LINES: dict[GearKind, Callable[[GearSpec], tuple[str, ...]]] = {EXTERNAL_HELICAL: _helix_lines}
+"""The header lines a kind adds after the gear's (rotary-table programs)."""
+
+
 def _three_axis_comments(job: Job, plan: CamPlan, operation: str) -> tuple[str, ...]:
     """Header comments of a 3-axis program ([machine] axes = 3): gear, tool, what it does, the set-up."""
     spec, planned = job.gear, getattr(plan, operation)
     tool = planned.tool
-    if operation == "roughing" and spec.kind.teeth_inward:
+    if operation == "roughing" and spec.kind.has_rim:
         entry = "a plunge in the blank's bore" if job.stock.inner_diameter_mm > 0.0 else "a helix at the centre"
         what = (f"3-axis roughing of the ring's hole: {len(planned.levels.heights_mm)} levels, {entry}, concentric "
                 f"passes from the centre out to {job.roughing.finish_stock_mm:g} mm from the outline; the rim's "
@@ -466,6 +494,11 @@ def _three_axis_comments(job: Job, plan: CamPlan, operation: str) -> tuple[str, 
     )
 
 
+_COMMENTS: dict[MachineSetup, Callable[[Job, CamPlan, str], tuple[str, ...]]] = {
+    ROTARY_TABLE: _rotary_table_comments, LYING_FLAT: _three_axis_comments}
+"""Each set-up's program header comments (program_comments)."""
+
+
 def cam_inputs(job: Job) -> CamInputs:
     """The part of a job the CAM stage reads."""
     return CamInputs(job.gear, job.stock, job.tools.roughing, job.tools.finishing, job.roughing, job.finishing,
@@ -492,32 +525,50 @@ def simulates_with_kernels(job: Job, plan: CamPlan) -> bool:
     """Whether simulate_stage runs the 4-axis simulation, whose kernels load numba (a job lying flat is simulated
     by spur_cad.sim.flat, in numpy)."""
     cuts = any(planned is not None for planned in (plan.roughing, plan.roughing_bottom, plan.finishing))
-    return job.simulation.enabled and cuts and job.machine.setup.rotary_axis
+    return job.simulation.enabled and cuts and _SIMULATIONS[job.machine.setup] is _simulate_turned
 
 
 def simulate_stage(job: Job, plan: CamPlan, progress: Callable[[float], None] | None = None) -> SimResult | None:
     """The job's stock cut by its roughing then finishing toolpaths (None when disabled or nothing to cut)."""
-    from spur_cad.sim.simulate import Cut, SimSettings, simulate
+    from spur_cad.sim.simulate import Cut
 
     operations = [Cut(planned.toolpath, planned.tool) for planned in (plan.roughing, plan.roughing_bottom,
                                                                       plan.finishing) if planned is not None]
     if not job.simulation.enabled or not operations:
         return None
-    if not job.machine.setup.rotary_axis:  # lying flat (a ring's blank: the rim's disc, its bore): spur_cad.sim.flat
-        from spur_cad.sim.flat import simulate_flat
+    return _SIMULATIONS[job.machine.setup](job, plan, operations, progress)
 
-        depths = -plan.finishing.toolpath.z[plan.finishing.toolpath.motion_mask] if plan.finishing is not None \
-            else np.zeros(0)
-        result = simulate_flat(job.gear, job.stock.blank_radius_mm(job.gear), operations,
-                               SimSettings(resolution_mm=job.simulation.resolution_mm), np.unique(depths),
-                               job.stock.inner_diameter_mm / 2.0)
-        if progress is not None:
-            progress(1.0)
-        return result
+
+def _simulate_lying_flat(job: Job, plan: CamPlan, operations: list[Cut],
+                         progress: Callable[[float], None] | None) -> SimResult:
+    """Lying flat (a ring's blank: the rim's disc, its bore): spur_cad.sim.flat, in numpy."""
+    from spur_cad.sim.flat import simulate_flat
+    from spur_cad.sim.simulate import SimSettings
+
+    depths = -plan.finishing.toolpath.z[plan.finishing.toolpath.motion_mask] if plan.finishing is not None \
+        else np.zeros(0)
+    result = simulate_flat(job.gear, job.stock.blank_radius_mm(job.gear), operations,
+                           SimSettings(resolution_mm=job.simulation.resolution_mm), np.unique(depths),
+                           job.stock.inner_diameter_mm / 2.0)
+    if progress is not None:
+        progress(1.0)
+    return result
+
+
+def _simulate_turned(job: Job, plan: CamPlan, operations: list[Cut],
+                     progress: Callable[[float], None] | None) -> SimResult:
+    """On the rotary table: the 4-axis simulation (spur_cad.sim.simulate, its kernels in numba)."""
+    from spur_cad.sim.simulate import SimSettings, simulate
+
     stations = plan.finishing.result.station_x_mm if plan.finishing is not None else np.zeros(0)
     result = simulate(job.gear, job_stock(job), operations, SimSettings(resolution_mm=job.simulation.resolution_mm),
                       station_x=stations, progress=progress, modifications=job.modifications)
     return dataclasses.replace(result, engagement=roughing_engagement(job, plan))
+
+
+_SIMULATIONS: dict[MachineSetup, Callable[[Job, CamPlan, list[Cut], Callable[[float], None] | None], SimResult]] = {
+    ROTARY_TABLE: _simulate_turned, LYING_FLAT: _simulate_lying_flat}
+"""Each set-up's simulation (simulate_stage)."""
 
 
 def roughing_engagement(job: Job, plan: CamPlan) -> Engagement | None:

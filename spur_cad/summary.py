@@ -90,17 +90,10 @@ def build_result(job, samples: ProfileSamples, cad: CadResult | None, plan: CamP
         job_file=job.section_values())
 
 
-BUDGET_INPUTS = ("rotary_accuracy_arcsec", "rotary_repeatability_arcsec", "rotary_calibration_file",
-                 "spindle_runout_um", "tool_runout_um", "tool_radius_error_um", "linear_accuracy_um")
-
-
 def error_budget_facts(job, terms, deflection, ideal: Grading, expected: Grading) -> ErrorBudgetFacts:
     """The budget's part of the result (`job` is a spur_cad.job.Job): its [machine] and [job] inputs, the terms
     as applied, the expected grade and each deviation's share from the budget."""
-    if job.machine.setup.rotary_axis:
-        inputs = {**{name: getattr(job.machine, name) for name in BUDGET_INPUTS}, "material": job.job.material}
-    else:  # 3 axes: no index error, no deflection (pipeline.error_budget)
-        inputs = {name: getattr(job.machine, name) for name in BUDGET_INPUTS if not name.startswith("rotary_")}
+    inputs = job.machine.setup.budget_inputs(job.machine, job.job.material)  # the keys its budget reads
     share = {name: round(value - ideal.deviations_um.get(name, 0.0), 3)
              for name, value in expected.deviations_um.items()}
     percent = {name: (round(100.0 * share[name] / value, 1) if value else None)

@@ -17,7 +17,7 @@ from spur_cad.post.settings import PostSettings
 from spur_cad.verify.reader import ProgramReadError, read_program
 from tests.rs274_helper import canon_args, run_rs274
 
-INFO = ProgramInfo("arcs", (), rotary_axis=False)
+INFO = ProgramInfo("arcs", (), writes_a=False)
 
 
 def arc_path():

@@ -91,7 +91,7 @@ def active_start_radius_mm(spec: GearSpec) -> float:
 def three_axis_program(spec: GearSpec, tool: Tool, tmp_path):
     check_three_axis(spec, tool, None)
     path, levels, _ = finishing_toolpath(spec, tool, Machine(), TOLERANCE_MM, spec.tip_radius_mm + 0.5)
-    text = post_program(path, PostSettings(), ProgramInfo("finishing", (), rotary_axis=False)).text
+    text = post_program(path, PostSettings(), ProgramInfo("finishing", (), writes_a=False)).text
     target = tmp_path / "finishing.ngc"
     target.write_text(text)
     return target, text, levels
@@ -136,7 +136,7 @@ def test_roughing_program_is_accepted_and_leaves_the_finish_stock(tmp_path):
     params = RoughingParams()
     path, levels, offsets = roughing_toolpath(spec, tool, Machine(), params, spec.tip_radius_mm + 0.5)
     program = tmp_path / "roughing.ngc"
-    program.write_text(post_program(path, PostSettings(), ProgramInfo("roughing", (), rotary_axis=False)).text)
+    program.write_text(post_program(path, PostSettings(), ProgramInfo("roughing", (), writes_a=False)).text)
     ok, canon, messages = run_rs274(program)
     assert ok, messages
     centres, _ = interpreted_path(canon)

@@ -48,7 +48,7 @@ def pinion_tip_contact_radius_mm(spec) -> float:
 
 
 def posted(path, name: str, tmp_path) -> tuple[Path, str]:
-    text = post_program(path, PostSettings(), ProgramInfo(name, (), rotary_axis=False)).text
+    text = post_program(path, PostSettings(), ProgramInfo(name, (), writes_a=False)).text
     target = tmp_path / f"{name}.ngc"
     target.write_text(text)
     return target, text

@@ -126,7 +126,7 @@ def test_an_onion_skin_leaves_the_bottom_uncut():
 def test_rs274_accepts_the_tabbed_programs(tabbed, tmp_path):
     for name, cut in zip(("roughing", "finishing"), tabbed[:2]):
         program = tmp_path / f"{name}.ngc"
-        program.write_text(post_program(cut.path, PostSettings(), ProgramInfo(name, (), rotary_axis=False)).text)
+        program.write_text(post_program(cut.path, PostSettings(), ProgramInfo(name, (), writes_a=False)).text)
         ok, _, messages = run_rs274(program)
         assert ok, messages
 

@@ -61,6 +61,7 @@ from spur_cad.cam.roughing import (
     estimated_roughing_moves,
     roughing_levels,
 )
+from spur_cad.cam.setups import LYING_FLAT, ROTARY_TABLE, MachineSetup
 from spur_cad.cam.strategies import (
     COMPARISON_STRATEGY,
     REGISTRY,
@@ -256,9 +257,18 @@ def plan_cam(inputs: CamInputs, checkpoint: Callable[[], None] | None = None) ->
 
     Roughing by flanks as a job file's default (`inputs.levels_fallback`): where the flank strategy is refused or
     leaves material beyond the flank allowance, the job is planned by levels instead (refused only where levels are
-    refused too), and CamPlan.flank_fallback says why."""
-    if not (inputs.levels_fallback and inputs.roughing.strategy == "flank"
-            and inputs.roughing_tool is not None and inputs.machine.setup.rotary_axis):
+    refused too), and CamPlan.flank_fallback says why. Each set-up plans its own way (SETUP_PLANS)."""
+    return SETUP_PLANS[inputs.machine.setup](inputs, checkpoint)
+
+
+def _plan_lying_flat(inputs: CamInputs, checkpoint: Callable[[], None] | None = None) -> CamPlan:
+    """The blank lying flat (spur_cad.cam.three_axis)."""
+    return plan_three_axis(inputs, inputs.profile_tolerance_mm)
+
+
+def _plan_on_table(inputs: CamInputs, checkpoint: Callable[[], None] | None = None) -> CamPlan:
+    """The part on the rotary table, roughing by flanks falling back to levels (plan_cam)."""
+    if not (inputs.levels_fallback and inputs.roughing.strategy == "flank" and inputs.roughing_tool is not None):
         return _plan_cam(inputs, checkpoint)
     try:
         plan = _plan_cam(inputs, checkpoint)
@@ -276,10 +286,8 @@ def plan_cam(inputs: CamInputs, checkpoint: Callable[[], None] | None = None) ->
 
 
 def _plan_cam(inputs: CamInputs, checkpoint: Callable[[], None] | None = None) -> CamPlan:
-    """plan_cam by the strategy `inputs` name."""
+    """The rotary table's plan by the strategy `inputs` name."""
     check = checkpoint if checkpoint is not None else (lambda: None)
-    if not inputs.machine.setup.rotary_axis:  # the blank lying flat (spur_cad.cam.three_axis)
-        return plan_three_axis(inputs, inputs.profile_tolerance_mm)
     rec, levels = check_cam_inputs(inputs)
     blank = inputs.stock.blank_radius_mm(inputs.spec)
     roughing = finishing = None
@@ -312,6 +320,15 @@ def _plan_cam(inputs: CamInputs, checkpoint: Callable[[], None] | None = None) -
         warnings.extend(finishing.toolpath.warnings)
     return CamPlan(rec, roughing, finishing, tuple(warnings), bottom, two_stage, declined, suggested, by_flanks,
                    levels_suggested=by_levels_instead)
+
+
+SETUP_PLANS: dict[MachineSetup, Callable[[CamInputs, Callable[[], None] | None], CamPlan]] = {
+    ROTARY_TABLE: _plan_on_table, LYING_FLAT: _plan_lying_flat}
+"""Each set-up's plan (plan_cam)."""
+SETUP_CHECKS: dict[MachineSetup, Callable[[CamInputs], tuple[ToolRecommendations, object]]] = {
+    ROTARY_TABLE: check_cam_inputs, LYING_FLAT: check_three_axis_inputs}
+"""Each set-up's checks that need no toolpath (a front end runs them while the user types): (the tool
+recommendations, the set-up's own analysis)."""
 
 
 def check_finishing_work(spec: GearSpec, tool: Tool, machine: Machine, section: FinishingSection,

@@ -83,6 +83,11 @@ class _SheetGear(Protocol):
     def face_width_mm(self) -> float: ...
 
 
+_BUDGET_KEYS = ("rotary_accuracy_arcsec", "rotary_repeatability_arcsec", "rotary_calibration_file",
+                "spindle_runout_um", "tool_runout_um", "tool_radius_error_um", "linear_accuracy_um")
+"""The `[machine]` keys an error budget may read (spur_cad.sim.budget), in summary.json's order."""
+
+
 @dataclass(frozen=True)
 class SheetRow:
     """One row of the set-up sheet as plain data: the label, the value's text with a `{}` where each of `numbers`
@@ -160,6 +165,35 @@ class MachineSetup:
         """The set-up sheet's rows (stock, work offset, how the part sits), as a machinist sets the part up."""
         raise NotImplementedError(f"machine set-up {self.name!r} writes no set-up sheet")
 
+    # --- asked by the pipeline, the summary, the post and the workbench (H4, issue 45) ----------------------------
+    @property
+    def writes_a(self) -> bool:
+        """Its programs turn A (the part on the rotary table): the post writes A words and the clamp codes; a set-up
+        without a rotary axis refuses a toolpath that turns or clamps A (spur_cad.post.ProgramInfo.writes_a)."""
+        return self.rotary_axis
+
+    budget_keys: ClassVar[tuple[str, ...]] = ()
+    """The `[machine]` keys its error budget reads (summary.json's error_budget inputs, in this order)."""
+    panel_limits_text: ClassVar[str] = ""
+    """The workbench's tool limits for this set-up when they are a fixed text (empty: the gear's computed limits
+    and the notes beside the tool fields are shown)."""
+
+    def budget_inputs(self, machine: object, material: str) -> dict[str, object]:
+        """Summary.json's error-budget inputs: the `[machine]` keys its budget reads (budget_keys, values of
+        `machine`, a spur_cad.cam.machine.Machine)."""
+        return {name: getattr(machine, name) for name in self.budget_keys}
+
+    @property
+    def machine_summary(self) -> str:
+        """What the workbench adds after the machine's name in its folded Machine group ("" on the rotary table,
+        the default; ", 3 axes" lying flat)."""
+        return "" if self.rotary_axis else f", {self.axes} axes"
+
+    def program_box_mm(self, blank_radius_mm: float, blank_x_mm: tuple[float, float], stub_length_mm: float,
+                       face_width_mm: float) -> tuple[float, float, float, float, float, float]:
+        """The blank's box in the programs' frame (x, y, z min then max; Siemens WORKPIECE)."""
+        raise NotImplementedError(f"machine set-up {self.name!r} has no program frame")
+
 
 @dataclass(frozen=True)
 class RotaryTable(MachineSetup):
@@ -175,6 +209,18 @@ class RotaryTable(MachineSetup):
         ("required_flute_length_mm", "flute length the tools need (blank to root)"),
         ("required_stick_out_mm", "stick-out the tools need"),
     )
+    budget_keys: ClassVar[tuple[str, ...]] = _BUDGET_KEYS
+
+    def budget_inputs(self, machine: object, material: str) -> dict[str, object]:
+        """Its `[machine]` keys and `[job] material`: the finishing tool's deflection is modelled in it."""
+        return {**super().budget_inputs(machine, material), "material": material}
+
+    def program_box_mm(self, blank_radius_mm: float, blank_x_mm: tuple[float, float], stub_length_mm: float,
+                       face_width_mm: float) -> tuple[float, float, float, float, float, float]:
+        """Along X from the blank's front to the stub's end, about the rotary axis (Y = Z = 0) to the blank radius."""
+        r = blank_radius_mm
+        return (blank_x_mm[0], -r, -r, blank_x_mm[1] + stub_length_mm, r, r)
+
     levels_roughing: ClassVar[str] = "z-level roughing, {levels} levels per space"
     levels_roughing_note: ClassVar[str] = ("Roughing: {levels} levels per space, the lowest {lowest_above_root_mm} mm "
                                            "above the root circle{tips}.")
@@ -212,6 +258,18 @@ class LyingFlat(MachineSetup):
         ("required_flute_length_mm", "flute length the tools need (the face width and the break-through)"),
         ("required_stick_out_mm", "stick-out the tools need"),
     )
+    budget_keys: ClassVar[tuple[str, ...]] = tuple(name for name in _BUDGET_KEYS if not name.startswith("rotary_"))
+    """No rotary table indexes the spaces: its keys are not read (no index error, no deflection modelled)."""
+    panel_limits_text: ClassVar[str] = (
+        "3 axes, the gear lying flat: flat end mills; the finishing tool's radius is the root fillet's at least, and "
+        "its side must reach the active profile (docs/cam.md).")
+
+    def program_box_mm(self, blank_radius_mm: float, blank_x_mm: tuple[float, float], stub_length_mm: float,
+                       face_width_mm: float) -> tuple[float, float, float, float, float, float]:
+        """The disc of the face width about the gear axis (Z), Z = 0 on its top face."""
+        r = blank_radius_mm
+        return (-r, -r, -face_width_mm, r, r, 0.0)
+
     levels_roughing: ClassVar[str] = "3-axis roughing, {levels} levels of passes offset from the blank inward"
     levels_roughing_note: ClassVar[str] = ("Roughing on 3 axes: {levels} levels down to Z {lowest_z_mm} mm, each a "
                                            "series of passes offset from the blank inward to the finish stock.")

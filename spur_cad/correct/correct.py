@@ -19,10 +19,14 @@ from spur_cad.correct.apply import (
 )
 from spur_cad.correct.identify import IdealFlanks, Identified
 from spur_cad.dialects import dialect
+from spur_cad.geometry.kinds import EXTERNAL_SPUR, INTERNAL_SPUR
 from spur_cad.grade.measured import MeasuredPoints
 from spur_cad.grade.simulated import SIDES, helix_range_mm, profile_range_mm
 
 IDEAL_RESOLUTION_MM = 0.002
+CORRECTED_KINDS = frozenset({EXTERNAL_SPUR, INTERNAL_SPUR})
+"""The kinds spur-cad correct corrects: prismatic teeth, one transverse section's deviation at every X (a helical
+gear's measured points are refused)."""
 """The ideal cut is simulated this finely: its scallops' mean (1.6 um for the reference gear's 5 um target) must
 be known to a fraction of a micrometre, since the measured mean less it is the tool's size error."""
 
@@ -193,8 +197,9 @@ def correct_job(job, measured, measured_source: str, datum: str = "best-fit", on
     from spur_cad.sim.contact import contact_angles
 
     spec = job.gear
-    if spec.kind.helical:
-        raise SpurCadError("correcting from measured points of a helical gear is not supported yet (spur gears only)")
+    if spec.kind not in CORRECTED_KINDS:
+        raise SpurCadError(f"correcting from measured points of an {spec.kind.name} gear is not supported yet (spur "
+                           "gears only)")
     if job.tools.finishing is None:
         raise SpurCadError("the job has no [tools.finishing]: there is no finishing program to correct")
     if once_per_turn not in ONCE_PER_TURN_MODELS:

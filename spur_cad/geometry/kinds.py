@@ -121,6 +121,13 @@ class GearKind:
             return np.linspace(0.0, face_width_mm, 401)
         return np.array([face_width_mm / 2.0])
 
+    # --- asked by the job loader, the pipeline, the mate, the 2-D outline and the report (H4, issue 45) ---------
+    @property
+    def has_rim(self) -> bool:
+        """A ring: a rim lies outside the root circle. Its 2-D outline is the rim circle and the toothed hole, its
+        mate meshes inside it (spur_cad.geometry.mate.PairMember.internal), a 3-axis program roughs its hole."""
+        return self.teeth_inward
+
 
 EXTERNAL_SPUR = GearKind("external spur", prismatic=True, teeth_inward=False, solid="extrude",
                          measured_in="transverse")

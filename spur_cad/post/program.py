@@ -41,7 +41,7 @@ class ProgramInfo:
     blank_box_mm: tuple[float, float, float, float, float, float] | None = None  # x, y, z min then max (WORKPIECE)
     approach_z_mm: float | None = None  # restart programs: a Z-only rapid to this height before the first move
     first_space_a_reference_deg: float | None = None  # restart programs: A of the full program's run (see _runs)
-    rotary_axis: bool = True  # False: a 3-axis machine ([machine] axes = 3): no A words (A must stay 0)
+    writes_a: bool = True  # False: a set-up without a rotary axis (MachineSetup.writes_a): no A words (A stays 0)
 
 
 @dataclass(frozen=True)
@@ -155,7 +155,7 @@ def _check_numbers(path: Toolpath, info: ProgramInfo) -> None:
         _check_arcs(path, path.center_x, path.center_y, arcs, info)
     check_rotary_code(info.rotary_clamp_code, "rotary_clamp_code")
     check_rotary_code(info.rotary_unclamp_code, "rotary_unclamp_code")
-    if not info.rotary_axis and (np.any(path.a) or np.any(path.kind == MoveKind.CLAMP_ROTARY)
+    if not info.writes_a and (np.any(path.a) or np.any(path.kind == MoveKind.CLAMP_ROTARY)
                                  or np.any(path.kind == MoveKind.UNCLAMP_ROTARY)):
         raise PostError(f"{shown(info.title)}: the toolpath turns or clamps A, and the machine has no rotary axis")
 
@@ -334,7 +334,7 @@ class _Writer:
         if z != last_z:
             words.append("Z" + _number(z, lin_dec))
         direction = None
-        if a_rel != last_a and self.info.rotary_axis:
+        if a_rel != last_a and self.info.writes_a:
             if folded:
                 offset = ("+" if a_rel > 0 else "") + _number(a_rel, rot_dec)
                 words.append(subs.param_word.format(address="A", param=subs.a_param) if a_rel == 0 else

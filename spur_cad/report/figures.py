@@ -231,7 +231,7 @@ def k_chart_figure(spec: GearSpec, grading: Grading, lying_flat: bool = False) -
     worst = max(profile, key=spread_in_range).space
     grade = grading.overall_class or 11
     d, b, m = 2.0 * spec.reference_radius_mm, spec.face_width_mm, spec.module_mm
-    profile_label = ("roll length [mm] (a ring's negative: root to tip)" if spec.kind.teeth_inward
+    profile_label = ("roll length [mm] (a ring's negative: root to tip)" if spec.kind.roll_sign < 0
                      else "roll length [mm]")
     row_name, row_label = row_axis_label(lying_flat)
     fig = figure(9.0, 6.5, left=0.08, right=0.98, bottom=0.08, top=0.95)

@@ -180,7 +180,7 @@ def _tool_reach_note(result: JobResult) -> str:
     generated = f"{facts.generated_by}-generated"
     graded = (f"the involute it cuts is graded from diameter {number(facts.form_diameter_mm, 3)} mm")
     if result.mate is not None:  # the mate's SAP nearer the tip than the tool's form diameter: graded from there
-        sap, ring = result.mate.start_of_active_profile_diameter_mm, result.kind.teeth_inward
+        sap, ring = result.mate.start_of_active_profile_diameter_mm, result.kind.has_rim
         if (sap < facts.form_diameter_mm) if ring else (sap > facts.form_diameter_mm):
             graded = (f"the involute is graded from the mate's start of active profile, diameter {number(sap, 3)} mm "
                       f"({'outside' if ring else 'below'} it the flank need not be exact)")
@@ -210,7 +210,7 @@ def report_context(result: JobResult, images: dict[str, bytes]) -> dict:
         "totals_rows": sheet.totals_rows(result), "operation_table": sheet.operation_table(result),
         "tool_table": sheet.tool_table(result), "gear_rows": sheet.gear_rows(result),
         "pair_rows": pair_rows(result), "no_mate_note": NO_MATE_NOTE if result.pair is None else "",
-        "helical": result.kind.helical, "inspection_rows": sheet.inspection_rows(result),
+        "helical": result.kind.measured_in == "normal", "inspection_rows": sheet.inspection_rows(result),
         "expected_tolerance": sheet.expected_tolerance(result), "limit_rows": sheet.limit_rows(result),
         "advice_rows": sheet.advice_rows(result), "advice_strategy": result.tools.advice_strategy,
         "program_table": sheet.program_table(result),

@@ -13,6 +13,7 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
 from spur_cad.cam.setups import ROTARY_TABLE, MachineSetup, SheetRow
+from spur_cad.geometry.kinds import EXTERNAL_HELICAL, GearKind
 from spur_cad.result import FinishingFacts, RoughingFacts
 
 if TYPE_CHECKING:
@@ -95,6 +96,8 @@ HELICAL_LABELS = (
     ("lead_mm", "lead", "mm", 3),
     ("overlap_ratio", "overlap ratio", "", 3),
 )
+KIND_LABELS: dict[GearKind, tuple[tuple[str, str, str, int], ...]] = {EXTERNAL_HELICAL: HELICAL_LABELS}
+"""The gear rows a kind adds to GEAR_LABELS (a helical gear's helix angle, hand, lead and overlap ratio)."""
 TOOL_KINDS = {"flat": "flat end mill", "bull_nose": "bull-nose end mill", "ball": "ball end mill"}
 OPERATION_NAMES = {"roughing": "roughing", "roughing_bottom": "roughing, bottom of the spaces",
                    "finishing": "finishing"}
@@ -110,7 +113,7 @@ def _value(value: object, digits: int) -> str:
 
 def gear_rows(result: JobResult) -> tuple[Row, ...]:
     """The gear's data, labelled (helical rows for a helical gear)."""
-    labels = GEAR_LABELS + (HELICAL_LABELS if result.kind.helical else ())
+    labels = GEAR_LABELS + KIND_LABELS.get(result.kind, ())
     return tuple(Row(label, _value(getattr(result.gear, name), digits), unit) for name, label, unit, digits in labels)
 
 

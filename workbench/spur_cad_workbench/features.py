@@ -24,6 +24,7 @@ from collections.abc import Set as AbstractSet
 
 import FreeCAD
 
+from spur_cad.cam.setups import LYING_FLAT
 from spur_cad_workbench import compat, schema, units
 from spur_cad_workbench.properties import (
     add_bookkeeping,
@@ -49,6 +50,8 @@ GEAR_DEVIATION_PERCENT = 0.02
 GEAR_ANGULAR_DEFLECTION_DEG = 5.0
 
 
+DRAWN_LYING_FLAT = frozenset({LYING_FLAT})
+"""The set-ups whose programs are drawn with the gear lying flat (Z0 on its top face: display.display_flat_path)."""
 ERROR_PREFIX = "error: "
 
 
@@ -384,7 +387,7 @@ class JobFeature(_Proxy):
             outputs[f"{title}Time"] = op.seconds / 60.0 if op is not None else 0.0
             outputs[f"{title}TimeWithAcceleration"] = op.seconds_with_acceleration / 60.0 if op is not None else 0.0
             outputs[f"{title}ProgramLines"] = op.program_lines if op is not None else 0
-        flat = None if job.machine.setup.rotary_axis else job.gear.face_width_mm  # drawn lying flat
+        flat = job.gear.face_width_mm if job.machine.setup in DRAWN_LYING_FLAT else None
         for name in schema.TOOL_ROLES:  # the bottom tool's program has no toolpath object (see workbench/README.md)
             target = getattr(obj, f"{name.capitalize()}Toolpath")
             if target is not None:

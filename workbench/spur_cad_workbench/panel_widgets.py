@@ -23,8 +23,6 @@ FIELD_MIN_WIDTH_PX = 112
 PANEL_MIN_WIDTH_PX = 170  # fits a 240 px task dock: its scroll area's 220 px less the task box's margins
 QUANTITY_UNITS = {"length": "mm", "distance": "mm", "angle": "deg", "speed": "mm/min"}
 NUMBER_DECIMALS = 6
-THREE_AXIS_LIMITS = ("3 axes, the gear lying flat: flat end mills; the finishing tool's radius is the root fillet's "
-                     "at least, and its side must reach the active profile (docs/cam.md).")
 MODIFICATIONS_TITLE = "Flank modifications"  # the gear's: a longer title is elided in a narrow dock
 CHART_DPI = 96
 CHART_MIN_WIDTH_IN = 2.5

@@ -233,8 +233,7 @@ def group_summary(group: str, job: dict[str, Any], units=None) -> str:
         text = (f"{job.get('RoughingStrategy', '')}, flank allowance "
                 f"{length_text(float(job.get('FlankAllowance', 0.0)), 'mm', units)}")
     elif group == "Machine":
-        setup = machine_setup(job)
-        text = str(job.get("MachineName", "")) + ("" if setup.rotary_axis else f", {setup.axes} axes")
+        text = str(job.get("MachineName", "")) + machine_setup(job).machine_summary
     elif group == "3-axis":
         text = _three_axis_summary(job, units)
     elif group in _SWITCH_SUMMARIES:

@@ -40,7 +40,6 @@ from spur_cad_workbench.panel_widgets import (
     PANEL_MIN_WIDTH_PX,
     QUANTITY_UNITS,
     REVALIDATE_DELAY_MS,
-    THREE_AXIS_LIMITS,
     TITLE_WIDTH_PX,
     FieldWidgets,
     NumberBox,
@@ -350,8 +349,8 @@ class JobTaskPanel:
             label.setVisible(group in advice)
         self._highlight(next((p.prop for p in result.problems if p.prop in self.widgets), None))
         two_stage = bool(values["job"].get("UseBottomTool"))
-        flat = not machine_setup(values["job"]).rotary_axis  # the rotary table's tool limits do not apply
-        notes = {**({} if flat else recommendation_notes(result.recommendations, two_stage, FreeCAD.Units)),
+        fixed_limits = machine_setup(values["job"]).panel_limits_text  # the set-up's own: no computed notes
+        notes = {**({} if fixed_limits else recommendation_notes(result.recommendations, two_stage, FreeCAD.Units)),
                  **unusual_value_notes(values["job"], FreeCAD.Units)}
         finishing_invalid = any(problem.group == "Finishing tool" for problem in result.problems)
         if finishing_invalid:  # the roughing limit depends on the finishing tool (A_p)
@@ -401,8 +400,7 @@ class JobTaskPanel:
             first = result.problems[0]
             self.summary.setText(f"{len(result.problems)} problem: {first.advice}")
             self.summary.setStyleSheet(ERROR_STYLE)
-        flat = not machine_setup(values["job"]).rotary_axis
-        self.summary_limits.setText(THREE_AXIS_LIMITS if flat else limits_text(
+        self.summary_limits.setText(machine_setup(values["job"]).panel_limits_text or limits_text(
             result.recommendations, with_roughing_limit, bool(values["job"].get("UseBottomTool")), FreeCAD.Units))
         figures, source = self._figures(values_signature(values)) if result.ok else (None, "")
         if figures is not None:

@@ -187,7 +187,7 @@ def validate(values: dict[str, dict[str, object]], source: str = "job", units=No
 
     Recommendations never use an invalid tool: with the finishing tool in error they are the gear's alone.
     """
-    from spur_cad.cam.plan import check_cam_inputs, check_three_axis_inputs
+    from spur_cad.cam.plan import SETUP_CHECKS
     from spur_cad.cam.recommend import recommend_tools
     from spur_cad.cam.strategies import get_strategy
     from spur_cad.job import job_from_dict
@@ -207,8 +207,7 @@ def validate(values: dict[str, dict[str, object]], source: str = "job", units=No
     except SpurCadError as exc:
         return Validation(None, (_problem(exc, source, values, units),),
                           recommend_tools(spec, blank, clearance, strategy=strategy))
-    # the blank on the table, or lying flat
-    check = check_cam_inputs if job.machine.setup.rotary_axis else check_three_axis_inputs
+    check = SETUP_CHECKS[job.machine.setup]  # the blank on the table, or lying flat
     try:
         rec, _ = check(cam_inputs(job))
     except SpurCadError as exc:
