@@ -69,6 +69,8 @@ def assert_no_error(found, table_arcsec: float = 0.5, size_um: float = 0.5, slop
         assert abs(found.helix_slope_um[side]) < slope_um, found.helix_slope_um
 
 
+# plans and cuts the modified example (25 s); tests/test_correct.py identifies on the reference gear in the fast tier
+@pytest.mark.slow
 def test_a_gear_cut_to_its_modified_design_identifies_no_correction(modified, exact_scan):
     _, job, plan, ideal = modified
     assert_no_error(identified(job, plan, exact_scan, ideal))
@@ -98,6 +100,8 @@ def planted(modified):
     return identified(job, plan, scan_csv(cut, ROWS_MM, slopes_mm(job.gear)), ideal)
 
 
+# a planted cut of the modified example (15 s); tests/test_correct.py's planted machine stays in the fast tier
+@pytest.mark.slow
 def test_the_planted_machines_errors_are_identified_on_a_modified_gear(modified, planted):
     _, job, _, _ = modified
     assert planted.size_um == pytest.approx(-TOOL_RADIUS_ERROR_UM, abs=1.0)

@@ -76,6 +76,7 @@ def test_the_pressure_angle_change_of_a_profile_slope_worked_by_hand(reference):
     assert pressure_angle_change_deg(spec, 6.0) == pytest.approx(-0.04423, abs=2e-5)
 
 
+@pytest.mark.slow  # a second planted cut (15 s); the identification above stays in the fast tier
 def test_the_corrected_finishing_cuts_the_opposite_slopes(reference, sloped):  # noqa: F811
     """The moved passes cut on an ideal machine (the simulator, ideal cut subtracted by identify) give back minus the
     planted slopes: on the sloped machine they would cut the design's."""

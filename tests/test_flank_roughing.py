@@ -157,6 +157,8 @@ def test_chip_thinning_follows_the_catalogue_formula():
     assert chip_thinning_factor(0.2, d, 2.0) == 2.0  # capped
 
 
+# simulates the helical example's roughing (8 s); tests/test_helical_cam.py simulates helical roughing in the fast tier
+@pytest.mark.slow
 def test_the_helical_example_s_flank_roughing_keeps_the_finish_stock():
     job = parse_job(flank_job_text(REFERENCE_JOB.with_name("helical_gear.toml")), "helical_flank.toml")
     plan = plan_cam(job)

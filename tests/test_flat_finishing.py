@@ -33,6 +33,7 @@ from spur_cad.sim.design import design_grid
 from spur_cad.sim.simulate import simulate_grid
 from spur_cad.summary import recommendations_section, simulation_section
 from tests.gears import REFERENCE_JOB, spec_of
+from tests.tiers import sweep
 
 RES = 0.002
 POINT_SPACING_MM = 0.001
@@ -105,7 +106,8 @@ CASES = [("reference", 0.999, "rack"), ("pa25_sharp_rack_z17", 0.999, "rack"), (
          ("reference", 0.7, "raised")]
 
 
-@pytest.mark.parametrize("name, fraction, end", CASES)
+@pytest.mark.parametrize("name, fraction, end", sweep(CASES, fast=["undercut_z8"]))  # 8 s each; the fast case is the
+# undercut gear (the rack and raised ends on the reference gear are the slow tier's)
 def test_a_flat_end_mill_finishes_by_generation_within_target_without_gouge(name, fraction, end):
     _, _, path, result, cut = _planned(name, fraction, end)
     facts = simulation_section(cut(path), RES)

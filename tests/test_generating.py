@@ -25,6 +25,7 @@ from tests import silhouette
 from tests.gcode_reader import inlined_lines
 from tests.gears import spec_of
 from tests.rs274_helper import canon_args, run_rs274
+from tests.tiers import sweep
 
 HALF_MICRON = 0.5e-3
 TOOL_LENGTH = 30.0
@@ -275,7 +276,7 @@ def _material_sides(spec: GearSpec, path, rows: np.ndarray, tool: Tool) -> np.nd
     return sides
 
 
-@pytest.mark.parametrize("direction", ["climb", "conventional"])
+@pytest.mark.parametrize("direction", sweep(["climb", "conventional"], fast=["conventional"]))  # 2 s each
 def test_cutting_direction_is_as_asked(direction):
     """Spindle clockwise seen from above (M3): the cutting edges on the tool's side s (+1: +Y) move toward
     s * X. Climb milling: they move against the tool's travel, i.e. s * dX < 0."""

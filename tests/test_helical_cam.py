@@ -514,6 +514,7 @@ def test_smaller_corners_finish_other_helical_gears_at_three_sections(name, frac
     assert leftover <= job.finishing.target_scallop_mm + 0.0005, leftover
 
 
+@pytest.mark.slow  # a whole simulation (5 s); the smaller corner's plan is checked above in the fast tier
 def test_the_smaller_corner_job_simulated_is_within_target_and_resolution(small_corner):
     """Three spaces roughed and finished with the 0.5 mm corner, the middle one measured over the whole face."""
     job, plan = small_corner

@@ -114,6 +114,7 @@ def _envelope_angles(ring: InternalGearSpec, radii: np.ndarray) -> np.ndarray:
     return result
 
 
+@pytest.mark.slow  # a brute-force envelope (25 s); the ring's own profile checks below stay in the fast tier
 def test_ring_profile_matches_an_independent_envelope_of_the_rolling_cutter():
     """z = 60, m = 2, cut by a 20-tooth cutter: fillet and involute within 1.5 um of the envelope (normal distance:
     the angular difference on the circle times the profile's radius and |n . e_theta|); root circle from the cutter's
@@ -181,6 +182,7 @@ def test_rotary_table_refuses_an_internal_gear_at_the_key():
     assert parse_job(text + "[tools.finishing]\ndiameter_mm = 2.0\n[machine]\naxes = 3\n", "ring.toml").gear.is_internal
 
 
+@pytest.mark.slow  # the ring's B-rep and STEP (20 s); test_cad checks the external gear's in the fast tier
 def test_ring_solid_is_valid_exact_and_survives_step(tmp_path):
     """The B-rep ring: OCP-valid; its face is pi R_rim^2 less the area inside the toothed outline (a prism: the
     volume is that times b); its mid-face section lies within 1 um of the exact outline and the rim circle; the

@@ -18,9 +18,8 @@ from spur_cad.grade.simulated import profile_range_mm
 from spur_cad.job import load_job
 from tests.gears import REFERENCE_JOB
 from tests.machine_model import IDEAL, Harmonic, PlantedMachine, cut_planes, flank_figures, scan_csv
-from tests.rs274_helper import rs274_path
 
-pytestmark = pytest.mark.skipif(rs274_path() is None, reason="rs274 (linuxcnc-uspace) not installed")
+pytestmark = pytest.mark.linuxcnc  # the programs as rs274 reads them
 
 ARCSEC_RAD = math.pi / (180.0 * 3600.0)
 ISSUE_MACHINE = PlantedMachine(8.0, (Harmonic(25.0, 1, 40.0),))  # tools 8 um larger, 25 arcsec x sin(A + 40 deg)

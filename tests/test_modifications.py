@@ -305,6 +305,7 @@ def test_slopes_that_add_more_than_the_finish_stock_are_refused_at_the_key(mods,
     parse_job(GEAR + mods, "f.toml")
 
 
+@pytest.mark.slow  # a loft of many sections (7 s); the modified solid's own checks stay in the fast tier
 def test_a_loft_through_unmodified_sections_has_the_design_volume():
     """A negligible lead crowning (0.001 um) makes the gear a loft sewn from B-spline shells: valid, and its volume is
     the design's (transverse area x face width) within 1e-6, spur and helical."""

@@ -38,7 +38,7 @@ GOUGE_MM = 0.001
 
 
 @pytest.fixture(scope="module", params=sweep(["spur", "spur sides", "helical", "helical profile", "helical lead",
-                                              "helical end relief"], fast=["spur", "spur sides", "helical profile"]))
+                                              "helical end relief"], fast=["spur", "spur sides"]))
 def planned(request):
     jobs = {"spur": SPUR, "spur sides": SPUR_SIDES, "helical": HELICAL, "helical profile": HELICAL_PROFILE,
             "helical lead": HELICAL_LEAD, "helical end relief": HELICAL_END}

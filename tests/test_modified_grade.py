@@ -17,6 +17,7 @@ from spur_cad.job import parse_job
 from spur_cad.pipeline import job_stock, plan_cam
 from spur_cad.sim import Cut, SimSettings, simulate, subset
 from tests.test_modified_cam import GEAR, RES, TOOLS
+from tests.tiers import sweep
 
 SPUR_MODS = ("[gear.modifications]\ntip_relief_um = 15\ntip_relief_start_diameter_mm = 98\nlead_crowning_um = 10\n"
              "profile_slope_um = 8\n")
@@ -58,7 +59,7 @@ def _flank_grade(job, measured):
     return worst, classes, overall
 
 
-@pytest.fixture(scope="module", params=["spur", "helical"])
+@pytest.fixture(scope="module", params=sweep(["spur", "helical"], fast=["spur"]))  # helical: 25 s
 def graded(request):
     """(name, modified job, its grading, its space-1 traces, the unmodified job's flank grade of space 1)."""
     plain, mods = {"spur": (GEAR + TOOLS, SPUR_MODS), "helical": (HELICAL, HELICAL_MODS)}[request.param]

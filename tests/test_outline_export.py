@@ -156,6 +156,7 @@ def test_svg_read_back_lies_on_the_exact_offset_and_escapes_the_name():
     assert re.search(rb'width="[\d.]+mm"', content)
 
 
+@pytest.mark.slow  # two whole runs (5 s)
 def test_two_runs_in_two_processes_give_the_same_bytes(tmp_path):
     """Fresh processes with different hash seeds (ezdxf orders some tables by sets; times and GUIDs change)."""
     script = ("import sys; from spur_cad.job import load_job; from spur_cad.pipeline import export_files; "

@@ -192,6 +192,7 @@ def test_a_probe_log_needs_the_jobs_probe_section_and_the_axis_datum(eccentric, 
     assert code == 2 and "--datum best-fit is for CSV scans" in capsys.readouterr().err
 
 
+@pytest.mark.slow  # the correct command end to end (6 s); tests/test_correct.py runs it in the fast tier
 def test_correct_reads_the_probe_log_for_the_tool_size_and_says_it_cannot_see_the_table(cut, tmp_path):
     """`spur-cad correct JOB probe.log`: a gear probed 6 um larger than cut (material left: the tool as it cut was
     smaller, or worn) gives a size error of +6 um (within 1 um: the ideal cut's scallops are simulated apart, at
@@ -222,6 +223,7 @@ def test_correct_reads_the_probe_log_for_the_tool_size_and_says_it_cannot_see_th
     assert "not seen" in report and "turns on the table that cut the gear" in report
 
 
+@pytest.mark.slow  # a planted cut and the correct command (6 s)
 def test_a_probe_log_of_a_machine_with_a_table_error_still_corrects_the_size_and_cannot_see_the_table(cut, tmp_path,
                                                                                                       capsys):
     """Issue 46: the reference gear cut on the planted machine of tests/test_correct.py (tool 8 um larger, the table

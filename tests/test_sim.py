@@ -18,6 +18,7 @@ from spur_cad.sim import Cut, SimSettings, StockCylinder, finishing_stations, si
 from spur_cad.sim.design import DesignGrid, row_positions
 from spur_cad.summary import simulation_section
 from tests.gears import reference_job_text
+from tests.tiers import sweep
 
 ROOT = Path(__file__).resolve().parents[1]
 REFERENCE_JOB = ROOT / "resources" / "examples" / "reference_gear.toml"
@@ -97,7 +98,8 @@ def tool_contains(kind: str, diameter: float, corner: float, dx, dy, dz):
     return shank | core | torus
 
 
-@pytest.mark.parametrize("kind, diameter, corner", [("bull_nose", 2.0, 0.5), ("ball", 3.0, 1.5)])
+@pytest.mark.parametrize("kind, diameter, corner", sweep([("bull_nose", 2.0, 0.5), ("ball", 3.0, 1.5)],
+                                                          fast=["bull_nose"]))  # 5 s each
 def test_plunge_of_a_curved_tool_matches_brute_force_membership(kind, diameter, corner):
     stock_r, design_r = 10.0, 9.5
     grid = cylinder_grid(design_r, 720, 0.0, 4.0, 0.05)

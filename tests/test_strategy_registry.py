@@ -61,6 +61,9 @@ class RowsStrategy:
     params_type = RowsParams
     simultaneous_rotary = AlongXStrategy.simultaneous_rotary
     helical = False
+    follows_modifications = False  # its capabilities declared, as a new strategy's are (the Protocol)
+    corrects_slopes = False
+    lying_flat = False
 
     def largest_tool(self, recommendations) -> tuple[str, float]:
         return contact_largest_tool(recommendations)

@@ -171,6 +171,7 @@ def step_volume_and_box(path) -> tuple[float, tuple[float, ...]]:
     return props.Mass(), exact_bounds(shape)
 
 
+@pytest.mark.slow  # a whole 3-axis run (20 s); tests/test_three_axis_sim.py cuts the plan lying flat in the fast tier
 def test_a_three_axis_job_runs_through_the_pipeline_without_a_rotary_axis(tmp_path):
     from spur_cad.job import load_job
     from spur_cad.pipeline import run_job
@@ -266,6 +267,7 @@ def test_root_thickness_against_the_involute_and_the_cut_the_finishing_path_leav
     assert leaving.fillet_thickness_mm == pytest.approx(walked, abs=0.0005)
 
 
+@pytest.mark.slow  # plans a deep slot job (10 s)
 def test_finishing_steps_down_no_deeper_than_a_slot_where_roughing_cannot_reach_the_root():
     """z 30 m 1 roughed with D 2 (wider than the spaces' bottoms) and finished with D 1: the finishing tool cuts
     almost a full slot at the root (its centre's depth in what roughing leaves measured here as its distance from

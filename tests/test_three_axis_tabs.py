@@ -86,6 +86,7 @@ def test_no_tool_circle_reaches_the_tabs_below_their_top(tabbed):
     assert finish.path.z.min() == pytest.approx(-MODULE_1.face_width_mm - 0.5)
 
 
+@pytest.mark.slow  # a simulated cut (8 s); the tabs' geometry tests above stay in the fast tier
 def test_the_simulated_cut_keeps_the_tabs_on_their_tips_only(tabbed):
     rough, finish, depths = tabbed
     result = simulate_flat(MODULE_1, BLANK_MM, [rough, finish], SimSettings(resolution_mm=0.005), depths)

@@ -71,6 +71,7 @@ def test_every_tool_conflict_in_one_line_with_a_set_that_fits(tmp_path):
     assert float(match["corner"]) == 0.8  # by generation the tool's corner is the rack's tip radius rho
 
 
+@pytest.mark.slow  # two whole runs (5 s); the suggestion itself is checked above in the fast tier
 def test_the_suggested_set_runs_and_equals_what_auto_takes(tmp_path):
     """The set the error proposes, typed into the job, runs; `auto` takes the same sizes; its tools obey the
     limits the run reports (the roughing tool within its largest diameter, the finishing corner rho)."""

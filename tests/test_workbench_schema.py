@@ -37,7 +37,6 @@ from spur_cad.job import (
 from spur_cad.post.settings import PostSettings
 from tests.gears import GEAR_CASES
 from tests.textbook import Textbook
-from tests.tiers import sweep
 from tests.workbench_helper import REFERENCE_JOB, ROOT, small_job_text
 
 
@@ -569,7 +568,8 @@ def test_activate_lets_preloaded_packages_find_the_environments_modules(wb, tmp_
     monkeypatch.delitem(sys.modules, "wb_test_toolkit.plot3d")
 
 
-@pytest.mark.parametrize("hand", sweep(["right", "left"], fast=["right"]))  # each plans a helical job (20 s)
+@pytest.mark.slow  # each hand plans a helical job (15 s); the helical toolpath display test stays in the fast tier
+@pytest.mark.parametrize("hand", ["right", "left"])
 def test_suggested_tools_for_a_helical_gear_plan_both_operations(wb, hand):
     """Helical: the finishing corner is the rack tip radius and the roughing tool passes the reach rule with the
     width it sweeps along the lead; the whole plan builds."""
