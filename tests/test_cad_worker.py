@@ -160,6 +160,8 @@ def test_the_worker_ends_once_its_outcome_is_sent_before_the_run_reads_it():
     assert facts.gear_volume_mm3 > 0.0 and facts.step_bytes == {name: len(data) for name, data in files.items()}
 
 
+# a whole run with its simulation in a subprocess (20 s); the worker's own import test stays in the fast tier
+@pytest.mark.slow
 def test_a_run_that_simulates_loads_numba_only_after_the_worker_has_ended(tmp_path):
     """OCP (in the worker, about 300 MB) and numba (the simulation's, about 130 MB) are never resident at once: the
     run waits for its worker before it simulates. The helical example at 0.05 mm: its CAD ends about 0.5 s after

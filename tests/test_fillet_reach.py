@@ -121,6 +121,7 @@ def test_corner_refused_without_the_mate_and_accepted_with_it() -> None:
     check_tools(mated, recommend_tools(mated, mated.tip_radius_mm + 0.5, 2.0), None, tool, pair_of(0.7))
 
 
+@pytest.mark.slow  # two simulated cuts (12 s); the reach limits above stay in the fast tier
 def test_what_the_corner_leaves_is_below_the_sap_and_clear_of_the_mates_tips() -> None:
     """Brute force: the swept outline leaves the design's only below the SAP, and the mate's tip corners stay out
     of it; with the design's own rack round the corners stay out too (the mesh reference is sound)."""

@@ -120,6 +120,7 @@ def test_a_flat_end_mill_finishes_by_generation_within_target_without_gouge(name
     assert result.facts.flat_height_mm <= TARGET and result.facts.tip_mode_leftover_mm <= TARGET
 
 
+@pytest.mark.slow  # a planted fault's simulated cut (8 s)
 def test_a_fillet_pass_left_out_is_found_by_the_same_check():
     """The acceptance above sees a missing tip-mode pass of the flat tool (so it would see a plan whose cusps
     it misjudges)."""

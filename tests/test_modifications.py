@@ -323,6 +323,7 @@ def test_a_loft_through_unmodified_sections_has_the_design_volume():
         assert solid_volume_mm3(lofted) == pytest.approx(design_volume, rel=1e-6)
 
 
+@pytest.mark.slow  # a solid of every modification (5 s)
 def test_the_every_modification_gear_loses_at_least_its_flanks_removal():
     """The 17-tooth gear with every modification: the volume lost is at least the removal integrated over the
     involute flanks (first order: flank area element L / r_b dL dX; the fillets lose material besides) and at most

@@ -185,6 +185,7 @@ json.dump(sorted(name for name in sys.modules if name.startswith("scipy")), sys.
 """
 
 
+@pytest.mark.slow  # a whole run in a subprocess (8 s)
 def test_a_reference_run_does_not_import_scipy_optimize(tmp_path):
     env = {**os.environ, "PYTHONPATH": str(ROOT)}
     done = subprocess.run([sys.executable, "-c", SCRIPT], cwd=ROOT, env=env, capture_output=True, text=True,

@@ -69,6 +69,7 @@ def deepest_row_check(result, finishing: Cut, labels: tuple[str, ...]):
     return simulated, independent, np.tile(np.hypot(*grid.points[chosen].T), grid.teeth)
 
 
+@pytest.mark.slow  # a ring simulated lying flat (12 s); the runout test below stays in the fast tier
 def test_the_ring_cut_is_within_the_scallop_target_inside_the_form_circle_the_tool_leaves(ring_cut):
     """On the involute from the tool's form circle to the tip: no gouge beyond 1 um, leftover within the 5 um
     scallop target, each point as the independent clearance says (0.2 um); nowhere a gouge beyond 1 um. The root

@@ -124,6 +124,7 @@ def test_auto_where_no_suggestion_exists_is_one_line_naming_the_key(tmp_path, se
     assert lines[0].startswith(f"spur-cad: error: {job}:{line_number}: [{section}] {key} = \"auto\"")
 
 
+@pytest.mark.slow  # two whole CLI runs (12 s)
 def test_warnings_reach_the_terminal_and_no_flat_end_mill_warning_for_a_bull_nose(tmp_path):
     """The own gear's largest flat finishing end mill (0.75 mm) is below the smallest end mill: a warning only
     when the job finishes with a flat end mill; the warnings on the terminal are summary.json's."""

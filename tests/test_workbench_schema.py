@@ -627,6 +627,7 @@ def _cut_points_inside_gear_mm(wb, path, spec, turn_back: bool = True) -> float:
     return deepest
 
 
+@pytest.mark.slow  # plans the helical example (7 s)
 def test_helical_toolpaths_are_drawn_in_the_tooth_spaces_of_the_helical_gear(wb):
     """Acceptance (workbench): the drawn roughing and finishing paths line up with the helical solid: every
     tool-tip centre of a cutting segment, turned back by the helix at its X, lies outside the gear (in a space
