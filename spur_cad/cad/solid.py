@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import math
 import sys
+from collections.abc import Callable
 
 import numpy as np
 from OCP.BRep import BRep_Builder
@@ -68,6 +69,7 @@ from spur_cad.cad.section_edges import (  # noqa: F401  (re-exported: the names 
 from spur_cad.cad.specs import BlankFeatures, GearSolidReport, StockSpec
 from spur_cad.errors import ArgumentError, WorkLimitError, require_instance
 from spur_cad.geometry.internal import InternalGearSpec, as_ring
+from spur_cad.geometry.kinds import EXTERNAL_HELICAL, EXTERNAL_SPUR, INTERNAL_SPUR, GearKind
 from spur_cad.geometry.modifications import SIDES, FlankModifications, modified_tooth_space_profile
 from spur_cad.geometry.sampling import segment_parameters
 from spur_cad.geometry.spec import GearSpec
@@ -294,6 +296,31 @@ def _ring_shape(edges: list[TopoDS_Edge], spec: InternalGearSpec) -> TopoDS_Shap
     return BRepPrimAPI_MakePrism(fix.Face(), gp_Vec(spec.face_width_mm, 0.0, 0.0)).Shape()
 
 
+def _toothed_disc(spec: GearSpec, edges: list[TopoDS_Edge], tolerance_mm: float, report: GearSolidReport,
+                  modifications: FlankModifications | None) -> TopoDS_Shape:
+    """An external gear's toothed body: the front face's outline extruded along X or swept along the helix (the
+    kind's `solid`); with `modifications` the modified outline, or a loft through modified sections when they
+    modify the lead."""
+    if modifications is not None and not modifications.is_zero:
+        if modifications.has_lead:
+            return _loft_lead_modified(spec, modifications, tolerance_mm, report)
+        edges = modified_face_edges(spec, modifications, 0.0, tolerance_mm)
+    return _sweep_helical(edges, spec) if spec.kind.solid == "sweep" else _extrude(edges, spec.face_width_mm)
+
+
+def _toothed_ring(spec: GearSpec, edges: list[TopoDS_Edge], tolerance_mm: float, report: GearSolidReport,
+                  modifications: FlankModifications | None) -> TopoDS_Shape:
+    """An internal gear's body: `_ring_shape` (a ring's flanks are not modified: its kind does not follow
+    modifications)."""
+    return _ring_shape(edges, as_ring(spec))
+
+
+_BODY_SHAPES: dict[GearKind, Callable[[GearSpec, list[TopoDS_Edge], float, GearSolidReport,
+                                       FlankModifications | None], TopoDS_Shape]] = {
+    EXTERNAL_SPUR: _toothed_disc, EXTERNAL_HELICAL: _toothed_disc, INTERNAL_SPUR: _toothed_ring}
+"""How each gear kind's toothed body is made from its front face's edges, by the kind object."""
+
+
 def build_gear_shape(spec: GearSpec, features: BlankFeatures = BlankFeatures(),
                      fit_tolerance_mm: float | None = None,
                      modifications: FlankModifications | None = None) -> tuple[TopoDS_Shape, GearSolidReport]:
@@ -309,16 +336,10 @@ def build_gear_shape(spec: GearSpec, features: BlankFeatures = BlankFeatures(),
     tolerance = default_fit_tolerance_mm(spec) if fit_tolerance_mm is None else fit_tolerance_mm
     edges, report = gear_face_edges(spec, tolerance)
     b = spec.face_width_mm
-    if spec.kind.teeth_inward:
-        shape = _ring_shape(edges, as_ring(spec))
-    elif modifications is not None and not modifications.is_zero:
-        if modifications.has_lead:
-            shape = _loft_lead_modified(spec, modifications, tolerance, report)
-        else:
-            edges = modified_face_edges(spec, modifications, 0.0, tolerance)
-            shape = _sweep_helical(edges, spec) if spec.kind.solid == "sweep" else _extrude(edges, b)
-    else:
-        shape = _sweep_helical(edges, spec) if spec.kind.solid == "sweep" else _extrude(edges, b)
+    body = _BODY_SHAPES.get(spec.kind)
+    if body is None:
+        raise ValueError(f"no solid is known for a {spec.kind.name} gear (cad/solid.py, _BODY_SHAPES)")
+    shape = body(spec, edges, tolerance, report, modifications)
     if features.bore_diameter_mm > 0.0:
         shape = _cut(shape, _x_cylinder(features.bore_diameter_mm / 2.0, -1.0, b + 1.0))
     if features.keyway_width_mm > 0.0:
@@ -357,8 +378,7 @@ def build_flat_stock_shape(spec: GearSpec, stock: StockSpec, features: BlankFeat
     require_instance(spec, GearSpec, "spec")
     require_instance(stock, StockSpec, "stock")
     shape = _x_cylinder(stock.blank_radius_mm(spec), 0.0, spec.face_width_mm)
-    # a ring: its blank's bore
-    bore_mm = stock.inner_diameter_mm if spec.kind.teeth_inward else features.bore_diameter_mm
+    bore_mm = stock.flat_bore_diameter_mm(spec, features)  # a ring: its blank's bore
     if bore_mm > 0.0:
         shape = _cut(shape, _x_cylinder(bore_mm / 2.0, -1.0, spec.face_width_mm + 1.0))
     return shape

@@ -10,6 +10,7 @@ from dataclasses import dataclass
 
 from spur_cad.errors import GearSpecError, StockError
 from spur_cad.geometry.internal import as_ring
+from spur_cad.geometry.kinds import EXTERNAL_HELICAL, EXTERNAL_SPUR, INTERNAL_SPUR, GearKind
 from spur_cad.geometry.spec import GearSpec
 from spur_cad.keys import check_section, key
 
@@ -60,20 +61,7 @@ class BlankFeatures:
     def validate(self, spec: GearSpec) -> None:
         """Raise GearSpecError unless the features suit the gear: none in a ring, a wall of at least one module under
         the root. Checked where the features meet the gear (the job loader, gear_shape), not again below."""
-        if spec.kind.teeth_inward and (self.bore_diameter_mm > 0.0 or self.keyway_width_mm > 0.0):
-            raise GearSpecError("an internal gear has no bore or keyway (its inside is the teeth; the rim is "
-                                "rim_outer_diameter_mm)", field="bore_diameter_mm")
-        wall = spec.module_mm
-        if self.bore_diameter_mm > 0.0 and self.bore_diameter_mm / 2.0 > spec.root_radius_mm - wall:
-            raise GearSpecError(
-                f"bore diameter {self.bore_diameter_mm:g} mm leaves less than one module ({wall:g} mm) of wall under "
-                f"the root circle (root diameter {2 * spec.root_radius_mm:.3f} mm)", field="bore_diameter_mm")
-        if self.keyway_width_mm > 0.0:
-            top = self.bore_diameter_mm / 2.0 + self.keyway_depth_mm
-            if top > spec.root_radius_mm - wall:
-                raise GearSpecError(
-                    f"keyway reaches radius {top:.3f} mm, leaving less than one module ({wall:g} mm) of wall under "
-                    f"the root circle ({spec.root_radius_mm:.3f} mm)", field="keyway_depth_mm")
+        gear_body(spec).check_features(self, spec)
 
 
 @dataclass(frozen=True)
@@ -113,23 +101,7 @@ class StockSpec:
         """Raise StockError for a blank that does not suit the gear (below its tip or rim, a bore in an external
         gear's blank, a stub wider than the blank). Checked where the stock meets the gear (the job loader,
         stock_shape, CamInputs), not again below."""
-        if spec.kind.teeth_inward:
-            rim = as_ring(spec).rim_outer_diameter_mm
-            if 0.0 < self.blank_diameter_mm < rim - 1e-9:
-                raise StockError(f"blank_diameter_mm = {self.blank_diameter_mm:g} is smaller than the internal gear's "
-                                 f"rim_outer_diameter_mm ({rim:g} mm)", field="blank_diameter_mm")
-        tip_diameter = 2.0 * spec.tip_radius_mm
-        if self.inner_diameter_mm > 0.0 and not spec.kind.teeth_inward:
-            raise StockError("inner_diameter_mm is an internal gear's blank bore (an external gear's bore is [gear] "
-                             "bore_diameter_mm)", field="inner_diameter_mm")
-        if spec.kind.teeth_inward and self.inner_diameter_mm > tip_diameter - 1e-9:
-            raise StockError(f"inner_diameter_mm = {self.inner_diameter_mm:g} is not below the ring's tip diameter "
-                             f"{tip_diameter:.4f} mm: the teeth would be short", field="inner_diameter_mm")
-        if not spec.kind.teeth_inward and 0.0 < self.blank_diameter_mm < tip_diameter - 1e-9:
-            short = (tip_diameter - self.blank_diameter_mm) / 2.0
-            raise StockError(f"blank_diameter_mm = {self.blank_diameter_mm:g} is smaller than the tip diameter "
-                             f"{tip_diameter:.4f} mm: the teeth would be {short:.4f} mm short of the tip circle",
-                             field="blank_diameter_mm")
+        gear_body(spec).check_stock(self, spec)
         if self.stub_diameter_mm > 2.0 * self.blank_radius_mm(spec):
             raise StockError(f"stub diameter {self.stub_diameter_mm:g} mm is larger than the blank "
                                 f"({2 * self.blank_radius_mm(spec):.3f} mm)", field="stub_diameter_mm")
@@ -144,5 +116,87 @@ class StockSpec:
         radial allowance."""
         if self.blank_diameter_mm > 0.0:
             return self.blank_diameter_mm / 2.0
-        outside = as_ring(spec).rim_outer_diameter_mm / 2.0 if spec.kind.teeth_inward else spec.tip_radius_mm
-        return outside + self.radial_allowance_mm
+        return gear_body(spec).outside_radius_mm(spec) + self.radial_allowance_mm
+
+    def flat_bore_diameter_mm(self, spec: GearSpec, features: BlankFeatures) -> float:
+        """The bore of the blank lying flat ([machine] axes = 3; 0: none): a ring's blank bore ([stock]
+        inner_diameter_mm), an external gear's [gear] bore (it is clamped on it)."""
+        return gear_body(spec).flat_bore_diameter_mm(self, features)
+
+
+# --- what differs between the bodies of the gear kinds -----------------------------------------------------------
+
+@dataclass(frozen=True)
+class _Disc:
+    """An external gear's body: a disc toothed on its outside (the tip circle); its bore and keyway are [gear]
+    features cut under the root circle, its blank a cylinder at least as wide as the tip circle."""
+
+    def check_features(self, features: BlankFeatures, spec: GearSpec) -> None:
+        wall = spec.module_mm
+        if features.bore_diameter_mm > 0.0 and features.bore_diameter_mm / 2.0 > spec.root_radius_mm - wall:
+            raise GearSpecError(
+                f"bore diameter {features.bore_diameter_mm:g} mm leaves less than one module ({wall:g} mm) of wall "
+                f"under the root circle (root diameter {2 * spec.root_radius_mm:.3f} mm)", field="bore_diameter_mm")
+        if features.keyway_width_mm > 0.0:
+            top = features.bore_diameter_mm / 2.0 + features.keyway_depth_mm
+            if top > spec.root_radius_mm - wall:
+                raise GearSpecError(
+                    f"keyway reaches radius {top:.3f} mm, leaving less than one module ({wall:g} mm) of wall under "
+                    f"the root circle ({spec.root_radius_mm:.3f} mm)", field="keyway_depth_mm")
+
+    def check_stock(self, stock: StockSpec, spec: GearSpec) -> None:
+        tip_diameter = 2.0 * spec.tip_radius_mm
+        if stock.inner_diameter_mm > 0.0:
+            raise StockError("inner_diameter_mm is an internal gear's blank bore (an external gear's bore is [gear] "
+                             "bore_diameter_mm)", field="inner_diameter_mm")
+        if 0.0 < stock.blank_diameter_mm < tip_diameter - 1e-9:
+            short = (tip_diameter - stock.blank_diameter_mm) / 2.0
+            raise StockError(f"blank_diameter_mm = {stock.blank_diameter_mm:g} is smaller than the tip diameter "
+                             f"{tip_diameter:.4f} mm: the teeth would be {short:.4f} mm short of the tip circle",
+                             field="blank_diameter_mm")
+
+    def outside_radius_mm(self, spec: GearSpec) -> float:
+        return spec.tip_radius_mm
+
+    def flat_bore_diameter_mm(self, stock: StockSpec, features: BlankFeatures) -> float:
+        return features.bore_diameter_mm
+
+
+@dataclass(frozen=True)
+class _Ring:
+    """An internal gear's body: a ring toothed on its inside, its outside the rim (rim_outer_diameter_mm); no bore
+    or keyway (its inside is the teeth), its blank at least as wide as the rim and its blank bore ([stock]
+    inner_diameter_mm) inside the tip circle."""
+
+    def check_features(self, features: BlankFeatures, spec: GearSpec) -> None:
+        if features.bore_diameter_mm > 0.0 or features.keyway_width_mm > 0.0:
+            raise GearSpecError("an internal gear has no bore or keyway (its inside is the teeth; the rim is "
+                                "rim_outer_diameter_mm)", field="bore_diameter_mm")
+
+    def check_stock(self, stock: StockSpec, spec: GearSpec) -> None:
+        rim = as_ring(spec).rim_outer_diameter_mm
+        if 0.0 < stock.blank_diameter_mm < rim - 1e-9:
+            raise StockError(f"blank_diameter_mm = {stock.blank_diameter_mm:g} is smaller than the internal gear's "
+                             f"rim_outer_diameter_mm ({rim:g} mm)", field="blank_diameter_mm")
+        tip_diameter = 2.0 * spec.tip_radius_mm
+        if stock.inner_diameter_mm > tip_diameter - 1e-9:
+            raise StockError(f"inner_diameter_mm = {stock.inner_diameter_mm:g} is not below the ring's tip diameter "
+                             f"{tip_diameter:.4f} mm: the teeth would be short", field="inner_diameter_mm")
+
+    def outside_radius_mm(self, spec: GearSpec) -> float:
+        return as_ring(spec).rim_outer_diameter_mm / 2.0
+
+    def flat_bore_diameter_mm(self, stock: StockSpec, features: BlankFeatures) -> float:
+        return stock.inner_diameter_mm
+
+
+_BODIES: dict[GearKind, _Disc | _Ring] = {EXTERNAL_SPUR: _Disc(), EXTERNAL_HELICAL: _Disc(), INTERNAL_SPUR: _Ring()}
+"""Each gear kind's body, by the kind object: its outside, what a bore may be, what its blank must be."""
+
+
+def gear_body(spec: GearSpec) -> _Disc | _Ring:
+    """The body of `spec`'s kind (ValueError naming a kind no body is known for)."""
+    body = _BODIES.get(spec.kind)
+    if body is None:
+        raise ValueError(f"no body is known for a {spec.kind.name} gear (cad/specs.py, _BODIES)")
+    return body

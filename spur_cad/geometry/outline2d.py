@@ -10,12 +10,14 @@ material) is always to the right of the direction of travel. Consumers: 2-D expo
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass, replace
 
 import numpy as np
 
 from spur_cad.geometry.frames import turn_points
 from spur_cad.geometry.internal import as_ring
+from spur_cad.geometry.kinds import EXTERNAL_HELICAL, EXTERNAL_SPUR, INTERNAL_SPUR, GearKind
 from spur_cad.geometry.profile import CircularArc, Segment
 from spur_cad.geometry.sampling import segment_parameters
 from spur_cad.geometry.spec import GearSpec
@@ -279,9 +281,9 @@ def fit_biarcs(points_xy: np.ndarray, tangents_xy: np.ndarray, tolerance_mm: flo
 
 # --- the gear outline -----------------------------------------------------------------------------
 
-def _fitted_segment(segment: Segment, tolerance_mm: float, internal: bool = False) -> list[Segment2D]:
-    """One exact profile segment (root to tip direction) as arcs and lines within tolerance_mm (`internal`: a
-    ring's segment, whose space lies right of its direction)."""
+def _fitted_segment(segment: Segment, tolerance_mm: float, roll_sign: int = 1) -> list[Segment2D]:
+    """One exact profile segment (root to tip direction) as arcs and lines within tolerance_mm (`roll_sign`: the
+    gear kind's; -1, a ring's segment, whose roll runs negative and whose space lies right of its direction)."""
     if isinstance(segment, CircularArc):
         a, b = segment.points(np.array([segment.start, segment.end]))
         # polar angle grows clockwise in the profile frame: start -> end is clockwise about the axis
@@ -289,9 +291,7 @@ def _fitted_segment(segment: Segment, tolerance_mm: float, internal: bool = Fals
     params = segment_parameters(segment, tolerance_mm * _SAMPLE_FRACTION)
     points = segment.points(params)
     normals = segment.normals(params)
-    tangents = np.stack([normals[:, 1], -normals[:, 0]], axis=-1)  # root -> tip, normal into the space
-    if internal:
-        tangents = -tangents
+    tangents = roll_sign * np.stack([normals[:, 1], -normals[:, 0]], axis=-1)  # root -> tip, normal into the space
     if float(np.sum(tangents[:-1] * np.diff(points, axis=0))) <= 0.0:
         raise ValueError(f"the {segment.label}'s normals do not match its direction")
     return fit_biarcs(points, tangents, tolerance_mm * _FIT_FRACTION)
@@ -304,7 +304,7 @@ def _space_segments(spec: GearSpec, tolerance_mm: float) -> list[Segment2D]:
     for segment in profile.segments:
         if segment.label in ("root", "tip"):
             continue
-        right.extend(_fitted_segment(segment, tolerance_mm, spec.kind.teeth_inward))
+        right.extend(_fitted_segment(segment, tolerance_mm, spec.kind.roll_sign))
     right = list(closed_chain(right))
     left = [s.mirrored() for s in right]
     down = [s.reversed() for s in reversed(right)]
@@ -330,19 +330,37 @@ def closed_chain(segments: list[Segment2D]) -> tuple[Segment2D, ...]:
     return tuple(out)
 
 
-def gear_outline_arcs(spec: GearSpec, tolerance_mm: float) -> Outline2D:
-    """The transverse outline of an external spur gear (all teeth) as arcs and lines: root and tip arcs
-    exact, involute and fillet by biarcs within tolerance_mm.
-
-    Counter-clockwise, starting at space 0's right tip corner; space k is space 0 turned by k 360/z
-    degrees counter-clockwise (as `sampling.gear_outline`). For a helical gear this is the transverse
-    section at the front face.
-    """
+def gear_outline_loops(spec: GearSpec, tolerance_mm: float) -> tuple[Outline2D, ...]:
+    """The gear's transverse outline as the closed loops its kind has, root and tip arcs exact, involute and fillet
+    by biarcs within tolerance_mm: an external gear's toothed loop (counter-clockwise, starting at space 0's right
+    tip corner; space k is space 0 turned by k 360/z degrees counter-clockwise, as `sampling.gear_outline`; a
+    helical gear's: the transverse section at the front face); a ring's rim circle (counter-clockwise) and toothed
+    inner loop (clockwise: the material on its left)."""
     if not (math.isfinite(tolerance_mm) and tolerance_mm > 0.0):
         raise ValueError(f"tolerance must be a positive number, got {tolerance_mm}")
-    if spec.kind.teeth_inward:
+    loops = _OUTLINES.get(spec.kind)
+    if loops is None:
+        raise ValueError(f"no outline is known for a {spec.kind.name} gear (geometry/outline2d.py, _OUTLINES)")
+    return loops(spec, tolerance_mm)
+
+
+def gear_outline_arcs(spec: GearSpec, tolerance_mm: float) -> Outline2D:
+    """The transverse outline of an external gear (all teeth) as arcs and lines: its one loop of
+    `gear_outline_loops`."""
+    loops = gear_outline_loops(spec, tolerance_mm)
+    if len(loops) != 1:
         raise ValueError("an internal gear's outline is two loops: use internal_gear_outline_arcs")
-    return _toothed_loop(spec, tolerance_mm)
+    return loops[0]
+
+
+def internal_gear_outline_arcs(spec: GearSpec, tolerance_mm: float) -> tuple[Outline2D, Outline2D]:
+    """An internal gear's transverse outline: the rim circle (counter-clockwise) and the toothed inner outline
+    (clockwise: the material on its left), its two loops of `gear_outline_loops`."""
+    loops = gear_outline_loops(spec, tolerance_mm)
+    if len(loops) != 2:
+        raise ValueError("not an internal gear: use gear_outline_arcs")
+    rim, teeth = loops
+    return rim, teeth
 
 
 def _toothed_loop(spec: GearSpec, tolerance_mm: float) -> Outline2D:
@@ -355,17 +373,20 @@ def _toothed_loop(spec: GearSpec, tolerance_mm: float) -> Outline2D:
     return closed_loop(segments)
 
 
-def internal_gear_outline_arcs(spec: GearSpec, tolerance_mm: float) -> tuple[Outline2D, Outline2D]:
-    """An internal gear's transverse outline: the rim circle (counter-clockwise) and the toothed inner outline
-    (clockwise: the material on its left), arcs exact and fillet and involute by biarcs within tolerance_mm."""
-    if not (math.isfinite(tolerance_mm) and tolerance_mm > 0.0):
-        raise ValueError(f"tolerance must be a positive number, got {tolerance_mm}")
-    if not spec.kind.teeth_inward:
-        raise ValueError("not an internal gear: use gear_outline_arcs")
+def _external_loops(spec: GearSpec, tolerance_mm: float) -> tuple[Outline2D, ...]:
+    return (_toothed_loop(spec, tolerance_mm),)
+
+
+def _ring_loops(spec: GearSpec, tolerance_mm: float) -> tuple[Outline2D, ...]:
     rim_top = (0.0, as_ring(spec).rim_outer_diameter_mm / 2.0)
     rim = Outline2D((Arc2D(rim_top, rim_top, (0.0, 0.0), True),))
     teeth = _toothed_loop(spec, tolerance_mm)
     return rim, Outline2D(tuple(segment.reversed() for segment in reversed(teeth.segments)))
+
+
+_OUTLINES: dict[GearKind, Callable[[GearSpec, float], tuple[Outline2D, ...]]] = {
+    EXTERNAL_SPUR: _external_loops, EXTERNAL_HELICAL: _external_loops, INTERNAL_SPUR: _ring_loops}
+"""Each gear kind's transverse outline loops, by the kind object."""
 
 
 # --- exact offset ---------------------------------------------------------------------------------
