@@ -224,7 +224,7 @@ def error_budget(job: Job, plan: CamPlan) -> ErrorBudget:
     and the finishing tool's deflection in the job's material (on the finish stock roughing leaves). On 3 axes the
     linear axes, runout and tool size only: no table indexes the spaces, and the deflection model (a corner's arc
     in the finish stock) is not the cut of a flat end mill's side over a whole step-down (docs/simulation.md)."""
-    return _BUDGETS[job.machine.setup](job, plan)
+    return SETUP_BUDGETS[job.machine.setup](job, plan)
 
 
 def _lying_flat_budget(job: Job, plan: CamPlan) -> ErrorBudget:
@@ -251,8 +251,8 @@ def _rotary_table_budget(job: Job, plan: CamPlan) -> ErrorBudget:
                        machine.linear_accuracy_um, deflection)
 
 
-_BUDGETS: dict[MachineSetup, Callable[[Job, CamPlan], ErrorBudget]] = {ROTARY_TABLE: _rotary_table_budget,
-                                                                       LYING_FLAT: _lying_flat_budget}
+SETUP_BUDGETS: dict[MachineSetup, Callable[[Job, CamPlan], ErrorBudget]] = {
+    ROTARY_TABLE: _rotary_table_budget, LYING_FLAT: _lying_flat_budget}
 """Each set-up's error budget (error_budget)."""
 CONTACT_KINDS = frozenset({EXTERNAL_SPUR})
 """The kinds whose finishing contacts spur_cad.sim.contact finds in a transverse section (finishing_point_angles)."""
@@ -400,7 +400,7 @@ def restart_program(job: Job, plan: CamPlan, point: RestartPoint) -> tuple[str, 
 
 def program_comments(job: Job, plan: CamPlan, operation: str) -> tuple[str, ...]:
     """Header comments of a program: gear data, tool, strategy, estimated time (no date: outputs are reproducible)."""
-    return _COMMENTS[job.machine.setup](job, plan, operation)
+    return SETUP_COMMENTS[job.machine.setup](job, plan, operation)
 
 
 def _rotary_table_comments(job: Job, plan: CamPlan, operation: str) -> tuple[str, ...]:
@@ -494,7 +494,7 @@ def _three_axis_comments(job: Job, plan: CamPlan, operation: str) -> tuple[str, 
     )
 
 
-_COMMENTS: dict[MachineSetup, Callable[[Job, CamPlan, str], tuple[str, ...]]] = {
+SETUP_COMMENTS: dict[MachineSetup, Callable[[Job, CamPlan, str], tuple[str, ...]]] = {
     ROTARY_TABLE: _rotary_table_comments, LYING_FLAT: _three_axis_comments}
 """Each set-up's program header comments (program_comments)."""
 
@@ -525,7 +525,7 @@ def simulates_with_kernels(job: Job, plan: CamPlan) -> bool:
     """Whether simulate_stage runs the 4-axis simulation, whose kernels load numba (a job lying flat is simulated
     by spur_cad.sim.flat, in numpy)."""
     cuts = any(planned is not None for planned in (plan.roughing, plan.roughing_bottom, plan.finishing))
-    return job.simulation.enabled and cuts and _SIMULATIONS[job.machine.setup] is _simulate_turned
+    return job.simulation.enabled and cuts and SETUP_SIMULATIONS[job.machine.setup] is _simulate_turned
 
 
 def simulate_stage(job: Job, plan: CamPlan, progress: Callable[[float], None] | None = None) -> SimResult | None:
@@ -536,7 +536,7 @@ def simulate_stage(job: Job, plan: CamPlan, progress: Callable[[float], None] | 
                                                                       plan.finishing) if planned is not None]
     if not job.simulation.enabled or not operations:
         return None
-    return _SIMULATIONS[job.machine.setup](job, plan, operations, progress)
+    return SETUP_SIMULATIONS[job.machine.setup](job, plan, operations, progress)
 
 
 def _simulate_lying_flat(job: Job, plan: CamPlan, operations: list[Cut],
@@ -566,7 +566,8 @@ def _simulate_turned(job: Job, plan: CamPlan, operations: list[Cut],
     return dataclasses.replace(result, engagement=roughing_engagement(job, plan))
 
 
-_SIMULATIONS: dict[MachineSetup, Callable[[Job, CamPlan, list[Cut], Callable[[float], None] | None], SimResult]] = {
+SETUP_SIMULATIONS: dict[MachineSetup, Callable[[Job, CamPlan, list[Cut], Callable[[float], None] | None],
+                                              SimResult]] = {
     ROTARY_TABLE: _simulate_turned, LYING_FLAT: _simulate_lying_flat}
 """Each set-up's simulation (simulate_stage)."""
 

@@ -5,7 +5,7 @@ from __future__ import annotations
 import re
 from dataclasses import dataclass
 
-from spur_cad.cam.setups import MachineSetup, setup_for_axes
+from spur_cad.cam.setups import ROTARY_TABLE, MachineSetup, setup_for_axes
 from spur_cad.errors import SpurCadError, shown
 from spur_cad.keys import check_section, key
 
@@ -178,7 +178,7 @@ def check_travel(machine: Machine, x, y, z, a, operation: str) -> None:
                                f"[{low:g}, {high:g}] {unit}", field=bound, section="machine")
 
 
-DEFAULT_ROUGHING_STRATEGY = "flank"
+DEFAULT_ROUGHING_STRATEGY = ROTARY_TABLE.default_roughing_strategy
 """[roughing] strategy where a job leaves it out, in job files and the workbench alike: roughing by flanks
 (constant engagement, docs/method.md 4.1), about three times faster than levels with the same tool and cutting
 data. It needs the rotary table, to turn A to each flank segment: on 3 axes the default is levels
@@ -190,7 +190,7 @@ def default_roughing_strategy(setup: MachineSetup) -> str:
     DEFAULT_ROUGHING_STRATEGY on the rotary table (spur and helical gears), "levels" lying flat (3 axes: no table
     turns a flank to the tool, and the 3-axis roughing is by levels, each a series of passes offset from the
     outline)."""
-    return DEFAULT_ROUGHING_STRATEGY if setup.rotary_axis else "levels"
+    return setup.default_roughing_strategy
 
 
 @dataclass(frozen=True)

@@ -177,6 +177,13 @@ class MachineSetup:
     panel_limits_text: ClassVar[str] = ""
     """The workbench's tool limits for this set-up when they are a fixed text (empty: the gear's computed limits
     and the notes beside the tool fields are shown)."""
+    default_roughing_strategy: ClassVar[str] = "levels"
+    """The [roughing] strategy of a job that leaves it out here (spur_cad.cam.machine.default_roughing_strategy)."""
+    error_budget_text: ClassVar[str] = ""
+    """The report's sentence on the error budget here, with named places the report fills ({klass}: the expected
+    class; {total}, {runout}, {tool_radius}, {linear}, {deflection}: the flank shifts; {thickness}: the tooth
+    thickness change; {index_source}, {seed}, {largest_index}: the index errors; {bent}: the tool's deflection;
+    {micro}: the micrometre sign)."""
 
     def budget_inputs(self, machine: object, material: str) -> dict[str, object]:
         """Summary.json's error-budget inputs: the `[machine]` keys its budget reads (budget_keys, values of
@@ -210,6 +217,14 @@ class RotaryTable(MachineSetup):
         ("required_stick_out_mm", "stick-out the tools need"),
     )
     budget_keys: ClassVar[tuple[str, ...]] = _BUDGET_KEYS
+    default_roughing_strategy: ClassVar[str] = "flank"
+    """Roughing by flanks (constant engagement, docs/method.md 4.1): A turns each flank segment to the tool."""
+    error_budget_text: ClassVar[str] = (
+        "With the machine's error budget the gear is expected in class {klass}: index errors from the {index_source} "
+        "and the repeatability drawn per space (seed {seed}), largest {largest_index} arcsec; every flank moved "
+        "{total} {micro} along its normal (runout {runout}, tool radius {tool_radius}, linear axes {linear}, "
+        "deflection {deflection}), {bent}; the tooth thickness on the reference circle changes by {thickness} "
+        "{micro}.")
 
     def budget_inputs(self, machine: object, material: str) -> dict[str, object]:
         """Its `[machine]` keys and `[job] material`: the finishing tool's deflection is modelled in it."""
@@ -260,6 +275,14 @@ class LyingFlat(MachineSetup):
     )
     budget_keys: ClassVar[tuple[str, ...]] = tuple(name for name in _BUDGET_KEYS if not name.startswith("rotary_"))
     """No rotary table indexes the spaces: its keys are not read (no index error, no deflection modelled)."""
+    default_roughing_strategy: ClassVar[str] = "levels"
+    """No table turns a flank to the tool: by levels, each a series of passes offset from the outline."""
+    error_budget_text: ClassVar[str] = (
+        "With the 3-axis machine's error budget the gear is expected in class {klass}: no index error (no rotary "
+        "table indexes the spaces); every flank moved {total} {micro} along its normal (runout {runout}, tool radius "
+        "{tool_radius}, linear axes {linear}; the side of a flat end mill cutting a whole step-down is not the "
+        "deflection model's cut: a measured figure goes in as tool_radius_error_um); the tooth thickness on the "
+        "reference circle changes by {thickness} {micro}.")
     panel_limits_text: ClassVar[str] = (
         "3 axes, the gear lying flat: flat end mills; the finishing tool's radius is the root fillet's at least, and "
         "its side must reach the active profile (docs/cam.md).")

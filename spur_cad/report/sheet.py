@@ -429,27 +429,16 @@ def error_budget_text(result: JobResult) -> str:
     if budget is None:
         return ""
     terms, shift = budget.terms, budget.terms.flank_shift_um
-    klass = budget.grading.overall_class or "beyond 11"
-    if not terms.rotary_table:
-        return (f"With the 3-axis machine's error budget the gear is expected in class {klass}: no index error (no "
-                f"rotary table indexes the spaces); every flank moved {signed(shift['total'], 1)} {MICRO} along its "
-                f"normal (runout {signed(shift['runout'], 1)}, tool radius {signed(shift['tool_radius'], 1)}, linear "
-                f"axes {signed(shift['linear'], 1)}; the side of a flat end mill cutting a whole step-down is not "
-                "the deflection model's cut: a measured figure goes in as tool_radius_error_um); the tooth "
-                f"thickness on the reference circle changes by {signed(budget.tooth_thickness_change_um, 1)} "
-                f"{MICRO}.")
     deflection = budget.deflection
     bent = (f"the finishing tool bent {number(deflection.deflection_um, 1)} {MICRO} by "
             f"{number(deflection.force_n, 2)} N "
             f"({deflection.material}, k_c1.1 {number(deflection.kc11_n_mm2, 0)} N/mm², m_c {number(deflection.mc, 2)})"
             if deflection is not None else "no tool deflection (no finishing tool with a stick-out)")
-    return (f"With the machine's error budget the gear is expected in class {klass}: index errors from the "
-            f"{terms.index_source} and the repeatability drawn per space (seed {terms.random_seed}), largest "
-            f"{number(max(abs(e) for e in terms.index_error_arcsec), 1)} arcsec; every flank moved "
-            f"{signed(shift['total'], 1)} {MICRO} along its normal (runout {signed(shift['runout'], 1)}, tool radius "
-            f"{signed(shift['tool_radius'], 1)}, linear axes {signed(shift['linear'], 1)}, deflection "
-            f"{signed(shift['deflection'], 1)}), {bent}; the tooth thickness on the reference circle changes by "
-            f"{signed(budget.tooth_thickness_change_um, 1)} {MICRO}." + eccentric_gear_text(terms))
+    places = {name: signed(shift[name], 1) for name in ("total", "runout", "tool_radius", "linear", "deflection")}
+    return machine_setup(result).error_budget_text.format(
+        klass=budget.grading.overall_class or "beyond 11", index_source=terms.index_source, seed=terms.random_seed,
+        largest_index=number(max((abs(e) for e in terms.index_error_arcsec), default=0.0), 1), bent=bent,
+        thickness=signed(budget.tooth_thickness_change_um, 1), micro=MICRO, **places) + eccentric_gear_text(terms)
 
 
 def eccentric_gear_text(terms) -> str:
