@@ -8,12 +8,14 @@ inspector should measure on the finished part.
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
 from spur_cad.errors import require_instance
-from spur_cad.geometry.internal import InternalGearSpec
+from spur_cad.geometry.internal import InternalGearSpec, as_ring
 from spur_cad.geometry.involute import inverse_involute_function, involute_function
+from spur_cad.geometry.kinds import EXTERNAL_HELICAL, EXTERNAL_SPUR, INTERNAL_SPUR, GearKind
 from spur_cad.geometry.spec import GearSpec
 
 if TYPE_CHECKING:
@@ -240,13 +242,20 @@ def internal_inspection_facts(spec: InternalGearSpec) -> InspectionSheet:
 
 
 def inspection_sheet(spec: GearSpec) -> InspectionSheet:
-    """The inspection values the report, summary.json's `inspection` and scripts read (one typed result).
-    Helical gears: span and chordal thickness in the normal section, over balls; the span's k is lowered until
-    the anvils fit the face width (b > W sin(beta_b)), and the span is None when not even k = 1 fits (measure
-    over balls)."""
+    """The inspection values the report, summary.json's `inspection` and scripts read (one typed result), as the
+    gear's kind is measured (_SHEETS): an external gear's (`external_inspection_facts`), a ring's
+    (`internal_inspection_facts`)."""
     require_instance(spec, GearSpec, "spec")
-    if isinstance(spec, InternalGearSpec):
-        return internal_inspection_facts(spec)
+    sheet = _SHEETS.get(spec.kind)
+    if sheet is None:
+        raise ValueError(f"no inspection sheet is known for a {spec.kind.name} gear (geometry/inspection.py, _SHEETS)")
+    return sheet(spec)
+
+
+def external_inspection_facts(spec: GearSpec) -> InspectionSheet:
+    """An external gear's sheet: span over k teeth, dimension over pins and chordal thickness. Helical gears: span
+    and chordal thickness in the normal section, over balls; the span's k is lowered until the anvils fit the face
+    width (b > W sin(beta_b)), and the span is None when not even k = 1 fits (measure over balls)."""
     k = recommended_span_teeth(spec)
     span = span_measurement(spec, k)
     while k > 1 and span_min_face_width_mm(spec, span) >= spec.face_width_mm:  # helical: the anvils must fit
@@ -265,6 +274,16 @@ def inspection_sheet(spec: GearSpec) -> InspectionSheet:
         chordal_height_mm=chord.chordal_height_mm, chordal_measuring_radius_mm=chord.measuring_radius_mm,
         tooth_thickness_mm=spec.tooth_thickness_mm, thickness_reduction_mm=spec.thickness_reduction_mm,
         min_teeth_without_undercut=math.ceil(z_min - 1e-9), min_teeth_without_undercut_exact=z_min)
+
+
+def _ring_inspection_facts(spec: GearSpec) -> InspectionSheet:
+    return internal_inspection_facts(as_ring(spec))
+
+
+_SHEETS: dict[GearKind, Callable[[GearSpec], InspectionSheet]] = {
+    EXTERNAL_SPUR: external_inspection_facts, EXTERNAL_HELICAL: external_inspection_facts,
+    INTERNAL_SPUR: _ring_inspection_facts}
+"""Each gear kind's inspection sheet, by the kind object."""
 
 
 MODIFICATION_NAMES = (  # (FlankModification field, ISO 21771 name as the sheet shows it)
