@@ -22,6 +22,7 @@ import math
 from dataclasses import dataclass
 
 from spur_cad.errors import SpurCadError
+from spur_cad.geometry.kinds import EXTERNAL_SPUR
 from spur_cad.geometry.mate import GearPair, pair_facts
 from spur_cad.geometry.mate_gear import mate_spec
 from spur_cad.geometry.mate_mesh import corner_intrusion_mm
@@ -76,9 +77,14 @@ def reach_spec(spec: GearSpec, corner_radius_mm: float) -> GearSpec | None:
     return reach
 
 
+RELAXED_BY_A_MATE = frozenset({EXTERNAL_SPUR})
+"""Gear kinds whose fillet limit a mate can relax (applies): external spur gears (a ring's or a helical gear's reach
+past the fillet is not worked out)."""
+
+
 def applies(spec: GearSpec, pair: GearPair | None) -> bool:
     """Whether the mate can relax the fillet limit: an external spur gear with an external mate."""
-    return (pair is not None and not pair.mate.internal and not spec.kind.teeth_inward and not spec.kind.helical
+    return (pair is not None and not pair.mate.internal and spec.kind in RELAXED_BY_A_MATE
             and spec.active_profile_start_diameter_mm > 0.0)
 
 

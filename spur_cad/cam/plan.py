@@ -99,7 +99,8 @@ def check_cam_inputs(inputs: CamInputs) -> tuple[ToolRecommendations, RoughingLe
     spec, machine, stock = inputs.spec, inputs.machine, inputs.stock
     strategy = get_strategy(inputs.finishing.strategy, inputs.strategies)
     if inputs.finishing_tool is not None and not spec.kind.accepts_strategy(strategy):
-        helical = " or ".join(f'"{name}"' for name, other in inputs.strategies.items() if other.helical)
+        helical = " or ".join(f'"{name}"' for name, other in inputs.strategies.items()
+                            if spec.kind.accepts_strategy(other))
         raise MachineError(f"[finishing] strategy = {shown(inputs.finishing.strategy)} is for spur gears; a "
                            f"helical gear (helix_angle_deg = {spec.helix_angle_deg:g}) is finished by "
                            f"strategy = {helical}",

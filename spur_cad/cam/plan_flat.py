@@ -4,14 +4,20 @@ Split from cam/plan.py, whose plan_cam calls plan_three_axis and which re-export
 
 from __future__ import annotations
 
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import Any
+
 import numpy as np
 
+from spur_cad.cam.allowances import ToolRecommendations
 from spur_cad.cam.estimate import estimate
 from spur_cad.cam.machine import MachineError, check_travel
 from spur_cad.cam.plan_types import CamInputs, CamPlan, FinishingPlan, RoughingPlan
 from spur_cad.cam.recommend import recommend_tools
 from spur_cad.cam.strategies import FinishingResult
 from spur_cad.cam.tools import ToolError
+from spur_cad.geometry.kinds import EXTERNAL_HELICAL, EXTERNAL_SPUR, INTERNAL_SPUR, GearKind
 from spur_cad.geometry.outline2d import Arc2D
 
 
@@ -27,21 +33,36 @@ def check_three_axis_inputs(inputs: CamInputs):
         raise ToolError("[machine] axes = 3 needs [tools.roughing]: finishing cuts only the finish stock around the "
                         "outline", field="diameter_mm", section="tools.roughing")
     root = check_three_axis(spec, inputs.finishing_tool, inputs.roughing_tool)
-    if spec.kind.teeth_inward:  # the rotary-table strategies' recommendations do not apply to a ring
-        from spur_cad.cam.three_axis_ring import ring_tool_recommendations
+    return FLAT_PLANS[spec.kind].recommendations(inputs), root
 
-        return ring_tool_recommendations(spec, inputs.machine.clearance_mm), root
+
+def _external_recommendations(inputs: CamInputs) -> ToolRecommendations:
+    """An external gear's tool limits lying flat (three_axis.flat_tool_recommendations)."""
     from spur_cad.cam.three_axis import flat_tool_recommendations
 
+    spec = inputs.spec
     rotary = recommend_tools(spec, inputs.stock.blank_radius_mm(spec), inputs.machine.clearance_mm)
-    return flat_tool_recommendations(spec, inputs.machine.clearance_mm, rotary.roughing_max_diameter_mm), root
+    return flat_tool_recommendations(spec, inputs.machine.clearance_mm, rotary.roughing_max_diameter_mm)
+
+
+def _ring_recommendations(inputs: CamInputs) -> ToolRecommendations:
+    """A ring's (the rotary-table strategies' recommendations do not apply to a ring)."""
+    from spur_cad.cam.three_axis_ring import ring_tool_recommendations
+
+    return ring_tool_recommendations(inputs.spec, inputs.machine.clearance_mm)
 
 
 def plan_three_axis(inputs: CamInputs, tolerance_mm: float) -> CamPlan:
     """The CAM plan of a 3-axis job ([machine] axes = 3): the checks of three_axis.check_three_axis, roughing and
-    finishing as spur_cad.cam.three_axis says; no tool recommendations for the rotary-table strategies
-    (empty; the cut is simulated by spur_cad.sim.flat, its error budget is the 3-axis machine's:
-    pipeline.error_budget)."""
+    finishing as spur_cad.cam.three_axis says (a ring's as spur_cad.cam.three_axis_ring says); no tool
+    recommendations for the rotary-table strategies (empty; the cut is simulated by spur_cad.sim.flat, its error
+    budget is the 3-axis machine's: pipeline.error_budget)."""
+    rec, root = check_three_axis_inputs(inputs)
+    return FLAT_PLANS[inputs.spec.kind].plan(inputs, tolerance_mm, rec, root)
+
+
+def _plan_three_axis_external(inputs: CamInputs, tolerance_mm: float, rec: ToolRecommendations, root) -> CamPlan:
+    """The 3-axis plan of an external gear (spur_cad.cam.three_axis)."""
     from spur_cad.cam.roughing import RoughingLevels
     from spur_cad.cam.three_axis import (
         ThreeAxisFinishingFacts,
@@ -54,9 +75,6 @@ def plan_three_axis(inputs: CamInputs, tolerance_mm: float) -> CamPlan:
     from spur_cad.cam.three_axis_root import root_thickness
 
     spec, machine, stock = inputs.spec, inputs.machine, inputs.stock
-    rec, root = check_three_axis_inputs(inputs)
-    if spec.kind.teeth_inward:
-        return _plan_three_axis_ring(inputs, tolerance_mm, root)
     blank = stock.blank_radius_mm(spec)
     roughing = finishing = None
     if inputs.roughing_tool is not None:
@@ -85,7 +103,7 @@ def plan_three_axis(inputs: CamInputs, tolerance_mm: float) -> CamPlan:
     return CamPlan(rec, roughing, finishing, ())
 
 
-def _plan_three_axis_ring(inputs: CamInputs, tolerance_mm: float, root) -> CamPlan:
+def _plan_three_axis_ring(inputs: CamInputs, tolerance_mm: float, rec: ToolRecommendations, root) -> CamPlan:
     """The 3-axis plan of an internal gear (spur_cad.cam.three_axis_ring): the hole roughed from the centre out
     (from [stock] inner_diameter_mm's bore, or a helix into a solid blank), the toothed inner outline finished;
     no tool recommendations; simulated and graded as an external gear's 3-axis cut (spur_cad.sim.flat)."""
@@ -96,7 +114,6 @@ def _plan_three_axis_ring(inputs: CamInputs, tolerance_mm: float, root) -> CamPl
         ring_finishing_toolpath,
         ring_roughing_leaves,
         ring_roughing_toolpath,
-        ring_tool_recommendations,
     )
     from spur_cad.cam.three_axis_root import root_thickness
 
@@ -105,7 +122,6 @@ def _plan_three_axis_ring(inputs: CamInputs, tolerance_mm: float, root) -> CamPl
         raise MachineError("[three_axis] tabs and onion_skin_mm hold a through-cut external gear; a ring is clamped "
                            "on its rim and its hole is milled away whole: leave them out",
                            field="tabs" if inputs.three_axis.tabs else "onion_skin_mm", section="three_axis")
-    rec = ring_tool_recommendations(spec, machine.clearance_mm)
     roughing = finishing = None
     if inputs.roughing_tool is not None:
         tool = inputs.roughing_tool
@@ -131,3 +147,18 @@ def _plan_three_axis_ring(inputs: CamInputs, tolerance_mm: float, root) -> CamPl
                                  lying_flat=True)
         finishing = FinishingPlan(tool, result, path, estimate(path, machine), None, None)
     return CamPlan(rec, roughing, finishing, ())
+
+
+@dataclass(frozen=True)
+class FlatPlan:
+    """How a gear kind is planned lying flat: its tool limits (check_three_axis_inputs) and its plan (given them and
+    the finishing tool's root)."""
+
+    recommendations: Callable[[CamInputs], ToolRecommendations]
+    plan: Callable[[CamInputs, float, ToolRecommendations, Any], CamPlan]
+
+
+EXTERNAL = FlatPlan(_external_recommendations, _plan_three_axis_external)
+FLAT_PLANS: dict[GearKind, FlatPlan] = {EXTERNAL_SPUR: EXTERNAL, EXTERNAL_HELICAL: EXTERNAL,
+                                        INTERNAL_SPUR: FlatPlan(_ring_recommendations, _plan_three_axis_ring)}
+"""How each gear kind is planned lying flat (a helical gear is refused by check_three_axis first)."""

@@ -35,6 +35,11 @@ from spur_cad.cam.roughing import (
 )
 from spur_cad.cam.tools import Tool
 from spur_cad.errors import SpurCadError
+from spur_cad.geometry.kinds import EXTERNAL_SPUR, INTERNAL_SPUR
+
+SUGGESTED_FOR = frozenset({EXTERNAL_SPUR, INTERNAL_SPUR})
+"""Gear kinds another roughing (by flanks, by levels, two-stage) is planned for to be suggested: not helical gears,
+each of whose roughing plans takes seconds."""
 
 
 def suggested_levels_roughing(inputs: CamInputs, roughing: RoughingPlan, blank: float) -> LevelsSuggestion | None:
@@ -60,7 +65,7 @@ def suggested_flank_roughing(inputs: CamInputs, roughing: RoughingPlan, blank: f
     """Roughing by levels with one tool (a job file's default strategy): roughing by flanks with the same tool,
     cutting data and allowances, when it takes at most TWO_STAGE_PAYS_FRACTION of `roughing`'s time and leaves
     nothing uncut; else None. Not for helical gears (a flank plan of theirs takes seconds)."""
-    if inputs.roughing.strategy != "levels" or inputs.spec.kind.helical:
+    if inputs.roughing.strategy != "levels" or inputs.spec.kind not in SUGGESTED_FOR:
         return None
     flank_inputs = dataclasses.replace(inputs, roughing=dataclasses.replace(inputs.roughing, strategy="flank"))
     try:  # bounded as the job's own roughing would be
@@ -83,7 +88,7 @@ def suggested_top_tool(inputs: CamInputs, roughing: RoughingPlan, blank: float) 
     flutes 3 D long (or the job tool's length). Not for helical gears (a plan of theirs takes seconds) nor by
     levels (the workbench's suggested_two_stage)."""
     spec, tool = inputs.spec, inputs.roughing_tool_set
-    if inputs.roughing.strategy != "flank" or spec.kind.helical or roughing.flank is None:
+    if inputs.roughing.strategy != "flank" or spec.kind not in SUGGESTED_FOR or roughing.flank is None:
         return None
     widest_mm = 2.0 * space_half_width_mm(flank_polyline(spec), spec.reference_radius_mm)
     diameter = float(np.floor(widest_mm / TOP_TOOL_STEP_MM + 1e-9) * TOP_TOOL_STEP_MM)
@@ -248,8 +253,8 @@ def suggested_two_stage(inputs: CamInputs) -> TwoStageSuggestion | None:
     roughing; None when none saves at least 1 - TWO_STAGE_PAYS_FRACTION of the bottom tool's time alone (by the job's
     strategy; the two stages run by levels)."""
     spec, bottom = inputs.spec, inputs.roughing_tool
-    if bottom is None or spec.kind.helical:  # not suggested for helical gears (each of their roughing plans takes
-        return None                        # seconds); a job file may still name a [tools.bottom] for one
+    if bottom is None or spec.kind not in SUGGESTED_FOR:  # a job file may still name a [tools.bottom] for one
+        return None
     blank = inputs.stock.blank_radius_mm(spec)
     job_strategy = plan_roughing(inputs, roughing_levels(spec, bottom, inputs.roughing, blank), blank, bottom)
     inputs = by_levels(inputs)

@@ -30,6 +30,7 @@ from spur_cad.cad.specs import StockSpec
 from spur_cad.cam.common import safe_height_mm
 from spur_cad.cam.machine import RESERVED_M_CODES, Machine
 from spur_cad.errors import SpurCadError, shown
+from spur_cad.geometry.kinds import EXTERNAL_SPUR, INTERNAL_SPUR
 from spur_cad.geometry.sampling import even_arc_length_parameters
 from spur_cad.geometry.spec import GearSpec
 from spur_cad.keys import check_section, key
@@ -256,10 +257,15 @@ def _clear(outline: np.ndarray, centres: np.ndarray, ball_mm: float, stem_mm: fl
                 and not _stem_hits(outline, centres, stem_mm))
 
 
+PROBED_KINDS = frozenset({EXTERNAL_SPUR, INTERNAL_SPUR})
+"""Gear kinds [probe] plans for: straight teeth, whose flank normals lie in the transverse plane (a helical flank's
+leaves it)."""
+
+
 def plan_probe(spec: GearSpec, stock: StockSpec, machine: Machine, probe: ProbeSection) -> ProbePlan:
     """The probing plan of `spec` as cut from `stock`; ProbeError (naming the key) for a helical gear or a
     ball that does not reach a point without touching the design elsewhere."""
-    if spec.kind.helical:
+    if spec.kind not in PROBED_KINDS:
         raise ProbeError(f"[probe] probes spur gears only: [gear] helix_angle_deg = {spec.helix_angle_deg:g} (a "
                          "helical flank's normal leaves the transverse plane); leave [probe] out")
     ball, stem = probe.ball_radius_mm, probe.stem_diameter_mm / 2.0

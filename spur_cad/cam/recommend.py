@@ -7,6 +7,7 @@ them when the space axis points up the tool axis.
 from __future__ import annotations
 
 import dataclasses
+from collections.abc import Callable
 
 import numpy as np
 
@@ -21,7 +22,9 @@ from spur_cad.cam.allowances import (  # noqa: F401  (re-exported: the names cal
 )
 from spur_cad.cam.fillet_reach import applies, fillet_reach, refusal_text
 from spur_cad.cam.tools import Tool, ToolError
+from spur_cad.geometry.kinds import EXTERNAL_HELICAL, EXTERNAL_SPUR, INTERNAL_SPUR, GearKind
 from spur_cad.geometry.mate import GearPair
+from spur_cad.geometry.profile import rack_corner
 from spur_cad.geometry.sampling import sample_profile
 from spur_cad.geometry.spec import GearSpec
 
@@ -55,20 +58,34 @@ def generating_max_diameter_mm(spec: GearSpec, corner_radius_mm: float, target_s
     end): the smaller of the tip-mode limit (flat within the rack's tip flat) and the flank-mode limit (no flank
     pass reaches into the design); 0.0 when none fits. Helical gears: any corner 0 < r_t <= rho (a flat end mill
     only for a sharp rack), the diameter within the normal tip flat 2 d_n + 2 r_t."""
-    from spur_cad.cam.strategies.generating_geometry import generating_tool_limits
-    from spur_cad.geometry.profile import rack_corner
-
-    rho = spec.rack_tip_radius_mm
-    if corner_radius_mm > rho + 1e-12:
+    if corner_radius_mm > spec.rack_tip_radius_mm + 1e-12:
         return 0.0
-    if spec.kind.helical:
-        if corner_radius_mm == 0.0 and rho > 0.0:
-            return 0.0
-        return max(2.0 * rack_corner(spec).normal_corner_offset_mm + 2.0 * corner_radius_mm, 0.0)
+    return GENERATING_MAX_DIAMETER[spec.kind](spec, corner_radius_mm, target_scallop_mm, blank_radius_mm)
+
+
+def _helical_generating_max_diameter_mm(spec: GearSpec, corner_radius_mm: float, target_scallop_mm: float,
+                                        blank_radius_mm: float) -> float:
+    """A helical gear: any corner 0 < r_t <= rho (a flat end mill only for a sharp rack), within 2 d_n + 2 r_t."""
+    if corner_radius_mm == 0.0 and spec.rack_tip_radius_mm > 0.0:
+        return 0.0
+    return max(2.0 * rack_corner(spec).normal_corner_offset_mm + 2.0 * corner_radius_mm, 0.0)
+
+
+def _spur_generating_max_diameter_mm(spec: GearSpec, corner_radius_mm: float, target_scallop_mm: float,
+                                     blank_radius_mm: float) -> float:
+    """A spur gear: the smaller of the tip-mode and the (either tool end's) flank-mode limit."""
+    from spur_cad.cam.strategies.generating_geometry import generating_tool_limits
+
     limits = generating_tool_limits(spec, corner_radius_mm, target_scallop_mm, blank_radius_mm)
     flank = max(limits.flank_mode_max_diameter_mm, limits.flank_mode_max_diameter_raised_mm)
     largest = min(limits.tip_mode_max_diameter_mm, flank)
     return float(largest) if largest > 2.0 * corner_radius_mm else 0.0
+
+
+GENERATING_MAX_DIAMETER: dict[GearKind, Callable[[GearSpec, float, float, float], float]] = {
+    EXTERNAL_SPUR: _spur_generating_max_diameter_mm, EXTERNAL_HELICAL: _helical_generating_max_diameter_mm,
+    INTERNAL_SPUR: _spur_generating_max_diameter_mm}
+"""generating_max_diameter_mm for each gear kind (spec, corner radius, target scallop, blank radius)."""
 
 
 def recommend_tools(spec: GearSpec, blank_radius_mm: float, clearance_mm: float,
@@ -144,20 +161,31 @@ def _check_flat_finishing(spec: GearSpec, tool: Tool, rec: ToolRecommendations) 
     strategies' own checks say why a strategy cannot take it)."""
     largest = rec.finishing_flat_end_mill_max_diameter_mm
     if largest <= 0.0:
-        if spec.kind.helical:
-            why = (f"a helical gear is finished by generation with a corner radius 0 < r_t <= the rack tip radius "
-                   f"rho = {spec.rack_tip_radius_mm:g} mm")
-        else:
-            why = "by generation its flat finds no room in the rack's tip flat and the flank passes"
         raise ToolError(f"finishing tool is a flat end mill, but no flat end mill can finish this gear "
-                        f"(finishing_flat_end_mill_max_diameter_mm = 0: {why}); the finishing tool must have a corner "
-                        "radius (bull_nose or ball)", field="kind", section="tools.finishing")
+                        f"(finishing_flat_end_mill_max_diameter_mm = 0: {NO_FLAT_END_MILL[spec.kind](spec)}); the "
+                        "finishing tool must have a corner radius (bull_nose or ball)", field="kind",
+                        section="tools.finishing")
     if tool.diameter_mm > largest + 1e-9:
         raise ToolError(f"finishing tool is a flat end mill of diameter {tool.diameter_mm:g} mm, above "
                         f"finishing_flat_end_mill_max_diameter_mm = {largest:.4f} mm (the largest flat end mill that "
                         "finishes this gear, by [finishing] strategy = \"generating\": its flat within the rack's tip "
                         "flat and its flank passes clear of the gear); a wider finishing tool must have a corner "
                         "radius (bull_nose or ball)", field="diameter_mm", section="tools.finishing")
+
+
+def _helical_no_flat_end_mill(spec: GearSpec) -> str:
+    return (f"a helical gear is finished by generation with a corner radius 0 < r_t <= the rack tip radius "
+            f"rho = {spec.rack_tip_radius_mm:g} mm")
+
+
+def _spur_no_flat_end_mill(spec: GearSpec) -> str:
+    return "by generation its flat finds no room in the rack's tip flat and the flank passes"
+
+
+NO_FLAT_END_MILL: dict[GearKind, Callable[[GearSpec], str]] = {
+    EXTERNAL_SPUR: _spur_no_flat_end_mill, EXTERNAL_HELICAL: _helical_no_flat_end_mill,
+    INTERNAL_SPUR: _spur_no_flat_end_mill}
+"""Why no flat end mill finishes a gear of each kind (_check_flat_finishing's message)."""
 
 
 def small_tool_warnings(rec: ToolRecommendations, smallest_end_mill_mm: float, strategy: str,

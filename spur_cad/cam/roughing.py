@@ -29,6 +29,7 @@ from spur_cad.cam.ir import Feature, MoveKind, Operation, Toolpath, ToolpathBuil
 from spur_cad.cam.machine import Machine, MachineError, RoughingParams
 from spur_cad.cam.recommend import space_half_width_mm
 from spur_cad.cam.tools import Tool, ToolError
+from spur_cad.geometry.kinds import EXTERNAL_HELICAL
 from spur_cad.geometry.spec import GearSpec
 
 
@@ -205,6 +206,11 @@ def roughing_levels(spec: GearSpec, tool: Tool, params: RoughingParams, blank_ra
     return RoughingLevels(levels, half_widths, junction)
 
 
+TURNS_A_ALONG_X = frozenset({EXTERNAL_HELICAL})
+"""Gear kinds whose roughing passes along X turn A with X (along the lead: follow_lead), so the table must turn
+while cutting and cannot be clamped; the passes of every other kind keep A."""
+
+
 def _check_clamp(spec: GearSpec, machine: Machine, params: RoughingParams) -> None:
     """Clamping the table for each space needs the machine's codes and a table that stays still (spur gears)."""
     if not params.clamp_rotary:
@@ -212,14 +218,14 @@ def _check_clamp(spec: GearSpec, machine: Machine, params: RoughingParams) -> No
     if not (machine.rotary_clamp_code and machine.rotary_unclamp_code):
         raise MachineError("[roughing] clamp_rotary needs [machine] rotary_clamp_code and rotary_unclamp_code",
                            field="clamp_rotary", section="roughing")
-    if spec.kind.helical:
+    if spec.kind in TURNS_A_ALONG_X:
         raise MachineError("[roughing] clamp_rotary cannot be used for a helical gear: its passes turn A along the "
                            "lead", field="clamp_rotary", section="roughing")
 
 
 def check_helical_roughing_machine(spec: GearSpec, machine: Machine) -> None:
     """Helical roughing turns A with X while cutting: a table that only indexes cannot run it."""
-    if spec.kind.helical and not machine.rotary_simultaneous:
+    if spec.kind in TURNS_A_ALONG_X and not machine.rotary_simultaneous:
         raise MachineError(f"roughing a helical gear (helix_angle_deg = {spec.helix_angle_deg:g}) turns A with X "
                            "along the lead while cutting, but [machine] rotary_simultaneous = false (the table only "
                            "indexes)", field="rotary_simultaneous", section="machine")
@@ -275,7 +281,7 @@ def roughing_toolpath(spec: GearSpec, tool: Tool, machine: Machine, params: Roug
             passes.levels(a_tip, k, tip_heights, [tip_offsets] * len(tip_heights), [-1] * len(tip_heights),
                           Feature.TIP)
     path = builder.build()
-    if spec.kind.helical:
+    if spec.kind in TURNS_A_ALONG_X:
         path = follow_lead(path, spec, machine)
     return path
 
@@ -558,6 +564,6 @@ def _flank_toolpath(spec: GearSpec, tool: Tool, machine: Machine, params: Roughi
             f"flank roughing leaves {plan.uncut_mm2:.3g} mm^2 of each tooth space's section farther than "
             "flank_allowance_mm from the design (its stock model); finishing would meet it: choose [roughing] "
             "strategy = \"levels\"",))
-    if spec.kind.helical:
+    if spec.kind in TURNS_A_ALONG_X:
         path = follow_lead(path, spec, machine)
     return path

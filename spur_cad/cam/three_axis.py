@@ -30,10 +30,8 @@ from spur_cad.cam.setups import LYING_FLAT
 from spur_cad.cam.three_axis_root import (
     FlatMillRoot,
     RootThickness,
-    check_ring_root,
-    flat_mill_root,
+    check_flat_mill_root,
     largest_flat_mill_radius_mm,
-    unreachable_message,
 )
 from spur_cad.cam.three_axis_tabs import (
     TabBand,
@@ -84,13 +82,7 @@ def check_three_axis(spec: GearSpec, finishing_tool: Tool | None, roughing_tool:
                             f"{tool.kind}", field="kind", section=f"tools.{role}")
     if finishing_tool is None:
         return None
-    if spec.kind.teeth_inward:  # a ring: its spaces open outward (spur_cad.cam.three_axis_ring)
-        return check_ring_root(spec, finishing_tool)
-    root = flat_mill_root(spec, finishing_tool.diameter_mm / 2.0)
-    if not root.fits:
-        raise ToolError(unreachable_message(spec, finishing_tool, root), field="diameter_mm",
-                        section="tools.finishing")
-    return root
+    return check_flat_mill_root(spec, finishing_tool)  # a ring's spaces open outward: three_axis_root.SPACES
 
 
 def flat_tool_recommendations(spec: GearSpec, clearance_mm: float, roughing_max_diameter_mm: float):

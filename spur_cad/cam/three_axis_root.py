@@ -11,14 +11,16 @@ from __future__ import annotations
 
 import dataclasses
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from spur_cad.cam.tools import Tool, ToolError
 from spur_cad.errors import SpurCadError
 from spur_cad.geometry.internal import as_ring, mating_pinion_mesh
+from spur_cad.geometry.kinds import EXTERNAL_HELICAL, EXTERNAL_SPUR, INTERNAL_SPUR, GearKind
 from spur_cad.geometry.mate import GearPair, PairMember, pair_facts
 from spur_cad.geometry.spec import GearSpec
 
@@ -59,13 +61,16 @@ def active_profile_start_radius_mm(spec: GearSpec) -> float:
     A ring's without a mate: ring_active_profile_start(spec)'s radius."""
     if spec.active_profile_start_diameter_mm > 0.0:
         return spec.active_profile_start_diameter_mm / 2.0
-    if spec.kind.teeth_inward:
-        return ring_active_profile_start(spec)[0]
+    return SPACES[spec.kind].active_start(spec)[0]
+
+
+def rack_active_profile_start(spec: GearSpec) -> tuple[float, str]:
+    """Where an external gear's active profile starts in mesh with the basic rack, and what sets it."""
     alpha = spec.pressure_angle_rad
     r, rb = spec.reference_radius_mm, spec.base_radius_mm
     depth = (spec.addendum_coefficient - spec.profile_shift_coefficient) * spec.module_mm
     along = r * math.sin(alpha) - depth / math.sin(alpha)  # from the base circle's tangent point
-    return math.sqrt(rb * rb + max(along, 0.0) ** 2)
+    return math.sqrt(rb * rb + max(along, 0.0) ** 2), "the basic rack"
 
 
 def _dense(segment, spacing_mm: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -124,9 +129,10 @@ def flat_mill_root(spec: GearSpec, tool_radius_mm: float, samples: _SpaceSamples
                                                  distance_upper_bound=limit)[0] >= limit))
     fillet_radius = profile.min_fillet_curvature_radius_mm if follows and samples.fillet is not None \
         else tool_radius_mm
-    form = min(form, profile.form_radius_mm) if spec.kind.teeth_inward else max(form, profile.form_radius_mm)
+    spaces = SPACES[spec.kind]
+    form = min(form, profile.form_radius_mm) if spaces.internal else max(form, profile.form_radius_mm)
     return FlatMillRoot(tool_radius_mm, form, profile.form_radius_mm, active_profile_start_radius_mm(spec),
-                        float(fillet_radius), not follows, spec.kind.teeth_inward)
+                        float(fillet_radius), not follows, spaces.internal)
 
 
 def largest_flat_mill_radius_mm(spec: GearSpec, resolution_mm: float = 0.005) -> float:
@@ -197,17 +203,7 @@ def root_thickness(spec: GearSpec, tool_radius_mm: float) -> RootThickness:
     from spur_cad.geometry.sampling import gear_outline
 
     outline = Polygon(gear_outline(spec, ROOT_THICKNESS_TOLERANCE_MM))
-    if spec.kind.teeth_inward:  # a ring: the rim disc less the hole; the tool's disk opens the hole instead
-        from shapely.geometry import Point
-
-        rim = Point(0.0, 0.0).buffer(as_ring(spec).rim_outer_diameter_mm / 2.0, quad_segs=ROOT_THICKNESS_QUAD_SEGMENTS)
-        gear = rim.difference(outline)
-        cut = rim.difference(outline.buffer(-tool_radius_mm, quad_segs=ROOT_THICKNESS_QUAD_SEGMENTS).buffer(
-            tool_radius_mm, quad_segs=ROOT_THICKNESS_QUAD_SEGMENTS))
-    else:
-        gear = outline
-        cut = gear.buffer(tool_radius_mm, quad_segs=ROOT_THICKNESS_QUAD_SEGMENTS).buffer(
-            -tool_radius_mm, quad_segs=ROOT_THICKNESS_QUAD_SEGMENTS)
+    gear, cut = SPACES[spec.kind].gear_and_cut(spec, outline, tool_radius_mm)
     form = spec.tooth_space_profile().form_radius_mm
     fillet = 0.5 * (spec.root_radius_mm + form)
     middle = math.pi / 2.0 + math.pi / spec.teeth  # tooth 0's centre: between spaces 0 (on +Y) and 1
@@ -229,9 +225,7 @@ def active_profile_start_source(spec: GearSpec) -> str:
     """What sets the start of the active profile, as a message names it."""
     if spec.active_profile_start_diameter_mm > 0.0:
         return "set by the mate's tips"
-    if spec.kind.teeth_inward:
-        return f"set by {ring_active_profile_start(spec)[1]}: no [mate]"
-    return "set by the basic rack: no [mate]"
+    return f"set by {SPACES[spec.kind].active_start(spec)[1]}: no [mate]"
 
 
 def _fits_text(spec: GearSpec) -> str:
@@ -244,7 +238,7 @@ def _remedies(spec: GearSpec) -> str:
     it would allow (found as for the job itself): the real mate (one like the gear at the standard centre distance
     as the example), half the rack tip radius, 0.2 more profile shift, a protuberance rack."""
     options = []
-    if spec.active_profile_start_diameter_mm == 0.0 and not spec.kind.teeth_inward:
+    if spec.active_profile_start_diameter_mm == 0.0 and SPACES[spec.kind].mate_remedy:
         pair = GearPair(PairMember(spec.teeth, profile_shift_coefficient=spec.profile_shift_coefficient),
                         PairMember(spec.teeth), spec.module_mm, spec.pressure_angle_deg, spec.helix_angle_deg)
         sap = pair_facts(pair).start_of_active_profile_diameter_mm
@@ -264,21 +258,60 @@ def _remedies(spec: GearSpec) -> str:
 def unreachable_message(spec: GearSpec, tool: Tool, root: FlatMillRoot) -> str:
     """One line: where the tool's side leaves the involute, the active profile's start and what sets it, then the
     largest tool that works, or when none does what the designer can change and with what effect."""
-    ring = spec.kind.teeth_inward
-    head = (f"a D {tool.diameter_mm:g} mm flat end mill's side leaves the {'ring' + chr(39) + 's ' if ring else ''}"
-            f"involute at diameter {2 * root.form_radius_mm:.3f} mm, {'inside' if ring else 'above'} the active "
-            f"profile's start at {2 * root.active_start_radius_mm:.3f} mm ({active_profile_start_source(spec)})")
+    spaces = SPACES[spec.kind]
+    head = (f"a D {tool.diameter_mm:g} mm flat end mill's side leaves the {spaces.involute} at diameter "
+            f"{2 * root.form_radius_mm:.3f} mm, {spaces.beyond} the active profile's start at "
+            f"{2 * root.active_start_radius_mm:.3f} mm ({active_profile_start_source(spec)})")
     largest = largest_flat_mill_radius_mm(spec)
     if largest > 0.0:
         return f"{head}; the largest tool radius that works is {largest:.3f} mm (D {2 * largest:.2f} mm)"
     return f"{head}; no flat end mill fits; change: {_remedies(spec)}"
 
 
-def check_ring_root(spec: GearSpec, finishing_tool: Tool) -> FlatMillRoot:
-    """The root the finishing tool leaves in the ring's spaces; ToolError (one line, unreachable_message) when its
-    fillet reaches the active profile."""
+def check_flat_mill_root(spec: GearSpec, finishing_tool: Tool) -> FlatMillRoot:
+    """The root the finishing tool leaves in the spaces (an external gear's or a ring's); ToolError (one line,
+    unreachable_message) when its fillet reaches the active profile."""
     root = flat_mill_root(spec, finishing_tool.diameter_mm / 2.0)
     if not root.fits:
         raise ToolError(unreachable_message(spec, finishing_tool, root), field="diameter_mm",
                         section="tools.finishing")
     return root
+
+
+def _external_gear_and_cut(spec: GearSpec, outline, tool_radius_mm: float) -> tuple:
+    """An external gear: its section, and the section closed by the tool's disk."""
+    return outline, outline.buffer(tool_radius_mm, quad_segs=ROOT_THICKNESS_QUAD_SEGMENTS).buffer(
+        -tool_radius_mm, quad_segs=ROOT_THICKNESS_QUAD_SEGMENTS)
+
+
+def _ring_gear_and_cut(spec: GearSpec, outline, tool_radius_mm: float) -> tuple:
+    """A ring: the rim disc less the hole; the tool's disk opens the hole instead."""
+    from shapely.geometry import Point
+
+    rim = Point(0.0, 0.0).buffer(as_ring(spec).rim_outer_diameter_mm / 2.0, quad_segs=ROOT_THICKNESS_QUAD_SEGMENTS)
+    return rim.difference(outline), rim.difference(outline.buffer(
+        -tool_radius_mm, quad_segs=ROOT_THICKNESS_QUAD_SEGMENTS).buffer(tool_radius_mm,
+                                                                        quad_segs=ROOT_THICKNESS_QUAD_SEGMENTS))
+
+
+@dataclass(frozen=True)
+class Spaces:
+    """Which way one gear kind's tooth spaces open, as a flat end mill's root is read there:
+    - `internal`: toward the axis (a ring: its root and form radius lie outward of the active profile);
+    - `active_start`: where the active profile starts without a [mate], and what sets it;
+    - `gear_and_cut`: the gear's section (shapely) and what the tool's disk leaves of it (root_thickness);
+    - `mate_remedy`: a mate like the gear is a remedy the message offers (external gears);
+    - `involute` / `beyond`: the message's words for the flank and for the side of the active profile's start."""
+
+    internal: bool
+    active_start: Callable[[GearSpec], tuple[float, str]]
+    gear_and_cut: Callable[[GearSpec, Any, float], tuple]
+    mate_remedy: bool
+    involute: str
+    beyond: str
+
+
+OUTWARD = Spaces(False, rack_active_profile_start, _external_gear_and_cut, True, "involute", "above")
+RING = Spaces(True, ring_active_profile_start, _ring_gear_and_cut, False, "ring's involute", "inside")
+SPACES: dict[GearKind, Spaces] = {EXTERNAL_SPUR: OUTWARD, EXTERNAL_HELICAL: OUTWARD, INTERNAL_SPUR: RING}
+"""How each gear kind's spaces open."""

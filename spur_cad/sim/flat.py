@@ -29,6 +29,7 @@ from typing import Sequence
 import numpy as np
 
 from spur_cad.cam.ir import Toolpath, arc_sweeps_rad
+from spur_cad.geometry.kinds import INTERNAL_SPUR
 from spur_cad.geometry.spec import GearSpec
 from spur_cad.sim.design import DesignGrid, design_grid
 from spur_cad.sim.simulate import (
@@ -194,6 +195,11 @@ def bore_entry_mm(grid: DesignGrid, bore_radius_mm: float) -> np.ndarray:
     return np.where((discriminant > 0.0) & (entry > 0.0), entry, np.inf)
 
 
+BORED_DISC_BLANKS = frozenset({INTERNAL_SPUR})
+"""Gear kinds whose flat blank is a disc with a bore and whose outline is the hole cut in it (a ring: the removed
+area is the hole less the bore); every other kind's outline is cut from a solid disc (the disc less the section)."""
+
+
 def simulate_flat(spec: GearSpec, blank_radius_mm: float, operations: Sequence[Cut],
                   settings: SimSettings | None = None, station_depths_mm: np.ndarray | None = None,
                   bore_radius_mm: float = 0.0) -> SimResult:
@@ -210,7 +216,7 @@ def simulate_flat(spec: GearSpec, blank_radius_mm: float, operations: Sequence[C
     extra = np.concatenate([stations, 0.5 * (stations[1:] + stations[:-1])]) if len(stations) else np.zeros(0)
     check_design_size(spec, spacing, b, len(extra), settings.resolution_mm)
     grid = design_grid(spec, spacing, 0.0, b, extra)
-    ring_bore_mm = bore_radius_mm if spec.kind.teeth_inward else None
+    ring_bore_mm = bore_radius_mm if spec.kind in BORED_DISC_BLANKS else None
     return simulate_flat_grid(grid, blank_radius_mm, operations, settings, b, stations, ring_bore_mm)
 
 

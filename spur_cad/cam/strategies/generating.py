@@ -8,6 +8,7 @@ generating_advice.
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass, replace
 from typing import TYPE_CHECKING
 
@@ -42,6 +43,7 @@ from spur_cad.cam.strategies.generating_plan import (
     planned_passes_per_space,
 )
 from spur_cad.cam.tools import Tool, ToolError
+from spur_cad.geometry.kinds import EXTERNAL_HELICAL, EXTERNAL_SPUR, INTERNAL_SPUR, GearKind
 from spur_cad.geometry.modifications import FlankModifications
 from spur_cad.geometry.profile import rack_corner
 from spur_cad.geometry.spec import GearSpec
@@ -93,6 +95,26 @@ def _space_poses(plan: GeneratingPlan) -> SpacePoses:
     return SpacePoses(right, root, right.mirrored(), empty)
 
 
+def _spur_suggested_flat(spec: GearSpec, corner_mm: float, target_scallop_mm: float, blank_radius_mm: float) -> float:
+    """95 % of the largest tool with this corner that fits both modes with the rack end, in 0.05 mm steps, less
+    the corner: its flat width."""
+    limits = generating_tool_limits(spec, corner_mm, target_scallop_mm, blank_radius_mm)
+    largest = min(limits.tip_mode_max_diameter_mm, limits.flank_mode_max_diameter_mm)
+    return floor_to_step(0.95 * largest, 0.05) - 2.0 * corner_mm
+
+
+def _helical_suggested_flat(spec: GearSpec, corner_mm: float, target_scallop_mm: float,
+                            blank_radius_mm: float) -> float:
+    """95 % of the rack's normal tip flat, in 0.05 mm steps."""
+    return floor_to_step(0.95 * 2.0 * rack_corner(spec).normal_corner_offset_mm, 0.05)
+
+
+SUGGESTED_FLAT: dict[GearKind, Callable[[GearSpec, float, float, float], float]] = {
+    EXTERNAL_SPUR: _spur_suggested_flat, EXTERNAL_HELICAL: _helical_suggested_flat,
+    INTERNAL_SPUR: _spur_suggested_flat}
+"""The suggested tool's flat width (mm) for each gear kind (spec, corner radius, target scallop, blank radius)."""
+
+
 class GeneratingStrategy:
     """See the module docstring."""
 
@@ -123,12 +145,7 @@ class GeneratingStrategy:
         corner = spec.rack_tip_radius_mm
         if corner <= 0.0:  # a sharp rack: no tool with a corner can play it
             return None
-        if spec.kind.helical:
-            flat = floor_to_step(0.95 * 2.0 * rack_corner(spec).normal_corner_offset_mm, 0.05)
-        else:
-            limits = generating_tool_limits(spec, corner, target_scallop_mm, blank_radius_mm)
-            largest = min(limits.tip_mode_max_diameter_mm, limits.flank_mode_max_diameter_mm)
-            flat = floor_to_step(0.95 * largest, 0.05) - 2.0 * corner
+        flat = SUGGESTED_FLAT[spec.kind](spec, corner, target_scallop_mm, blank_radius_mm)
         return (corner, flat) if flat >= 0.0 else None
 
     def check_tool(self, spec: GearSpec, tool: Tool) -> None:

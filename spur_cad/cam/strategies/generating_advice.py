@@ -3,6 +3,7 @@ passes need (summary.json `tools.generating_advice`, docs/cam.md)."""
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -10,6 +11,7 @@ import numpy as np
 from spur_cad.cam.strategies.generating_geometry import GeneratingPass, GeneratingToolLimits, generating_tool_limits
 from spur_cad.cam.strategies.generating_plan import GeneratingParams, GeneratingPlan
 from spur_cad.cam.tools import Tool
+from spur_cad.geometry.kinds import EXTERNAL_HELICAL, EXTERNAL_SPUR, INTERNAL_SPUR, GearKind
 from spur_cad.geometry.profile import rack_corner
 from spur_cad.geometry.spec import GearSpec
 
@@ -46,11 +48,21 @@ def tool_advice(spec: GearSpec, tool: Tool, params: GeneratingParams, plan: Gene
                 blank_radius_mm: float) -> GeneratingAdvice:
     """Limits for this tool's corner radius, the largest tool with the advised corner radius (rho), and the
     flute length this tool's passes need."""
-    if spec.kind.helical:  # any corner up to rho (rho advised: fewest passes); the tip mode bounds the diameter
-        rho, d_n = spec.rack_tip_radius_mm, rack_corner(spec).normal_corner_offset_mm
-        widest_mm = 2.0 * d_n + 2.0 * tool.effective_corner_radius_mm
-        return GeneratingAdvice(rho, rho, None, None, widest_mm, widest_mm, None, None,
-                                passes_flute_length_mm(plan.passes, tool, blank_radius_mm, spec.face_width_mm))
+    return ADVICE[spec.kind](spec, tool, params, plan, blank_radius_mm)
+
+
+def _helical_advice(spec: GearSpec, tool: Tool, params: GeneratingParams, plan: GeneratingPlan,
+                    blank_radius_mm: float) -> GeneratingAdvice:
+    """A helical gear: any corner up to rho (rho advised: fewest passes); the tip mode bounds the diameter."""
+    rho, d_n = spec.rack_tip_radius_mm, rack_corner(spec).normal_corner_offset_mm
+    widest_mm = 2.0 * d_n + 2.0 * tool.effective_corner_radius_mm
+    return GeneratingAdvice(rho, rho, None, None, widest_mm, widest_mm, None, None,
+                            passes_flute_length_mm(plan.passes, tool, blank_radius_mm, spec.face_width_mm))
+
+
+def _spur_advice(spec: GearSpec, tool: Tool, params: GeneratingParams, plan: GeneratingPlan,
+                 blank_radius_mm: float) -> GeneratingAdvice:
+    """A spur gear: the limits of both modes for this tool's corner and for the advised one."""
     end = params.flank_tool_end
     own = generating_tool_limits(spec, tool.effective_corner_radius_mm, params.target_scallop_mm, blank_radius_mm,
                                  end)
@@ -65,3 +77,8 @@ def tool_advice(spec: GearSpec, tool: Tool, params: GeneratingParams, plan: Gene
                             own.tip_mode_max_diameter_mm, largest(own), largest(advised),
                             advised.required_flute_length_mm,
                             passes_flute_length_mm(plan.passes, tool, blank_radius_mm))
+
+
+ADVICE: dict[GearKind, Callable[[GearSpec, Tool, GeneratingParams, GeneratingPlan, float], GeneratingAdvice]] = {
+    EXTERNAL_SPUR: _spur_advice, EXTERNAL_HELICAL: _helical_advice, INTERNAL_SPUR: _spur_advice}
+"""tool_advice for each gear kind."""

@@ -92,6 +92,7 @@ bottom cuts; its passes follow the side of the nearer fillet (roll >= 0: +Y side
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -102,6 +103,7 @@ from spur_cad.cam.strategies.generating_flat import flat_leftover_mm
 from spur_cad.cam.strategies.generating_helical import check_helical_generating_tool
 from spur_cad.cam.tools import Tool, ToolError
 from spur_cad.geometry.frames import turn_points
+from spur_cad.geometry.kinds import EXTERNAL_HELICAL, EXTERNAL_SPUR, INTERNAL_SPUR, GearKind
 from spur_cad.geometry.profile import rack_corner
 from spur_cad.geometry.roots import brentq
 from spur_cad.geometry.sampling import full_space_points, sample_profile
@@ -346,10 +348,13 @@ def tip_rolls(spec: GearSpec, tool: Tool, goal: float) -> tuple[np.ndarray, np.n
 def check_generating_tool(spec: GearSpec, tool: Tool) -> None:
     """ToolError when the tool cannot play the rack: corner radius above the rack tip radius (or the
     fillet's smallest curvature radius), or a flat wider than the rack's tip flat 2 d_1. A flat end mill
-    (r_t = 0 <= rho) plays it with its sharp corner; its flat is its whole diameter, so D <= 2 d_1."""
-    if spec.kind.helical:
-        check_helical_generating_tool(spec, tool)
-        return
+    (r_t = 0 <= rho) plays it with its sharp corner; its flat is its whole diameter, so D <= 2 d_1. A helical
+    gear's tool: check_helical_generating_tool."""
+    TOOL_CHECKS[spec.kind](spec, tool)
+
+
+def _check_spur_generating_tool(spec: GearSpec, tool: Tool) -> None:
+    """check_generating_tool of a spur gear (its transverse rack)."""
     rho = spec.rack_tip_radius_mm
     r_t = tool.effective_corner_radius_mm
     profile = spec.tooth_space_profile()
@@ -370,6 +375,12 @@ def check_generating_tool(spec: GearSpec, tool: Tool) -> None:
         raise ToolError(f"finishing strategy generating: tool flat width d = {tool.flat_width_mm:g} mm (D - 2 r_t) is "
                         f"wider than the rack's tip flat 2 d_1 = {2 * d1:.4f} mm; largest diameter for tip mode with "
                         f"{largest}", field="diameter_mm", section="tools.finishing")
+
+
+TOOL_CHECKS: dict[GearKind, Callable[[GearSpec, Tool], None]] = {
+    EXTERNAL_SPUR: _check_spur_generating_tool, EXTERNAL_HELICAL: check_helical_generating_tool,
+    INTERNAL_SPUR: _check_spur_generating_tool}
+"""check_generating_tool's check for each gear kind."""
 
 
 def design_points(spec: GearSpec) -> np.ndarray:

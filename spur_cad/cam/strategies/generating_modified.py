@@ -32,7 +32,9 @@ the design moved by the removal spur_cad.geometry.modifications gives, each pass
 from __future__ import annotations
 
 import math
-from dataclasses import replace
+from collections.abc import Callable
+from dataclasses import dataclass, replace
+from typing import Any
 
 import numpy as np
 
@@ -41,6 +43,7 @@ from spur_cad.cam.strategies.generating_geometry import RAISED_END_MARGIN_MM, Ge
 from spur_cad.cam.strategies.generating_helical import CORNER_MATCH_MM
 from spur_cad.cam.tools import Tool, ToolError
 from spur_cad.geometry.frames import part_to_machine
+from spur_cad.geometry.kinds import EXTERNAL_HELICAL, EXTERNAL_SPUR, INTERNAL_SPUR, GearKind
 from spur_cad.geometry.modifications import FlankModifications
 from spur_cad.geometry.profile import rack_corner
 from spur_cad.geometry.spec import GearSpec
@@ -262,9 +265,65 @@ def helical_fillet_parameters(spec: GearSpec, tool: Tool, p: GeneratingPass, x: 
     return np.full(len(x), min(max(b, 0.0), fillet.end))
 
 
+@dataclass(frozen=True)
+class _Ends:
+    """The passes to move and where their tool ends go: {(side, roll): how far below its planned end a spur flank
+    pass's tool end goes (lowered) / the raised end it never goes below (raised)}; {(side, roll): the tool end Z at
+    each face position} of helical flank passes (per_section)."""
+
+    passes: tuple[GeneratingPass, ...]
+    lowered: dict
+    raised: dict
+    per_section: dict
+
+
+def _spur_ends(spec: GearSpec, tool: Tool, passes: tuple[GeneratingPass, ...], mods: FlankModifications,
+               supports: dict, x: np.ndarray) -> _Ends:
+    """Spur flank passes turned to touch the modified flank at their planned contacts, their ends raised."""
+    passes, lowered = _touching_modified_contacts(spec, tool, passes, mods, supports)
+    return _Ends(passes, lowered, _raised_ends(spec, tool, passes), {})
+
+
+def _helical_ends(spec: GearSpec, tool: Tool, passes: tuple[GeneratingPass, ...], mods: FlankModifications,
+                  supports: dict, x: np.ndarray) -> _Ends:
+    """Helical flank passes keep their rolls; their ends are raised per section X."""
+    return _Ends(passes, {}, {}, _helical_raised_ends(spec, tool, passes, x))
+
+
+def _swept_dy(tool: Tool, p: GeneratingPass, dy: np.ndarray, x: np.ndarray, side: int) -> np.ndarray:
+    """A helical pass's sideways offsets less the swept tool's growth with the path's slope."""
+    return dy - side * _envelope_growth_mm(tool, p.dy_per_x, p.dy_per_x + np.gradient(dy, x))
+
+
+@dataclass(frozen=True)
+class _Following:
+    """How one gear kind's planned passes follow the modified flanks (see the module docstring):
+    - `ends`: the passes to move and their tool ends;
+    - `moves_tip_pass`: whether a tip-mode pass follows the modified fillet (spur: its fillet passes, which carry a
+      fillet parameter; helical: every one but the root's);
+    - `fillet_parameter`: the fillet parameter a tip-mode pass touches (spur: its own; helical: per section X);
+    - `swept_dy`: the sideways offsets as cut (a helical pass's less the swept tool's growth);
+    - `into_tooth`: the sign of Y into the material that bounds the dY chords (0: both ways within the tolerance)."""
+
+    ends: Callable[[GearSpec, Tool, tuple[GeneratingPass, ...], FlankModifications, dict, np.ndarray], _Ends]
+    moves_tip_pass: Callable[[GeneratingPass], bool]
+    fillet_parameter: Callable[[GearSpec, Tool, GeneratingPass, np.ndarray, Any], Any]
+    swept_dy: Callable[[Tool, GeneratingPass, np.ndarray, np.ndarray, int], np.ndarray]
+    into_tooth: Callable[[int], int]
+
+
+_SPUR = _Following(_spur_ends, lambda p: not math.isnan(p.beta_rad), lambda spec, tool, p, x, fillet: p.beta_rad,
+                   lambda tool, p, dy, x, side: dy, lambda side: 0)
+_HELICAL = _Following(_helical_ends, lambda p: p.feature != Feature.ROOT, helical_fillet_parameters, _swept_dy,
+                      lambda side: side)
+FOLLOWING: dict[GearKind, _Following] = {EXTERNAL_SPUR: _SPUR, EXTERNAL_HELICAL: _HELICAL, INTERNAL_SPUR: _SPUR}
+"""How each gear kind's passes follow modified flanks (a ring's flanks are not modified: as a spur gear's)."""
+
+
 def modified_passes(spec: GearSpec, tool: Tool, passes: tuple[GeneratingPass, ...], mods: FlankModifications,
                     tolerance_mm: float) -> tuple[GeneratingPass, ...]:
     """`passes` (one space's, planned for the design) moved onto the modified flanks (see the module docstring)."""
+    following = FOLLOWING[spec.kind]
     profile = spec.tooth_space_profile()
     fillet = profile.fillet
     involute = profile.involute
@@ -273,39 +332,30 @@ def modified_passes(spec: GearSpec, tool: Tool, passes: tuple[GeneratingPass, ..
     sides = {+1: mods.right, -1: mods.left}
     form_normal = involute.normals(np.array(involute.start))
     form_removal = {s: float(sides[s].profile_offset_mm(spec.base_radius_mm * involute.start)) for s in sides}
-    lowered: dict = {}
-    if not spec.kind.helical:
-        passes, lowered = _touching_modified_contacts(spec, tool, passes, mods, supports)
-    raised = {} if spec.kind.helical else _raised_ends(spec, tool, passes)
-    helical_ends = _helical_raised_ends(spec, tool, passes, x) if spec.kind.helical else {}
+    ends = following.ends(spec, tool, passes, mods, supports, x)
     out = []
-    for p in passes:
+    for p in ends.passes:
         side = p.side
         lead = sides[side].lead_offset_mm(x)
         if p.mode == "flank":
             rolls = p.roll_rad - side * p.dy_per_x * x / spec.base_radius_mm
             removal = supports[side].removal_mm(rolls) + lead
-            if spec.kind.helical:
-                removal = removal - _envelope_growth_mm(tool, p.dy_per_x, p.dy_per_x + side * np.gradient(removal, x))
-            dy, dz = side * removal, np.zeros_like(x)
-            if (side, p.roll_rad) in helical_ends:
-                dz = helical_ends[side, p.roll_rad] - (p.z_mm + x * p.dz_per_x)
-        elif p.mode == "tip" and fillet is not None and fillet.end > 0.0 \
-                and (p.feature != Feature.ROOT if spec.kind.helical else not math.isnan(p.beta_rad)):
-            beta = helical_fillet_parameters(spec, tool, p, x, fillet) if spec.kind.helical else p.beta_rad
+            dy, dz = following.swept_dy(tool, p, side * removal, x, side), np.zeros_like(x)
+            if (side, p.roll_rad) in ends.per_section:
+                dz = ends.per_section[side, p.roll_rad] - (p.z_mm + x * p.dz_per_x)
+        elif p.mode == "tip" and fillet is not None and fillet.end > 0.0 and following.moves_tip_pass(p):
+            beta = following.fillet_parameter(spec, tool, p, x, fillet)
             removal = (form_removal[side] + lead) * (beta / fillet.end) ** 2
             normal = form_normal * np.array([1.0 if side > 0 else -1.0, 1.0])
             # section X lies turned by its turn (0 for a spur gear): the form normal turns with it
             turns = math.radians(p.a_deg) + np.array([spec.section_turn_rad(xi) for xi in x])
             moved = -removal[:, None] * np.stack([normal[0] * np.cos(turns) - normal[1] * np.sin(turns),
                                                   normal[0] * np.sin(turns) + normal[1] * np.cos(turns)], axis=-1)
-            dy, dz = moved[:, 0], moved[:, 1]
-            if spec.kind.helical:
-                dy = dy - side * _envelope_growth_mm(tool, p.dy_per_x, p.dy_per_x + np.gradient(dy, x))
+            dy, dz = following.swept_dy(tool, p, moved[:, 0], x, side), moved[:, 1]
         else:
             out.append(p)
             continue
-        z = (max(p.z_mm, raised.get((p.side, p.roll_rad), p.z_mm)) - lowered.get((p.side, p.roll_rad), 0.0)
-             if p.mode == "flank" else p.z_mm)
-        out.append(replace(p, z_mm=z, path=_path(x, dy, dz, tolerance_mm, side if spec.kind.helical else 0)))
+        z = (max(p.z_mm, ends.raised.get((p.side, p.roll_rad), p.z_mm))
+             - ends.lowered.get((p.side, p.roll_rad), 0.0) if p.mode == "flank" else p.z_mm)
+        out.append(replace(p, z_mm=z, path=_path(x, dy, dz, tolerance_mm, following.into_tooth(side))))
     return tuple(out)

@@ -5,6 +5,7 @@ cutting order, spur (spur_cad.cam.strategies.generating_geometry) or helical
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
@@ -44,6 +45,7 @@ from spur_cad.cam.strategies.generating_helical import (
 )
 from spur_cad.cam.tools import Tool, ToolError
 from spur_cad.errors import WorkLimitError
+from spur_cad.geometry.kinds import EXTERNAL_HELICAL, EXTERNAL_SPUR, INTERNAL_SPUR, GearKind
 from spur_cad.geometry.spec import GearSpec
 from spur_cad.keys import key
 
@@ -131,8 +133,12 @@ def plan_generating(spec: GearSpec, tool: Tool, params: GeneratingParams, *, lan
     cutting order. `kink_rolls_rad`: involute rolls where a modified flank has a kink (a relief's start), each
     given a flank pass of its own so the kink is cut exactly (spur gears; a helical pass meets a roll at one X).
     The tool is one `check_generating_tool` has passed (the strategy's check_tool, run by the plan)."""
-    if spec.kind.helical:
-        return _plan_helical(spec, tool, params, lands)
+    return PLANNERS[spec.kind](spec, tool, params, lands, check, kink_rolls_rad)
+
+
+def _plan_spur(spec: GearSpec, tool: Tool, params: GeneratingParams, lands: bool, check: bool,
+               kink_rolls_rad: tuple[float, ...]) -> GeneratingPlan:
+    """A spur gear's passes (its section is the same at every X: one pose per roll, placed in the section)."""
     profile = spec.tooth_space_profile()
     target = params.target_scallop_mm
     rough = rough_passes_per_space(spec, tool, target)
@@ -188,8 +194,14 @@ def plan_generating(spec: GearSpec, tool: Tool, params: GeneratingParams, *, lan
 def planned_passes_per_space(spec: GearSpec, tool: Tool, params: GeneratingParams, *, lands: bool = True) -> int:
     """plan_generating(...).passes_per_space (without kink passes), refused as it would be; a helical gear's
     passes are counted, not placed (their ends take a bisection each), so the work bound does not plan them twice."""
-    if not spec.kind.helical:
-        return plan_generating(spec, tool, params, lands=lands, check=False).passes_per_space
+    return PASS_COUNTS[spec.kind](spec, tool, params, lands)
+
+
+def _spur_pass_count(spec: GearSpec, tool: Tool, params: GeneratingParams, lands: bool) -> int:
+    return plan_generating(spec, tool, params, lands=lands, check=False).passes_per_space
+
+
+def _helical_pass_count(spec: GearSpec, tool: Tool, params: GeneratingParams, lands: bool) -> int:
     _check_helical_work(spec, tool, params.target_scallop_mm)
     return helical_pass_count(spec, tool, params.target_scallop_mm, lands)
 
@@ -203,8 +215,10 @@ def _check_helical_work(spec: GearSpec, tool: Tool, target: float) -> None:
                              "target_scallop_mm", field="target_scallop_mm", section="finishing")
 
 
-def _plan_helical(spec: GearSpec, tool: Tool, params: GeneratingParams, lands: bool) -> GeneratingPlan:
-    """The helical gear's passes (spur_cad.cam.strategies.generating_helical) as a plan."""
+def _plan_helical(spec: GearSpec, tool: Tool, params: GeneratingParams, lands: bool, check: bool,
+                  kink_rolls_rad: tuple[float, ...]) -> GeneratingPlan:
+    """The helical gear's passes (spur_cad.cam.strategies.generating_helical) as a plan: their ends are placed clear
+    of the design by construction (no `check`), and a pass meets a roll at one X only (no kink passes)."""
     target = params.target_scallop_mm
     _check_helical_work(spec, tool, target)
     lo, hi = face_turn_range(spec)
@@ -226,3 +240,12 @@ def _plan_helical(spec: GearSpec, tool: Tool, params: GeneratingParams, lands: b
         tip_bound = (TIP_SAFETY_HELICAL * (1.0 - CORNER_GAP_SHARE) + CORNER_GAP_SHARE) * target
     return GeneratingPlan(tuple(passes), flank, np.zeros(0), tips, land,
                           flat_leftover_mm(rb, t_worst - step, t_worst), tip_bound)
+
+
+_Planner = Callable[[GearSpec, Tool, GeneratingParams, bool, bool, tuple[float, ...]], GeneratingPlan]
+PLANNERS: dict[GearKind, _Planner] = {
+    EXTERNAL_SPUR: _plan_spur, EXTERNAL_HELICAL: _plan_helical, INTERNAL_SPUR: _plan_spur}
+"""plan_generating's planner for each gear kind (spec, tool, params, lands, check, kink_rolls_rad)."""
+PASS_COUNTS: dict[GearKind, Callable[[GearSpec, Tool, GeneratingParams, bool], int]] = {
+    EXTERNAL_SPUR: _spur_pass_count, EXTERNAL_HELICAL: _helical_pass_count, INTERNAL_SPUR: _spur_pass_count}
+"""planned_passes_per_space's count for each gear kind (spec, tool, params, lands)."""
