@@ -15,11 +15,16 @@ from pathlib import Path
 
 import pytest
 
-from spur_cad.cam.strategies import REGISTRY
+from spur_cad.cam.plan import check_cam_inputs
+from spur_cad.cam.strategies import REGISTRY, FinishingParams
+from spur_cad.cam.strategies.generating import GeneratingStrategy
 from spur_cad.cam.tools import Tool, ToolError
 from spur_cad.errors import SpurCadError
+from spur_cad.geometry.spec import GearSpec
+from spur_cad.job import load_job, parse_job
 from spur_cad.job_sections import MODIFICATION_SECTIONS, SECTIONS
 from spur_cad.keys import keys_of
+from spur_cad.pipeline import cam_inputs
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -159,3 +164,32 @@ def test_a_section_s_own_checks_are_in_its_post_init():
 ])
 def test_validate_calls_finds_each_form(snippet, expected):
     assert validate_calls(snippet) == expected
+
+
+# --- a strategy's tool check: once per plan ----------------------------------------------------------------
+
+
+class CountingGenerating(GeneratingStrategy):
+    """The generating strategy, counting the calls of its tool check."""
+
+    def __init__(self) -> None:
+        self.checks = 0
+
+    def check_tool(self, spec: GearSpec, tool: Tool) -> None:
+        self.checks += 1
+        super().check_tool(spec, tool)
+
+
+@pytest.mark.parametrize("two_stage", [False, True], ids=["one stage", "two stages"])
+def test_the_strategy_s_tool_check_runs_once_per_plan_s_checks(two_stage):
+    """check_cam_inputs runs the finishing strategy's check_tool once, with the tool conflicts (one stage) or before
+    the finishing work bound (two stages), not again in check_finishing_work."""
+    from tests.test_two_stage import JOB
+
+    job = parse_job(JOB, "two.toml") if two_stage else load_job(ROOT / "resources" / "examples" / "reference_gear.toml")
+    counting = CountingGenerating()
+    inputs = dataclasses.replace(cam_inputs(job), finishing=FinishingParams(strategy="generating"),
+                                 strategies={**REGISTRY, "generating": counting})
+    assert (inputs.bottom_tool is not None) == two_stage
+    check_cam_inputs(inputs)
+    assert counting.checks == 1

@@ -123,6 +123,9 @@ def check_cam_inputs(inputs: CamInputs) -> tuple[ToolRecommendations, RoughingLe
         if conflicts:
             raise conflicts_error(inputs, conflicts)
     if inputs.finishing_tool is not None:
+        # the strategy's rule for the tool, once: one-stage roughing ran it in tool_conflicts, two-stage's checks do not
+        if inputs.bottom_tool is not None:
+            strategy.check_tool(inputs.finishing_spec, inputs.finishing_tool)
         check_finishing_work(inputs.finishing_spec, inputs.finishing_tool, machine, inputs.finishing,
                              inputs.strategies)
     if inputs.roughing_tool is None:
@@ -334,11 +337,10 @@ recommendations, the set-up's own analysis)."""
 
 def check_finishing_work(spec: GearSpec, tool: Tool, machine: Machine, section: FinishingSection,
                          strategies: Strategies = REGISTRY, **overrides) -> None:
-    """The strategy's tool check, then refuse finishing whose contacts per flank or moves exceed the limits,
-    before generating it (what generate_finishing trusts)."""
+    """Refuse finishing whose contacts per flank or moves exceed the limits, before generating it (what
+    generate_finishing trusts), for a tool that passed the strategy's `check_tool` (its callers run it, once)."""
     strategy = get_strategy(section.strategy, strategies)
     params = params_from_section(strategy, section, **overrides)
-    strategy.check_tool(spec, tool)
     if strategy.simultaneous_rotary and not machine.rotary_simultaneous:
         raise MachineError(f"finishing strategy '{strategy.name}' turns A while cutting, but [machine] "
                            "rotary_simultaneous = false (the table only indexes); choose a strategy that keeps A "
@@ -385,7 +387,8 @@ def _comparison_estimate(spec: GearSpec, tool: Tool, machine: Machine, blank: fl
     simultaneous = dataclasses.replace(machine, rotary_simultaneous=True)
     params = params_from_section(strategy, section, **overrides)
     try:
-        check_finishing_work(spec, tool, simultaneous, section, **overrides)  # the tool check with the others
+        strategy.check_tool(spec, tool)  # the comparison strategy's own rule for the tool
+        check_finishing_work(spec, tool, simultaneous, section, **overrides)
         if strategy.estimate_moves(spec, tool, params) > MAX_COMPARISON_MOVES:
             return None
         return strategy.estimate(spec, tool, simultaneous, params, blank)  # without building its toolpath
