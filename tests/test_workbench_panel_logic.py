@@ -285,3 +285,15 @@ def test_the_modification_summary_names_the_amounts_of_each_table(wb):
     assert wb.summary.group_summary("Mate", {"UseMate": True, "MateTeeth": 40}) == "z 40"
     assert wb.summary.group_summary("Mate", {"UseMate": True, "MateTeeth": 60, "MateInternal": True,
                                              "MateCentreDistance": 40.0}) == "z 60 ring, a 40 mm"
+
+
+@pytest.mark.parametrize("resolution_mm", [0.0001, 0.2, float("nan")])
+def test_simulate_refuses_a_resolution_out_of_range_when_its_settings_are_made(wb, resolution_mm):
+    """The resolution the Simulate command asks for is checked when the [simulation] section is made (its
+    __post_init__), naming the key, before anything is simulated (the plan is not looked at)."""
+    from spur_cad.errors import SimulationError
+
+    job = parse_job(small_job_text(), "small.toml")
+    with pytest.raises(SimulationError, match=r"\[simulation\] resolution_mm must") as raised:
+        wb.simulation.simulate_job(job, None, resolution_mm)
+    assert raised.value.field == "resolution_mm"
