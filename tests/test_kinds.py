@@ -21,7 +21,12 @@ RING = dict(teeth=60, module_mm=2.0, addendum_coefficient=0.9, rack_tip_radius_m
 ROOT = Path(__file__).resolve().parents[1]
 KIND_MODULES = frozenset({"spur_cad/geometry/kinds.py", "spur_cad/geometry/spec.py", "spur_cad/geometry/internal.py"})
 SETUP_MODULES = frozenset({"spur_cad/cam/setups.py", "spur_cad/cam/machine.py"})
-KIND_FLAGS = frozenset({"is_helical", "is_internal"})
+# The flags, under their old names (GearSpec.is_helical) and as the kind's and set-up's own booleans: reading one
+# outside the defining modules is a branch on the kind or set-up that should be a question to the object.
+KIND_FLAGS = frozenset({"is_helical", "is_internal", "helical", "prismatic", "teeth_inward"})
+SETUP_FLAGS = frozenset({"rotary_axis", "cuts_helical", "cuts_teeth_inward"})
+# A finishing strategy declares `helical` too (what it can cut): read where its capabilities are defined.
+STRATEGY_CAPABILITY_MODULES = frozenset({"spur_cad/cam/strategies/__init__.py", "spur_cad/cam/strategies/base.py"})
 ORDERING = (ast.Eq, ast.NotEq, ast.Lt, ast.LtE, ast.Gt, ast.GtE)
 
 
@@ -47,6 +52,8 @@ def flag_reads(source: str) -> list[tuple[int, str, str]]:
     for node in ast.walk(ast.parse(source)):
         if isinstance(node, ast.Attribute) and node.attr in KIND_FLAGS and isinstance(node.ctx, ast.Load):
             found.append((node.lineno, "kind", node.attr))
+        elif isinstance(node, ast.Attribute) and node.attr in SETUP_FLAGS and isinstance(node.ctx, ast.Load):
+            found.append((node.lineno, "setup", node.attr))
         elif isinstance(node, ast.Compare) and all(isinstance(op, ORDERING) for op in node.ops):
             operands = [node.left, *node.comparators]
             if any(_mentions(o, {"helix_angle_deg"}) for o in operands) and any(_is_zero(o) for o in operands):
@@ -79,7 +86,8 @@ def test_flags_are_read_only_where_kinds_and_setups_are_defined():
     assert len(KIND_MODULES) <= 3 and len(SETUP_MODULES) <= 3
     stray = [f"{name}:{line}: {what}" for name, source in _package_sources()
              for line, family, what in flag_reads(source)
-             if name not in (KIND_MODULES if family == "kind" else SETUP_MODULES)]
+             if name not in (KIND_MODULES if family == "kind" else SETUP_MODULES)
+             and not (what == "helical" and name in STRATEGY_CAPABILITY_MODULES)]
     assert not stray, "flags read outside the kind and set-up modules:\n" + "\n".join(stray)
 
 
@@ -92,7 +100,10 @@ def test_flags_are_read_only_where_kinds_and_setups_are_defined():
     ("flat = job.machine.axes == 3\n", [(1, "setup", "axes compared")]),
     ("flat = int(values['job']['MachineAxes']) != 4\n", [(1, "setup", "axes compared")]),
     ("ok = letter in self.axes\n", []),  # a string of axis letters (verify/reader.py), not the set-up
-    ("turn = spec.section_turn_rad(1.0)\nflat = machine.setup.rotary_axis\n", []),
+    ("if spec.kind.helical:\n    pass\n", [(1, "kind", "helical")]),
+    ("k = spec.kind\nsign = -1 if k.teeth_inward else 1\n", [(2, "kind", "teeth_inward")]),
+    ("flat = not job.machine.setup.rotary_axis\n", [(1, "setup", "rotary_axis")]),
+    ("turn = spec.section_turn_rad(1.0)\nok = machine.setup.cuts(spec.kind)\n", []),
 ])
 def test_flag_reads_finds_each_form(snippet, expected):
     """The checker itself: each form of a flag read is found, the kind's and set-up's questions are not."""
@@ -191,7 +202,7 @@ def test_lying_flat_cuts_with_flat_end_mills_only():
 
 def test_a_setup_with_inconsistent_capabilities_is_refused():
     with pytest.raises(ValueError, match="rotary axis"):
-        MachineSetup("x", axes=3, rotary_axis=True, cuts_helical=True, cuts_teeth_inward=False,
+        MachineSetup("x", axes=3, rotary_axis=True, reaches=frozenset({"helical teeth"}),
                      follows_modifications=True, tool_kinds=(), finishing_needs_roughing=False, sections=(),
                      z_origin="the rotary axis")
 

@@ -18,15 +18,14 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import ClassVar, Protocol
 
+from spur_cad.geometry.kinds import CUTTING_NEEDS
+
 
 class _Kind(Protocol):
     """What a set-up asks of a gear kind (spur_cad.geometry.kinds.GearKind)."""
 
     @property
-    def prismatic(self) -> bool: ...
-
-    @property
-    def teeth_inward(self) -> bool: ...
+    def cutting_needs(self) -> frozenset[str]: ...
 
 
 class _Strategy(Protocol):
@@ -107,7 +106,8 @@ class MachineSetup:
     - `axes`: the `[machine] axes` value that chooses it.
     - `rotary_axis`: the programs turn A (the part on the rotary table): the 4-axis simulation, the rotary
       table's errors in the error budget, the rotary-table finishing strategies and their comparison.
-    - `cuts_helical` / `cuts_teeth_inward`: whether its tool reaches a helical gear's / a ring's spaces.
+    - `reaches`: the kinds' cutting needs its tool meets (spur_cad.geometry.kinds.CUTTING_NEEDS): helical teeth,
+      teeth inward (a ring's spaces); it cuts a kind whose needs it all reaches.
     - `follows_modifications`: it cuts `[modifications]` tables (generating or perimeter finishing).
     - `tool_kinds`: the tool kinds it cuts with (empty: any); `finishing_needs_roughing`: a finishing tool
       alone cannot cut the part (finishing takes only the finish stock).
@@ -118,8 +118,7 @@ class MachineSetup:
     name: str
     axes: int
     rotary_axis: bool
-    cuts_helical: bool
-    cuts_teeth_inward: bool
+    reaches: frozenset[str]
     follows_modifications: bool
     tool_kinds: tuple[str, ...]
     finishing_needs_roughing: bool
@@ -131,12 +130,14 @@ class MachineSetup:
             raise ValueError(f"machine set-up {self.name!r}: axes = {self.axes} is not 3, 4 or 5")
         if self.rotary_axis != (self.axes > 3):
             raise ValueError(f"machine set-up {self.name!r}: a rotary axis means more than 3 axes")
+        if not self.reaches <= set(CUTTING_NEEDS):
+            raise ValueError(f"machine set-up {self.name!r}: unknown cutting needs {sorted(self.reaches)}")
         if self.tool_kinds and not set(self.tool_kinds) <= {"flat", "bull_nose", "ball"}:
             raise ValueError(f"machine set-up {self.name!r}: unknown tool kinds {self.tool_kinds}")
 
     def cuts(self, kind: _Kind) -> bool:
         """Whether this set-up can cut a gear of this kind."""
-        return (kind.prismatic or self.cuts_helical) and (not kind.teeth_inward or self.cuts_teeth_inward)
+        return kind.cutting_needs <= self.reaches
 
     def accepts_tool_kind(self, tool_kind: str) -> bool:
         """Whether this set-up cuts with a tool of this kind ("flat", "bull_nose", "ball")."""
@@ -317,10 +318,10 @@ class LyingFlat(MachineSetup):
         )
 
 
-ROTARY_TABLE = RotaryTable("rotary table", axes=4, rotary_axis=True, cuts_helical=True, cuts_teeth_inward=False,
+ROTARY_TABLE = RotaryTable("rotary table", axes=4, rotary_axis=True, reaches=frozenset({"helical teeth"}),
                            follows_modifications=True, tool_kinds=(), finishing_needs_roughing=False, sections=(),
                            z_origin="the rotary axis")
-LYING_FLAT = LyingFlat("lying flat", axes=3, rotary_axis=False, cuts_helical=False, cuts_teeth_inward=True,
+LYING_FLAT = LyingFlat("lying flat", axes=3, rotary_axis=False, reaches=frozenset({"teeth inward"}),
                        follows_modifications=False, tool_kinds=("flat",), finishing_needs_roughing=True,
                        sections=("three_axis",), z_origin="the blank's top face")
 

@@ -23,6 +23,8 @@ SOLIDS = ("extrude", "sweep")
 """How cad/solid.py makes the toothed body: the section extruded along X, or swept along the helix."""
 
 SECTIONS = ("transverse", "normal")
+CUTTING_NEEDS = ("helical teeth", "teeth inward")
+"""What a kind may ask of a set-up's tool (GearKind.cutting_needs; spur_cad.cam.setups.MachineSetup.reaches)."""
 """The section a kind's inspection sizes (span, balls, chordal thickness) are measured in."""
 
 
@@ -107,6 +109,13 @@ class GearKind:
         if self.prismatic:
             return math.inf
         return 2.0 * math.pi * spec.reference_radius_mm / math.tan(spec.helix_angle_rad)
+
+    @property
+    def cutting_needs(self) -> frozenset[str]:
+        """What a set-up's tool must reach to cut this kind (CUTTING_NEEDS): helical teeth winding round the axis,
+        teeth pointing inward (a ring's spaces open toward the axis). A set-up cuts the kind when it reaches all."""
+        return frozenset(need for need, present in zip(CUTTING_NEEDS, (not self.prismatic, self.teeth_inward))
+                         if present)
 
     def accepts_strategy(self, strategy: _Strategy) -> bool:
         """Whether a finishing strategy can finish this kind (a helical kind needs a strategy declared helical)."""
