@@ -453,6 +453,7 @@ def test_plan_cam_runs_the_generating_strategy():
 # --------------------------------------------------------------------------- what it buys (estimator)
 
 
+@pytest.mark.slow  # plans perimeter finishing too (4 s)
 def test_generating_takes_a_fraction_of_the_perimeter_time_on_the_reference_job():
     """Issue's acceptance bounds (feed-bound estimates, not timed): the reference job's own tools at 5 um at
     most 1/4 of perimeter finishing at 5 um, at 1 um at most 1/2 of it, with the advised tool (r_t = rho,

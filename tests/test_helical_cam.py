@@ -458,6 +458,7 @@ def _corner_passes(path, z_of_contact: float):
             & np.isclose(path.z, z_of_contact, rtol=0.0, atol=1e-9))
 
 
+@pytest.mark.slow  # a second helical plan (5 s)
 def test_a_smaller_corner_finishes_a_helical_gear_without_gouge_within_the_target(small_corner):
     """The exact sweep of every finishing move of space 0 against the design at three sections: no penetration
     beyond 0.5 um, the leftover within the target + 0.5 um; the corner's passes sit at several heights (one per

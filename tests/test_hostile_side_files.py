@@ -102,6 +102,7 @@ def test_a_side_file_outside_the_jobs_folder_is_refused(small_job, tmp_path, sec
     assert "spur-cad-secret" not in line
 
 
+@pytest.mark.slow  # a whole run (6 s)
 def test_side_files_may_live_in_a_folder_named_on_the_command_line(small_job, tmp_path):
     """--side-files DIR: the template is found there (by its name alone or through a link into DIR), the same
     name without the option is not found, and a link from DIR to elsewhere is still refused."""
@@ -208,7 +209,7 @@ def test_a_template_passing_its_bounds_is_refused_at_once(small_result, name):
     (MemoryError, OverflowError) and the recursions ended in a RecursionError: each an internal error, exit 3.
     Now each is one ReportTemplateError naming the template's line (where it has one), within a second or two."""
     template, says = HOSTILE_TEMPLATES[name]
-    start = time.monotonic()
+    start = time.process_time()  # the work done, not the wall clock: other processes on the machine do not count
     with pytest.raises(ReportTemplateError) as refused:
         render_report(small_result, {}, template, "hostile.j2")
     message = str(refused.value)
@@ -216,7 +217,7 @@ def test_a_template_passing_its_bounds_is_refused_at_once(small_result, name):
     assert message.startswith("[job] report_template: hostile.j2"), message
     assert says in message, message
     assert refused.value.field == "report_template" and refused.value.section == "job"
-    assert time.monotonic() - start < 5.0
+    assert time.process_time() - start < 5.0
 
 
 @pytest.mark.parametrize("template", [

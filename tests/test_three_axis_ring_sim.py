@@ -94,6 +94,7 @@ def test_the_ring_cut_is_within_the_scallop_target_inside_the_form_circle_the_to
         assert np.abs(tree.query(ends)[0] - tool_radius).max() < 0.0002
 
 
+@pytest.mark.slow  # a ring simulated lying flat (8 s); the runout test stays in the fast tier
 def test_the_ring_removed_volume_is_its_hole(ring_cut):
     """A solid disc: what is cut is the hole, the exact outline's area (shoelace of the dense outline, this test's)
     times the face width, less the leftover in the roots (at most 0.224 mm over each space's root and fillets);

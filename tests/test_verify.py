@@ -228,6 +228,7 @@ def _legacy_program(path, corner_radius_mm: float, swap_direction: bool = False)
     return "\n".join(lines + ["M30"]) + "\n"
 
 
+@pytest.mark.slow  # two whole verifications (7 s)
 def test_a_legacy_program_verifies_as_the_original_and_the_wrong_rotary_direction_fails(tmp_path):
     # perimeter finishing turns A while it cuts: the way round matters there
     job = parse_job(_job_text("perimeter"), "p.toml")
