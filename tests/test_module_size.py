@@ -1,6 +1,6 @@
-"""No module of spur_cad/ is longer than MAX_LINES lines (issue 45): a module that grows past it is split along
-a real seam (the reader's text, flow and controller; the flank roughing's space geometry and stock model), with
-the public import paths kept."""
+"""No module of spur_cad/ or of the workbench is longer than MAX_LINES lines (issue 45): a module that grows past
+it is split along a real seam (the reader's text, flow and controller; the flank roughing's space geometry and stock
+model), with the public import paths kept."""
 
 from __future__ import annotations
 
@@ -23,7 +23,7 @@ def long_modules(folder: Path, root: Path, max_lines: int = MAX_LINES) -> dict[s
 
 
 def test_no_module_is_over_the_limit():
-    long = long_modules(ROOT / "spur_cad", ROOT)
+    long = {**long_modules(ROOT / "spur_cad", ROOT), **long_modules(ROOT / "workbench", ROOT)}
     assert {path: count for path, count in long.items() if path not in NOT_YET_SPLIT} == {}
     assert NOT_YET_SPLIT <= set(long), f"split now, take them off NOT_YET_SPLIT: {sorted(NOT_YET_SPLIT - set(long))}"
 
