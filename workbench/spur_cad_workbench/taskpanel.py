@@ -94,6 +94,7 @@ class JobTaskPanel:
         self._planned: tuple[str, object] | None = None  # (values signature, PlanFigures) planned by the panel
         layout = QtGui.QVBoxLayout(self.form)
         layout.setContentsMargins(0, 0, 0, 0)
+        layout.setSpacing(3)  # not the style's: FreeCAD 1.1's Qt 6 style spaced the folded groups past the dock
         layout.addWidget(self._summary_box())
         for extra in ("Gear", "Stock", "Job"):
             layout.addWidget(self._message_label(extra))
