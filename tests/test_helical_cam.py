@@ -254,8 +254,10 @@ def _other_gear_job(name: str):
     rho = spec.rack_tip_radius_mm
     diameter = 0.9 * (2.0 * rack_corner(spec).normal_corner_offset_mm + 2.0 * rho)
     tool = dataclasses.replace(job.tools.finishing, diameter_mm=diameter, corner_radius_mm=rho)
-    # a blank the tool can take off the tips in one pass (at most half its diameter above the tip circle)
-    stock = dataclasses.replace(job.stock, radial_allowance_mm=min(job.stock.radial_allowance_mm, 0.4 * diameter))
+    # a blank the tool can take off the tips in one pass (at most half its diameter above the tip circle), on a stub
+    # thinner than the gear's root (the example's 80 mm stub is larger than these gears' blanks: CamInputs refuses it)
+    stock = dataclasses.replace(job.stock, radial_allowance_mm=min(job.stock.radial_allowance_mm, 0.4 * diameter),
+                                stub_diameter_mm=min(job.stock.stub_diameter_mm, 1.6 * spec.root_radius_mm))
     return dataclasses.replace(job, gear=spec, stock=stock,
                                tools=dataclasses.replace(job.tools, finishing=tool, roughing=None))
 
