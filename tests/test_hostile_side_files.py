@@ -243,7 +243,9 @@ def test_the_deadline_stops_a_slow_template(small_result):
                                                   r"rendering took longer than 0.5 s"):
         render_report(small_result, {}, slow, "hostile.j2", TemplateLimits(time_s=0.5, loop_passes=10**7,
                                                                             made_size=10**12))
-    assert time.monotonic() - start < 3.0
+    # the deadline is wall time; the bound leaves room for a machine whose cores are busy with other tests (it failed
+    # at 3 s on a fresh clone's `make test`, 2 workers on 2 cores); without the deadline the template runs minutes
+    assert time.monotonic() - start < 10.0
 
 
 def test_spur_cads_own_template_is_well_within_the_bounds(small_result):
