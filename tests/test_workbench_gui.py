@@ -17,6 +17,7 @@ from spur_cad.pipeline import plan_cam, restart_program
 from tests.freecad_helper import describe
 from tests.workbench_helper import (
     ARTIFACTS,
+    SETTLE_VIEW,
     SMALL_GEAR_PROPERTIES,
     SMALL_JOB_PROPERTIES,
     SMALL_STOCK_PROPERTIES,
@@ -42,6 +43,7 @@ FreeCAD.ParamGet("User parameter:BaseApp/Preferences/Macro").SetBool("ScriptToPy
 def settle():
     for _ in range(5):
         QtGui.QApplication.processEvents()
+""" + SETTLE_VIEW + r"""
 
 def answer_file_dialog(path):
     # type the path into the next file dialog and press OK, as a user would (give up after 5 s)
@@ -132,7 +134,7 @@ FreeCADGui.Selection.clearSelection()  # no selection highlight in the picture
 view = FreeCADGui.ActiveDocument.ActiveView
 view.viewIsometric()
 view.fitAll()
-settle()
+settle_view(view)
 view.saveImage(SCREENSHOT, 1280, 960, "White")
 
 select(job)

@@ -213,7 +213,7 @@ for obj in (stock, job.RoughingToolpath, job.FinishingToolpath):
     obj.ViewObject.Visibility = False
 view.viewIsometric()
 view.fitAll()
-settle()
+settle_view(view)
 view.saveImage(VIEW_SHOT, 1000, 800, "White")
 job.TargetScallop = 0.03
 doc.recompute()

@@ -34,6 +34,7 @@ COMMON = GUI_PRELUDE + r"""
 def camera(doc, objects):
     # the view direction and where the objects' bounding box corners land on the screen (pixels)
     view = FreeCADGui.getDocument(doc.Name).ActiveView
+    settle_view(view)
     box = FreeCAD.BoundBox()
     for obj in objects:
         box.add(obj.Shape.BoundBox)
@@ -138,7 +139,7 @@ RESULT["simulation"] = [simulation.ViewObject.Visibility, simulation.ViewObject.
 view = FreeCADGui.ActiveDocument.ActiveView
 view.viewIsometric()
 view.fitAll()
-settle()
+settle_view(view)
 view.saveImage(REOPENED_SHOT, 1000, 800, "White")
 doc.recompute()                             # the job plans again: the same values, the simulation stays current
 settle()

@@ -64,6 +64,25 @@ SMALL_JOB_PROPERTIES = dict(JobName="small quick gear", ProfileTolerance=0.002, 
 # that is off, then the verdict. For tests that make one fail on purpose (run_freecad_code's log_allowed).
 VERIFY_FAIL_LOG = r"^Err: Verify program: space 0: [^\n]*(\nspace \d+: [^\n]*)*\nFAIL: [^\n]*$"
 
+# Waits for the 3D view's camera to come to rest, for GUI code (needs time, QtGui and settle()).
+SETTLE_VIEW = r"""
+import time
+
+def settle_view(view, limit_s=15.0):
+    # process events until the 3D view's camera has come to rest: FreeCAD 1.0 and 1.1 animate a change of view
+    # (viewIsometric, fitAll) over a quarter of a second or more, longer on a busy machine, and a camera read before
+    # the end sees a view on its way. At rest: unchanged over three reads 50 ms apart; at most limit_s.
+    deadline = time.monotonic() + limit_s
+    readings = [view.getCamera()]
+    while time.monotonic() < deadline:
+        settle()
+        time.sleep(0.05)
+        readings.append(view.getCamera())
+        if len(readings) >= 4 and len(set(readings[-4:])) == 1:
+            return
+    raise RuntimeError(f"the 3D view's camera still moved after {limit_s} s")
+"""
+
 GUI_PRELUDE = r"""
 import os, sys, time, traceback
 import FreeCAD, FreeCADGui
@@ -114,7 +133,7 @@ def set_task_dock_width(width):
         main_window.resizeDocks([dock], [width], QtCore.Qt.Horizontal)
     settle()
     return dock
-"""
+""" + SETTLE_VIEW
 """The start of a test body run in FreeCAD's GUI: uncaught exceptions collected in `hooked` (a test asserts it
 stays empty), the main window and its report view, `settle()` (let Qt process pending events), and the docks
 found by what they hold (`task_dock()`, `model_dock()`, `set_task_dock_width(px)`), whose titles and places differ
