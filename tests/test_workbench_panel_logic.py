@@ -281,7 +281,7 @@ def test_the_modification_summary_names_the_amounts_of_each_table(wb):
     assert wb.summary.group_summary("Machine", {"MachineName": "VMC", "MachineAxes": 3}) == "VMC, 3 axes"
     assert wb.summary.group_summary("3-axis", {"MachineAxes": 3, "HoldingTabs": 3}) == "3 holding tabs"
     # the mate only when the job designs against one (off: the basic rack, as the switch's own text says)
-    assert wb.summary.group_summary("Mate", {"UseMate": False, "MateTeeth": 40}) == ""
+    assert wb.summary.group_summary("Mate", {"UseMate": False, "MateTeeth": 40}) == "none: basic rack"
     assert wb.summary.group_summary("Mate", {"UseMate": True, "MateTeeth": 40}) == "z 40"
     assert wb.summary.group_summary("Mate", {"UseMate": True, "MateTeeth": 60, "MateInternal": True,
                                              "MateCentreDistance": 40.0}) == "z 60 ring, a 40 mm"

@@ -197,11 +197,11 @@ def _three_axis_summary(job: dict[str, Any], units=None) -> str:
 
 def _mate_summary(job: dict[str, Any], units=None) -> str:
     """The folded "Mate" group: the mating gear when the job designs against one ("z 40", "z 60 ring, a 40 mm");
-    nothing when it does not (the checks then assume the basic rack, as the group's switch says)."""
+    "none: basic rack" when it does not (the checks then assume the basic rack, as the report says)."""
     from spur_cad_workbench.units import text as length_text
 
     if not job.get("UseMate"):
-        return ""
+        return "none: basic rack"
     text = f"z {int(job.get('MateTeeth', 0))}" + (" ring" if job.get("MateInternal") else "")
     centre_mm = float(job.get("MateCentreDistance", 0.0))
     return text + (f", a {length_text(centre_mm, 'mm', units)}" if centre_mm > 0.0 else "")
