@@ -38,7 +38,16 @@ Their STEP files and programs are byte-identical to that run's (SHA-256 below), 
 (set to a fixed value before hashing; SOURCE_DATE_EPOCH sets it, tested below) and, in job.step, the order
 of the two parts' colour styles, which OCCT wrote in an order that changed from run to run when the goldens were
 recorded: job.step's entities are compared with them as a set, each with its references' numbers left out, and
-its styles must now come in the parts' order (gear, stock) so that two runs write the same bytes (docs/cad.md)."""
+its styles must now come in the parts' order (gear, stock) so that two runs write the same bytes (docs/cad.md).
+
+The STEP files are compared by their structure and their numbers, not their bytes, since a machine without AVX-512
+(an AMD EPYC) wrote the helical gear.step 2 bytes longer than the Intel Xeons the goldens were recorded on: numpy's
+float64 sin, cos, tan, arctan, exp and log take Intel's SVML code on AVX-512 and the C library's elsewhere, which
+agree within one unit in the last place but not always in it, and one last digit printed differently. Same machine,
+same bytes (test_two_runs_with_source_date_epoch_write_the_same_files); across machines, the same entities and
+integers exactly and every real within STEP_REAL_ABS_TOL (step_fingerprint;
+tests/data/golden/step_fingerprints.json, recorded by `python -m tests.test_summary_golden --record`), and
+summary.json's cad.step_bytes within STEP_BYTES_REL_TOL."""
 
 from __future__ import annotations
 
@@ -48,9 +57,11 @@ import math
 import re
 from pathlib import Path
 
+import numpy as np
 import pytest
 
-from spur_cad.cad.step import GEAR_COLOUR, STOCK_COLOUR
+from spur_cad.cad.solid import build_stock_shape
+from spur_cad.cad.step import GEAR_COLOUR, STOCK_COLOUR, step_files
 from spur_cad.cad_worker import CadWorker
 from spur_cad.job import load_job
 from spur_cad.pipeline import run_job
@@ -61,7 +72,12 @@ ROOT = Path(__file__).resolve().parents[1]
 GOLDEN = ROOT / "tests" / "data" / "golden"
 TIMED = {("timings_s",), ("simulation", "seconds")}  # wall-clock figures of the run itself: values not compared
 NUMBER_REL_TOL = 1e-9  # floating-point noise across machines (the same machine reproduces every bit)
-KEY_REL_TOL = {("cad", "gear_volume_mm3"): 1e-6}
+STEP_BYTES_REL_TOL = 1e-5
+"""summary.json's STEP sizes: a real whose last digit differs across machines may print one or two characters
+longer (the helical gear.step: 3,343,779 bytes on an Intel Xeon, 3,343,781 on an AMD EPYC); the files themselves
+are compared by step_fingerprint."""
+KEY_REL_TOL = {("cad", "gear_volume_mm3"): 1e-6,
+               **{("cad", "step_bytes", name): STEP_BYTES_REL_TOL for name in ("gear.step", "stock.step", "job.step")}}
 """The gear's volume is the front face's area times the face width since issue 27 (exact for the section
 moved along X), where the recorded run integrated the solid: the helical solid's pipe shell approximates
 its screw surfaces, and its integral was 4.5e-7 smaller (docs/cad.md)."""
@@ -80,18 +96,22 @@ its index_source says so. Nothing else changed."""
 for _example, _changed in ISSUE_46_BUDGET.items():
     CHANGED_ON_PURPOSE[_example].update({("error_budget", key): value for key, value in _changed.items()})
 
+STEP_FILES = ("gear.step", "stock.step", "job.step")
+STEP_FINGERPRINTS = GOLDEN / "step_fingerprints.json"
+STEP_REAL_ABS_TOL = 1e-7
+"""How far each real checksum of a STEP file may move (step_fingerprint): a last-digit difference in a few thousand
+coordinates of 50 mm moves it by about 1e-12, a point moved by 0.2 nm moves at least one of them past this."""
+STEP_REAL_CHECKSUMS = 16
+STEP_TOKENS = re.compile(rb"'(?:[^']|'')*'|(?<![#\w.])[-+]?\d+\.\d*(?:E[-+]?\d+)?|\s+")
+"""A STEP file's strings (kept), reals (compared within STEP_REAL_ABS_TOL) and white space (dropped: OCCT breaks
+its lines at 80 characters, so a real printed one digit longer can move a line break)."""
+
 FILE_SHA256 = {
     "reference_gear": {
-        "gear.step": "d63e1fbe9f6b1a9dbb03295d016cc495645ac63bd01ead54b0ef15ba5f43b726",
-        "job.step": "64724ed5fc3cb76ccdec76bd6326985294039c3aa149ffb77eed498aafde1e47",
-        "stock.step": "f29f32d10d575d3b033b99c2db42bd461c52ee614dec62272ebd18331587afa7",
         "finishing.ngc": "a412b900207c83c6e9216c7c7a664fad482160b5308cab6ab3d60fdf66c260df",
         "roughing.ngc": "f3cc0cc0a2e2c61bcb8e68520f81ededd35b6eb3e88678013e46e4d06e0e33a7",
     },
     "helical_gear": {
-        "gear.step": "55151216afe658ced2126a3425feae957ce86633099a47124e9eabc72b2905ee",
-        "job.step": "7e19aab6bbd41f68a02af8fb4b706e9f5326b57ddb045532a8e3c6b36c9c7ebc",
-        "stock.step": "36aa673a6487d20e588c6234896e20f6242d28191541c96d2476681b318784a0",
         "finishing.ngc": "8b25588cef4d2c29ac1a8bfaeadbf5e899d7510c72619d3f0e06036ee1cbcb4e",
         "roughing.ngc": "348c4fea6ec48af374540a81fd0dd307ce7b1ef67a460131cb6cbded21eb80ed",
     },
@@ -114,7 +134,7 @@ def differences(expected: object, actual: object, path: tuple = ()) -> list[str]
         return [d for i, (e, a) in enumerate(zip(expected, actual)) for d in differences(e, a, path + (i,))]
     if type(expected) is not type(actual):
         return [f"{where}: {expected!r} became {actual!r}"]
-    if isinstance(expected, float):
+    if isinstance(expected, float) or path in KEY_REL_TOL:
         same = math.isclose(expected, actual, rel_tol=KEY_REL_TOL.get(path, NUMBER_REL_TOL), abs_tol=1e-12)
         return [] if same else [f"{where}: {expected!r} became {actual!r}"]
     return [] if expected == actual else [f"{where}: {expected!r} became {actual!r}"]
@@ -144,11 +164,87 @@ def test_the_summary_and_the_files_of_the_examples_are_unchanged(example, cad_in
         expected[section][key] = value
     assert differences(expected, json.loads(files["summary.json"])) == []
     for name, digest in FILE_SHA256[example].items():
-        content = _without_clock_and_counters(files[name])
-        if name == "job.step":
-            content = _entities_without_numbers(content)
-        assert hashlib.sha256(content).hexdigest() == digest, name
+        assert hashlib.sha256(files[name]).hexdigest() == digest, name
+    recorded = json.loads(STEP_FINGERPRINTS.read_text())[example]
+    for name in STEP_FILES:
+        assert step_differences(recorded[name], step_fingerprint(files[name], name)) == [], name
     assert _colours_in_file_order(files["job.step"]) == [GEAR_COLOUR[:3], STOCK_COLOUR[:3]]
+
+
+def step_fingerprint(content: bytes, name: str) -> dict:
+    """What of a STEP file must not change across machines: its structure (every entity, reference, integer and
+    string, the header's clock and counters set to fixed values; job.step's entities as a sorted set, each with its
+    own and its references' numbers left out, see the module docstring) as a SHA-256, the count of its reals, and
+    STEP_REAL_CHECKSUMS weighted sums of its reals (in file order; job.step's sorted), each real weighted by a fixed
+    pseudo-random number in [-1, 1) and summed exactly (math.fsum), so that every real counts and a last-digit
+    difference moves a sum by no more than it moves the real."""
+    reals: list[float] = []
+
+    def placeholder(match: re.Match) -> bytes:
+        token = match.group()
+        if token.startswith(b"'"):
+            return token
+        if token.isspace():
+            return b""
+        reals.append(float(token))
+        return b"R"
+
+    structure = STEP_TOKENS.sub(placeholder, _without_clock_and_counters(content))
+    if name == "job.step":
+        structure, reals = _entities_without_numbers(structure), sorted(reals)
+    weights = np.random.default_rng(20261205).uniform(-1.0, 1.0, (STEP_REAL_CHECKSUMS, len(reals)))
+    return {"structure_sha256": hashlib.sha256(structure).hexdigest(), "reals": len(reals),
+            "real_checksums": [math.fsum((row * np.asarray(reals)).tolist()) for row in weights]}
+
+
+def step_differences(recorded: dict, actual: dict) -> list[str]:
+    """Where a STEP file's fingerprint differs from the recorded one: structure or count exactly, the checksums
+    within STEP_REAL_ABS_TOL."""
+    found = [f"{key}: {recorded[key]} became {actual[key]}" for key in ("structure_sha256", "reals")
+             if recorded[key] != actual[key]]
+    return found or [f"real checksum {i}: {old!r} became {new!r}" for i, (old, new)
+                     in enumerate(zip(recorded["real_checksums"], actual["real_checksums"], strict=True))
+                     if abs(new - old) > STEP_REAL_ABS_TOL]
+
+
+def test_the_step_comparison_sees_a_moved_point_an_entity_or_a_name_but_not_a_last_digit():
+    """Planted as machines and regressions make them, on the reference gear's stock.step as written by the CAD
+    stage: the last digit of every coordinate (what another CPU's sin and cos do) and a line broken elsewhere are no
+    difference; one point moved by
+    1 nm, a renamed product or a changed entity is."""
+    content = _reference_stock_step()
+    recorded = step_fingerprint(content, "stock.step")
+    assert recorded["reals"] > 100
+
+    def last_digit_up(match: re.Match) -> bytes:
+        value = float(match.group())
+        return f"{math.nextafter(value, math.inf):.16E}".encode() if value else match.group()
+
+    data_at = content.index(b"DATA;")
+    noisy = content[:data_at] + re.sub(rb"(?<=[(,])-?\d+\.\d+(?:E[-+]?\d+)?(?=[,)])", last_digit_up,
+                                       content[data_at:])
+    assert noisy != content
+    assert step_differences(recorded, step_fingerprint(noisy, "stock.step")) == []
+    rewrapped = content[:data_at] + content[data_at:].replace(b"));", b")\n  );", 1)
+    assert rewrapped != content
+    assert step_differences(recorded, step_fingerprint(rewrapped, "stock.step")) == []
+    point = re.search(rb"CARTESIAN_POINT\('',\((-?[1-9]\d*\.\d*(?:E[-+]?\d+)?),", content[data_at:])
+    assert point is not None
+    moved_value = f"{float(point.group(1)) + 1e-6:.16E}".encode()
+    moved = content[:data_at] + content[data_at:].replace(point.group(0),
+                                                        point.group(0).replace(point.group(1), moved_value), 1)
+    assert step_differences(recorded, step_fingerprint(moved, "stock.step"))
+    renamed = content.replace(b"PRODUCT('stock'", b"PRODUCT('stack'", 1)
+    assert renamed != content and step_differences(recorded, step_fingerprint(renamed, "stock.step"))
+    dropped = content.replace(b"CARTESIAN_POINT", b"CARTESIAN_POINTS", 1)
+    assert step_differences(recorded, step_fingerprint(dropped, "stock.step"))
+
+
+def _reference_stock_step() -> bytes:
+    """The reference gear's stock.step as the run writes it (the CAD stage's writer, no other stage)."""
+    job = load_job(ROOT / "resources" / "examples" / "reference_gear.toml")
+    stock = build_stock_shape(job.gear, job.stock)
+    return step_files(stock, stock, timestamp="2026-01-01T00:00:00")["stock.step"]
 
 
 def _colours_in_file_order(content: bytes) -> list[tuple[float, ...]]:
@@ -188,3 +284,21 @@ def test_two_runs_with_source_date_epoch_write_the_same_files(monkeypatch):
             assert first[name] == second[name], name
     timed = json.loads(first["summary.json"]), json.loads(second["summary.json"])
     assert differences(*timed) == []
+
+
+def record_step_fingerprints() -> None:
+    """Write tests/data/golden/step_fingerprints.json from a run of each example: only when the STEP files change
+    on purpose, said in the commit (`python -m tests.test_summary_golden --record`)."""
+    recorded = {}
+    for example in ("reference_gear", "helical_gear"):
+        files = run_job(load_job(ROOT / "resources" / "examples" / f"{example}.toml")).files
+        recorded[example] = {name: step_fingerprint(files[name], name) for name in STEP_FILES}
+    STEP_FINGERPRINTS.write_text(json.dumps(recorded, indent=1) + "\n")
+
+
+if __name__ == "__main__":
+    import sys
+
+    if sys.argv[1:] != ["--record"]:
+        sys.exit("usage: python -m tests.test_summary_golden --record")
+    record_step_fingerprints()
