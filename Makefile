@@ -9,12 +9,12 @@ PYTEST_ARGS ?=
 FAST_TIER   := not slow and not freecad and not linuxcnc and not browser
 # The markers `make test` selects; CI's FreeCAD 1.0 / 1.1 tiers add the FreeCAD tests (.ci/tier)
 MARKS       ?= $(FAST_TIER)
-# The fast tier runs on up to 4 workers (pytest-xdist), a test file each at a time (its module fixtures computed
-# once): every test writes under its own tmp_path. Other MARKS (the FreeCAD GUI tests start Xvfb servers) run in one
-# process. `make test PARALLEL=` runs the fast tier in one process too.
-PARALLEL    ?= $(if $(subst $(FAST_TIER),,$(MARKS)),,-n auto --maxprocesses=4 --dist loadfile)
+# Tests not marked freecad run on up to 4 workers (pytest-xdist), a test file each at a time (its module fixtures
+# computed once): every test writes under its own tmp_path. The FreeCAD tests (their GUI tests start Xvfb servers and
+# FreeCAD's own windows) run afterwards in one process. `make test PARALLEL=` runs everything in one process.
+PARALLEL    ?= -n auto --maxprocesses=4 --dist loadfile
 
-.PHONY: venv demo test test-all lint bench clean
+.PHONY: venv demo test test-all run-tests lint bench clean
 
 venv: $(STAMP)
 
@@ -38,11 +38,24 @@ lint: venv
 	$(VENV)/bin/ruff check .
 	$(VENV)/bin/mypy
 
+# `make test` with MARKS naming FreeCAD tests (CI's FreeCAD 1.0 / 1.1 tiers) runs them after the others.
+WITH_FREECAD = $(if $(subst $(FAST_TIER),,$(MARKS)),yes,)
+
+# Both parts run even when the first fails (every failure is seen in one run); pytest's exit 5 ("no tests
+# selected": MARKS that select only FreeCAD tests, or none of them) counts as success for either part.
+run-tests: venv
+	@status=0; \
+	$(PYTHON) -m pytest -q $(PARALLEL) -m "($(MARKS)) and not freecad" $(PYTEST_ARGS) || [ $$? -eq 5 ] || status=1; \
+	if [ -n "$(WITH_FREECAD)" ]; then \
+	    $(PYTHON) -m pytest -q -m "($(MARKS)) and freecad" $(PYTEST_ARGS) || [ $$? -eq 5 ] || status=1; \
+	fi; \
+	exit $$status
+
 test: lint
-	$(PYTHON) -m pytest -q $(PARALLEL) -m "$(MARKS)" $(PYTEST_ARGS)
+	@$(MAKE) --no-print-directory run-tests
 
 test-all: lint
-	$(PYTHON) -m pytest -q $(PYTEST_ARGS)
+	@$(MAKE) --no-print-directory run-tests MARKS="slow or not slow"
 
 bench: venv
 	$(VENV)/bin/pip install -q -e '.[test,bench]'

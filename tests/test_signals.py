@@ -23,7 +23,7 @@ from spur_cad.outputs import JOURNAL, MANIFEST, recover
 pytestmark = pytest.mark.slow
 
 BASE = Path(__file__).resolve().parent / "data" / "hostile" / "clearance_negative.toml"  # the corpus's base job
-TRIALS = 10
+TRIALS = 5
 STARTUP_S = 0.5
 DETERMINISTIC = (".ngc", ".nc", ".csv")  # files equal byte for byte between runs of one job
 
