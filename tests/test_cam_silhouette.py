@@ -19,6 +19,7 @@ from spur_cad.cam.strategies import FinishingParams
 from spur_cad.geometry import gear_outline
 from tests import silhouette
 from tests.gears import CAM_GEARS, spec_of, tools_for
+from tests.tiers import sweep
 
 HALF_MICRON = 0.5e-3
 SCALLOP = 0.005
@@ -72,7 +73,7 @@ def test_finishing_cuts_every_flank_downward(name):
 
 
 @pytest.mark.parametrize("strategy", ["flank", "levels"])
-@pytest.mark.parametrize("name", CAM_GEARS)
+@pytest.mark.parametrize("name", sweep(CAM_GEARS, fast=["reference_z23_m4", "undercut_z8"]))
 def test_roughing_respects_finish_stock_and_flank_allowance(name, strategy, design_polygons):
     spec = spec_of(name)
     tool, finishing = tools_for(name)
@@ -112,7 +113,7 @@ def _left_above_tip_mm(spec, path, tool, blank: float) -> float:
 
 
 @pytest.mark.parametrize("strategy", ["flank", "levels"])
-@pytest.mark.parametrize("name", CAM_GEARS)
+@pytest.mark.parametrize("name", sweep(CAM_GEARS, fast=["reference_z23_m4", "undercut_z8"]))
 def test_roughing_takes_the_blank_down_to_the_tip_circle_plus_the_finish_stock(name, strategy, design_polygons):
     """The tip passes never come nearer the design than the finish stock, and leave over the tooth at most the
     finish stock plus the height of the flat tool bottom over the circle at its passes' edge (by flanks, beside the
@@ -188,7 +189,7 @@ def test_along_x_strategy_is_as_safe_and_warns_about_marks(name, design_polygons
 
 
 @pytest.mark.parametrize("strategy", ["flank", "levels"])
-@pytest.mark.parametrize("name", CAM_GEARS)
+@pytest.mark.parametrize("name", sweep(CAM_GEARS, fast=["reference_z23_m4", "undercut_z8"]))
 def test_roughing_leaves_no_material_beyond_the_flank_allowance(name, strategy, design_polygons):
     """The material itself, not only the design points' distance to the tools: of space 0's sector of the blank
     above the lowest pass at A = 0, what no silhouette of spaces 0, 1 and z - 1 (their tip lands' passes

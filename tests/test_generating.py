@@ -103,7 +103,7 @@ def _check(name, spec, tool, path, spaces, rows=None, labels=("root", "fillet", 
 # --------------------------------------------------------------------------- the acceptance check
 
 
-@pytest.mark.parametrize("name, diameter, corner", CASES)
+@pytest.mark.parametrize("name, diameter, corner", sweep(CASES, fast=["reference_z23_m4", "undercut_z8"]))
 def test_generating_never_gouges_and_leaves_at_most_the_target(name, diameter, corner):
     spec, tool = _gear(name), _tool(diameter, corner)
     scallop = 0.005
@@ -506,7 +506,7 @@ def test_the_table_is_clamped_for_every_pass_when_the_machine_has_clamp_codes(fo
 
 
 @pytest.mark.parametrize("dialect", ["linuxcnc", "fanuc", "haas", "siemens", "okuma"])
-@pytest.mark.parametrize("name, diameter, corner", [CASES[0], CASES[2]])
+@pytest.mark.parametrize("name, diameter, corner", [CASES[0], pytest.param(*CASES[2], marks=pytest.mark.slow)])
 def test_every_dialect_reads_back_the_generating_passes_flat_and_folded(dialect, name, diameter, corner):
     """Each dialect's program, read back by the tests' own G-code reader: the IR's moves in order (flat and
     folded the same), no inverse-time feed, and A changes only in rapids at the safe height."""

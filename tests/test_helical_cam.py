@@ -18,6 +18,7 @@ from spur_cad.pipeline import job_stock, plan_cam
 from spur_cad.sim import Cut, SimSettings, simulate, subset
 from tests.gears import with_roughing_strategy
 from tests.textbook import HelicalTextbook
+from tests.tiers import sweep
 
 HELICAL_EXAMPLE = Path(__file__).resolve().parents[1] / "resources" / "examples" / "helical_gear.toml"
 RES = 0.005
@@ -339,7 +340,8 @@ def test_helical_finishing_tools_and_strategies_are_refused_with_their_reason():
         plan_cam(dataclasses.replace(job, finishing=perimeter))
 
 
-@pytest.mark.parametrize("dialect", ["linuxcnc", "fanuc", "haas", "siemens", "okuma"])
+@pytest.mark.parametrize("dialect", sweep(["linuxcnc", "fanuc", "haas", "siemens", "okuma"],
+                                         fast=["linuxcnc", "fanuc"]))
 def test_every_dialect_reads_back_the_helical_programs_flat_and_folded(dialect, finished):
     from spur_cad.post import PostSettings, post_program
     from tests.gcode_reader import read_program

@@ -20,6 +20,8 @@ from pathlib import Path
 
 import pytest
 
+from tests.tiers import sweep
+
 MEMORY_LIMIT_BYTES = 3 * 1024**3  # address space: numba and OCP reserve much more than they use
 QUICK_S = 60  # a refusal that needs no reading comes in about a second; this only catches a hang
 ONE_LINE = 400
@@ -118,7 +120,7 @@ def test_many_subprogram_definitions_are_read_in_linear_time(job, tmp_path):
         assert "internal error" not in result.stderr
 
 
-@pytest.mark.parametrize("dialect, program", [
+@pytest.mark.parametrize("dialect, program", sweep([
     ("linuxcnc", "T1 M6\nG0 X0 Y0 Z60 A0\no1 repeat [100000]\no2 repeat [100000]\no3 repeat [100000]\nG0 X1\nG0 X2\n"
                  "o3 endrepeat\no2 endrepeat\no1 endrepeat\nM30\n"),
     ("fanuc", "%\nO0001\nT1 M6\nG0 X0 Y0 Z60 A0\nM98 P100 L99999\nM30\nO100\nM98 P200 L99999\nM99\nO200\n"
@@ -128,7 +130,7 @@ def test_many_subprogram_definitions_are_read_in_linear_time(job, tmp_path):
     ("siemens", "T1 D1\nM6\nG0 X0 Y0 Z60 A0\nA1:\nG0 X1\nA2:\nREPEAT A1 A2 P=100000\nB1:\nREPEAT A1 A2 P=100000\n"
                 "B2:\nREPEAT B1 B2 P=100000\nM30\n"),
     ("okuma", "O1000\nT1 M6\nG0 X0 Y0 Z60 A0\nCALL O100\nM30\nO100\nG65 P200 L99999\nRTS\n"),
-], ids=["linuxcnc-repeat", "fanuc-m98", "haas-m97", "siemens-repeat", "okuma"])
+], fast=["linuxcnc-repeat", "haas-m97"], ids=["linuxcnc-repeat", "fanuc-m98", "haas-m97", "siemens-repeat", "okuma"]))
 def test_nested_loops_are_estimated_and_refused_at_once(job, tmp_path, dialect, program):
     """Three nested loops of about 100,000 ran 155-250 s before the move limit stopped them; the first run of a
     loop's body now tells what the rest would cost. (Okuma has no G65: refused as unsupported, as before.)"""

@@ -250,6 +250,7 @@ def test_step_sections_are_the_design_involute_moved_by_the_modification(text, s
             assert on_involute.sum() > spec.teeth * 20
 
 
+@pytest.mark.slow  # a modified gear's whole inspection sheet (9 s)
 def test_the_inspection_sheet_lists_the_modifications_and_says_where_span_and_pins_touch():
     from spur_cad.pipeline import run_job
 

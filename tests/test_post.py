@@ -19,6 +19,7 @@ from spur_cad.post import DIALECT_NAMES, PostError, PostSettings, ProgramInfo, p
 from tests.gcode_reader import inlined_lines, read_program
 from tests.gears import CAM_GEARS, spec_of, tools_for
 from tests.rs274_helper import canon_args, run_rs274
+from tests.tiers import sweep
 
 DECIMALS = {"linuxcnc": (4, 4), "fanuc": (3, 3), "haas": (3, 3), "siemens": (4, 4), "okuma": (3, 3)}
 INFO = ProgramInfo("spur_cad test (program)", ("gear: z = test",))
@@ -204,8 +205,8 @@ def test_rs274_accepts_line_numbers_at_the_limit(cam_paths, tmp_path):
 # --- every dialect, read back independently -------------------------------------------------------
 
 @pytest.mark.parametrize("dialect", DIALECT_NAMES)
-@pytest.mark.parametrize("name", ["reference_z23_m4", "undercut_z8",
-                                  pytest.param("many_teeth_z120", marks=pytest.mark.slow)])
+@pytest.mark.parametrize("name", sweep(["reference_z23_m4", "undercut_z8", "many_teeth_z120"],
+                                      fast=["reference_z23_m4"]))
 def test_every_dialect_reads_back_as_the_ir_with_its_invariants(dialect, name, cam_paths):
     spec, _, _, roughing, finishing = cam_paths[name]
     linear, rotary = DECIMALS[dialect]
@@ -249,6 +250,7 @@ def test_folding_divides_the_finishing_program_by_about_the_tooth_count(dialect,
     assert folded.subprograms >= 1
 
 
+@pytest.mark.slow  # each dialect's feed mode over the whole program (8 s); the read-backs stay in the fast tier
 def test_inverse_time_where_the_dialect_has_it_and_compensated_feed_where_it_has_not(cam_paths):
     spec, _, tool, _, finishing = cam_paths["reference_z23_m4"]
     machine = Machine()

@@ -15,8 +15,12 @@ from shapely.ops import unary_union
 from spur_cad.geometry import SEGMENT_LABELS, gear_outline, sample_profile
 from tests.gears import GEAR_CASES, spec_of, textbook_of
 from tests.textbook import inv
+from tests.tiers import sweep
 
 ALL = list(GEAR_CASES)
+FAST_GEARS = ["reference_z23_m4", "undercut_z8", "undercut_negative_shift_z14", "pa25_sharp_rack_z17"]
+"""The gears whose envelope checks (fillet and generating rack) run in the fast tier: a plain, an undercut, a
+negatively shifted undercut and a sharp-rack gear; the others in `make test-all`."""
 
 
 def _labelled(samples, label):
@@ -98,7 +102,7 @@ def test_undercut_junction_is_a_transverse_intersection(name):
     assert abs(math.atan2(n_f[0] * n_i[1] - n_f[1] * n_i[0], n_f @ n_i)) > 1e-3
 
 
-@pytest.mark.parametrize("name", ALL)
+@pytest.mark.parametrize("name", sweep(ALL, fast=FAST_GEARS))
 def test_fillet_obeys_willis_camus_law(name):
     """Each fillet point's normal line passes through the pitch point of some instant phi, and at
     that instant the rack's corner circle (placed by the test's own kinematics) touches the
@@ -127,7 +131,7 @@ def _gear_polygon(spec, tolerance):
     return Polygon(gear_outline(spec, tolerance))
 
 
-@pytest.mark.parametrize("name", ALL)
+@pytest.mark.parametrize("name", sweep(ALL, fast=FAST_GEARS))
 def test_generating_rack_never_enters_the_tooth_and_touches_every_point(name):
     """The space is the envelope of the rack: no rack position overlaps the tooth material
     (beyond the sampling tolerance), and every profile point is reached by some position."""

@@ -19,6 +19,7 @@ from spur_cad.job import load_job, parse_job
 from spur_cad.pipeline import build_programs, plan_cam
 from tests.ocp_helper import exact_bounds
 from tests.rs274_helper import run_rs274
+from tests.tiers import sweep
 from tests.workbench_helper import small_job_text
 
 REFERENCE = "resources/examples/reference_gear.toml"
@@ -126,9 +127,14 @@ def test_with_roughing_the_tips_are_roughed_to_the_finish_stock_and_a_larger_sto
     assert (err.value.section, err.value.field) == ("roughing", "finish_stock_mm")
 
 
-@pytest.mark.parametrize("offset", ["G54", "G57", "G59"])
-@pytest.mark.parametrize("dialect, expected", [("linuxcnc", "{g}"), ("fanuc", "{g}"), ("haas", "{g}"),
-                                               ("siemens", "{g}"), ("okuma", "G15 H{n}")])
+WORK_OFFSET_CASES = [(dialect, expected, offset) for dialect, expected in
+                     [("linuxcnc", "{g}"), ("fanuc", "{g}"), ("haas", "{g}"), ("siemens", "{g}"), ("okuma", "G15 H{n}")]
+                     for offset in ("G54", "G57", "G59")]
+WORK_OFFSET_IDS = [f"{offset}-{dialect}" for dialect, _, offset in WORK_OFFSET_CASES]
+
+
+@pytest.mark.parametrize("dialect, expected, offset", sweep(  # each dialect in the fast tier, at one offset each
+    WORK_OFFSET_CASES, fast=["G54-linuxcnc", "G57-fanuc", "G59-haas", "G57-siemens", "G59-okuma"], ids=WORK_OFFSET_IDS))
 def test_every_program_selects_the_work_offset_before_the_tool(dialect, expected, offset):
     job = parse_job(_with(small_job_text(), "post", f'dialect = "{dialect}"\nwork_offset = "{offset}"'), "s.toml")
     files = build_programs(job, plan_cam(job))[1]

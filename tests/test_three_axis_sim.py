@@ -119,6 +119,7 @@ def involute_check(result, finishing: Cut, lowest_radius_mm: float):
     return deepest_row_deviations(result, finishing, involute)
 
 
+@pytest.mark.slow  # the lying-flat cut graded end to end (10 s); its level and row checks stay in the fast tier
 def test_the_reference_gear_cut_lying_flat_measures_as_the_exact_outline_says(reference_plan):
     """No gouge beyond 1 um on the involute, leftover within the 5 um scallop target, each point's deviation as
     the independent clearance says (within 0.2 um); graded class 1 (an ideal machine); a finishing path moved

@@ -139,6 +139,7 @@ def test_durations_and_long_job_advice(wb):
     assert "larger roughing tool" in s.long_job_advice(long_rough, "generating")
 
 
+@pytest.mark.slow  # one job per value (7 s)
 def test_values_fingerprint_changes_with_every_job_value(wb):
     values = _values(wb)
     base = wb.summary.values_signature(values)

@@ -37,6 +37,7 @@ from spur_cad.job import (
 from spur_cad.post.settings import PostSettings
 from tests.gears import GEAR_CASES
 from tests.textbook import Textbook
+from tests.tiers import sweep
 from tests.workbench_helper import REFERENCE_JOB, ROOT, small_job_text
 
 
@@ -394,7 +395,7 @@ def test_gear_errors_are_filed_under_gear(wb):
 
 
 @pytest.mark.parametrize("strategy", ["generating", "perimeter"])
-@pytest.mark.parametrize("name", sorted(GEAR_CASES))
+@pytest.mark.parametrize("name", sweep(sorted(GEAR_CASES), fast=["pa25_sharp_rack_z17", "undercut_z8"]))
 def test_suggested_tools_pass_the_tool_limits(wb, name, strategy):
     z, m, pa, x, rho, frac, mm = GEAR_CASES[name]
     values = wb.schema.default_values()
